@@ -1,0 +1,131 @@
+// Benchmarks print figures; they never pass or fail (speed goals are not tests).
+#include <chrono>
+#include <cstdio>
+#include <random>
+
+#include "cli.h"
+#include "render/bvh.h"
+#include "retile/log.h"
+#include "retile/render.h"
+
+namespace retile::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+int benchThroughput(const std::vector<std::string>& argv) {
+  auto args = parseArgs(argv, {"--size", "--frames", "--max-bounces"});
+  if (!args || args->positional.size() != 1) {
+    std::fprintf(stderr, "usage: retile bench throughput SCENE [--size WxH] [--frames N] [--max-bounces B]\n");
+    return 2;
+  }
+  int w = 256, h = 256, frames = 16, bounces = -1;
+  if (args->has("--size")) {
+    auto r = parseSize(args->get("--size"), &w, &h);
+    if (!r) return std::fprintf(stderr, "error: %s\n", r.error().c_str()), 2;
+  }
+  if (args->has("--frames")) {
+    auto v = parseInt("--frames", args->get("--frames"), 1, 100000);
+    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
+    frames = v.value();
+  }
+  if (args->has("--max-bounces")) {
+    auto v = parseInt("--max-bounces", args->get("--max-bounces"), 0, 1024);
+    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
+    bounces = v.value();
+  }
+  auto loaded = loadScene(args->positional[0]);
+  if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
+
+  Renderer renderer;
+  auto t0 = Clock::now();
+  renderer.setScene(loaded->scene);
+  double setup = std::chrono::duration<double>(Clock::now() - t0).count();
+  renderer.setMaxBounces(bounces >= 0 ? bounces : loaded->scene.settings.maxBounces);
+  renderer.resize(w, h);
+  // One frame to warm up (pipeline creation, first-touch of buffers), not measured.
+  TileWork all{0, 0, w, h, 1, 0, true};
+  renderer.renderFrame({all});
+  FrameStats sum;
+  auto start = Clock::now();
+  for (int f = 0; f < frames; ++f) {
+    all.sampleBase = static_cast<std::uint32_t>(f + 1);
+    all.restart = false;
+    FrameStats s = renderer.renderFrame({all});
+    sum.samples += s.samples;
+    sum.primaryRays += s.primaryRays;
+    sum.bounceRays += s.bounceRays;
+    sum.shadowRays += s.shadowRays;
+    sum.seconds += s.seconds;
+  }
+  double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  double sec = sum.seconds;
+  auto tris = renderer.sceneTriangles();
+  std::printf("scene          %s (%llu triangles)\n", args->positional[0].c_str(), static_cast<unsigned long long>(tris));
+  std::printf("device         %s\n", renderer.deviceName().c_str());
+  std::printf("image          %dx%d, max bounces %d, %d frames of 1 spp\n", w, h,
+              bounces >= 0 ? bounces : loaded->scene.settings.maxBounces, frames);
+  std::printf("samples/s      %.3f M\n", static_cast<double>(sum.samples) / sec * 1e-6);
+  std::printf("rays/s         %.3f M total: primary %.3f M, bounce %.3f M, shadow %.3f M\n",
+              static_cast<double>(sum.primaryRays + sum.bounceRays + sum.shadowRays) / sec * 1e-6,
+              static_cast<double>(sum.primaryRays) / sec * 1e-6, static_cast<double>(sum.bounceRays) / sec * 1e-6,
+              static_cast<double>(sum.shadowRays) / sec * 1e-6);
+  std::printf("rays/sample    %.2f\n", static_cast<double>(sum.primaryRays + sum.bounceRays + sum.shadowRays) /
+                                            static_cast<double>(sum.samples));
+  std::printf("frame time     %.1f ms (device), %.1f ms (wall)\n", sec / frames * 1e3, wall / frames * 1e3);
+  std::printf("scene upload   %.3f s (BVH bottom level %.3f s, top level %.4f s)\n", setup, renderer.lastBlasSeconds(),
+              renderer.lastTlasSeconds());
+  std::printf("device memory  %.2f MiB scene data, %.1f bytes per triangle\n",
+              static_cast<double>(renderer.sceneDeviceBytes()) / (1 << 20),
+              tris ? static_cast<double>(renderer.sceneDeviceBytes()) / static_cast<double>(tris) : 0.0);
+  return 0;
+}
+
+int benchBvh(const std::vector<std::string>& argv) {
+  auto args = parseArgs(argv, {"--triangles"});
+  if (!args) return std::fprintf(stderr, "error: %s\n", args.error().c_str()), 2;
+  int n = 1'000'000;
+  if (args->has("--triangles")) {
+    auto v = parseInt("--triangles", args->get("--triangles"), 1, 50'000'000);
+    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
+    n = v.value();
+  }
+  // A tessellated wavy surface: triangles of even size, like a scanned mesh.
+  int side = static_cast<int>(std::sqrt(n / 2.0)) + 1;
+  std::vector<Bounds3> boxes;
+  boxes.reserve(static_cast<std::size_t>(side) * side * 2);
+  auto height = [](float x, float z) { return 0.1f * std::sin(x * 20) * std::cos(z * 17); };
+  for (int j = 0; j < side && static_cast<int>(boxes.size()) < n; ++j)
+    for (int i = 0; i < side && static_cast<int>(boxes.size()) < n; ++i) {
+      float x0 = static_cast<float>(i) / side, x1 = static_cast<float>(i + 1) / side;
+      float z0 = static_cast<float>(j) / side, z1 = static_cast<float>(j + 1) / side;
+      Vec3 a{x0, height(x0, z0), z0}, b{x1, height(x1, z0), z0}, c{x1, height(x1, z1), z1}, d{x0, height(x0, z1), z1};
+      Bounds3 t1, t2;
+      t1.grow(a); t1.grow(b); t1.grow(c);
+      t2.grow(a); t2.grow(c); t2.grow(d);
+      boxes.push_back(t1);
+      if (static_cast<int>(boxes.size()) < n) boxes.push_back(t2);
+    }
+  auto start = Clock::now();
+  Bvh bvh = buildBvh(boxes);
+  double s = std::chrono::duration<double>(Clock::now() - start).count();
+  std::printf("bvh build      %zu triangles in %.3f s (%.2f M triangles/s), %zu nodes, depth %d\n", boxes.size(), s,
+              static_cast<double>(boxes.size()) / s * 1e-6, bvh.nodes.size(), bvh.depth);
+  return 0;
+}
+
+}  // namespace
+
+int runBench(const std::vector<std::string>& argv) {
+  if (argv.empty()) {
+    std::fprintf(stderr, "usage: retile bench throughput SCENE ... | retile bench bvh [--triangles N]\n");
+    return 2;
+  }
+  std::vector<std::string> rest(argv.begin() + 1, argv.end());
+  if (argv[0] == "throughput") return benchThroughput(rest);
+  if (argv[0] == "bvh") return benchBvh(rest);
+  std::fprintf(stderr, "retile bench: unknown benchmark '%s' (throughput, bvh)\n", argv[0].c_str());
+  return 2;
+}
+
+}  // namespace retile::cli

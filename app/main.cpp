@@ -1,0 +1,46 @@
+// retile: the editor (issue 4 brings it) and the command line.
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "cli.h"
+#include "retile/log.h"
+
+namespace {
+
+void usage() {
+  std::fprintf(stderr,
+               "usage:\n"
+               "  retile render SCENE [--size WxH] [--spp N] [--seed S] [--max-bounces B] [--out FILE.exr|png]\n"
+               "                      [--view Standard|Filmic] [--exposure STOPS]\n"
+               "  retile bench throughput SCENE [--size WxH] [--frames N] [--max-bounces B]\n"
+               "  retile bench bvh [--triangles N]\n"
+               "  retile import FILE\n"
+               "SCENE is a file (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default'.\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (const char* v = std::getenv("RETILE_LOG"); v && std::strcmp(v, "debug") == 0) retile::setLogLevel(retile::LogLevel::Debug);
+  try {
+    if (args.empty() || args[0] == "--help" || args[0] == "-h") {
+      usage();
+      return args.empty() ? 2 : 0;
+    }
+    std::string cmd = args[0];
+    std::vector<std::string> rest(args.begin() + 1, args.end());
+    if (cmd == "render") return retile::cli::runRender(rest);
+    if (cmd == "bench") return retile::cli::runBench(rest);
+    if (cmd == "import") return retile::cli::runImport(rest);
+    std::fprintf(stderr, "retile: unknown command '%s'\n", cmd.c_str());
+    usage();
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,95 @@
+// The path tracer. A Renderer owns its own headless Vulkan device, the scene's GPU copy and the
+// accumulation buffers.
+//
+// Threads: a Renderer is used by one thread at a time (the render thread in the editor, the
+// main thread on the command line); it blocks that thread while the device works. The Scene
+// passed in is read during the call only.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "retile/image.h"
+#include "retile/scene.h"
+
+namespace retile {
+
+struct RendererOptions {
+  std::string device;       // a substring of the device name or an index; RETILE_DEVICE overrides
+  bool validation = false;  // Vulkan validation layers (debug builds turn them on)
+};
+
+// A rectangle of pixels that receives `quality` samples each in one frame. Pixel samples use
+// sample indices sampleBase .. sampleBase + quality - 1. `restart` replaces the pixels' sums
+// instead of adding to them.
+struct TileWork {
+  int x = 0, y = 0, width = 0, height = 0;
+  int quality = 1;
+  std::uint32_t sampleBase = 0;
+  bool restart = false;
+};
+
+struct FrameStats {
+  std::uint64_t samples = 0;       // path samples traced this frame
+  std::uint64_t primaryRays = 0;
+  std::uint64_t bounceRays = 0;
+  std::uint64_t shadowRays = 0;
+  double seconds = 0;              // wall time of trace + accumulate on the device
+};
+
+struct RenderRequest {
+  int width = 0, height = 0;       // 0: the scene's settings
+  int samplesPerPixel = 0;         // 0: the scene's settings
+  int maxBounces = -1;             // -1: the scene's settings
+  std::uint32_t seed = 0;
+};
+
+class Renderer {
+ public:
+  explicit Renderer(const RendererOptions& options = {});
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  std::string deviceName() const;
+  bool cpuDevice() const;
+
+  // Uploads the whole scene. Returns warnings (missing textures and their substitutes).
+  std::vector<std::string> setScene(const Scene& scene);
+  // Refreshes what `updateFlags` (edit.h) says changed in `scene`, which must be the scene last
+  // given, edited. Cost follows the flags: a transform never touches mesh data.
+  std::vector<std::string> updateScene(const Scene& scene, std::uint32_t updateFlags);
+
+  // Sets the image size and clears the accumulation.
+  void resize(int width, int height);
+  void setMaxBounces(int maxBounces);
+  void setSeed(std::uint32_t seed);
+
+  // Traces one frame: every tile's pixels get `quality` samples, accumulated as the tile says.
+  FrameStats renderFrame(const std::vector<TileWork>& tiles);
+  // Reads back the accumulated image (mean per pixel) and auxiliary outputs.
+  RenderImage readback();
+
+  // Convenience for the command line and tests: resize, then samplesPerPixel frames of one
+  // sample per pixel each (the same-time budget W x H per frame), then read back. `progress`
+  // gets (frames done, frames total) and may return false to stop early.
+  // Uses the scene last given to setScene/updateScene.
+  RenderImage render(const RenderRequest& request, const std::function<bool(int, int)>& progress = {},
+                     FrameStats* total = nullptr);
+
+  // Device memory held by the scene's buffers, and triangles, for the benchmarks.
+  std::uint64_t sceneDeviceBytes() const;
+  std::uint64_t sceneTriangles() const;
+  // Seconds the last setScene/updateScene spent building BVHs (bottom level, top level).
+  double lastBlasSeconds() const;
+  double lastTlasSeconds() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace retile

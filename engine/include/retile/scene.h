@@ -1,0 +1,190 @@
+// The scene document: what an artist edits and what files hold. Plain values with stable ids.
+//
+// Ownership and threads: a Scene is a value. The editor's GUI thread owns the live document; the
+// render thread holds its own copy, brought up to date by edits (edit.h). Mesh geometry is
+// immutable and shared between copies through shared_ptr<const>, so copying a Scene or sending
+// an object edit never copies vertex data.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "retile/math.h"
+
+namespace retile {
+
+using NodeId = std::uint64_t;
+constexpr NodeId kNoNode = 0;
+
+// Immutable triangle data in object space. normals and uvs are empty or one per position.
+struct MeshGeometry {
+  std::vector<Vec3> positions;
+  std::vector<Vec3> normals;
+  std::vector<Vec2> uvs;
+  std::vector<std::uint32_t> indices;  // three per triangle, all < positions.size()
+
+  std::size_t triangleCount() const { return indices.size() / 3; }
+  Bounds3 bounds() const;
+};
+
+struct Mesh {
+  NodeId id = kNoNode;
+  std::string name;
+  std::shared_ptr<const MeshGeometry> geometry;
+};
+
+enum class TextureKind { File, Embedded, Checker };
+// How texel values are turned into linear scene values. Auto: 8-bit formats are sRGB-encoded,
+// floating-point formats (EXR, HDR) are linear. Raw: no conversion (roughness, alpha masks).
+enum class TextureColorSpace { Auto, SRGB, Linear, Raw };
+
+struct Texture {
+  NodeId id = kNoNode;
+  std::string name;
+  TextureKind kind = TextureKind::File;
+  std::filesystem::path path;           // File: absolute, or relative to Scene::baseDirectory
+  std::vector<std::uint8_t> encoded;    // Embedded: the file's bytes (PNG, JPEG, ...)
+  std::string encodedFormat;            // Embedded: a file extension hint such as "png"
+  TextureColorSpace colorSpace = TextureColorSpace::Auto;
+  Vec3 checkerOn{0.8f}, checkerOff{0.2f};  // Checker: colours and squares per unit of uv
+  int checkerResU = 8, checkerResV = 8;
+};
+
+// The materials the scenes we open use, and no more (see docs/ARCHITECTURE.md).
+enum class MaterialType {
+  Lambert,
+  OrenNayar,        // roughness is the slope deviation sigma in radians
+  Plastic,          // smooth dielectric coating (ior) over a Lambert base (albedo)
+  RoughPlastic,     // GGX coating of `roughness` over a Lambert base
+  Conductor,        // smooth metal with complex index eta + i k, tinted by albedo
+  RoughConductor,   // GGX metal
+  Mirror,           // perfect reflector of reflectance albedo
+  Dielectric,       // smooth glass of index ior, tinted by albedo on transmission
+  RoughDielectric,  // GGX glass
+  ThinSheet,        // thin dielectric film: reflects by Fresnel, transmits straight through
+  Null,             // scatters nothing: a black emitter surface (paths end on it)
+};
+constexpr int kMaterialTypeCount = 11;
+const char* materialTypeName(MaterialType t);
+bool materialTypeFromName(const std::string& name, MaterialType* out);
+
+struct Material {
+  NodeId id = kNoNode;
+  std::string name;
+  MaterialType type = MaterialType::Lambert;
+  Vec3 albedo{0.8f};
+  NodeId albedoTexture = kNoNode;
+  float roughness = 0.1f;          // GGX alpha for rough types; sigma for Oren-Nayar
+  NodeId roughnessTexture = kNoNode;
+  float ior = 1.5f;                // dielectric index (plastic coating, glass, thin sheet)
+  std::string metal = "Cu";        // conductors: a named metal (see conductorNames) or "custom"
+  Vec3 eta{0.2f, 0.92f, 1.1f};     // conductors with metal == "custom"
+  Vec3 k{3.9f, 2.45f, 2.14f};
+  Vec3 emission{0.0f};             // radiance emitted from the front side
+  float alpha = 1.0f;              // coverage; < 1 or an alpha texture makes a cut-out
+  NodeId alphaTexture = kNoNode;
+
+  bool emissive() const { return emission.x > 0 || emission.y > 0 || emission.z > 0; }
+};
+
+// Named metals with RGB complex indices of refraction (linear sRGB primaries).
+std::vector<std::string> conductorNames();
+bool conductorIor(const std::string& name, Vec3* eta, Vec3* k);
+
+struct Object {
+  NodeId id = kNoNode;
+  std::string name;
+  NodeId mesh = kNoNode;
+  NodeId material = kNoNode;
+  Mat4 transform;  // object to world
+  bool visible = true;
+};
+
+enum class LightType { Point, Spot, Directional };
+
+// Lights without a surface. Area lights are objects with an emissive material.
+struct Light {
+  NodeId id = kNoNode;
+  std::string name;
+  LightType type = LightType::Point;
+  Vec3 color{1.0f};
+  float intensity = 1.0f;  // point/spot: W/sr scale; directional: irradiance scale
+  Vec3 position{0.0f};
+  Vec3 direction{0.0f, -1.0f, 0.0f};  // spot and directional: where the light travels
+  float spotAngle = radians(30.0f);   // spot: half angle of the cone
+  float spotBlend = 0.1f;             // spot: fraction of the cone that falls off
+  bool visible = true;
+};
+
+struct Camera {
+  Vec3 position{0.0f, 1.0f, 5.0f};
+  Vec3 target{0.0f, 1.0f, 0.0f};
+  Vec3 up{0.0f, 1.0f, 0.0f};
+  float verticalFov = radians(40.0f);
+};
+
+enum class EnvironmentType { Constant, Map, Sky };
+struct Environment {
+  EnvironmentType type = EnvironmentType::Constant;
+  Vec3 color{0.0f};                   // Constant: radiance; Map: multiplier
+  float intensity = 1.0f;
+  NodeId map = kNoNode;               // Map: an equirectangular texture
+  float rotation = 0.0f;              // radians about +y
+  Vec3 zenith{0.35f, 0.55f, 0.95f};   // Sky: a gradient from zenith to horizon, ground below
+  Vec3 horizon{0.9f, 0.92f, 0.95f};
+  Vec3 ground{0.3f, 0.28f, 0.25f};
+};
+
+struct RenderSettings {
+  int width = 640;
+  int height = 360;
+  int maxBounces = 8;
+  int samplesPerPixel = 64;
+  std::uint32_t seed = 0;
+};
+
+class Scene {
+ public:
+  std::vector<Mesh> meshes;
+  std::vector<Texture> textures;
+  std::vector<Material> materials;
+  std::vector<Object> objects;
+  std::vector<Light> lights;
+  Camera camera;
+  Environment environment;
+  RenderSettings settings;
+  std::filesystem::path baseDirectory;  // relative texture paths resolve against it
+
+  NodeId newId() { return nextId_++; }
+  NodeId peekNextId() const { return nextId_; }
+  void reserveIds(NodeId next) { if (next > nextId_) nextId_ = next; }
+
+  Mesh* mesh(NodeId id);
+  const Mesh* mesh(NodeId id) const;
+  Texture* texture(NodeId id);
+  const Texture* texture(NodeId id) const;
+  Material* material(NodeId id);
+  const Material* material(NodeId id) const;
+  Object* object(NodeId id);
+  const Object* object(NodeId id) const;
+  Light* light(NodeId id);
+  const Light* light(NodeId id) const;
+
+  // World bounds of visible objects; used to frame cameras and size environment lights.
+  Bounds3 worldBounds() const;
+  std::size_t triangleCount() const;
+  // Aspect ratio from settings, guarded against zero.
+  float aspect() const;
+
+ private:
+  NodeId nextId_ = 1;
+};
+
+// The built-in look-dev scene: ground, glossy sphere, a cup by a mirror-like panel, a textured
+// box, an area light and a sky. Generated in code, so it needs no files.
+Scene makeDefaultScene();
+
+}  // namespace retile

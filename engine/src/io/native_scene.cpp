@@ -1,0 +1,497 @@
+// The native scene format: one JSON document, versioned, lossless. Geometry and embedded images
+// are base64 inside it so that a scene is one file (saves are atomic, autosaves self-contained).
+#include <cstring>
+
+#include "core/files.h"
+#include "core/json.h"
+#include "retile/io.h"
+#include "retile/log.h"
+
+namespace fs = std::filesystem;
+
+namespace retile {
+namespace {
+
+using json::Value;
+
+const char* const kFormatTag = "retile-scene";
+
+template <class T>
+Value blob(const std::vector<T>& v) {
+  return Value(base64Encode(reinterpret_cast<const std::uint8_t*>(v.data()), v.size() * sizeof(T)));
+}
+
+Value mat4(const Mat4& m) {
+  json::Array a;
+  for (const auto& row : m.m)
+    for (float f : row) a.emplace_back(f);
+  return Value(std::move(a));
+}
+
+const char* colorSpaceName(TextureColorSpace c) {
+  switch (c) {
+    case TextureColorSpace::Auto: return "auto";
+    case TextureColorSpace::SRGB: return "srgb";
+    case TextureColorSpace::Linear: return "linear";
+    case TextureColorSpace::Raw: return "raw";
+  }
+  return "auto";
+}
+const char* textureKindName(TextureKind k) {
+  switch (k) {
+    case TextureKind::File: return "file";
+    case TextureKind::Embedded: return "embedded";
+    case TextureKind::Checker: return "checker";
+  }
+  return "file";
+}
+const char* lightTypeName(LightType t) {
+  switch (t) {
+    case LightType::Point: return "point";
+    case LightType::Spot: return "spot";
+    case LightType::Directional: return "directional";
+  }
+  return "point";
+}
+const char* environmentTypeName(EnvironmentType t) {
+  switch (t) {
+    case EnvironmentType::Constant: return "constant";
+    case EnvironmentType::Map: return "map";
+    case EnvironmentType::Sky: return "sky";
+  }
+  return "constant";
+}
+
+// Reads fields of one JSON object, remembering the first problem with its location.
+class Reader {
+ public:
+  Reader(std::string* error, std::string where, const Value* v) : error_(error), where_(std::move(where)), v_(v) {
+    if (!v_ || !v_->isObject()) problem("", "expected an object");
+  }
+
+  bool ok() const { return error_->empty(); }
+  const Value* raw(const char* key) const { return v_ && v_->isObject() ? v_->find(key) : nullptr; }
+
+  void problem(const char* key, const std::string& what) {
+    if (error_->empty()) *error_ = cat(where_, (key && *key) ? "." : "", key ? key : "", ": ", what);
+  }
+
+  template <class F>
+  void field(const char* key, F&& read, const char* expected, bool required = false) {
+    const Value* f = raw(key);
+    if (!f) {
+      if (required) problem(key, "missing");
+      return;
+    }
+    if (!read(*f)) problem(key, cat("expected ", expected, ", found ", json::typeName(f->type())));
+  }
+
+  void number(const char* key, float* out, bool required = false) {
+    field(key, [&](const Value& f) { return json::toFloat(f, out); }, "a finite number", required);
+  }
+  void integer(const char* key, int* out) {
+    field(key, [&](const Value& f) {
+      if (!f.isNumber() || f.asNumber() != std::floor(f.asNumber()) || std::abs(f.asNumber()) > 1e9) return false;
+      *out = static_cast<int>(f.asNumber());
+      return true;
+    }, "an integer");
+  }
+  void id(const char* key, NodeId* out, bool required = false) {
+    field(key, [&](const Value& f) {
+      if (!f.isNumber() || f.asNumber() < 0 || f.asNumber() > 9e15 || f.asNumber() != std::floor(f.asNumber())) return false;
+      *out = static_cast<NodeId>(f.asNumber());
+      return true;
+    }, "a node id", required);
+  }
+  void vec3(const char* key, Vec3* out) {
+    field(key, [&](const Value& f) { return json::toVec3(f, out); }, "three numbers");
+  }
+  void boolean(const char* key, bool* out) {
+    field(key, [&](const Value& f) {
+      if (!f.isBool()) return false;
+      *out = f.asBool();
+      return true;
+    }, "true or false");
+  }
+  void string(const char* key, std::string* out, bool required = false) {
+    field(key, [&](const Value& f) {
+      if (!f.isString()) return false;
+      *out = f.asString();
+      return true;
+    }, "a string", required);
+  }
+  void matrix(const char* key, Mat4* out) {
+    field(key, [&](const Value& f) {
+      if (!f.isArray() || f.asArray().size() != 16) return false;
+      for (int i = 0; i < 16; ++i)
+        if (!json::toFloat(f.asArray()[static_cast<std::size_t>(i)], &out->m[i / 4][i % 4])) return false;
+      return true;
+    }, "16 numbers");
+  }
+  template <class T>
+  void blob(const char* key, std::vector<T>* out) {
+    const Value* f = raw(key);
+    if (!f) return;
+    if (!f->isString()) return problem(key, "expected base64 text");
+    auto bytes = base64Decode(f->asString());
+    if (!bytes) return problem(key, bytes.error());
+    if (bytes->size() % sizeof(T)) return problem(key, "data length is not a whole number of elements");
+    out->resize(bytes->size() / sizeof(T));
+    if (!out->empty()) std::memcpy(out->data(), bytes->data(), bytes->size());
+  }
+  template <class E>
+  void enumeration(const char* key, E* out, const char* (*name)(E), int count) {
+    const Value* f = raw(key);
+    if (!f) return;
+    if (f->isString())
+      for (int i = 0; i < count; ++i)
+        if (f->asString() == name(static_cast<E>(i))) {
+          *out = static_cast<E>(i);
+          return;
+        }
+    problem(key, f->isString() ? cat("unknown value '", f->asString(), "'") : std::string("expected a name"));
+  }
+
+ private:
+  std::string* error_;
+  std::string where_;
+  const Value* v_;
+};
+
+const char* materialName(MaterialType t) { return materialTypeName(t); }
+
+}  // namespace
+
+std::string nativeSceneToString(const Scene& s) {
+  Value root(json::Object{});
+  root.set("format", kFormatTag);
+  root.set("version", kNativeFormatVersion);
+  root.set("next_id", s.peekNextId());
+
+  Value settings(json::Object{});
+  settings.set("width", s.settings.width);
+  settings.set("height", s.settings.height);
+  settings.set("max_bounces", s.settings.maxBounces);
+  settings.set("spp", s.settings.samplesPerPixel);
+  settings.set("seed", s.settings.seed);
+  root.set("settings", settings);
+
+  Value cam(json::Object{});
+  cam.set("position", json::fromVec3(s.camera.position));
+  cam.set("target", json::fromVec3(s.camera.target));
+  cam.set("up", json::fromVec3(s.camera.up));
+  cam.set("vertical_fov", s.camera.verticalFov);
+  root.set("camera", cam);
+
+  const Environment& e = s.environment;
+  Value env(json::Object{});
+  env.set("type", environmentTypeName(e.type));
+  env.set("color", json::fromVec3(e.color));
+  env.set("intensity", e.intensity);
+  env.set("map", e.map);
+  env.set("rotation", e.rotation);
+  env.set("zenith", json::fromVec3(e.zenith));
+  env.set("horizon", json::fromVec3(e.horizon));
+  env.set("ground", json::fromVec3(e.ground));
+  root.set("environment", env);
+
+  json::Array meshes;
+  for (const Mesh& m : s.meshes) {
+    Value v(json::Object{});
+    v.set("id", m.id);
+    v.set("name", m.name);
+    if (m.geometry) {
+      v.set("positions", blob(m.geometry->positions));
+      v.set("normals", blob(m.geometry->normals));
+      v.set("uvs", blob(m.geometry->uvs));
+      v.set("indices", blob(m.geometry->indices));
+    }
+    meshes.push_back(std::move(v));
+  }
+  root.set("meshes", std::move(meshes));
+
+  json::Array textures;
+  for (const Texture& t : s.textures) {
+    Value v(json::Object{});
+    v.set("id", t.id);
+    v.set("name", t.name);
+    v.set("kind", textureKindName(t.kind));
+    v.set("color_space", colorSpaceName(t.colorSpace));
+    if (t.kind == TextureKind::File) {
+      // Stored as written, plus the absolute location so a copy saved elsewhere still finds it.
+      v.set("path", t.path.generic_string());
+      fs::path abs = t.path.is_absolute() ? t.path : s.baseDirectory / t.path;
+      v.set("absolute_path", abs.lexically_normal().generic_string());
+    } else if (t.kind == TextureKind::Embedded) {
+      v.set("format", t.encodedFormat);
+      v.set("data", blob(t.encoded));
+    } else {
+      v.set("on", json::fromVec3(t.checkerOn));
+      v.set("off", json::fromVec3(t.checkerOff));
+      v.set("res_u", t.checkerResU);
+      v.set("res_v", t.checkerResV);
+    }
+    textures.push_back(std::move(v));
+  }
+  root.set("textures", std::move(textures));
+
+  json::Array materials;
+  for (const Material& m : s.materials) {
+    Value v(json::Object{});
+    v.set("id", m.id);
+    v.set("name", m.name);
+    v.set("type", materialTypeName(m.type));
+    v.set("albedo", json::fromVec3(m.albedo));
+    v.set("albedo_texture", m.albedoTexture);
+    v.set("roughness", m.roughness);
+    v.set("roughness_texture", m.roughnessTexture);
+    v.set("ior", m.ior);
+    v.set("metal", m.metal);
+    v.set("eta", json::fromVec3(m.eta));
+    v.set("k", json::fromVec3(m.k));
+    v.set("emission", json::fromVec3(m.emission));
+    v.set("alpha", m.alpha);
+    v.set("alpha_texture", m.alphaTexture);
+    materials.push_back(std::move(v));
+  }
+  root.set("materials", std::move(materials));
+
+  json::Array objects;
+  for (const Object& o : s.objects) {
+    Value v(json::Object{});
+    v.set("id", o.id);
+    v.set("name", o.name);
+    v.set("mesh", o.mesh);
+    v.set("material", o.material);
+    v.set("transform", mat4(o.transform));
+    v.set("visible", o.visible);
+    objects.push_back(std::move(v));
+  }
+  root.set("objects", std::move(objects));
+
+  json::Array lights;
+  for (const Light& l : s.lights) {
+    Value v(json::Object{});
+    v.set("id", l.id);
+    v.set("name", l.name);
+    v.set("type", lightTypeName(l.type));
+    v.set("color", json::fromVec3(l.color));
+    v.set("intensity", l.intensity);
+    v.set("position", json::fromVec3(l.position));
+    v.set("direction", json::fromVec3(l.direction));
+    v.set("spot_angle", l.spotAngle);
+    v.set("spot_blend", l.spotBlend);
+    v.set("visible", l.visible);
+    lights.push_back(std::move(v));
+  }
+  root.set("lights", std::move(lights));
+  return json::write(root);
+}
+
+Result<bool> saveNativeScene(const Scene& scene, const fs::path& file) {
+  return writeFileAtomic(file, nativeSceneToString(scene));
+}
+
+Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::path& file, const fs::path& baseDir) {
+  using R = Result<ImportedScene>;
+  auto parsed = json::parse(text);
+  if (!parsed) return R::failure(cat(file.string(), ": not valid JSON: ", parsed.error()));
+  const Value& root = parsed.value();
+  const Value* tag = root.find("format");
+  if (!tag || !tag->isString() || tag->asString() != kFormatTag)
+    return R::failure(cat(file.string(), ": not a Retile scene (no \"format\": \"", kFormatTag, "\")"));
+  const Value* ver = root.find("version");
+  if (!ver || !ver->isNumber()) return R::failure(cat(file.string(), ": no format version"));
+  if (ver->asNumber() > kNativeFormatVersion)
+    return R::failure(cat(file.string(), ": written by a newer Retile (format version ", ver->asNumber(),
+                          ", this build reads up to ", kNativeFormatVersion, ")"));
+
+  ImportedScene out;
+  out.format = "native";
+  Scene& s = out.scene;
+  s.baseDirectory = baseDir;
+  std::string error;
+  auto where = [&](const char* list, std::size_t i) { return cat(list, "[", i, "]"); };
+
+  Reader top(&error, "", &root);
+  NodeId nextId = 1;
+  top.id("next_id", &nextId);
+
+  if (const Value* v = root.find("settings")) {
+    Reader r(&error, "settings", v);
+    r.integer("width", &s.settings.width);
+    r.integer("height", &s.settings.height);
+    r.integer("max_bounces", &s.settings.maxBounces);
+    r.integer("spp", &s.settings.samplesPerPixel);
+    int seed = 0;
+    r.integer("seed", &seed);
+    s.settings.seed = static_cast<std::uint32_t>(seed);
+  }
+  if (const Value* v = root.find("camera")) {
+    Reader r(&error, "camera", v);
+    r.vec3("position", &s.camera.position);
+    r.vec3("target", &s.camera.target);
+    r.vec3("up", &s.camera.up);
+    r.number("vertical_fov", &s.camera.verticalFov);
+  }
+  if (const Value* v = root.find("environment")) {
+    Reader r(&error, "environment", v);
+    Environment& e = s.environment;
+    r.enumeration("type", &e.type, environmentTypeName, 3);
+    r.vec3("color", &e.color);
+    r.number("intensity", &e.intensity);
+    r.id("map", &e.map);
+    r.number("rotation", &e.rotation);
+    r.vec3("zenith", &e.zenith);
+    r.vec3("horizon", &e.horizon);
+    r.vec3("ground", &e.ground);
+  }
+  auto list = [&](const char* key) -> const json::Array* {
+    const Value* v = root.find(key);
+    if (!v) return nullptr;
+    if (!v->isArray()) {
+      if (error.empty()) error = cat(key, ": expected an array");
+      return nullptr;
+    }
+    return &v->asArray();
+  };
+  if (auto* a = list("meshes"))
+    for (std::size_t i = 0; i < a->size() && error.empty(); ++i) {
+      Reader r(&error, where("meshes", i), &(*a)[i]);
+      Mesh m;
+      auto g = std::make_shared<MeshGeometry>();
+      r.id("id", &m.id, true);
+      r.string("name", &m.name);
+      r.blob("positions", &g->positions);
+      r.blob("normals", &g->normals);
+      r.blob("uvs", &g->uvs);
+      r.blob("indices", &g->indices);
+      std::size_t dropped = sanitizeGeometry(*g);
+      if (dropped) out.warnings.push_back(cat(file.string(), ": mesh '", m.name, "': dropped ", dropped, " invalid triangles"));
+      m.geometry = std::move(g);
+      s.meshes.push_back(std::move(m));
+    }
+  if (auto* a = list("textures"))
+    for (std::size_t i = 0; i < a->size() && error.empty(); ++i) {
+      Reader r(&error, where("textures", i), &(*a)[i]);
+      Texture t;
+      r.id("id", &t.id, true);
+      r.string("name", &t.name);
+      r.enumeration("kind", &t.kind, textureKindName, 3);
+      r.enumeration("color_space", &t.colorSpace, colorSpaceName, 4);
+      std::string path, absolute;
+      r.string("path", &path);
+      r.string("absolute_path", &absolute);
+      if (t.kind == TextureKind::File) {
+        // Prefer the recorded relative path when it still resolves next to this file.
+        std::error_code ec;
+        if (!path.empty() && (fs::path(path).is_absolute() || fs::exists(baseDir / path, ec)))
+          t.path = path;
+        else if (!absolute.empty())
+          t.path = absolute;
+        else
+          t.path = path;
+      }
+      r.string("format", &t.encodedFormat);
+      r.blob("data", &t.encoded);
+      r.vec3("on", &t.checkerOn);
+      r.vec3("off", &t.checkerOff);
+      r.integer("res_u", &t.checkerResU);
+      r.integer("res_v", &t.checkerResV);
+      s.textures.push_back(std::move(t));
+    }
+  if (auto* a = list("materials"))
+    for (std::size_t i = 0; i < a->size() && error.empty(); ++i) {
+      Reader r(&error, where("materials", i), &(*a)[i]);
+      Material m;
+      r.id("id", &m.id, true);
+      r.string("name", &m.name);
+      r.enumeration("type", &m.type, materialName, kMaterialTypeCount);
+      r.vec3("albedo", &m.albedo);
+      r.id("albedo_texture", &m.albedoTexture);
+      r.number("roughness", &m.roughness);
+      r.id("roughness_texture", &m.roughnessTexture);
+      r.number("ior", &m.ior);
+      r.string("metal", &m.metal);
+      r.vec3("eta", &m.eta);
+      r.vec3("k", &m.k);
+      r.vec3("emission", &m.emission);
+      r.number("alpha", &m.alpha);
+      r.id("alpha_texture", &m.alphaTexture);
+      s.materials.push_back(std::move(m));
+    }
+  if (auto* a = list("objects"))
+    for (std::size_t i = 0; i < a->size() && error.empty(); ++i) {
+      Reader r(&error, where("objects", i), &(*a)[i]);
+      Object o;
+      r.id("id", &o.id, true);
+      r.string("name", &o.name);
+      r.id("mesh", &o.mesh);
+      r.id("material", &o.material);
+      r.matrix("transform", &o.transform);
+      r.boolean("visible", &o.visible);
+      s.objects.push_back(std::move(o));
+    }
+  if (auto* a = list("lights"))
+    for (std::size_t i = 0; i < a->size() && error.empty(); ++i) {
+      Reader r(&error, where("lights", i), &(*a)[i]);
+      Light l;
+      r.id("id", &l.id, true);
+      r.string("name", &l.name);
+      r.enumeration("type", &l.type, lightTypeName, 3);
+      r.vec3("color", &l.color);
+      r.number("intensity", &l.intensity);
+      r.vec3("position", &l.position);
+      r.vec3("direction", &l.direction);
+      r.number("spot_angle", &l.spotAngle);
+      r.number("spot_blend", &l.spotBlend);
+      r.boolean("visible", &l.visible);
+      s.lights.push_back(std::move(l));
+    }
+  if (!error.empty()) return R::failure(cat(file.string(), ": ", error));
+
+  // References must point at existing nodes of the right kind; ids must be unique.
+  std::vector<NodeId> ids;
+  NodeId maxId = 0;
+  auto note = [&](NodeId id) {
+    ids.push_back(id);
+    maxId = std::max(maxId, id);
+  };
+  for (auto& m : s.meshes) note(m.id);
+  for (auto& t : s.textures) note(t.id);
+  for (auto& m : s.materials) note(m.id);
+  for (auto& o : s.objects) note(o.id);
+  for (auto& l : s.lights) note(l.id);
+  std::sort(ids.begin(), ids.end());
+  if (std::adjacent_find(ids.begin(), ids.end()) != ids.end() || (!ids.empty() && ids.front() == kNoNode))
+    return R::failure(cat(file.string(), ": node ids are not unique and non-zero"));
+  for (Material& m : s.materials)
+    for (NodeId* t : {&m.albedoTexture, &m.roughnessTexture, &m.alphaTexture})
+      if (*t != kNoNode && !s.texture(*t)) {
+        out.warnings.push_back(cat(file.string(), ": material '", m.name, "' names missing texture ", *t));
+        *t = kNoNode;
+      }
+  for (Object& o : s.objects) {
+    if (o.mesh != kNoNode && !s.mesh(o.mesh)) return R::failure(cat(file.string(), ": object '", o.name, "' names missing mesh ", o.mesh));
+    if (o.material != kNoNode && !s.material(o.material)) {
+      out.warnings.push_back(cat(file.string(), ": object '", o.name, "' names missing material ", o.material));
+      o.material = kNoNode;
+    }
+  }
+  if (s.environment.map != kNoNode && !s.texture(s.environment.map)) {
+    out.warnings.push_back(cat(file.string(), ": environment names missing texture ", s.environment.map));
+    s.environment.map = kNoNode;
+  }
+  if (s.settings.width < 1 || s.settings.height < 1 || s.settings.width > 16384 || s.settings.height > 16384)
+    return R::failure(cat(file.string(), ": settings: size ", s.settings.width, "x", s.settings.height, " is outside 1..16384"));
+  s.reserveIds(std::max(nextId, maxId + 1));
+  return out;
+}
+
+Result<ImportedScene> loadNativeScene(const fs::path& file, const ImportOptions& options) {
+  auto text = readFile(file, options.maxFileBytes);
+  if (!text) return Result<ImportedScene>::failure(text.error());
+  return nativeSceneFromString(text.value(), file, file.parent_path());
+}
+
+}  // namespace retile

@@ -1,0 +1,738 @@
+// Tungsten / Bitterli scene.json: the format the paper's scenes come in. Conventions (transform
+// order, Euler angles, shape extents, camera field of view, bounce counting) follow Tungsten so
+// scenes look as their authors rendered them; see docs/ARCHITECTURE.md for the mapping.
+#include <cmath>
+#include <cstring>
+#include <map>
+
+#include "core/files.h"
+#include "core/json.h"
+#include "retile/io.h"
+#include "retile/log.h"
+#include "scene/primitives.h"
+
+namespace fs = std::filesystem;
+
+namespace retile {
+namespace {
+
+using json::Value;
+
+struct TextureRef {
+  bool isTexture = false;
+  Vec3 constant{1.0f};
+  NodeId texture = kNoNode;
+};
+
+class TungstenImporter {
+ public:
+  TungstenImporter(fs::path file, const ImportOptions& options) : file_(std::move(file)), options_(options) {
+    base_ = file_.parent_path();
+    out_.format = "tungsten";
+    out_.scene.baseDirectory = base_;
+  }
+
+  Result<ImportedScene> run() {
+    using R = Result<ImportedScene>;
+    auto text = readFile(file_, options_.maxFileBytes);
+    if (!text) return R::failure(text.error());
+    auto parsed = json::parse(text.value());
+    if (!parsed) return R::failure(cat(file_.string(), ": not valid JSON: ", parsed.error()));
+    const Value& root = parsed.value();
+    if (!root.isObject()) return R::failure(cat(file_.string(), ": the top level is not a JSON object"));
+    if (!root.find("primitives") && !root.find("bsdfs"))
+      return R::failure(cat(file_.string(), ": not a Tungsten scene (no \"primitives\" or \"bsdfs\")"));
+    Scene& s = out_.scene;
+    s.environment.type = EnvironmentType::Constant;
+    s.environment.color = Vec3{0.0f};
+
+    if (const Value* b = root.find("bsdfs")) {
+      if (!b->isArray()) return fail("bsdfs: expected an array");
+      for (std::size_t i = 0; i < b->asArray().size() && ok(); ++i) {
+        const Value& v = b->asArray()[i];
+        Material m = bsdf(v, cat("bsdfs[", i, "]"));
+        if (!ok()) break;
+        m.id = s.newId();
+        if (m.name.empty()) m.name = cat("bsdf ", i);
+        named_[m.name] = m;
+        s.materials.push_back(m);
+      }
+    }
+    if (const Value* c = root.find("camera"); c && ok()) camera(*c);
+    if (const Value* in = root.find("integrator"); in && in->isObject()) {
+      float mb;
+      if (const Value* v = in->find("max_bounces"); v && json::toFloat(*v, &mb) && mb >= 0)
+        s.settings.maxBounces = std::clamp(static_cast<int>(mb) - 1, 0, 1024);  // Tungsten counts segments
+    }
+    if (const Value* r = root.find("renderer"); r && r->isObject()) {
+      float spp;
+      if (const Value* v = r->find("spp"); v && json::toFloat(*v, &spp) && spp >= 1)
+        s.settings.samplesPerPixel = std::clamp(static_cast<int>(spp), 1, 1 << 20);
+    }
+    if (const Value* p = root.find("primitives"); p && ok()) {
+      if (!p->isArray()) return fail("primitives: expected an array");
+      for (std::size_t i = 0; i < p->asArray().size() && ok(); ++i) primitive(p->asArray()[i], cat("primitives[", i, "]"));
+    }
+    // Not Tungsten's own key, but Bitterli's living room names its sky this way.
+    if (const Value* e = root.find("emissions"); e && e->isArray() && ok())
+      for (std::size_t i = 0; i < e->asArray().size(); ++i) environmentEntry(e->asArray()[i], cat("emissions[", i, "]"));
+    if (!ok()) return R::failure(error_);
+    if (s.objects.empty() && s.environment.type == EnvironmentType::Constant && maxComponent(s.environment.color) <= 0)
+      return fail("the scene has no geometry and no light");
+    return std::move(out_);
+  }
+
+ private:
+  bool ok() const { return error_.empty(); }
+  Result<ImportedScene> fail(const std::string& what) {
+    if (error_.empty()) error_ = cat(file_.string(), ": ", what);
+    return Result<ImportedScene>::failure(error_);
+  }
+  void problem(const std::string& where, const std::string& what) {
+    if (error_.empty()) error_ = cat(file_.string(), ": ", where, ": ", what);
+  }
+  void warn(const std::string& what) { out_.warnings.push_back(cat(file_.filename().string(), ": ", what)); }
+
+  bool number(const Value& obj, const char* key, float* out, const std::string& where) {
+    const Value* v = obj.find(key);
+    if (!v) return false;
+    if (!json::toFloat(*v, out)) {
+      problem(where, cat(key, ": expected a finite number"));
+      return false;
+    }
+    return true;
+  }
+  bool vec3(const Value& obj, const char* key, Vec3* out, const std::string& where) {
+    const Value* v = obj.find(key);
+    if (!v) return false;
+    if (!json::toVec3(*v, out)) {
+      problem(where, cat(key, ": expected a number or three numbers"));
+      return false;
+    }
+    return true;
+  }
+  std::string string(const Value& obj, const char* key, const std::string& fallback = {}) {
+    const Value* v = obj.find(key);
+    return v && v->isString() ? v->asString() : fallback;
+  }
+
+  NodeId fileTexture(const std::string& ref, TextureColorSpace cs) {
+    std::string key = cat(ref, "|", static_cast<int>(cs));
+    if (auto it = textures_.find(key); it != textures_.end()) return it->second;
+    Texture t;
+    t.id = out_.scene.newId();
+    t.kind = TextureKind::File;
+    t.path = ref;
+    t.name = fs::path(ref).filename().string();
+    t.colorSpace = cs;
+    if (!resolveScenePath(base_, ref))
+      warn(cat("texture '", ref, "' not found; it renders as a magenta checker until the file is there"));
+    out_.scene.textures.push_back(t);
+    textures_[key] = t.id;
+    return t.id;
+  }
+
+  // A Tungsten texture value: number, [r,g,b], "file", or {type: bitmap|constant|checker}.
+  TextureRef texture(const Value& v, const std::string& where, bool data) {
+    TextureRef r;
+    if (json::toVec3(v, &r.constant)) return r;
+    if (v.isString()) {
+      r.isTexture = true;
+      r.constant = Vec3{1.0f};
+      r.texture = fileTexture(v.asString(), data ? TextureColorSpace::Raw : TextureColorSpace::Auto);
+      return r;
+    }
+    if (!v.isObject()) {
+      problem(where, "expected a number, a colour, a file name or a texture object");
+      return r;
+    }
+    std::string type = string(v, "type");
+    if (type == "constant") {
+      if (const Value* c = v.find("value"); !c || !json::toVec3(*c, &r.constant)) problem(where, "constant texture without a value");
+      return r;
+    }
+    if (type == "bitmap") {
+      std::string f = string(v, "file");
+      if (f.empty()) {
+        problem(where, "bitmap texture without a file");
+        return r;
+      }
+      bool gamma = true;
+      if (const Value* g = v.find("gamma_correct"); g && g->isBool()) gamma = g->asBool();
+      float scale = 1;
+      number(v, "scale", &scale, where);
+      r.isTexture = true;
+      r.constant = Vec3{scale};
+      r.texture = fileTexture(f, data ? TextureColorSpace::Raw : gamma ? TextureColorSpace::Auto : TextureColorSpace::Linear);
+      return r;
+    }
+    if (type == "checker") {
+      Texture t;
+      t.id = out_.scene.newId();
+      t.kind = TextureKind::Checker;
+      t.name = "checker";
+      t.checkerOn = Vec3{0.8f};
+      t.checkerOff = Vec3{0.2f};
+      vec3(v, "on_color", &t.checkerOn, where);
+      vec3(v, "off_color", &t.checkerOff, where);
+      float ru = 20, rv = 20;
+      number(v, "res_u", &ru, where);
+      number(v, "res_v", &rv, where);
+      t.checkerResU = std::clamp(static_cast<int>(ru), 1, 100000);
+      t.checkerResV = std::clamp(static_cast<int>(rv), 1, 100000);
+      out_.scene.textures.push_back(t);
+      r.isTexture = true;
+      r.texture = t.id;
+      return r;
+    }
+    warn(cat(where, ": texture type '", type, "' is not supported; using white"));
+    return r;
+  }
+
+  Material bsdf(const Value& v, const std::string& where, int depth = 0) {
+    Material m;
+    m.albedo = Vec3{1.0f};  // Tungsten's default albedo
+    if (v.isString()) {
+      auto it = named_.find(v.asString());
+      if (it == named_.end()) problem(where, cat("bsdf '", v.asString(), "' is not defined (before this point)"));
+      else m = it->second;
+      return m;
+    }
+    if (!v.isObject()) {
+      problem(where, "expected a bsdf object or name");
+      return m;
+    }
+    if (depth > 8) {
+      problem(where, "bsdfs nested too deeply");
+      return m;
+    }
+    m.name = string(v, "name");
+    std::string type = string(v, "type");
+    if (type.empty()) {
+      problem(where, "bsdf without a \"type\"");
+      return m;
+    }
+    if (type == "transparency") {
+      Material base = v.find("base") ? bsdf(*v.find("base"), where + ".base", depth + 1) : Material{};
+      std::string name = m.name;
+      m = base;
+      m.name = name;
+      if (const Value* a = v.find("alpha")) {
+        TextureRef t = texture(*a, where + ".alpha", true);
+        m.alpha = std::clamp(luminance(t.constant), 0.0f, 1.0f);
+        if (t.isTexture) {
+          const Texture* tex = out_.scene.texture(t.texture);
+          if (tex && tex->kind == TextureKind::File && !resolveScenePath(base_, tex->path.string())) {
+            warn(cat(where, ": alpha map '", tex->path.string(), "' is missing; the surface is drawn opaque"));
+          } else {
+            m.alphaTexture = t.texture;
+          }
+        }
+      }
+      return m;
+    }
+    if (const Value* a = v.find("albedo")) {
+      TextureRef t = texture(*a, where + ".albedo", false);
+      m.albedo = t.constant;
+      m.albedoTexture = t.texture;
+    }
+    std::string dist = string(v, "distribution", "ggx");
+    if (dist != "ggx") warn(cat(where, ": distribution '", dist, "' is rendered as GGX"));
+    auto roughness = [&](float fallback) {
+      m.roughness = fallback;
+      if (const Value* r = v.find("roughness")) {
+        TextureRef t = texture(*r, where + ".roughness", true);
+        m.roughness = luminance(t.constant);
+        m.roughnessTexture = t.texture;
+      }
+    };
+    auto metal = [&]() {
+      m.metal = "Cu";
+      Vec3 eta, k;
+      if (vec3(v, "eta", &eta, where) && vec3(v, "k", &k, where)) {
+        m.metal = "custom";
+        m.eta = eta;
+        m.k = k;
+      }
+      std::string named = string(v, "material");
+      if (!named.empty()) {
+        Vec3 e2, k2;
+        if (conductorIor(named, &e2, &k2)) {
+          m.metal = named;
+        } else {
+          warn(cat(where, ": unknown metal '", named, "'; using copper"));
+          m.metal = "Cu";
+        }
+      }
+    };
+    number(v, "ior", &m.ior, where);
+    if (type == "lambert") {
+      m.type = MaterialType::Lambert;
+    } else if (type == "oren_nayar") {
+      m.type = MaterialType::OrenNayar;
+      roughness(1.0f);
+      m.roughness /= std::sqrt(2.0f);  // Tungsten's roughness is sigma * sqrt(2)
+    } else if (type == "plastic") {
+      m.type = MaterialType::Plastic;
+    } else if (type == "rough_plastic") {
+      m.type = MaterialType::RoughPlastic;
+      roughness(0.02f);
+    } else if (type == "conductor") {
+      m.type = MaterialType::Conductor;
+      metal();
+    } else if (type == "rough_conductor") {
+      m.type = MaterialType::RoughConductor;
+      metal();
+      roughness(0.1f);
+    } else if (type == "mirror") {
+      m.type = MaterialType::Mirror;
+    } else if (type == "dielectric") {
+      m.type = MaterialType::Dielectric;
+      if (const Value* e = v.find("enable_refraction"); e && e->isBool() && !e->asBool())
+        warn(cat(where, ": dielectric without refraction is rendered as glass"));
+    } else if (type == "rough_dielectric") {
+      m.type = MaterialType::RoughDielectric;
+      roughness(0.1f);
+    } else if (type == "thinsheet") {
+      m.type = MaterialType::ThinSheet;
+    } else if (type == "null") {
+      m.type = MaterialType::Null;
+    } else if (type == "forward") {
+      m.type = MaterialType::Lambert;
+      m.alpha = 0;  // an invisible boundary: every ray passes
+    } else {
+      warn(cat(where, ": bsdf type '", type, "' is not supported; rendered as lambert with its albedo"));
+      m.type = MaterialType::Lambert;
+    }
+    if (const Value* s = v.find("sigma_a")) {
+      Vec3 sa;
+      if (json::toVec3(*s, &sa) && maxComponent(sa) > 0) warn(cat(where, ": absorbing coatings (sigma_a) are not rendered"));
+    }
+    return m;
+  }
+
+  // Tungsten's rotYXZ: R = Ry(-ry) Rx(rx) Rz(rz), angles in degrees.
+  static Mat4 rotation(Vec3 deg) {
+    return Mat4::rotateY(radians(-deg.y)) * Mat4::rotateX(radians(deg.x)) * Mat4::rotateZ(radians(deg.z));
+  }
+
+  // flatY: the shape lies in y = 0 (quad, disk), so a zero y scale means nothing and is
+  // replaced by 1 to keep the matrix invertible.
+  Mat4 transform(const Value* v, const std::string& where, Vec3* scaleOut = nullptr, bool flatY = false) {
+    Mat4 m;
+    if (scaleOut) *scaleOut = Vec3{1.0f};
+    if (!v) return m;
+    if (v->isArray()) {
+      if (v->asArray().size() != 16) {
+        problem(where, "transform: a matrix needs 16 numbers");
+        return m;
+      }
+      for (int i = 0; i < 16; ++i)
+        if (!json::toFloat(v->asArray()[static_cast<std::size_t>(i)], &m.m[i / 4][i % 4])) {
+          problem(where, "transform: matrix entries must be finite numbers");
+          return m;
+        }
+      if (scaleOut)
+        *scaleOut = {length(m.transformVector({1, 0, 0})), length(m.transformVector({0, 1, 0})), length(m.transformVector({0, 0, 1}))};
+      return m;
+    }
+    if (!v->isObject()) {
+      problem(where, "transform: expected an object or 16 numbers");
+      return m;
+    }
+    Vec3 pos{0.0f}, scale{1.0f}, rot{0.0f};
+    vec3(*v, "position", &pos, where);
+    vec3(*v, "scale", &scale, where);
+    vec3(*v, "rotation", &rot, where);
+    if (flatY && scale.y == 0) scale.y = 1;
+    Vec3 axis[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    bool given[3] = {false, false, false};
+    Vec3 lookAt;
+    if (vec3(*v, "look_at", &lookAt, where)) {
+      axis[2] = lookAt - pos;
+      given[2] = true;
+    }
+    Vec3 up;
+    if (vec3(*v, "up", &up, where)) {
+      axis[1] = up;
+      given[1] = true;
+    }
+    const char* names[3] = {"x_axis", "y_axis", "z_axis"};
+    for (int i = 0; i < 3; ++i) {
+      Vec3 a;
+      if (vec3(*v, names[i], &a, where)) {
+        axis[i] = a;
+        given[i] = true;
+      }
+    }
+    // Gram-Schmidt in an order that keeps the explicitly given axes (Tungsten's rules).
+    int order[3] = {2, 1, 0};
+    if (given[0] && !given[1] && !given[2]) order[0] = 0, order[1] = 2, order[2] = 1;
+    else if (!given[0] && given[1] && !given[2]) order[0] = 1, order[1] = 2, order[2] = 0;
+    else if (given[0] && given[1] && !given[2]) order[0] = 1, order[1] = 0, order[2] = 2;
+    else if (given[0] && !given[1] && given[2]) order[0] = 2, order[1] = 0, order[2] = 1;
+    Vec3& a = axis[order[0]];
+    Vec3& b = axis[order[1]];
+    Vec3& c = axis[order[2]];
+    a = normalize(a);
+    if (length(a) == 0) a = order[0] == 0 ? Vec3{1, 0, 0} : order[0] == 1 ? Vec3{0, 1, 0} : Vec3{0, 0, 1};
+    b = b - a * dot(a, b);
+    if (length(b) < 1e-6f) b = std::abs(a.x) < 0.9f ? cross(a, {1, 0, 0}) : cross(a, {0, 1, 0});
+    b = normalize(b);
+    c = c - a * dot(a, c) - b * dot(b, c);
+    c = length(c) < 1e-6f ? cross(a, b) : normalize(c);
+    if (dot(cross(axis[0], axis[1]), axis[2]) < 0) {
+      if (!given[0]) axis[0] = -axis[0];
+      else if (!given[1]) axis[1] = -axis[1];
+      else axis[2] = -axis[2];
+    }
+    Mat4 basis;
+    for (int col = 0; col < 3; ++col)
+      for (int row = 0; row < 3; ++row) basis.m[row][col] = axis[col][row];
+    if (scaleOut) *scaleOut = scale;
+    return Mat4::translate(pos) * rotation(rot) * basis * Mat4::scale(scale);
+  }
+
+  void camera(const Value& c) {
+    const std::string where = "camera";
+    if (!c.isObject()) return problem(where, "expected an object");
+    Scene& s = out_.scene;
+    std::string type = string(c, "type", "pinhole");
+    if (type != "pinhole") warn(cat("camera type '", type, "' is rendered as a pinhole camera"));
+    if (const Value* r = c.find("resolution")) {
+      Vec2 res;
+      if (!json::toVec2(*r, &res) || res.x < 1 || res.y < 1 || res.x > 16384 || res.y > 16384)
+        return problem(where, "resolution: expected one or two whole numbers within 1..16384");
+      s.settings.width = static_cast<int>(res.x);
+      s.settings.height = static_cast<int>(res.y);
+    } else {
+      s.settings.width = 1000;
+      s.settings.height = 563;
+    }
+    float fov = 60;
+    number(c, "fov", &fov, where);
+    if (!(fov > 0 && fov < 180)) return problem(where, "fov must be between 0 and 180 degrees");
+    // Tungsten's fov is horizontal; ours is vertical at the scene's aspect ratio.
+    s.camera.verticalFov = 2.0f * std::atan(std::tan(radians(fov) * 0.5f) / s.aspect());
+    const Value* t = c.find("transform");
+    if (t && t->isObject() && t->find("look_at")) {
+      Vec3 pos{0.0f}, at{0, 0, 1}, up{0, 1, 0};
+      vec3(*t, "position", &pos, where);
+      vec3(*t, "look_at", &at, where);
+      vec3(*t, "up", &up, where);
+      if (length(at - pos) == 0) return problem(where, "position and look_at coincide");
+      s.camera.position = pos;
+      s.camera.target = at;
+      s.camera.up = length(up) > 0 ? up : Vec3{0, 1, 0};
+    } else if (t) {
+      Mat4 m = transform(t, where);
+      s.camera.position = m.transformPoint({0, 0, 0});
+      s.camera.target = s.camera.position + normalize(m.transformVector({0, 0, 1}));
+      s.camera.up = normalize(m.transformVector({0, 1, 0}));
+    }
+  }
+
+  std::shared_ptr<const MeshGeometry> shape(const std::string& kind) {
+    auto it = shapes_.find(kind);
+    if (it != shapes_.end()) return it->second;
+    std::shared_ptr<const MeshGeometry> g;
+    if (kind == "quad") g = makeQuad();
+    else if (kind == "cube") g = makeCube();
+    else if (kind == "sphere") g = makeSphere();
+    else if (kind == "disk") g = makeLathe({{1.0f, 0.0f}, {0.0f, 0.0f}}, 64);
+    shapes_[kind] = g;
+    return g;
+  }
+
+  NodeId meshNode(const std::string& key, const std::string& name, std::shared_ptr<const MeshGeometry> g) {
+    if (auto it = meshIds_.find(key); it != meshIds_.end()) return it->second;
+    Mesh m;
+    m.id = out_.scene.newId();
+    m.name = name;
+    m.geometry = std::move(g);
+    out_.scene.meshes.push_back(m);
+    meshIds_[key] = m.id;
+    return m.id;
+  }
+
+  static void smoothNormals(MeshGeometry& g) {
+    g.normals.assign(g.positions.size(), Vec3{0.0f});
+    for (std::size_t i = 0; i + 2 < g.indices.size(); i += 3) {
+      Vec3 a = g.positions[g.indices[i]], b = g.positions[g.indices[i + 1]], c = g.positions[g.indices[i + 2]];
+      Vec3 n = cross(b - a, c - a);  // area-weighted
+      for (int k = 0; k < 3; ++k) g.normals[g.indices[i + static_cast<std::size_t>(k)]] += n;
+    }
+    for (Vec3& n : g.normals) n = normalize(n);
+  }
+
+  NodeId loadMesh(const Value& p, const std::string& where) {
+    std::string f = string(p, "file");
+    if (f.empty()) {
+      problem(where, "mesh without a \"file\"");
+      return kNoNode;
+    }
+    bool smooth = false, recompute = false;
+    if (const Value* v = p.find("smooth"); v && v->isBool()) smooth = v->asBool();
+    if (const Value* v = p.find("recompute_normals"); v && v->isBool()) recompute = v->asBool();
+    std::string key = cat(f, "|", smooth, recompute);
+    if (auto it = meshIds_.find(key); it != meshIds_.end()) return it->second;
+    auto path = resolveScenePath(base_, f);
+    if (!path) {
+      warn(cat(where, ": mesh file '", f, "' not found; the primitive is skipped"));
+      return kNoNode;
+    }
+    std::vector<std::string> warnings;
+    Result<MeshGeometry> g = Result<MeshGeometry>::failure("");
+    std::string ext = extensionLower(*path);
+    if (ext == "obj") g = readObjGeometry(*path, &warnings, options_);
+    else if (ext == "wo3") g = readWo3(*path);
+    else g = Result<MeshGeometry>::failure(cat(path->string(), ": unsupported mesh format '.", ext, "' (obj or wo3)"));
+    for (auto& w : warnings) out_.warnings.push_back(w);
+    if (!g) {
+      warn(cat(where, ": ", g.error(), "; the primitive is skipped"));
+      return kNoNode;
+    }
+    MeshGeometry geom = std::move(g.value());
+    if (!smooth) geom.normals.clear();  // flat shading
+    else if (recompute || geom.normals.empty()) smoothNormals(geom);
+    return meshNode(key, fs::path(f).stem().string(), std::make_shared<MeshGeometry>(std::move(geom)));
+  }
+
+  // Tungsten's binary mesh: uint64 vertex count, {pos, normal, uv} per vertex, uint64 triangle
+  // count, {3 x uint32, int32 material} per triangle.
+  Result<MeshGeometry> readWo3(const fs::path& path) {
+    using R = Result<MeshGeometry>;
+    auto data = readFile(path, options_.maxFileBytes);
+    if (!data) return R::failure(data.error());
+    const std::string& d = data.value();
+    std::size_t pos = 0;
+    auto u64 = [&](std::uint64_t* v) {
+      if (pos + 8 > d.size()) return false;
+      std::memcpy(v, d.data() + pos, 8);
+      pos += 8;
+      return true;
+    };
+    std::uint64_t nv = 0, nt = 0;
+    if (!u64(&nv) || nv > (d.size() - pos) / 32) return R::failure(cat(path.string(), ": truncated or corrupt (vertex count)"));
+    MeshGeometry g;
+    g.positions.resize(nv);
+    g.normals.resize(nv);
+    g.uvs.resize(nv);
+    for (std::uint64_t i = 0; i < nv; ++i) {
+      float f[8];
+      std::memcpy(f, d.data() + pos, 32);
+      pos += 32;
+      g.positions[i] = {f[0], f[1], f[2]};
+      g.normals[i] = {f[3], f[4], f[5]};
+      g.uvs[i] = {f[6], f[7]};
+    }
+    if (!u64(&nt) || nt > (d.size() - pos) / 16) return R::failure(cat(path.string(), ": truncated or corrupt (triangle count)"));
+    if (nt > options_.maxTriangles) return R::failure(cat(path.string(), ": more than ", options_.maxTriangles, " triangles"));
+    g.indices.resize(nt * 3);
+    for (std::uint64_t i = 0; i < nt; ++i) {
+      std::uint32_t t[4];
+      std::memcpy(t, d.data() + pos, 16);
+      pos += 16;
+      g.indices[i * 3] = t[0];
+      g.indices[i * 3 + 1] = t[1];
+      g.indices[i * 3 + 2] = t[2];
+    }
+    std::size_t dropped = sanitizeGeometry(g);
+    if (dropped) warn(cat(path.filename().string(), ": dropped ", dropped, " invalid triangles"));
+    if (g.indices.empty()) return R::failure(cat(path.string(), ": contains no triangles"));
+    return g;
+  }
+
+  float worldArea(const MeshGeometry& g, const Mat4& m) {
+    double a = 0;
+    for (std::size_t i = 0; i + 2 < g.indices.size(); i += 3) {
+      Vec3 p0 = m.transformPoint(g.positions[g.indices[i]]);
+      Vec3 p1 = m.transformPoint(g.positions[g.indices[i + 1]]);
+      Vec3 p2 = m.transformPoint(g.positions[g.indices[i + 2]]);
+      a += 0.5 * length(cross(p1 - p0, p2 - p0));
+    }
+    return static_cast<float>(a);
+  }
+
+  void environmentFromEmission(const Value& p, const std::string& where, Vec3 rotationDeg) {
+    Environment& e = out_.scene.environment;
+    e.intensity = 1;
+    e.rotation = radians(-rotationDeg.y);
+    if (std::abs(rotationDeg.x) > 1e-3f || std::abs(rotationDeg.z) > 1e-3f)
+      warn(cat(where, ": only rotation about y is applied to the environment"));
+    const Value* em = p.find("emission");
+    if (!em) em = p.find("radiance");
+    float powerScale = 1;
+    if (!em) {
+      em = p.find("power");
+      powerScale = 1 / (4 * kPi);
+    }
+    if (!em) {
+      e.type = EnvironmentType::Constant;
+      e.color = Vec3{1.0f};
+      return;
+    }
+    TextureRef t = texture(*em, where + ".emission", false);
+    if (t.isTexture) {
+      e.type = EnvironmentType::Map;
+      e.map = t.texture;
+      e.color = t.constant * powerScale;
+      const Texture* tex = out_.scene.texture(t.texture);
+      if (tex && tex->kind == TextureKind::File && !resolveScenePath(base_, tex->path.string()))
+        warn(cat("environment map '", tex->path.string(), "' is missing: the scene is lit by a constant sky of radiance ",
+                 luminance(e.color), " instead"));
+    } else {
+      e.type = EnvironmentType::Constant;
+      e.color = t.constant * powerScale;
+    }
+  }
+
+  void environmentEntry(const Value& v, const std::string& where) {
+    if (!v.isObject()) return;
+    std::string type = string(v, "type");
+    if (type == "envmap" || type == "infinite_sphere" || type == "constant") {
+      Vec3 rot{0.0f};
+      if (const Value* t = v.find("transform"); t && t->isObject()) vec3(*t, "rotation", &rot, where);
+      environmentFromEmission(v, where, rot);
+    } else {
+      warn(cat(where, ": emitter type '", type, "' is not supported; skipped"));
+    }
+  }
+
+  void primitive(const Value& p, const std::string& where) {
+    if (!p.isObject()) return problem(where, "expected an object");
+    std::string type = string(p, "type");
+    if (type.empty()) return problem(where, "primitive without a \"type\"");
+    Scene& s = out_.scene;
+    Vec3 scale;
+    const Value* tv = p.find("transform");
+
+    if (type == "infinite_sphere") {
+      Vec3 rot{0.0f};
+      if (tv && tv->isObject()) vec3(*tv, "rotation", &rot, where);
+      environmentFromEmission(p, where, rot);
+      return;
+    }
+    if (type == "skydome") {
+      float intensity = 2;
+      number(p, "intensity", &intensity, where);
+      s.environment.type = EnvironmentType::Sky;
+      s.environment.intensity = intensity * 0.5f;
+      warn(cat(where, ": the physical skydome is approximated by a gradient sky"));
+      return;
+    }
+    if (type == "infinite_sphere_cap") {
+      // A small bright cap is a sun: a directional light carrying the cap's irradiance.
+      Mat4 m = transform(tv, where);
+      float cap = 10;
+      number(p, "cap_angle", &cap, where);
+      Vec3 radiance{1.0f};
+      if (const Value* e = p.find("emission")) radiance = texture(*e, where, false).constant;
+      Light l;
+      l.id = s.newId();
+      l.name = string(p, "name", "sun");
+      l.type = LightType::Directional;
+      l.direction = -normalize(m.transformVector({0, 1, 0}));
+      float solidAngle = 2 * kPi * (1 - std::cos(radians(cap)));
+      float power = maxComponent(radiance) * solidAngle;
+      l.color = power > 0 ? radiance / maxComponent(radiance) : Vec3{1.0f};
+      l.intensity = power;
+      s.lights.push_back(l);
+      return;
+    }
+
+    NodeId mesh = kNoNode;
+    Mat4 xf = transform(tv, where, &scale, type == "quad" || type == "disk");
+    if (!ok()) return;
+    if (type == "mesh") {
+      mesh = loadMesh(p, where);
+    } else if (type == "quad" || type == "cube" || type == "disk") {
+      mesh = meshNode(type, type, shape(type));
+    } else if (type == "sphere") {
+      // Tungsten's sphere radius is the largest scale; the shape stays round.
+      float r = std::max({std::abs(scale.x), std::abs(scale.y), std::abs(scale.z)});
+      Vec3 safe{scale.x != 0 ? r / scale.x : 0, scale.y != 0 ? r / scale.y : 0, scale.z != 0 ? r / scale.z : 0};
+      xf = xf * Mat4::scale(safe);
+      mesh = meshNode(type, type, shape(type));
+    } else {
+      warn(cat(where, ": primitive type '", type, "' is not supported; skipped"));
+      return;
+    }
+    if (!ok() || mesh == kNoNode) return;
+
+    Material mat;
+    mat.albedo = Vec3{1.0f};
+    if (const Value* b = p.find("bsdf")) {
+      // An array names one bsdf per material index; OBJ meshes carry index 0.
+      const Value& first = b->isArray() && !b->asArray().empty() ? b->asArray()[0] : *b;
+      mat = bsdf(first, where + ".bsdf");
+      if (!ok()) return;
+    }
+    Vec3 emission{0.0f};
+    bool emissive = false;
+    if (const Value* e = p.find("emission")) {
+      TextureRef t = texture(*e, where + ".emission", false);
+      if (t.isTexture) warn(cat(where, ": textured emission is rendered as its constant factor"));
+      emission = t.constant;
+      emissive = true;
+    }
+    if (const Value* pw = p.find("power")) {
+      TextureRef t = texture(*pw, where + ".power", false);
+      const Mesh* mm = s.mesh(mesh);
+      float area = mm && mm->geometry ? worldArea(*mm->geometry, xf) : 0.0f;
+      emission = area > 0 ? t.constant / (kPi * area) : Vec3{0.0f};
+      emissive = true;
+    }
+    NodeId materialId = kNoNode;
+    if (emissive) {
+      // Emission belongs to the primitive in Tungsten and to the material here: give each
+      // emitter its own copy of its bsdf.
+      Material m = mat;
+      m.id = s.newId();
+      m.name = cat(mat.name.empty() ? std::string("emitter") : mat.name, " (", string(p, "name", cat("light ", ++emitters_)), ")");
+      m.emission = max(emission, Vec3{0.0f});
+      s.materials.push_back(m);
+      materialId = m.id;
+    } else if (!mat.name.empty() && named_.count(mat.name) && p.find("bsdf")->isString()) {
+      materialId = named_[mat.name].id;
+    } else {
+      Material m = mat;
+      m.id = s.newId();
+      if (m.name.empty()) m.name = cat(where, " material");
+      s.materials.push_back(m);
+      materialId = m.id;
+    }
+
+    Object o;
+    o.id = s.newId();
+    const Mesh* mm = s.mesh(mesh);
+    o.name = string(p, "name", mm ? mm->name : type);
+    o.mesh = mesh;
+    o.material = materialId;
+    o.transform = xf;
+    if (!xf.isFinite() || xf.inverse().m[3][3] == 0.0f) {
+      warn(cat(where, ": transform is degenerate; the primitive is skipped"));
+      return;
+    }
+    s.objects.push_back(o);
+  }
+
+  fs::path file_;
+  fs::path base_;
+  ImportOptions options_;
+  ImportedScene out_;
+  std::string error_;
+  std::map<std::string, Material> named_;
+  std::map<std::string, NodeId> textures_;
+  std::map<std::string, NodeId> meshIds_;
+  std::map<std::string, std::shared_ptr<const MeshGeometry>> shapes_;
+  int emitters_ = 0;
+};
+
+}  // namespace
+
+Result<ImportedScene> importTungsten(const fs::path& file, const ImportOptions& options) {
+  return TungstenImporter(file, options).run();
+}
+
+}  // namespace retile

@@ -1,0 +1,60 @@
+// Bounding volume hierarchies on the CPU, packed for the GPU. Pure computation: no Vulkan, any
+// thread, testable without a device.
+//
+// GPU node layout (four RGBA32F texels, 64 bytes): each node stores the boxes of both children,
+// so one fetch decides which children a ray enters and in which order.
+//   texel 0: left.min.xyz,  left index        texel 2: right.min.xyz, right index
+//   texel 1: left.max.xyz,  left count        texel 3: right.max.xyz, right count
+// count > 0: a leaf of `count` primitives starting at `index` (in the packed primitive order);
+// count == 0: an inner node at `index`; count < 0: an empty slot (its box never hits).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "retile/math.h"
+
+namespace retile {
+
+struct GpuBvhNode {
+  float lmin[3];
+  std::int32_t left;
+  float lmax[3];
+  std::int32_t leftCount;
+  float rmin[3];
+  std::int32_t right;
+  float rmax[3];
+  std::int32_t rightCount;
+};
+static_assert(sizeof(GpuBvhNode) == 64);
+
+struct BvhBuildOptions {
+  int maxLeafSize = 4;     // leaves never hold more (forced splits beyond it)
+  int bins = 16;           // SAH bins per axis
+  float traversalCost = 1.0f;
+  float intersectionCost = 1.0f;
+};
+
+struct Bvh {
+  std::vector<GpuBvhNode> nodes;        // nodes[0] is the root
+  std::vector<std::uint32_t> primOrder; // packed primitive i is input primitive primOrder[i]
+  Bounds3 bounds;
+  int depth = 0;
+};
+
+// Builds with binned SAH over the given primitive boxes. An empty input yields a single root
+// with two empty slots, so traversal code needs no special case.
+Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options = {});
+
+// Reference traversal of a packed triangle BVH, mirroring the shader, for tests.
+struct RayHit {
+  float t = 0;
+  float u = 0, v = 0;
+  std::int32_t prim = -1;  // packed primitive index
+};
+// triangles: three vertices per packed primitive, in packed order.
+RayHit traverseClosest(const Bvh& bvh, std::span<const Vec3> triangles, Vec3 origin, Vec3 direction, float tMax);
+bool intersectTriangle(Vec3 o, Vec3 d, Vec3 v0, Vec3 v1, Vec3 v2, float tMax, float* t, float* u, float* v);
+
+}  // namespace retile

@@ -1,0 +1,562 @@
+#include "render/render_scene.h"
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <numeric>
+
+#include "core/files.h"
+#include "io/image_io.h"
+#include "retile/log.h"
+
+namespace retile {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+vec4 v4(Vec3 v, float w) { return {v.x, v.y, v.z, w}; }
+float bitsOf(std::int32_t i) { return std::bit_cast<float>(i); }
+vec4 ints(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d) {
+  return {bitsOf(a), bitsOf(b), bitsOf(c), bitsOf(d)};
+}
+
+// Vose's alias method: O(1) sampling of an emitter proportional to its power.
+std::vector<vec4> aliasTable(const std::vector<float>& weights) {
+  std::size_t n = weights.size();
+  std::vector<vec4> table(n, vec4{1, 0, 0, 0});
+  double total = std::accumulate(weights.begin(), weights.end(), 0.0);
+  if (n == 0 || total <= 0) return table;
+  std::vector<double> scaled(n);
+  std::vector<std::uint32_t> small, large;
+  for (std::size_t i = 0; i < n; ++i) {
+    scaled[i] = weights[i] * static_cast<double>(n) / total;
+    (scaled[i] < 1.0 ? small : large).push_back(static_cast<std::uint32_t>(i));
+  }
+  while (!small.empty() && !large.empty()) {
+    std::uint32_t s = small.back(), l = large.back();
+    small.pop_back();
+    table[s] = {static_cast<float>(scaled[s]), bitsOf(static_cast<std::int32_t>(l)), 0, 0};
+    scaled[l] = (scaled[l] + scaled[s]) - 1.0;
+    if (scaled[l] < 1.0) {
+      large.pop_back();
+      small.push_back(l);
+    }
+  }
+  for (std::uint32_t i : large) table[i] = {1.0f, bitsOf(static_cast<std::int32_t>(i)), 0, 0};
+  for (std::uint32_t i : small) table[i] = {1.0f, bitsOf(static_cast<std::int32_t>(i)), 0, 0};
+  return table;
+}
+
+std::string textureSignature(const Texture& t, const std::filesystem::path& base) {
+  switch (t.kind) {
+    case TextureKind::File: return cat("file|", (t.path.is_absolute() ? t.path : base / t.path).string(), "|", static_cast<int>(t.colorSpace));
+    case TextureKind::Embedded:
+      return cat("emb|", t.encoded.size(), "|", fnv1a64(std::string_view(reinterpret_cast<const char*>(t.encoded.data()), t.encoded.size())), "|", static_cast<int>(t.colorSpace));
+    case TextureKind::Checker: return "checker";  // analytic: nothing decoded to cache
+  }
+  return {};
+}
+
+// The sky gradient as an equirectangular image: zenith to horizon above, ground below, with a
+// soft horizon so importance sampling sees a smooth function.
+LinearImage bakeSky(const Environment& e) {
+  LinearImage img;
+  img.width = 128;
+  img.height = 64;
+  img.rgba.resize(static_cast<std::size_t>(img.width * img.height * 4));
+  for (int y = 0; y < img.height; ++y) {
+    float theta = kPi * (static_cast<float>(y) + 0.5f) / static_cast<float>(img.height);
+    float up = std::cos(theta);
+    Vec3 c;
+    if (up >= 0) {
+      float t = std::pow(up, 0.5f);
+      c = e.horizon * (1 - t) + e.zenith * t;
+    } else {
+      float t = std::min(1.0f, -up * 8.0f);
+      c = e.horizon * (1 - t) + e.ground * t;
+    }
+    for (int x = 0; x < img.width; ++x) {
+      float* p = &img.rgba[static_cast<std::size_t>((y * img.width + x) * 4)];
+      p[0] = c.x;
+      p[1] = c.y;
+      p[2] = c.z;
+      p[3] = 1;
+    }
+  }
+  return img;
+}
+
+}  // namespace
+
+std::uint16_t floatToHalf(float f) {
+  std::uint32_t x = std::bit_cast<std::uint32_t>(f);
+  std::uint32_t sign = (x >> 16) & 0x8000u;
+  std::uint32_t mant = x & 0x7fffffu;
+  int exp = static_cast<int>((x >> 23) & 0xff);
+  if (exp == 255) return static_cast<std::uint16_t>(sign | 0x7c00u | (mant ? 0x200u : 0));  // inf/nan
+  int e = exp - 127 + 15;
+  if (e >= 31) return static_cast<std::uint16_t>(sign | 0x7c00u);  // overflow to inf
+  if (e <= 0) {
+    if (e < -10) return static_cast<std::uint16_t>(sign);
+    mant |= 0x800000u;
+    int shift = 14 - e;
+    std::uint32_t half = mant >> shift;
+    std::uint32_t rem = mant & ((1u << shift) - 1);
+    std::uint32_t mid = 1u << (shift - 1);
+    if (rem > mid || (rem == mid && (half & 1))) ++half;
+    return static_cast<std::uint16_t>(sign | half);
+  }
+  std::uint32_t half = sign | (static_cast<std::uint32_t>(e) << 10) | (mant >> 13);
+  std::uint32_t rem = mant & 0x1fffu;
+  if (rem > 0x1000u || (rem == 0x1000u && (half & 1))) ++half;  // may carry into the exponent: correct
+  return static_cast<std::uint16_t>(half);
+}
+
+float halfToFloat(std::uint16_t h) {
+  std::uint32_t sign = (h & 0x8000u) << 16;
+  std::uint32_t exp = (h >> 10) & 0x1f;
+  std::uint32_t mant = h & 0x3ffu;
+  std::uint32_t bits;
+  if (exp == 0) {
+    if (mant == 0) {
+      bits = sign;
+    } else {
+      int e = -1;
+      do {
+        mant <<= 1;
+        ++e;
+      } while (!(mant & 0x400u));
+      bits = sign | (static_cast<std::uint32_t>(127 - 15 - e) << 23) | ((mant & 0x3ffu) << 13);
+    }
+  } else if (exp == 31) {
+    bits = sign | 0x7f800000u | (mant << 13);
+  } else {
+    bits = sign | ((exp + 127 - 15) << 23) | (mant << 13);
+  }
+  return std::bit_cast<float>(bits);
+}
+
+std::uint64_t RenderSceneData::deviceBytes() const {
+  auto v = [](const auto& x) { return static_cast<std::uint64_t>(x.size() * sizeof(x[0])); };
+  return v(blasNodes) + v(tlasNodes) + v(triangles) + v(triangleShading) + v(instances) + v(materials) +
+         v(textureInfo) + v(texels) + v(emitters) + v(emitterAlias) + v(deltaLights) + v(environmentCdf);
+}
+
+int RenderSceneBuilder::textureIndex(NodeId id) const {
+  auto it = textureIndex_.find(id);
+  return it == textureIndex_.end() ? -1 : it->second;
+}
+
+int RenderSceneBuilder::materialIndex(NodeId id) const {
+  auto it = materialIndex_.find(id);
+  return it == materialIndex_.end() ? defaultMaterial_ : it->second;
+}
+
+std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags, std::vector<std::string>* warnings) {
+  if (first_) flags = kUpdateAll;
+  first_ = false;
+  timing_ = {};
+  std::uint32_t dirty = 0;
+  if (flags & kUpdateTextures || flags & kUpdateEnvironment) {
+    auto t = Clock::now();
+    packTextures(scene, warnings);
+    packEnvironment(scene, warnings);
+    timing_.textures = secondsSince(t);
+    dirty |= kDirtyTextures | kDirtyEnvironment;
+    flags |= kUpdateMaterials;  // texture indices may have moved
+  }
+  if (flags & kUpdateGeometry) {
+    auto t = Clock::now();
+    packGeometry(scene);
+    timing_.blas = secondsSince(t);
+    dirty |= kDirtyGeometry;
+    flags |= kUpdateInstances;
+  }
+  if (flags & kUpdateMaterials) {
+    packMaterials(scene);
+    dirty |= kDirtyMaterials;
+    flags |= kUpdateInstances;  // instance flags depend on material type and alpha
+  }
+  if (flags & (kUpdateInstances | kUpdateLights)) {
+    auto t = Clock::now();
+    packInstances(scene);
+    timing_.tlas = secondsSince(t);
+    t = Clock::now();
+    packEmitters(scene);
+    timing_.emitters = secondsSince(t);
+    dirty |= kDirtyInstances | kDirtyEmitters;
+  }
+  if (dirty & (kDirtyEmitters | kDirtyEnvironment | kDirtyInstances)) choosePickProbabilities(scene);
+  return dirty;
+}
+
+void RenderSceneBuilder::packGeometry(const Scene& scene) {
+  for (auto& [key, e] : meshes_) e.used = false;
+  meshOf_.clear();
+  for (const Mesh& m : scene.meshes) {
+    if (!m.geometry || m.geometry->indices.empty()) continue;
+    auto [it, inserted] = meshes_.try_emplace(m.geometry.get());
+    MeshEntry& e = it->second;
+    e.used = true;
+    meshOf_[m.id] = &e;
+    if (!inserted) continue;
+    e.geometry = m.geometry;
+    const MeshGeometry& g = *m.geometry;
+    std::size_t n = g.triangleCount();
+    std::vector<Bounds3> boxes(n);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int k = 0; k < 3; ++k) boxes[i].grow(g.positions[g.indices[i * 3 + static_cast<std::size_t>(k)]]);
+    e.bvh = buildBvh(boxes);
+    e.triangles.resize(n * gpu::kTriTexels);
+    e.shading.resize(n * gpu::kTriShadeTexels);
+    bool hasN = !g.normals.empty(), hasUv = !g.uvs.empty();
+    for (std::size_t p = 0; p < n; ++p) {
+      std::size_t src = e.bvh.primOrder[p];
+      std::uint32_t i0 = g.indices[src * 3], i1 = g.indices[src * 3 + 1], i2 = g.indices[src * 3 + 2];
+      Vec3 v0 = g.positions[i0], v1 = g.positions[i1], v2 = g.positions[i2];
+      e.triangles[p * 3 + 0] = v4(v0, 0);
+      e.triangles[p * 3 + 1] = v4(v1 - v0, 0);
+      e.triangles[p * 3 + 2] = v4(v2 - v0, 0);
+      Vec3 n0 = hasN ? g.normals[i0] : Vec3{}, n1 = hasN ? g.normals[i1] : Vec3{}, n2 = hasN ? g.normals[i2] : Vec3{};
+      Vec2 t0 = hasUv ? g.uvs[i0] : Vec2{}, t1 = hasUv ? g.uvs[i1] : Vec2{}, t2 = hasUv ? g.uvs[i2] : Vec2{};
+      // Zero normals (from NaN in the file) fall back to the geometric normal in the shader.
+      bool useN = hasN && dot(n0, n0) > 0 && dot(n1, n1) > 0 && dot(n2, n2) > 0;
+      e.shading[p * 4 + 0] = v4(n0, t0.x);
+      e.shading[p * 4 + 1] = v4(n1, t0.y);
+      e.shading[p * 4 + 2] = v4(n2, t1.x);
+      e.shading[p * 4 + 3] = {t1.y, t2.x, t2.y, useN ? 1.0f : 0.0f};
+    }
+  }
+  std::erase_if(meshes_, [](const auto& kv) { return !kv.second.used; });
+
+  data_.blasNodes.clear();
+  data_.triangles.clear();
+  data_.triangleShading.clear();
+  data_.triangleCount = 0;
+  for (auto& [key, e] : meshes_) {
+    e.nodeOffset = static_cast<std::uint32_t>(data_.blasNodes.size());
+    e.triOffset = static_cast<std::uint32_t>(data_.triangles.size() / gpu::kTriTexels);
+    for (GpuBvhNode n : e.bvh.nodes) {
+      auto fix = [&](std::int32_t& idx, std::int32_t count) {
+        if (count == 0) idx += static_cast<std::int32_t>(e.nodeOffset);
+        else if (count > 0) idx += static_cast<std::int32_t>(e.triOffset);
+      };
+      fix(n.left, n.leftCount);
+      fix(n.right, n.rightCount);
+      data_.blasNodes.push_back(n);
+    }
+    data_.triangles.insert(data_.triangles.end(), e.triangles.begin(), e.triangles.end());
+    data_.triangleShading.insert(data_.triangleShading.end(), e.shading.begin(), e.shading.end());
+    data_.triangleCount += e.bvh.primOrder.size();
+  }
+}
+
+void RenderSceneBuilder::packMaterials(const Scene& scene) {
+  data_.materials.clear();
+  materialIndex_.clear();
+  auto pack = [&](const Material& m) {
+    Vec3 eta = m.eta, k = m.k;
+    if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
+    int type = static_cast<int>(m.type);
+    // Keep roughness away from zero, where GGX turns into a delta the rough code cannot sample.
+    float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
+    if (m.type == MaterialType::RoughPlastic || m.type == MaterialType::RoughConductor ||
+        m.type == MaterialType::RoughDielectric)
+      roughness = std::max(roughness, 1e-3f);
+    if (m.type == MaterialType::OrenNayar) roughness = std::clamp(m.roughness, 0.0f, kPi / 2);
+    data_.materials.push_back(v4(max(m.albedo, Vec3{0.0f}), bitsOf(type)));
+    float ior = std::clamp(m.ior, 1.0001f, 10.0f);
+    // Diffuse light inside a plastic coating reflects back this fraction at the boundary
+    // (Jensen et al.'s polynomial fit of the internal diffuse Fresnel reflectance).
+    float fdrInt = -1.4399f / (ior * ior) + 0.7099f / ior + 0.6681f + 0.0636f * ior;
+    data_.materials.push_back({roughness, ior, std::clamp(m.alpha, 0.0f, 1.0f), std::clamp(fdrInt, 0.0f, 1.0f)});
+    data_.materials.push_back(v4(eta, bitsOf(textureIndex(m.albedoTexture))));
+    data_.materials.push_back(v4(k, bitsOf(textureIndex(m.roughnessTexture))));
+    data_.materials.push_back(v4(max(m.emission, Vec3{0.0f}), bitsOf(textureIndex(m.alphaTexture))));
+  };
+  for (const Material& m : scene.materials) {
+    materialIndex_[m.id] = static_cast<int>(data_.materials.size() / gpu::kMaterialTexels);
+    pack(m);
+  }
+  defaultMaterial_ = static_cast<int>(data_.materials.size() / gpu::kMaterialTexels);
+  Material fallback;
+  fallback.albedo = Vec3{0.6f};
+  pack(fallback);
+}
+
+void RenderSceneBuilder::packInstances(const Scene& scene) {
+  struct Candidate {
+    const Object* object;
+    const MeshEntry* mesh;
+    Bounds3 bounds;
+  };
+  std::vector<Candidate> cands;
+  for (const Object& o : scene.objects) {
+    if (!o.visible) continue;
+    auto it = meshOf_.find(o.mesh);
+    if (it == meshOf_.end()) continue;
+    Bounds3 b = transformBounds(o.transform, it->second->bvh.bounds);
+    if (b.empty()) continue;
+    cands.push_back({&o, it->second, b});
+  }
+  std::vector<Bounds3> boxes;
+  boxes.reserve(cands.size());
+  for (const auto& c : cands) boxes.push_back(c.bounds);
+  BvhBuildOptions opt;
+  opt.maxLeafSize = 1;  // a TLAS leaf is one instance: traversal enters its BVH directly
+  Bvh tlas = buildBvh(boxes, opt);
+  auto offset = static_cast<std::int32_t>(data_.blasNodes.size());
+  data_.tlasNodes = tlas.nodes;
+  for (GpuBvhNode& n : data_.tlasNodes) {
+    if (n.leftCount == 0) n.left += offset;
+    if (n.rightCount == 0) n.right += offset;
+  }
+  data_.instances.clear();
+  data_.instanceObject.clear();
+  data_.bounds = tlas.bounds;
+  data_.instancedTriangles = 0;
+  for (std::uint32_t p : tlas.primOrder) {
+    const Candidate& c = cands[p];
+    const Material* mat = scene.material(c.object->material);
+    int flags = 0;
+    if (mat && (mat->alpha < 1.0f || textureIndex(mat->alphaTexture) >= 0)) flags |= gpu::kInstanceAlphaTested;
+    if (mat && mat->emissive()) flags |= gpu::kInstanceEmissive;
+    Mat4 inv = c.object->transform.inverse();
+    for (int r = 0; r < 3; ++r) data_.instances.push_back({inv.m[r][0], inv.m[r][1], inv.m[r][2], inv.m[r][3]});
+    data_.instances.push_back(ints(static_cast<std::int32_t>(c.mesh->nodeOffset), static_cast<std::int32_t>(c.mesh->triOffset),
+                                   materialIndex(c.object->material), -1));
+    data_.instances.push_back(ints(static_cast<std::int32_t>(data_.instanceObject.size() + 1), flags, 0, 0));
+    data_.instanceObject.push_back(c.object->id);
+    data_.instancedTriangles += c.mesh->bvh.primOrder.size();
+  }
+}
+
+void RenderSceneBuilder::packEmitters(const Scene& scene) {
+  data_.emitters.clear();
+  std::vector<float> power;
+  std::size_t count = data_.instanceObject.size();
+  for (std::size_t i = 0; i < count; ++i) {
+    const Object* o = scene.object(data_.instanceObject[i]);
+    const Material* mat = o ? scene.material(o->material) : nullptr;
+    if (!mat || !mat->emissive()) continue;
+    const MeshEntry* mesh = meshOf_.at(o->mesh);
+    Mat4 normalMatrix = o->transform.inverse().transposed();
+    auto first = static_cast<std::int32_t>(data_.emitters.size() / gpu::kEmitterTexels);
+    data_.instances[i * gpu::kInstanceTexels + 3].w = bitsOf(first);
+    float radianceLum = std::max(luminance(mat->emission), 1e-6f);
+    std::size_t n = mesh->bvh.primOrder.size();
+    for (std::size_t p = 0; p < n; ++p) {
+      Vec3 v0{mesh->triangles[p * 3].x, mesh->triangles[p * 3].y, mesh->triangles[p * 3].z};
+      Vec3 e1{mesh->triangles[p * 3 + 1].x, mesh->triangles[p * 3 + 1].y, mesh->triangles[p * 3 + 1].z};
+      Vec3 e2{mesh->triangles[p * 3 + 2].x, mesh->triangles[p * 3 + 2].y, mesh->triangles[p * 3 + 2].z};
+      Vec3 w0 = o->transform.transformPoint(v0);
+      Vec3 w1 = o->transform.transformPoint(v0 + e1);
+      Vec3 w2 = o->transform.transformPoint(v0 + e2);
+      Vec3 c = cross(w1 - w0, w2 - w0);
+      float area = 0.5f * length(c);
+      // The front side is the object-space winding normal carried by the normal matrix, so a
+      // mirrored transform does not turn a light around.
+      Vec3 nrm = normalize(normalMatrix.transformVector(cross(e1, e2)));
+      data_.emitters.push_back(v4(w0, area));
+      data_.emitters.push_back(v4(w1 - w0, bitsOf(static_cast<std::int32_t>(i))));
+      data_.emitters.push_back(v4(w2 - w0, 0));
+      data_.emitters.push_back(v4(mat->emission, 0));
+      data_.emitters.push_back(v4(nrm, 0));
+      power.push_back(area > 0 && std::isfinite(area) ? area * kPi * radianceLum : 0.0f);
+    }
+  }
+  double total = std::accumulate(power.begin(), power.end(), 0.0);
+  for (std::size_t i = 0; i < power.size(); ++i)
+    data_.emitters[i * gpu::kEmitterTexels + 3].w = total > 0 ? static_cast<float>(power[i] / total) : 0.0f;
+  data_.emitterAlias = aliasTable(power);
+  emitterPower_ = static_cast<float>(total);
+
+  data_.deltaLights.clear();
+  deltaPower_ = 0;
+  Bounds3 b = data_.bounds;
+  float radius = b.empty() ? 1.0f : 0.5f * length(b.extent());
+  for (const Light& l : scene.lights) {
+    if (!l.visible || l.intensity <= 0 || maxComponent(l.color) <= 0) continue;
+    Vec3 intensity = l.color * l.intensity;
+    int type = l.type == LightType::Point ? gpu::kLightPoint : l.type == LightType::Spot ? gpu::kLightSpot : gpu::kLightDirectional;
+    float cosOuter = std::cos(std::clamp(l.spotAngle, 0.001f, kPi / 2));
+    float cosInner = std::cos(std::clamp(l.spotAngle * (1 - std::clamp(l.spotBlend, 0.0f, 1.0f)), 0.0f, kPi / 2));
+    data_.deltaLights.push_back(v4(l.position, bitsOf(type)));
+    data_.deltaLights.push_back(v4(normalize(l.direction), cosOuter));
+    data_.deltaLights.push_back(v4(intensity, cosInner));
+    data_.deltaLights.push_back({0, 0, 0, 0});
+    float lum = luminance(intensity);
+    if (type == gpu::kLightPoint) deltaPower_ += 4 * kPi * lum;
+    else if (type == gpu::kLightSpot) deltaPower_ += 2 * kPi * (1 - 0.5f * (cosInner + cosOuter)) * lum;
+    else deltaPower_ += kPi * radius * radius * lum;
+  }
+}
+
+void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::string>* warnings) {
+  auto& cache = decoded_;
+  data_.textureInfo.clear();
+  data_.texels.clear();
+  textureIndex_.clear();
+  auto appendBitmap = [&](const LinearImage& img, bool hasAlpha) {
+    auto offset = static_cast<std::int32_t>(data_.texels.size() / 4);
+    data_.textureInfo.push_back(ints(offset, img.width, img.height, gpu::kTexBitmap | (hasAlpha ? 16 : 0)));
+    data_.textureInfo.push_back({0, 0, 0, 0});
+    data_.textureInfo.push_back({0, 0, 0, 0});
+    data_.texels.reserve(data_.texels.size() + img.rgba.size());
+    for (float f : img.rgba) data_.texels.push_back(floatToHalf(std::isfinite(f) ? f : 0.0f));
+  };
+  auto appendChecker = [&](Vec3 on, Vec3 off, int ru, int rv) {
+    data_.textureInfo.push_back(ints(0, 0, 0, gpu::kTexChecker));
+    data_.textureInfo.push_back(v4(on, static_cast<float>(std::max(ru, 1))));
+    data_.textureInfo.push_back(v4(off, static_cast<float>(std::max(rv, 1))));
+  };
+  for (const Texture& t : scene.textures) {
+    int index = static_cast<int>(data_.textureInfo.size() / gpu::kTextureTexels);
+    if (t.kind == TextureKind::Checker) {
+      appendChecker(t.checkerOn, t.checkerOff, t.checkerResU, t.checkerResV);
+      textureIndex_[t.id] = index;
+      continue;
+    }
+    std::string sig = textureSignature(t, scene.baseDirectory);
+    Decoded& d = cache[t.id];
+    if (d.signature != sig) {
+      d.signature = sig;
+      auto img = loadTextureImage(t, scene.baseDirectory);
+      d.ok = img.ok();
+      if (img.ok()) {
+        d.image = std::move(img.value());
+      } else {
+        d.image = {};
+        if (warnings) warnings->push_back(cat(img.error(), "; shown as a magenta checker"));
+      }
+    }
+    if (d.ok) {
+      appendBitmap(d.image, d.image.hasAlpha);
+    } else {
+      // A visible substitute: nobody mistakes magenta and black squares for the real texture.
+      appendChecker({1, 0, 1}, {0.05f, 0.05f, 0.05f}, 8, 8);
+    }
+    textureIndex_[t.id] = index;
+  }
+  // Forget textures that left the scene.
+  std::erase_if(cache, [&](const auto& kv) { return !scene.texture(kv.first); });
+}
+
+void RenderSceneBuilder::packEnvironment(const Scene& scene, std::vector<std::string>* warnings) {
+  const Environment& e = scene.environment;
+  data_.environmentCdf.assign(1, 0.0f);
+  data_.environmentType = gpu::kEnvNone;
+  data_.environmentMap = -1;
+  data_.environmentWidth = data_.environmentHeight = 0;
+  data_.environmentRotation = e.rotation;
+  environmentPower_ = 0;
+  LinearImage map;
+  Vec3 tint = e.color * e.intensity;
+  if (e.type == EnvironmentType::Map) {
+    const Texture* t = scene.texture(e.map);
+    auto img = t ? loadTextureImage(*t, scene.baseDirectory) : Result<LinearImage>::failure("environment: no map texture set");
+    if (img.ok()) {
+      map = std::move(img.value());
+    } else {
+      if (warnings) warnings->push_back(cat(img.error(), "; lighting with a constant sky of radiance ", luminance(tint), " instead"));
+    }
+  } else if (e.type == EnvironmentType::Sky) {
+    map = bakeSky(e);
+    tint = Vec3{e.intensity};
+  }
+  if (map.width == 0) {
+    if (maxComponent(tint) > 0) {
+      data_.environmentType = gpu::kEnvConstant;
+      data_.environmentTint = tint;
+      environmentPower_ = kPi * luminance(tint);
+    }
+    return;
+  }
+  // The map joins the texture table so the shader reads it like any bitmap.
+  data_.environmentMap = static_cast<int>(data_.textureInfo.size() / gpu::kTextureTexels);
+  auto offset = static_cast<std::int32_t>(data_.texels.size() / 4);
+  data_.textureInfo.push_back(ints(offset, map.width, map.height, gpu::kTexBitmap));
+  data_.textureInfo.push_back({0, 0, 0, 0});
+  data_.textureInfo.push_back({0, 0, 0, 0});
+  for (float f : map.rgba) data_.texels.push_back(floatToHalf(std::isfinite(f) ? std::max(f, 0.0f) : 0.0f));
+  data_.environmentType = gpu::kEnvMap;
+  data_.environmentTint = tint;
+  data_.environmentWidth = map.width;
+  data_.environmentHeight = map.height;
+
+  // Piecewise-constant 2D distribution proportional to luminance * sin(theta) of the texel, so
+  // directions are drawn in proportion to the radiance they carry. Values are read back from the
+  // half-float texels so the shader's pdf uses exactly what it samples.
+  int w = map.width, h = map.height;
+  std::vector<float>& cdf = data_.environmentCdf;
+  cdf.assign(1 + static_cast<std::size_t>(h + 1) + static_cast<std::size_t>(h) * static_cast<std::size_t>(w + 1), 0.0f);
+  float* marginal = &cdf[1];
+  float* conditional = &cdf[1 + static_cast<std::size_t>(h + 1)];
+  double total = 0;
+  std::vector<double> rowSums(static_cast<std::size_t>(h));
+  for (int y = 0; y < h; ++y) {
+    float sinTheta = std::sin(kPi * (static_cast<float>(y) + 0.5f) / static_cast<float>(h));
+    float* row = conditional + static_cast<std::size_t>(y) * static_cast<std::size_t>(w + 1);
+    double acc = 0;
+    row[0] = 0;
+    for (int x = 0; x < w; ++x) {
+      const std::uint16_t* px = &data_.texels[static_cast<std::size_t>(offset) * 4 + static_cast<std::size_t>((y * w + x) * 4)];
+      float lum = luminance({halfToFloat(px[0]), halfToFloat(px[1]), halfToFloat(px[2])});
+      acc += std::max(lum, 0.0f) * sinTheta;
+      row[x + 1] = static_cast<float>(acc);
+    }
+    rowSums[static_cast<std::size_t>(y)] = acc;
+    if (acc > 0)
+      for (int x = 1; x <= w; ++x) row[x] = static_cast<float>(row[x] / acc);
+    else
+      for (int x = 1; x <= w; ++x) row[x] = static_cast<float>(x) / static_cast<float>(w);
+    total += acc;
+  }
+  marginal[0] = 0;
+  double acc = 0;
+  for (int y = 0; y < h; ++y) {
+    acc += rowSums[static_cast<std::size_t>(y)];
+    marginal[y + 1] = total > 0 ? static_cast<float>(acc / total) : static_cast<float>(y + 1) / static_cast<float>(h);
+  }
+  // Normaliser: mean of luminance * sin(theta) over texels. pdf(direction) = lum / (norm * 2 pi^2).
+  cdf[0] = total > 0 ? static_cast<float>(total / (static_cast<double>(w) * h)) : 0.0f;
+  environmentPower_ = kPi * luminance(tint) * static_cast<float>(total / (static_cast<double>(w) * h)) * (kPi / 2);
+  if (total <= 0) data_.environmentType = gpu::kEnvNone;
+}
+
+void RenderSceneBuilder::choosePickProbabilities(const Scene&) {
+  Bounds3 b = data_.bounds;
+  float radius = b.empty() ? 1.0f : std::max(0.5f * length(b.extent()), 1e-3f);
+  // Rough powers; every present kind keeps at least 15 % so a weak but important light (a sky
+  // through a small window) is never starved.
+  float pe = data_.emitters.empty() ? 0.0f : std::max(emitterPower_, 1e-6f);
+  float pv = data_.environmentType == gpu::kEnvNone ? 0.0f : std::max(environmentPower_ * kPi * radius * radius, 1e-6f);
+  float pd = data_.deltaLights.empty() ? 0.0f : std::max(deltaPower_, 1e-6f);
+  float sum = pe + pv + pd;
+  float p[3] = {0, 0, 0};
+  if (sum > 0) {
+    p[0] = pe / sum;
+    p[1] = pv / sum;
+    p[2] = pd / sum;
+    int present = (pe > 0) + (pv > 0) + (pd > 0);
+    const float floor = 0.15f;
+    if (present > 1) {
+      float extra = 0;
+      for (int i = 0; i < 3; ++i)
+        if ((i == 0 ? pe : i == 1 ? pv : pd) > 0 && p[i] < floor) {
+          extra += floor - p[i];
+          p[i] = floor;
+        }
+      float big = 0;
+      for (float v : p) big += v > floor ? v - floor : 0;
+      for (float& v : p)
+        if (v > floor && big > 0) v -= extra * (v - floor) / big;
+    }
+  }
+  for (int i = 0; i < 3; ++i) data_.lightPick[i] = p[i];
+}
+
+}  // namespace retile

@@ -1,0 +1,126 @@
+// The render scene: the document flattened into the arrays the shaders read (see
+// shaders/shared/layouts.h). Pure CPU, no Vulkan: the GPU upload lives in the renderer.
+//
+// Updates follow the edit's UpdateFlags so that the cost of an edit matches what it changed:
+// a transform repacks instances, the top-level BVH and emitters, never mesh data; mesh BVHs are
+// cached by geometry and shared by every instance of a mesh.
+//
+// Threads: owned and used by one thread (the render thread).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "io/image_io.h"
+#include "render/bvh.h"
+#include "retile/edit.h"
+#include "retile/scene.h"
+#include "shared/layouts.h"
+
+namespace retile {
+
+using gpu::vec4;
+
+// Which arrays changed in the last update, so the uploader copies only those.
+enum DirtyArrays : std::uint32_t {
+  kDirtyGeometry = 1u << 0,   // blasNodes, triangles, triangleShading
+  kDirtyInstances = 1u << 1,  // instances, tlasNodes
+  kDirtyMaterials = 1u << 2,
+  kDirtyTextures = 1u << 3,   // textureInfo, texels
+  kDirtyEmitters = 1u << 4,   // emitters, emitterAlias, deltaLights
+  kDirtyEnvironment = 1u << 5,
+  kDirtyAllArrays = 0xffu,
+};
+
+struct RenderSceneData {
+  std::vector<GpuBvhNode> blasNodes;   // every mesh BVH, concatenated
+  std::vector<GpuBvhNode> tlasNodes;   // instance BVH; its node indices are offset by blasNodes.size()
+  std::vector<vec4> triangles;         // kTriTexels per triangle
+  std::vector<vec4> triangleShading;   // kTriShadeTexels per triangle
+  std::vector<vec4> instances;         // kInstanceTexels per instance
+  std::vector<vec4> materials;         // kMaterialTexels per material
+  std::vector<vec4> textureInfo;       // kTextureTexels per texture
+  std::vector<std::uint16_t> texels;   // RGBA16F, all bitmaps
+  std::vector<vec4> emitters;          // kEmitterTexels per emissive triangle
+  std::vector<vec4> emitterAlias;      // one per emitter: (keep probability, alias index, -, -)
+  std::vector<vec4> deltaLights;       // kDeltaLightTexels per light
+  std::vector<float> environmentCdf;   // marginal (h+1) then conditional rows (w+1 each)
+
+  std::vector<NodeId> instanceObject;  // instance index -> object id
+  Bounds3 bounds;
+  float lightPick[3] = {0, 0, 0};      // emitters, environment, delta lights
+  int environmentType = 0;             // kEnvNone / kEnvConstant / kEnvMap
+  int environmentMap = -1;             // texture index of the map
+  int environmentWidth = 0, environmentHeight = 0;
+  Vec3 environmentTint{0.0f};
+  float environmentRotation = 0;
+  std::uint64_t triangleCount = 0;     // unique (per mesh) triangles
+  std::uint64_t instancedTriangles = 0;
+
+  std::uint32_t tlasRoot() const { return static_cast<std::uint32_t>(blasNodes.size()); }
+  std::uint64_t deviceBytes() const;
+};
+
+class RenderSceneBuilder {
+ public:
+  // Applies `flags` (from edit.h) by refreshing the affected arrays; returns DirtyArrays.
+  // Warnings (missing textures and the substitutes used) are appended to `warnings`.
+  std::uint32_t update(const Scene& scene, std::uint32_t flags, std::vector<std::string>* warnings);
+  const RenderSceneData& data() const { return data_; }
+
+  // Seconds spent in the last update, by part, for the benchmarks.
+  struct Timing {
+    double blas = 0, tlas = 0, textures = 0, emitters = 0, environment = 0;
+  };
+  const Timing& lastTiming() const { return timing_; }
+
+ private:
+  struct MeshEntry {
+    std::shared_ptr<const MeshGeometry> geometry;  // keeps the key alive
+    Bvh bvh;
+    std::vector<vec4> triangles;
+    std::vector<vec4> shading;
+    std::uint32_t nodeOffset = 0;  // in data_.blasNodes
+    std::uint32_t triOffset = 0;   // in triangles (packed order)
+    bool used = false;
+  };
+  // Decoding is the slow part of a texture update; bitmaps of unchanged textures are kept.
+  struct Decoded {
+    std::string signature;
+    LinearImage image;
+    bool ok = false;
+  };
+
+  void packGeometry(const Scene& scene);
+  void packInstances(const Scene& scene);
+  void packMaterials(const Scene& scene);
+  void packTextures(const Scene& scene, std::vector<std::string>* warnings);
+  void packEmitters(const Scene& scene);
+  void packEnvironment(const Scene& scene, std::vector<std::string>* warnings);
+  void choosePickProbabilities(const Scene& scene);
+  int textureIndex(NodeId id) const;
+  int materialIndex(NodeId id) const;
+
+  RenderSceneData data_;
+  std::map<const MeshGeometry*, MeshEntry> meshes_;
+  std::unordered_map<NodeId, Decoded> decoded_;
+  std::unordered_map<NodeId, int> textureIndex_;
+  std::unordered_map<NodeId, int> materialIndex_;
+  std::unordered_map<NodeId, const MeshEntry*> meshOf_;  // mesh node id -> entry
+  int defaultMaterial_ = 0;
+  float emitterPower_ = 0;
+  float environmentPower_ = 0;
+  float deltaPower_ = 0;
+  bool first_ = true;
+  Timing timing_;
+};
+
+// IEEE half from float (round to nearest even), for RGBA16F texels.
+std::uint16_t floatToHalf(float f);
+float halfToFloat(std::uint16_t h);
+
+}  // namespace retile

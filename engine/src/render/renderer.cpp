@@ -1,0 +1,364 @@
+#include "retile/render.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include "render/render_scene.h"
+#include "retile/log.h"
+#include "shared/layouts.h"
+#include "vk/buffer.h"
+#include "vk/check.h"
+#include "vk/context.h"
+#include "vk/pipeline.h"
+
+namespace retile {
+
+using vk::Binding;
+using vk::Buffer;
+
+namespace {
+
+constexpr VkBufferUsageFlags kTexelUsage = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+constexpr VkBufferUsageFlags kStorageUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+
+// Binding numbers of trace.comp (shaders/common/scene.glsl and trace.comp).
+enum TraceBinding : std::uint32_t {
+  kBindFrame = 0, kBindWork = 1, kBindNodes = 2, kBindTris = 3, kBindTriShade = 4, kBindInstances = 5,
+  kBindMaterials = 6, kBindTexInfo = 7, kBindTexels = 8, kBindEmitters = 9, kBindAlias = 10,
+  kBindDelta = 11, kBindEnvCdf = 12, kBindSamples = 13, kBindAux = 14, kBindStats = 15,
+};
+
+std::uint32_t groupsFor(std::uint64_t invocations, std::uint32_t local, std::uint32_t* groupsY) {
+  std::uint64_t groups = (invocations + local - 1) / local;
+  auto x = static_cast<std::uint32_t>(std::min<std::uint64_t>(groups, 65535));
+  *groupsY = x ? static_cast<std::uint32_t>((groups + x - 1) / x) : 0;
+  return x;
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+  vk::Context ctx;
+  std::unique_ptr<vk::ComputePipeline> trace;
+  std::unique_ptr<vk::ComputePipeline> accumulate;
+  RenderSceneBuilder builder;
+
+  Buffer frameUbo, work, stats;
+  Buffer nodes, tris, triShade, instances, materials, texInfo, texels, emitters, alias, delta, envCdf;
+  Buffer samples, aux, accum, accumAux;
+
+  Camera camera;
+  int width = 0, height = 0;
+  int maxBounces = 8;
+  std::uint32_t seed = 0;
+  RenderSettings sceneSettings;
+  bool hasScene = false;
+
+  explicit Impl(const RendererOptions& o) : ctx(vk::DeviceChoice{o.device, o.validation || kDebugValidation}) {
+    trace = std::make_unique<vk::ComputePipeline>(
+        ctx, "trace.comp",
+        std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::UniformTexel, Binding::UniformTexel,
+                             Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel,
+                             Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel,
+                             Binding::UniformTexel, Binding::Storage, Binding::Storage, Binding::Storage},
+        static_cast<std::uint32_t>(sizeof(gpu::TracePush)));
+    accumulate = std::make_unique<vk::ComputePipeline>(
+        ctx, "accumulate.comp",
+        std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::Storage, Binding::Storage, Binding::Storage,
+                             Binding::Storage},
+        static_cast<std::uint32_t>(sizeof(gpu::AccumulatePush)));
+    frameUbo = Buffer(ctx, sizeof(gpu::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true, "frame constants");
+    stats = Buffer(ctx, 16, kStorageUsage, true, "ray statistics");
+    work = Buffer(ctx, sizeof(gpu::WorkItem) * 64, kStorageUsage, true, "work items");
+  }
+
+#ifdef RETILE_VULKAN_VALIDATION
+  static constexpr bool kDebugValidation = true;
+#else
+  static constexpr bool kDebugValidation = false;
+#endif
+
+  template <class T>
+  void uploadArray(Buffer& b, const std::vector<T>& data, const char* what) {
+    VkDeviceSize bytes = data.size() * sizeof(T);
+    if (!b.valid() || b.size() < bytes || (b.size() > 2 * bytes + 65536)) b = Buffer(ctx, bytes, kTexelUsage, false, what);
+    b.upload(data.data(), bytes);
+  }
+
+  void upload(std::uint32_t dirty) {
+    const RenderSceneData& d = builder.data();
+    if (dirty & (kDirtyGeometry | kDirtyInstances)) {
+      std::vector<GpuBvhNode> all;
+      all.reserve(d.blasNodes.size() + d.tlasNodes.size());
+      all.insert(all.end(), d.blasNodes.begin(), d.blasNodes.end());
+      all.insert(all.end(), d.tlasNodes.begin(), d.tlasNodes.end());
+      if (dirty & kDirtyGeometry || !nodes.valid() || nodes.size() != all.size() * sizeof(GpuBvhNode)) {
+        uploadArray(nodes, all, "BVH nodes");
+      } else {
+        // Only the top level moved: copy it alone, after the mesh BVHs.
+        nodes.upload(d.tlasNodes.data(), d.tlasNodes.size() * sizeof(GpuBvhNode), d.blasNodes.size() * sizeof(GpuBvhNode));
+      }
+    }
+    if (dirty & kDirtyGeometry) {
+      uploadArray(tris, d.triangles, "triangles");
+      uploadArray(triShade, d.triangleShading, "triangle shading data");
+    }
+    if (dirty & kDirtyInstances) uploadArray(instances, d.instances, "instances");
+    if (dirty & kDirtyMaterials) uploadArray(materials, d.materials, "materials");
+    if (dirty & (kDirtyTextures | kDirtyEnvironment)) {
+      uploadArray(texInfo, d.textureInfo, "texture table");
+      uploadArray(texels, d.texels, "texels");
+      uploadArray(envCdf, d.environmentCdf, "environment distribution");
+    }
+    if (dirty & kDirtyEmitters) {
+      uploadArray(emitters, d.emitters, "emitters");
+      uploadArray(alias, d.emitterAlias, "emitter alias table");
+      uploadArray(delta, d.deltaLights, "delta lights");
+    }
+    bindAll();
+  }
+
+  void bindAll() {
+    auto& t = *trace;
+    t.bind(kBindFrame, frameUbo);
+    t.bind(kBindWork, work);
+    t.bind(kBindNodes, nodes, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(kBindTris, tris, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(kBindTriShade, triShade, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(kBindInstances, instances, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(kBindMaterials, materials, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(kBindTexInfo, texInfo, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(kBindTexels, texels, VK_FORMAT_R16G16B16A16_SFLOAT);
+    t.bind(kBindEmitters, emitters, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(kBindAlias, alias, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(kBindDelta, delta, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(kBindEnvCdf, envCdf, VK_FORMAT_R32_SFLOAT);
+    t.bind(kBindStats, stats);
+    if (samples.valid()) {
+      t.bind(kBindSamples, samples);
+      t.bind(kBindAux, aux);
+    }
+    auto& a = *accumulate;
+    a.bind(0, frameUbo);
+    a.bind(1, work);
+    if (samples.valid()) {
+      a.bind(2, samples);
+      a.bind(3, aux);
+    }
+    if (accum.valid()) {
+      a.bind(4, accum);
+      a.bind(5, accumAux);
+    }
+  }
+
+  void ensureSampleCapacity(std::uint64_t slots) {
+    VkDeviceSize need = std::max<std::uint64_t>(slots, 1) * 16;
+    if (samples.valid() && samples.size() >= need) return;
+    samples = Buffer(ctx, need, kStorageUsage, false, "samples");
+    aux = Buffer(ctx, need * 2, kStorageUsage, false, "auxiliary samples");
+    bindAll();
+  }
+
+  void resize(int w, int h) {
+    RETILE_ASSERT(w > 0 && h > 0 && w <= 16384 && h <= 16384, cat("size ", w, "x", h));
+    width = w;
+    height = h;
+    VkDeviceSize bytes = static_cast<VkDeviceSize>(w) * static_cast<VkDeviceSize>(h) * 32;
+    accum = Buffer(ctx, bytes, kStorageUsage, false, "accumulation");
+    accumAux = Buffer(ctx, bytes, kStorageUsage, false, "auxiliary accumulation");
+    ctx.submitAndWait([&](VkCommandBuffer cb) {
+      vkCmdFillBuffer(cb, accum.handle(), 0, VK_WHOLE_SIZE, 0);
+      vkCmdFillBuffer(cb, accumAux.handle(), 0, VK_WHOLE_SIZE, 0);
+    });
+    ensureSampleCapacity(static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h));
+    bindAll();
+  }
+
+  void writeFrameUniforms(std::uint32_t itemCount, std::uint64_t slots) {
+    const RenderSceneData& d = builder.data();
+    gpu::FrameUniforms u{};
+    Vec3 forward = normalize(camera.target - camera.position);
+    Vec3 right = normalize(cross(forward, camera.up));
+    if (length(right) == 0) right = normalize(cross(forward, std::abs(forward.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 0, 1}));
+    Vec3 up = cross(right, forward);
+    float tanHalf = std::tan(0.5f * camera.verticalFov);
+    u.cameraPosition = {camera.position.x, camera.position.y, camera.position.z, tanHalf};
+    u.cameraRight = {right.x, right.y, right.z, static_cast<float>(width) / static_cast<float>(height)};
+    u.cameraUp = {up.x, up.y, up.z, 0};
+    u.cameraForward = {forward.x, forward.y, forward.z, 0};
+    u.image = {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height), seed,
+               static_cast<std::uint32_t>(std::max(maxBounces, 0))};
+    u.scene = {static_cast<std::int32_t>(d.tlasRoot()), static_cast<std::int32_t>(d.instanceObject.size()),
+               static_cast<std::int32_t>(d.emitters.size() / gpu::kEmitterTexels),
+               static_cast<std::int32_t>(d.deltaLights.size() / gpu::kDeltaLightTexels)};
+    u.lightPick = {d.lightPick[0], d.lightPick[1], d.lightPick[2], 0};
+    u.environment = {d.environmentType, d.environmentMap, d.environmentWidth, d.environmentHeight};
+    u.environmentTint = {d.environmentTint.x, d.environmentTint.y, d.environmentTint.z, d.environmentRotation};
+    Vec3 c = d.bounds.empty() ? Vec3{0.0f} : d.bounds.center();
+    u.sceneSphere = {c.x, c.y, c.z, d.bounds.empty() ? 1.0f : 0.5f * length(d.bounds.extent())};
+    u.work = {itemCount, static_cast<std::uint32_t>(slots), 0, 0};
+    frameUbo.upload(&u, sizeof u);
+  }
+
+  FrameStats renderFrame(const std::vector<TileWork>& tiles) {
+    RETILE_ASSERT(hasScene, "renderFrame before setScene");
+    RETILE_ASSERT(width > 0, "renderFrame before resize");
+    std::vector<gpu::WorkItem> items;
+    items.reserve(tiles.size());
+    std::uint64_t slots = 0, pixels = 0;
+    for (const TileWork& t : tiles) {
+      // Clip to the image; an empty tile is skipped rather than an error.
+      int x0 = std::max(t.x, 0), y0 = std::max(t.y, 0);
+      int x1 = std::min(t.x + t.width, width), y1 = std::min(t.y + t.height, height);
+      if (x1 <= x0 || y1 <= y0 || t.quality < 1) continue;
+      gpu::WorkItem w{};
+      w.rect = {x0, y0, x1 - x0, y1 - y0};
+      w.info = {static_cast<std::uint32_t>(t.quality), static_cast<std::uint32_t>(slots), t.sampleBase,
+                t.restart ? gpu::kWorkRestart : 0u};
+      w.pixels = {static_cast<std::uint32_t>(pixels), 0, 0, 0};
+      std::uint64_t n = static_cast<std::uint64_t>(x1 - x0) * static_cast<std::uint64_t>(y1 - y0);
+      slots += n * static_cast<std::uint64_t>(t.quality);
+      pixels += n;
+      items.push_back(w);
+    }
+    FrameStats fs;
+    if (items.empty()) return fs;
+    RETILE_ASSERT(slots < (1ull << 32), cat("a frame of ", slots, " samples"));
+    ensureSampleCapacity(slots);
+    VkDeviceSize workBytes = items.size() * sizeof(gpu::WorkItem);
+    if (work.size() < workBytes) {
+      work = Buffer(ctx, workBytes * 2, kStorageUsage, true, "work items");
+      bindAll();
+    }
+    work.upload(items.data(), workBytes);
+    writeFrameUniforms(static_cast<std::uint32_t>(items.size()), slots);
+    std::uint32_t zero[4] = {0, 0, 0, 0};
+    stats.upload(zero, sizeof zero);
+
+    auto start = std::chrono::steady_clock::now();
+    ctx.submitAndWait([&](VkCommandBuffer cb) {
+      gpu::TracePush tp{0, static_cast<std::uint32_t>(slots), 0, 0};
+      std::uint32_t gy;
+      std::uint32_t gx = groupsFor(slots, gpu::kTraceWorkgroup, &gy);
+      trace->dispatch(cb, gx, gy, &tp, sizeof tp);
+      vk::computeBarrier(cb);
+      gpu::AccumulatePush ap{0, static_cast<std::uint32_t>(pixels), static_cast<std::uint32_t>(items.size()), 0};
+      gx = groupsFor(pixels, gpu::kAccumulateWorkgroup, &gy);
+      accumulate->dispatch(cb, gx, gy, &ap, sizeof ap);
+    });
+    fs.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::uint32_t counts[4];
+    stats.download(counts, sizeof counts);
+    fs.samples = slots;
+    fs.primaryRays = counts[0];
+    fs.bounceRays = counts[1];
+    fs.shadowRays = counts[2];
+    return fs;
+  }
+
+  RenderImage readback() {
+    RenderImage img;
+    img.width = width;
+    img.height = height;
+    auto n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+    std::vector<gpu::vec4> acc(n * 2), ax(n * 2);
+    accum.download(acc.data(), acc.size() * sizeof(gpu::vec4));
+    accumAux.download(ax.data(), ax.size() * sizeof(gpu::vec4));
+    img.color.resize(n * 3);
+    img.albedo.resize(n * 3);
+    img.normal.resize(n * 3);
+    img.depth.resize(n);
+    img.objectId.resize(n);
+    img.sampleCount.resize(n);
+    const auto& objects = builder.data().instanceObject;
+    for (std::size_t i = 0; i < n; ++i) {
+      const gpu::vec4& s = acc[i * 2];
+      float count = s.w;
+      float inv = count > 0 ? 1.0f / count : 0.0f;
+      img.color[i * 3 + 0] = s.x * inv;
+      img.color[i * 3 + 1] = s.y * inv;
+      img.color[i * 3 + 2] = s.z * inv;
+      img.sampleCount[i] = count;
+      const gpu::vec4& a = ax[i * 2];
+      const gpu::vec4& b = ax[i * 2 + 1];
+      img.albedo[i * 3 + 0] = a.x * inv;
+      img.albedo[i * 3 + 1] = a.y * inv;
+      img.albedo[i * 3 + 2] = a.z * inv;
+      Vec3 nrm = normalize(Vec3{b.x, b.y, b.z});
+      img.normal[i * 3 + 0] = nrm.x;
+      img.normal[i * 3 + 1] = nrm.y;
+      img.normal[i * 3 + 2] = nrm.z;
+      img.depth[i] = a.w >= 1e29f ? std::numeric_limits<float>::infinity() : a.w;
+      std::int32_t inst;
+      std::memcpy(&inst, &b.w, sizeof inst);
+      img.objectId[i] = (inst > 0 && static_cast<std::size_t>(inst) <= objects.size()) ? objects[static_cast<std::size_t>(inst - 1)] : kNoNode;
+    }
+    return img;
+  }
+};
+
+Renderer::Renderer(const RendererOptions& options) : impl_(std::make_unique<Impl>(options)) {}
+Renderer::~Renderer() = default;
+
+std::string Renderer::deviceName() const { return impl_->ctx.deviceName(); }
+bool Renderer::cpuDevice() const { return impl_->ctx.isCpuDevice(); }
+
+std::vector<std::string> Renderer::setScene(const Scene& scene) {
+  impl_->builder = RenderSceneBuilder{};
+  return updateScene(scene, kUpdateAll);
+}
+
+std::vector<std::string> Renderer::updateScene(const Scene& scene, std::uint32_t flags) {
+  std::vector<std::string> warnings;
+  std::uint32_t dirty = impl_->builder.update(scene, flags, &warnings);
+  impl_->upload(dirty);
+  impl_->camera = scene.camera;
+  impl_->sceneSettings = scene.settings;
+  if (!impl_->hasScene) impl_->maxBounces = scene.settings.maxBounces;
+  if (flags & kUpdateSettings) impl_->maxBounces = scene.settings.maxBounces;
+  impl_->hasScene = true;
+  for (const auto& w : warnings) logWarning(w);
+  return warnings;
+}
+
+void Renderer::resize(int width, int height) { impl_->resize(width, height); }
+void Renderer::setMaxBounces(int maxBounces) { impl_->maxBounces = std::max(0, maxBounces); }
+void Renderer::setSeed(std::uint32_t seed) { impl_->seed = seed; }
+FrameStats Renderer::renderFrame(const std::vector<TileWork>& tiles) { return impl_->renderFrame(tiles); }
+RenderImage Renderer::readback() { return impl_->readback(); }
+std::uint64_t Renderer::sceneDeviceBytes() const { return impl_->builder.data().deviceBytes(); }
+std::uint64_t Renderer::sceneTriangles() const { return impl_->builder.data().triangleCount; }
+double Renderer::lastBlasSeconds() const { return impl_->builder.lastTiming().blas; }
+double Renderer::lastTlasSeconds() const { return impl_->builder.lastTiming().tlas; }
+
+RenderImage Renderer::render(const RenderRequest& request, const std::function<bool(int, int)>& progress, FrameStats* total) {
+  const RenderSettings& s = impl_->sceneSettings;
+  int w = request.width > 0 ? request.width : s.width;
+  int h = request.height > 0 ? request.height : s.height;
+  int spp = request.samplesPerPixel > 0 ? request.samplesPerPixel : s.samplesPerPixel;
+  impl_->maxBounces = request.maxBounces >= 0 ? request.maxBounces : s.maxBounces;
+  impl_->seed = request.seed;
+  resize(w, h);
+  FrameStats sum;
+  for (int f = 0; f < spp; ++f) {
+    TileWork all;
+    all.width = w;
+    all.height = h;
+    all.quality = 1;
+    all.sampleBase = static_cast<std::uint32_t>(f);
+    all.restart = f == 0;
+    FrameStats fs = renderFrame({all});
+    sum.samples += fs.samples;
+    sum.primaryRays += fs.primaryRays;
+    sum.bounceRays += fs.bounceRays;
+    sum.shadowRays += fs.shadowRays;
+    sum.seconds += fs.seconds;
+    if (progress && !progress(f + 1, spp)) break;
+  }
+  if (total) *total = sum;
+  return readback();
+}
+
+}  // namespace retile

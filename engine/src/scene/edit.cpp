@@ -1,0 +1,219 @@
+#include "retile/edit.h"
+
+#include <algorithm>
+
+#include "retile/log.h"
+
+namespace retile {
+namespace {
+
+template <class... Ts>
+struct Overloaded : Ts... {
+  using Ts::operator()...;
+};
+template <class... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;
+
+using Applied = Result<std::uint32_t>;
+
+Applied fail(const std::string& message) { return Applied::failure(message); }
+
+bool finite(float v) { return std::isfinite(v); }
+
+std::string checkMaterial(const Scene& s, const Material& m) {
+  if (!isFinite(m.albedo) || !isFinite(m.emission) || !isFinite(m.eta) || !isFinite(m.k) ||
+      !finite(m.roughness) || !finite(m.ior) || !finite(m.alpha))
+    return cat("material '", m.name, "': a parameter is not a finite number");
+  for (NodeId t : {m.albedoTexture, m.roughnessTexture, m.alphaTexture})
+    if (t != kNoNode && !s.texture(t)) return cat("material '", m.name, "': texture ", t, " does not exist");
+  return {};
+}
+
+std::string checkObject(const Scene& s, const Object& o) {
+  if (!o.transform.isFinite()) return cat("object '", o.name, "': transform is not finite");
+  if (o.mesh != kNoNode && !s.mesh(o.mesh)) return cat("object '", o.name, "': mesh ", o.mesh, " does not exist");
+  if (o.material != kNoNode && !s.material(o.material))
+    return cat("object '", o.name, "': material ", o.material, " does not exist");
+  return {};
+}
+
+std::string checkLight(const Light& l) {
+  if (!isFinite(l.color) || !isFinite(l.position) || !isFinite(l.direction) || !finite(l.intensity) ||
+      !finite(l.spotAngle) || !finite(l.spotBlend))
+    return cat("light '", l.name, "': a parameter is not a finite number");
+  return {};
+}
+
+std::string checkCamera(const Camera& c) {
+  if (!isFinite(c.position) || !isFinite(c.target) || !isFinite(c.up) || !finite(c.verticalFov))
+    return "camera: a parameter is not a finite number";
+  if (c.verticalFov <= 0 || c.verticalFov >= kPi) return "camera: field of view must be between 0 and 180 degrees";
+  if (length(c.target - c.position) == 0) return "camera: position and target coincide";
+  return {};
+}
+
+std::string checkSettings(const RenderSettings& r) {
+  if (r.width < 1 || r.height < 1 || r.width > 16384 || r.height > 16384)
+    return cat("render settings: size ", r.width, "x", r.height, " is outside 1..16384");
+  if (r.maxBounces < 0 || r.maxBounces > 1024) return "render settings: max bounces must be within 0..1024";
+  if (r.samplesPerPixel < 1) return "render settings: samples per pixel must be at least 1";
+  return {};
+}
+
+template <class T>
+bool idTaken(const Scene& s, NodeId id) {
+  return s.mesh(id) || s.material(id) || s.object(id) || s.light(id) || s.texture(id);
+}
+
+template <class Node>
+Applied replaceNode(std::vector<Node>& nodes, const Node& value, const char* kind, std::uint32_t flags) {
+  for (Node& n : nodes)
+    if (n.id == value.id) {
+      n = value;
+      return flags;
+    }
+  return fail(cat(kind, " ", value.id, " does not exist"));
+}
+
+template <class Node>
+Applied addNode(Scene& s, std::vector<Node>& nodes, const Node& value, const char* kind, std::uint32_t flags) {
+  if (value.id == kNoNode) return fail(cat("new ", kind, " has no id"));
+  if (idTaken<Node>(s, value.id)) return fail(cat("new ", kind, ": id ", value.id, " is taken"));
+  nodes.push_back(value);
+  s.reserveIds(value.id + 1);
+  return flags;
+}
+
+}  // namespace
+
+NodeId editTarget(const Edit& edit) {
+  return std::visit(Overloaded{
+                        [](const SetMaterial& e) { return e.material.id; },
+                        [](const SetObject& e) { return e.object.id; },
+                        [](const SetLight& e) { return e.light.id; },
+                        [](const SetTexture& e) { return e.texture.id; },
+                        [](const SetCamera&) { return kNoNode; },
+                        [](const SetEnvironment&) { return kNoNode; },
+                        [](const SetRenderSettings&) { return kNoNode; },
+                        [](const AddMesh& e) { return e.mesh.id; },
+                        [](const AddMaterial& e) { return e.material.id; },
+                        [](const AddObject& e) { return e.object.id; },
+                        [](const AddLight& e) { return e.light.id; },
+                        [](const AddTexture& e) { return e.texture.id; },
+                        [](const RemoveNode& e) { return e.id; },
+                    },
+                    edit);
+}
+
+std::uint64_t editCoalesceKey(const Edit& edit) {
+  return (static_cast<std::uint64_t>(edit.index()) << 56) ^ editTarget(edit);
+}
+
+const char* editName(const Edit& edit) {
+  static const char* const names[] = {"set material", "set object", "set light", "set texture",
+                                      "set camera", "set environment", "set render settings",
+                                      "add mesh", "add material", "add object", "add light",
+                                      "add texture", "remove node"};
+  return names[edit.index()];
+}
+
+Result<std::uint32_t> applyEdit(Scene& s, const Edit& edit) {
+  return std::visit(
+      Overloaded{
+          [&](const SetMaterial& e) -> Applied {
+            if (auto why = checkMaterial(s, e.material); !why.empty()) return fail(why);
+            const Material* old = s.material(e.material.id);
+            if (!old) return fail(cat("material ", e.material.id, " does not exist"));
+            // Emission decides which triangles are lights.
+            std::uint32_t flags = kUpdateMaterials;
+            if (old->emission != e.material.emission) flags |= kUpdateLights;
+            return replaceNode(s.materials, e.material, "material", flags);
+          },
+          [&](const SetObject& e) -> Applied {
+            if (auto why = checkObject(s, e.object); !why.empty()) return fail(why);
+            return replaceNode(s.objects, e.object, "object", kUpdateInstances | kUpdateLights);
+          },
+          [&](const SetLight& e) -> Applied {
+            if (auto why = checkLight(e.light); !why.empty()) return fail(why);
+            return replaceNode(s.lights, e.light, "light", kUpdateLights);
+          },
+          [&](const SetTexture& e) -> Applied {
+            return replaceNode(s.textures, e.texture, "texture",
+                               kUpdateTextures | kUpdateMaterials | kUpdateEnvironment);
+          },
+          [&](const SetCamera& e) -> Applied {
+            if (auto why = checkCamera(e.camera); !why.empty()) return fail(why);
+            s.camera = e.camera;
+            return kUpdateCamera;
+          },
+          [&](const SetEnvironment& e) -> Applied {
+            const Environment& v = e.environment;
+            if (!isFinite(v.color) || !std::isfinite(v.intensity) || !std::isfinite(v.rotation) ||
+                !isFinite(v.zenith) || !isFinite(v.horizon) || !isFinite(v.ground))
+              return fail("environment: a parameter is not a finite number");
+            if (v.map != kNoNode && !s.texture(v.map)) return fail("environment: map texture does not exist");
+            s.environment = v;
+            return kUpdateEnvironment | kUpdateLights;
+          },
+          [&](const SetRenderSettings& e) -> Applied {
+            if (auto why = checkSettings(e.settings); !why.empty()) return fail(why);
+            s.settings = e.settings;
+            return kUpdateSettings;
+          },
+          [&](const AddMesh& e) -> Applied {
+            if (!e.mesh.geometry) return fail("new mesh has no geometry");
+            return addNode(s, s.meshes, e.mesh, "mesh", kUpdateGeometry);
+          },
+          [&](const AddMaterial& e) -> Applied {
+            if (auto why = checkMaterial(s, e.material); !why.empty()) return fail(why);
+            return addNode(s, s.materials, e.material, "material", kUpdateMaterials);
+          },
+          [&](const AddObject& e) -> Applied {
+            if (auto why = checkObject(s, e.object); !why.empty()) return fail(why);
+            return addNode(s, s.objects, e.object, "object", kUpdateInstances | kUpdateLights);
+          },
+          [&](const AddLight& e) -> Applied {
+            if (auto why = checkLight(e.light); !why.empty()) return fail(why);
+            return addNode(s, s.lights, e.light, "light", kUpdateLights);
+          },
+          [&](const AddTexture& e) -> Applied {
+            return addNode(s, s.textures, e.texture, "texture", kUpdateTextures);
+          },
+          [&](const RemoveNode& e) -> Applied {
+            NodeId id = e.id;
+            std::uint32_t flags = 0;
+            auto erase = [&](auto& nodes, std::uint32_t f) {
+              auto n = std::erase_if(nodes, [&](const auto& node) { return node.id == id; });
+              if (n) flags |= f;
+            };
+            erase(s.meshes, kUpdateGeometry | kUpdateInstances | kUpdateLights);
+            erase(s.materials, kUpdateMaterials | kUpdateInstances | kUpdateLights);
+            erase(s.objects, kUpdateInstances | kUpdateLights);
+            erase(s.lights, kUpdateLights);
+            erase(s.textures, kUpdateTextures | kUpdateMaterials | kUpdateEnvironment);
+            if (!flags) return fail(cat("node ", id, " does not exist"));
+            // Clear dangling references so the scene stays consistent.
+            for (Object& o : s.objects) {
+              if (o.mesh == id) o.mesh = kNoNode;
+              if (o.material == id) o.material = kNoNode;
+            }
+            for (Material& m : s.materials)
+              for (NodeId* t : {&m.albedoTexture, &m.roughnessTexture, &m.alphaTexture})
+                if (*t == id) *t = kNoNode;
+            if (s.environment.map == id) {
+              s.environment.map = kNoNode;
+              s.environment.type = EnvironmentType::Constant;
+            }
+            return flags;
+          },
+      },
+      edit);
+}
+
+Result<std::uint32_t> Document::apply(const Edit& edit) {
+  auto r = applyEdit(scene_, edit);
+  if (r.ok()) ++version_;
+  return r;
+}
+
+}  // namespace retile

@@ -1,0 +1,20 @@
+// Procedural meshes for the default scene and for the analytic primitives of scene files.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "retile/scene.h"
+
+namespace retile {
+
+// Unit square in the XZ plane, x and z in [-0.5, 0.5], facing +y, uv over [0,1]^2.
+std::shared_ptr<const MeshGeometry> makeQuad();
+// Cube [-0.5, 0.5]^3 with flat faces facing outwards.
+std::shared_ptr<const MeshGeometry> makeCube();
+// Sphere of radius 1 about the origin, smooth normals.
+std::shared_ptr<const MeshGeometry> makeSphere(int rings = 48, int segments = 96);
+// Surface of revolution about +y through the (radius, height) points of `profile`, in order.
+std::shared_ptr<const MeshGeometry> makeLathe(const std::vector<Vec2>& profile, int segments);
+
+}  // namespace retile

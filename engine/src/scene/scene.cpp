@@ -1,0 +1,117 @@
+#include "retile/scene.h"
+
+#include <algorithm>
+#include <cstring>
+
+namespace retile {
+
+Bounds3 MeshGeometry::bounds() const {
+  Bounds3 b;
+  for (const Vec3& p : positions) b.grow(p);
+  return b;
+}
+
+namespace {
+
+const char* const kMaterialNames[kMaterialTypeCount] = {
+    "lambert", "oren_nayar", "plastic", "rough_plastic", "conductor", "rough_conductor",
+    "mirror",  "dielectric", "rough_dielectric", "thinsheet", "null"};
+
+// RGB complex indices of refraction of common metals (the same RGB values Tungsten's scenes
+// name, from the RPI refractive index tables), so that scene files naming a metal look as
+// their authors saw them.
+struct Metal {
+  const char* name;
+  Vec3 eta, k;
+};
+const Metal kMetals[] = {
+    {"Ag", {0.1552646f, 0.1167233f, 0.1383807f}, {4.8283433f, 3.1222459f, 2.1469504f}},
+    {"Al", {1.6574600f, 0.8803690f, 0.5212287f}, {9.2238692f, 6.2695232f, 4.8370012f}},
+    {"Au", {0.1431190f, 0.3749570f, 1.4424786f}, {3.9831604f, 2.3857207f, 1.6032153f}},
+    {"Cr", {4.3696829f, 2.9167025f, 1.6547005f}, {5.2064338f, 4.2313645f, 3.7549468f}},
+    {"Cu", {0.2004377f, 0.9240334f, 1.1022120f}, {3.9129485f, 2.4528477f, 2.1421880f}},
+    {"Hg", {2.3989315f, 1.4400255f, 0.9095512f}, {6.3276269f, 4.3719414f, 3.4217899f}},
+    {"Ir", {3.0864098f, 2.0821938f, 1.6178867f}, {5.5921510f, 4.0671757f, 3.2672611f}},
+    {"Mo", {4.4837010f, 3.5254578f, 2.7760769f}, {4.1111308f, 3.4208716f, 3.1506031f}},
+    {"Ni", {2.3672754f, 1.6633583f, 1.4670554f}, {4.4988330f, 3.0501644f, 2.3454274f}},
+    {"Rh", {2.5857955f, 1.8601866f, 1.5544280f}, {6.7822927f, 4.7029501f, 3.9760892f}},
+    {"Ta", {2.0625847f, 2.3930916f, 2.6280685f}, {2.4080468f, 1.7413706f, 1.9470377f}},
+    {"TiN", {1.6484692f, 1.1504483f, 1.3797795f}, {3.3684596f, 1.9434889f, 1.1020123f}},
+    {"V", {4.2775126f, 3.5131538f, 2.7611257f}, {3.4911845f, 2.8893581f, 3.1116965f}},
+    {"W", {4.3707030f, 3.3002972f, 2.9982667f}, {3.5006779f, 2.6048653f, 2.2731931f}},
+};
+
+template <class T>
+T* findById(std::vector<T>& v, NodeId id) {
+  if (id == kNoNode) return nullptr;
+  for (T& n : v)
+    if (n.id == id) return &n;
+  return nullptr;
+}
+
+}  // namespace
+
+const char* materialTypeName(MaterialType t) { return kMaterialNames[static_cast<int>(t)]; }
+
+bool materialTypeFromName(const std::string& name, MaterialType* out) {
+  for (int i = 0; i < kMaterialTypeCount; ++i)
+    if (name == kMaterialNames[i]) {
+      *out = static_cast<MaterialType>(i);
+      return true;
+    }
+  return false;
+}
+
+std::vector<std::string> conductorNames() {
+  std::vector<std::string> names;
+  for (const Metal& m : kMetals) names.emplace_back(m.name);
+  return names;
+}
+
+bool conductorIor(const std::string& name, Vec3* eta, Vec3* k) {
+  for (const Metal& m : kMetals)
+    if (name == m.name) {
+      *eta = m.eta;
+      *k = m.k;
+      return true;
+    }
+  return false;
+}
+
+Mesh* Scene::mesh(NodeId id) { return findById(meshes, id); }
+const Mesh* Scene::mesh(NodeId id) const { return findById(const_cast<std::vector<Mesh>&>(meshes), id); }
+Texture* Scene::texture(NodeId id) { return findById(textures, id); }
+const Texture* Scene::texture(NodeId id) const { return findById(const_cast<std::vector<Texture>&>(textures), id); }
+Material* Scene::material(NodeId id) { return findById(materials, id); }
+const Material* Scene::material(NodeId id) const { return findById(const_cast<std::vector<Material>&>(materials), id); }
+Object* Scene::object(NodeId id) { return findById(objects, id); }
+const Object* Scene::object(NodeId id) const { return findById(const_cast<std::vector<Object>&>(objects), id); }
+Light* Scene::light(NodeId id) { return findById(lights, id); }
+const Light* Scene::light(NodeId id) const { return findById(const_cast<std::vector<Light>&>(lights), id); }
+
+Bounds3 Scene::worldBounds() const {
+  Bounds3 b;
+  for (const Object& o : objects) {
+    if (!o.visible) continue;
+    const Mesh* m = mesh(o.mesh);
+    if (!m || !m->geometry) continue;
+    b.grow(transformBounds(o.transform, m->geometry->bounds()));
+  }
+  return b;
+}
+
+std::size_t Scene::triangleCount() const {
+  std::size_t n = 0;
+  for (const Object& o : objects) {
+    const Mesh* m = mesh(o.mesh);
+    if (m && m->geometry) n += m->geometry->triangleCount();
+  }
+  return n;
+}
+
+float Scene::aspect() const {
+  if (settings.width <= 0 || settings.height <= 0) return 1.0f;
+  return static_cast<float>(settings.width) / static_cast<float>(settings.height);
+}
+
+}  // namespace retile

@@ -1,0 +1,245 @@
+#include "vk/context.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include "retile/log.h"
+#include "vk/check.h"
+
+namespace retile::vk {
+
+const char* resultName(VkResult r) {
+  switch (r) {
+#define RETILE_VK_CASE(x) \
+  case x: return #x;
+    RETILE_VK_CASE(VK_SUCCESS)
+    RETILE_VK_CASE(VK_NOT_READY)
+    RETILE_VK_CASE(VK_TIMEOUT)
+    RETILE_VK_CASE(VK_EVENT_SET)
+    RETILE_VK_CASE(VK_EVENT_RESET)
+    RETILE_VK_CASE(VK_INCOMPLETE)
+    RETILE_VK_CASE(VK_ERROR_OUT_OF_HOST_MEMORY)
+    RETILE_VK_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY)
+    RETILE_VK_CASE(VK_ERROR_INITIALIZATION_FAILED)
+    RETILE_VK_CASE(VK_ERROR_DEVICE_LOST)
+    RETILE_VK_CASE(VK_ERROR_MEMORY_MAP_FAILED)
+    RETILE_VK_CASE(VK_ERROR_LAYER_NOT_PRESENT)
+    RETILE_VK_CASE(VK_ERROR_EXTENSION_NOT_PRESENT)
+    RETILE_VK_CASE(VK_ERROR_FEATURE_NOT_PRESENT)
+    RETILE_VK_CASE(VK_ERROR_INCOMPATIBLE_DRIVER)
+    RETILE_VK_CASE(VK_ERROR_TOO_MANY_OBJECTS)
+    RETILE_VK_CASE(VK_ERROR_FORMAT_NOT_SUPPORTED)
+    RETILE_VK_CASE(VK_ERROR_FRAGMENTED_POOL)
+    RETILE_VK_CASE(VK_ERROR_UNKNOWN)
+    RETILE_VK_CASE(VK_ERROR_OUT_OF_POOL_MEMORY)
+    RETILE_VK_CASE(VK_ERROR_INVALID_EXTERNAL_HANDLE)
+    RETILE_VK_CASE(VK_ERROR_FRAGMENTATION)
+#undef RETILE_VK_CASE
+    default: return "VK_ERROR_(unnamed)";
+  }
+}
+
+void throwVk(VkResult r, const char* what) {
+  std::string message = cat("Vulkan: ", what, " failed: ", resultName(r), " (", static_cast<int>(r), ")");
+  if (r == VK_ERROR_DEVICE_LOST) throw DeviceLost(message);
+  throw Error(message);
+}
+
+namespace {
+
+VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                             VkDebugUtilsMessageTypeFlagsEXT,
+                                             const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
+  LogLevel level = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? LogLevel::Error : LogLevel::Warning;
+  logMessage(level, cat("Vulkan validation: ", data && data->pMessage ? data->pMessage : "?"));
+  return VK_FALSE;
+}
+
+int typeRank(VkPhysicalDeviceType t) {
+  switch (t) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
+    default: return 4;
+  }
+}
+
+bool hasLayer(const char* name) {
+  std::uint32_t n = 0;
+  vkEnumerateInstanceLayerProperties(&n, nullptr);
+  std::vector<VkLayerProperties> layers(n);
+  vkEnumerateInstanceLayerProperties(&n, layers.data());
+  return std::any_of(layers.begin(), layers.end(), [&](const auto& l) { return std::strcmp(l.layerName, name) == 0; });
+}
+
+}  // namespace
+
+Context::Context(const DeviceChoice& choiceIn) {
+  DeviceChoice choice = choiceIn;
+  if (const char* env = std::getenv("RETILE_DEVICE"); env && *env) choice.preferred = env;
+  if (const char* env = std::getenv("RETILE_VALIDATION"); env && *env) choice.validation = std::strcmp(env, "0") != 0;
+
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "Retile";
+  app.pEngineName = "Retile";
+  app.apiVersion = VK_API_VERSION_1_2;
+
+  std::vector<const char*> layers, extensions;
+  const char* kValidation = "VK_LAYER_KHRONOS_validation";
+  if (choice.validation) {
+    if (hasLayer(kValidation)) {
+      layers.push_back(kValidation);
+      extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    } else {
+      logWarning("Vulkan validation requested but ", kValidation, " is not installed (package vulkan-validationlayers)");
+    }
+  }
+  VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  ici.pApplicationInfo = &app;
+  ici.enabledLayerCount = static_cast<std::uint32_t>(layers.size());
+  ici.ppEnabledLayerNames = layers.data();
+  ici.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
+  ici.ppEnabledExtensionNames = extensions.data();
+  VkResult r = vkCreateInstance(&ici, nullptr, &instance_);
+  if (r == VK_ERROR_INCOMPATIBLE_DRIVER)
+    throw Error("Vulkan: no Vulkan 1.2 driver found (on Debian, install mesa-vulkan-drivers for the CPU driver lavapipe)");
+  checkVk(r, "creating the Vulkan instance");
+
+  if (!layers.empty()) {
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+    if (create) {
+      VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+      mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+      mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                        VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+      mci.pfnUserCallback = debugCallback;
+      checkVk(create(instance_, &mci, nullptr, &messenger_), "creating the validation messenger");
+    }
+  }
+
+  std::uint32_t count = 0;
+  checkVk(vkEnumeratePhysicalDevices(instance_, &count, nullptr), "enumerating devices");
+  std::vector<VkPhysicalDevice> devices(count);
+  checkVk(vkEnumeratePhysicalDevices(instance_, &count, devices.data()), "enumerating devices");
+
+  struct Candidate {
+    VkPhysicalDevice dev;
+    VkPhysicalDeviceProperties props;
+    std::uint32_t family;
+  };
+  std::vector<Candidate> usable;
+  for (VkPhysicalDevice d : devices) {
+    VkPhysicalDeviceProperties p;
+    vkGetPhysicalDeviceProperties(d, &p);
+    if (p.apiVersion < VK_API_VERSION_1_2) continue;
+    std::uint32_t nq = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(d, &nq, nullptr);
+    std::vector<VkQueueFamilyProperties> qs(nq);
+    vkGetPhysicalDeviceQueueFamilyProperties(d, &nq, qs.data());
+    for (std::uint32_t i = 0; i < nq; ++i)
+      if (qs[i].queueFlags & VK_QUEUE_COMPUTE_BIT) {
+        usable.push_back({d, p, i});
+        break;
+      }
+  }
+  if (usable.empty())
+    throw Error("Vulkan: no device with Vulkan 1.2 compute found (on Debian, install mesa-vulkan-drivers for lavapipe)");
+  std::stable_sort(usable.begin(), usable.end(), [](const Candidate& a, const Candidate& b) {
+    return typeRank(a.props.deviceType) < typeRank(b.props.deviceType);
+  });
+  const Candidate* chosen = &usable.front();
+  if (!choice.preferred.empty()) {
+    const Candidate* match = nullptr;
+    char* end = nullptr;
+    long index = std::strtol(choice.preferred.c_str(), &end, 10);
+    if (end && *end == '\0' && index >= 0 && index < static_cast<long>(usable.size())) {
+      match = &usable[static_cast<std::size_t>(index)];
+    } else {
+      for (const auto& c : usable)
+        if (std::strstr(c.props.deviceName, choice.preferred.c_str())) match = &c;
+    }
+    if (match) {
+      chosen = match;
+    } else {
+      logWarning("Vulkan: no device matches RETILE_DEVICE='", choice.preferred, "'; using ", chosen->props.deviceName);
+    }
+  }
+  physical_ = chosen->dev;
+  props_ = chosen->props;
+  queueFamily_ = chosen->family;
+  name_ = props_.deviceName;
+  vkGetPhysicalDeviceMemoryProperties(physical_, &memProps_);
+
+  float priority = 1.0f;
+  VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  qci.queueFamilyIndex = queueFamily_;
+  qci.queueCount = 1;
+  qci.pQueuePriorities = &priority;
+  VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  dci.queueCreateInfoCount = 1;
+  dci.pQueueCreateInfos = &qci;
+  checkVk(vkCreateDevice(physical_, &dci, nullptr, &device_), "creating the device");
+  vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
+
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pci.queueFamilyIndex = queueFamily_;
+  checkVk(vkCreateCommandPool(device_, &pci, nullptr, &pool_), "creating a command pool");
+  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  checkVk(vkCreateFence(device_, &fci, nullptr, &fence_), "creating a fence");
+  logInfo("Vulkan device: ", name_);
+}
+
+Context::~Context() {
+  if (device_) {
+    vkDeviceWaitIdle(device_);
+    if (fence_) vkDestroyFence(device_, fence_, nullptr);
+    if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
+    vkDestroyDevice(device_, nullptr);
+  }
+  if (messenger_) {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+    if (destroy) destroy(instance_, messenger_, nullptr);
+  }
+  if (instance_) vkDestroyInstance(instance_, nullptr);
+}
+
+std::uint32_t Context::memoryType(std::uint32_t bits, VkMemoryPropertyFlags wanted, VkMemoryPropertyFlags fallback) const {
+  for (VkMemoryPropertyFlags flags : {wanted, fallback})
+    for (std::uint32_t i = 0; i < memProps_.memoryTypeCount; ++i)
+      if ((bits & (1u << i)) && (memProps_.memoryTypes[i].propertyFlags & flags) == flags) return i;
+  throw Error("Vulkan: no suitable memory type for a buffer");
+}
+
+void Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record) {
+  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  ai.commandPool = pool_;
+  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ai.commandBufferCount = 1;
+  VkCommandBuffer cb;
+  checkVk(vkAllocateCommandBuffers(device_, &ai, &cb), "allocating a command buffer");
+  struct Free {
+    VkDevice d;
+    VkCommandPool p;
+    VkCommandBuffer c;
+    ~Free() { vkFreeCommandBuffers(d, p, 1, &c); }
+  } freeLater{device_, pool_, cb};
+  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  checkVk(vkBeginCommandBuffer(cb, &bi), "beginning a command buffer");
+  record(cb);
+  checkVk(vkEndCommandBuffer(cb), "ending a command buffer");
+  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cb;
+  checkVk(vkResetFences(device_, 1, &fence_), "resetting a fence");
+  checkVk(vkQueueSubmit(queue_, 1, &si, fence_), "submitting work");
+  checkVk(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "waiting for the device");
+}
+
+}  // namespace retile::vk

@@ -1,0 +1,74 @@
+#version 460
+// Accumulate pass: one invocation per served pixel. Reduces the pixel's q samples of this frame
+// (exactly, for any q) and adds them to its running sum, or replaces the sum when the work
+// item restarts the pixel. Sums use compensated (Kahan) addition so that thousands of samples
+// do not drift.
+#extension GL_GOOGLE_include_directive : require
+
+#include "shared/layouts.h"
+
+layout(local_size_x = kAccumulateWorkgroup) in;
+
+layout(set = 0, binding = 0, std140) uniform Frame { FrameUniforms frame; };
+layout(set = 0, binding = 1, std430) readonly buffer Work { WorkItem items[]; };
+layout(set = 0, binding = 2, std430) readonly buffer Samples { vec4 samples[]; };
+layout(set = 0, binding = 3, std430) readonly buffer Aux { vec4 aux[]; };
+// Per pixel: [0] colour sum.rgb, sample count; [1] compensation.rgb, -.
+layout(set = 0, binding = 4, std430) buffer Accum { vec4 accum[]; };
+// Per pixel: [0] albedo sum.rgb, depth; [1] normal sum.xyz, instance id.
+layout(set = 0, binding = 5, std430) buffer AccumAux { vec4 accumAux[]; };
+
+layout(push_constant) uniform Push { AccumulatePush push; };
+
+int findItem(uint pixel) {
+  int lo = 0, hi = int(push.itemCount) - 1;
+  while (lo < hi) {
+    int mid = (lo + hi + 1) >> 1;
+    if (items[mid].pixels.x <= pixel) lo = mid; else hi = mid - 1;
+  }
+  return lo;
+}
+
+void main() {
+  uint local = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * uint(kAccumulateWorkgroup) + gl_LocalInvocationID.x;
+  if (local >= push.pixelCount) return;
+  uint k = push.pixelOffset + local;
+  WorkItem item = items[findItem(k)];
+  uint p = k - item.pixels.x;
+  uint pixels = uint(item.rect.z * item.rect.w);
+  int px = item.rect.x + int(p % uint(item.rect.z));
+  int py = item.rect.y + int(p / uint(item.rect.z));
+  uint pixel = uint(py) * frame.image.x + uint(px);
+
+  precise vec3 sum = vec3(0.0);
+  precise float count = 0.0;
+  vec3 albedo = vec3(0.0), normal = vec3(0.0);
+  float depth = 1e30;
+  float instance = intBitsToFloat(0);
+  for (uint r = 0u; r < item.info.x; ++r) {
+    uint slot = item.info.y + r * pixels + p;
+    vec4 s = samples[slot];
+    sum += s.rgb;
+    count += s.w;
+    vec4 a0 = aux[slot * 2u], a1 = aux[slot * 2u + 1u];
+    albedo += a0.rgb;
+    normal += a1.xyz;
+    depth = min(depth, a0.w);
+    if (r == 0u) instance = a1.w;
+  }
+
+  bool restart = (item.info.w & kWorkRestart) != 0u;
+  vec4 acc = restart ? vec4(0.0) : accum[pixel * 2u];
+  vec4 comp = restart ? vec4(0.0) : accum[pixel * 2u + 1u];
+  // Kahan: add (sum - compensation); the new compensation is what the addition lost.
+  precise vec3 y = sum - comp.rgb;
+  precise vec3 t = acc.rgb + y;
+  precise vec3 c = (t - acc.rgb) - y;
+  accum[pixel * 2u] = vec4(t, acc.w + count);
+  accum[pixel * 2u + 1u] = vec4(c, 0.0);
+
+  vec4 aa = restart ? vec4(0.0, 0.0, 0.0, 1e30) : accumAux[pixel * 2u];
+  vec4 an = restart ? vec4(0.0) : accumAux[pixel * 2u + 1u];
+  accumAux[pixel * 2u] = vec4(aa.rgb + albedo, min(aa.w, depth));
+  accumAux[pixel * 2u + 1u] = vec4(an.xyz + normal, instance);
+}

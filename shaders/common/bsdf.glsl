@@ -1,0 +1,346 @@
+// The materials of scene.h, evaluated and sampled in a local frame whose z axis is the shading
+// normal. eval returns f * |cos(wi)|; sample returns that divided by the pdf. Opaque materials
+// expect wo.z > 0 (the caller makes surfaces two-sided); dielectrics use the sign of wo.z to
+// tell entering from leaving.
+#ifndef RETILE_BSDF_GLSL
+#define RETILE_BSDF_GLSL
+
+#include "shared/layouts.h"
+#include "common/sampling.glsl"
+
+struct Material {
+  int type;
+  vec3 albedo;
+  float roughness;   // GGX alpha, or Oren-Nayar sigma
+  float ior;
+  float fdrInt;      // plastic: internal diffuse Fresnel reflectance of the coating
+  vec3 eta;
+  vec3 k;
+  vec3 emission;
+};
+
+struct BsdfSample {
+  vec3 wi;
+  vec3 weight;  // f * |cos| / pdf
+  float pdf;    // solid angle; meaningless when delta
+  bool delta;
+  bool transmitted;
+};
+
+// Materials with only delta lobes: light sampling cannot reach them. Smooth plastic is not one:
+// its diffuse base takes light samples and its specular lobe is sampled inside bsdfSample.
+bool isDeltaMaterial(Material m) {
+  return m.type == kMatConductor || m.type == kMatMirror || m.type == kMatDielectric || m.type == kMatThinSheet ||
+         m.type == kMatNull;
+}
+
+bool isTransmissive(Material m) {
+  return m.type == kMatDielectric || m.type == kMatRoughDielectric || m.type == kMatThinSheet;
+}
+
+// Unpolarised Fresnel reflectance at a dielectric boundary; eta = n_transmitted / n_incident,
+// cosI >= 0. Returns 1 for total internal reflection.
+float fresnelDielectric(float cosI, float eta, out float cosT) {
+  float sin2T = (1.0 - cosI * cosI) / (eta * eta);
+  if (sin2T >= 1.0) {
+    cosT = 0.0;
+    return 1.0;
+  }
+  cosT = sqrt(1.0 - sin2T);
+  float rs = (cosI - eta * cosT) / (cosI + eta * cosT);
+  float rp = (eta * cosI - cosT) / (eta * cosI + cosT);
+  return 0.5 * (rs * rs + rp * rp);
+}
+
+float fresnelDielectric(float cosI, float eta) {
+  float cosT;
+  return fresnelDielectric(cosI, eta, cosT);
+}
+
+// Exact unpolarised reflectance of a conductor with complex index eta + i k.
+vec3 fresnelConductor(float cosI, vec3 eta, vec3 k) {
+  float c2 = cosI * cosI;
+  float s2 = 1.0 - c2;
+  vec3 eta2 = eta * eta, k2 = k * k;
+  vec3 t0 = eta2 - k2 - s2;
+  vec3 a2b2 = sqrt(max(t0 * t0 + 4.0 * eta2 * k2, vec3(0.0)));
+  vec3 t1 = a2b2 + c2;
+  vec3 a = sqrt(max(0.5 * (a2b2 + t0), vec3(0.0)));
+  vec3 t2 = 2.0 * cosI * a;
+  vec3 rs = (t1 - t2) / max(t1 + t2, vec3(1e-12));
+  vec3 t3 = c2 * a2b2 + s2 * s2;
+  vec3 t4 = t2 * s2;
+  vec3 rp = rs * (t3 - t4) / max(t3 + t4, vec3(1e-12));
+  return clamp(0.5 * (rp + rs), 0.0, 1.0);
+}
+
+float ggxD(vec3 h, float a) {
+  float a2 = a * a;
+  float c = h.z * h.z * (a2 - 1.0) + 1.0;
+  return a2 / (PI * c * c);
+}
+
+float ggxLambda(vec3 w, float a) {
+  float c2 = w.z * w.z;
+  if (c2 >= 1.0) return 0.0;
+  float t2 = (1.0 - c2) / max(c2, 1e-12);
+  return 0.5 * (-1.0 + sqrt(1.0 + a * a * t2));
+}
+
+float ggxG1(vec3 w, float a) { return 1.0 / (1.0 + ggxLambda(w, a)); }
+float ggxG2(vec3 wo, vec3 wi, float a) { return 1.0 / (1.0 + ggxLambda(wo, a) + ggxLambda(wi, a)); }
+
+// Heitz 2018: sample a microfacet normal from the distribution of normals visible from wo.
+vec3 sampleGgxVisibleNormal(vec3 wo, float a, vec2 u) {
+  vec3 vh = normalize(vec3(a * wo.x, a * wo.y, wo.z));
+  float lensq = vh.x * vh.x + vh.y * vh.y;
+  vec3 t1 = lensq > 0.0 ? vec3(-vh.y, vh.x, 0.0) / sqrt(lensq) : vec3(1.0, 0.0, 0.0);
+  vec3 t2 = cross(vh, t1);
+  float r = sqrt(u.x);
+  float phi = 2.0 * PI * u.y;
+  float p1 = r * cos(phi);
+  float p2 = r * sin(phi);
+  float s = 0.5 * (1.0 + vh.z);
+  p2 = (1.0 - s) * sqrt(max(0.0, 1.0 - p1 * p1)) + s * p2;
+  vec3 nh = p1 * t1 + p2 * t2 + sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
+  return normalize(vec3(a * nh.x, a * nh.y, max(1e-6, nh.z)));
+}
+
+// pdf of wi = reflect(wo, h) under visible-normal sampling.
+float ggxReflectionPdf(vec3 wo, vec3 h, float a) { return ggxD(h, a) * ggxG1(wo, a) / (4.0 * wo.z); }
+
+float plasticSpecularProbability(Material m, float cosO) {
+  float fo = fresnelDielectric(cosO, m.ior);
+  float diffuse = (1.0 - fo) * luminance(m.albedo);
+  return clamp(fo / max(fo + diffuse, 1e-6), 0.05, 0.95);
+}
+
+// Lambertian base under a dielectric coating: both Fresnel transmissions, the 1/eta^2 of
+// leaving the denser layer, and the sum of internal reflections (1 - albedo * fdrInt).
+vec3 plasticDiffuse(Material m, vec3 wo, vec3 wi) {
+  float fo = fresnelDielectric(wo.z, m.ior);
+  float fi = fresnelDielectric(wi.z, m.ior);
+  vec3 base = m.albedo / (1.0 - m.albedo * m.fdrInt);
+  return base * (INV_PI * (1.0 - fo) * (1.0 - fi) / (m.ior * m.ior));
+}
+
+float orenNayarFactor(Material m, vec3 wo, vec3 wi) {
+  float s2 = m.roughness * m.roughness;
+  float A = 1.0 - 0.5 * s2 / (s2 + 0.33);
+  float B = 0.45 * s2 / (s2 + 0.09);
+  float sinO = sqrt(max(0.0, 1.0 - wo.z * wo.z)), sinI = sqrt(max(0.0, 1.0 - wi.z * wi.z));
+  float cosPhi = 0.0;
+  if (sinO > 1e-4 && sinI > 1e-4) cosPhi = max(0.0, (wo.x * wi.x + wo.y * wi.y) / (sinO * sinI));
+  float sinAlpha = wo.z < wi.z ? sinO : sinI;
+  float tanBeta = wo.z < wi.z ? sinI / max(wi.z, 1e-6) : sinO / max(wo.z, 1e-6);
+  return A + B * cosPhi * sinAlpha * tanBeta;
+}
+
+// f * |cos(wi)| and the pdf sample() would have for wi. Zero for delta lobes.
+vec3 bsdfEval(Material m, vec3 wo, vec3 wi, out float pdf) {
+  pdf = 0.0;
+  int t = m.type;
+  if (t == kMatRoughDielectric) {
+    float a = m.roughness;
+    bool entering = wo.z > 0.0;
+    float eta = entering ? m.ior : 1.0 / m.ior;
+    vec3 o = entering ? wo : -wo;
+    vec3 i = entering ? wi : -wi;
+    if (o.z <= 0.0 || i.z == 0.0) return vec3(0.0);
+    if (i.z > 0.0) {
+      vec3 h = normalize(o + i);
+      float F = fresnelDielectric(dot(o, h), eta);
+      float D = ggxD(h, a);
+      pdf = F * D * ggxG1(o, a) / (4.0 * o.z);
+      return vec3(F * D * ggxG2(o, i, a) / (4.0 * o.z));
+    }
+    vec3 h = -(o + eta * i);
+    float hl = length(h);
+    if (hl <= 0.0) return vec3(0.0);
+    h /= hl;
+    if (h.z < 0.0) h = -h;
+    float oh = dot(o, h), ih = dot(i, h);
+    if (oh <= 0.0 || ih >= 0.0) return vec3(0.0);
+    float F = fresnelDielectric(oh, eta);
+    float D = ggxD(h, a);
+    float denom = oh + eta * ih;
+    float jac = eta * eta * abs(ih) / (denom * denom);
+    pdf = (1.0 - F) * D * ggxG1(o, a) * oh / o.z * jac;
+    float f = abs(ih) * oh / (o.z * abs(i.z)) * (1.0 - F) * D * ggxG2(o, i, a) / (denom * denom);
+    return m.albedo * (f * abs(i.z));
+  }
+  if (wo.z <= 0.0 || wi.z <= 0.0 || isDeltaMaterial(m)) return vec3(0.0);
+  if (t == kMatLambert) {
+    pdf = wi.z * INV_PI;
+    return m.albedo * (INV_PI * wi.z);
+  }
+  if (t == kMatOrenNayar) {
+    pdf = wi.z * INV_PI;
+    return m.albedo * (INV_PI * orenNayarFactor(m, wo, wi) * wi.z);
+  }
+  if (t == kMatPlastic) {
+    float ps = plasticSpecularProbability(m, wo.z);
+    pdf = (1.0 - ps) * wi.z * INV_PI;
+    return plasticDiffuse(m, wo, wi) * wi.z;
+  }
+  if (t == kMatRoughPlastic) {
+    float a = m.roughness;
+    vec3 h = normalize(wo + wi);
+    float F = fresnelDielectric(dot(wo, h), m.ior);
+    float D = ggxD(h, a);
+    float spec = F * D * ggxG2(wo, wi, a) / (4.0 * wo.z * wi.z);
+    float ps = plasticSpecularProbability(m, wo.z);
+    pdf = ps * ggxReflectionPdf(wo, h, a) + (1.0 - ps) * wi.z * INV_PI;
+    return (vec3(spec) + plasticDiffuse(m, wo, wi)) * wi.z;
+  }
+  if (t == kMatRoughConductor) {
+    float a = m.roughness;
+    vec3 h = normalize(wo + wi);
+    float D = ggxD(h, a);
+    vec3 F = fresnelConductor(dot(wo, h), m.eta, m.k);
+    pdf = ggxReflectionPdf(wo, h, a);
+    return m.albedo * F * (D * ggxG2(wo, wi, a) / (4.0 * wo.z));
+  }
+  return vec3(0.0);
+}
+
+BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
+  BsdfSample s;
+  s.wi = vec3(0.0, 0.0, 1.0);
+  s.weight = vec3(0.0);
+  s.pdf = 0.0;
+  s.delta = false;
+  s.transmitted = false;
+  int t = m.type;
+  if (t == kMatDielectric || t == kMatThinSheet) {
+    bool entering = wo.z > 0.0;
+    float cosO = abs(wo.z);
+    float eta = entering ? m.ior : 1.0 / m.ior;
+    float cosT;
+    float F = fresnelDielectric(cosO, eta, cosT);
+    s.delta = true;
+    if (t == kMatThinSheet) {
+      // Both faces of a thin film: R + T^2 R / (1 - R^2) reflected in total, the rest passes.
+      float Fs = fresnelDielectric(cosO, m.ior);
+      float R = Fs < 1.0 ? 2.0 * Fs / (1.0 + Fs) : 1.0;
+      if (u.x < R) {
+        s.wi = vec3(-wo.x, -wo.y, wo.z);
+        s.weight = vec3(1.0);
+        s.pdf = R;
+      } else {
+        s.wi = -wo;
+        s.weight = m.albedo;
+        s.pdf = 1.0 - R;
+        s.transmitted = true;
+      }
+      return s;
+    }
+    if (u.x < F) {
+      s.wi = vec3(-wo.x, -wo.y, wo.z);
+      s.weight = vec3(1.0);
+      s.pdf = F;
+    } else {
+      float inv = 1.0 / eta;
+      s.wi = normalize(vec3(-wo.x * inv, -wo.y * inv, entering ? -cosT : cosT));
+      // Radiance is compressed by 1/eta^2 on entering and expanded on leaving.
+      s.weight = m.albedo * (inv * inv);
+      s.pdf = 1.0 - F;
+      s.transmitted = true;
+    }
+    return s;
+  }
+  if (t == kMatRoughDielectric) {
+    float a = m.roughness;
+    bool entering = wo.z > 0.0;
+    float eta = entering ? m.ior : 1.0 / m.ior;
+    vec3 o = entering ? wo : -wo;
+    if (o.z <= 0.0) return s;
+    vec3 h = sampleGgxVisibleNormal(o, a, u.xy);
+    float oh = dot(o, h);
+    if (oh <= 0.0) return s;
+    float F = fresnelDielectric(oh, eta);
+    vec3 i;
+    if (u.z < F) {
+      i = reflect(-o, h);
+      if (i.z <= 0.0) return s;
+      s.weight = vec3(ggxG2(o, i, a) / ggxG1(o, a));
+    } else {
+      i = refract(-o, h, 1.0 / eta);
+      if (i.z >= 0.0 || dot(i, i) == 0.0) return s;
+      s.weight = m.albedo * (ggxG2(o, i, a) / ggxG1(o, a) / (eta * eta));
+      s.transmitted = true;
+    }
+    s.wi = entering ? i : -i;
+    float p;
+    bsdfEval(m, wo, s.wi, p);
+    s.pdf = p;
+    if (!(p > 0.0)) s.weight = vec3(0.0);
+    return s;
+  }
+  if (wo.z <= 0.0) return s;
+  if (t == kMatMirror) {
+    s.wi = vec3(-wo.x, -wo.y, wo.z);
+    s.weight = m.albedo;
+    s.pdf = 1.0;
+    s.delta = true;
+    return s;
+  }
+  if (t == kMatConductor) {
+    s.wi = vec3(-wo.x, -wo.y, wo.z);
+    s.weight = m.albedo * fresnelConductor(wo.z, m.eta, m.k);
+    s.pdf = 1.0;
+    s.delta = true;
+    return s;
+  }
+  if (t == kMatRoughConductor) {
+    float a = m.roughness;
+    vec3 h = sampleGgxVisibleNormal(wo, a, u.xy);
+    vec3 i = reflect(-wo, h);
+    if (i.z <= 0.0) return s;
+    s.wi = i;
+    s.pdf = ggxReflectionPdf(wo, h, a);
+    s.weight = m.albedo * fresnelConductor(dot(wo, h), m.eta, m.k) * (ggxG2(wo, i, a) / ggxG1(wo, a));
+    return s;
+  }
+  if (t == kMatPlastic) {
+    float ps = plasticSpecularProbability(m, wo.z);
+    if (u.z < ps) {
+      s.wi = vec3(-wo.x, -wo.y, wo.z);
+      s.weight = vec3(fresnelDielectric(wo.z, m.ior) / ps);
+      s.pdf = ps;
+      s.delta = true;
+      return s;
+    }
+    s.wi = sampleCosineHemisphere(u.xy);
+    float p;
+    vec3 f = bsdfEval(m, wo, s.wi, p);
+    s.pdf = p;
+    s.weight = p > 0.0 ? f / p : vec3(0.0);
+    return s;
+  }
+  if (t == kMatRoughPlastic) {
+    float ps = plasticSpecularProbability(m, wo.z);
+    if (u.z < ps) {
+      vec3 h = sampleGgxVisibleNormal(wo, m.roughness, u.xy);
+      s.wi = reflect(-wo, h);
+    } else {
+      s.wi = sampleCosineHemisphere(u.xy);
+    }
+    if (s.wi.z <= 0.0) return s;
+    float p;
+    vec3 f = bsdfEval(m, wo, s.wi, p);
+    s.pdf = p;
+    s.weight = p > 0.0 ? f / p : vec3(0.0);
+    return s;
+  }
+  // Lambert and Oren-Nayar: cosine-weighted hemisphere.
+  s.wi = sampleCosineHemisphere(u.xy);
+  if (s.wi.z <= 0.0) return s;
+  float p;
+  vec3 f = bsdfEval(m, wo, s.wi, p);
+  s.pdf = p;
+  s.weight = p > 0.0 ? f / p : vec3(0.0);
+  return s;
+}
+
+#endif

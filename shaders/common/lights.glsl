@@ -1,0 +1,179 @@
+// Light sources for next-event estimation and MIS: emissive triangles (alias table by power),
+// the environment (constant, or an equirectangular map importance-sampled by luminance) and
+// delta lights (point, spot, directional).
+#ifndef RETILE_LIGHTS_GLSL
+#define RETILE_LIGHTS_GLSL
+
+#include "common/scene.glsl"
+
+// Equirectangular convention (Tungsten's): the top row is straight up (+y), the centre column
+// looks along +x and u grows towards +z; the environment's rotation turns it about +y.
+vec2 directionToEnvUv(vec3 d) {
+  float phi = atan(d.z, d.x) + frame.environmentTint.w;
+  float u = phi * (0.5 * INV_PI) + 0.5;
+  u -= floor(u);
+  float v = acos(clamp(d.y, -1.0, 1.0)) * INV_PI;
+  return vec2(u, v);
+}
+
+vec3 envUvToDirection(vec2 uv) {
+  float phi = 2.0 * PI * (uv.x - 0.5) - frame.environmentTint.w;
+  float theta = PI * uv.y;
+  float s = sin(theta);
+  return vec3(s * cos(phi), cos(theta), s * sin(phi));
+}
+
+ivec2 envTexel(vec2 uv) {
+  ivec2 size = frame.environment.zw;
+  return clamp(ivec2(uv * vec2(size)), ivec2(0), size - 1);
+}
+
+vec3 envTexelRadiance(ivec2 t) {
+  vec4 info = texelFetch(uTexInfo, frame.environment.y * kTextureTexels);
+  int offset = floatBitsToInt(info.x);
+  return texelFetch(uTexels, offset + t.y * frame.environment.z + t.x).rgb * frame.environmentTint.rgb;
+}
+
+vec3 envRadiance(vec3 d) {
+  int type = frame.environment.x;
+  if (type == kEnvConstant) return frame.environmentTint.rgb;
+  if (type == kEnvMap) return envTexelRadiance(envTexel(directionToEnvUv(d)));
+  return vec3(0.0);
+}
+
+// Density (solid angle) with which sampleEnvironment picks direction d.
+float envPdf(vec3 d) {
+  int type = frame.environment.x;
+  if (type == kEnvConstant) return 1.0 / (4.0 * PI);
+  if (type != kEnvMap) return 0.0;
+  vec2 uv = directionToEnvUv(d);
+  ivec2 t = envTexel(uv);
+  float norm = texelFetch(uEnvCdf, 0).x;
+  float sinActual = sqrt(max(0.0, 1.0 - d.y * d.y));
+  if (norm <= 0.0 || sinActual <= 1e-6) return 0.0;
+  float sinRow = sin(PI * (float(t.y) + 0.5) / float(frame.environment.w));
+  vec4 info = texelFetch(uTexInfo, frame.environment.y * kTextureTexels);
+  vec3 c = texelFetch(uTexels, floatBitsToInt(info.x) + t.y * frame.environment.z + t.x).rgb;
+  return luminance(c) * sinRow / (norm * 2.0 * PI * PI * sinActual);
+}
+
+// Largest index i in [0, n) with cdf[base + i] <= u.
+int searchCdf(int base, int n, float u) {
+  int lo = 0, hi = n;  // cdf[base] = 0, cdf[base + n] = 1
+  while (hi - lo > 1) {
+    int mid = (lo + hi) >> 1;
+    if (texelFetch(uEnvCdf, base + mid).x <= u) lo = mid; else hi = mid;
+  }
+  return lo;
+}
+
+vec3 sampleEnvironment(vec2 u, out vec3 radiance, out float pdf) {
+  int type = frame.environment.x;
+  if (type == kEnvConstant) {
+    radiance = frame.environmentTint.rgb;
+    pdf = 1.0 / (4.0 * PI);
+    return sampleUniformSphere(u);
+  }
+  int w = frame.environment.z, h = frame.environment.w;
+  int marginal = 1;
+  int row = searchCdf(marginal, h, u.y);
+  float r0 = texelFetch(uEnvCdf, marginal + row).x, r1 = texelFetch(uEnvCdf, marginal + row + 1).x;
+  float fy = r1 > r0 ? (u.y - r0) / (r1 - r0) : 0.5;
+  int condBase = 1 + (h + 1) + row * (w + 1);
+  int col = searchCdf(condBase, w, u.x);
+  float c0 = texelFetch(uEnvCdf, condBase + col).x, c1 = texelFetch(uEnvCdf, condBase + col + 1).x;
+  float fx = c1 > c0 ? (u.x - c0) / (c1 - c0) : 0.5;
+  vec2 uv = vec2((float(col) + clamp(fx, 0.0, 0.999)) / float(w), (float(row) + clamp(fy, 0.0, 0.999)) / float(h));
+  vec3 d = envUvToDirection(uv);
+  radiance = envRadiance(d);
+  pdf = envPdf(d);
+  return d;
+}
+
+struct LightSample {
+  vec3 dir;       // from the shading point towards the light
+  float dist;     // kInfinity for the environment and directional lights
+  vec3 radiance;  // arriving radiance (or, for delta lights, irradiance-like intensity / dist^2)
+  float pdf;      // solid angle, including the choice of light; for delta lights the pick probability
+  bool delta;
+};
+
+// Picks one light in proportion to frame.lightPick and samples it as seen from p.
+LightSample sampleLight(vec3 p, vec3 u) {
+  LightSample ls;
+  ls.dir = vec3(0.0, 1.0, 0.0);
+  ls.dist = kInfinity;
+  ls.radiance = vec3(0.0);
+  ls.pdf = 0.0;
+  ls.delta = false;
+  float pe = frame.lightPick.x, pv = frame.lightPick.y;
+  if (u.z < pe) {
+    int n = frame.scene.z;
+    float scaled = u.x * float(n);
+    int i = min(int(scaled), n - 1);
+    float frac = scaled - float(i);
+    vec4 alias = texelFetch(uEmitterAlias, i);
+    int e = frac < alias.x ? i : floatBitsToInt(alias.y);
+    int base = e * kEmitterTexels;
+    vec4 t0 = texelFetch(uEmitters, base), t1 = texelFetch(uEmitters, base + 1), t2 = texelFetch(uEmitters, base + 2);
+    vec4 t3 = texelFetch(uEmitters, base + 3), t4 = texelFetch(uEmitters, base + 4);
+    // The fraction left over from the alias choice is again uniform: reuse it for the point.
+    float reuse = frac < alias.x ? frac / max(alias.x, 1e-7) : (frac - alias.x) / max(1.0 - alias.x, 1e-7);
+    vec2 b = sampleTriangle(vec2(clamp(reuse, 0.0, 0.9999999), u.y));
+    vec3 q = t0.xyz + b.x * t1.xyz + b.y * t2.xyz;
+    vec3 toL = q - p;
+    float d2 = dot(toL, toL);
+    float d = sqrt(d2);
+    if (d <= 0.0) return ls;
+    ls.dir = toL / d;
+    float cosL = -dot(t4.xyz, ls.dir);
+    if (cosL <= 0.0 || t0.w <= 0.0) return ls;  // emitters shine from their front only
+    ls.dist = d;
+    ls.radiance = t3.rgb;
+    ls.pdf = pe * t3.w * d2 / (cosL * t0.w);
+    return ls;
+  }
+  if (u.z < pe + pv) {
+    float pdf;
+    ls.dir = sampleEnvironment(u.xy, ls.radiance, pdf);
+    ls.pdf = pv * pdf;
+    return ls;
+  }
+  int n = frame.scene.w;
+  if (n == 0) return ls;
+  int i = min(int(u.x * float(n)), n - 1);
+  vec4 a = texelFetch(uDeltaLights, i * kDeltaLightTexels);
+  vec4 b = texelFetch(uDeltaLights, i * kDeltaLightTexels + 1);
+  vec4 c = texelFetch(uDeltaLights, i * kDeltaLightTexels + 2);
+  int type = floatBitsToInt(a.w);
+  ls.delta = true;
+  ls.pdf = frame.lightPick.z / float(n);
+  if (type == kLightDirectional) {
+    ls.dir = -b.xyz;
+    ls.radiance = c.rgb;
+    return ls;
+  }
+  vec3 toL = a.xyz - p;
+  float d2 = dot(toL, toL);
+  if (d2 <= 0.0) return ls;
+  ls.dist = sqrt(d2);
+  ls.dir = toL / ls.dist;
+  float falloff = 1.0;
+  if (type == kLightSpot) {
+    float cosA = dot(-ls.dir, b.xyz);
+    falloff = smoothstep(b.w, max(c.w, b.w + 1e-4), cosA);
+  }
+  ls.radiance = c.rgb * (falloff / d2);
+  return ls;
+}
+
+// pdf with which sampleLight would have chosen the emitter point hit by a BSDF ray.
+float emitterPdf(int emitter, vec3 from, vec3 hitPos, float cosL) {
+  vec4 t0 = texelFetch(uEmitters, emitter * kEmitterTexels);
+  vec4 t3 = texelFetch(uEmitters, emitter * kEmitterTexels + 3);
+  vec3 d = hitPos - from;
+  if (cosL <= 0.0 || t0.w <= 0.0) return 0.0;
+  return frame.lightPick.x * t3.w * dot(d, d) / (cosL * t0.w);
+}
+
+#endif

@@ -1,0 +1,206 @@
+// Scene data (read-only texel buffers: on lavapipe a texel fetch costs a fraction of an SSBO
+// load, see DESIGN.md) and ray traversal of the two-level BVH.
+#ifndef RETILE_SCENE_GLSL
+#define RETILE_SCENE_GLSL
+
+#include "shared/layouts.h"
+#include "common/sampling.glsl"
+
+layout(set = 0, binding = 0, std140) uniform Frame { FrameUniforms frame; };
+layout(set = 0, binding = 2) uniform samplerBuffer uNodes;
+layout(set = 0, binding = 3) uniform samplerBuffer uTris;
+layout(set = 0, binding = 4) uniform samplerBuffer uTriShade;
+layout(set = 0, binding = 5) uniform samplerBuffer uInstances;
+layout(set = 0, binding = 6) uniform samplerBuffer uMaterials;
+layout(set = 0, binding = 7) uniform samplerBuffer uTexInfo;
+layout(set = 0, binding = 8) uniform samplerBuffer uTexels;
+layout(set = 0, binding = 9) uniform samplerBuffer uEmitters;
+layout(set = 0, binding = 10) uniform samplerBuffer uEmitterAlias;
+layout(set = 0, binding = 11) uniform samplerBuffer uDeltaLights;
+layout(set = 0, binding = 12) uniform samplerBuffer uEnvCdf;
+
+const int kStackSize = 64;
+const float kInfinity = 1e30;
+
+struct Hit {
+  float t;
+  float u, v;
+  int prim;      // global packed triangle index, -1 for a miss
+  int instance;
+};
+
+// Texture lookup with repeat wrapping and bilinear filtering; checkers are analytic.
+vec4 sampleTexture(int index, vec2 uv) {
+  vec4 info = texelFetch(uTexInfo, index * kTextureTexels);
+  int kind = floatBitsToInt(info.w);
+  if ((kind & 15) == kTexChecker) {
+    vec4 on = texelFetch(uTexInfo, index * kTextureTexels + 1);
+    vec4 off = texelFetch(uTexInfo, index * kTextureTexels + 2);
+    ivec2 cell = ivec2(floor(uv * vec2(on.w, off.w)));
+    return ((cell.x ^ cell.y) & 1) != 0 ? vec4(on.rgb, 1.0) : vec4(off.rgb, 1.0);
+  }
+  int offset = floatBitsToInt(info.x);
+  int w = floatBitsToInt(info.y), h = floatBitsToInt(info.z);
+  // v points up in every format we import; image rows go down.
+  vec2 p = vec2(uv.x * float(w), (1.0 - uv.y) * float(h)) - 0.5;
+  vec2 f = fract(p);
+  ivec2 i0 = ivec2(floor(p));
+  i0 = ((i0 % ivec2(w, h)) + ivec2(w, h)) % ivec2(w, h);
+  ivec2 i1 = (i0 + 1) % ivec2(w, h);
+  vec4 a = texelFetch(uTexels, offset + i0.y * w + i0.x);
+  vec4 b = texelFetch(uTexels, offset + i0.y * w + i1.x);
+  vec4 c = texelFetch(uTexels, offset + i1.y * w + i0.x);
+  vec4 d = texelFetch(uTexels, offset + i1.y * w + i1.x);
+  return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
+}
+
+float sampleAlphaTexture(int index, vec2 uv) {
+  vec4 info = texelFetch(uTexInfo, index * kTextureTexels);
+  vec4 t = sampleTexture(index, uv);
+  return (floatBitsToInt(info.w) & 16) != 0 ? t.a : t.r;
+}
+
+vec2 triangleUv(int prim, float u, float v) {
+  vec4 s0 = texelFetch(uTriShade, prim * kTriShadeTexels + 0);
+  vec4 s1 = texelFetch(uTriShade, prim * kTriShadeTexels + 1);
+  vec4 s2 = texelFetch(uTriShade, prim * kTriShadeTexels + 2);
+  vec4 s3 = texelFetch(uTriShade, prim * kTriShadeTexels + 3);
+  vec2 t0 = vec2(s0.w, s1.w), t1 = vec2(s2.w, s3.x), t2 = s3.yz;
+  return (1.0 - u - v) * t0 + u * t1 + v * t2;
+}
+
+// Stochastic cut-out: a candidate hit on an alpha-tested instance counts with probability alpha.
+// The random number comes from the ray and the triangle, so a shadow ray and the camera agree.
+bool alphaPasses(int instance, int prim, float u, float v, float rayRandom) {
+  int material = floatBitsToInt(texelFetch(uInstances, instance * kInstanceTexels + 3).z);
+  vec4 m1 = texelFetch(uMaterials, material * kMaterialTexels + 1);
+  int alphaTex = floatBitsToInt(texelFetch(uMaterials, material * kMaterialTexels + 4).w);
+  float alpha = m1.z;
+  if (alphaTex >= 0) alpha *= sampleAlphaTexture(alphaTex, triangleUv(prim, u, v));
+  uint h = floatBitsToUint(rayRandom) ^ (uint(prim) * 2654435761u);
+  h = h * 747796405u + 2891336453u;
+  h = ((h >> ((h >> 28u) + 4u)) ^ h) * 277803737u;
+  float r = float(((h >> 22u) ^ h) >> 8) * (1.0 / 16777216.0);
+  return r < alpha;
+}
+
+bool slabTest(vec3 bmin, vec3 bmax, vec3 o, vec3 invD, float tMax, out float tNear) {
+  vec3 t0 = (bmin - o) * invD;
+  vec3 t1 = (bmax - o) * invD;
+  vec3 lo = min(t0, t1), hi = max(t0, t1);
+  tNear = max(max(lo.x, lo.y), max(lo.z, 0.0));
+  float tFar = min(min(hi.x, hi.y), min(hi.z, tMax));
+  return tNear <= tFar;
+}
+
+vec3 safeInverse(vec3 d) {
+  const float eps = 1e-12;
+  return vec3(abs(d.x) > eps ? 1.0 / d.x : (d.x >= 0.0 ? 1e30 : -1e30),
+              abs(d.y) > eps ? 1.0 / d.y : (d.y >= 0.0 ? 1e30 : -1e30),
+              abs(d.z) > eps ? 1.0 / d.z : (d.z >= 0.0 ? 1e30 : -1e30));
+}
+
+// Closest hit (anyHit == false) or any opaque hit (anyHit == true, for shadow rays).
+Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
+  Hit hit;
+  hit.t = tMax;
+  hit.prim = -1;
+  hit.instance = -1;
+  hit.u = 0.0;
+  hit.v = 0.0;
+  if (frame.scene.y == 0) return hit;
+
+  int stack[kStackSize];
+  int sp = 0;
+  int node = frame.scene.x;  // TLAS root
+  vec3 o = origin, d = dir, invD = safeInverse(dir);
+  int instance = -1;
+  int instFlags = 0;
+  int triOffset = 0;
+
+  for (;;) {
+    if (node == -1) {
+      // Marker: back from an instance to world space.
+      o = origin;
+      d = dir;
+      invD = safeInverse(dir);
+      instance = -1;
+    } else if (node <= -2) {
+      // Enter an instance: transform the ray (t is preserved because d is not renormalised).
+      instance = -node - 2;
+      int base = instance * kInstanceTexels;
+      vec4 r0 = texelFetch(uInstances, base), r1 = texelFetch(uInstances, base + 1), r2 = texelFetch(uInstances, base + 2);
+      vec4 info = texelFetch(uInstances, base + 3);
+      instFlags = floatBitsToInt(texelFetch(uInstances, base + 4).y);
+      o = vec3(dot(r0.xyz, origin) + r0.w, dot(r1.xyz, origin) + r1.w, dot(r2.xyz, origin) + r2.w);
+      d = vec3(dot(r0.xyz, dir), dot(r1.xyz, dir), dot(r2.xyz, dir));
+      invD = safeInverse(d);
+      triOffset = floatBitsToInt(info.y);
+      if (sp < kStackSize) stack[sp++] = -1;
+      node = floatBitsToInt(info.x);
+    }
+    if (node >= 0) {
+      vec4 a = texelFetch(uNodes, node * kNodeTexels + 0);
+      vec4 b = texelFetch(uNodes, node * kNodeTexels + 1);
+      vec4 c = texelFetch(uNodes, node * kNodeTexels + 2);
+      vec4 e = texelFetch(uNodes, node * kNodeTexels + 3);
+      int li = floatBitsToInt(a.w), lc = floatBitsToInt(b.w);
+      int ri = floatBitsToInt(c.w), rc = floatBitsToInt(e.w);
+      float tl, tr;
+      bool hl = lc >= 0 && slabTest(a.xyz, b.xyz, o, invD, hit.t, tl);
+      bool hr = rc >= 0 && slabTest(c.xyz, e.xyz, o, invD, hit.t, tr);
+      // Leaves: in the TLAS a leaf is one instance (pushed as an entry); in a BLAS, triangles.
+      for (int side = 0; side < 2; ++side) {
+        bool h = side == 0 ? hl : hr;
+        int cnt = side == 0 ? lc : rc;
+        if (!h || cnt <= 0) continue;
+        int start = side == 0 ? li : ri;
+        if (instance < 0) {
+          // Turned into an entry below, ordered like an inner node.
+          continue;
+        }
+        for (int p = start; p < start + cnt; ++p) {
+          vec3 v0 = texelFetch(uTris, p * kTriTexels).xyz;
+          vec3 e1 = texelFetch(uTris, p * kTriTexels + 1).xyz;
+          vec3 e2 = texelFetch(uTris, p * kTriTexels + 2).xyz;
+          vec3 pv = cross(d, e2);
+          float det = dot(e1, pv);
+          if (det == 0.0) continue;
+          float inv = 1.0 / det;
+          vec3 s = o - v0;
+          float uu = dot(s, pv) * inv;
+          if (uu < 0.0 || uu > 1.0) continue;
+          vec3 q = cross(s, e1);
+          float vv = dot(d, q) * inv;
+          if (vv < 0.0 || uu + vv > 1.0) continue;
+          float tt = dot(e2, q) * inv;
+          if (!(tt > 0.0 && tt < hit.t)) continue;
+          if ((instFlags & kInstanceAlphaTested) != 0 && !alphaPasses(instance, p, uu, vv, rayRandom)) continue;
+          hit.t = tt;
+          hit.u = uu;
+          hit.v = vv;
+          hit.prim = p;
+          hit.instance = instance;
+          if (anyHit) return hit;
+        }
+        if (side == 0) hl = false; else hr = false;
+      }
+      // Children to visit: inner nodes, or (in the TLAS) instance entries.
+      int ln = lc == 0 ? li : -li - 2;
+      int rn = rc == 0 ? ri : -ri - 2;
+      if (hl && hr) {
+        bool leftFirst = tl <= tr;
+        if (sp < kStackSize) stack[sp++] = leftFirst ? rn : ln;
+        node = leftFirst ? ln : rn;
+        continue;
+      }
+      if (hl) { node = ln; continue; }
+      if (hr) { node = rn; continue; }
+    }
+    if (sp == 0) break;
+    node = stack[--sp];
+  }
+  return hit;
+}
+
+#endif

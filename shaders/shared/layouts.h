@@ -1,0 +1,105 @@
+// Layouts shared by the C++ renderer and the GLSL shaders. Included by both: keep it to
+// constants and std140-safe structs of 16-byte members. The C++ side static_asserts sizes.
+#ifndef RETILE_SHARED_LAYOUTS_H
+#define RETILE_SHARED_LAYOUTS_H
+
+#ifdef __cplusplus
+#include <cstdint>
+namespace retile::gpu {
+using uint = std::uint32_t;
+struct alignas(16) vec4 { float x, y, z, w; };
+struct alignas(16) uvec4 { std::uint32_t x, y, z, w; };
+struct alignas(16) ivec4 { std::int32_t x, y, z, w; };
+#define RT_CONST(type, name, value) constexpr type name = value;
+#else
+#define RT_CONST(type, name, value) const type name = value;
+#endif
+
+// Texels (RGBA32F) per record in the read-only scene buffers.
+RT_CONST(int, kNodeTexels, 4)       // render/bvh.h: both child boxes per node
+RT_CONST(int, kTriTexels, 3)        // v0, e1 = v1 - v0, e2 = v2 - v0 (object space)
+RT_CONST(int, kTriShadeTexels, 4)   // n0.xyz uv0.x | n1.xyz uv0.y | n2.xyz uv1.x | uv1.y uv2.xy hasNormals
+RT_CONST(int, kInstanceTexels, 5)   // world-to-object rows 0..2 | blasRoot triOffset material emitterOffset | objectIndex+1 flags
+RT_CONST(int, kMaterialTexels, 5)   // see render/render_scene.cpp packMaterial
+RT_CONST(int, kTextureTexels, 3)    // offset w h kind | on.rgb resU | off.rgb resV
+RT_CONST(int, kEmitterTexels, 5)    // v0.xyz area | e1.xyz instance | e2.xyz - | radiance.rgb pick pdf | normal.xyz -
+RT_CONST(int, kDeltaLightTexels, 4) // position.xyz type | direction.xyz cosOuter | intensity.rgb cosInner | -
+
+RT_CONST(int, kInstanceAlphaTested, 1)
+RT_CONST(int, kInstanceEmissive, 4)
+
+RT_CONST(int, kMatLambert, 0)
+RT_CONST(int, kMatOrenNayar, 1)
+RT_CONST(int, kMatPlastic, 2)
+RT_CONST(int, kMatRoughPlastic, 3)
+RT_CONST(int, kMatConductor, 4)
+RT_CONST(int, kMatRoughConductor, 5)
+RT_CONST(int, kMatMirror, 6)
+RT_CONST(int, kMatDielectric, 7)
+RT_CONST(int, kMatRoughDielectric, 8)
+RT_CONST(int, kMatThinSheet, 9)
+RT_CONST(int, kMatNull, 10)
+
+RT_CONST(int, kTexBitmap, 0)
+RT_CONST(int, kTexChecker, 1)
+
+RT_CONST(int, kLightPoint, 0)
+RT_CONST(int, kLightSpot, 1)
+RT_CONST(int, kLightDirectional, 2)
+
+RT_CONST(int, kEnvNone, 0)
+RT_CONST(int, kEnvConstant, 1)
+RT_CONST(int, kEnvMap, 2)
+
+RT_CONST(int, kTraceWorkgroup, 64)
+RT_CONST(int, kAccumulateWorkgroup, 64)
+RT_CONST(int, kMaxWorkItems, 65536)
+
+// One frame's constants (std140 uniform block).
+struct FrameUniforms {
+  vec4 cameraPosition;  // xyz, tan(verticalFov / 2)
+  vec4 cameraRight;     // xyz (unit), aspect = width / height
+  vec4 cameraUp;        // xyz (unit)
+  vec4 cameraForward;   // xyz (unit)
+  uvec4 image;          // width, height, seed, maxBounces
+  ivec4 scene;          // tlasRoot, instanceCount, emitterCount, deltaLightCount
+  vec4 lightPick;       // probability of picking: emitters, environment, delta lights; -
+  ivec4 environment;    // type, map texture, map width, map height
+  vec4 environmentTint; // rgb multiplier (constant: the radiance), rotation about +y in radians
+  vec4 sceneSphere;     // bounding sphere: centre xyz, radius
+  uvec4 work;           // work item count, total sample slots, -, -
+};
+
+// A rectangle of pixels that receives q samples each this frame. Slot s of the frame belongs to
+// the item with the largest slotStart <= s. Pixel samples use sampleBase + r as their sample
+// index, so sampling depends only on (pixel, sample index, seed).
+struct WorkItem {
+  ivec4 rect;   // x0, y0, width, height
+  uvec4 info;   // q, slotStart, sampleBase, flags (kWorkRestart: replace the pixel's sums)
+  uvec4 pixels; // pixelStart (prefix of width * height over items), -, -, -
+};
+RT_CONST(uint, kWorkRestart, 1u)
+
+struct TracePush {
+  uint slotOffset;   // first slot of this dispatch (dispatches are split by size)
+  uint slotCount;    // slots in this dispatch
+  uint pad0;
+  uint pad1;
+};
+
+struct AccumulatePush {
+  uint pixelOffset;  // first (item, pixel) of this dispatch, in the items' pixel order
+  uint pixelCount;
+  uint itemCount;
+  uint pad;
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(FrameUniforms) == 11 * 16);
+static_assert(sizeof(WorkItem) == 48);
+static_assert(sizeof(TracePush) == 16);
+}  // namespace retile::gpu
+#endif
+#undef RT_CONST
+
+#endif

@@ -1,0 +1,246 @@
+#version 460
+// Path tracing pass: one invocation per sample slot. A frame's slots are spread over work items
+// (rectangles of pixels with q samples each), so global rendering (one item, q = 1) and tile
+// re-rendering (many items, any q) run the same kernel. Writes per-slot radiance and the first
+// hit's albedo, normal, depth and instance for the accumulate pass.
+#extension GL_GOOGLE_include_directive : require
+
+#include "common/rng.glsl"
+#include "common/bsdf.glsl"
+#include "common/lights.glsl"
+
+layout(local_size_x = kTraceWorkgroup) in;
+
+layout(set = 0, binding = 1, std430) readonly buffer Work { WorkItem items[]; };
+layout(set = 0, binding = 13, std430) writeonly buffer Samples { vec4 samples[]; };
+layout(set = 0, binding = 14, std430) writeonly buffer Aux { vec4 aux[]; };
+layout(set = 0, binding = 15, std430) buffer Stats { uint rayCounts[4]; };  // primary, bounce, shadow, -
+
+layout(push_constant) uniform Push { TracePush push; };
+
+Material fetchMaterial(int index, vec2 uv) {
+  int base = index * kMaterialTexels;
+  vec4 t0 = texelFetch(uMaterials, base), t1 = texelFetch(uMaterials, base + 1), t2 = texelFetch(uMaterials, base + 2);
+  vec4 t3 = texelFetch(uMaterials, base + 3), t4 = texelFetch(uMaterials, base + 4);
+  Material m;
+  m.type = floatBitsToInt(t0.w);
+  m.albedo = t0.rgb;
+  m.roughness = t1.x;
+  m.ior = t1.y;
+  m.fdrInt = t1.w;
+  m.eta = t2.xyz;
+  m.k = t3.xyz;
+  m.emission = t4.rgb;
+  int albedoTex = floatBitsToInt(t2.w), roughTex = floatBitsToInt(t3.w);
+  if (albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
+  if (roughTex >= 0) m.roughness = max(m.roughness * sampleTexture(roughTex, uv).r, 1e-3);
+  return m;
+}
+
+// Offsets a ray origin off the surface by a few float ulps along n (Waechter and Binder,
+// Ray Tracing Gems ch. 6): robust at any distance from the origin, no scene-scale epsilon.
+vec3 offsetRay(vec3 p, vec3 n) {
+  const float origin = 1.0 / 32.0, floatScale = 1.0 / 65536.0, intScale = 256.0;
+  ivec3 oi = ivec3(intScale * n);
+  vec3 pi = vec3(intBitsToFloat(floatBitsToInt(p.x) + (p.x < 0.0 ? -oi.x : oi.x)),
+                 intBitsToFloat(floatBitsToInt(p.y) + (p.y < 0.0 ? -oi.y : oi.y)),
+                 intBitsToFloat(floatBitsToInt(p.z) + (p.z < 0.0 ? -oi.z : oi.z)));
+  return vec3(abs(p.x) < origin ? p.x + floatScale * n.x : pi.x,
+              abs(p.y) < origin ? p.y + floatScale * n.y : pi.y,
+              abs(p.z) < origin ? p.z + floatScale * n.z : pi.z);
+}
+
+int findItem(uint slot) {
+  int lo = 0, hi = int(frame.work.x) - 1;
+  while (lo < hi) {
+    int mid = (lo + hi + 1) >> 1;
+    if (items[mid].info.y <= slot) lo = mid; else hi = mid - 1;
+  }
+  return lo;
+}
+
+void main() {
+  uint local = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * uint(kTraceWorkgroup) + gl_LocalInvocationID.x;
+  if (local >= push.slotCount) return;
+  uint slot = push.slotOffset + local;
+  WorkItem item = items[findItem(slot)];
+  uint inItem = slot - item.info.y;
+  uint pixels = uint(item.rect.z * item.rect.w);
+  uint rep = inItem / pixels;
+  uint p = inItem - rep * pixels;
+  int px = item.rect.x + int(p % uint(item.rect.z));
+  int py = item.rect.y + int(p / uint(item.rect.z));
+  uint width = frame.image.x, height = frame.image.y;
+  uint pixelIndex = uint(py) * width + uint(px);
+  Rng rng = rngInit(pixelIndex, item.info.z + rep, frame.image.z);
+
+  // Every sample jitters its own primary ray over the pixel (box filter).
+  vec2 jitter = rand2(rng);
+  vec2 ndc = vec2((float(px) + jitter.x) / float(width), (float(py) + jitter.y) / float(height)) * 2.0 - 1.0;
+  float tanHalf = frame.cameraPosition.w;
+  vec3 rd = normalize(frame.cameraForward.xyz + ndc.x * tanHalf * frame.cameraRight.w * frame.cameraRight.xyz -
+                      ndc.y * tanHalf * frame.cameraUp.xyz);
+  vec3 ro = frame.cameraPosition.xyz;
+
+  vec3 L = vec3(0.0);
+  vec3 beta = vec3(1.0);
+  float etaScale = 1.0;
+  bool specular = true;  // the camera ray counts as specular: emitters it sees get full weight
+  float prevPdf = 0.0;
+  vec3 prevPos = ro;
+  int depth = 0;
+  int maxBounces = int(frame.image.w);
+  uint primaryRays = 0u, bounceRays = 0u, shadowRays = 0u;
+
+  vec3 auxAlbedo = vec3(0.0), auxNormal = vec3(0.0);
+  float auxDepth = kInfinity;
+  int auxInstance = 0;
+  bool auxDone = false;
+
+  for (;;) {
+    Hit hit = traceRay(ro, rd, kInfinity, false, rand(rng));
+    if (depth == 0) primaryRays++; else bounceRays++;
+
+    if (hit.prim < 0) {
+      vec3 Le = envRadiance(rd);
+      if (specular) {
+        L += beta * Le;
+      } else {
+        float lightPdf = frame.lightPick.y * envPdf(rd);
+        L += beta * Le * powerHeuristic(prevPdf, lightPdf);
+      }
+      break;
+    }
+
+    int ibase = hit.instance * kInstanceTexels;
+    vec4 r0 = texelFetch(uInstances, ibase), r1 = texelFetch(uInstances, ibase + 1), r2 = texelFetch(uInstances, ibase + 2);
+    vec4 info = texelFetch(uInstances, ibase + 3);
+    vec4 info2 = texelFetch(uInstances, ibase + 4);
+    int instFlags = floatBitsToInt(info2.y);
+    vec3 pos = ro + hit.t * rd;
+
+    // Normals go to world space with the inverse transpose, i.e. the transposed world-to-object rows.
+    vec3 e1 = texelFetch(uTris, hit.prim * kTriTexels + 1).xyz;
+    vec3 e2 = texelFetch(uTris, hit.prim * kTriTexels + 2).xyz;
+    vec3 ngObj = cross(e1, e2);
+    vec3 ng = normalize(r0.xyz * ngObj.x + r1.xyz * ngObj.y + r2.xyz * ngObj.z);
+    vec4 s0 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 0);
+    vec4 s1 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 1);
+    vec4 s2 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 2);
+    vec4 s3 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 3);
+    float bw = 1.0 - hit.u - hit.v;
+    vec2 uv = bw * vec2(s0.w, s1.w) + hit.u * vec2(s2.w, s3.x) + hit.v * s3.yz;
+    vec3 ns = ng;
+    if (s3.w > 0.5) {
+      vec3 nObj = bw * s0.xyz + hit.u * s1.xyz + hit.v * s2.xyz;
+      vec3 n = r0.xyz * nObj.x + r1.xyz * nObj.y + r2.xyz * nObj.z;
+      if (dot(n, n) > 0.0) {
+        ns = normalize(n);
+        // Shading normals from files may disagree with the winding; the winding decides the front.
+        if (dot(ns, ng) < 0.0) ns = -ns;
+      }
+    }
+
+    Material m = fetchMaterial(floatBitsToInt(info.z), uv);
+    vec3 wo = -rd;
+    bool frontFace = dot(ng, wo) > 0.0;
+
+    if ((instFlags & kInstanceEmissive) != 0 && frontFace) {
+      if (specular) {
+        L += beta * m.emission;
+      } else {
+        int emitter = floatBitsToInt(info.w) + (hit.prim - floatBitsToInt(info.y));
+        float lightPdf = emitterPdf(emitter, prevPos, pos, dot(ng, wo));
+        L += beta * m.emission * powerHeuristic(prevPdf, lightPdf);
+      }
+    }
+
+    if (m.type == kMatNull) break;  // an emitter that does not reflect: the path ends here
+
+    if (!auxDone) {
+      auxDone = true;
+      auxAlbedo = m.albedo;
+      auxNormal = frontFace ? ns : -ns;
+      auxDepth = length(pos - frame.cameraPosition.xyz);
+      auxInstance = floatBitsToInt(info2.x);
+    }
+
+    if (depth >= maxBounces) break;
+
+    // Shading frame. Opaque materials are two-sided: flip to the viewer's side.
+    bool transmissive = isTransmissive(m);
+    vec3 ngs = ng, nss = ns;
+    if (!transmissive && !frontFace) {
+      ngs = -ng;
+      nss = -ns;
+    }
+    vec3 t, b;
+    makeFrame(nss, t, b);
+    vec3 woL = toLocal(wo, t, b, nss);
+    if (!transmissive && woL.z <= 0.0) {
+      // The interpolated normal faces away from the viewer: shade with the geometric one.
+      nss = ngs;
+      makeFrame(nss, t, b);
+      woL = toLocal(wo, t, b, nss);
+    }
+
+    // Next-event estimation with multiple importance sampling.
+    if (!isDeltaMaterial(m) && (frame.lightPick.x + frame.lightPick.y + frame.lightPick.z) > 0.0) {
+      vec3 lu = vec3(rand(rng), rand(rng), rand(rng));
+      LightSample ls = sampleLight(pos, lu);
+      if (ls.pdf > 0.0 && maxComponent(ls.radiance) > 0.0) {
+        float sideL = dot(ls.dir, ngs);
+        bool sameSide = sideL > 0.0;
+        if (sameSide || transmissive) {
+          float bsdfPdf;
+          vec3 f = bsdfEval(m, woL, toLocal(ls.dir, t, b, nss), bsdfPdf);
+          if (maxComponent(f) > 0.0) {
+            vec3 origin = offsetRay(pos, sideL > 0.0 ? ngs : -ngs);
+            float tMax = ls.dist >= kInfinity ? kInfinity : ls.dist * (1.0 - 1e-4);
+            shadowRays++;
+            Hit sh = traceRay(origin, ls.dir, tMax, true, rand(rng));
+            if (sh.prim < 0) {
+              float w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, bsdfPdf);
+              L += beta * f * ls.radiance * (w / ls.pdf);
+            }
+          }
+        }
+      }
+    }
+
+    // Continue the path by sampling the BSDF.
+    BsdfSample bs = bsdfSample(m, woL, vec3(rand(rng), rand(rng), rand(rng)));
+    if (maxComponent(bs.weight) <= 0.0 || any(isnan(bs.weight))) break;
+    vec3 wi = toWorld(bs.wi, t, b, nss);
+    float sideI = dot(wi, ngs);
+    // A reflected direction must leave on the viewer's side of the true surface, a transmitted
+    // one on the other side; otherwise the shading normal lied and the path would leak.
+    if (bs.transmitted ? sideI >= 0.0 : sideI <= 0.0) break;
+    beta *= bs.weight;
+    // Roulette must not see the 1/eta^2 radiance scaling inside glass as lost energy.
+    if (bs.transmitted && m.type != kMatThinSheet) etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
+    specular = bs.delta;
+    prevPdf = bs.pdf;
+    prevPos = pos;
+    ro = offsetRay(pos, sideI > 0.0 ? ngs : -ngs);
+    rd = wi;
+    depth++;
+
+    // Russian roulette after a few bounces, keeping the expected value.
+    if (depth > 3) {
+      float q = max(0.05, 1.0 - maxComponent(beta * etaScale));
+      if (rand(rng) < q) break;
+      beta /= 1.0 - q;
+    }
+  }
+
+  // A non-finite sample is traced (it counts against the budget) but weighted 0, so one bad path
+  // cannot poison a pixel's sum; the accumulator counts only weighted samples.
+  bool valid = !(any(isnan(L)) || any(isinf(L)));
+  samples[slot] = valid ? vec4(L, 1.0) : vec4(0.0);
+  aux[slot * 2u] = vec4(auxAlbedo, auxDepth);
+  aux[slot * 2u + 1u] = vec4(auxNormal, intBitsToFloat(auxInstance));
+  atomicAdd(rayCounts[0], primaryRays);
+  atomicAdd(rayCounts[1], bounceRays);
+  atomicAdd(rayCounts[2], shadowRays);
+}
