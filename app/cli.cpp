@@ -1,5 +1,7 @@
 #include "cli.h"
 
+#include <unistd.h>
+
 #include <charconv>
 #include <cstdio>
 #include <iostream>
@@ -78,6 +80,15 @@ Result<ImportedScene> loadScene(const std::string& name) {
 }
 
 void progressBar(const std::string& label, int done, int total, double seconds) {
+  // Redrawing in place needs a terminal; in a log (CI, a pipe) print one line per tenth instead.
+  static const bool terminal = isatty(fileno(stderr)) != 0;
+  if (!terminal) {
+    int tenths = total > 0 ? done * 10 / total : 10;
+    int before = total > 0 ? (done - 1) * 10 / total : 9;
+    if (done < total && tenths == before) return;
+    std::fprintf(stderr, "%s %d/%d  %.1f s\n", label.c_str(), done, total, seconds);
+    return;
+  }
   const int width = 30;
   int filled = total > 0 ? done * width / total : width;
   std::string bar(static_cast<std::size_t>(filled), '#');

@@ -40,7 +40,9 @@ void main() {
   int py = item.rect.y + int(p / uint(item.rect.z));
   uint pixel = uint(py) * frame.image.x + uint(px);
 
+  // Compensated summation within the frame too: a tile may take hundreds of samples at once.
   precise vec3 sum = vec3(0.0);
+  precise vec3 lost = vec3(0.0);
   precise float count = 0.0;
   vec3 albedo = vec3(0.0), normal = vec3(0.0);
   float depth = 1e30;
@@ -48,7 +50,10 @@ void main() {
   for (uint r = 0u; r < item.info.x; ++r) {
     uint slot = item.info.y + r * pixels + p;
     vec4 s = samples[slot];
-    sum += s.rgb;
+    precise vec3 y = s.rgb - lost;
+    precise vec3 t = sum + y;
+    lost = (t - sum) - y;
+    sum = t;
     count += s.w;
     vec4 a0 = aux[slot * 2u], a1 = aux[slot * 2u + 1u];
     albedo += a0.rgb;
@@ -61,7 +66,7 @@ void main() {
   vec4 acc = restart ? vec4(0.0) : accum[pixel * 2u];
   vec4 comp = restart ? vec4(0.0) : accum[pixel * 2u + 1u];
   // Kahan: add (sum - compensation); the new compensation is what the addition lost.
-  precise vec3 y = sum - comp.rgb;
+  precise vec3 y = (sum - lost) - comp.rgb;
   precise vec3 t = acc.rgb + y;
   precise vec3 c = (t - acc.rgb) - y;
   accum[pixel * 2u] = vec4(t, acc.w + count);

@@ -19,7 +19,15 @@ layout(set = 0, binding = 10) uniform samplerBuffer uEmitterAlias;
 layout(set = 0, binding = 11) uniform samplerBuffer uDeltaLights;
 layout(set = 0, binding = 12) uniform samplerBuffer uEnvCdf;
 
-const int kStackSize = 64;
+// Two levels of BVH plus the instance marker; the builder bounds each level's depth.
+const int kStackSize = 48;
+
+// Alpha-tested geometry needs a texture lookup inside traversal, which costs lavapipe a factor of
+// about three even when no instance uses it, so the renderer compiles it in only for scenes
+// that have cut-outs.
+#ifndef RETILE_ALPHA_TEST
+#define RETILE_ALPHA_TEST 1
+#endif
 const float kInfinity = 1e30;
 
 struct Hit {
@@ -175,7 +183,9 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
           if (vv < 0.0 || uu + vv > 1.0) continue;
           float tt = dot(e2, q) * inv;
           if (!(tt > 0.0 && tt < hit.t)) continue;
+#if RETILE_ALPHA_TEST
           if ((instFlags & kInstanceAlphaTested) != 0 && !alphaPasses(instance, p, uu, vv, rayRandom)) continue;
+#endif
           hit.t = tt;
           hit.u = uu;
           hit.v = vv;

@@ -1,5 +1,7 @@
 #include "io/assimp_worker.h"
 
+#include <algorithm>
+
 #include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/config.h>
@@ -13,6 +15,7 @@
 #include <new>
 #include <unordered_map>
 
+#include "io/assimp_precheck.h"
 #include "core/files.h"
 #include "retile/io.h"
 #include "retile/log.h"
@@ -34,7 +37,11 @@ struct Converter {
   int nodesVisited = 0;
   bool gltf = false;
 
-  void warn(std::string w) { warnings.push_back(cat(file.filename().string(), ": ", std::move(w))); }
+  // Printed at once, so that the warnings leading up to a failure still reach the user.
+  void warn(std::string w) {
+    warnings.push_back(cat(file.filename().string(), ": ", std::move(w)));
+    std::fprintf(stderr, "warning: %s\n", warnings.back().c_str());
+  }
 
   static Mat4 toMat4(const aiMatrix4x4& a) {
     Mat4 m;
@@ -300,6 +307,10 @@ struct Converter {
     Bounds3 b = scene.worldBounds();
     Vec3 center = b.empty() ? Vec3{0.0f} : b.center();
     float radius = b.empty() ? 1.0f : std::max(0.5f * length(b.extent()), 1e-3f);
+    if (!isFinite(center) || !std::isfinite(radius)) {
+      center = Vec3{0.0f};
+      radius = 1.0f;
+    }
     if (ai->mCameras && ai->mNumCameras > 0 && ai->mCameras[0]) {
       const aiCamera* ac = ai->mCameras[0];
       auto it = nodeWorld.find(ac->mName.C_Str());
@@ -322,12 +333,19 @@ struct Converter {
       }
       warn("the file's camera is unusable; framing the scene instead");
     }
-    // No camera: look at the whole scene from the front, a little above.
+    // No camera: the front view (from +z, y up) with the model's front face filling the frame,
+    // through a 70 mm-like lens (19.5 degrees vertical), the framing look-dev shots and the
+    // classic Cornell box use. The image takes the front face's aspect ratio.
     Camera cam;
-    cam.verticalFov = radians(40);
-    float dist = radius / std::sin(cam.verticalFov * 0.5f) * 1.1f;
+    cam.verticalFov = radians(19.5f);
+    Vec3 half = b.empty() ? Vec3{1.0f} : b.extent() * 0.5f;
+    float aspect = std::clamp(half.y > 0 ? half.x / half.y : 1.0f, 0.5f, 2.0f);
+    scene.settings.height = 512;
+    scene.settings.width = static_cast<int>(std::lround(512 * aspect));
+    float fit = std::max(half.y, half.x / aspect);
+    float dist = std::max(fit, 1e-3f) / std::tan(cam.verticalFov * 0.5f) + half.z;
     cam.target = center;
-    cam.position = center + normalize(Vec3{0.35f, 0.3f, 1.0f}) * dist;
+    cam.position = center + Vec3{0, 0, dist};
     scene.camera = cam;
   }
 
@@ -348,20 +366,34 @@ struct Converter {
     visit(ai->mRootNode, Mat4{}, 0);
     if (scene.objects.empty()) throw Error("the file contains no triangle meshes");
     lightsAndCamera();
-    // Models rarely bring their own lighting: a sky lights them until the user adds more.
-    scene.environment.type = EnvironmentType::Sky;
+    // Most models bring no lighting: a sky lights them until the user adds more. A file with its
+    // own lights or emitters (an OBJ Cornell box) is a closed set-up, and a sky would add light.
+    bool lit = !scene.lights.empty() ||
+               std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return maxComponent(m.emission) > 0; });
+    scene.environment.type = lit ? EnvironmentType::Constant : EnvironmentType::Sky;
+    scene.environment.color = Vec3{0.0f};
     scene.environment.intensity = 1.0f;
   }
 };
 
-class StderrAssimpLog : public Assimp::LogStream {
+// Collects the errors Assimp logs. When the import still succeeds they describe what it dropped
+// or replaced (a mesh with NaN positions, an unknown material), so the user sees them as warnings.
+class CollectingAssimpLog : public Assimp::LogStream {
  public:
+  explicit CollectingAssimpLog(std::vector<std::string>* out) : out_(out) {}
   void write(const char* message) override {
-    // Assimp's warnings are noisy and about its internals; keep only errors, for context.
     std::string m(message ? message : "");
     while (!m.empty() && (m.back() == '\n' || m.back() == '\r')) m.pop_back();
-    if (!m.empty()) std::fprintf(stderr, "assimp: %s\n", m.c_str());
+    if (auto p = m.find(", T0: "); p != std::string::npos) m.erase(0, p + 6);  // "Error, T0: "
+    // Messages quote bytes of hostile files: keep them printable and short.
+    for (char& c : m)
+      if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+    if (m.size() > 200) m = m.substr(0, 200) + "...";
+    if (!m.empty() && std::find(out_->begin(), out_->end(), m) == out_->end()) out_->push_back(m);
   }
+
+ private:
+  std::vector<std::string>* out_;
 };
 
 }  // namespace
@@ -374,10 +406,23 @@ int assimpWorkerMain(int argc, char** argv) {
   fs::path file = argv[1];
   try {
     Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);  // no default streams
-    Assimp::DefaultLogger::get()->attachStream(new StderrAssimpLog, Assimp::Logger::Err);
+    std::vector<std::string> assimpErrors;
+    Assimp::DefaultLogger::get()->attachStream(new CollectingAssimpLog(&assimpErrors), Assimp::Logger::Err);
+    auto checked = precheckAssimpInput(file);
+    if (!checked) {
+      std::fprintf(stderr, "error: %s\n", checked.error().c_str());
+      return 2;
+    }
+    for (const auto& w : checked.value()) std::fprintf(stderr, "warning: %s: %s\n", file.filename().string().c_str(), w.c_str());
     Assimp::Importer importer;
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     importer.SetPropertyBool(AI_CONFIG_PP_FD_REMOVE, true);
+    // Assimp's area test uses an absolute 1e-6 and deletes every triangle of a model authored in
+    // small units (Khronos' MetalRoughSpheres). Zero-area triangles are never hit, so keeping them is harmless.
+    importer.SetPropertyBool(AI_CONFIG_PP_FD_CHECKAREA, false);
+    // Files without normals get smooth ones, but not across hard edges: Assimp's default of 175
+    // degrees rounds a box's corners into its faces (the Cornell box's blocks shade wrongly).
+    importer.SetPropertyFloat(AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, 60.0f);
     unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_SortByPType |
                      aiProcess_JoinIdenticalVertices | aiProcess_GenSmoothNormals | aiProcess_FindInvalidData |
                      aiProcess_FindDegenerates;
@@ -395,7 +440,12 @@ int assimpWorkerMain(int argc, char** argv) {
     std::string ext = lowercase(file.extension().string());
     conv.gltf = ext == ".gltf" || ext == ".glb";
     conv.run();
-    for (const auto& w : conv.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    const std::size_t kShown = 6;
+    for (std::size_t i = 0; i < assimpErrors.size() && i < kShown; ++i)
+      std::fprintf(stderr, "warning: %s: Assimp: %s\n", file.filename().string().c_str(), assimpErrors[i].c_str());
+    if (assimpErrors.size() > kShown)
+      std::fprintf(stderr, "warning: %s: Assimp reported %zu more problems\n", file.filename().string().c_str(),
+                   assimpErrors.size() - kShown);
     std::string out = nativeSceneToString(conv.scene);
     std::fwrite(out.data(), 1, out.size(), stdout);
     std::fflush(stdout);

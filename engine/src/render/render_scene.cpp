@@ -318,12 +318,14 @@ void RenderSceneBuilder::packInstances(const Scene& scene) {
   data_.instanceObject.clear();
   data_.bounds = tlas.bounds;
   data_.instancedTriangles = 0;
+  data_.alphaTested = false;
   for (std::uint32_t p : tlas.primOrder) {
     const Candidate& c = cands[p];
     const Material* mat = scene.material(c.object->material);
     int flags = 0;
     if (mat && (mat->alpha < 1.0f || textureIndex(mat->alphaTexture) >= 0)) flags |= gpu::kInstanceAlphaTested;
     if (mat && mat->emissive()) flags |= gpu::kInstanceEmissive;
+    if (flags & gpu::kInstanceAlphaTested) data_.alphaTested = true;
     Mat4 inv = c.object->transform.inverse();
     for (int r = 0; r < 3; ++r) data_.instances.push_back({inv.m[r][0], inv.m[r][1], inv.m[r][2], inv.m[r][3]});
     data_.instances.push_back(ints(static_cast<std::int32_t>(c.mesh->nodeOffset), static_cast<std::int32_t>(c.mesh->triOffset),

@@ -41,7 +41,8 @@ std::uint32_t groupsFor(std::uint64_t invocations, std::uint32_t local, std::uin
 
 struct Renderer::Impl {
   vk::Context ctx;
-  std::unique_ptr<vk::ComputePipeline> trace;
+  std::unique_ptr<vk::ComputePipeline> traceVariants[2];  // without, with alpha-tested geometry
+  vk::ComputePipeline* trace = nullptr;
   std::unique_ptr<vk::ComputePipeline> accumulate;
   RenderSceneBuilder builder;
 
@@ -57,13 +58,6 @@ struct Renderer::Impl {
   bool hasScene = false;
 
   explicit Impl(const RendererOptions& o) : ctx(vk::DeviceChoice{o.device, o.validation || kDebugValidation}) {
-    trace = std::make_unique<vk::ComputePipeline>(
-        ctx, "trace.comp",
-        std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::UniformTexel, Binding::UniformTexel,
-                             Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel,
-                             Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel,
-                             Binding::UniformTexel, Binding::Storage, Binding::Storage, Binding::Storage},
-        static_cast<std::uint32_t>(sizeof(gpu::TracePush)));
     accumulate = std::make_unique<vk::ComputePipeline>(
         ctx, "accumulate.comp",
         std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::Storage, Binding::Storage, Binding::Storage,
@@ -117,11 +111,33 @@ struct Renderer::Impl {
       uploadArray(alias, d.emitterAlias, "emitter alias table");
       uploadArray(delta, d.deltaLights, "delta lights");
     }
+    selectTrace(d.alphaTested);
     bindAll();
   }
 
+  // Picks the trace kernel the scene needs, compiling it on first use.
+  void selectTrace(bool alpha) {
+    auto& slot = traceVariants[alpha ? 1 : 0];
+    if (!slot) {
+      slot = std::make_unique<vk::ComputePipeline>(
+          ctx, "trace.comp",
+          std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::UniformTexel, Binding::UniformTexel,
+                               Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel,
+                               Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel,
+                               Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel, Binding::Storage,
+                               Binding::Storage, Binding::Storage},
+          static_cast<std::uint32_t>(sizeof(gpu::TracePush)),
+          std::vector<vk::ShaderDefine>{{"RETILE_ALPHA_TEST", alpha ? "1" : "0"}});
+    }
+    trace = slot.get();
+  }
+
   void bindAll() {
-    auto& t = *trace;
+    if (trace) bindTrace(*trace);
+    bindAccumulate(*accumulate);
+  }
+
+  void bindTrace(vk::ComputePipeline& t) {
     t.bind(kBindFrame, frameUbo);
     t.bind(kBindWork, work);
     t.bind(kBindNodes, nodes, VK_FORMAT_R32G32B32A32_SFLOAT);
@@ -140,7 +156,9 @@ struct Renderer::Impl {
       t.bind(kBindSamples, samples);
       t.bind(kBindAux, aux);
     }
-    auto& a = *accumulate;
+  }
+
+  void bindAccumulate(vk::ComputePipeline& a) {
     a.bind(0, frameUbo);
     a.bind(1, work);
     if (samples.valid()) {
@@ -275,11 +293,14 @@ struct Renderer::Impl {
     const auto& objects = builder.data().instanceObject;
     for (std::size_t i = 0; i < n; ++i) {
       const gpu::vec4& s = acc[i * 2];
+      const gpu::vec4& comp = acc[i * 2 + 1];
       float count = s.w;
-      float inv = count > 0 ? 1.0f / count : 0.0f;
-      img.color[i * 3 + 0] = s.x * inv;
-      img.color[i * 3 + 1] = s.y * inv;
-      img.color[i * 3 + 2] = s.z * inv;
+      double invD = count > 0 ? 1.0 / count : 0.0;
+      float inv = static_cast<float>(invD);
+      // The compensation holds what the last additions lost: take it back out.
+      img.color[i * 3 + 0] = static_cast<float>((double(s.x) - comp.x) * invD);
+      img.color[i * 3 + 1] = static_cast<float>((double(s.y) - comp.y) * invD);
+      img.color[i * 3 + 2] = static_cast<float>((double(s.z) - comp.z) * invD);
       img.sampleCount[i] = count;
       const gpu::vec4& a = ax[i * 2];
       const gpu::vec4& b = ax[i * 2 + 1];

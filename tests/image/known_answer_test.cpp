@@ -1,0 +1,162 @@
+// Renders with known answers: each would catch a real bug in sampling, MIS or light transport.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <utility>
+
+#include "gpu_support.h"
+#include "scene/primitives.h"
+#include "test_support.h"
+
+namespace retile {
+namespace {
+
+RenderImage renderScene(Renderer& r, const Scene& s, int spp, std::uint32_t seed = 1) {
+  r.setScene(s);
+  RenderRequest req;
+  req.samplesPerPixel = spp;
+  req.seed = seed;
+  return r.render(req);
+}
+
+// Mean over the pixels whose first hit is `object`.
+double meanOver(const RenderImage& img, NodeId object, int* count = nullptr) {
+  double sum = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < img.objectId.size(); ++i)
+    if (img.objectId[i] == object) {
+      sum += img.color[i * 3 + 1];  // green channel: all tests use grey
+      ++n;
+    }
+  if (count) *count = n;
+  return n ? sum / n : 0.0;
+}
+
+TEST(KnownAnswer, WhiteFurnaceConvexObject) {
+  // A convex diffuse sphere of albedo rho under a uniform sky of radiance L reflects rho * L in
+  // every direction: light reaches it once and leaves. Exercises environment sampling and MIS.
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(48, 48);
+  s.camera = test::frontCamera(30);
+  s.settings.maxBounces = 4;
+  s.environment.color = Vec3{1.0f};
+  Material m;
+  m.albedo = Vec3{0.8f};
+  NodeId sphere = test::addMeshObject(s, "sphere", makeSphere(), test::addMaterial(s, m), Mat4::translate({0, 0, -4}));
+  RenderImage img = renderScene(*r, s, 256);
+  int n;
+  double mean = meanOver(img, sphere, &n);
+  ASSERT_GT(n, 500);
+  EXPECT_NEAR(mean, 0.8, 0.008) << "within 1 %";
+}
+
+TEST(KnownAnswer, ClosedFurnaceWithBounceLimit) {
+  // Inside a sphere that emits Le and reflects rho, a path of at most B bounces sees
+  // Le * (1 + rho + ... + rho^B). Exercises emitter sampling, MIS, roulette and the bounce limit.
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(16, 16);
+  s.camera = test::frontCamera(60);
+  const float rho = 0.5f, le = 1.0f;
+  const int bounces = 6;
+  s.settings.maxBounces = bounces;
+  Material m;
+  m.albedo = Vec3{rho};
+  m.emission = Vec3{le};
+  // Reversed winding and normals turn the sphere's front side, and so its emission, inwards.
+  // (A negative scale would not: transformed normals keep pointing out of the surface.)
+  auto inside = std::make_shared<MeshGeometry>(*makeSphere(24, 48));
+  for (std::size_t t = 0; t < inside->indices.size(); t += 3) std::swap(inside->indices[t + 1], inside->indices[t + 2]);
+  for (Vec3& n : inside->normals) n = -n;
+  test::addMeshObject(s, "inside", inside, test::addMaterial(s, m), Mat4::scale(Vec3{3.0f}));
+  RenderImage img = renderScene(*r, s, 256);
+  double expected = le * (1 - std::pow(rho, bounces + 1)) / (1 - rho);
+  double mean = test::meanLuminance(img, 0, 0, 16, 16);
+  EXPECT_NEAR(mean, expected, expected * 0.01) << "expected " << expected;
+}
+
+TEST(KnownAnswer, DiffusePlaneUnderUniformSky) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(32, 32);
+  // Looking straight down at a large plane: it sees only sky above it.
+  s.camera.position = {0, 3, 0};
+  s.camera.target = {0, 0, 0};
+  s.camera.up = {0, 0, -1};
+  s.camera.verticalFov = radians(20);
+  s.settings.maxBounces = 3;
+  s.environment.color = Vec3{2.0f};
+  Material m;
+  m.albedo = Vec3{0.5f};
+  NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, m), Mat4::scale({1000, 1, 1000}));
+  RenderImage img = renderScene(*r, s, 128);
+  EXPECT_NEAR(meanOver(img, plane), 1.0, 0.01);
+}
+
+double smallLightOnPlane(Renderer& r, float height, NodeId* planeOut) {
+  Scene s = test::emptyScene(16, 16);
+  s.camera.position = {0, 0.5f, 0};
+  s.camera.target = {0, 0, 0};
+  s.camera.up = {0, 0, -1};
+  s.camera.verticalFov = radians(2);  // just the spot below the light
+  s.settings.maxBounces = 1;         // direct light only
+  Material plane;
+  plane.albedo = Vec3{1.0f};
+  *planeOut = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, plane), Mat4::scale({100, 1, 100}));
+  Material light;
+  light.albedo = Vec3{0.0f};
+  light.emission = Vec3{100.0f};
+  test::addMeshObject(s, "light", makeQuad(), test::addMaterial(s, light),
+                      Mat4::translate({0, height, 0}) * Mat4::rotateX(kPi) * Mat4::scale({0.05f, 1, 0.05f}));
+  RenderImage img = renderScene(r, s, 64);
+  return meanOver(img, *planeOut);
+}
+
+TEST(KnownAnswer, InverseSquareFalloffOfASmallLight) {
+  RETILE_RENDERER_OR_SKIP(r);
+  NodeId plane;
+  double near = smallLightOnPlane(*r, 1.0f, &plane);
+  double far = smallLightOnPlane(*r, 2.0f, &plane);
+  // Radiance of a Lambertian plane of albedo 1 under a small source: Le * A / (pi * h^2).
+  double expectedNear = 100.0 * 0.0025 / (kPi * 1.0);
+  EXPECT_NEAR(near, expectedNear, expectedNear * 0.02);
+  EXPECT_NEAR(near / far, 4.0, 0.08);
+}
+
+TEST(KnownAnswer, ConvergedRenderEqualsMeanOfIndependentRenders) {
+  // One render of K*N samples against K independent renders of N samples each: per pixel the
+  // difference of the means must look like noise of the size the parts' spread predicts. K = 16
+  // gives the spread estimate 15 degrees of freedom, so a 4.5 sigma excess is rare (< 0.1 %) for an
+  // unbiased renderer; a biased or seed-correlated one fails on many pixels at once.
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = makeDefaultScene();
+  s.settings.width = 40;
+  s.settings.height = 24;
+  s.settings.maxBounces = 4;
+  const int n = 8, k = 16;
+  RenderImage big = renderScene(*r, s, k * n, 1000);
+  std::vector<RenderImage> parts;
+  for (int seed = 1; seed <= k; ++seed) parts.push_back(renderScene(*r, s, n, std::uint32_t(seed)));
+  int outliers = 0, tested = 0;
+  double sumDiff = 0, sumMean = 0;
+  for (std::size_t i = 0; i < big.color.size(); ++i) {
+    double m = 0, m2 = 0;
+    for (const auto& p : parts) {
+      m += p.color[i];
+      m2 += double(p.color[i]) * p.color[i];
+    }
+    m /= k;
+    double var = std::max(0.0, (m2 / k - m * m) * k / (k - 1));  // spread of one N-sample mean
+    double se = std::sqrt(var / k + var / k);  // of (mean of K parts) minus (one K*N render)
+    sumDiff += big.color[i] - m;
+    sumMean += m;
+    if (se <= 1e-6) continue;
+    ++tested;
+    if (std::abs(big.color[i] - m) > 4.5 * se) ++outliers;
+  }
+  EXPECT_GT(tested, int(big.color.size() / 2));
+  EXPECT_LT(outliers, tested / 100 + 1) << outliers << " of " << tested << " pixels differ by more than 4.5 sigma";
+  EXPECT_NEAR(sumDiff / sumMean, 0.0, 0.02) << "the image means must agree";
+}
+
+}  // namespace
+}  // namespace retile

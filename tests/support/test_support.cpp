@@ -1,0 +1,106 @@
+#include "test_support.h"
+
+#include <atomic>
+#include <cmath>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace retile::test {
+
+fs::path sharedDir() {
+  if (const char* env = std::getenv("RETILE_SHARED"); env && *env) return env;
+  return RETILE_SHARED_DIR;
+}
+
+fs::path sharedPath(const std::string& relative) {
+  fs::path p = sharedDir() / relative;
+  std::error_code ec;
+  return fs::exists(p, ec) ? p : fs::path();
+}
+
+fs::path tempDir() {
+  static std::atomic<int> counter{0};
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "test";
+  fs::path p = fs::temp_directory_path() / ("retile-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++)) / name;
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+NodeId addMaterial(Scene& s, Material m) {
+  m.id = s.newId();
+  s.materials.push_back(m);
+  return m.id;
+}
+
+NodeId addMeshObject(Scene& s, const std::string& name, std::shared_ptr<const MeshGeometry> g, NodeId material,
+                     const Mat4& transform) {
+  Mesh mesh;
+  mesh.id = s.newId();
+  mesh.name = name;
+  mesh.geometry = std::move(g);
+  s.meshes.push_back(mesh);
+  Object o;
+  o.id = s.newId();
+  o.name = name;
+  o.mesh = mesh.id;
+  o.material = material;
+  o.transform = transform;
+  s.objects.push_back(o);
+  return o.id;
+}
+
+Scene emptyScene(int width, int height) {
+  Scene s;
+  s.settings.width = width;
+  s.settings.height = height;
+  s.environment.type = EnvironmentType::Constant;
+  s.environment.color = Vec3{0.0f};
+  return s;
+}
+
+double meanLuminance(const RenderImage& img, int x0, int y0, int x1, int y1) {
+  double sum = 0;
+  int n = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      std::size_t i = static_cast<std::size_t>(y * img.width + x) * 3;
+      sum += luminance({img.color[i], img.color[i + 1], img.color[i + 2]});
+      ++n;
+    }
+  return n ? sum / n : 0.0;
+}
+
+bool allFinite(const RenderImage& img) {
+  for (float v : img.color)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
+}  // namespace retile::test
+
+#include "gpu_support.h"
+
+namespace retile::test {
+
+std::unique_ptr<Renderer> makeRenderer(std::string* whyNot) {
+  try {
+    return std::make_unique<Renderer>();
+  } catch (const std::exception& e) {
+    *whyNot = e.what();
+    return nullptr;
+  }
+}
+
+Camera frontCamera(float fov) {
+  Camera c;
+  c.position = {0, 0, 0};
+  c.target = {0, 0, -1};
+  c.up = {0, 1, 0};
+  c.verticalFov = radians(fov);
+  return c;
+}
+
+}  // namespace retile::test

@@ -1,0 +1,79 @@
+// Assimp runs in a child process: crashes, hangs and bad files become messages.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "retile/io.h"
+#include "test_support.h"
+
+namespace retile {
+namespace {
+
+TEST(Assimp, CornellObjWithMtlEmissionAsLight) {
+  RETILE_SHARED_OR_SKIP(file, "scenes/cornell-box/cornell-box.obj");
+  auto r = importScene(file);
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  EXPECT_EQ(s.triangleCount(), 36u);
+  int emissive = 0;
+  for (const auto& o : s.objects) {
+    const Material* m = s.material(o.material);
+    if (m && m->emissive()) {
+      ++emissive;
+      EXPECT_EQ(m->emission, Vec3(17, 12, 4));
+    }
+  }
+  EXPECT_EQ(emissive, 1);
+  // No camera in the file: the front view that frames the opening, as in the box's pbrt scene.
+  EXPECT_NEAR(s.camera.position.z, 6.8f, 0.05f);
+  EXPECT_NEAR(s.camera.position.y, 1.0f, 0.05f);
+  EXPECT_EQ(s.settings.width, s.settings.height);
+}
+
+TEST(Assimp, CrashingFileIsReportedNotFatal) {
+  RETILE_SHARED_OR_SKIP(file, "corpus/malformed/other/assimp-malformed_zero_numvertices/malformed_zero_numvertices.md2");
+  auto r = importScene(file);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("malformed_zero_numvertices.md2"), std::string::npos) << r.error();
+  EXPECT_NE(r.error().find("crashed"), std::string::npos) << r.error();
+}
+
+TEST(Assimp, HangIsStoppedByTheTimeLimit) {
+  // A worker that sleeps stands in for an importer that never returns.
+  auto dir = test::tempDir();
+  auto fake = dir / "sleepy-worker";
+  std::ofstream(fake) << "#!/bin/sh\nsleep 30\n";
+  std::filesystem::permissions(fake, std::filesystem::perms::owner_all);
+  auto model = dir / "model.ply";
+  std::ofstream(model) << "ply\n";
+  ::setenv("RETILE_IMPORT_WORKER", fake.c_str(), 1);
+  ImportOptions o;
+  o.assimpTimeout = std::chrono::milliseconds(500);
+  auto start = std::chrono::steady_clock::now();
+  auto r = importScene(model, o);
+  ::unsetenv("RETILE_IMPORT_WORKER");
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("did not finish"), std::string::npos) << r.error();
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+}
+
+TEST(Assimp, GarbageFileFailsCleanly) {
+  auto dir = test::tempDir();
+  auto f = dir / "garbage.fbx";
+  std::ofstream(f) << "this is not an FBX file at all";
+  auto r = importScene(f);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("garbage.fbx"), std::string::npos) << r.error();
+}
+
+TEST(Assimp, MemoryLimitStopsABlowUp) {
+  RETILE_SHARED_OR_SKIP(file, "scenes/bunny/bunny.obj");
+  ImportOptions o;
+  o.assimpMemoryLimit = std::uint64_t(64) << 20;  // far too little for the bunny
+  auto r = importScene(file, o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("bunny.obj"), std::string::npos) << r.error();
+}
+
+}  // namespace
+}  // namespace retile

@@ -1,0 +1,59 @@
+#include <gtest/gtest.h>
+
+#include "core/json.h"
+
+namespace retile::json {
+namespace {
+
+TEST(Json, ParsesNestedValues) {
+  auto v = parse(R"({"a": [1, 2.5, -3e2], "b": {"c": "x\ny\u00e9"}, "d": true, "e": null})");
+  ASSERT_TRUE(v.ok()) << v.error();
+  const Value* a = v->find("a");
+  ASSERT_TRUE(a && a->isArray());
+  EXPECT_EQ(a->asArray().size(), 3u);
+  EXPECT_DOUBLE_EQ(a->asArray()[2].asNumber(), -300.0);
+  EXPECT_EQ(v->find("b")->find("c")->asString(), "x\ny\xc3\xa9");
+  EXPECT_TRUE(v->find("d")->asBool());
+  EXPECT_TRUE(v->find("e")->isNull());
+}
+
+TEST(Json, ErrorsNameLineAndColumn) {
+  auto v = parse("{\n  \"a\": [1, 2,\n  ]\n}");
+  ASSERT_FALSE(v.ok());
+  EXPECT_NE(v.error().find("line 3"), std::string::npos) << v.error();
+}
+
+TEST(Json, RejectsHostileInput) {
+  EXPECT_FALSE(parse(std::string(10000, '[')).ok());       // nesting bomb
+  EXPECT_FALSE(parse("{\"a\": 1e999}").ok());                // overflow to infinity
+  EXPECT_FALSE(parse("\"unterminated").ok());
+  EXPECT_FALSE(parse("{\"a\": \"\\ud800\"}").ok());          // lone surrogate
+  EXPECT_FALSE(parse("[1, 2] trailing").ok());
+  EXPECT_FALSE(parse("").ok());
+  EXPECT_FALSE(parse(std::string("\"a\0b\"", 5)).ok());     // control character in a string
+}
+
+TEST(Json, WriteRoundTripsFloatsExactly) {
+  Value v(Object{});
+  v.set("f", 0.1f);
+  v.set("d", 1.0 / 3.0);
+  v.set("s", "quote \" backslash \\ tab \t");
+  auto back = parse(write(v));
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_EQ(static_cast<float>(back->find("f")->asNumber()), 0.1f);
+  EXPECT_EQ(back->find("d")->asNumber(), 1.0 / 3.0);
+  EXPECT_EQ(back->find("s")->asString(), "quote \" backslash \\ tab \t");
+}
+
+TEST(Json, LenientVectorReaders) {
+  Vec3 v;
+  EXPECT_TRUE(toVec3(Value(0.5), &v));
+  EXPECT_EQ(v, Vec3(0.5f, 0.5f, 0.5f));
+  EXPECT_TRUE(toVec3(parse("[1, 2, 3]").value(), &v));
+  EXPECT_EQ(v, Vec3(1, 2, 3));
+  EXPECT_FALSE(toVec3(parse("[1, 2]").value(), &v));
+  EXPECT_FALSE(toVec3(Value("x"), &v));
+}
+
+}  // namespace
+}  // namespace retile::json

@@ -1,0 +1,96 @@
+#include <gtest/gtest.h>
+
+#include "retile/edit.h"
+#include "test_support.h"
+
+namespace retile {
+namespace {
+
+TEST(DefaultScene, HasWhatLookDevNeeds) {
+  Scene s = makeDefaultScene();
+  auto named = [&](const std::string& n) {
+    for (const auto& o : s.objects)
+      if (o.name == n) return &o;
+    return static_cast<const Object*>(nullptr);
+  };
+  ASSERT_TRUE(named("Ground"));
+  ASSERT_TRUE(named("Cup"));
+  ASSERT_TRUE(named("Glossy Sphere"));
+  ASSERT_TRUE(named("Checkered Box"));
+  const Object* light = named("Area Light");
+  ASSERT_TRUE(light);
+  EXPECT_TRUE(s.material(light->material)->emissive());
+  EXPECT_TRUE(s.material(named("Checkered Box")->material)->albedoTexture != kNoNode);
+  EXPECT_EQ(s.environment.type, EnvironmentType::Sky);
+  // Ids are unique across every kind of node.
+  std::vector<NodeId> ids;
+  for (auto& m : s.meshes) ids.push_back(m.id);
+  for (auto& m : s.materials) ids.push_back(m.id);
+  for (auto& o : s.objects) ids.push_back(o.id);
+  for (auto& t : s.textures) ids.push_back(t.id);
+  std::sort(ids.begin(), ids.end());
+  EXPECT_EQ(std::adjacent_find(ids.begin(), ids.end()), ids.end());
+}
+
+TEST(Document, EditsAdvanceTheVersionAndReportWhatChanged) {
+  Document doc(makeDefaultScene());
+  auto v0 = doc.version();
+  Object cup = doc.scene().objects[1];
+  cup.transform = Mat4::translate({0, 0.1f, 0}) * cup.transform;
+  auto r = doc.apply(SetObject{cup});
+  ASSERT_TRUE(r.ok()) << r.error();
+  EXPECT_EQ(doc.version(), v0 + 1);
+  EXPECT_TRUE(r.value() & kUpdateInstances);
+  EXPECT_FALSE(r.value() & kUpdateGeometry);
+  EXPECT_EQ(doc.scene().object(cup.id)->transform, cup.transform);
+
+  Material m = doc.scene().materials[0];
+  m.roughness = 0.5f;
+  r = doc.apply(SetMaterial{m});
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.value(), static_cast<std::uint32_t>(kUpdateMaterials));
+}
+
+TEST(Document, BadEditsAreRefusedAndChangeNothing) {
+  Document doc(makeDefaultScene());
+  auto v0 = doc.version();
+  Object o = doc.scene().objects[0];
+  o.transform.m[0][0] = std::nanf("");
+  EXPECT_FALSE(doc.apply(SetObject{o}).ok());
+  Object missing = doc.scene().objects[0];
+  missing.id = 999999;
+  EXPECT_FALSE(doc.apply(SetObject{missing}).ok());
+  Object dangling = doc.scene().objects[0];
+  dangling.material = 424242;
+  EXPECT_FALSE(doc.apply(SetObject{dangling}).ok());
+  Camera c = doc.scene().camera;
+  c.verticalFov = 0;
+  EXPECT_FALSE(doc.apply(SetCamera{c}).ok());
+  RenderSettings rs;
+  rs.width = 0;
+  EXPECT_FALSE(doc.apply(SetRenderSettings{rs}).ok());
+  EXPECT_EQ(doc.version(), v0);
+}
+
+TEST(Document, RemovingANodeClearsReferences) {
+  Document doc(makeDefaultScene());
+  NodeId tex = doc.scene().textures[0].id;
+  auto r = doc.apply(RemoveNode{tex});
+  ASSERT_TRUE(r.ok()) << r.error();
+  for (const auto& m : doc.scene().materials) EXPECT_NE(m.albedoTexture, tex);
+  EXPECT_FALSE(doc.apply(RemoveNode{tex}).ok());
+}
+
+TEST(Document, CoalesceKeysSeparateTargetsAndKinds) {
+  Scene s = makeDefaultScene();
+  Edit a = SetObject{s.objects[0]};
+  Edit b = SetObject{s.objects[0]};
+  Edit c = SetObject{s.objects[1]};
+  Edit d = SetMaterial{s.materials[0]};
+  EXPECT_EQ(editCoalesceKey(a), editCoalesceKey(b));
+  EXPECT_NE(editCoalesceKey(a), editCoalesceKey(c));
+  EXPECT_NE(editCoalesceKey(a), editCoalesceKey(d));
+}
+
+}  // namespace
+}  // namespace retile

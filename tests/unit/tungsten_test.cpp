@@ -1,0 +1,153 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "retile/io.h"
+#include "test_support.h"
+
+namespace retile {
+namespace {
+
+const Object* objectWithMaterial(const Scene& s, const std::string& prefix) {
+  for (const auto& o : s.objects) {
+    const Material* m = s.material(o.material);
+    if (m && m->name.rfind(prefix, 0) == 0) return &o;
+  }
+  return nullptr;
+}
+
+Bounds3 worldBounds(const Scene& s, const Object& o) {
+  return transformBounds(o.transform, s.mesh(o.mesh)->geometry->bounds());
+}
+
+TEST(Tungsten, CornellBoxMatchesTheObjVersion) {
+  RETILE_SHARED_OR_SKIP(file, "scenes/cornell-box/scene.json");
+  auto r = importTungsten(file);
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  EXPECT_EQ(s.objects.size(), 8u);
+  EXPECT_EQ(s.settings.width, 1024);
+  EXPECT_EQ(s.settings.maxBounces, 63) << "Tungsten counts path segments, we count bounces";
+  EXPECT_NEAR(degrees(s.camera.verticalFov), 19.5f, 1e-3f);  // square image: horizontal == vertical
+
+  // The light: a downward-facing quad 2 cm below the ceiling, corners as in cornell-box.obj.
+  const Object* light = objectWithMaterial(s, "Light");
+  ASSERT_TRUE(light);
+  EXPECT_EQ(s.material(light->material)->emission, Vec3(17, 12, 4));
+  Bounds3 b = worldBounds(s, *light);
+  EXPECT_NEAR(b.lo.x, -0.24f, 2e-3f);
+  EXPECT_NEAR(b.hi.x, 0.23f, 2e-3f);
+  EXPECT_NEAR(b.lo.z, -0.22f, 2e-3f);
+  EXPECT_NEAR(b.hi.z, 0.16f, 2e-3f);
+  EXPECT_NEAR(b.lo.y, 1.98f, 1e-4f);
+  Vec3 n = normalize(light->transform.inverse().transposed().transformVector({0, 1, 0}));
+  EXPECT_NEAR(n.y, -1.0f, 1e-5f) << "the light must face down into the room";
+
+  // The short box's bottom corners, as in the OBJ (Euler order and sign of rotation matter).
+  const Object* shortBox = objectWithMaterial(s, "ShortBox");
+  ASSERT_TRUE(shortBox);
+  const Vec3 expected[4] = {{-0.046f, 0, 0.573f}, {0.124f, 0, 0.003f}, {0.533f, 0, 0.746f}, {0.703f, 0, 0.176f}};
+  for (const Vec3& e : expected) {
+    float best = 1e9f;
+    for (const Vec3& p : s.mesh(shortBox->mesh)->geometry->positions)
+      best = std::min(best, length(shortBox->transform.transformPoint(p) - e));
+    EXPECT_LT(best, 2e-3f) << "corner " << e.x << "," << e.z;
+  }
+}
+
+TEST(Tungsten, LivingRoomOpensWithSubstitutesForMissingFiles) {
+  RETILE_SHARED_OR_SKIP(file, "scenes/living-room/scene.json");
+  auto r = importTungsten(file);
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  EXPECT_EQ(s.objects.size(), 65u);
+  EXPECT_GT(s.triangleCount(), 140000u);
+  EXPECT_EQ(s.environment.type, EnvironmentType::Map);
+  EXPECT_EQ(s.environment.color, Vec3(1.0f)) << "the substitute sky has radiance 1";
+  bool skyWarned = false, leafWarned = false;
+  for (const auto& w : r->warnings) {
+    skyWarned = skyWarned || (w.find("Sky 19.exr") != std::string::npos && w.find("constant sky") != std::string::npos);
+    leafWarned = leafWarned || w.find("leaf.png") != std::string::npos;
+  }
+  EXPECT_TRUE(skyWarned);
+  EXPECT_TRUE(leafWarned);
+  int textured = 0, mirrors = 0, aluminium = 0;
+  for (const auto& m : s.materials) {
+    textured += m.albedoTexture != kNoNode;
+    mirrors += m.type == MaterialType::Mirror;
+    aluminium += m.type == MaterialType::RoughConductor && m.metal == "Al";
+    if (m.name == "PlantPot") {
+      EXPECT_NEAR(m.roughness, 1.0f / std::sqrt(2.0f), 1e-6f);
+    }
+    if (m.name == "TableWood") {
+      EXPECT_EQ(m.type, MaterialType::RoughPlastic);
+      EXPECT_FLOAT_EQ(m.roughness, 0.05f);
+    }
+  }
+  EXPECT_GE(textured, 3);
+  EXPECT_EQ(mirrors, 2);
+  EXPECT_EQ(aluminium, 1);
+  EXPECT_NEAR(degrees(s.camera.verticalFov), 58.7f, 0.1f);
+}
+
+std::filesystem::path writeScene(const std::string& text) {
+  auto p = test::tempDir() / "scene.json";
+  std::ofstream(p) << text;
+  return p;
+}
+
+TEST(Tungsten, BrokenScenesFailWithTheFileAndPlace) {
+  struct Case {
+    const char* text;
+    const char* expect;
+  } cases[] = {
+      {"{", "not valid JSON"},
+      {"[]", "not a JSON object"},
+      {"{\"bsdfs\": 3}", "bsdfs: expected an array"},
+      {"{\"primitives\": [{\"type\": \"quad\", \"bsdf\": \"Nope\"}]}", "bsdf 'Nope' is not defined"},
+      {"{\"primitives\": [{\"bsdf\": {}}]}", "without a \"type\""},
+      {"{\"primitives\": [{\"type\": \"quad\", \"transform\": {\"position\": [1, 2]}}]}", "primitives[0]: position"},
+      {"{\"primitives\": [{\"type\": \"quad\", \"transform\": [1, 2, 3]}]}", "16 numbers"},
+      {"{\"camera\": {\"fov\": 500}, \"primitives\": []}", "fov"},
+  };
+  for (const Case& c : cases) {
+    auto file = writeScene(c.text);
+    auto r = importTungsten(file);
+    ASSERT_FALSE(r.ok()) << c.text;
+    EXPECT_NE(r.error().find("scene.json"), std::string::npos) << r.error();
+    EXPECT_NE(r.error().find(c.expect), std::string::npos) << c.text << " -> " << r.error();
+  }
+}
+
+TEST(Tungsten, MissingMeshIsSkippedWithAWarning) {
+  auto file = writeScene(R"({"primitives": [
+      {"type": "mesh", "file": "nowhere.obj"},
+      {"type": "sphere", "transform": {"scale": 0.5}, "emission": 2}]})");
+  auto r = importTungsten(file);
+  ASSERT_TRUE(r.ok()) << r.error();
+  EXPECT_EQ(r->scene.objects.size(), 1u);
+  ASSERT_FALSE(r->warnings.empty());
+  EXPECT_NE(r->warnings[0].find("nowhere.obj"), std::string::npos);
+}
+
+TEST(Tungsten, TexturePathsMatchCaseInsensitivelyWithEitherSeparator) {
+  auto dir = test::tempDir();
+  std::filesystem::create_directories(dir / "Textures");
+  std::ofstream(dir / "Textures" / "Wood.PNG") << "not really a png";
+  std::ofstream(dir / "scene.json") << R"({"bsdfs": [{"name": "w", "type": "lambert", "albedo": "textures\\wood.png"}],
+      "primitives": [{"type": "quad", "bsdf": "w"}]})";
+  auto r = importTungsten(dir / "scene.json");
+  ASSERT_TRUE(r.ok()) << r.error();
+  for (const auto& w : r->warnings) EXPECT_EQ(w.find("not found"), std::string::npos) << w;
+}
+
+TEST(Tungsten, PowerBecomesRadianceByArea) {
+  auto file = writeScene(R"({"primitives": [{"type": "quad", "transform": {"scale": [2, 1, 0.5]}, "power": 10}]})");
+  auto r = importTungsten(file);
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Material* m = r->scene.material(r->scene.objects[0].material);
+  EXPECT_NEAR(m->emission.x, 10.0f / (kPi * 1.0f), 1e-4f);
+}
+
+}  // namespace
+}  // namespace retile
