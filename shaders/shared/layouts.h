@@ -83,7 +83,7 @@ RT_CONST(uint, kWorkRestart, 1u)
 struct TracePush {
   uint slotOffset;   // first slot of this dispatch (dispatches are split by size)
   uint slotCount;    // slots in this dispatch
-  uint laneCount;    // invocations; each traces slots lane, lane + laneCount, ... (regeneration)
+  uint pad0;
   uint pad1;
 };
 

@@ -30,11 +30,6 @@ enum TraceBinding : std::uint32_t {
   kBindDelta = 11, kBindEnvCdf = 12, kBindSamples = 13, kBindAux = 14, kBindStats = 15,
 };
 
-// Path regeneration: a lane traces about this many paths per frame (more amortises lanes held
-// back by one long path; fewer leaves more lanes for wide devices).
-constexpr std::uint64_t kPathsPerLane = 32;
-constexpr std::uint64_t kMinTraceLanes = 1024;
-
 std::uint32_t groupsFor(std::uint64_t invocations, std::uint32_t local, std::uint32_t* groupsY) {
   std::uint64_t groups = (invocations + local - 1) / local;
   auto x = static_cast<std::uint32_t>(std::min<std::uint64_t>(groups, 65535));
@@ -262,12 +257,9 @@ struct Renderer::Impl {
 
     auto start = std::chrono::steady_clock::now();
     ctx.submitAndWait([&](VkCommandBuffer cb) {
-      // Fewer lanes than slots, so that each lane regenerates paths (see trace.comp); enough lanes
-      // to keep every core of a CPU device, or a GPU's cores, busy to the end.
-      std::uint64_t lanes = std::min<std::uint64_t>(slots, std::max<std::uint64_t>(kMinTraceLanes, slots / kPathsPerLane));
-      gpu::TracePush tp{0, static_cast<std::uint32_t>(slots), static_cast<std::uint32_t>(lanes), 0};
+      gpu::TracePush tp{0, static_cast<std::uint32_t>(slots), 0, 0};
       std::uint32_t gy;
-      std::uint32_t gx = groupsFor(lanes, gpu::kTraceWorkgroup, &gy);
+      std::uint32_t gx = groupsFor(slots, gpu::kTraceWorkgroup, &gy);
       trace->dispatch(cb, gx, gy, &tp, sizeof tp);
       vk::computeBarrier(cb);
       gpu::AccumulatePush ap{0, static_cast<std::uint32_t>(pixels), static_cast<std::uint32_t>(items.size()), 0};
