@@ -1,4 +1,5 @@
 // Benchmarks print figures; they never pass or fail (speed goals are not tests).
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <random>
@@ -57,6 +58,8 @@ int benchThroughput(const std::vector<std::string>& argv) {
     sum.bounceRays += s.bounceRays;
     sum.shadowRays += s.shadowRays;
     sum.seconds += s.seconds;
+    sum.maxLoopIterations = std::max(sum.maxLoopIterations, s.maxLoopIterations);
+    sum.cutPaths += s.cutPaths;
   }
   double wall = std::chrono::duration<double>(Clock::now() - start).count();
   double sec = sum.seconds;
@@ -75,7 +78,9 @@ int benchThroughput(const std::vector<std::string>& argv) {
   std::printf("frame time     %.1f ms (device), %.1f ms (wall)\n", sec / frames * 1e3, wall / frames * 1e3);
   std::printf("scene upload   %.3f s (BVH bottom level %.3f s, top level %.4f s)\n", setup, renderer.lastBlasSeconds(),
               renderer.lastTlasSeconds());
-  std::printf("device memory  %.2f MiB scene data, %.1f bytes per triangle\n",
+  std::printf("loop iterations %u at most in one invocation (lavapipe's limit 65535); %llu paths cut short\n",
+              sum.maxLoopIterations, static_cast<unsigned long long>(sum.cutPaths));
+  std::printf("device memory  %.3f MiB scene data, %.1f bytes per triangle\n",
               static_cast<double>(renderer.sceneDeviceBytes()) / (1 << 20),
               tris ? static_cast<double>(renderer.sceneDeviceBytes()) / static_cast<double>(tris) : 0.0);
   return 0;

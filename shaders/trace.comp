@@ -14,7 +14,12 @@ layout(local_size_x = kTraceWorkgroup) in;
 layout(set = 0, binding = 1, std430) readonly buffer Work { WorkItem items[]; };
 layout(set = 0, binding = 13, std430) writeonly buffer Samples { vec4 samples[]; };
 layout(set = 0, binding = 14, std430) writeonly buffer Aux { vec4 aux[]; };
-layout(set = 0, binding = 15, std430) buffer Stats { uint rayCounts[4]; };  // primary, bounce, shadow, -
+// primary, bounce, shadow rays; the most loop iterations of one invocation; paths cut short.
+layout(set = 0, binding = 15, std430) buffer Stats { uint rayCounts[kStatsCount]; };
+
+// A path ends before its invocation could reach lavapipe's loop limit (65535, see scene.glsl):
+// one more segment with its shadow ray costs well under 5000 iterations in any scene seen.
+const uint kLoopBudget = 60000u;
 
 layout(push_constant) uniform Push { TracePush push; };
 
@@ -97,7 +102,13 @@ void main() {
   int auxInstance = 0;
   bool auxDone = false;
 
+  bool cut = false;
   for (;;) {
+    loopIterations++;
+    if (loopIterations > kLoopBudget) {
+      cut = true;
+      break;
+    }
     Hit hit = traceRay(ro, rd, kInfinity, false, rand(rng));
     if (depth == 0) primaryRays++; else bounceRays++;
 
@@ -243,4 +254,6 @@ void main() {
   atomicAdd(rayCounts[0], primaryRays);
   atomicAdd(rayCounts[1], bounceRays);
   atomicAdd(rayCounts[2], shadowRays);
+  atomicMax(rayCounts[3], loopIterations);
+  if (cut) atomicAdd(rayCounts[4], 1u);
 }

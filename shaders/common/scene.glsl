@@ -30,6 +30,12 @@ const int kStackSize = 48;
 #endif
 const float kInfinity = 1e30;
 
+// lavapipe (gallivm) ends every loop of an invocation once 65535 iterations have run in total,
+// counted over all loops together, silently: a ray cut off there misses what it should hit. Each
+// invocation counts its iterations, and a path stops before it can reach the limit (see
+// kLoopBudget in trace.comp); the renderer reports both. Real GPUs have no such limit.
+uint loopIterations = 0u;
+
 struct Hit {
   float t;
   float u, v;
@@ -49,12 +55,18 @@ vec4 sampleTexture(int index, vec2 uv) {
   }
   int offset = floatBitsToInt(info.x);
   int w = floatBitsToInt(info.y), h = floatBitsToInt(info.z);
-  // v points up in every format we import; image rows go down.
-  vec2 p = vec2(uv.x * float(w), (1.0 - uv.y) * float(h)) - 0.5;
+  // v points up in every format we import; image rows go down. Wrap in floating point first:
+  // GLSL leaves % of negative integers undefined, and far-away uvs overflow an int.
+  vec2 wrapped = vec2(uv.x, 1.0 - uv.y);
+  wrapped = any(isnan(wrapped)) || any(isinf(wrapped)) ? vec2(0.0) : wrapped - floor(wrapped);
+  ivec2 size = ivec2(w, h);
+  vec2 p = wrapped * vec2(size) - 0.5;
   vec2 f = fract(p);
   ivec2 i0 = ivec2(floor(p));
-  i0 = ((i0 % ivec2(w, h)) + ivec2(w, h)) % ivec2(w, h);
-  ivec2 i1 = (i0 + 1) % ivec2(w, h);
+  i0 += ivec2(lessThan(i0, ivec2(0))) * size;
+  i0 = clamp(i0, ivec2(0), size - 1);
+  ivec2 i1 = i0 + 1;
+  i1 -= ivec2(greaterThanEqual(i1, size)) * size;
   vec4 a = texelFetch(uTexels, offset + i0.y * w + i0.x);
   vec4 b = texelFetch(uTexels, offset + i0.y * w + i1.x);
   vec4 c = texelFetch(uTexels, offset + i1.y * w + i0.x);
@@ -127,6 +139,7 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
   int triOffset = 0;
 
   for (;;) {
+    loopIterations++;
     if (node == -1) {
       // Marker: back from an instance to world space.
       o = origin;
@@ -168,6 +181,7 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
           continue;
         }
         for (int p = start; p < start + cnt; ++p) {
+          loopIterations++;
           vec3 v0 = texelFetch(uTris, p * kTriTexels).xyz;
           vec3 e1 = texelFetch(uTris, p * kTriTexels + 1).xyz;
           vec3 e2 = texelFetch(uTris, p * kTriTexels + 2).xyz;

@@ -52,6 +52,7 @@ RT_CONST(int, kEnvConstant, 1)
 RT_CONST(int, kEnvMap, 2)
 
 RT_CONST(int, kTraceWorkgroup, 64)
+RT_CONST(int, kStatsCount, 8)  // counters the trace pass writes (see trace.comp)
 RT_CONST(int, kAccumulateWorkgroup, 64)
 RT_CONST(int, kMaxWorkItems, 65536)
 

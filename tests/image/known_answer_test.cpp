@@ -122,6 +122,48 @@ TEST(KnownAnswer, InverseSquareFalloffOfASmallLight) {
   EXPECT_NEAR(near / far, 4.0, 0.08);
 }
 
+TEST(KnownAnswer, EveryMaterialGivesOnlyFiniteSamples) {
+  // A non-finite path is dropped by the accumulator (its sample does not count), so a material
+  // whose sampling or evaluation goes wrong shows as pixels with fewer samples than traced.
+  // Each material type lies on a plane and a sphere, lit by a sky, an area light and a point light.
+  RETILE_RENDERER_OR_SKIP(r);
+  for (int t = 0; t < kMaterialTypeCount; ++t) {
+    auto type = static_cast<MaterialType>(t);
+    if (type == MaterialType::Null) continue;
+    for (float roughness : {0.02f, 0.15f, 0.6f}) {
+      Scene s = test::emptyScene(24, 16);
+      s.camera.position = {0, 1.0f, 3};
+      s.camera.target = {0, 0.3f, 0};
+      s.settings.maxBounces = 6;
+      s.environment.color = Vec3{1.0f};
+      Material m;
+      m.type = type;
+      m.roughness = roughness;
+      m.albedo = Vec3{0.7f};
+      NodeId mat = test::addMaterial(s, m);
+      test::addMeshObject(s, "plane", makeQuad(), mat, Mat4::scale({10, 1, 10}));
+      test::addMeshObject(s, "sphere", makeSphere(16, 32), mat, Mat4::translate({0, 0.5f, 0}) * Mat4::scale(Vec3{0.5f}));
+      Material light;
+      light.albedo = Vec3{0.0f};
+      light.emission = Vec3{5.0f};
+      test::addMeshObject(s, "light", makeQuad(), test::addMaterial(s, light),
+                          Mat4::translate({0.5f, 2, 0.5f}) * Mat4::rotateX(kPi) * Mat4::scale({0.5f, 1, 0.5f}));
+      Light point;
+      point.id = s.newId();
+      point.position = {-1, 1.5f, 1};
+      point.intensity = 2.0f;
+      s.lights.push_back(point);
+      const int spp = 8;
+      RenderImage img = renderScene(*r, s, spp, 7);
+      int dropped = 0;
+      for (float c : img.sampleCount) dropped += spp - static_cast<int>(c);
+      EXPECT_EQ(dropped, 0) << materialTypeName(type) << " at roughness " << roughness << " dropped " << dropped
+                            << " of " << img.sampleCount.size() * spp << " samples as non-finite";
+      EXPECT_TRUE(test::allFinite(img)) << materialTypeName(type);
+    }
+  }
+}
+
 TEST(KnownAnswer, ConvergedRenderEqualsMeanOfIndependentRenders) {
   // One render of K*N samples against K independent renders of N samples each: per pixel the
   // difference of the means must look like noise of the size the parts' spread predicts. K = 16

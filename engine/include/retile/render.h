@@ -38,6 +38,9 @@ struct FrameStats {
   std::uint64_t bounceRays = 0;
   std::uint64_t shadowRays = 0;
   double seconds = 0;              // wall time of trace + accumulate on the device
+  // lavapipe stops an invocation's loops after 65535 iterations in all; paths end before that.
+  std::uint32_t maxLoopIterations = 0;  // the most any one invocation ran (a per-lane lower bound)
+  std::uint64_t cutPaths = 0;           // paths ended early to stay under that limit
 };
 
 struct RenderRequest {

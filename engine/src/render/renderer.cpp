@@ -64,7 +64,7 @@ struct Renderer::Impl {
                              Binding::Storage},
         static_cast<std::uint32_t>(sizeof(gpu::AccumulatePush)));
     frameUbo = Buffer(ctx, sizeof(gpu::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true, "frame constants");
-    stats = Buffer(ctx, 16, kStorageUsage, true, "ray statistics");
+    stats = Buffer(ctx, gpu::kStatsCount * sizeof(std::uint32_t), kStorageUsage, true, "ray statistics");
     work = Buffer(ctx, sizeof(gpu::WorkItem) * 64, kStorageUsage, true, "work items");
   }
 
@@ -252,7 +252,7 @@ struct Renderer::Impl {
     }
     work.upload(items.data(), workBytes);
     writeFrameUniforms(static_cast<std::uint32_t>(items.size()), slots);
-    std::uint32_t zero[4] = {0, 0, 0, 0};
+    std::uint32_t zero[gpu::kStatsCount] = {};
     stats.upload(zero, sizeof zero);
 
     auto start = std::chrono::steady_clock::now();
@@ -267,12 +267,14 @@ struct Renderer::Impl {
       accumulate->dispatch(cb, gx, gy, &ap, sizeof ap);
     });
     fs.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::uint32_t counts[4];
+    std::uint32_t counts[gpu::kStatsCount];
     stats.download(counts, sizeof counts);
     fs.samples = slots;
     fs.primaryRays = counts[0];
     fs.bounceRays = counts[1];
     fs.shadowRays = counts[2];
+    fs.maxLoopIterations = counts[3];
+    fs.cutPaths = counts[4];
     return fs;
   }
 
@@ -376,6 +378,8 @@ RenderImage Renderer::render(const RenderRequest& request, const std::function<b
     sum.bounceRays += fs.bounceRays;
     sum.shadowRays += fs.shadowRays;
     sum.seconds += fs.seconds;
+    sum.maxLoopIterations = std::max(sum.maxLoopIterations, fs.maxLoopIterations);
+    sum.cutPaths += fs.cutPaths;
     if (progress && !progress(f + 1, spp)) break;
   }
   if (total) *total = sum;
