@@ -26,6 +26,8 @@ Result<bool> parseSize(const std::string& text, int* width, int* height);
 Result<ImportedScene> loadScene(const std::string& name);
 
 // A one-line progress bar on stderr, redrawn in place.
+// Prints the renderer's warnings about a scene, leaving out files the import already reported.
+void printRenderWarnings(const std::vector<std::string>& renderWarnings, const std::vector<std::string>& importWarnings);
 void progressBar(const std::string& label, int done, int total, double seconds);
 
 int runRender(const std::vector<std::string>& args);

@@ -40,7 +40,7 @@ int benchThroughput(const std::vector<std::string>& argv) {
 
   Renderer renderer;
   auto t0 = Clock::now();
-  renderer.setScene(loaded->scene);
+  printRenderWarnings(renderer.setScene(loaded->scene), loaded->warnings);
   double setup = std::chrono::duration<double>(Clock::now() - t0).count();
   renderer.setMaxBounces(bounces >= 0 ? bounces : loaded->scene.settings.maxBounces);
   renderer.resize(w, h);

@@ -59,7 +59,7 @@ int runRender(const std::vector<std::string>& argv) {
 
   Renderer renderer;
   std::fprintf(stderr, "device: %s\n", renderer.deviceName().c_str());
-  renderer.setScene(loaded->scene);
+  printRenderWarnings(renderer.setScene(loaded->scene), loaded->warnings);
   auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   FrameStats stats;

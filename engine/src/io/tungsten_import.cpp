@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <set>
 
 #include "core/files.h"
 #include "core/json.h"
@@ -125,7 +126,8 @@ class TungstenImporter {
     t.path = ref;
     t.name = fs::path(ref).filename().string();
     t.colorSpace = cs;
-    if (!resolveScenePath(base_, ref))
+    // One warning per missing file, however many materials use it; the environment says its own.
+    if (!resolveScenePath(base_, ref) && !quietMissingTexture_ && missingWarned_.insert(ref).second)
       warn(cat("texture '", ref, "' not found; it renders as a magenta checker until the file is there"));
     out_.scene.textures.push_back(t);
     textures_[key] = t.id;
@@ -572,7 +574,9 @@ class TungstenImporter {
       e.color = Vec3{1.0f};
       return;
     }
+    quietMissingTexture_ = true;
     TextureRef t = texture(*em, where + ".emission", false);
+    quietMissingTexture_ = false;
     if (t.isTexture) {
       e.type = EnvironmentType::Map;
       e.map = t.texture;
@@ -724,6 +728,8 @@ class TungstenImporter {
   std::string error_;
   std::map<std::string, Material> named_;
   std::map<std::string, NodeId> textures_;
+  std::set<std::string> missingWarned_;
+  bool quietMissingTexture_ = false;
   std::map<std::string, NodeId> meshIds_;
   std::map<std::string, std::shared_ptr<const MeshGeometry>> shapes_;
   int emitters_ = 0;

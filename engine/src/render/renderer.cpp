@@ -342,7 +342,6 @@ std::vector<std::string> Renderer::updateScene(const Scene& scene, std::uint32_t
   if (!impl_->hasScene) impl_->maxBounces = scene.settings.maxBounces;
   if (flags & kUpdateSettings) impl_->maxBounces = scene.settings.maxBounces;
   impl_->hasScene = true;
-  for (const auto& w : warnings) logWarning(w);
   return warnings;
 }
 
