@@ -1,0 +1,197 @@
+#include "schedule/scheduler.h"
+
+#include <algorithm>
+
+namespace retile {
+
+const char* accumModeName(AccumMode m) {
+  switch (m) {
+    case AccumMode::GlobalUpdate: return "global-update";
+    case AccumMode::Incremental: return "incremental";
+    case AccumMode::Refinement: return "refinement";
+    case AccumMode::Probe: return "probe";
+  }
+  return "?";
+}
+
+void TileScheduler::reset(const TileGrid& grid) {
+  grid_ = grid;
+  auto n = static_cast<std::size_t>(grid.count());
+  samples_.assign(n, 0.0);
+  nextIndex_.assign(n, 0);
+  queue_.clear();
+  pass_.clear();
+  finished_.clear();
+  pos_ = 0;
+  refineCursor_ = 0;
+  pendingGlobal_ = true;
+  pendingProbe_ = false;
+}
+
+void TileScheduler::globalUpdate() {
+  pendingGlobal_ = true;
+  pendingProbe_ = false;
+  queue_.clear();
+  pass_.clear();
+  pos_ = 0;
+}
+
+void TileScheduler::probe() { pendingProbe_ = true; }
+
+void TileScheduler::startPass(std::vector<int> order, int quality, int prioritized, bool smooth, int staleCap) {
+  std::vector<char> seen(static_cast<std::size_t>(grid_.count()), 0);
+  queue_.clear();
+  for (int t : order)
+    if (t >= 0 && t < grid_.count() && !seen[static_cast<std::size_t>(t)]) {
+      seen[static_cast<std::size_t>(t)] = 1;
+      queue_.push_back(t);
+    }
+  quality_ = std::max(1, quality);
+  pass_.assign(queue_.size(), PassTile{quality_, false});
+  pos_ = 0;
+  prioritized_ = std::clamp(prioritized, 0, static_cast<int>(queue_.size()));
+  smooth_ = smooth;
+  staleCap_ = std::max(1, staleCap);
+  finished_.clear();
+  pendingProbe_ = false;
+}
+
+AccumMode TileScheduler::mode() const {
+  if (pendingGlobal_) return AccumMode::GlobalUpdate;
+  if (pendingProbe_) return AccumMode::Probe;
+  return passActive() ? AccumMode::Incremental : AccumMode::Refinement;
+}
+
+std::vector<float> TileScheduler::priorities() const {
+  std::vector<float> p(static_cast<std::size_t>(grid_.count()), -1.0f);
+  float last = queue_.size() > 1 ? static_cast<float>(queue_.size() - 1) : 1.0f;
+  for (std::size_t i = 0; i < queue_.size(); ++i)
+    p[static_cast<std::size_t>(queue_[i])] = 1.0f - static_cast<float>(i) / last;
+  return p;
+}
+
+void TileScheduler::emit(FramePlan& plan, int tile, TileRect rect, int quality, bool restart, int cap, bool wholeTile) {
+  auto t = static_cast<std::size_t>(tile);
+  TileChunk c;
+  c.tile = tile;
+  c.rect = rect;
+  c.quality = quality;
+  c.sampleBase = nextIndex_[t];
+  c.restart = restart;
+  c.capStale = cap;
+  // Sample indices only grow per tile, so no pixel ever sees the same index twice.
+  nextIndex_[t] += static_cast<std::uint32_t>(quality);
+  double share = wholeTile ? 1.0 : static_cast<double>(rect.pixels()) / static_cast<double>(grid_.rect(tile).pixels());
+  if (restart) samples_[t] = quality * share;
+  else if (cap > 0) samples_[t] = std::min(samples_[t], static_cast<double>(cap)) + quality * share;
+  else samples_[t] += quality * share;
+  if (plan.servedTiles.empty() || std::find(plan.servedTiles.begin(), plan.servedTiles.end(), tile) == plan.servedTiles.end())
+    plan.servedTiles.push_back(tile);
+  plan.chunks.push_back(c);
+  plan.samples += rect.pixels() * quality;
+}
+
+// The budget left after whole tiles is smaller than the next tile: spend it as 1-spp strips
+// (whole rows, then part of a row) on tiles this frame has not touched, fresh ones first, so the
+// frame traces exactly W x H samples and no pixel is served twice.
+void TileScheduler::fillRemainder(FramePlan& plan, std::int64_t remainder, const std::vector<char>& served) {
+  std::vector<char> used = served;
+  auto strip = [&](int t, bool restart, int cap) {
+    TileRect r = grid_.rect(t);
+    std::int64_t m = std::min(remainder, r.pixels());
+    int rows = static_cast<int>(m / r.width);
+    int rest = static_cast<int>(m - static_cast<std::int64_t>(rows) * r.width);
+    if (rows > 0) emit(plan, t, {r.x, r.y, r.width, rows}, 1, restart, cap, rows == r.height);
+    if (rest > 0) emit(plan, t, {r.x, r.y + rows, rest, 1}, 1, restart, cap, false);
+    remainder -= m;
+    used[static_cast<std::size_t>(t)] = 1;
+  };
+  // 1. Tiles the pass has finished: their sums are fresh, extra samples only help.
+  for (auto it = finished_.rbegin(); it != finished_.rend() && remainder > 0; ++it)
+    if (!used[static_cast<std::size_t>(*it)]) strip(*it, false, 0);
+  // 2. Tiles still queued. One not yet started restarts its strip pixels (its whole-tile chunk
+  //    restarts them again later: those samples are spent, never biased).
+  for (std::size_t i = pos_; i < queue_.size() && remainder > 0; ++i) {
+    int t = queue_[i];
+    if (used[static_cast<std::size_t>(t)]) continue;
+    bool prior = static_cast<int>(i) < prioritized_ || !smooth_;
+    bool started = pass_[i].started;
+    strip(t, !started && prior, !started && !prior ? staleCap_ : 0);
+  }
+  // 3. Refinement: the tiles the cursor reaches next.
+  for (int i = 0; i < grid_.count() && remainder > 0; ++i) {
+    int t = static_cast<int>((refineCursor_ + static_cast<std::size_t>(i)) % static_cast<std::size_t>(grid_.count()));
+    if (!used[static_cast<std::size_t>(t)]) strip(t, false, 0);
+  }
+}
+
+FramePlan TileScheduler::nextFrame() {
+  FramePlan plan;
+  const std::int64_t budget = grid_.pixels();
+  const int n = grid_.count();
+  std::vector<char> served(static_cast<std::size_t>(n), 0);
+
+  if (pendingGlobal_ || pendingProbe_) {
+    plan.mode = pendingGlobal_ ? AccumMode::GlobalUpdate : AccumMode::Probe;
+    for (int t = 0; t < n; ++t) {
+      if (plan.mode == AccumMode::Probe) {
+        // Traced and compared, never accumulated: the tile's sums and indices stay as they are.
+        TileChunk c;
+        c.tile = t;
+        c.rect = grid_.rect(t);
+        c.sampleBase = nextIndex_[static_cast<std::size_t>(t)];
+        plan.chunks.push_back(c);
+        plan.servedTiles.push_back(t);
+        plan.samples += c.rect.pixels();
+      } else {
+        emit(plan, t, grid_.rect(t), 1, true, 0, true);
+      }
+    }
+    if (pendingGlobal_) {
+      queue_.clear();
+      pass_.clear();
+      pos_ = 0;
+      refineCursor_ = 0;
+    }
+    pendingGlobal_ = pendingProbe_ = false;
+    return plan;
+  }
+
+  std::int64_t remaining = budget;
+  plan.mode = passActive() ? AccumMode::Incremental : AccumMode::Refinement;
+  while (pos_ < queue_.size()) {
+    int t = queue_[pos_];
+    PassTile& pt = pass_[pos_];
+    std::int64_t pixels = grid_.rect(t).pixels();
+    int k = static_cast<int>(std::min<std::int64_t>(pt.need, remaining / pixels));
+    if (k <= 0) break;
+    bool prior = static_cast<int>(pos_) < prioritized_ || !smooth_;
+    emit(plan, t, grid_.rect(t), k, !pt.started && prior, !pt.started && !prior ? staleCap_ : 0, true);
+    served[static_cast<std::size_t>(t)] = 1;
+    pt.started = true;
+    pt.need -= k;
+    remaining -= pixels * k;
+    if (pt.need > 0) break;  // the budget ran out inside this tile; it continues next frame
+    finished_.push_back(t);
+    ++pos_;
+  }
+  if (!passActive()) {
+    // Continuous refinement: every tile at 1 spp, round robin, so that a full frame is exactly
+    // one pass over the image.
+    int visited = 0;
+    for (; visited < n; ++visited) {
+      int t = static_cast<int>((refineCursor_ + static_cast<std::size_t>(visited)) % static_cast<std::size_t>(n));
+      if (served[static_cast<std::size_t>(t)]) continue;
+      std::int64_t pixels = grid_.rect(t).pixels();
+      if (pixels > remaining) break;
+      emit(plan, t, grid_.rect(t), 1, false, 0, true);
+      served[static_cast<std::size_t>(t)] = 1;
+      remaining -= pixels;
+    }
+    refineCursor_ = (refineCursor_ + static_cast<std::size_t>(visited)) % static_cast<std::size_t>(n);
+  }
+  if (remaining > 0) fillRemainder(plan, remaining, served);
+  return plan;
+}
+
+}  // namespace retile

@@ -1,0 +1,92 @@
+// Plans each frame's tiles on the exact same-time budget: every frame traces exactly W x H
+// samples, whatever the mode, T or Q. Owns the accumulator's three modes of METHOD.md:
+//   global update  - every tile at 1 spp, sums restarted (camera change, resize, global method)
+//   incremental    - the queued tiles at Q spp, restarted on their first chunk of the pass
+//   refinement     - every tile at 1 spp added to its sum, once the queue ran empty
+// plus the change policy's probe frame (every tile at 1 spp, traced but not accumulated).
+// Pure CPU; owned by the render thread.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "schedule/tile_grid.h"
+
+namespace retile {
+
+enum class AccumMode { GlobalUpdate, Incremental, Refinement, Probe };
+const char* accumModeName(AccumMode m);
+
+// A rectangle (a whole tile, or a strip of one) and how it is traced and accumulated this frame.
+struct TileChunk {
+  int tile = 0;
+  TileRect rect;
+  int quality = 1;
+  std::uint32_t sampleBase = 0;  // sample indices sampleBase .. sampleBase + quality - 1
+  bool restart = false;          // replace the pixels' sums
+  int capStale = 0;              // > 0: first scale the sums down to at most this many samples
+};
+
+struct FramePlan {
+  AccumMode mode = AccumMode::Refinement;
+  std::vector<TileChunk> chunks;  // disjoint: no pixel appears twice in a frame
+  std::int64_t samples = 0;       // always grid.pixels()
+  std::vector<int> servedTiles;   // tiles with at least one chunk, in serving order
+};
+
+class TileScheduler {
+ public:
+  TileScheduler() = default;
+  explicit TileScheduler(const TileGrid& grid) { reset(grid); }
+
+  // A new grid (resize, new T): everything restarts with a global update.
+  void reset(const TileGrid& grid);
+  // The next frame restarts every tile at 1 spp; refinement follows.
+  void globalUpdate();
+  // The next frame is a probe (traced, not accumulated); the caller then starts a pass.
+  void probe();
+  // Starts an incremental pass (a new edit restarts the queue from its point of change). Tiles
+  // of `order` (each at most once; tiles left out are not served by the pass) get `quality` spp
+  // each. The first `prioritized` restart their sums; with `smooth`, the others keep their stale
+  // sums capped at `staleCap` samples per pixel and add fresh ones, else they restart too.
+  void startPass(std::vector<int> order, int quality, int prioritized, bool smooth, int staleCap);
+
+  FramePlan nextFrame();
+
+  const TileGrid& grid() const { return grid_; }
+  AccumMode mode() const;
+  bool passActive() const { return pos_ < queue_.size(); }
+  std::size_t queueLength() const { return queue_.size(); }
+  std::size_t queueServed() const { return pos_; }  // tiles of the pass finished
+  int quality() const { return quality_; }
+  // Per tile: mean samples per pixel accumulated since its last restart.
+  const std::vector<double>& tileSamples() const { return samples_; }
+  // Per tile: 1 for the head of the queue falling linearly to 0 at its end; -1 when unqueued.
+  std::vector<float> priorities() const;
+
+ private:
+  struct PassTile {
+    int need = 0;         // spp still to serve to the whole tile
+    bool started = false;
+  };
+  void emit(FramePlan& plan, int tile, TileRect rect, int quality, bool restart, int cap, bool wholeTile);
+  void fillRemainder(FramePlan& plan, std::int64_t remainder, const std::vector<char>& served);
+
+  TileGrid grid_;
+  bool pendingGlobal_ = true;
+  bool pendingProbe_ = false;
+  std::vector<int> queue_;
+  std::vector<PassTile> pass_;  // per queue position
+  std::size_t pos_ = 0;
+  int quality_ = 1;
+  int prioritized_ = 0;
+  bool smooth_ = false;
+  int staleCap_ = 0;
+  std::size_t refineCursor_ = 0;
+  std::vector<double> samples_;
+  std::vector<std::uint32_t> nextIndex_;
+  std::vector<int> finished_;  // tiles of the pass already at quality, most recent last
+};
+
+}  // namespace retile
