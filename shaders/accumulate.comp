@@ -65,6 +65,17 @@ void main() {
   bool restart = (item.info.w & kWorkRestart) != 0u;
   vec4 acc = restart ? vec4(0.0) : accum[pixel * 2u];
   vec4 comp = restart ? vec4(0.0) : accum[pixel * 2u + 1u];
+  vec4 aa = restart ? vec4(0.0, 0.0, 0.0, 1e30) : accumAux[pixel * 2u];
+  vec4 an = restart ? vec4(0.0) : accumAux[pixel * 2u + 1u];
+  if (!restart && (item.info.w & kWorkCapStale) != 0u && acc.w > float(item.pixels.y)) {
+    // Smooth transition: the stale sums keep the weight of at most `cap` samples, so the old
+    // image fades out in a known number of frames instead of after as many as it had samples.
+    float keep = float(item.pixels.y) / acc.w;
+    acc = vec4(acc.rgb * keep, float(item.pixels.y));
+    comp.rgb *= keep;
+    aa.rgb *= keep;
+    an.xyz *= keep;
+  }
   // Kahan: add (sum - compensation); the new compensation is what the addition lost.
   precise vec3 y = (sum - lost) - comp.rgb;
   precise vec3 t = acc.rgb + y;
@@ -72,8 +83,6 @@ void main() {
   accum[pixel * 2u] = vec4(t, acc.w + count);
   accum[pixel * 2u + 1u] = vec4(c, 0.0);
 
-  vec4 aa = restart ? vec4(0.0, 0.0, 0.0, 1e30) : accumAux[pixel * 2u];
-  vec4 an = restart ? vec4(0.0) : accumAux[pixel * 2u + 1u];
   accumAux[pixel * 2u] = vec4(aa.rgb + albedo, min(aa.w, depth));
   accumAux[pixel * 2u + 1u] = vec4(an.xyz + normal, instance);
 }

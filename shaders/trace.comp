@@ -21,7 +21,18 @@ layout(set = 0, binding = 15, std430) buffer Stats { uint rayCounts[kStatsCount]
 // one more segment with its shadow ray costs well under 5000 iterations in any scene seen.
 const uint kLoopBudget = 60000u;
 
+// What the tracer sees of the selected object, per tile (the indirection-aware policy).
+layout(set = 0, binding = 16, std430) buffer Selection { uint selectionCounts[]; };
+
 layout(push_constant) uniform Push { TracePush push; };
+
+// Index of the counters of the tile holding pixel (px, py), or -1 when not counting.
+int selectionBase(int px, int py) {
+  uint t = frame.work.w;
+  if (t == 0u || frame.work.z == 0u) return -1;
+  uint cols = (frame.image.x + t - 1u) / t;
+  return int(((uint(py) / t) * cols + uint(px) / t) * uint(kSelectionCounters));
+}
 
 Material fetchMaterial(int index, vec2 uv) {
   int base = index * kMaterialTexels;
@@ -87,6 +98,9 @@ void main() {
                       ndc.y * tanHalf * frame.cameraUp.xyz);
   vec3 ro = frame.cameraPosition.xyz;
 
+  int selBase = selectionBase(px, py);
+  int selected = int(frame.work.z) - 1;
+
   vec3 L = vec3(0.0);
   vec3 beta = vec3(1.0);
   float etaScale = 1.0;
@@ -111,6 +125,11 @@ void main() {
     }
     Hit hit = traceRay(ro, rd, kInfinity, false, rand(rng));
     if (depth == 0) primaryRays++; else bounceRays++;
+    if (selBase >= 0 && hit.prim >= 0 && hit.instance == selected) {
+      // Direct hits, then reflections weighted (maxBounces + 1) / depth: 4, 2, 1 at 3 bounces.
+      if (depth == 0) atomicAdd(selectionCounts[selBase], 1u);
+      else atomicAdd(selectionCounts[selBase + 1], uint(max(maxBounces + 1, 1) / depth));
+    }
 
     if (hit.prim < 0) {
       vec3 Le = envRadiance(rd);
@@ -210,6 +229,7 @@ void main() {
             float tMax = ls.dist >= kInfinity ? kInfinity : ls.dist * (1.0 - 1e-4);
             shadowRays++;
             Hit sh = traceRay(origin, ls.dir, tMax, true, rand(rng));
+            if (selBase >= 0 && sh.prim >= 0 && sh.instance == selected) atomicAdd(selectionCounts[selBase + 2], 1u);
             if (sh.prim < 0) {
               float w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, bsdfPdf);
               L += beta * f * ls.radiance * (w / ls.pdf);

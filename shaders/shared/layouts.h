@@ -68,7 +68,8 @@ struct FrameUniforms {
   ivec4 environment;    // type, map texture, map width, map height
   vec4 environmentTint; // rgb multiplier (constant: the radiance), rotation about +y in radians
   vec4 sceneSphere;     // bounding sphere: centre xyz, radius
-  uvec4 work;           // work item count, total sample slots, -, -
+  uvec4 work;           // work item count, total sample slots, selected instance + 1 (0: none),
+                        // tile size of the selection counters (0: not counting)
 };
 
 // A rectangle of pixels that receives q samples each this frame. Slot s of the frame belongs to
@@ -77,9 +78,11 @@ struct FrameUniforms {
 struct WorkItem {
   ivec4 rect;   // x0, y0, width, height
   uvec4 info;   // q, slotStart, sampleBase, flags (kWorkRestart: replace the pixel's sums)
-  uvec4 pixels; // pixelStart (prefix of width * height over items), -, -, -
+  uvec4 pixels; // pixelStart (prefix of width * height over items), stale cap (kWorkCapStale), -, -
 };
 RT_CONST(uint, kWorkRestart, 1u)
+RT_CONST(uint, kWorkCapStale, 2u)   // scale the pixel's sums down to at most pixels.y samples first
+RT_CONST(int, kSelectionCounters, 3) // per tile: direct hits, weighted reflections, blocked shadow rays
 
 struct TracePush {
   uint slotOffset;   // first slot of this dispatch (dispatches are split by size)

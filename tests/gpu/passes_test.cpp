@@ -1,6 +1,8 @@
 // Each compute pass on its own, with inputs whose outputs are known exactly.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "gpu_support.h"
 #include "retile/edit.h"
 #include "scene/primitives.h"
@@ -78,6 +80,97 @@ TEST(AccumulatePass, ThousandsOfSamplesDoNotDrift) {
   EXPECT_EQ(img.sampleCount[0], 8192.0f);
   EXPECT_NEAR(img.color[0], 0.1f, 0.1f * 1e-6f);
   EXPECT_NEAR(img.color[2], 0.7f, 0.7f * 1e-6f);
+}
+
+TEST(AccumulatePass, StaleCapKeepsAtMostCapSamplesOfTheOldValue) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const int w = 8, h = 8;
+  Scene s = wallScene(w, h, Vec3{1.0f});
+  r->setScene(s);
+  r->resize(w, h);
+  r->renderFrame({{0, 0, w, h, 100, 0, true}});  // 100 samples of 1
+  s.materials[0].emission = Vec3{4.0f};
+  r->updateScene(s, kUpdateMaterials | kUpdateLights);
+  TileWork capped{0, 0, w, h, 2, 100, false};
+  capped.capStale = 6;
+  r->renderFrame({capped});
+  RenderImage img = r->readback();
+  // 6 stale samples of 1 and 2 fresh of 4: (6 + 8) / 8.
+  EXPECT_EQ(img.sampleCount[0], 8.0f);
+  EXPECT_FLOAT_EQ(img.color[0], 14.0f / 8.0f);
+}
+
+TEST(TracePass, ProbeFramesAreTracedButNotAccumulated) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const int w = 12, h = 6;
+  Scene s = wallScene(w, h, Vec3{1.0f});
+  r->setScene(s);
+  r->resize(w, h);
+  r->renderFrame({{0, 0, w, h, 3, 0, true}});
+  s.materials[0].emission = Vec3{2.0f};
+  r->updateScene(s, kUpdateMaterials | kUpdateLights);
+  FrameOptions probe;
+  probe.accumulate = false;
+  FrameStats fs = r->renderFrame({{0, 0, 6, h, 1, 3, false}}, probe);
+  EXPECT_EQ(fs.samples, 36u);
+  std::vector<float> lum = r->readbackFrameLuminance();
+  ASSERT_EQ(lum.size(), static_cast<std::size_t>(w * h));
+  EXPECT_FLOAT_EQ(lum[0], 2.0f) << "the probe sees the edited scene";
+  EXPECT_TRUE(std::isnan(lum[11])) << "pixels the probe did not trace";
+  RenderImage img = r->readback();
+  EXPECT_EQ(img.color[0], 1.0f) << "the accumulation is untouched";
+  EXPECT_EQ(img.sampleCount[0], 3.0f);
+}
+
+TEST(TracePass, SelectionCountersSeeDirectHitsReflectionsAndShadows) {
+  RETILE_RENDERER_OR_SKIP(r);
+  // Looking down at a floor; a small box sits left of centre under a light high above, so it is
+  // seen directly, casts a shadow onto the floor, and floor paths bounce onto it.
+  const int w = 64, h = 32, tile = 16;
+  Scene s = test::emptyScene(w, h);
+  s.camera.position = {0, 6, 0.01f};
+  s.camera.target = {0, 0, 0};
+  s.camera.up = {0, 0, -1};
+  s.camera.verticalFov = radians(40);
+  s.settings.maxBounces = 3;
+  Material grey;
+  grey.albedo = Vec3{0.7f};
+  NodeId mg = test::addMaterial(s, grey);
+  test::addMeshObject(s, "floor", makeQuad(), mg, Mat4::scale({40, 1, 40}));
+  NodeId box = test::addMeshObject(s, "box", makeCube(), mg, Mat4::translate({-1.5f, 0.25f, 0}) * Mat4::scale(Vec3{0.5f}));
+  Light sun;
+  sun.id = s.newId();
+  sun.type = LightType::Point;
+  sun.position = {-1.5f, 3.0f, 0};
+  sun.intensity = 20.0f;
+  s.lights.push_back(sun);
+  r->setScene(s);
+  r->resize(w, h);
+  r->setSelection(box);
+  FrameOptions count;
+  count.selectionTileSize = tile;
+  for (int f = 0; f < 4; ++f) r->renderFrame({{0, 0, w, h, 4, static_cast<std::uint32_t>(f * 4), f == 0}}, count);
+  SelectionCounts c = r->takeSelectionCounts();
+  ASSERT_EQ(c.tileSize, tile);
+  ASSERT_EQ(c.direct.size(), 8u);  // 4 x 2 tiles
+  std::uint64_t direct = 0, reflection = 0, shadow = 0;
+  for (std::size_t t = 0; t < c.direct.size(); ++t) {
+    direct += c.direct[t];
+    reflection += c.reflection[t];
+    shadow += c.shadow[t];
+  }
+  EXPECT_GT(direct, 0u);
+  EXPECT_GT(reflection, 0u) << "floor paths bounce onto the box";
+  EXPECT_GT(shadow, 0u) << "the box blocks shadow rays from the floor";
+  // The box is left of centre: its direct hits are all in the left half of the tiles.
+  EXPECT_EQ(c.direct[3] + c.direct[7], 0u);
+  SelectionCounts again = r->takeSelectionCounts();
+  EXPECT_EQ(again.direct[1] + again.direct[5], 0u) << "taking the counts clears them";
+  // Nothing selected: nothing counted.
+  r->setSelection(kNoNode);
+  r->renderFrame({{0, 0, w, h, 1, 100, false}}, count);
+  SelectionCounts none = r->takeSelectionCounts();
+  for (auto v : none.direct) EXPECT_EQ(v, 0u);
 }
 
 TEST(TracePass, AuxiliaryOutputsDescribeTheFirstHit) {

@@ -30,6 +30,19 @@ struct TileWork {
   int quality = 1;
   std::uint32_t sampleBase = 0;
   bool restart = false;
+  int capStale = 0;  // > 0 (and not restart): first scale the sums down to at most this many samples
+};
+
+struct FrameOptions {
+  bool accumulate = true;    // false: trace only (a probe); readbackFrameLuminance() gives the result
+  int selectionTileSize = 0; // > 0: count what the tracer sees of the selection per tile of this size
+};
+
+// Per tile of the counting tile size, summed over frames until read: primary hits on the selected
+// object, later path vertices on it weighted (maxBounces + 1) / depth, and shadow rays it blocked.
+struct SelectionCounts {
+  int tileSize = 0;
+  std::vector<std::uint32_t> direct, reflection, shadow;
 };
 
 struct FrameStats {
@@ -72,7 +85,15 @@ class Renderer {
   void setSeed(std::uint32_t seed);
 
   // Traces one frame: every tile's pixels get `quality` samples, accumulated as the tile says.
-  FrameStats renderFrame(const std::vector<TileWork>& tiles);
+  // Tiles must not overlap within a frame.
+  FrameStats renderFrame(const std::vector<TileWork>& tiles, const FrameOptions& options = {});
+  // Per pixel (row-major), the mean luminance of the last frame's samples; NaN where it traced
+  // nothing. For the change-aware policy's probe frame.
+  std::vector<float> readbackFrameLuminance();
+  // The object whose hits are counted (kNoNode: none). Takes effect with the next frame.
+  void setSelection(NodeId object);
+  // Returns the counts gathered since the last call (or since the tile size changed) and clears them.
+  SelectionCounts takeSelectionCounts();
   // Reads back the accumulated image (mean per pixel) and auxiliary outputs.
   RenderImage readback();
 

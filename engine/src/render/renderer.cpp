@@ -27,7 +27,7 @@ constexpr VkBufferUsageFlags kStorageUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
 enum TraceBinding : std::uint32_t {
   kBindFrame = 0, kBindWork = 1, kBindNodes = 2, kBindTris = 3, kBindTriShade = 4, kBindInstances = 5,
   kBindMaterials = 6, kBindTexInfo = 7, kBindTexels = 8, kBindEmitters = 9, kBindAlias = 10,
-  kBindDelta = 11, kBindEnvCdf = 12, kBindSamples = 13, kBindAux = 14, kBindStats = 15,
+  kBindDelta = 11, kBindEnvCdf = 12, kBindSamples = 13, kBindAux = 14, kBindStats = 15, kBindSelection = 16,
 };
 
 std::uint32_t groupsFor(std::uint64_t invocations, std::uint32_t local, std::uint32_t* groupsY) {
@@ -46,7 +46,7 @@ struct Renderer::Impl {
   std::unique_ptr<vk::ComputePipeline> accumulate;
   RenderSceneBuilder builder;
 
-  Buffer frameUbo, work, stats;
+  Buffer frameUbo, work, stats, selection;
   Buffer nodes, tris, triShade, instances, materials, texInfo, texels, emitters, alias, delta, envCdf;
   Buffer samples, aux, accum, accumAux;
 
@@ -56,6 +56,9 @@ struct Renderer::Impl {
   std::uint32_t seed = 0;
   RenderSettings sceneSettings;
   bool hasScene = false;
+  NodeId selectedObject = kNoNode;
+  int countTileSize = 0;            // tile size the selection buffer is laid out for
+  std::vector<gpu::WorkItem> lastItems;  // the last frame's work, for readbackFrameLuminance
 
   explicit Impl(const RendererOptions& o) : ctx(vk::DeviceChoice{o.device, o.validation || kDebugValidation}) {
     accumulate = std::make_unique<vk::ComputePipeline>(
@@ -65,6 +68,7 @@ struct Renderer::Impl {
         static_cast<std::uint32_t>(sizeof(gpu::AccumulatePush)));
     frameUbo = Buffer(ctx, sizeof(gpu::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true, "frame constants");
     stats = Buffer(ctx, gpu::kStatsCount * sizeof(std::uint32_t), kStorageUsage, true, "ray statistics");
+    selection = Buffer(ctx, 16, kStorageUsage, true, "selection counters");
     work = Buffer(ctx, sizeof(gpu::WorkItem) * 64, kStorageUsage, true, "work items");
   }
 
@@ -125,7 +129,7 @@ struct Renderer::Impl {
                                Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel,
                                Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel,
                                Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel, Binding::Storage,
-                               Binding::Storage, Binding::Storage},
+                               Binding::Storage, Binding::Storage, Binding::Storage},
           static_cast<std::uint32_t>(sizeof(gpu::TracePush)),
           std::vector<vk::ShaderDefine>{{"RETILE_ALPHA_TEST", alpha ? "1" : "0"}});
     }
@@ -152,6 +156,7 @@ struct Renderer::Impl {
     t.bind(kBindDelta, delta, VK_FORMAT_R32G32B32A32_SFLOAT);
     t.bind(kBindEnvCdf, envCdf, VK_FORMAT_R32_SFLOAT);
     t.bind(kBindStats, stats);
+    t.bind(kBindSelection, selection);
     if (samples.valid()) {
       t.bind(kBindSamples, samples);
       t.bind(kBindAux, aux);
@@ -183,6 +188,7 @@ struct Renderer::Impl {
     RETILE_ASSERT(w > 0 && h > 0 && w <= 16384 && h <= 16384, cat("size ", w, "x", h));
     width = w;
     height = h;
+    countTileSize = 0;  // the counters' layout follows the image
     VkDeviceSize bytes = static_cast<VkDeviceSize>(w) * static_cast<VkDeviceSize>(h) * 32;
     accum = Buffer(ctx, bytes, kStorageUsage, false, "accumulation");
     accumAux = Buffer(ctx, bytes, kStorageUsage, false, "auxiliary accumulation");
@@ -194,7 +200,76 @@ struct Renderer::Impl {
     bindAll();
   }
 
-  void writeFrameUniforms(std::uint32_t itemCount, std::uint64_t slots) {
+  std::uint32_t selectedInstance() const {
+    if (selectedObject == kNoNode) return 0;
+    const auto& objects = builder.data().instanceObject;
+    for (std::size_t i = 0; i < objects.size(); ++i)
+      if (objects[i] == selectedObject) return static_cast<std::uint32_t>(i + 1);
+    return 0;  // hidden or removed: nothing to count
+  }
+
+  // Lays the counters out for `tileSize` (clearing them when it changes).
+  void prepareSelection(int tileSize) {
+    if (tileSize <= 0) return;
+    std::size_t tiles = static_cast<std::size_t>((width + tileSize - 1) / tileSize) *
+                        static_cast<std::size_t>((height + tileSize - 1) / tileSize);
+    VkDeviceSize bytes = tiles * gpu::kSelectionCounters * sizeof(std::uint32_t);
+    if (tileSize != countTileSize || selection.size() < bytes) {
+      selection = Buffer(ctx, std::max<VkDeviceSize>(bytes, 16), kStorageUsage, true, "selection counters");
+      std::vector<std::uint32_t> zero(selection.size() / sizeof(std::uint32_t), 0);
+      selection.upload(zero.data(), zero.size() * sizeof(std::uint32_t));
+      countTileSize = tileSize;
+      bindAll();
+    }
+  }
+
+  SelectionCounts takeSelectionCounts() {
+    SelectionCounts c;
+    c.tileSize = countTileSize;
+    if (countTileSize <= 0 || width <= 0) return c;
+    std::size_t tiles = static_cast<std::size_t>((width + countTileSize - 1) / countTileSize) *
+                        static_cast<std::size_t>((height + countTileSize - 1) / countTileSize);
+    std::vector<std::uint32_t> raw(tiles * gpu::kSelectionCounters);
+    selection.download(raw.data(), raw.size() * sizeof(std::uint32_t));
+    std::vector<std::uint32_t> zero(raw.size(), 0);
+    selection.upload(zero.data(), zero.size() * sizeof(std::uint32_t));
+    c.direct.resize(tiles);
+    c.reflection.resize(tiles);
+    c.shadow.resize(tiles);
+    for (std::size_t t = 0; t < tiles; ++t) {
+      c.direct[t] = raw[t * 3];
+      c.reflection[t] = raw[t * 3 + 1];
+      c.shadow[t] = raw[t * 3 + 2];
+    }
+    return c;
+  }
+
+  std::vector<float> readbackFrameLuminance() {
+    std::vector<float> lum(static_cast<std::size_t>(width) * static_cast<std::size_t>(height),
+                           std::numeric_limits<float>::quiet_NaN());
+    std::uint64_t slots = 0;
+    for (const auto& w : lastItems) slots += static_cast<std::uint64_t>(w.rect.z) * static_cast<std::uint64_t>(w.rect.w) * w.info.x;
+    if (slots == 0) return lum;
+    std::vector<gpu::vec4> s(slots);
+    samples.download(s.data(), slots * sizeof(gpu::vec4));
+    for (const auto& w : lastItems) {
+      std::uint64_t pixels = static_cast<std::uint64_t>(w.rect.z) * static_cast<std::uint64_t>(w.rect.w);
+      for (std::uint64_t p = 0; p < pixels; ++p) {
+        double sum = 0, n = 0;
+        for (std::uint32_t r = 0; r < w.info.x; ++r) {
+          const gpu::vec4& v = s[w.info.y + r * pixels + p];
+          sum += 0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z;
+          n += v.w;
+        }
+        int x = w.rect.x + static_cast<int>(p % static_cast<std::uint64_t>(w.rect.z));
+        int y = w.rect.y + static_cast<int>(p / static_cast<std::uint64_t>(w.rect.z));
+        if (n > 0) lum[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)] = static_cast<float>(sum / n);
+      }
+    }
+    return lum;
+  }
+
+  void writeFrameUniforms(std::uint32_t itemCount, std::uint64_t slots, int countTile) {
     const RenderSceneData& d = builder.data();
     gpu::FrameUniforms u{};
     Vec3 forward = normalize(camera.target - camera.position);
@@ -216,11 +291,12 @@ struct Renderer::Impl {
     u.environmentTint = {d.environmentTint.x, d.environmentTint.y, d.environmentTint.z, d.environmentRotation};
     Vec3 c = d.bounds.empty() ? Vec3{0.0f} : d.bounds.center();
     u.sceneSphere = {c.x, c.y, c.z, d.bounds.empty() ? 1.0f : 0.5f * length(d.bounds.extent())};
-    u.work = {itemCount, static_cast<std::uint32_t>(slots), 0, 0};
+    std::uint32_t sel = countTile > 0 ? selectedInstance() : 0u;
+    u.work = {itemCount, static_cast<std::uint32_t>(slots), sel, sel ? static_cast<std::uint32_t>(countTile) : 0u};
     frameUbo.upload(&u, sizeof u);
   }
 
-  FrameStats renderFrame(const std::vector<TileWork>& tiles) {
+  FrameStats renderFrame(const std::vector<TileWork>& tiles, const FrameOptions& options) {
     RETILE_ASSERT(hasScene, "renderFrame before setScene");
     RETILE_ASSERT(width > 0, "renderFrame before resize");
     std::vector<gpu::WorkItem> items;
@@ -233,9 +309,9 @@ struct Renderer::Impl {
       if (x1 <= x0 || y1 <= y0 || t.quality < 1) continue;
       gpu::WorkItem w{};
       w.rect = {x0, y0, x1 - x0, y1 - y0};
-      w.info = {static_cast<std::uint32_t>(t.quality), static_cast<std::uint32_t>(slots), t.sampleBase,
-                t.restart ? gpu::kWorkRestart : 0u};
-      w.pixels = {static_cast<std::uint32_t>(pixels), 0, 0, 0};
+      std::uint32_t flags = t.restart ? gpu::kWorkRestart : (t.capStale > 0 ? gpu::kWorkCapStale : 0u);
+      w.info = {static_cast<std::uint32_t>(t.quality), static_cast<std::uint32_t>(slots), t.sampleBase, flags};
+      w.pixels = {static_cast<std::uint32_t>(pixels), static_cast<std::uint32_t>(std::max(t.capStale, 0)), 0, 0};
       std::uint64_t n = static_cast<std::uint64_t>(x1 - x0) * static_cast<std::uint64_t>(y1 - y0);
       slots += n * static_cast<std::uint64_t>(t.quality);
       pixels += n;
@@ -251,7 +327,9 @@ struct Renderer::Impl {
       bindAll();
     }
     work.upload(items.data(), workBytes);
-    writeFrameUniforms(static_cast<std::uint32_t>(items.size()), slots);
+    prepareSelection(options.selectionTileSize);
+    writeFrameUniforms(static_cast<std::uint32_t>(items.size()), slots, options.selectionTileSize);
+    lastItems = items;
     std::uint32_t zero[gpu::kStatsCount] = {};
     stats.upload(zero, sizeof zero);
 
@@ -264,7 +342,7 @@ struct Renderer::Impl {
       vk::computeBarrier(cb);
       gpu::AccumulatePush ap{0, static_cast<std::uint32_t>(pixels), static_cast<std::uint32_t>(items.size()), 0};
       gx = groupsFor(pixels, gpu::kAccumulateWorkgroup, &gy);
-      accumulate->dispatch(cb, gx, gy, &ap, sizeof ap);
+      if (options.accumulate) accumulate->dispatch(cb, gx, gy, &ap, sizeof ap);
     });
     fs.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::uint32_t counts[gpu::kStatsCount];
@@ -348,7 +426,12 @@ std::vector<std::string> Renderer::updateScene(const Scene& scene, std::uint32_t
 void Renderer::resize(int width, int height) { impl_->resize(width, height); }
 void Renderer::setMaxBounces(int maxBounces) { impl_->maxBounces = std::max(0, maxBounces); }
 void Renderer::setSeed(std::uint32_t seed) { impl_->seed = seed; }
-FrameStats Renderer::renderFrame(const std::vector<TileWork>& tiles) { return impl_->renderFrame(tiles); }
+FrameStats Renderer::renderFrame(const std::vector<TileWork>& tiles, const FrameOptions& options) {
+  return impl_->renderFrame(tiles, options);
+}
+std::vector<float> Renderer::readbackFrameLuminance() { return impl_->readbackFrameLuminance(); }
+void Renderer::setSelection(NodeId object) { impl_->selectedObject = object; }
+SelectionCounts Renderer::takeSelectionCounts() { return impl_->takeSelectionCounts(); }
 RenderImage Renderer::readback() { return impl_->readback(); }
 std::uint64_t Renderer::sceneDeviceBytes() const { return impl_->builder.data().deviceBytes(); }
 std::uint64_t Renderer::sceneTriangles() const { return impl_->builder.data().triangleCount; }
@@ -371,7 +454,7 @@ RenderImage Renderer::render(const RenderRequest& request, const std::function<b
     all.quality = 1;
     all.sampleBase = static_cast<std::uint32_t>(f);
     all.restart = f == 0;
-    FrameStats fs = renderFrame({all});
+    FrameStats fs = renderFrame({all}, {});
     sum.samples += fs.samples;
     sum.primaryRays += fs.primaryRays;
     sum.bounceRays += fs.bounceRays;
