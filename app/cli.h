@@ -1,4 +1,4 @@
-// The command line: `retile render`, `retile bench`, `retile import`. Runs on the main thread.
+// The command line: `retile render`, `retile edit`, `retile bench`, `retile import`. Runs on the main thread.
 #pragma once
 
 #include <string>
@@ -25,13 +25,14 @@ Result<bool> parseSize(const std::string& text, int* width, int* height);
 // "default" is the built-in scene; anything else a file any importer reads.
 Result<ImportedScene> loadScene(const std::string& name);
 
-// A one-line progress bar on stderr, redrawn in place.
 // Prints the renderer's warnings about a scene, leaving out files the import already reported.
 void printRenderWarnings(const std::vector<std::string>& renderWarnings, const std::vector<std::string>& importWarnings);
+// A one-line progress bar on stderr, redrawn in place (a line per tenth when not a terminal).
 void progressBar(const std::string& label, int done, int total, double seconds);
 
 int runRender(const std::vector<std::string>& args);
 int runBench(const std::vector<std::string>& args);
 int runImport(const std::vector<std::string>& args);
+int runEdit(const std::vector<std::string>& args);
 
 }  // namespace retile::cli

@@ -15,6 +15,8 @@ void usage() {
                "usage:\n"
                "  retile render SCENE [--size WxH] [--spp N] [--seed S] [--max-bounces B] [--out FILE.exr|png]\n"
                "                      [--view Standard|Filmic] [--exposure STOPS]\n"
+               "  retile edit SCENE --script EDITS.json --method NAME --out-dir DIR [--size WxH] [--tile T]\n"
+               "                    [--quality Q|auto] [--smooth] [--converge SPP] [--reference SPP]\n"
                "  retile bench throughput SCENE [--size WxH] [--frames N] [--max-bounces B]\n"
                "  retile bench bvh [--triangles N]\n"
                "  retile import FILE\n"
@@ -36,6 +38,7 @@ int main(int argc, char** argv) {
     if (cmd == "render") return retile::cli::runRender(rest);
     if (cmd == "bench") return retile::cli::runBench(rest);
     if (cmd == "import") return retile::cli::runImport(rest);
+    if (cmd == "edit") return retile::cli::runEdit(rest);
     std::fprintf(stderr, "retile: unknown command '%s'\n", cmd.c_str());
     usage();
     return 2;

@@ -1,0 +1,200 @@
+// `retile edit`: converges a scene, plays a script of timed edits under one method, and writes
+// every frame (EXR) and a per-frame CSV. With --reference, also renders the scene's final state
+// fresh and reports each frame's error against it.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "cli.h"
+#include "retile/image.h"
+#include "retile/log.h"
+#include "retile/render.h"
+#include "retile/scenario.h"
+#include "retile/session.h"
+
+namespace retile::cli {
+
+namespace {
+
+void usage(const std::string& error) {
+  if (!error.empty()) std::fprintf(stderr, "error: %s\n", error.c_str());
+  std::fprintf(stderr,
+               "usage: retile edit SCENE --script EDITS.json --method NAME --out-dir DIR [--size WxH] [--tile T]\n"
+               "                   [--quality Q|auto] [--smooth] [--stale-cap N] [--converge SPP] [--max-bounces B]\n"
+               "                   [--reference SPP] [--block B] [--threshold REL] [--no-images]\n"
+               "methods:");
+  for (const auto& n : methodNames()) std::fprintf(stderr, " %s", n.c_str());
+  std::fprintf(stderr, "\n");
+}
+
+// Plays the script on a copy of the scene without rendering: the state after the last edit.
+Result<Scene> finalState(const Scenario& sc, Scene scene) {
+  NodeId selection = kNoNode;
+  for (const auto& step : sc.steps)
+    for (int f = 0; f < std::max(step.frames, 1); ++f) {
+      auto e = stepEdits(step, f, scene, selection);
+      if (!e) return Result<Scene>::failure(e.error());
+      if (e->select) selection = *e->select;
+      for (const Edit& edit : e->edits) {
+        auto r = applyEdit(scene, edit);
+        if (!r) return Result<Scene>::failure(r.error());
+      }
+      if (step.kind == ScenarioStep::Kind::Select || step.kind == ScenarioStep::Kind::Focus) break;
+    }
+  return scene;
+}
+
+}  // namespace
+
+int runEdit(const std::vector<std::string>& argv) {
+  auto args = parseArgs(argv,
+                        {"--script", "--method", "--out-dir", "--size", "--tile", "--quality", "--stale-cap", "--converge",
+                         "--max-bounces", "--reference", "--block", "--threshold"},
+                        {"--smooth", "--no-images"});
+  if (!args) return usage(args.error()), 2;
+  if (args->positional.size() != 1 || !args->has("--script") || !args->has("--method") || !args->has("--out-dir"))
+    return usage("SCENE, --script, --method and --out-dir are required"), 2;
+
+  MethodSettings method;
+  if (!methodFromName(args->get("--method"), &method.kind)) return usage(cat("unknown method '", args->get("--method"), "'")), 2;
+  auto intOpt = [&](const char* name, int lo, int hi, int* out) -> bool {
+    if (!args->has(name)) return true;
+    auto v = parseInt(name, args->get(name), lo, hi);
+    if (!v) {
+      usage(v.error());
+      return false;
+    }
+    *out = v.value();
+    return true;
+  };
+  if (args->get("--quality") == "auto") method.quality = 0;
+  else if (!intOpt("--quality", 1, 4096, &method.quality)) return 2;
+  int converge = -1, maxBounces = -1, reference = 0, block = 4;
+  if (!intOpt("--tile", 8, 32, &method.tileSize) || !intOpt("--stale-cap", 1, 1 << 20, &method.staleCap) ||
+      !intOpt("--converge", 0, 1 << 20, &converge) || !intOpt("--max-bounces", 0, 1024, &maxBounces) ||
+      !intOpt("--reference", 1, 1 << 20, &reference) || !intOpt("--block", 1, 64, &block))
+    return 2;
+  double threshold = 0.01;
+  if (args->has("--threshold")) threshold = std::atof(args->get("--threshold").c_str());
+  method.smooth = args->has("--smooth");
+  if (std::string bad = validateMethodSettings(method); !bad.empty()) return usage(bad), 2;
+
+  auto loaded = loadScene(args->positional[0]);
+  if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
+  for (const auto& w : loaded->warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  Scene scene = loaded->scene;
+  if (args->has("--size")) {
+    auto r = parseSize(args->get("--size"), &scene.settings.width, &scene.settings.height);
+    if (!r) return usage(r.error()), 2;
+  }
+  if (maxBounces >= 0) scene.settings.maxBounces = maxBounces;
+  auto scenario = loadScenario(args->get("--script"));
+  if (!scenario) return std::fprintf(stderr, "error: %s\n", scenario.error().c_str()), 1;
+  if (converge < 0) converge = scenario->converge;
+  auto final = finalState(scenario.value(), scene);
+  if (!final) return std::fprintf(stderr, "error: %s: %s\n", args->get("--script").c_str(), final.error().c_str()), 1;
+
+  std::filesystem::path outDir = args->get("--out-dir");
+  std::error_code ec;
+  std::filesystem::create_directories(outDir, ec);
+  if (ec) return std::fprintf(stderr, "error: cannot create %s: %s\n", outDir.string().c_str(), ec.message().c_str()), 1;
+  const bool images = !args->has("--no-images");
+  const int w = scene.settings.width, h = scene.settings.height;
+
+  // The fresh render of the final state, from its own renderer and seed.
+  std::vector<float> ref;
+  if (reference > 0) {
+    Renderer r;
+    r.setScene(final.value());
+    RenderRequest req;
+    req.width = w;
+    req.height = h;
+    req.samplesPerPixel = reference;
+    req.seed = 0x5eed;
+    auto t0 = std::chrono::steady_clock::now();
+    RenderImage img = r.render(req, [&](int done, int total) {
+      progressBar("reference", done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      return true;
+    });
+    ref = img.color;
+    writeRenderImage(img, outDir / "reference.exr");
+  }
+
+  RenderSession session(scene, method);
+  std::fprintf(stderr, "device: %s\n", session.deviceName().c_str());
+  auto t0 = std::chrono::steady_clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  for (int f = 0; f < converge; ++f) {
+    session.renderFrame(false);
+    progressBar("converging", f + 1, converge, elapsed());
+  }
+
+  std::ofstream csv(outDir / "frames.csv");
+  csv << "frame,step,method,mode,samples,tiles_served,queue_left,quality,ms,schedule_ms,trace_ms,rel_rmse\n";
+  const int total = scenario->totalFrames();
+  int frame = 0, lastEditFrame = 0, settledFrame = -1;
+  double sumMs = 0, sumScheduleMs = 0;
+  bool exact = true;
+  t0 = std::chrono::steady_clock::now();
+  for (std::size_t si = 0; si < scenario->steps.size(); ++si) {
+    const ScenarioStep& step = scenario->steps[si];
+    bool instant = step.kind == ScenarioStep::Kind::Select || step.kind == ScenarioStep::Kind::Focus;
+    for (int f = 0; f < (instant ? 1 : step.frames); ++f) {
+      auto e = stepEdits(step, f, session.scene(), session.selection());
+      if (!e) return std::fprintf(stderr, "\nerror: %s: steps[%zu]: %s\n", args->get("--script").c_str(), si, e.error().c_str()), 1;
+      if (e->select) session.select(*e->select);
+      if (e->focus) session.setFocus(*e->focus);
+      for (const Edit& edit : e->edits) {
+        auto r = session.applyEdit(edit);
+        if (!r) return std::fprintf(stderr, "\nerror: steps[%zu]: %s\n", si, r.error().c_str()), 1;
+      }
+      if (instant) break;
+      FrameRecord rec = session.renderFrame(images || !ref.empty());
+      ++frame;
+      if (!e->edits.empty()) {
+        lastEditFrame = frame;
+        settledFrame = -1;
+      }
+      exact = exact && rec.samples == static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
+      double err = !ref.empty() && rec.image ? relativeRmse(rec.image->color, ref, w, h, block) : NAN;
+      if (!ref.empty() && frame > lastEditFrame && settledFrame < 0 && err < threshold) settledFrame = frame;
+      if (!ref.empty() && err >= threshold) settledFrame = -1;  // settled means: stays under
+      sumMs += rec.frameMs;
+      sumScheduleMs += rec.scheduleMs;
+      char line[512];
+      std::snprintf(line, sizeof line, "%d,%zu,%s,%s,%llu,%zu,%zu,%d,%.3f,%.4f,%.3f,%s\n", frame, si, rec.method.c_str(),
+                    rec.mode.c_str(), static_cast<unsigned long long>(rec.samples), rec.servedTiles.size(),
+                    rec.queueLength - rec.queueServed, rec.quality, rec.frameMs, rec.scheduleMs, rec.traceMs,
+                    std::isnan(err) ? "" : std::to_string(err).c_str());
+      csv << line;
+      if (images && rec.image) {
+        char name[64];
+        std::snprintf(name, sizeof name, "frame_%05d.exr", frame);
+        auto written = writeRenderImage(*rec.image, outDir / name);
+        if (!written) return std::fprintf(stderr, "\nerror: %s\n", written.error().c_str()), 1;
+      }
+      progressBar(rec.method, frame, total, elapsed());
+    }
+  }
+  csv.close();
+  std::printf("method         %s%s, T=%d, Q=%s\n", methodName(method.kind), method.smooth ? " (smooth)" : "", method.tileSize,
+              method.quality ? std::to_string(method.quality).c_str() : "auto");
+  std::printf("frames         %d after %d converging; every frame traced %s %dx%d samples\n", frame, converge,
+              exact ? "exactly" : "NOT", w, h);
+  std::printf("scheduling     %.2f %% of frame time (%.3f ms of %.1f ms per frame)\n",
+              sumMs > 0 ? 100.0 * sumScheduleMs / sumMs : 0.0, frame ? sumScheduleMs / frame : 0.0, frame ? sumMs / frame : 0.0);
+  if (!ref.empty()) {
+    if (settledFrame > 0)
+      std::printf("settled        %d frames after the last edit (relative RMSE of %dx%d blocks below %.3g from then on)\n",
+                  settledFrame - lastEditFrame, block, block, threshold);
+    else
+      std::printf("settled        not within the script (relative RMSE of %dx%d blocks stayed above %.3g)\n", block, block,
+                  threshold);
+  }
+  std::printf("wrote          %s\n", (outDir / "frames.csv").string().c_str());
+  return exact ? 0 : 1;
+}
+
+}  // namespace retile::cli

@@ -1,0 +1,90 @@
+// One render session: a scene, a method and the path tracer, driven frame by frame. Edits are
+// applied in place between frames; each frame plans its tiles on the exact W x H budget, traces
+// them and returns a FrameRecord that carries everything overlays, charts and tests need.
+//
+// Threads: a RenderSession belongs to one thread at a time (the render thread in the editor, the
+// main thread on the command line, see engine.h). Every call blocks while the device works.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "retile/edit.h"
+#include "retile/image.h"
+#include "retile/method.h"
+#include "retile/render.h"
+#include "retile/scene.h"
+
+namespace retile {
+
+// Everything about one published frame. Immutable once published; shared between threads.
+struct FrameRecord {
+  std::uint64_t frame = 0;            // frames rendered by the session, from 1
+  std::uint64_t documentVersion = 0;  // of the last edit applied before this frame
+  std::string method;                 // methodName()
+  std::string mode;                   // accumulator mode: global-update, incremental, refinement, probe
+  bool smooth = false;
+  int staleCap = 0;
+  int width = 0, height = 0;
+  int tileSize = 0, cols = 0, rows = 0;
+  int quality = 0;                    // Q of the current pass (automatic Q resolved)
+  Vec2 pointOfChange{0.0f};           // image position of the last edit's point of change
+  std::vector<Vec2> focus;            // focus points in use (followed ones moved)
+  NodeId selection = kNoNode;
+  std::vector<float> tilePriority;    // per tile: 1 at the head of the queue to 0 at its end; -1 unqueued
+  std::vector<std::uint8_t> tileClass;  // indirection: 0 high, 1 middle, 2 low, 3 rest; else empty
+  std::vector<float> tileSamples;     // per tile: mean samples per pixel since its last restart
+  std::vector<int> servedTiles;       // tiles traced this frame, in order
+  std::size_t queueLength = 0;        // tiles in the current pass
+  std::size_t queueServed = 0;        // tiles of the pass finished
+  std::uint64_t samples = 0;          // samples traced this frame: always width x height
+  double scheduleMs = 0, traceMs = 0, readbackMs = 0, frameMs = 0;
+  std::shared_ptr<const RenderImage> image;  // the accumulated image after this frame (may be null)
+};
+
+// Image position (pixels, y down) of a world point seen by `camera` in a width x height image,
+// or nullopt when it lies behind the camera.
+std::optional<Vec2> projectToImage(const Camera& camera, int width, int height, Vec3 p);
+
+class RenderSession {
+ public:
+  // Uploads the scene; throws Error when no Vulkan device exists.
+  RenderSession(Scene scene, MethodSettings method, const RendererOptions& options = {});
+  ~RenderSession();
+  RenderSession(const RenderSession&) = delete;
+  RenderSession& operator=(const RenderSession&) = delete;
+
+  std::string deviceName() const;
+  const Scene& scene() const { return scene_; }
+  const MethodSettings& method() const { return method_; }
+  NodeId selection() const { return selection_; }
+
+  // Applies an edit to the session's scene and the renderer (in place: a transform touches only
+  // instance data and the top-level BVH), then restarts the queue from the edit's point of change
+  // (or resets globally: camera, resolution, global method). Fails leaving everything unchanged.
+  Result<std::uint32_t> applyEdit(const Edit& edit, std::uint64_t documentVersion = 0);
+  void select(NodeId object);
+  // Focus points for the focus policies (at most 3 are used).
+  void setFocus(std::vector<FocusPoint> focus);
+  // A new method or new settings; returns what is wrong, or an empty string. Resets globally.
+  std::string setMethod(const MethodSettings& method);
+  void resize(int width, int height);
+  void setMaxBounces(int maxBounces);
+
+  // Plans, traces and accumulates one frame. `readImage`: read the accumulated image back into
+  // the record (the command line and the viewport need it; benchmarks may not).
+  FrameRecord renderFrame(bool readImage = true);
+
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  Scene scene_;
+  MethodSettings method_;
+  NodeId selection_ = kNoNode;
+};
+
+}  // namespace retile
