@@ -192,7 +192,8 @@ Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t d
     d.meshBounds[add->mesh.id] = add->mesh.geometry->bounds();
   if (const auto* add = std::get_if<AddObject>(&edit)) targets.push_back(add->object.id);
   for (const auto& w : d.renderer.updateScene(scene_, flags)) logWarning(w);
-  if (documentVersion) d.documentVersion = documentVersion;
+  // Coalesced commands may arrive out of version order: the record shows the newest applied.
+  d.documentVersion = std::max(d.documentVersion, documentVersion);
   if (selection_ != kNoNode && !scene_.object(selection_)) select(kNoNode);
 
   if (flags & kUpdateSettings) {

@@ -1,0 +1,194 @@
+#include "retile/engine.h"
+
+#include <pthread.h>
+
+#include <algorithm>
+#include <exception>
+
+#include "retile/log.h"
+
+namespace retile {
+
+namespace {
+
+// Two commands may be coalesced when they are of the same kind and target; session commands
+// (select, focus, method, resize, pause) coalesce by kind.
+std::uint64_t commandKey(const Command& c) {
+  if (const Edit* e = std::get_if<Edit>(&c)) {
+    if (std::holds_alternative<AddMesh>(*e) || std::holds_alternative<AddMaterial>(*e) ||
+        std::holds_alternative<AddObject>(*e) || std::holds_alternative<AddLight>(*e) ||
+        std::holds_alternative<AddTexture>(*e) || std::holds_alternative<RemoveNode>(*e))
+      return 0;  // structural: never coalesced
+    return editCoalesceKey(*e);
+  }
+  return 0xff00000000000000ull + c.index();
+}
+
+bool structural(const Command& c) { return commandKey(c) == 0; }
+
+}  // namespace
+
+void EditQueue::push(Command command, std::uint64_t version) {
+  {
+    std::lock_guard lock(mutex_);
+    std::uint64_t key = commandKey(command);
+    bool replaced = false;
+    if (key != 0) {
+      for (auto it = queue_.rbegin(); it != queue_.rend(); ++it) {
+        if (structural(it->command)) break;  // the newer value must not jump an add or remove
+        if (commandKey(it->command) == key) {
+          it->command = std::move(command);
+          it->version = std::max(it->version, version);
+          ++coalesced_;
+          replaced = true;
+          break;
+        }
+      }
+    }
+    if (!replaced) queue_.push_back({std::move(command), version});
+  }
+  cv_.notify_one();
+}
+
+std::vector<EditQueue::Entry> EditQueue::drain() {
+  std::lock_guard lock(mutex_);
+  std::vector<Entry> out(std::make_move_iterator(queue_.begin()), std::make_move_iterator(queue_.end()));
+  queue_.clear();
+  woken_ = false;
+  return out;
+}
+
+void EditQueue::waitForWork(std::chrono::milliseconds timeout) {
+  std::unique_lock lock(mutex_);
+  cv_.wait_for(lock, timeout, [&] { return !queue_.empty() || woken_; });
+}
+
+void EditQueue::wake() {
+  {
+    std::lock_guard lock(mutex_);
+    woken_ = true;
+  }
+  cv_.notify_all();
+}
+
+std::size_t EditQueue::size() const {
+  std::lock_guard lock(mutex_);
+  return queue_.size();
+}
+
+std::uint64_t EditQueue::coalesced() const {
+  std::lock_guard lock(mutex_);
+  return coalesced_;
+}
+
+Engine::Engine(Scene scene, MethodSettings method, EngineOptions options)
+    : initialScene_(std::move(scene)), initialMethod_(std::move(method)), options_(options) {}
+
+Engine::~Engine() { stop(); }
+
+void Engine::start() {
+  if (running_.exchange(true)) return;
+  stop_ = false;
+  thread_ = std::thread([this] { run(); });
+}
+
+void Engine::stop() {
+  stop_ = true;
+  queue_.wake();
+  if (thread_.joinable()) thread_.join();
+  running_ = false;
+}
+
+void Engine::submit(Command command, std::uint64_t documentVersion) { queue_.push(std::move(command), documentVersion); }
+
+void Engine::setFrameCallback(std::function<void()> callback) {
+  std::lock_guard lock(mutex_);
+  callback_ = std::move(callback);
+}
+
+std::vector<std::string> Engine::takeErrors() {
+  std::lock_guard lock(mutex_);
+  return std::exchange(errors_, {});
+}
+
+std::string Engine::deviceName() const {
+  std::lock_guard lock(mutex_);
+  return device_;
+}
+
+void Engine::run() {
+  pthread_setname_np(pthread_self(), "retile-render");
+  auto report = [this](std::string e) {
+    logWarning("render thread: ", e);
+    std::lock_guard lock(mutex_);
+    errors_.push_back(std::move(e));
+  };
+  std::unique_ptr<RenderSession> session;
+  try {
+    session = std::make_unique<RenderSession>(std::move(initialScene_), initialMethod_, options_.renderer);
+    std::lock_guard lock(mutex_);
+    device_ = session->deviceName();
+  } catch (const std::exception& e) {
+    report(cat("cannot start rendering: ", e.what()));
+    running_ = false;
+    return;
+  }
+  bool paused = false;
+  std::shared_ptr<const FrameRecord> last;
+  while (!stop_) {
+    bool changed = false;
+    for (auto& entry : queue_.drain()) {
+      changed = true;
+      try {
+        std::visit(
+            [&](auto& c) {
+              using T = std::decay_t<decltype(c)>;
+              if constexpr (std::is_same_v<T, Edit>) {
+                auto r = session->applyEdit(c, entry.version);
+                if (!r) report(cat(editName(c), ": ", r.error()));
+              } else if constexpr (std::is_same_v<T, SelectCommand>) {
+                session->select(c.object);
+              } else if constexpr (std::is_same_v<T, FocusCommand>) {
+                session->setFocus(c.focus);
+              } else if constexpr (std::is_same_v<T, MethodCommand>) {
+                if (auto bad = session->setMethod(c.method); !bad.empty()) report(cat("method: ", bad));
+              } else if constexpr (std::is_same_v<T, ResizeCommand>) {
+                session->resize(c.width, c.height);
+              } else if constexpr (std::is_same_v<T, PauseCommand>) {
+                paused = c.paused;
+              }
+            },
+            entry.command);
+      } catch (const std::exception& e) {
+        report(cat("applying a command: ", e.what()));
+      }
+    }
+    if (stop_) break;
+    bool converged = options_.maxSamplesPerPixel > 0 && last && !changed && last->mode == "refinement" &&
+                     !last->tileSamples.empty() &&
+                     *std::min_element(last->tileSamples.begin(), last->tileSamples.end()) >= options_.maxSamplesPerPixel;
+    if (paused || converged) {
+      queue_.waitForWork(std::chrono::milliseconds(100));
+      continue;
+    }
+    try {
+      auto rec = std::make_shared<const FrameRecord>(session->renderFrame(true));
+      last = rec;
+      mailbox_.publish(rec);
+      ++frames_;
+      std::function<void()> cb;
+      {
+        std::lock_guard lock(mutex_);
+        cb = callback_;
+      }
+      if (cb) cb();
+    } catch (const std::exception& e) {
+      // A failed frame (device lost, out of memory) ends rendering; the document is untouched.
+      report(cat("rendering stopped: ", e.what()));
+      break;
+    }
+  }
+  running_ = false;
+}
+
+}  // namespace retile
