@@ -14,6 +14,7 @@ namespace retile {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+constexpr int kMaxAutomaticQuality = 256;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
 struct CameraFrame {
@@ -286,7 +287,9 @@ Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t d
     }
     order = plan.order;
     prioritized = plan.prioritized;
-    if (method_.quality == 0) quality = automaticQuality(grid, plan.high, 1024);
+    // Automatic Q; capped so that a tiny object does not stretch the pass over hundreds of
+    // frames, and the default when the object is out of view (no high tiles at all).
+    if (method_.quality == 0) quality = plan.high.empty() ? 64 : automaticQuality(grid, plan.high, kMaxAutomaticQuality);
     d.plan = std::move(plan);
   } else {
     // Spiral and focus (and indirection before its counters exist): with the smooth transition
