@@ -8,6 +8,8 @@
 #include "render/bvh.h"
 #include "retile/log.h"
 #include "retile/render.h"
+#include "retile/session.h"
+#include "scene/primitives.h"
 
 namespace retile::cli {
 namespace {
@@ -119,17 +121,72 @@ int benchBvh(const std::vector<std::string>& argv) {
   return 0;
 }
 
+
+// Edit cost against mesh size: the default scene plus one mesh of N triangles; times moving that
+// object and changing its material through a RenderSession (what the render thread does between
+// frames), N from 10 k to 1 M. Both must stay flat: neither touches mesh data.
+int benchEdit(const std::vector<std::string>& argv) {
+  auto args = parseArgs(argv, {"--edits"});
+  if (!args) return std::fprintf(stderr, "usage: retile bench edit [--edits N]\n"), 2;
+  int edits = 20;
+  if (args->has("--edits")) {
+    auto v = parseInt("--edits", args->get("--edits"), 1, 10000);
+    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
+    edits = v.value();
+  }
+  std::printf("%10s %14s %14s %14s\n", "triangles", "upload s", "move ms/edit", "material ms/edit");
+  for (int rings : {64, 224, 708}) {  // 2 * rings * 2 * rings triangles: ~16 k, ~200 k, ~2 M
+    Scene scene = makeDefaultScene();
+    scene.settings.width = 64;
+    scene.settings.height = 36;
+    Mesh mesh;
+    mesh.id = scene.newId();
+    mesh.name = "dense sphere";
+    mesh.geometry = makeSphere(rings, 2 * rings);
+    scene.meshes.push_back(mesh);
+    Material mat;
+    mat.id = scene.newId();
+    mat.name = "dense material";
+    scene.materials.push_back(mat);
+    Object o;
+    o.id = scene.newId();
+    o.name = "dense";
+    o.mesh = mesh.id;
+    o.material = mat.id;
+    o.transform = Mat4::translate({0, 1, 0}) * Mat4::scale(Vec3{0.3f});
+    scene.objects.push_back(o);
+    auto t0 = Clock::now();
+    RenderSession session(scene, MethodSettings{});
+    double upload = std::chrono::duration<double>(Clock::now() - t0).count();
+    session.renderFrame(false);
+    double moveMs = 0, materialMs = 0;
+    for (int i = 0; i < edits; ++i) {
+      o.transform = Mat4::translate({0.001f, 0, 0}) * o.transform;
+      auto a = Clock::now();
+      session.applyEdit(SetObject{o});
+      moveMs += std::chrono::duration<double, std::milli>(Clock::now() - a).count();
+      mat.roughness = 0.1f + 0.01f * static_cast<float>(i);
+      a = Clock::now();
+      session.applyEdit(SetMaterial{mat});
+      materialMs += std::chrono::duration<double, std::milli>(Clock::now() - a).count();
+    }
+    std::printf("%10zu %14.3f %14.3f %14.3f\n", mesh.geometry->triangleCount(), upload, moveMs / edits, materialMs / edits);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int runBench(const std::vector<std::string>& argv) {
   if (argv.empty()) {
-    std::fprintf(stderr, "usage: retile bench throughput SCENE ... | retile bench bvh [--triangles N]\n");
+    std::fprintf(stderr, "usage: retile bench throughput SCENE ... | retile bench bvh [--triangles N] | retile bench edit\n");
     return 2;
   }
   std::vector<std::string> rest(argv.begin() + 1, argv.end());
   if (argv[0] == "throughput") return benchThroughput(rest);
   if (argv[0] == "bvh") return benchBvh(rest);
-  std::fprintf(stderr, "retile bench: unknown benchmark '%s' (throughput, bvh)\n", argv[0].c_str());
+  if (argv[0] == "edit") return benchEdit(rest);
+  std::fprintf(stderr, "retile bench: unknown benchmark '%s' (throughput, bvh, edit)\n", argv[0].c_str());
   return 2;
 }
 

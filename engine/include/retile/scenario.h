@@ -9,7 +9,8 @@
 //       { "material": "Ceramic", "set": { "roughness": 0.4, "albedo": [0.8, 0.2, 0.2] } },
 //       { "light": "Area Light", "move": [0.5, 0, 0], "color": [1, 0.8, 0.6], "intensity": 2 },
 //       { "camera": { "position": [0, 1, 5], "target": [0, 0.5, 0] } },
-//       { "focus": [ { "pixel": [100, 90], "follows": false } ] } ] }
+//       { "focus": [ { "pixel": [100, 90], "follows": false },     // image pixels, or
+//                    { "uv": [0.7, 0.4], "follows": true } ] } ] }  // fractions of the image
 //
 // A `light` names a Light node or an emissive object (the default scene's area light): colour
 // and intensity set the emission, `move` translates it. Every step but `select` and `focus` takes
@@ -38,6 +39,7 @@ struct ScenarioStep {
   std::optional<Vec3> albedo, emission, color, position;
   std::optional<Vec3> cameraPosition, cameraTarget;
   std::vector<FocusPoint> focus;
+  std::vector<bool> focusIsUv;  // per focus point: given as fractions of the image size
 };
 
 struct Scenario {
@@ -56,8 +58,8 @@ struct StepEdits {
   std::optional<NodeId> select;             // a select step
   std::optional<std::vector<FocusPoint>> focus;  // a focus step
 };
-// The edits of frame `frameInStep` (from 0) of a step, against `scene` as it is now. Fails
-// naming the target when it does not exist.
+// The edits of frame `frameInStep` (from 0) of a step, against `scene` as it is now (focus points
+// in pixels of the scene's image size). Fails naming the target when it does not exist.
 Result<StepEdits> stepEdits(const ScenarioStep& step, int frameInStep, const Scene& scene, NodeId selection);
 
 // Relative RMSE of two images' luminance after averaging b x b pixel blocks (b = 1: per pixel):

@@ -117,7 +117,10 @@ Result<Scenario> parseScenario(const std::string& text, const std::string& name)
       for (const Value& p : f->asArray()) {
         FocusPoint fp;
         const Value* px = p.find("pixel");
-        if (!px || !json::toVec2(*px, &fp.pixel)) return R::failure(cat(r.where, ": a focus point needs \"pixel\": [x, y]"));
+        const Value* uv = p.find("uv");
+        if (!(px && json::toVec2(*px, &fp.pixel)) && !(uv && json::toVec2(*uv, &fp.pixel)))
+          return R::failure(cat(r.where, ": a focus point needs \"pixel\": [x, y] or \"uv\": [u, v]"));
+        s.focusIsUv.push_back(!px);
         if (const Value* fo = p.find("follows"); fo && fo->isBool()) fp.follows = fo->asBool();
         s.focus.push_back(fp);
       }
@@ -159,6 +162,10 @@ Result<StepEdits> stepEdits(const ScenarioStep& step, int frameInStep, const Sce
     }
     case K::Focus:
       out.focus = step.focus;
+      for (std::size_t i = 0; i < out.focus->size() && i < step.focusIsUv.size(); ++i)
+        if (step.focusIsUv[i])
+          (*out.focus)[i].pixel = {(*out.focus)[i].pixel.x * static_cast<float>(scene.settings.width),
+                                   (*out.focus)[i].pixel.y * static_cast<float>(scene.settings.height)};
       return out;
     case K::Wait:
       return out;

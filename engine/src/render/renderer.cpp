@@ -88,15 +88,20 @@ struct Renderer::Impl {
   void upload(std::uint32_t dirty) {
     const RenderSceneData& d = builder.data();
     if (dirty & (kDirtyGeometry | kDirtyInstances)) {
-      std::vector<GpuBvhNode> all;
-      all.reserve(d.blasNodes.size() + d.tlasNodes.size());
-      all.insert(all.end(), d.blasNodes.begin(), d.blasNodes.end());
-      all.insert(all.end(), d.tlasNodes.begin(), d.tlasNodes.end());
-      if (dirty & kDirtyGeometry || !nodes.valid() || nodes.size() != all.size() * sizeof(GpuBvhNode)) {
+      VkDeviceSize blasBytes = d.blasNodes.size() * sizeof(GpuBvhNode);
+      VkDeviceSize need = blasBytes + d.tlasNodes.size() * sizeof(GpuBvhNode);
+      if (dirty & kDirtyGeometry || !nodes.valid() || nodes.size() < need) {
+        // Room for the top level to grow, so that adding objects does not re-upload mesh BVHs.
+        std::vector<GpuBvhNode> all;
+        all.reserve(d.blasNodes.size() + 2 * d.tlasNodes.size() + 64);
+        all.insert(all.end(), d.blasNodes.begin(), d.blasNodes.end());
+        all.insert(all.end(), d.tlasNodes.begin(), d.tlasNodes.end());
+        all.resize(all.capacity());
         uploadArray(nodes, all, "BVH nodes");
       } else {
-        // Only the top level moved: copy it alone, after the mesh BVHs.
-        nodes.upload(d.tlasNodes.data(), d.tlasNodes.size() * sizeof(GpuBvhNode), d.blasNodes.size() * sizeof(GpuBvhNode));
+        // Only the top level changed: copy it alone, after the mesh BVHs. The cost of moving an
+        // object does not depend on the size of any mesh.
+        nodes.upload(d.tlasNodes.data(), d.tlasNodes.size() * sizeof(GpuBvhNode), blasBytes);
       }
     }
     if (dirty & kDirtyGeometry) {
