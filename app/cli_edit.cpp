@@ -124,6 +124,18 @@ int runEdit(const std::vector<std::string>& argv) {
 
   RenderSession session(scene, method);
   std::fprintf(stderr, "device: %s\n", session.deviceName().c_str());
+  printRenderWarnings(session.sceneWarnings(), loaded->warnings);
+  // Selection and focus steps at the head of the script hold while the scene converges, as an
+  // artist selects before editing: the indirection counters are gathered then.
+  std::size_t firstStep = 0;
+  for (; firstStep < scenario->steps.size(); ++firstStep) {
+    const ScenarioStep& step = scenario->steps[firstStep];
+    if (step.kind != ScenarioStep::Kind::Select && step.kind != ScenarioStep::Kind::Focus) break;
+    auto e = stepEdits(step, 0, session.scene(), session.selection());
+    if (!e) return std::fprintf(stderr, "error: %s: steps[%zu]: %s\n", args->get("--script").c_str(), firstStep, e.error().c_str()), 1;
+    if (e->select) session.select(*e->select);
+    if (e->focus) session.setFocus(*e->focus);
+  }
   auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   for (int f = 0; f < converge; ++f) {
@@ -138,7 +150,7 @@ int runEdit(const std::vector<std::string>& argv) {
   double sumMs = 0, sumScheduleMs = 0;
   bool exact = true;
   t0 = std::chrono::steady_clock::now();
-  for (std::size_t si = 0; si < scenario->steps.size(); ++si) {
+  for (std::size_t si = firstStep; si < scenario->steps.size(); ++si) {
     const ScenarioStep& step = scenario->steps[si];
     bool instant = step.kind == ScenarioStep::Kind::Select || step.kind == ScenarioStep::Kind::Focus;
     for (int f = 0; f < (instant ? 1 : step.frames); ++f) {

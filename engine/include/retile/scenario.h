@@ -3,7 +3,9 @@
 //
 //   { "converge": 1024,                      // spp accumulated before the first step
 //     "steps": [
-//       { "select": "Cup" },                 // selects an object (no frame)
+//       { "select": "Cup" },                 // selects an object (no frame); a list of names
+//                                            // selects the first that exists, so one script
+//                                            // can serve several scenes
 //       { "move": [0, 0.005, 0], "frames": 100, "object": "Cup" },  // per frame; default: selection
 //       { "wait": 100 },                     // frames with no edit
 //       { "material": "Ceramic", "set": { "roughness": 0.4, "albedo": [0.8, 0.2, 0.2] } },
@@ -33,6 +35,7 @@ namespace retile {
 struct ScenarioStep {
   enum class Kind { Select, Move, Wait, Material, Light, Camera, Focus } kind = Kind::Wait;
   std::string target;           // object, material or light name
+  std::vector<std::string> candidates;  // select: names to try in order
   int frames = 1;
   Vec3 vector{0.0f};            // move: per frame
   std::optional<float> roughness, ior, intensity;

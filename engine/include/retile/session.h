@@ -61,6 +61,8 @@ class RenderSession {
   const Scene& scene() const { return scene_; }
   const MethodSettings& method() const { return method_; }
   NodeId selection() const { return selection_; }
+  // What uploading the scene warned about (missing textures and their substitutes).
+  const std::vector<std::string>& sceneWarnings() const { return sceneWarnings_; }
 
   // Applies an edit to the session's scene and the renderer (in place: a transform touches only
   // instance data and the top-level BVH), then restarts the queue from the edit's point of change
@@ -85,6 +87,7 @@ class RenderSession {
   Scene scene_;
   MethodSettings method_;
   NodeId selection_ = kNoNode;
+  std::vector<std::string> sceneWarnings_;
 };
 
 }  // namespace retile

@@ -80,9 +80,13 @@ Result<Scenario> parseScenario(const std::string& text, const std::string& name)
     };
     bool ok = true;
     if (const Value* x = v.find("select")) {
-      if (!x->isString()) return R::failure(cat(r.where, ": select names an object"));
       s.kind = ScenarioStep::Kind::Select;
-      s.target = x->asString();
+      if (x->isString()) s.candidates.push_back(x->asString());
+      if (x->isArray())
+        for (const Value& n : x->asArray())
+          if (n.isString()) s.candidates.push_back(n.asString());
+      if (s.candidates.empty()) return R::failure(cat(r.where, ": select names an object, or lists names to try"));
+      s.target = s.candidates.front();
     } else if (const Value* m = v.find("move"); m && !v.find("light")) {
       s.kind = ScenarioStep::Kind::Move;
       if (!json::toVec3(*m, &s.vector) || !isFinite(s.vector)) return R::failure(cat(r.where, ": move must be three numbers"));
@@ -155,10 +159,15 @@ Result<StepEdits> stepEdits(const ScenarioStep& step, int frameInStep, const Sce
   using K = ScenarioStep::Kind;
   switch (step.kind) {
     case K::Select: {
-      const Object* o = objectByName(scene, step.target);
-      if (!o) return R::failure(cat("select: no object named '", step.target, "'"));
-      out.select = o->id;
-      return out;
+      std::string tried;
+      for (const auto& name : step.candidates.empty() ? std::vector<std::string>{step.target} : step.candidates) {
+        if (const Object* o = objectByName(scene, name)) {
+          out.select = o->id;
+          return out;
+        }
+        tried += (tried.empty() ? "'" : ", '") + name + "'";
+      }
+      return R::failure(cat("select: no object named ", tried));
     }
     case K::Focus:
       out.focus = step.focus;

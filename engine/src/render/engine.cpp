@@ -128,6 +128,7 @@ void Engine::run() {
     session = std::make_unique<RenderSession>(std::move(initialScene_), initialMethod_, options_.renderer);
     std::lock_guard lock(mutex_);
     device_ = session->deviceName();
+    for (const auto& w : session->sceneWarnings()) errors_.push_back("warning: " + w);
   } catch (const std::exception& e) {
     report(cat("cannot start rendering: ", e.what()));
     running_ = false;

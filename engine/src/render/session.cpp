@@ -79,7 +79,7 @@ RenderSession::RenderSession(Scene scene, MethodSettings method, const RendererO
   }
   for (const Mesh& m : scene_.meshes)
     if (m.geometry) impl_->meshBounds[m.id] = m.geometry->bounds();
-  for (const auto& w : impl_->renderer.setScene(scene_)) logWarning(w);
+  sceneWarnings_ = impl_->renderer.setScene(scene_);
   impl_->renderer.setMaxBounces(scene_.settings.maxBounces);
   impl_->renderer.setSeed(scene_.settings.seed);
   resize(scene_.settings.width, scene_.settings.height);
@@ -192,7 +192,7 @@ Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t d
   if (const auto* add = std::get_if<AddMesh>(&edit); add && add->mesh.geometry)
     d.meshBounds[add->mesh.id] = add->mesh.geometry->bounds();
   if (const auto* add = std::get_if<AddObject>(&edit)) targets.push_back(add->object.id);
-  for (const auto& w : d.renderer.updateScene(scene_, flags)) logWarning(w);
+  for (auto& w : d.renderer.updateScene(scene_, flags)) sceneWarnings_.push_back(std::move(w));
   // Coalesced commands may arrive out of version order: the record shows the newest applied.
   d.documentVersion = std::max(d.documentVersion, documentVersion);
   if (selection_ != kNoNode && !scene_.object(selection_)) select(kNoNode);
