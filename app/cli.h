@@ -34,5 +34,8 @@ int runRender(const std::vector<std::string>& args);
 int runBench(const std::vector<std::string>& args);
 int runImport(const std::vector<std::string>& args);
 int runEdit(const std::vector<std::string>& args);
+// The Qt editor on `file` ("" or "default": the built-in scene). Needs a display.
+int runEditor(int argc, char** argv, const std::string& file);
+bool isCommand(const std::string& word);
 
 }  // namespace retile::cli

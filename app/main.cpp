@@ -13,6 +13,7 @@ namespace {
 void usage() {
   std::fprintf(stderr,
                "usage:\n"
+               "  retile [SCENE]                      opens the editor (the built-in scene without SCENE)\n"
                "  retile render SCENE [--size WxH] [--spp N] [--seed S] [--max-bounces B] [--out FILE.exr|png]\n"
                "                      [--view Standard|Filmic] [--exposure STOPS]\n"
                "  retile edit SCENE --script EDITS.json --method NAME --out-dir DIR [--size WxH] [--tile T]\n"
@@ -29,9 +30,11 @@ int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (const char* v = std::getenv("RETILE_LOG"); v && std::strcmp(v, "debug") == 0) retile::setLogLevel(retile::LogLevel::Debug);
   try {
-    if (args.empty() || args[0] == "--help" || args[0] == "-h") {
+    if (args.empty() || (args.size() == 1 && args[0].rfind("-", 0) != 0 && !retile::cli::isCommand(args[0])))
+      return retile::cli::runEditor(argc, argv, args.empty() ? std::string() : args[0]);
+    if (args[0] == "--help" || args[0] == "-h") {
       usage();
-      return args.empty() ? 2 : 0;
+      return 0;
     }
     std::string cmd = args[0];
     std::vector<std::string> rest(args.begin() + 1, args.end());

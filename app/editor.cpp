@@ -1,0 +1,62 @@
+// `retile [SCENE]`: the editor. The only place the command line meets Qt.
+#include <QApplication>
+#include <QMessageBox>
+#include <QTimer>
+
+#include "cli.h"
+#include "main_window.h"
+#include "retile/log.h"
+
+namespace retile::cli {
+
+bool isCommand(const std::string& word) {
+  return word == "render" || word == "edit" || word == "bench" || word == "import";
+}
+
+int runEditor(int argc, char** argv, const std::string& file) {
+  QApplication app(argc, argv);
+  QApplication::setApplicationName("Retile");
+  Scene scene = makeDefaultScene();
+  std::filesystem::path path;
+  QString openError;
+  if (!file.empty() && file != "default") {
+    auto loaded = importScene(file);
+    if (loaded) {
+      scene = std::move(loaded->scene);
+      path = file;
+    } else {
+      // The editor still opens, on the built-in scene, and says why.
+      openError = QString::fromStdString(loaded.error());
+    }
+  }
+  ui::MainWindow window(std::move(scene), path);
+  window.show();
+  // scripts/screenshot.sh: converge a little, select and move an object so that the overlays show
+  // a pass in progress, then save the whole window and quit.
+  if (qEnvironmentVariableIsSet("RETILE_SCREENSHOT")) {
+    auto* timer = new QTimer(&window);
+    int settle = qEnvironmentVariableIntValue("RETILE_SCREENSHOT_FRAMES");
+    if (settle <= 0) settle = 40;
+    QObject::connect(timer, &QTimer::timeout, &window, [&window, settle, stage = 0]() mutable {
+      std::uint64_t frames = window.engine()->framesRendered();
+      if (stage == 0 && frames >= static_cast<std::uint64_t>(settle)) {
+        for (const Object& o : window.scene().objects)
+          if (o.name == qgetenv("RETILE_SCREENSHOT_SELECT").toStdString()) {
+            window.select(o.id);
+            Object moved = o;
+            moved.transform = Mat4::translate({0.0f, 0.08f, 0.0f}) * o.transform;
+            window.edit(SetObject{o}, SetObject{moved}, QObject::tr("Move"));
+          }
+        stage = 1;
+      } else if (stage >= 1 && ++stage > 6) {
+        window.grab().save(qEnvironmentVariable("RETILE_SCREENSHOT"));
+        QApplication::quit();
+      }
+    });
+    timer->start(250);
+  }
+  if (!openError.isEmpty()) QMessageBox::warning(&window, QObject::tr("Cannot open scene"), openError);
+  return QApplication::exec();
+}
+
+}  // namespace retile::cli

@@ -1,0 +1,141 @@
+// The editor under Qt's offscreen platform with the engine on lavapipe: the window builds, an
+// edit from the properties reaches the render thread and re-renders around the object, undo
+// restores, save and open round-trip, overlays draw, a broken file leaves the scene alone.
+#include <QApplication>
+#include <QDoubleSpinBox>
+#include <QTemporaryDir>
+#include <QTest>
+#include <QTreeWidget>
+
+#include <gtest/gtest.h>
+
+#include "main_window.h"
+
+namespace retile::ui {
+namespace {
+
+std::unique_ptr<MainWindow> makeWindow() {
+  EditorOptions o;
+  o.initialRenderSize = QSize(96, 54);
+  auto w = std::make_unique<MainWindow>(makeDefaultScene(), std::filesystem::path(), o);
+  w->resize(1000, 700);
+  w->show();
+  return w;
+}
+
+bool waitForFrame(MainWindow& w, const std::function<bool(const FrameRecord&)>& pred, int ms = 60000) {
+  return QTest::qWaitFor([&] { return w.viewport()->frame() && pred(*w.viewport()->frame()); }, ms);
+}
+
+NodeId objectNamed(const Scene& s, const std::string& name) {
+  for (const auto& o : s.objects)
+    if (o.name == name) return o.id;
+  return kNoNode;
+}
+
+TEST(Editor, EditFromThePropertiesReRendersAroundTheObjectAndUndoes) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; })) << "frames reach the viewport";
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  // Select it in the outliner.
+  QTreeWidgetItem* item = nullptr;
+  for (QTreeWidgetItemIterator it(w->outliner()); *it; ++it)
+    if ((*it)->text(0) == "Glossy Sphere") item = *it;
+  ASSERT_TRUE(item);
+  item->setSelected(true);
+  ASSERT_EQ(w->selection(), sphere);
+  auto* rough = w->findChild<QDoubleSpinBox*>("roughness");
+  ASSERT_TRUE(rough) << "the properties show the sphere's material";
+  const NodeId material = w->scene().object(sphere)->material;
+  const float before = w->scene().material(material)->roughness;
+  rough->setValue(0.6);
+  EXPECT_FLOAT_EQ(w->scene().material(material)->roughness, 0.6f);
+  const std::uint64_t version = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version && f.mode == "incremental"; }));
+  const FrameRecord& f = *w->viewport()->frame();
+  ASSERT_FALSE(f.servedTiles.empty());
+  // The first tile served holds the point of change: the sphere's projected centre.
+  int t = f.servedTiles.front();
+  float x0 = static_cast<float>((t % f.cols) * f.tileSize), y0 = static_cast<float>((t / f.cols) * f.tileSize);
+  EXPECT_GE(f.pointOfChange.x, x0);
+  EXPECT_LT(f.pointOfChange.x, x0 + f.tileSize);
+  EXPECT_GE(f.pointOfChange.y, y0);
+  EXPECT_LT(f.pointOfChange.y, y0 + f.tileSize);
+  EXPECT_LT(f.pointOfChange.x, f.width / 2.0f) << "the sphere is on the left of the default view";
+
+  w->undoStack()->undo();
+  EXPECT_FLOAT_EQ(w->scene().material(material)->roughness, before);
+  const std::uint64_t undone = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& fr) { return fr.documentVersion == undone; })) << "the undo reached the engine";
+  w->undoStack()->redo();
+  EXPECT_FLOAT_EQ(w->scene().material(material)->roughness, 0.6f);
+}
+
+TEST(Editor, OverlaysDrawOverTheImage) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  NodeId cup = objectNamed(w->scene(), "Cup");
+  Object o = *w->scene().object(cup);
+  Object moved = o;
+  moved.transform = Mat4::translate({0, 0.05f, 0}) * o.transform;
+  w->edit(SetObject{o}, SetObject{moved}, "move");
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.mode == "incremental"; }));
+  OverlaySettings none{false, false, false, false, false, false};
+  OverlaySettings all;
+  all.order = true;
+  all.samples = true;
+  w->viewport()->setOverlays(none);
+  QImage plain = w->viewport()->grab().toImage();
+  w->viewport()->setOverlays(all);
+  QImage drawn = w->viewport()->grab().toImage();
+  ASSERT_EQ(plain.size(), drawn.size());
+  // The point-of-change marker is pure-ish red; the legend's box darkens the lower left.
+  int red = 0, changed = 0;
+  for (int y = 0; y < drawn.height(); ++y)
+    for (int x = 0; x < drawn.width(); ++x) {
+      QColor a = plain.pixelColor(x, y), b = drawn.pixelColor(x, y);
+      if (a != b) ++changed;
+      if (b.red() > 230 && b.green() < 90 && b.blue() < 90 && !(a.red() > 230 && a.green() < 90 && a.blue() < 90)) ++red;
+    }
+  EXPECT_GT(red, 20) << "the point-of-change cross";
+  EXPECT_GT(changed, drawn.width() * drawn.height() / 10) << "the heat map covers the queued tiles";
+}
+
+TEST(Editor, SaveOpenRoundTripAndABrokenFileKeepsTheScene) {
+  auto w = makeWindow();
+  QTemporaryDir dir;
+  std::filesystem::path file = (dir.path() + "/scene.retile").toStdString();
+  NodeId cup = objectNamed(w->scene(), "Cup");
+  Object o = *w->scene().object(cup);
+  Object renamed = o;
+  renamed.name = "Teacup";
+  w->edit(SetObject{o}, SetObject{renamed}, "rename");
+  ASSERT_TRUE(w->saveTo(file));
+  EXPECT_TRUE(w->undoStack()->isClean());
+  ASSERT_TRUE(w->openFile(file));
+  EXPECT_NE(objectNamed(w->scene(), "Teacup"), kNoNode) << "the saved edit came back";
+  const std::size_t objects = w->scene().objects.size();
+
+  std::filesystem::path broken = (dir.path() + "/broken.retile").toStdString();
+  {
+    QFile f(QString::fromStdString(broken.string()));
+    ASSERT_TRUE(f.open(QIODevice::WriteOnly));
+    f.write("{ \"version\": 1, \"objects\": [ {\"name\": ");
+  }
+  EXPECT_FALSE(w->openFile(broken));
+  EXPECT_TRUE(w->lastError().contains("broken.retile")) << w->lastError().toStdString();
+  EXPECT_EQ(w->scene().objects.size(), objects) << "the current scene stays";
+  EXPECT_NE(objectNamed(w->scene(), "Teacup"), kNoNode);
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 1; })) << "and keeps rendering";
+}
+
+}  // namespace
+}  // namespace retile::ui
+
+int main(int argc, char** argv) {
+  qputenv("QT_QPA_PLATFORM", "offscreen");
+  qputenv("RETILE_NO_PROMPTS", "1");
+  QApplication app(argc, argv);
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

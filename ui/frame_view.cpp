@@ -1,0 +1,167 @@
+#include "frame_view.h"
+
+#include <QMouseEvent>
+#include <QPainter>
+
+#include <algorithm>
+#include <cmath>
+
+#include "retile/color.h"
+
+namespace retile::ui {
+
+QColor priorityColor(float priority) {
+  // Violet (served last) through red and orange to yellow (served next): readable over dark and
+  // light images alike, and never confused with the cyan outlines of served tiles.
+  float t = std::clamp(priority, 0.0f, 1.0f);
+  return QColor::fromHsvF(std::fmod(0.8f + 0.35f * t, 1.0f), 0.9f, 1.0f, 0.3f);
+}
+
+FrameView::FrameView(QWidget* parent) : QWidget(parent) {
+  setMinimumSize(160, 90);
+  setAttribute(Qt::WA_OpaquePaintEvent);
+  setMouseTracking(false);
+}
+
+void FrameView::setOverlays(const OverlaySettings& o) {
+  overlays_ = o;
+  update();
+}
+
+void FrameView::setPaused(bool paused) {
+  paused_ = paused;
+  update();
+}
+
+void FrameView::showFrame(std::shared_ptr<const FrameRecord> frame) {
+  if (!frame || !frame->image) return;
+  frame_ = std::move(frame);
+  const RenderImage& img = *frame_->image;
+  QImage q(img.width, img.height, QImage::Format_RGBA8888);
+  auto config = ColorConfig::get();
+  for (int y = 0; y < img.height; ++y)
+    config->toDisplay8(img.color.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) * 3,
+                       static_cast<std::size_t>(img.width), DisplaySettings{}, q.scanLine(y));
+  image_ = std::move(q);
+  update();
+}
+
+QRectF FrameView::imageRect() const {
+  if (image_.isNull()) return rect();
+  double s = std::min(width() / static_cast<double>(image_.width()), height() / static_cast<double>(image_.height()));
+  double w = image_.width() * s, h = image_.height() * s;
+  return {(width() - w) / 2, (height() - h) / 2, w, h};
+}
+
+void FrameView::paintEvent(QPaintEvent*) {
+  QPainter p(this);
+  p.fillRect(rect(), QColor(32, 32, 36));
+  if (image_.isNull()) {
+    p.setPen(Qt::lightGray);
+    p.drawText(rect(), Qt::AlignCenter, tr("Starting the renderer..."));
+    return;
+  }
+  QRectF r = imageRect();
+  p.setRenderHint(QPainter::SmoothPixmapTransform, true);
+  p.drawImage(r, image_);
+  drawOverlays(p, r);
+  if (paused_) {
+    p.setPen(QPen(QColor(255, 190, 40), 4));
+    p.drawRect(r.adjusted(2, 2, -2, -2));
+    p.setFont(QFont(font().family(), 14, QFont::Bold));
+    p.drawText(r.adjusted(10, 8, -10, -8), Qt::AlignTop | Qt::AlignRight, tr("PAUSED (Esc resumes)"));
+  }
+}
+
+void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
+  if (!frame_) return;
+  const FrameRecord& f = *frame_;
+  const double sx = r.width() / f.width, sy = r.height() / f.height;
+  auto tileRect = [&](int t) {
+    int c = t % f.cols, row = t / f.cols;
+    double x0 = c * f.tileSize, y0 = row * f.tileSize;
+    double x1 = std::min<double>(x0 + f.tileSize, f.width), y1 = std::min<double>(y0 + f.tileSize, f.height);
+    return QRectF(r.x() + x0 * sx, r.y() + y0 * sy, (x1 - x0) * sx, (y1 - y0) * sy);
+  };
+  const int tiles = f.cols * f.rows;
+  if (overlays_.priority && static_cast<int>(f.tilePriority.size()) == tiles) {
+    for (int t = 0; t < tiles; ++t) {
+      float pr = f.tilePriority[static_cast<std::size_t>(t)];
+      if (pr < 0) continue;
+      p.fillRect(tileRect(t), priorityColor(pr));
+    }
+  }
+  QFont small(font().family(), std::max(6, static_cast<int>(f.tileSize * sy / 3.2)));
+  p.setFont(small);
+  if (overlays_.order && static_cast<int>(f.tilePriority.size()) == tiles && f.queueLength > 1) {
+    p.setPen(Qt::white);
+    for (int t = 0; t < tiles; ++t) {
+      float pr = f.tilePriority[static_cast<std::size_t>(t)];
+      if (pr < 0) continue;
+      int rank = static_cast<int>(std::lround((1.0f - pr) * static_cast<float>(f.queueLength - 1))) + 1;
+      p.drawText(tileRect(t), Qt::AlignCenter, QString::number(rank));
+    }
+  }
+  if (overlays_.samples && static_cast<int>(f.tileSamples.size()) == tiles) {
+    p.setPen(QColor(180, 255, 180));
+    for (int t = 0; t < tiles; ++t)
+      p.drawText(tileRect(t).adjusted(2, 1, -2, -1), Qt::AlignBottom | Qt::AlignRight,
+                 QString::number(static_cast<int>(f.tileSamples[static_cast<std::size_t>(t)])));
+  }
+  if (overlays_.served && static_cast<int>(f.servedTiles.size()) < tiles) {
+    p.setPen(QPen(QColor(80, 220, 255), 1.5));
+    p.setBrush(Qt::NoBrush);
+    for (int t : f.servedTiles) p.drawRect(tileRect(t).adjusted(0.5, 0.5, -0.5, -0.5));
+  }
+  if (overlays_.markers) {
+    QPointF poc(r.x() + f.pointOfChange.x * sx, r.y() + f.pointOfChange.y * sy);
+    p.setPen(QPen(QColor(255, 60, 60), 2.5));
+    p.drawLine(poc + QPointF(-10, 0), poc + QPointF(10, 0));
+    p.drawLine(poc + QPointF(0, -10), poc + QPointF(0, 10));
+    p.setPen(QPen(QColor(80, 255, 120), 2.5));
+    for (const Vec2& fp : f.focus) p.drawEllipse(QPointF(r.x() + fp.x * sx, r.y() + fp.y * sy), 9, 9);
+  }
+  if (overlays_.legend) {
+    QFont lf(font().family(), 9);
+    p.setFont(lf);
+    QRectF box(r.x() + 8, r.bottom() - 86, 230, 78);
+    p.fillRect(box, QColor(0, 0, 0, 170));
+    QLinearGradient g(box.x() + 10, 0, box.x() + 150, 0);
+    for (int i = 0; i <= 10; ++i) {
+      QColor c = priorityColor(1.0f - i / 10.0f);
+      c.setAlphaF(1.0);
+      g.setColorAt(i / 10.0, c);
+    }
+    p.fillRect(QRectF(box.x() + 10, box.y() + 8, 140, 10), g);
+    p.setPen(Qt::white);
+    p.drawText(QRectF(box.x() + 10, box.y() + 20, 210, 14), tr("served first  ...  last (tile priority)"));
+    p.setPen(QColor(80, 220, 255));
+    p.drawText(QRectF(box.x() + 10, box.y() + 36, 210, 14), tr("outlined: tiles traced this frame"));
+    p.setPen(QColor(255, 90, 90));
+    p.drawText(QRectF(box.x() + 10, box.y() + 50, 210, 14), tr("+ point of change"));
+    p.setPen(QColor(80, 255, 120));
+    p.drawText(QRectF(box.x() + 120, box.y() + 50, 110, 14), tr("o focus point"));
+    p.setPen(Qt::lightGray);
+    p.drawText(QRectF(box.x() + 10, box.y() + 62, 210, 14),
+               tr("%1, %2: %3/%4 tiles").arg(QString::fromStdString(f.method), QString::fromStdString(f.mode))
+                   .arg(f.queueServed).arg(f.queueLength));
+  }
+}
+
+void FrameView::mousePressEvent(QMouseEvent* e) {
+  if (!frame_ || !frame_->image) return;
+  QRectF r = imageRect();
+  if (!r.contains(e->position())) return;
+  double u = (e->position().x() - r.x()) / r.width(), v = (e->position().y() - r.y()) / r.height();
+  int x = std::clamp(static_cast<int>(u * frame_->width), 0, frame_->width - 1);
+  int y = std::clamp(static_cast<int>(v * frame_->height), 0, frame_->height - 1);
+  if (e->modifiers() & Qt::ShiftModifier) {
+    emit focusPlaced(QPointF(u * frame_->width, v * frame_->height));
+    return;
+  }
+  const auto& ids = frame_->image->objectId;
+  std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(frame_->width) + static_cast<std::size_t>(x);
+  emit objectPicked(i < ids.size() ? static_cast<quint64>(ids[i]) : 0);
+}
+
+}  // namespace retile::ui

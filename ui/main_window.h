@@ -1,0 +1,101 @@
+// The editor's main window: outliner, properties, method panel, log and the viewport, around
+// one document and one engine. The window owns the document (the GUI thread's copy of the scene)
+// and the undo stack; every change is an EditCommand that updates the document and is sent, as a
+// value, to the render thread. GUI thread only; nothing here waits on rendering.
+#pragma once
+
+#include <QMainWindow>
+#include <QUndoStack>
+
+#include <filesystem>
+#include <memory>
+
+#include "frame_view.h"
+#include "retile/edit.h"
+#include "retile/engine.h"
+
+class QTreeWidget;
+class QTreeWidgetItem;
+class QPlainTextEdit;
+class QFormLayout;
+class QLabel;
+class QComboBox;
+class QSpinBox;
+class QCheckBox;
+class QWidget;
+
+namespace retile::ui {
+
+struct EditorOptions {
+  int renderScale = 4;        // render at 1/scale of the viewport (lavapipe traces well under 1 M samples/s)
+  QSize initialRenderSize{};  // fixed render size (tests); empty: follow the viewport
+};
+
+class MainWindow : public QMainWindow {
+  Q_OBJECT
+ public:
+  MainWindow(Scene scene, std::filesystem::path file, EditorOptions options = {}, QWidget* parent = nullptr);
+  ~MainWindow() override;
+
+  // Opens a scene file; on failure shows the error and keeps the current scene. Returns success.
+  bool openFile(const std::filesystem::path& file);
+  bool saveTo(const std::filesystem::path& file);
+
+  const Scene& scene() const { return doc_.scene(); }
+  std::uint64_t documentVersion() const { return doc_.version(); }
+  QUndoStack* undoStack() { return &undo_; }
+  FrameView* viewport() { return view_; }
+  Engine* engine() { return engine_.get(); }
+  QTreeWidget* outliner() { return outliner_; }
+  NodeId selection() const { return selection_; }
+  void select(NodeId object);
+  // Applies an edit through the undo stack (dragId > 0 merges a drag into one step).
+  void edit(const Edit& before, const Edit& after, const QString& text, int dragId = 0);
+  QString lastError() const { return lastError_; }
+
+ protected:
+  void closeEvent(QCloseEvent* e) override;
+  void keyPressEvent(QKeyEvent* e) override;
+  void resizeEvent(QResizeEvent* e) override;
+
+ private:
+  void buildMenus();
+  void buildDocks();
+  void startEngine(Scene scene);
+  void rebuildOutliner();
+  void rebuildProperties();
+  void onFrame();
+  void sendMethod();
+  void log(const QString& line);
+  void showError(const QString& title, const QString& message);
+  bool applyToDocument(const Edit& e);
+  void updateRenderSize();
+
+  EditorOptions options_;
+  Document doc_;
+  std::filesystem::path file_;
+  std::unique_ptr<Engine> engine_;
+  QUndoStack undo_;
+  NodeId selection_ = kNoNode;
+  MethodSettings method_;
+  bool paused_ = false;
+  int dragCounter_ = 0;
+  QString lastError_;
+  QSize renderSize_;
+
+  FrameView* view_ = nullptr;
+  QTreeWidget* outliner_ = nullptr;
+  QWidget* properties_ = nullptr;
+  QFormLayout* propertiesForm_ = nullptr;
+  QPlainTextEdit* log_ = nullptr;
+  QComboBox* methodBox_ = nullptr;
+  QComboBox* tileBox_ = nullptr;
+  QSpinBox* qualityBox_ = nullptr;
+  QCheckBox* smoothBox_ = nullptr;
+  QLabel* status_ = nullptr;
+  std::uint64_t framesSeen_ = 0;
+  qint64 fpsStart_ = 0;
+  double fps_ = 0;
+};
+
+}  // namespace retile::ui
