@@ -149,7 +149,12 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
 }
 
 void FrameView::mousePressEvent(QMouseEvent* e) {
-  if (!frame_ || !frame_->image) return;
+  last_ = e->position();
+  if (e->modifiers() & Qt::AltModifier) {
+    drag_ = e->button() == Qt::LeftButton ? Drag::Orbit : e->button() == Qt::MiddleButton ? Drag::Pan : Drag::Dolly;
+    return;
+  }
+  if (!frame_ || !frame_->image || e->button() != Qt::LeftButton) return;
   QRectF r = imageRect();
   if (!r.contains(e->position())) return;
   double u = (e->position().x() - r.x()) / r.width(), v = (e->position().y() - r.y()) / r.height();
@@ -161,7 +166,39 @@ void FrameView::mousePressEvent(QMouseEvent* e) {
   }
   const auto& ids = frame_->image->objectId;
   std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(frame_->width) + static_cast<std::size_t>(x);
-  emit objectPicked(i < ids.size() ? static_cast<quint64>(ids[i]) : 0);
+  quint64 id = i < ids.size() ? static_cast<quint64>(ids[i]) : 0;
+  // Pressing on the selection starts moving it; anywhere else picks.
+  if (id != 0 && id == selected_) {
+    drag_ = Drag::Object;
+    return;
+  }
+  emit objectPicked(id);
+}
+
+void FrameView::mouseMoveEvent(QMouseEvent* e) {
+  QPointF d = e->position() - last_;
+  last_ = e->position();
+  switch (drag_) {
+    case Drag::Orbit: emit orbitDragged(d); break;
+    case Drag::Pan: emit panDragged(d); break;
+    case Drag::Dolly: emit dollyDragged(-d.y() / 200.0); break;
+    case Drag::Object: {
+      QRectF r = imageRect();
+      if (frame_ && r.width() > 0) emit objectDragged(QPointF(d.x() * frame_->width / r.width(), d.y() * frame_->height / r.height()));
+      break;
+    }
+    case Drag::None: break;
+  }
+}
+
+void FrameView::mouseReleaseEvent(QMouseEvent*) {
+  if (drag_ != Drag::None) emit dragFinished();
+  drag_ = Drag::None;
+}
+
+void FrameView::wheelEvent(QWheelEvent* e) {
+  emit dollyDragged(e->angleDelta().y() / 1200.0);
+  emit dragFinished();
 }
 
 }  // namespace retile::ui

@@ -38,10 +38,20 @@ class FrameView : public QWidget {
  signals:
   void objectPicked(quint64 object);  // 0: nothing under the cursor
   void focusPlaced(QPointF imagePixel);
+  // Drags, in widget pixels since the last event. A drag starts with a press and ends with the
+  // release (dragFinished), so a whole drag can be one undo step.
+  void orbitDragged(QPointF delta);       // Alt + left
+  void panDragged(QPointF delta);         // Alt + middle
+  void dollyDragged(double amount);       // Alt + right, or the wheel (positive: closer)
+  void objectDragged(QPointF imageDelta);  // left drag starting on the selection: image pixels
+  void dragFinished();
 
  protected:
   void paintEvent(QPaintEvent*) override;
   void mousePressEvent(QMouseEvent* e) override;
+  void mouseMoveEvent(QMouseEvent* e) override;
+  void mouseReleaseEvent(QMouseEvent* e) override;
+  void wheelEvent(QWheelEvent* e) override;
 
  private:
   void drawOverlays(QPainter& p, const QRectF& r) const;
@@ -50,6 +60,12 @@ class FrameView : public QWidget {
   QImage image_;
   OverlaySettings overlays_;
   bool paused_ = false;
+  enum class Drag { None, Orbit, Pan, Dolly, Object } drag_ = Drag::None;
+  QPointF last_;
+  quint64 selected_ = 0;
+
+ public:
+  void setSelected(quint64 object) { selected_ = object; }
 };
 
 // The heat map's colour for a priority in [0, 1] (1: served first).

@@ -1,6 +1,7 @@
 #include "main_window.h"
 
 #include <QAction>
+#include <QActionGroup>
 #include <QApplication>
 #include <QCheckBox>
 #include <QCloseEvent>
@@ -24,6 +25,7 @@
 #include <QStatusBar>
 #include <QTreeWidget>
 
+#include <cmath>
 #include <numeric>
 
 #include "edit_command.h"
@@ -61,6 +63,51 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
     method_.focus = {FocusPoint{Vec2{static_cast<float>(p.x()), static_cast<float>(p.y())}, false}};
     engine_->submit(FocusCommand{method_.focus});
     log(tr("focus point at %1, %2").arg(p.x(), 0, 'f', 0).arg(p.y(), 0, 'f', 0));
+  });
+  // Camera navigation (Alt + left/middle/right, wheel) and moving the selection in the screen
+  // plane; each whole drag is one undo step.
+  connect(view_, &FrameView::dragFinished, this, [this] { ++dragCounter_; });
+  connect(view_, &FrameView::orbitDragged, this, [this](QPointF d) {
+    editCamera([d](Camera& c) {
+      Vec3 offset = c.position - c.target;
+      float yaw = static_cast<float>(-d.x() * 0.008), pitch = static_cast<float>(-d.y() * 0.008);
+      Mat4 turn = Mat4::rotateY(yaw);
+      offset = turn.transformPoint(offset);
+      Vec3 right = normalize(cross(normalize(c.target - c.position), c.up));
+      // Rodrigues' rotation of the offset about the camera's right axis.
+      Vec3 tilted = offset * std::cos(pitch) + cross(right, offset) * std::sin(pitch) +
+                    right * (dot(right, offset) * (1.0f - std::cos(pitch)));
+      // Stay clear of the poles, where "up" would flip.
+      if (std::abs(dot(normalize(tilted), Vec3{0, 1, 0})) < 0.97f) offset = tilted;
+      c.position = c.target + offset;
+    }, tr("Orbit"));
+  });
+  connect(view_, &FrameView::panDragged, this, [this](QPointF d) {
+    editCamera([this, d](Camera& c) {
+      Vec3 fwd = normalize(c.target - c.position);
+      Vec3 right = normalize(cross(fwd, c.up)), up = cross(right, fwd);
+      float k = 2.0f * length(c.target - c.position) * std::tan(c.verticalFov * 0.5f) / static_cast<float>(std::max(1, view_->height()));
+      Vec3 move = right * static_cast<float>(-d.x() * k) + up * static_cast<float>(d.y() * k);
+      c.position = c.position + move;
+      c.target = c.target + move;
+    }, tr("Pan"));
+  });
+  connect(view_, &FrameView::dollyDragged, this, [this](double a) {
+    editCamera([a](Camera& c) { c.position = c.target + (c.position - c.target) * static_cast<float>(std::exp(-a)); }, tr("Dolly"));
+  });
+  connect(view_, &FrameView::objectDragged, this, [this](QPointF d) {
+    const Object* o = doc_.scene().object(selection_);
+    auto frame = view_->frame();
+    if (!o || !frame) return;
+    const Camera& c = doc_.scene().camera;
+    Vec3 fwd = normalize(c.target - c.position);
+    Vec3 right = normalize(cross(fwd, c.up)), up = cross(right, fwd);
+    Vec3 at = o->transform.transformPoint(Vec3{0.0f});
+    float depth = std::max(0.01f, dot(at - c.position, fwd));
+    float k = 2.0f * depth * std::tan(c.verticalFov * 0.5f) / static_cast<float>(frame->height);
+    Object after = *o;
+    after.transform = Mat4::translate(right * static_cast<float>(d.x() * k) - up * static_cast<float>(d.y() * k)) * o->transform;
+    edit(SetObject{*o}, SetObject{after}, tr("Move %1").arg(QString::fromStdString(o->name)), dragCounter_ + 1);
   });
   resize(1280, 800);
   startEngine(doc_.scene());
@@ -124,6 +171,19 @@ void MainWindow::buildMenus() {
   toggle(tr("&Legend"), &OverlaySettings::legend);
 
   QMenu* render = menuBar()->addMenu(tr("&Render"));
+  QMenu* scale = render->addMenu(tr("Render &resolution"));
+  auto* scales = new QActionGroup(this);
+  for (int k : {1, 2, 3, 4}) {
+    QAction* a = scale->addAction(k == 1 ? tr("Full viewport") : tr("1/%1 of the viewport").arg(k));
+    a->setCheckable(true);
+    a->setChecked(k == options_.renderScale);
+    scales->addAction(a);
+    connect(a, &QAction::triggered, this, [this, k] {
+      options_.renderScale = k;
+      options_.initialRenderSize = QSize();
+      updateRenderSize();
+    });
+  }
   QAction* pause = render->addAction(tr("&Pause / resume"));
   pause->setShortcut(Qt::Key_Escape);
   connect(pause, &QAction::triggered, this, [this] {
@@ -302,6 +362,7 @@ void MainWindow::edit(const Edit& before, const Edit& after, const QString& text
 void MainWindow::select(NodeId object) {
   if (object != kNoNode && !doc_.scene().object(object)) object = kNoNode;
   selection_ = object;
+  view_->setSelected(object);
   engine_->submit(SelectCommand{object});
   {
     QSignalBlocker block(outliner_);
@@ -513,7 +574,36 @@ void MainWindow::closeEvent(QCloseEvent* e) {
   e->accept();
 }
 
-void MainWindow::keyPressEvent(QKeyEvent* e) { QMainWindow::keyPressEvent(e); }
+void MainWindow::keyPressEvent(QKeyEvent* e) {
+  if (e->key() == Qt::Key_F && !(e->modifiers() & Qt::ControlModifier)) {
+    frameSelected();
+    return;
+  }
+  QMainWindow::keyPressEvent(e);
+}
+
+void MainWindow::editCamera(const std::function<void(Camera&)>& change, const QString& what) {
+  Camera before = doc_.scene().camera, after = before;
+  change(after);
+  if (!isFinite(after.position) || !isFinite(after.target) || length(after.position - after.target) < 1e-4f) return;
+  edit(SetCamera{before}, SetCamera{after}, what, dragCounter_ + 1);
+}
+
+void MainWindow::frameSelected() {
+  const Object* o = doc_.scene().object(selection_);
+  const Mesh* m = o ? doc_.scene().mesh(o->mesh) : nullptr;
+  if (!m || !m->geometry) return;
+  Bounds3 b = transformBounds(o->transform, m->geometry->bounds());
+  if (b.empty()) return;
+  editCamera([&](Camera& c) {
+    Vec3 fwd = normalize(c.target - c.position);
+    float radius = 0.5f * length(b.extent());
+    float dist = radius / std::sin(0.5f * c.verticalFov) * 1.1f;
+    c.target = b.center();
+    c.position = c.target - fwd * dist;
+  }, tr("Frame selected"));
+  ++dragCounter_;
+}
 
 void MainWindow::resizeEvent(QResizeEvent* e) {
   QMainWindow::resizeEvent(e);

@@ -70,6 +70,8 @@ class MainWindow : public QMainWindow {
   void showError(const QString& title, const QString& message);
   bool applyToDocument(const Edit& e);
   void updateRenderSize();
+  void editCamera(const std::function<void(Camera&)>& change, const QString& what);
+  void frameSelected();
 
   EditorOptions options_;
   Document doc_;

@@ -71,6 +71,49 @@ TEST(Editor, EditFromThePropertiesReRendersAroundTheObjectAndUndoes) {
   EXPECT_FLOAT_EQ(w->scene().material(material)->roughness, 0.6f);
 }
 
+TEST(Editor, CameraNavigationAndDraggingTheSelectionAreSingleUndoSteps) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  FrameView* v = w->viewport();
+  const Camera start = w->scene().camera;
+  QPoint c = v->rect().center();
+  QTest::mousePress(v, Qt::LeftButton, Qt::AltModifier, c);
+  for (int i = 1; i <= 5; ++i) QTest::mouseMove(v, c + QPoint(8 * i, 2 * i));
+  QTest::mouseRelease(v, Qt::LeftButton, Qt::AltModifier, c + QPoint(40, 10));
+  EXPECT_GT(length(w->scene().camera.position - start.position), 0.01f) << "Alt+drag orbits";
+  EXPECT_LT(length(w->scene().camera.target - start.target), 1e-5f) << "around the target";
+  const std::uint64_t version = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version && f.mode == "global-update"; }))
+      << "a camera move resets globally";
+  w->undoStack()->undo();
+  EXPECT_LT(length(w->scene().camera.position - start.position), 1e-5f) << "the whole orbit is one undo step";
+
+  // Select the sphere, then drag it to the right in the screen plane.
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 3; }));
+  auto frame = v->frame();
+  QRectF r = v->imageRect();
+  // A pixel showing the sphere: search the object ids.
+  QPoint on(-1, -1);
+  for (int y = 0; y < frame->height && on.x() < 0; ++y)
+    for (int x = 0; x < frame->width; ++x)
+      if (frame->image->objectId[static_cast<std::size_t>(y * frame->width + x)] == sphere) {
+        on = QPoint(static_cast<int>(r.x() + (x + 0.5) * r.width() / frame->width), static_cast<int>(r.y() + (y + 0.5) * r.height() / frame->height));
+        break;
+      }
+  ASSERT_GE(on.x(), 0);
+  Vec3 before = w->scene().object(sphere)->transform.transformPoint(Vec3{0.0f});
+  QTest::mousePress(v, Qt::LeftButton, Qt::NoModifier, on);
+  for (int i = 1; i <= 4; ++i) QTest::mouseMove(v, on + QPoint(10 * i, 0));
+  QTest::mouseRelease(v, Qt::LeftButton, Qt::NoModifier, on + QPoint(40, 0));
+  Vec3 after = w->scene().object(sphere)->transform.transformPoint(Vec3{0.0f});
+  EXPECT_GT(length(after - before), 0.05f) << "dragging the selection moves it";
+  w->undoStack()->undo();
+  Vec3 undone = w->scene().object(sphere)->transform.transformPoint(Vec3{0.0f});
+  EXPECT_LT(length(undone - before), 1e-5f) << "the whole drag is one undo step";
+}
+
 TEST(Editor, OverlaysDrawOverTheImage) {
   auto w = makeWindow();
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
