@@ -1,5 +1,6 @@
 // `retile [SCENE]`: the editor. The only place the command line meets Qt.
 #include <QApplication>
+#include <QFileInfo>
 #include <QMessageBox>
 #include <QTimer>
 
@@ -16,6 +17,7 @@ bool isCommand(const std::string& word) {
 int runEditor(int argc, char** argv, const std::string& file) {
   QApplication app(argc, argv);
   QApplication::setApplicationName("Retile");
+  QApplication::setOrganizationName("Retile");
   Scene scene = makeDefaultScene();
   std::filesystem::path path;
   QString openError;
@@ -29,8 +31,15 @@ int runEditor(int argc, char** argv, const std::string& file) {
       openError = QString::fromStdString(loaded.error());
     }
   }
+  QStringList recovery = ui::MainWindow::recoveryCandidates();
   ui::MainWindow window(std::move(scene), path);
   window.show();
+  // The last session did not close cleanly: offer its newest autosave.
+  if (!recovery.isEmpty() && !qEnvironmentVariableIsSet("RETILE_NO_PROMPTS") &&
+      QMessageBox::question(&window, QObject::tr("Recover"),
+                            QObject::tr("Retile did not close cleanly last time. Open the autosaved scene from %1?")
+                                .arg(QFileInfo(recovery.front()).lastModified().toString())) == QMessageBox::Yes)
+    window.openFile(recovery.front().toStdString());
   // scripts/screenshot.sh: converge a little, select and move an object so that the overlays show
   // a pass in progress, then save the whole window and quit.
   if (qEnvironmentVariableIsSet("RETILE_SCREENSHOT")) {

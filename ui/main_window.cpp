@@ -8,6 +8,15 @@
 #include <QColorDialog>
 #include <QComboBox>
 #include <QDateTime>
+#include <QDir>
+#include <QDragEnterEvent>
+#include <QDropEvent>
+#include <QFileInfo>
+#include <QMimeData>
+#include <QSettings>
+#include <QStandardPaths>
+#include <QTimer>
+#include <QUrl>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
 #include <QFileDialog>
@@ -109,6 +118,15 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
     after.transform = Mat4::translate(right * static_cast<float>(d.x() * k) - up * static_cast<float>(d.y() * k)) * o->transform;
     edit(SetObject{*o}, SetObject{after}, tr("Move %1").arg(QString::fromStdString(o->name)), dragCounter_ + 1);
   });
+  setAcceptDrops(true);
+  // Autosave every 5 minutes ($RETILE_AUTOSAVE_SECONDS overrides) to rotating recovery files.
+  auto* autosaveTimer = new QTimer(this);
+  int every = qEnvironmentVariableIsSet("RETILE_AUTOSAVE_SECONDS") ? qEnvironmentVariableIntValue("RETILE_AUTOSAVE_SECONDS") : 300;
+  connect(autosaveTimer, &QTimer::timeout, this, [this] { autosave(); });
+  autosaveTimer->start(std::max(1, every) * 1000);
+  QDir().mkpath(recoveryDirectory());
+  QFile lock(recoveryDirectory() + "/session.lock");
+  if (lock.open(QIODevice::WriteOnly)) lock.write(QByteArray::number(QCoreApplication::applicationPid()));
   resize(1280, 800);
   startEngine(doc_.scene());
   rebuildOutliner();
@@ -126,6 +144,8 @@ void MainWindow::buildMenus() {
                                              tr("Scenes (*.json *.retile *.gltf *.glb *.obj *.fbx *.ply *.dae);;All files (*)"));
     if (!f.isEmpty()) openFile(f.toStdString());
   });
+  recentMenu_ = file->addMenu(tr("Open &Recent"));
+  connect(recentMenu_, &QMenu::aboutToShow, this, [this] { rebuildRecentMenu(); });
   file->addAction(tr("&Save"), QKeySequence::Save, this, [this] {
     if (file_.empty() || file_.extension() != ".retile") {
       QString f = QFileDialog::getSaveFileName(this, tr("Save scene"), QString(), tr("Retile scenes (*.retile)"));
@@ -523,6 +543,66 @@ void MainWindow::rebuildProperties() {
   propertiesForm_->addRow(tr("Emission"), emission);
 }
 
+QString MainWindow::recoveryDirectory() {
+  QString base = qEnvironmentVariable("RETILE_RECOVERY_DIR");
+  if (base.isEmpty()) base = QStandardPaths::writableLocation(QStandardPaths::AppDataLocation) + "/recovery";
+  return base;
+}
+
+QStringList MainWindow::recoveryCandidates() {
+  QDir dir(recoveryDirectory());
+  if (!dir.exists("session.lock")) return {};  // the last session closed cleanly
+  QStringList out;
+  for (const QFileInfo& f : dir.entryInfoList({"autosave-*.retile"}, QDir::Files, QDir::Time)) out << f.absoluteFilePath();
+  return out;
+}
+
+bool MainWindow::autosave() {
+  if (undo_.index() == autosavedIndex_ || undo_.isClean()) return false;
+  QString file = recoveryDirectory() + QString("/autosave-%1.retile").arg(autosaveSlot_);
+  auto r = saveNativeScene(doc_.scene(), file.toStdString());
+  if (!r) {
+    log(tr("autosave failed: %1").arg(QString::fromStdString(r.error())));
+    return false;
+  }
+  autosaveSlot_ = (autosaveSlot_ + 1) % 3;
+  autosavedIndex_ = undo_.index();
+  log(tr("autosaved to %1").arg(file));
+  return true;
+}
+
+void MainWindow::rememberRecent(const std::filesystem::path& file) {
+  QSettings settings;
+  QStringList recent = settings.value("recentFiles").toStringList();
+  QString f = QString::fromStdString(std::filesystem::absolute(file).string());
+  recent.removeAll(f);
+  recent.prepend(f);
+  while (recent.size() > 10) recent.removeLast();
+  settings.setValue("recentFiles", recent);
+}
+
+void MainWindow::rebuildRecentMenu() {
+  recentMenu_->clear();
+  QSettings settings;
+  for (const QString& f : settings.value("recentFiles").toStringList()) {
+    QAction* a = recentMenu_->addAction(f, this, [this, f] { openFile(f.toStdString()); });
+    a->setEnabled(QFileInfo::exists(f));  // greyed when the file has gone
+  }
+  if (recentMenu_->isEmpty()) recentMenu_->addAction(tr("(none yet)"))->setEnabled(false);
+}
+
+void MainWindow::dragEnterEvent(QDragEnterEvent* e) {
+  if (e->mimeData()->hasUrls()) e->acceptProposedAction();
+}
+
+void MainWindow::dropEvent(QDropEvent* e) {
+  for (const QUrl& url : e->mimeData()->urls())
+    if (url.isLocalFile()) {
+      openFile(url.toLocalFile().toStdString());
+      return;
+    }
+}
+
 bool MainWindow::openFile(const std::filesystem::path& file) {
   auto r = importScene(file);
   if (!r) {
@@ -539,6 +619,7 @@ bool MainWindow::openFile(const std::filesystem::path& file) {
   rebuildOutliner();
   rebuildProperties();
   log(tr("opened %1").arg(QString::fromStdString(file.string())));
+  rememberRecent(file);
   return true;
 }
 
@@ -550,6 +631,7 @@ bool MainWindow::saveTo(const std::filesystem::path& file) {
   }
   file_ = file;
   undo_.setClean();
+  rememberRecent(file);
   log(tr("saved %1").arg(QString::fromStdString(file.string())));
   return true;
 }
@@ -571,6 +653,9 @@ void MainWindow::closeEvent(QCloseEvent* e) {
     }
   }
   if (engine_) engine_->stop();
+  // A clean close: no recovery is offered next time.
+  QDir dir(recoveryDirectory());
+  for (const QString& f : dir.entryList({"autosave-*.retile", "session.lock"}, QDir::Files)) dir.remove(f);
   e->accept();
 }
 

@@ -23,6 +23,7 @@ class QComboBox;
 class QSpinBox;
 class QCheckBox;
 class QWidget;
+class QMenu;
 
 namespace retile::ui {
 
@@ -52,9 +53,16 @@ class MainWindow : public QMainWindow {
   // Applies an edit through the undo stack (dragId > 0 merges a drag into one step).
   void edit(const Edit& before, const Edit& after, const QString& text, int dragId = 0);
   QString lastError() const { return lastError_; }
+  // Autosave: writes the document to the newest of three rotating recovery files when it changed.
+  bool autosave();
+  // Recovery files left by a session that did not close cleanly (newest first).
+  static QStringList recoveryCandidates();
+  static QString recoveryDirectory();
 
  protected:
   void closeEvent(QCloseEvent* e) override;
+  void dragEnterEvent(QDragEnterEvent* e) override;
+  void dropEvent(QDropEvent* e) override;
   void keyPressEvent(QKeyEvent* e) override;
   void resizeEvent(QResizeEvent* e) override;
 
@@ -70,6 +78,8 @@ class MainWindow : public QMainWindow {
   void showError(const QString& title, const QString& message);
   bool applyToDocument(const Edit& e);
   void updateRenderSize();
+  void rememberRecent(const std::filesystem::path& file);
+  void rebuildRecentMenu();
   void editCamera(const std::function<void(Camera&)>& change, const QString& what);
   void frameSelected();
 
@@ -95,6 +105,9 @@ class MainWindow : public QMainWindow {
   QSpinBox* qualityBox_ = nullptr;
   QCheckBox* smoothBox_ = nullptr;
   QLabel* status_ = nullptr;
+  QMenu* recentMenu_ = nullptr;
+  int autosaveSlot_ = 0;
+  int autosavedIndex_ = -1;  // undo index at the last autosave
   std::uint64_t framesSeen_ = 0;
   qint64 fpsStart_ = 0;
   double fps_ = 0;

@@ -2,6 +2,7 @@
 // edit from the properties reaches the render thread and re-renders around the object, undo
 // restores, save and open round-trip, overlays draw, a broken file leaves the scene alone.
 #include <QApplication>
+#include <QStandardPaths>
 #include <QDoubleSpinBox>
 #include <QTemporaryDir>
 #include <QTest>
@@ -10,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "main_window.h"
+#include "retile/io.h"
 
 namespace retile::ui {
 namespace {
@@ -172,12 +174,36 @@ TEST(Editor, SaveOpenRoundTripAndABrokenFileKeepsTheScene) {
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 1; })) << "and keeps rendering";
 }
 
+TEST(Editor, AutosaveRotatesAndACleanCloseLeavesNothingToRecover) {
+  auto w = makeWindow();
+  EXPECT_FALSE(w->autosave()) << "nothing changed yet";
+  NodeId cup = objectNamed(w->scene(), "Cup");
+  for (int i = 0; i < 4; ++i) {
+    Object o = *w->scene().object(cup);
+    Object renamed = o;
+    renamed.name = "Cup " + std::to_string(i);
+    w->edit(SetObject{o}, SetObject{renamed}, "rename");
+    EXPECT_TRUE(w->autosave());
+  }
+  QStringList files = MainWindow::recoveryCandidates();
+  EXPECT_EQ(files.size(), 3) << "three rotating files while the session is open";
+  auto recovered = importScene(files.front().toStdString());
+  ASSERT_TRUE(recovered.ok()) << recovered.error();
+  EXPECT_NE(objectNamed(recovered->scene, "Cup 3"), kNoNode) << "the newest holds the last edit";
+  w->undoStack()->setClean();
+  w->close();
+  EXPECT_TRUE(MainWindow::recoveryCandidates().isEmpty());
+}
+
 }  // namespace
 }  // namespace retile::ui
 
 int main(int argc, char** argv) {
   qputenv("QT_QPA_PLATFORM", "offscreen");
   qputenv("RETILE_NO_PROMPTS", "1");
+  QTemporaryDir recovery;
+  qputenv("RETILE_RECOVERY_DIR", recovery.path().toUtf8());
+  QStandardPaths::setTestModeEnabled(true);  // recent files go to a test location
   QApplication app(argc, argv);
   testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();
