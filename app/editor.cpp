@@ -2,6 +2,8 @@
 #include <QApplication>
 #include <QFileInfo>
 #include <QMessageBox>
+#include <QPixmap>
+#include <QScreen>
 #include <QTimer>
 
 #include "cli.h"
@@ -58,7 +60,8 @@ int runEditor(int argc, char** argv, const std::string& file) {
           }
         stage = 1;
       } else if (stage >= 1 && ++stage > 6) {
-        window.grab().save(qEnvironmentVariable("RETILE_SCREENSHOT"));
+        // From the X server: QWidget::grab cannot see the Vulkan window's swapchain.
+        window.screen()->grabWindow(window.winId()).save(qEnvironmentVariable("RETILE_SCREENSHOT"));
         QApplication::quit();
       }
     });

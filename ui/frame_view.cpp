@@ -2,11 +2,13 @@
 
 #include <QMouseEvent>
 #include <QPainter>
+#include <QWindow>
 
 #include <algorithm>
 #include <cmath>
 
 #include "retile/color.h"
+#include "vulkan_viewport.h"
 
 namespace retile::ui {
 
@@ -20,30 +22,71 @@ QColor priorityColor(float priority) {
 FrameView::FrameView(QWidget* parent) : QWidget(parent) {
   setMinimumSize(160, 90);
   setAttribute(Qt::WA_OpaquePaintEvent);
-  setMouseTracking(false);
+  setMouseTracking(true);  // the pixel inspector follows the cursor
+  setFocusPolicy(Qt::StrongFocus);
+  QString why;
+  if (qEnvironmentVariable("RETILE_VIEWPORT") == "widget") {
+    presentation_ = tr("widget (RETILE_VIEWPORT=widget)");
+  } else if (VulkanViewport::sharedInstance(&why)) {
+    vulkan_ = new VulkanViewport(this);
+    container_ = QWidget::createWindowContainer(vulkan_, this);
+    container_->setGeometry(rect());
+    container_->setFocusPolicy(Qt::NoFocus);
+    presentation_ = tr("Vulkan window");
+  } else {
+    presentation_ = tr("widget (%1)").arg(why);
+  }
 }
 
 void FrameView::setOverlays(const OverlaySettings& o) {
   overlays_ = o;
-  update();
+  refresh();
 }
 
 void FrameView::setPaused(bool paused) {
   paused_ = paused;
-  update();
+  refresh();
+}
+
+void FrameView::setDisplay(const DisplaySettings& d) {
+  display_ = d;
+  if (frame_ && frame_->image) image_ = toDisplay(*frame_->image);
+  if (snapshotLinear_) snapshot_ = toDisplay(*snapshotLinear_);
+  refresh();
+}
+
+QImage FrameView::toDisplay(const RenderImage& img) const {
+  QImage q(img.width, img.height, QImage::Format_RGBA8888);
+  auto config = ColorConfig::get();
+  for (int y = 0; y < img.height; ++y)
+    config->toDisplay8(img.color.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) * 3,
+                       static_cast<std::size_t>(img.width), display_, q.scanLine(y));
+  return q;
 }
 
 void FrameView::showFrame(std::shared_ptr<const FrameRecord> frame) {
   if (!frame || !frame->image) return;
   frame_ = std::move(frame);
-  const RenderImage& img = *frame_->image;
-  QImage q(img.width, img.height, QImage::Format_RGBA8888);
-  auto config = ColorConfig::get();
-  for (int y = 0; y < img.height; ++y)
-    config->toDisplay8(img.color.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) * 3,
-                       static_cast<std::size_t>(img.width), DisplaySettings{}, q.scanLine(y));
-  image_ = std::move(q);
-  update();
+  image_ = toDisplay(*frame_->image);
+  if (!region_.isEmpty()) inspectRegion();
+  refresh();
+}
+
+void FrameView::takeSnapshot() {
+  if (!frame_ || !frame_->image) return;
+  snapshotLinear_ = frame_->image;  // frames are immutable once published: sharing is enough
+  snapshot_ = image_;
+  refresh();
+}
+
+void FrameView::setCompare(Compare c) {
+  compare_ = hasSnapshot() ? c : Compare::Off;
+  refresh();
+}
+
+void FrameView::setWipe(double x) {
+  wipe_ = std::clamp(x, 0.0, 1.0);
+  refresh();
 }
 
 QRectF FrameView::imageRect() const {
@@ -53,18 +96,73 @@ QRectF FrameView::imageRect() const {
   return {(width() - w) / 2, (height() - h) / 2, w, h};
 }
 
+QImage FrameView::composed() const {
+  const qreal dpr = devicePixelRatioF();
+  QImage pic(size() * dpr, QImage::Format_RGB32);
+  pic.setDevicePixelRatio(dpr);
+  QPainter p(&pic);
+  compose(p, rect());
+  return pic;
+}
+
+void FrameView::refresh() {
+  if (vulkan_) vulkan_->setPicture(composed());
+  else update();
+}
+
+void FrameView::resizeEvent(QResizeEvent*) {
+  if (container_) container_->setGeometry(rect());
+  refresh();
+}
+
 void FrameView::paintEvent(QPaintEvent*) {
+  if (vulkan_) return;  // the Vulkan window covers the widget
   QPainter p(this);
-  p.fillRect(rect(), QColor(32, 32, 36));
+  compose(p, rect());
+}
+
+void FrameView::compose(QPainter& p, const QRect& area) const {
+  p.fillRect(area, QColor(32, 32, 36));
   if (image_.isNull()) {
     p.setPen(Qt::lightGray);
-    p.drawText(rect(), Qt::AlignCenter, tr("Starting the renderer..."));
+    p.drawText(area, Qt::AlignCenter, tr("Starting the renderer..."));
     return;
   }
   QRectF r = imageRect();
   p.setRenderHint(QPainter::SmoothPixmapTransform, true);
-  p.drawImage(r, image_);
+  const bool snapshotUsable = !snapshot_.isNull() && snapshot_.size() == image_.size();
+  if (compare_ == Compare::Toggle && snapshotUsable) {
+    p.drawImage(r, snapshot_);
+  } else if (compare_ == Compare::Wipe && snapshotUsable) {
+    // Left of the line: the snapshot (B); right: the live render (A).
+    const double split = std::round(wipe_ * image_.width());
+    const double sx = r.width() / image_.width();
+    p.drawImage(QRectF(r.x(), r.y(), split * sx, r.height()), snapshot_, QRectF(0, 0, split, image_.height()));
+    p.drawImage(QRectF(r.x() + split * sx, r.y(), r.width() - split * sx, r.height()), image_,
+                QRectF(split, 0, image_.width() - split, image_.height()));
+  } else {
+    p.drawImage(r, image_);
+  }
   drawOverlays(p, r);
+  if (compare_ != Compare::Off && snapshotUsable) {
+    p.setFont(QFont(font().family(), 11, QFont::Bold));
+    p.setPen(QColor(255, 255, 255));
+    if (compare_ == Compare::Wipe) {
+      const double x = r.x() + wipe_ * r.width();
+      p.setPen(QPen(QColor(255, 255, 255), 2));
+      p.drawLine(QPointF(x, r.top()), QPointF(x, r.bottom()));
+      p.drawText(QRectF(x - 60, r.y() + 6, 52, 18), Qt::AlignRight, tr("B"));
+      p.drawText(QRectF(x + 8, r.y() + 6, 52, 18), Qt::AlignLeft, tr("A"));
+    } else {
+      p.drawText(r.adjusted(10, 8, -10, -8), Qt::AlignTop | Qt::AlignLeft, tr("B: snapshot"));
+    }
+  }
+  if (!region_.isEmpty() && frame_) {
+    const double sx = r.width() / frame_->width, sy = r.height() / frame_->height;
+    p.setPen(QPen(QColor(255, 255, 255), 1, Qt::DashLine));
+    p.setBrush(Qt::NoBrush);
+    p.drawRect(QRectF(r.x() + region_.x() * sx, r.y() + region_.y() * sy, region_.width() * sx, region_.height() * sy));
+  }
   if (paused_) {
     p.setPen(QPen(QColor(255, 190, 40), 4));
     p.drawRect(r.adjusted(2, 2, -2, -2));
@@ -148,8 +246,53 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
   }
 }
 
+QPoint FrameView::imagePixel(QPointF pos) const {
+  QRectF r = imageRect();
+  if (!frame_ || r.width() <= 0) return {-1, -1};
+  double u = (pos.x() - r.x()) / r.width(), v = (pos.y() - r.y()) / r.height();
+  if (u < 0 || v < 0 || u >= 1 || v >= 1) return {-1, -1};
+  return {std::clamp(static_cast<int>(u * frame_->width), 0, frame_->width - 1),
+          std::clamp(static_cast<int>(v * frame_->height), 0, frame_->height - 1)};
+}
+
+void FrameView::inspectRegion() {
+  if (!frame_ || !frame_->image || region_.isEmpty()) return;
+  const RenderImage& img = *frame_->image;
+  QRect rr = region_.intersected(QRect(0, 0, img.width, img.height));
+  if (rr.isEmpty()) return;
+  double sum[3] = {0, 0, 0};
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int y = rr.top(); y <= rr.bottom(); ++y)
+    for (int x = rr.left(); x <= rr.right(); ++x) {
+      const float* c = img.color.data() + (static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x)) * 3;
+      for (int k = 0; k < 3; ++k) {
+        sum[k] += c[k];
+        lo[k] = std::min(lo[k], c[k]);
+        hi[k] = std::max(hi[k], c[k]);
+      }
+    }
+  const double n = static_cast<double>(rr.width()) * rr.height();
+  emit regionInspected(rr, QVector3D(static_cast<float>(sum[0] / n), static_cast<float>(sum[1] / n), static_cast<float>(sum[2] / n)),
+                       QVector3D(lo[0], lo[1], lo[2]), QVector3D(hi[0], hi[1], hi[2]));
+}
+
 void FrameView::mousePressEvent(QMouseEvent* e) {
   last_ = e->position();
+  setFocus();
+  if (compare_ == Compare::Wipe && e->button() == Qt::LeftButton && !(e->modifiers() & Qt::AltModifier)) {
+    QRectF r = imageRect();
+    if (std::abs(e->position().x() - (r.x() + wipe_ * r.width())) < 8) {
+      drag_ = Drag::Wipe;
+      return;
+    }
+  }
+  if ((e->modifiers() & Qt::ControlModifier) && e->button() == Qt::LeftButton) {
+    drag_ = Drag::Region;
+    regionStart_ = e->position();
+    region_ = QRect();  // a Ctrl+click without a drag clears the region
+    refresh();
+    return;
+  }
   if (e->modifiers() & Qt::AltModifier) {
     drag_ = e->button() == Qt::LeftButton ? Drag::Orbit : e->button() == Qt::MiddleButton ? Drag::Pan : Drag::Dolly;
     return;
@@ -178,7 +321,27 @@ void FrameView::mousePressEvent(QMouseEvent* e) {
 void FrameView::mouseMoveEvent(QMouseEvent* e) {
   QPointF d = e->position() - last_;
   last_ = e->position();
+  QPoint px = imagePixel(e->position());
+  if (px.x() >= 0 && frame_ && frame_->image) {
+    const float* c = frame_->image->color.data() +
+                     (static_cast<std::size_t>(px.y()) * static_cast<std::size_t>(frame_->width) + static_cast<std::size_t>(px.x())) * 3;
+    emit pixelInspected(px, QVector3D(c[0], c[1], c[2]));
+  }
   switch (drag_) {
+    case Drag::Region: {
+      QPoint a = imagePixel(regionStart_), b = imagePixel(e->position());
+      if (a.x() >= 0 && b.x() >= 0) {
+        region_ = QRect(a, b).normalized();
+        inspectRegion();
+        refresh();
+      }
+      break;
+    }
+    case Drag::Wipe: {
+      QRectF r = imageRect();
+      if (r.width() > 0) setWipe((e->position().x() - r.x()) / r.width());
+      break;
+    }
     case Drag::Orbit: emit orbitDragged(d); break;
     case Drag::Pan: emit panDragged(d); break;
     case Drag::Dolly: emit dollyDragged(-d.y() / 200.0); break;
@@ -192,7 +355,7 @@ void FrameView::mouseMoveEvent(QMouseEvent* e) {
 }
 
 void FrameView::mouseReleaseEvent(QMouseEvent*) {
-  if (drag_ != Drag::None) emit dragFinished();
+  if (drag_ != Drag::None && drag_ != Drag::Region && drag_ != Drag::Wipe) emit dragFinished();
   drag_ = Drag::None;
 }
 

@@ -1,17 +1,22 @@
-// The viewport as a plain widget: paints the newest frame from the engine, scaled up to the
-// widget, with the teaching overlays drawn from the frame record. Works on every Qt platform
-// (offscreen included). GUI thread only; it never waits on rendering: newFrame() takes whatever
-// the mailbox holds.
+// The viewport: composes the newest frame from the engine (through the display transform),
+// scaled up to the widget, with the teaching overlays drawn from the frame record, and presents
+// it through a QVulkanWindow where the platform has Vulkan surfaces, or paints it itself where it
+// has not (Qt's offscreen platform). All viewport interaction lives here, whichever presents.
+// GUI thread only; it never waits on rendering: showFrame() takes whatever the mailbox held.
 #pragma once
 
 #include <QImage>
+#include <QVector3D>
 #include <QWidget>
 
 #include <memory>
 
+#include "retile/image.h"
 #include "retile/session.h"
 
 namespace retile::ui {
+
+class VulkanViewport;
 
 struct OverlaySettings {
   bool priority = true;   // per-tile priority as a heat map
@@ -32,8 +37,26 @@ class FrameView : public QWidget {
   OverlaySettings& overlays() { return overlays_; }
   void setOverlays(const OverlaySettings& o);
   void setPaused(bool paused);
+  // Display-only: exposure, gamma and OCIO view; the accumulated samples are untouched.
+  void setDisplay(const DisplaySettings& d);
+  const DisplaySettings& display() const { return display_; }
   // The image rectangle inside the widget (letterboxed to the frame's aspect).
   QRectF imageRect() const;
+
+  // Snapshots for A/B comparison: B is the snapshot, A the live render. Toggle shows B instead of
+  // A; wipe shows B left of a vertical line at `wipe` (0..1 of the image width), A right of it.
+  enum class Compare { Off, Toggle, Wipe };
+  void takeSnapshot();
+  bool hasSnapshot() const { return !snapshot_.isNull(); }
+  void setCompare(Compare c);
+  Compare compare() const { return compare_; }
+  void setWipe(double x);
+
+  // The presenting Vulkan window, or nullptr when this widget paints (and why, for the log).
+  VulkanViewport* vulkanWindow() const { return vulkan_; }
+  QString presentation() const { return presentation_; }
+  // The picture exactly as presented: image, overlays and banners at the widget's size.
+  QImage composed() const;
 
  signals:
   void objectPicked(quint64 object);  // 0: nothing under the cursor
@@ -45,6 +68,10 @@ class FrameView : public QWidget {
   void dollyDragged(double amount);       // Alt + right, or the wheel (positive: closer)
   void objectDragged(QPointF imageDelta);  // left drag starting on the selection: image pixels
   void dragFinished();
+  // Pixel inspector: linear values under the cursor, and the statistics of a Ctrl+drag region
+  // (image pixels, inclusive-exclusive).
+  void pixelInspected(QPoint pixel, QVector3D linear);
+  void regionInspected(QRect region, QVector3D mean, QVector3D min, QVector3D max);
 
  protected:
   void paintEvent(QPaintEvent*) override;
@@ -52,17 +79,32 @@ class FrameView : public QWidget {
   void mouseMoveEvent(QMouseEvent* e) override;
   void mouseReleaseEvent(QMouseEvent* e) override;
   void wheelEvent(QWheelEvent* e) override;
+  void resizeEvent(QResizeEvent* e) override;
 
  private:
+  void refresh();
+  void compose(QPainter& p, const QRect& area) const;
   void drawOverlays(QPainter& p, const QRectF& r) const;
+  QImage toDisplay(const RenderImage& img) const;
+  QPoint imagePixel(QPointF widgetPos) const;
+  void inspectRegion();
 
   std::shared_ptr<const FrameRecord> frame_;
   QImage image_;
   OverlaySettings overlays_;
+  DisplaySettings display_;
   bool paused_ = false;
-  enum class Drag { None, Orbit, Pan, Dolly, Object } drag_ = Drag::None;
-  QPointF last_;
+  enum class Drag { None, Orbit, Pan, Dolly, Object, Region, Wipe } drag_ = Drag::None;
+  QPointF last_, regionStart_;
+  QRect region_;  // the inspected region in image pixels
   quint64 selected_ = 0;
+  std::shared_ptr<const RenderImage> snapshotLinear_;
+  QImage snapshot_;
+  Compare compare_ = Compare::Off;
+  double wipe_ = 0.5;
+  VulkanViewport* vulkan_ = nullptr;
+  QWidget* container_ = nullptr;
+  QString presentation_;
 
  public:
   void setSelected(quint64 object) { selected_ = object; }

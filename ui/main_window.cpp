@@ -21,6 +21,8 @@
 #include <QDoubleSpinBox>
 #include <QFileDialog>
 #include <QFormLayout>
+#include <QGroupBox>
+#include <QVBoxLayout>
 #include <QHBoxLayout>
 #include <QHeaderView>
 #include <QKeyEvent>
@@ -38,6 +40,11 @@
 #include <numeric>
 
 #include "edit_command.h"
+#include "fields.h"
+#include "live_chart.h"
+#include "node_graph.h"
+#include "retile/color.h"
+#include "vulkan_viewport.h"
 #include "retile/io.h"
 #include "retile/log.h"
 
@@ -46,15 +53,7 @@ namespace retile::ui {
 namespace {
 
 constexpr int kIdRole = Qt::UserRole + 1;
-
-QColor toQColor(Vec3 c, float scale = 1.0f) {
-  auto ch = [&](float v) { return std::clamp(static_cast<int>(std::lround(v / scale * 255.0f)), 0, 255); };
-  return QColor(ch(c.x), ch(c.y), ch(c.z));
-}
-
-Vec3 fromQColor(const QColor& c, float scale = 1.0f) {
-  return Vec3{static_cast<float>(c.redF()), static_cast<float>(c.greenF()), static_cast<float>(c.blueF())} * scale;
-}
+constexpr int kKindRole = Qt::UserRole + 2;  // a PropertyTarget::Kind
 
 }  // namespace
 
@@ -69,10 +68,33 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
   statusBar()->addPermanentWidget(status_, 1);
   connect(view_, &FrameView::objectPicked, this, [this](quint64 id) { select(static_cast<NodeId>(id)); });
   connect(view_, &FrameView::focusPlaced, this, [this](QPointF p) {
-    method_.focus = {FocusPoint{Vec2{static_cast<float>(p.x()), static_cast<float>(p.y())}, false}};
+    if (focusModeBox_->currentIndex() == 2) return;  // the cursor places it
+    const bool follows = focusModeBox_->currentIndex() == 1;
+    // Up to three points: a fourth replaces the oldest.
+    if (method_.focus.size() >= 3) method_.focus.erase(method_.focus.begin());
+    method_.focus.push_back(FocusPoint{Vec2{static_cast<float>(p.x()), static_cast<float>(p.y())}, follows});
     engine_->submit(FocusCommand{method_.focus});
-    log(tr("focus point at %1, %2").arg(p.x(), 0, 'f', 0).arg(p.y(), 0, 'f', 0));
+    log(tr("focus point %1 at %2, %3%4").arg(method_.focus.size()).arg(p.x(), 0, 'f', 0).arg(p.y(), 0, 'f', 0)
+            .arg(follows ? tr(", following the object") : QString()));
   });
+  connect(view_, &FrameView::pixelInspected, this, [this](QPoint px, QVector3D c) {
+    pixelText_ = tr("pixel %1, %2: R %3  G %4  B %5 (linear)").arg(px.x()).arg(px.y())
+                     .arg(c.x(), 0, 'f', 4).arg(c.y(), 0, 'f', 4).arg(c.z(), 0, 'f', 4);
+    inspector_->setText(pixelText_ + (regionText_.isEmpty() ? QString() : "\n\n" + regionText_));
+    // An eye-tracker stand-in: the focus point follows the cursor, at most ten times a second.
+    if (focusModeBox_->currentIndex() == 2 && focusTimer_.elapsed() > 100) {
+      focusTimer_.restart();
+      method_.focus = {FocusPoint{Vec2{px.x() + 0.5f, px.y() + 0.5f}, false}};
+      engine_->submit(FocusCommand{method_.focus});
+    }
+  });
+  connect(view_, &FrameView::regionInspected, this, [this](QRect r, QVector3D mean, QVector3D lo, QVector3D hi) {
+    auto v = [](QVector3D c) { return QString("%1  %2  %3").arg(c.x(), 0, 'f', 4).arg(c.y(), 0, 'f', 4).arg(c.z(), 0, 'f', 4); };
+    regionText_ = tr("region %1x%2 at %3, %4\nmean %5\nmin  %6\nmax  %7")
+                      .arg(r.width()).arg(r.height()).arg(r.x()).arg(r.y()).arg(v(mean), v(lo), v(hi));
+    inspector_->setText((pixelText_.isEmpty() ? QString() : pixelText_ + "\n\n") + regionText_);
+  });
+  focusTimer_.start();
   // Camera navigation (Alt + left/middle/right, wheel) and moving the selection in the screen
   // plane; each whole drag is one undo step.
   connect(view_, &FrameView::dragFinished, this, [this] { ++dragCounter_; });
@@ -131,6 +153,7 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
   startEngine(doc_.scene());
   rebuildOutliner();
   rebuildProperties();
+  log(tr("viewport: %1").arg(view_->presentation()));
 }
 
 MainWindow::~MainWindow() {
@@ -139,7 +162,13 @@ MainWindow::~MainWindow() {
 
 void MainWindow::buildMenus() {
   QMenu* file = menuBar()->addMenu(tr("&File"));
+  file->addAction(tr("&New (built-in scene)"), QKeySequence::New, this, [this] {
+    if (!maybeSave()) return;
+    replaceDocument(makeDefaultScene(), {});
+    log(tr("new document from the built-in scene"));
+  });
   file->addAction(tr("&Open..."), QKeySequence::Open, this, [this] {
+    if (!maybeSave()) return;
     QString f = QFileDialog::getOpenFileName(this, tr("Open scene"), QString(),
                                              tr("Scenes (*.json *.retile *.gltf *.glb *.obj *.fbx *.ply *.dae);;All files (*)"));
     if (!f.isEmpty()) openFile(f.toStdString());
@@ -190,6 +219,25 @@ void MainWindow::buildMenus() {
   toggle(tr("Point of change and &focus points"), &OverlaySettings::markers);
   toggle(tr("&Legend"), &OverlaySettings::legend);
 
+  QMenu* compare = menuBar()->addMenu(tr("&Compare"));
+  compare->addAction(tr("Take &snapshot (B)"), QKeySequence(Qt::CTRL | Qt::Key_B), this, [this] {
+    view_->takeSnapshot();
+    log(tr("snapshot taken: B in the A/B compare"));
+  });
+  auto* modes = new QActionGroup(this);
+  auto mode = [&](const QString& name, FrameView::Compare c, const QKeySequence& key) {
+    QAction* a = compare->addAction(name, key, this, [this, c] {
+      if (!view_->hasSnapshot()) log(tr("compare: take a snapshot first (Ctrl+B)"));
+      view_->setCompare(c);
+    });
+    a->setCheckable(true);
+    a->setChecked(c == FrameView::Compare::Off);
+    modes->addAction(a);
+  };
+  mode(tr("&Live render (A)"), FrameView::Compare::Off, QKeySequence(Qt::Key_A));
+  mode(tr("S&napshot (B)"), FrameView::Compare::Toggle, QKeySequence(Qt::Key_B));
+  mode(tr("&Wipe A/B (drag the line)"), FrameView::Compare::Wipe, QKeySequence(Qt::SHIFT | Qt::Key_B));
+
   QMenu* render = menuBar()->addMenu(tr("&Render"));
   QMenu* scale = render->addMenu(tr("Render &resolution"));
   auto* scales = new QActionGroup(this);
@@ -223,7 +271,12 @@ void MainWindow::buildDocks() {
     if (items.isEmpty()) return;
     bool ok = false;
     qulonglong id = items[0]->data(0, kIdRole).toULongLong(&ok);
-    if (ok && id && doc_.scene().object(static_cast<NodeId>(id)) && id != selection_) select(static_cast<NodeId>(id));
+    auto kind = static_cast<PropertyTarget::Kind>(items[0]->data(0, kKindRole).toInt());
+    if (kind == PropertyTarget::Kind::Object) {
+      if (ok && id && doc_.scene().object(static_cast<NodeId>(id)) && id != selection_) select(static_cast<NodeId>(id));
+    } else if (kind != PropertyTarget::Kind::None) {
+      panel_->setTarget({kind, static_cast<NodeId>(id)});
+    }
   });
   connect(outliner_, &QTreeWidget::itemChanged, this, [this](QTreeWidgetItem* item, int column) {
     NodeId id = static_cast<NodeId>(item->data(0, kIdRole).toULongLong());
@@ -240,38 +293,112 @@ void MainWindow::buildDocks() {
   outlinerDock->setWidget(outliner_);
   addDockWidget(Qt::LeftDockWidgetArea, outlinerDock);
 
-  properties_ = new QWidget(this);
-  propertiesForm_ = new QFormLayout(properties_);
+  auto push = [this](const Edit& before, const Edit& after, const QString& text, int dragId) { edit(before, after, text, dragId); };
+  auto sceneRef = [this]() -> const Scene& { return doc_.scene(); };
+  panel_ = new PropertyPanel(sceneRef, push, this);
+  panel_->setObjectName("propertyPanel");
   auto* propDock = new QDockWidget(tr("Properties"), this);
   propDock->setObjectName("properties");
-  propDock->setWidget(properties_);
+  propDock->setWidget(panel_);
   addDockWidget(Qt::RightDockWidgetArea, propDock);
 
-  auto* methodPanel = new QWidget(this);
-  auto* mf = new QFormLayout(methodPanel);
-  methodBox_ = new QComboBox(methodPanel);
+  // Render settings: the method and its parameters, the display transform (display only: no
+  // samples are lost), and the scene's render settings.
+  auto* settingsPanel = new QWidget(this);
+  auto* sl = new QVBoxLayout(settingsPanel);
+  auto* methodBox = new QGroupBox(tr("Method"), settingsPanel);
+  auto* mf = new QFormLayout(methodBox);
+  methodBox_ = new QComboBox(methodBox);
+  methodBox_->setObjectName("method");
   for (const auto& n : methodNames()) methodBox_->addItem(QString::fromStdString(n));
   methodBox_->setCurrentText(methodName(method_.kind));
-  tileBox_ = new QComboBox(methodPanel);
+  tileBox_ = new QComboBox(methodBox);
   for (int t : {8, 16, 32}) tileBox_->addItem(QString::number(t), t);
   tileBox_->setCurrentText(QString::number(method_.tileSize));
-  qualityBox_ = new QSpinBox(methodPanel);
+  qualityBox_ = new QSpinBox(methodBox);
   qualityBox_->setRange(0, 4096);
   qualityBox_->setSpecialValueText(tr("auto"));
   qualityBox_->setValue(method_.quality);
-  smoothBox_ = new QCheckBox(tr("smooth transition"), methodPanel);
-  mf->addRow(tr("Method"), methodBox_);
+  qualityBox_->setToolTip(tr("Samples per pixel of a served tile; auto (0) fits all high-priority tiles in one frame (indirection)"));
+  smoothBox_ = new QCheckBox(tr("smooth transition"), methodBox);
+  staleBox_ = new QSpinBox(methodBox);
+  staleBox_->setObjectName("staleCap");
+  staleBox_->setRange(1, 4096);
+  staleBox_->setValue(method_.staleCap);
+  staleBox_->setToolTip(tr("Stale samples kept per pixel by the smooth transition: the old image weighs C/(C+n) after n fresh samples"));
+  focusModeBox_ = new QComboBox(methodBox);
+  focusModeBox_->setObjectName("focusMode");
+  focusModeBox_->addItems({tr("Shift+click: static point"), tr("Shift+click: follows the object"), tr("follows the cursor")});
+  focusModeBox_->setToolTip(tr("Focus points (up to 3) for the focus methods. Shift+click adds one; 'follows the cursor' "
+                               "stands in for an eye tracker."));
+  auto* clearFocus = new QPushButton(tr("Clear focus points"), methodBox);
+  mf->addRow(tr("Policy"), methodBox_);
   mf->addRow(tr("Tile size T"), tileBox_);
   mf->addRow(tr("Quality Q"), qualityBox_);
   mf->addRow(QString(), smoothBox_);
+  mf->addRow(tr("Stale cap C"), staleBox_);
+  mf->addRow(tr("Focus"), focusModeBox_);
+  mf->addRow(QString(), clearFocus);
   connect(methodBox_, &QComboBox::currentTextChanged, this, [this] { sendMethod(); });
   connect(tileBox_, &QComboBox::currentIndexChanged, this, [this] { sendMethod(); });
   connect(qualityBox_, &QSpinBox::valueChanged, this, [this] { sendMethod(); });
   connect(smoothBox_, &QCheckBox::toggled, this, [this] { sendMethod(); });
-  auto* methodDock = new QDockWidget(tr("Method"), this);
-  methodDock->setObjectName("method");
-  methodDock->setWidget(methodPanel);
+  connect(staleBox_, &QSpinBox::valueChanged, this, [this] { sendMethod(); });
+  connect(clearFocus, &QPushButton::clicked, this, [this] {
+    method_.focus.clear();
+    engine_->submit(FocusCommand{method_.focus});
+    log(tr("focus points cleared"));
+  });
+  sl->addWidget(methodBox);
+
+  auto* displayBox = new QGroupBox(tr("Display (viewport only)"), settingsPanel);
+  auto* df = new QFormLayout(displayBox);
+  auto* viewBox = new QComboBox(displayBox);
+  viewBox->setObjectName("displayView");
+  try {
+    for (const auto& v : ColorConfig::get()->views()) viewBox->addItem(QString::fromStdString(v));
+  } catch (const std::exception& e) {
+    log(tr("colour config: %1").arg(e.what()));
+  }
+  viewBox->setCurrentText(QString::fromStdString(view_->display().view));
+  auto* exposure = new ScrubField(0.0, -16.0, 16.0, 0.0, 2, displayBox);
+  exposure->setObjectName("exposure");
+  exposure->setSuffix(tr(" stops"));
+  auto* gamma = new ScrubField(1.0, 0.1, 5.0, 1.0, 2, displayBox);
+  gamma->setObjectName("gamma");
+  df->addRow(tr("View"), viewBox);
+  df->addRow(tr("Exposure"), exposure);
+  df->addRow(tr("Gamma"), gamma);
+  auto applyDisplay = [this, viewBox, exposure, gamma] {
+    DisplaySettings d;
+    d.view = viewBox->currentText().toStdString();
+    d.exposure = static_cast<float>(exposure->value());
+    d.gamma = static_cast<float>(gamma->value());
+    view_->setDisplay(d);
+  };
+  connect(viewBox, &QComboBox::currentTextChanged, this, applyDisplay);
+  connect(exposure, &ScrubField::edited, this, applyDisplay);
+  connect(gamma, &ScrubField::edited, this, applyDisplay);
+  sl->addWidget(displayBox);
+
+  renderPanel_ = new PropertyPanel([this]() -> const Scene& { return doc_.scene(); }, push, settingsPanel);
+  renderPanel_->setTarget({PropertyTarget::Kind::Render, kNoNode});
+  sl->addWidget(renderPanel_, 1);
+  auto* methodDock = new QDockWidget(tr("Render settings"), this);
+  methodDock->setObjectName("renderSettings");
+  methodDock->setWidget(settingsPanel);
   addDockWidget(Qt::RightDockWidgetArea, methodDock);
+
+  // The pixel inspector: linear values under the cursor; Ctrl+drag a region for its statistics.
+  inspector_ = new QLabel(tr("Hover the image for linear values; Ctrl+drag a region for its mean, min and max."), this);
+  inspector_->setObjectName("inspector");
+  inspector_->setWordWrap(true);
+  inspector_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  inspector_->setAlignment(Qt::AlignTop | Qt::AlignLeft);
+  auto* inspectorDock = new QDockWidget(tr("Pixel inspector"), this);
+  inspectorDock->setObjectName("inspectorDock");
+  inspectorDock->setWidget(inspector_);
+  addDockWidget(Qt::LeftDockWidgetArea, inspectorDock);
 
   log_ = new QPlainTextEdit(this);
   log_->setReadOnly(true);
@@ -280,6 +407,41 @@ void MainWindow::buildDocks() {
   logDock->setObjectName("log");
   logDock->setWidget(log_);
   addDockWidget(Qt::BottomDockWidgetArea, logDock);
+
+  graph_ = new NodeGraphView(this);
+  graph_->setObjectName("nodeGraph");
+  graph_->setDocument(doc_.scene());
+  connect(graph_, &NodeGraphView::editRequested, this, [this](const GraphEdit& g) {
+    // One undo step for the whole gesture (a delete clears references before removing).
+    undo_.beginMacro(g.text);
+    for (const auto& [before, after] : g.steps)
+      undo_.push(new EditCommand(before, after, g.text, [this](const Edit& e) { return applyToDocument(e); }));
+    undo_.endMacro();
+    refreshGraph();
+    panel_->rebuild();
+  });
+  connect(graph_, &NodeGraphView::objectSelected, this, [this](quint64 id) { select(static_cast<NodeId>(id)); });
+  auto* graphDock = new QDockWidget(tr("Node graph"), this);
+  graphDock->setObjectName("nodeGraphDock");
+  graphDock->setWidget(graph_);
+  addDockWidget(Qt::BottomDockWidgetArea, graphDock);
+
+  chart_ = new LiveChart(this);
+  chart_->setObjectName("liveChart");
+  connect(chart_, &LiveChart::referenceRequested, this, [this] {
+    Scene s = doc_.scene();
+    s.settings.width = renderSize_.width();
+    s.settings.height = renderSize_.height();
+    chart_->renderReference(s, doc_.version(), 256);
+    log(tr("rendering a 256 spp reference of the current state in the background"));
+  });
+  auto* chartDock = new QDockWidget(tr("Live chart"), this);
+  chartDock->setObjectName("chartDock");
+  chartDock->setWidget(chart_);
+  addDockWidget(Qt::BottomDockWidgetArea, chartDock);
+  tabifyDockWidget(graphDock, chartDock);
+  tabifyDockWidget(graphDock, logDock);
+  graphDock->raise();
 }
 
 void MainWindow::sendMethod() {
@@ -288,6 +450,8 @@ void MainWindow::sendMethod() {
   m.tileSize = tileBox_->currentData().toInt();
   m.quality = qualityBox_->value();
   m.smooth = smoothBox_->isChecked();
+  m.staleCap = staleBox_->value();
+  staleBox_->setEnabled(m.smooth);
   if (m.quality == 0 && m.kind != MethodKind::Indirection && m.kind != MethodKind::IndirectionFocus) m.quality = 64;
   if (std::string bad = validateMethodSettings(m); !bad.empty()) {
     log(tr("method: %1").arg(QString::fromStdString(bad)));
@@ -317,7 +481,9 @@ void MainWindow::startEngine(Scene scene) {
   renderSize_ = size;
   scene.settings.width = size.width();
   scene.settings.height = size.height();
-  engine_ = std::make_unique<Engine>(std::move(scene), method_);
+  EngineOptions engineOptions;
+  engineOptions.documentVersion = doc_.version();
+  engine_ = std::make_unique<Engine>(std::move(scene), method_, engineOptions);
   engine_->setFrameCallback([this] { QMetaObject::invokeMethod(this, [this] { onFrame(); }, Qt::QueuedConnection); });
   engine_->start();
   fpsStart_ = QDateTime::currentMSecsSinceEpoch();
@@ -330,6 +496,7 @@ void MainWindow::onFrame() {
   for (const auto& e : engine_->takeErrors()) log(QString::fromStdString(e));
   if (!frame) return;
   view_->showFrame(frame);
+  chart_->addFrame(*frame);
   ++framesSeen_;
   qint64 now = QDateTime::currentMSecsSinceEpoch();
   if (now - fpsStart_ > 1000) {
@@ -372,7 +539,18 @@ bool MainWindow::applyToDocument(const Edit& e) {
   }
   engine_->submit(e, doc_.version());
   if (!std::holds_alternative<SetMaterial>(e)) rebuildOutliner();  // names, visibility, membership
+  refreshGraph();
   return true;
+}
+
+void MainWindow::refreshGraph() {
+  // Coalesced: a drag applies an edit per mouse move, the graph needs only the last state.
+  if (graphRefreshQueued_ || !graph_) return;
+  graphRefreshQueued_ = true;
+  QMetaObject::invokeMethod(this, [this] {
+    graphRefreshQueued_ = false;
+    graph_->setDocument(doc_.scene());
+  }, Qt::QueuedConnection);
 }
 
 void MainWindow::edit(const Edit& before, const Edit& after, const QString& text, int dragId) {
@@ -384,13 +562,15 @@ void MainWindow::select(NodeId object) {
   selection_ = object;
   view_->setSelected(object);
   engine_->submit(SelectCommand{object});
+  if (graph_) graph_->setSelectedObject(object);
+  if (object != kNoNode) panel_->setTarget({PropertyTarget::Kind::Object, object});
+  else if (panel_->target().kind == PropertyTarget::Kind::Object) panel_->setTarget({});
   {
     QSignalBlocker block(outliner_);
     outliner_->clearSelection();
     for (QTreeWidgetItemIterator it(outliner_); *it; ++it)
       if ((*it)->data(0, kIdRole).toULongLong() == object && object != kNoNode) (*it)->setSelected(true);
   }
-  rebuildProperties();
 }
 
 void MainWindow::rebuildOutliner() {
@@ -407,6 +587,7 @@ void MainWindow::rebuildOutliner() {
   for (const Object& o : s.objects) {
     auto* it = new QTreeWidgetItem(objects, {QString::fromStdString(o.name), tr("object")});
     it->setData(0, kIdRole, static_cast<qulonglong>(o.id));
+    it->setData(0, kKindRole, static_cast<int>(PropertyTarget::Kind::Object));
     it->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsEditable | Qt::ItemIsUserCheckable);
     it->setCheckState(0, o.visible ? Qt::Checked : Qt::Unchecked);
     if (o.id == selection_) it->setSelected(true);
@@ -415,132 +596,29 @@ void MainWindow::rebuildOutliner() {
   for (const Material& m : s.materials) {
     auto* it = new QTreeWidgetItem(materials, {QString::fromStdString(m.name), materialTypeName(m.type)});
     it->setData(0, kIdRole, static_cast<qulonglong>(m.id));
+    it->setData(0, kKindRole, static_cast<int>(PropertyTarget::Kind::Material));
   }
   QTreeWidgetItem* lights = group(tr("Lights"));
   for (const Light& l : s.lights) {
     auto* it = new QTreeWidgetItem(lights, {QString::fromStdString(l.name), tr("light")});
     it->setData(0, kIdRole, static_cast<qulonglong>(l.id));
+    it->setData(0, kKindRole, static_cast<int>(PropertyTarget::Kind::Light));
   }
-  group(tr("Camera"));
+  QTreeWidgetItem* scene = group(tr("Scene"));
+  auto single = [&](const QString& name, PropertyTarget::Kind kind) {
+    auto* it = new QTreeWidgetItem(scene, {name, QString()});
+    it->setData(0, kKindRole, static_cast<int>(kind));
+  };
+  single(tr("Camera"), PropertyTarget::Kind::Camera);
+  single(tr("Environment"), PropertyTarget::Kind::Environment);
+  single(tr("Render settings"), PropertyTarget::Kind::Render);
 }
 
 void MainWindow::rebuildProperties() {
-  while (propertiesForm_->rowCount() > 0) propertiesForm_->removeRow(0);
-  const Scene& s = doc_.scene();
-  const Object* o = s.object(selection_);
-  if (!o) {
-    propertiesForm_->addRow(new QLabel(tr("Click an object in the viewport or the outliner."), properties_));
-    return;
-  }
-  propertiesForm_->addRow(tr("Object"), new QLabel(QString::fromStdString(o->name), properties_));
-  // Position: moves the object, keeping its rotation and scale.
-  Vec3 pos = o->transform.transformPoint(Vec3{0.0f});
-  auto* posRow = new QWidget(properties_);
-  auto* posLayout = new QHBoxLayout(posRow);
-  posLayout->setContentsMargins(0, 0, 0, 0);
-  for (int axis = 0; axis < 3; ++axis) {
-    auto* spin = new QDoubleSpinBox(posRow);
-    spin->setRange(-1e4, 1e4);
-    spin->setDecimals(3);
-    spin->setSingleStep(0.05);
-    spin->setValue(axis == 0 ? pos.x : axis == 1 ? pos.y : pos.z);
-    spin->setObjectName(QString("position%1").arg(axis));
-    posLayout->addWidget(spin);
-    connect(spin, &QDoubleSpinBox::valueChanged, this, [this, axis](double v) {
-      const Object* cur = doc_.scene().object(selection_);
-      if (!cur) return;
-      Vec3 p = cur->transform.transformPoint(Vec3{0.0f});
-      Vec3 d{0.0f};
-      (axis == 0 ? d.x : axis == 1 ? d.y : d.z) = static_cast<float>(v) - (axis == 0 ? p.x : axis == 1 ? p.y : p.z);
-      Object after = *cur;
-      after.transform = Mat4::translate(d) * cur->transform;
-      undo_.push(new EditCommand(SetObject{*cur}, SetObject{after}, tr("Move %1").arg(QString::fromStdString(cur->name)),
-                                 [this](const Edit& e) { return applyToDocument(e); }));
-    });
-  }
-  propertiesForm_->addRow(tr("Position"), posRow);
-
-  const Material* m = s.material(o->material);
-  if (!m) return;
-  propertiesForm_->addRow(tr("Material"), new QLabel(QString::fromStdString(m->name), properties_));
-  NodeId mid = m->id;
-  auto materialEdit = [this, mid](const std::function<void(Material&)>& change, const QString& what, int dragId) {
-    const Material* cur = doc_.scene().material(mid);
-    if (!cur) return;
-    Material after = *cur;
-    change(after);
-    undo_.push(new EditCommand(SetMaterial{*cur}, SetMaterial{after}, what, [this](const Edit& e) { return applyToDocument(e); }, dragId));
-  };
-  auto* type = new QComboBox(properties_);
-  for (int t = 0; t < kMaterialTypeCount; ++t) type->addItem(materialTypeName(static_cast<MaterialType>(t)));
-  type->setCurrentIndex(static_cast<int>(m->type));
-  connect(type, &QComboBox::currentIndexChanged, this, [materialEdit](int i) {
-    materialEdit([i](Material& x) { x.type = static_cast<MaterialType>(i); }, tr("Material type"), 0);
-  });
-  propertiesForm_->addRow(tr("Type"), type);
-
-  auto* albedo = new QPushButton(properties_);
-  albedo->setObjectName("albedo");
-  QColor ac = toQColor(m->albedo);
-  albedo->setStyleSheet(QString("background-color: %1").arg(ac.name()));
-  albedo->setText(ac.name());
-  connect(albedo, &QPushButton::clicked, this, [this, materialEdit, ac] {
-    QColor c = QColorDialog::getColor(ac, this, tr("Albedo"));
-    if (c.isValid()) materialEdit([c](Material& x) { x.albedo = fromQColor(c); }, tr("Albedo"), 0);
-  });
-  propertiesForm_->addRow(tr("Albedo"), albedo);
-
-  // Roughness: a slider whose whole drag is one undo step, and a box for typed values.
-  auto* roughRow = new QWidget(properties_);
-  auto* rl = new QHBoxLayout(roughRow);
-  rl->setContentsMargins(0, 0, 0, 0);
-  auto* slider = new QSlider(Qt::Horizontal, roughRow);
-  slider->setObjectName("roughnessSlider");
-  slider->setRange(0, 1000);
-  slider->setValue(static_cast<int>(std::lround(m->roughness * 1000)));
-  auto* box = new QDoubleSpinBox(roughRow);
-  box->setObjectName("roughness");
-  box->setRange(0.0, 1.0);
-  box->setDecimals(3);
-  box->setSingleStep(0.01);
-  box->setValue(m->roughness);
-  rl->addWidget(slider, 1);
-  rl->addWidget(box);
-  connect(slider, &QSlider::sliderPressed, this, [this] { ++dragCounter_; });
-  connect(slider, &QSlider::valueChanged, this, [this, slider, box, materialEdit](int v) {
-    QSignalBlocker b(box);
-    box->setValue(v / 1000.0);
-    materialEdit([v](Material& x) { x.roughness = std::max(0.001f, v / 1000.0f); }, tr("Roughness"),
-                 slider->isSliderDown() ? dragCounter_ : 0);
-  });
-  connect(box, &QDoubleSpinBox::valueChanged, this, [slider, materialEdit](double v) {
-    QSignalBlocker b(slider);
-    slider->setValue(static_cast<int>(std::lround(v * 1000)));
-    materialEdit([v](Material& x) { x.roughness = std::max(0.001f, static_cast<float>(v)); }, tr("Roughness"), 0);
-  });
-  propertiesForm_->addRow(tr("Roughness"), roughRow);
-
-  auto* ior = new QDoubleSpinBox(properties_);
-  ior->setRange(1.0, 4.0);
-  ior->setDecimals(3);
-  ior->setSingleStep(0.01);
-  ior->setValue(m->ior);
-  connect(ior, &QDoubleSpinBox::valueChanged, this, [materialEdit](double v) {
-    materialEdit([v](Material& x) { x.ior = static_cast<float>(v); }, tr("IOR"), 0);
-  });
-  propertiesForm_->addRow(tr("IOR"), ior);
-
-  float strength = std::max({m->emission.x, m->emission.y, m->emission.z});
-  auto* emission = new QDoubleSpinBox(properties_);
-  emission->setRange(0.0, 1e5);
-  emission->setDecimals(2);
-  emission->setValue(strength);
-  connect(emission, &QDoubleSpinBox::valueChanged, this, [materialEdit, m](double v) {
-    Vec3 tint = std::max({m->emission.x, m->emission.y, m->emission.z}) > 0 ? m->emission : Vec3{1.0f};
-    float peak = std::max({tint.x, tint.y, tint.z});
-    materialEdit([v, tint, peak](Material& x) { x.emission = tint * static_cast<float>(v / peak); }, tr("Emission"), 0);
-  });
-  propertiesForm_->addRow(tr("Emission"), emission);
+  panel_->setRenderSize(renderSize_);
+  panel_->rebuild();
+  renderPanel_->setRenderSize(renderSize_);
+  renderPanel_->rebuild();
 }
 
 QString MainWindow::recoveryDirectory() {
@@ -585,7 +663,9 @@ void MainWindow::rebuildRecentMenu() {
   recentMenu_->clear();
   QSettings settings;
   for (const QString& f : settings.value("recentFiles").toStringList()) {
-    QAction* a = recentMenu_->addAction(f, this, [this, f] { openFile(f.toStdString()); });
+    QAction* a = recentMenu_->addAction(f, this, [this, f] {
+      if (maybeSave()) openFile(f.toStdString());
+    });
     a->setEnabled(QFileInfo::exists(f));  // greyed when the file has gone
   }
   if (recentMenu_->isEmpty()) recentMenu_->addAction(tr("(none yet)"))->setEnabled(false);
@@ -598,6 +678,7 @@ void MainWindow::dragEnterEvent(QDragEnterEvent* e) {
 void MainWindow::dropEvent(QDropEvent* e) {
   for (const QUrl& url : e->mimeData()->urls())
     if (url.isLocalFile()) {
+      if (!maybeSave()) return;
       openFile(url.toLocalFile().toStdString());
       return;
     }
@@ -609,18 +690,41 @@ bool MainWindow::openFile(const std::filesystem::path& file) {
     showError(tr("Cannot open scene"), QString::fromStdString(r.error()));
     return false;
   }
-  doc_ = Document(std::move(r->scene));
-  file_ = file;
-  undo_.clear();
-  selection_ = kNoNode;
-  setWindowTitle(tr("Retile - %1").arg(QString::fromStdString(file.filename().string())));
   for (const auto& w : r->warnings) log(tr("warning: %1").arg(QString::fromStdString(w)));
-  startEngine(doc_.scene());
-  rebuildOutliner();
-  rebuildProperties();
+  replaceDocument(std::move(r->scene), file);
   log(tr("opened %1").arg(QString::fromStdString(file.string())));
   rememberRecent(file);
   return true;
+}
+
+void MainWindow::replaceDocument(Scene scene, const std::filesystem::path& file) {
+  doc_ = Document(std::move(scene));
+  file_ = file;
+  undo_.clear();
+  selection_ = kNoNode;
+  method_.focus.clear();
+  setWindowTitle(file.empty() ? tr("Retile - built-in scene") : tr("Retile - %1").arg(QString::fromStdString(file.filename().string())));
+  startEngine(doc_.scene());
+  rebuildOutliner();
+  panel_->setTarget({});
+  rebuildProperties();
+  graph_->setDocument(doc_.scene());
+  graph_->resetLayout();
+}
+
+bool MainWindow::maybeSave() {
+  if (undo_.isClean() || qEnvironmentVariableIsSet("RETILE_NO_PROMPTS")) return true;
+  auto answer = QMessageBox::question(this, tr("Unsaved changes"), tr("Save the changes to the current scene first?"),
+                                      QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel);
+  if (answer == QMessageBox::Cancel) return false;
+  if (answer == QMessageBox::Discard) return true;
+  std::filesystem::path target = file_;
+  if (target.empty() || target.extension() != ".retile") {
+    QString f = QFileDialog::getSaveFileName(this, tr("Save scene"), QString(), tr("Retile scenes (*.retile)"));
+    if (f.isEmpty()) return false;
+    target = f.toStdString();
+  }
+  return saveTo(target);
 }
 
 bool MainWindow::saveTo(const std::filesystem::path& file) {
@@ -637,20 +741,9 @@ bool MainWindow::saveTo(const std::filesystem::path& file) {
 }
 
 void MainWindow::closeEvent(QCloseEvent* e) {
-  if (!undo_.isClean() && !qEnvironmentVariableIsSet("RETILE_NO_PROMPTS")) {
-    auto answer = QMessageBox::question(this, tr("Unsaved changes"), tr("Save the changes before closing?"),
-                                        QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel);
-    if (answer == QMessageBox::Cancel) {
-      e->ignore();
-      return;
-    }
-    if (answer == QMessageBox::Save) {
-      QString f = QFileDialog::getSaveFileName(this, tr("Save scene"), QString(), tr("Retile scenes (*.retile)"));
-      if (f.isEmpty() || !saveTo(f.toStdString())) {
-        e->ignore();
-        return;
-      }
-    }
+  if (!maybeSave()) {
+    e->ignore();
+    return;
   }
   if (engine_) engine_->stop();
   // A clean close: no recovery is offered next time.

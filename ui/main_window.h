@@ -4,6 +4,7 @@
 // value, to the render thread. GUI thread only; nothing here waits on rendering.
 #pragma once
 
+#include <QElapsedTimer>
 #include <QMainWindow>
 #include <QUndoStack>
 
@@ -11,6 +12,7 @@
 #include <memory>
 
 #include "frame_view.h"
+#include "property_panel.h"
 #include "retile/edit.h"
 #include "retile/engine.h"
 
@@ -46,6 +48,9 @@ class MainWindow : public QMainWindow {
   std::uint64_t documentVersion() const { return doc_.version(); }
   QUndoStack* undoStack() { return &undo_; }
   FrameView* viewport() { return view_; }
+  PropertyPanel* properties() { return panel_; }
+  class LiveChart* chart() { return chart_; }
+  class NodeGraphView* graph() { return graph_; }
   Engine* engine() { return engine_.get(); }
   QTreeWidget* outliner() { return outliner_; }
   NodeId selection() const { return selection_; }
@@ -68,6 +73,10 @@ class MainWindow : public QMainWindow {
 
  private:
   void buildMenus();
+  // Asks to save unsaved changes; false when the user cancels.
+  bool maybeSave();
+  void refreshGraph();
+  void replaceDocument(Scene scene, const std::filesystem::path& file);
   void buildDocks();
   void startEngine(Scene scene);
   void rebuildOutliner();
@@ -97,8 +106,16 @@ class MainWindow : public QMainWindow {
 
   FrameView* view_ = nullptr;
   QTreeWidget* outliner_ = nullptr;
-  QWidget* properties_ = nullptr;
-  QFormLayout* propertiesForm_ = nullptr;
+  PropertyPanel* panel_ = nullptr;
+  PropertyPanel* renderPanel_ = nullptr;
+  class NodeGraphView* graph_ = nullptr;
+  bool graphRefreshQueued_ = false;
+  QLabel* inspector_ = nullptr;
+  class LiveChart* chart_ = nullptr;
+  QString pixelText_, regionText_;
+  QElapsedTimer focusTimer_;
+  QSpinBox* staleBox_ = nullptr;
+  QComboBox* focusModeBox_ = nullptr;
   QPlainTextEdit* log_ = nullptr;
   QComboBox* methodBox_ = nullptr;
   QComboBox* tileBox_ = nullptr;

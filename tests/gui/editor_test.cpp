@@ -5,12 +5,17 @@
 #include <QStandardPaths>
 #include <QDoubleSpinBox>
 #include <QTemporaryDir>
+#include <QLabel>
+#include <QPushButton>
 #include <QTest>
 #include <QTreeWidget>
 
 #include <gtest/gtest.h>
 
+#include "fields.h"
+#include "live_chart.h"
 #include "main_window.h"
+#include "node_graph.h"
 #include "retile/io.h"
 
 namespace retile::ui {
@@ -193,6 +198,180 @@ TEST(Editor, AutosaveRotatesAndACleanCloseLeavesNothingToRecover) {
   w->undoStack()->setClean();
   w->close();
   EXPECT_TRUE(MainWindow::recoveryCandidates().isEmpty());
+}
+
+
+TEST(Editor, ScrubbingAFieldIsOneUndoStepAndEscCancelsTyping) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  auto* rough = w->findChild<ScrubField*>("roughness");
+  ASSERT_TRUE(rough);
+  const NodeId material = w->scene().object(sphere)->material;
+  const float before = w->scene().material(material)->roughness;
+  const int steps = w->undoStack()->count();
+  QPoint c(6, rough->height() / 2);
+  QTest::mousePress(rough, Qt::LeftButton, Qt::NoModifier, c);
+  for (int i = 1; i <= 10; ++i) QTest::mouseMove(rough, c + QPoint(3 * i, 0));
+  QTest::mouseRelease(rough, Qt::LeftButton, Qt::NoModifier, c + QPoint(30, 0));
+  const float scrubbed = w->scene().material(material)->roughness;
+  EXPECT_GT(scrubbed, before + 0.1f) << "a drag to the right raises the value";
+  EXPECT_EQ(w->undoStack()->count(), steps + 1) << "the whole scrub is one undo step";
+  w->undoStack()->undo();
+  EXPECT_FLOAT_EQ(w->scene().material(material)->roughness, before);
+
+  // Typing then Esc changes nothing; typing then Enter commits.
+  rough = w->findChild<ScrubField*>("roughness");
+  rough->setFocus();
+  rough->selectAll();
+  QTest::keyClicks(rough, "0.9");
+  QTest::keyClick(rough, Qt::Key_Escape);
+  EXPECT_FLOAT_EQ(w->scene().material(material)->roughness, before);
+  rough->setFocus();
+  rough->selectAll();
+  QTest::keyClicks(rough, "0.9");
+  QTest::keyClick(rough, Qt::Key_Return);
+  EXPECT_NEAR(w->scene().material(material)->roughness, 0.9f, 1e-6f);
+}
+
+TEST(Editor, CameraEnvironmentAndRenderSettingsHavePanels) {
+  auto w = makeWindow();
+  auto pick = [&](const QString& name) {
+    for (QTreeWidgetItemIterator it(w->outliner()); *it; ++it)
+      if ((*it)->text(0) == name) {
+        w->outliner()->clearSelection();
+        (*it)->setSelected(true);
+        return true;
+      }
+    return false;
+  };
+  ASSERT_TRUE(pick("Camera"));
+  auto* fov = w->properties()->findChild<ScrubField*>("fov");
+  ASSERT_TRUE(fov);
+  fov->setValue(55.0);
+  EXPECT_NEAR(degrees(w->scene().camera.verticalFov), 55.0f, 1e-3f);
+  ASSERT_TRUE(pick("Environment"));
+  auto* intensity = w->properties()->findChild<ScrubField*>("environmentIntensity");
+  ASSERT_TRUE(intensity);
+  intensity->setValue(2.5);
+  EXPECT_FLOAT_EQ(w->scene().environment.intensity, 2.5f);
+  const std::uint64_t version = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; })) << "the edit reached the engine";
+  auto* bounces = w->findChild<ScrubField*>("maxBounces");
+  ASSERT_TRUE(bounces);
+  bounces->setValue(3);
+  EXPECT_EQ(w->scene().settings.maxBounces, 3);
+  const std::uint64_t v2 = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == v2; }));
+  EXPECT_EQ(w->viewport()->frame()->width, 96) << "a settings edit keeps the viewport's render size";
+}
+
+TEST(Editor, DisplayExposureSnapshotsAndTheInspector) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 3; }));
+  w->engine()->submit(PauseCommand{true});
+  QTest::qWait(300);
+  FrameView* v = w->viewport();
+  auto mean = [](const QImage& img, const QRectF& r) {
+    double sum = 0;
+    int n = 0;
+    for (int y = static_cast<int>(r.top()) + 1; y < static_cast<int>(r.bottom()) - 1; y += 2)
+      for (int x = static_cast<int>(r.left()) + 1; x < static_cast<int>(r.right()) - 1; x += 2, ++n) sum += qGray(img.pixel(x, y));
+    return sum / std::max(1, n);
+  };
+  OverlaySettings none{false, false, false, false, false, false};
+  v->setOverlays(none);
+  const double base = mean(v->composed(), v->imageRect());
+  auto* exposure = w->findChild<ScrubField*>("exposure");
+  ASSERT_TRUE(exposure);
+  exposure->setValue(-2.0);
+  const double darker = mean(v->composed(), v->imageRect());
+  EXPECT_LT(darker, base * 0.8) << "two stops down darkens the picture";
+  EXPECT_EQ(w->undoStack()->count(), 0) << "display settings are not scene edits";
+  exposure->setValue(0.0);
+
+  exposure->setValue(0.0);
+
+  // A/B: a snapshot, then a brighter sky; the wipe shows the snapshot (B) left of the line and
+  // the live render (A) right of it, exactly as the two single views show them.
+  const QRectF r = v->imageRect();
+  v->takeSnapshot();
+  Environment env = w->scene().environment, brighter = env;
+  brighter.intensity *= 4.0f;
+  w->engine()->submit(PauseCommand{false});
+  w->edit(SetEnvironment{env}, SetEnvironment{brighter}, "sky");
+  const std::uint64_t version = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) {
+    return f.documentVersion == version && f.queueServed >= f.queueLength && f.mode == "refinement";
+  })) << "the whole image re-rendered";
+  w->engine()->submit(PauseCommand{true});
+  QTest::qWait(300);
+  const QImage live = v->composed();
+  v->setCompare(FrameView::Compare::Toggle);
+  const QImage snapshot = v->composed();
+  v->setCompare(FrameView::Compare::Wipe);
+  v->setWipe(0.5);
+  const QImage wiped = v->composed();
+  v->setCompare(FrameView::Compare::Off);
+  const QRectF leftHalf(r.x() + 4, r.y() + 24, r.width() * 0.5 - 12, r.height() - 28);
+  const QRectF rightHalf(r.center().x() + 8, r.y() + 24, r.width() * 0.5 - 12, r.height() - 28);
+  EXPECT_GT(mean(live, leftHalf), mean(snapshot, leftHalf) + 5) << "the live render took the brighter sky";
+  EXPECT_NEAR(mean(wiped, leftHalf), mean(snapshot, leftHalf), 0.5) << "left of the wipe: B";
+  EXPECT_NEAR(mean(wiped, rightHalf), mean(live, rightHalf), 0.5) << "right of the wipe: A";
+
+  // The inspector reads linear values under the cursor and a Ctrl+drag region's statistics.
+  auto* inspector = w->findChild<QLabel*>("inspector");
+  ASSERT_TRUE(inspector);
+  QPoint c = r.center().toPoint();
+  QTest::mouseMove(v, c);
+  QMouseEvent move(QEvent::MouseMove, QPointF(c), v->mapToGlobal(QPointF(c)), Qt::NoButton, Qt::NoButton, Qt::NoModifier);
+  QApplication::sendEvent(v, &move);
+  EXPECT_TRUE(inspector->text().contains("pixel")) << inspector->text().toStdString();
+  QTest::mousePress(v, Qt::LeftButton, Qt::ControlModifier, c - QPoint(30, 20));
+  QMouseEvent drag(QEvent::MouseMove, QPointF(c + QPoint(30, 20)), v->mapToGlobal(QPointF(c + QPoint(30, 20))), Qt::NoButton,
+                   Qt::LeftButton, Qt::ControlModifier);
+  QApplication::sendEvent(v, &drag);
+  QTest::mouseRelease(v, Qt::LeftButton, Qt::ControlModifier, c + QPoint(30, 20));
+  EXPECT_TRUE(inspector->text().contains("mean")) << inspector->text().toStdString();
+}
+
+TEST(Editor, TheLiveChartPlotsThroughputAndErrorAgainstAReference) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 3; }));
+  LiveChart* chart = w->chart();
+  ASSERT_TRUE(chart);
+  EXPECT_GT(chart->throughputPoints(), 0);
+  auto* button = chart->findChild<QPushButton*>("renderReference");
+  ASSERT_TRUE(button);
+  button->click();
+  ASSERT_TRUE(QTest::qWaitFor([&] { return chart->hasReference(); }, 120000)) << "the reference renders in the background";
+  ASSERT_TRUE(QTest::qWaitFor([&] { return chart->errorPoints() >= 2; }, 60000))
+      << chart->findChild<QLabel*>()->text().toStdString();
+  EXPECT_GT(chart->lastError(), 0.0);
+  EXPECT_LT(chart->lastError(), 0.3) << "the viewport shows the same scene as the reference";
+}
+
+
+TEST(Editor, LinkingADifferentMaterialInTheNodeGraphChangesTheObjectsMaterial) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  const NodeId before = w->scene().object(sphere)->material;
+  NodeId other = kNoNode;
+  for (const auto& m : w->scene().materials)
+    if (m.id != before && !m.emissive()) other = m.id;
+  ASSERT_NE(other, kNoNode);
+  NodeGraphView* graph = w->graph();
+  ASSERT_TRUE(graph);
+  ASSERT_TRUE(graph->link(other, sphere, "material"));
+  EXPECT_EQ(w->scene().object(sphere)->material, other);
+  const std::uint64_t version = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version && !f.servedTiles.empty(); }))
+      << "the assignment re-renders through the same queue";
+  QTest::qWait(50);  // the graph refreshes from the document on the next turn of the event loop
+  EXPECT_EQ(graph->linkSource(sphere, "material"), other);
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().object(sphere)->material, before) << "one undo step restores the assignment";
 }
 
 }  // namespace

@@ -89,6 +89,8 @@ struct EngineOptions {
   // Continuous refinement stops (the thread sleeps until a command) once every tile has this many
   // samples per pixel; 0 refines for ever.
   int maxSamplesPerPixel = 4096;
+  // The document version the initial scene corresponds to: frames carry it until the first edit.
+  std::uint64_t documentVersion = 0;
 };
 
 class Engine {

@@ -75,6 +75,8 @@ class RenderSession {
   std::string setMethod(const MethodSettings& method);
   void resize(int width, int height);
   void setMaxBounces(int maxBounces);
+  // The document version of the scene the session was made from (frames report it until an edit).
+  void setDocumentVersion(std::uint64_t version);
 
   // Plans, traces and accumulates one frame. `readImage`: read the accumulated image back into
   // the record (the command line and the viewport need it; benchmarks may not).

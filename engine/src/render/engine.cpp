@@ -126,6 +126,7 @@ void Engine::run() {
   std::unique_ptr<RenderSession> session;
   try {
     session = std::make_unique<RenderSession>(std::move(initialScene_), initialMethod_, options_.renderer);
+    session->setDocumentVersion(options_.documentVersion);
     std::lock_guard lock(mutex_);
     device_ = session->deviceName();
     for (const auto& w : session->sceneWarnings()) errors_.push_back("warning: " + w);

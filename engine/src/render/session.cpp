@@ -172,6 +172,8 @@ TileRect screenRect(const Camera& cam, int w, int h, const Bounds3& b) {
 
 }  // namespace
 
+void RenderSession::setDocumentVersion(std::uint64_t version) { impl_->documentVersion = version; }
+
 Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t documentVersion) {
   Impl& d = *impl_;
   // Where the edit's target was, before: the smooth transition prioritizes old and new places.

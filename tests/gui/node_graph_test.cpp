@@ -1,0 +1,335 @@
+// The node graph over a document, driven the way an artist drives it: mouse drags on the viewport
+// link and unlink, keys delete, duplicate, rename, copy and paste, Tab searches and creates. Each
+// requested GraphEdit is applied to a Document (its afters in order) and the graph refreshed, as
+// the main window does; undo is the befores in reverse order.
+#include <QLineEdit>
+#include <QListWidget>
+#include <QSignalSpy>
+#include <QTest>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <sstream>
+
+#include "node_graph.h"
+
+namespace retile::ui {
+namespace {
+
+// Everything the graph can change, by id, so two scenes compare regardless of list order.
+std::string describe(const Scene& s) {
+  std::ostringstream out;
+  auto sorted = [](auto nodes) {
+    std::sort(nodes.begin(), nodes.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+    return nodes;
+  };
+  for (const Material& m : sorted(s.materials))
+    out << "M" << m.id << " " << m.name << " " << static_cast<int>(m.type) << " " << m.albedo.x << " " << m.roughness
+        << " " << m.albedoTexture << " " << m.roughnessTexture << " " << m.alphaTexture << "\n";
+  for (const Object& o : sorted(s.objects))
+    out << "O" << o.id << " " << o.name << " " << o.mesh << " " << o.material << "\n";
+  for (const Texture& t : sorted(s.textures)) out << "T" << t.id << " " << t.name << "\n";
+  for (const Light& l : sorted(s.lights)) out << "L" << l.id << " " << l.name << "\n";
+  out << "E" << static_cast<int>(s.environment.type) << " " << s.environment.map << "\n";
+  return out.str();
+}
+
+template <class Node>
+NodeId named(const std::vector<Node>& nodes, const std::string& name) {
+  for (const Node& n : nodes)
+    if (n.name == name) return n.id;
+  return kNoNode;
+}
+
+class NodeGraph : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    view.resize(1000, 700);
+    QObject::connect(&view, &NodeGraphView::editRequested, &view, [this](const GraphEdit& e) {
+      for (const auto& [before, after] : e.steps) {
+        auto r = doc.apply(after);
+        EXPECT_TRUE(r.ok()) << e.text.toStdString() << ": " << (r.ok() ? std::string() : r.error());
+      }
+      edits.push_back(e);
+      view.setDocument(doc.scene());
+    });
+    view.setDocument(doc.scene());
+    view.show();
+    ASSERT_TRUE(QTest::qWaitForWindowExposed(&view));
+  }
+
+  void undo(const GraphEdit& e) {
+    for (auto it = e.steps.rbegin(); it != e.steps.rend(); ++it) {
+      auto r = doc.apply(it->first);
+      EXPECT_TRUE(r.ok()) << "undo " << e.text.toStdString() << ": " << (r.ok() ? std::string() : r.error());
+    }
+    view.setDocument(doc.scene());
+  }
+
+  const Scene& scene() const { return doc.scene(); }
+  QWidget* vp() { return view.viewport(); }
+  QPoint at(QPointF scenePos) { return view.mapFromScene(scenePos); }
+  QPoint header(NodeId id) { return at(view.nodePosition(id) + QPointF(95, 12)); }
+
+  void drag(QPoint from, QPoint to, Qt::KeyboardModifiers mods = {}) {
+    QTest::mousePress(vp(), Qt::LeftButton, mods, from);
+    for (int i = 1; i <= 6; ++i) QTest::mouseMove(vp(), from + (to - from) * i / 6);
+    QTest::mouseRelease(vp(), Qt::LeftButton, mods, to);
+  }
+  void click(NodeId id, Qt::KeyboardModifiers mods = {}) { QTest::mouseClick(vp(), Qt::LeftButton, mods, header(id)); }
+
+  Document doc{makeDefaultScene()};
+  NodeGraphView view;
+  std::vector<GraphEdit> edits;
+};
+
+TEST_F(NodeGraph, LaysOutColumnsShowsAssignmentsAndKeepsMovedNodesWhereTheyAre) {
+  const NodeId checker = named(scene().textures, "Checker");
+  const NodeId ground = named(scene().materials, "Ground");
+  const NodeId sphere = named(scene().objects, "Glossy Sphere");
+  for (const Material& m : scene().materials) EXPECT_TRUE(view.hasNode(m.id)) << m.name;
+  for (const Object& o : scene().objects) EXPECT_TRUE(view.hasNode(o.id)) << o.name;
+  EXPECT_TRUE(view.hasNode(NodeGraphView::kCameraNode));
+  EXPECT_TRUE(view.hasNode(NodeGraphView::kSettingsNode));
+  EXPECT_LT(view.nodePosition(checker).x(), view.nodePosition(ground).x()) << "textures | materials";
+  EXPECT_LT(view.nodePosition(ground).x(), view.nodePosition(sphere).x()) << "materials | objects";
+  EXPECT_EQ(view.linkSource(sphere, "material"), scene().object(sphere)->material);
+  const NodeId checkered = named(scene().materials, "Checkered");
+  EXPECT_EQ(view.linkSource(checkered, "albedo"), checker);
+
+  // Drag the sphere's node by its header; the link follows and a refresh keeps the place.
+  const QPointF before = view.nodePosition(sphere);
+  drag(header(sphere), header(sphere) + QPoint(60, 30));
+  const QPointF moved = view.nodePosition(sphere);
+  EXPECT_GT(moved.x() - before.x(), 40);
+  EXPECT_GT(moved.y() - before.y(), 20);
+  EXPECT_TRUE(edits.empty()) << "moving a node is view state, not an edit";
+  view.setDocument(scene());
+  EXPECT_EQ(view.nodePosition(sphere), moved);
+}
+
+TEST_F(NodeGraph, DraggingSocketsLinksAndDraggingTheLinkOffUnlinks) {
+  const NodeId sphere = named(scene().objects, "Glossy Sphere");
+  const NodeId steel = named(scene().materials, "Brushed Steel");
+  const NodeId lacquer = scene().object(sphere)->material;
+  ASSERT_NE(steel, lacquer);
+
+  drag(at(view.socketScenePos(steel, "material", true)), at(view.socketScenePos(sphere, "material", false)));
+  ASSERT_EQ(edits.size(), 1u);
+  EXPECT_EQ(scene().object(sphere)->material, steel) << "material output onto the object's input assigns it";
+  EXPECT_EQ(view.linkSource(sphere, "material"), steel);
+
+  // Pick the link up by its input end and drop it on empty space between the columns.
+  const QPoint input = at(view.socketScenePos(sphere, "material", false));
+  drag(input, input + QPoint(-40, 0));
+  ASSERT_EQ(edits.size(), 2u);
+  EXPECT_EQ(scene().object(sphere)->material, kNoNode) << "dragging a link off unlinks";
+  EXPECT_EQ(view.linkSource(sphere, "material"), kNoNode);
+  undo(edits.back());
+  EXPECT_EQ(scene().object(sphere)->material, steel);
+
+  // A texture onto a material's roughness input.
+  const NodeId checker = named(scene().textures, "Checker");
+  const NodeId ground = named(scene().materials, "Ground");
+  drag(at(view.socketScenePos(checker, "texture", true)), at(view.socketScenePos(ground, "roughness", false)));
+  EXPECT_EQ(scene().material(ground)->roughnessTexture, checker);
+  EXPECT_EQ(scene().material(ground)->albedoTexture, kNoNode);
+
+  // Moving a link's input end to another input is one step: roughness to alpha.
+  drag(at(view.socketScenePos(ground, "roughness", false)), at(view.socketScenePos(ground, "alpha", false)));
+  EXPECT_EQ(scene().material(ground)->roughnessTexture, kNoNode);
+  EXPECT_EQ(scene().material(ground)->alphaTexture, checker);
+  EXPECT_EQ(edits.back().steps.size(), 2u);
+  undo(edits.back());
+  EXPECT_EQ(scene().material(ground)->roughnessTexture, checker);
+  EXPECT_EQ(scene().material(ground)->alphaTexture, kNoNode);
+
+  // Dropping a material on a texture input is refused: no edit.
+  const std::size_t count = edits.size();
+  drag(at(view.socketScenePos(steel, "material", true)), at(view.socketScenePos(ground, "albedo", false)));
+  EXPECT_EQ(edits.size(), count);
+  EXPECT_FALSE(view.link(steel, ground, "albedo"));
+  EXPECT_FALSE(view.link(steel, sphere, "material")) << "already linked: nothing to do";
+}
+
+TEST_F(NodeGraph, DeleteRemovesTheSelectionAndTheBeforesRestoreEveryReference) {
+  const Scene original = scene();
+  const NodeId lacquer = named(scene().materials, "Red Lacquer");
+  const NodeId sphere = named(scene().objects, "Glossy Sphere");
+  click(lacquer);
+  EXPECT_EQ(view.selectedNodes(), std::vector<NodeId>{lacquer});
+  QTest::keyClick(&view, Qt::Key_Delete);
+  ASSERT_EQ(edits.size(), 1u);
+  EXPECT_FALSE(scene().material(lacquer));
+  EXPECT_EQ(scene().object(sphere)->material, kNoNode);
+  EXPECT_FALSE(view.hasNode(lacquer));
+  undo(edits.back());
+  EXPECT_EQ(describe(scene()), describe(original));
+  EXPECT_EQ(view.linkSource(sphere, "material"), lacquer);
+
+  // A texture and a material together, marquee-selected with the camera: the camera stays.
+  const NodeId checker = named(scene().textures, "Checker");
+  const NodeId checkered = named(scene().materials, "Checkered");
+  view.selectNodes({checker, checkered, NodeGraphView::kCameraNode});
+  QTest::keyClick(&view, Qt::Key_Delete);
+  ASSERT_EQ(edits.size(), 2u);
+  EXPECT_FALSE(scene().texture(checker));
+  EXPECT_FALSE(scene().material(checkered));
+  EXPECT_TRUE(view.hasNode(NodeGraphView::kCameraNode));
+  undo(edits.back());
+  EXPECT_EQ(describe(scene()), describe(original));
+
+  view.selectNodes({NodeGraphView::kCameraNode, NodeGraphView::kSettingsNode});
+  QTest::keyClick(&view, Qt::Key_Delete);
+  EXPECT_EQ(edits.size(), 2u) << "camera and settings cannot be deleted";
+}
+
+TEST_F(NodeGraph, TabSearchCreatesNodesWithUnusedIds) {
+  const std::size_t materials = scene().materials.size();
+  const NodeId expected = scene().peekNextId();
+  QTest::keyClick(&view, Qt::Key_Tab);
+  auto* search = view.findChild<QLineEdit*>("nodeSearch");
+  ASSERT_TRUE(search);
+  EXPECT_TRUE(search->isVisible());
+  QTest::keyClicks(search, "mat");
+  auto* list = view.findChild<QListWidget*>("nodeSearchList");
+  ASSERT_TRUE(list);
+  int shown = 0;
+  for (int i = 0; i < list->count(); ++i) shown += list->item(i)->isHidden() ? 0 : 1;
+  EXPECT_EQ(shown, 1) << "the filter leaves only Material";
+  QTest::keyClick(search, Qt::Key_Return);
+  EXPECT_FALSE(search->isVisible());
+  ASSERT_EQ(scene().materials.size(), materials + 1);
+  const Material& made = scene().materials.back();
+  EXPECT_EQ(made.id, expected);
+  EXPECT_EQ(made.name, "Material");
+  EXPECT_TRUE(view.hasNode(made.id));
+  EXPECT_EQ(view.selectedNodes(), std::vector<NodeId>{made.id}) << "the new node is selected";
+
+  // Right-click opens the same menu where the node will go; arrows pick among the matches.
+  const QPoint where = vp()->rect().center();
+  QTest::mouseClick(vp(), Qt::RightButton, {}, where);
+  ASSERT_TRUE(search->isVisible());
+  QTest::keyClicks(search, "light");
+  QTest::keyClick(search, Qt::Key_Down);  // Light -> Spot Light
+  QTest::keyClick(search, Qt::Key_Return);
+  ASSERT_EQ(scene().lights.size(), 1u);
+  EXPECT_EQ(scene().lights[0].type, LightType::Spot);
+  EXPECT_GT(scene().lights[0].id, made.id);
+  EXPECT_LT(QLineF(view.nodePosition(scene().lights[0].id), view.mapToScene(where)).length(), 2.0);
+
+  const std::size_t count = edits.size();
+  undo(edits.back());
+  EXPECT_TRUE(scene().lights.empty());
+  EXPECT_FALSE(view.createNode("Teapot", {}));
+  EXPECT_EQ(edits.size(), count);
+}
+
+TEST_F(NodeGraph, F2RenamesInPlace) {
+  const NodeId sphere = named(scene().objects, "Glossy Sphere");
+  view.setSelectedObject(sphere);
+  QTest::keyClick(&view, Qt::Key_F2);
+  auto* editor = view.findChild<QLineEdit*>("nodeRename");
+  ASSERT_TRUE(editor);
+  EXPECT_EQ(editor->text(), "Glossy Sphere");
+  editor->selectAll();
+  QTest::keyClicks(editor, "Hero Sphere");
+  QTest::keyClick(editor, Qt::Key_Return);
+  ASSERT_EQ(edits.size(), 1u);
+  EXPECT_EQ(scene().object(sphere)->name, "Hero Sphere");
+  undo(edits.back());
+  EXPECT_EQ(scene().object(sphere)->name, "Glossy Sphere");
+
+  // Escape leaves the name alone.
+  QTest::keyClick(&view, Qt::Key_F2);
+  QCoreApplication::processEvents();
+  editor = nullptr;
+  for (auto* e : view.findChildren<QLineEdit*>("nodeRename"))
+    if (e->isVisible()) editor = e;
+  ASSERT_TRUE(editor);
+  QTest::keyClicks(editor, "Oops");
+  QTest::keyClick(editor, Qt::Key_Escape);
+  EXPECT_EQ(edits.size(), 1u);
+  EXPECT_EQ(scene().object(sphere)->name, "Glossy Sphere");
+}
+
+TEST_F(NodeGraph, ClickShiftAndCtrlSelectAndCtrlDDuplicates) {
+  const NodeId lacquer = named(scene().materials, "Red Lacquer");
+  const NodeId sphere = named(scene().objects, "Glossy Sphere");
+  const NodeId cup = named(scene().objects, "Cup");
+  QSignalSpy picked(&view, &NodeGraphView::objectSelected);
+  click(cup);
+  ASSERT_EQ(picked.count(), 1);
+  EXPECT_EQ(picked.front().front().toULongLong(), cup);
+  click(lacquer);
+  EXPECT_EQ(view.selectedNodes(), std::vector<NodeId>{lacquer}) << "a click replaces the selection";
+  click(sphere, Qt::ShiftModifier);
+  click(cup, Qt::ShiftModifier);
+  EXPECT_EQ(view.selectedNodes().size(), 3u) << "Shift adds";
+  click(cup, Qt::ControlModifier);
+  EXPECT_EQ(view.selectedNodes().size(), 2u) << "Ctrl toggles";
+  view.setSelectedObject(cup);
+  EXPECT_EQ(picked.count(), 3) << "selection from elsewhere does not echo back";
+  view.selectNodes({lacquer, sphere});
+
+  const NodeId next = scene().peekNextId();
+  QTest::keyClick(&view, Qt::Key_D, Qt::ControlModifier);
+  ASSERT_EQ(edits.size(), 1u);
+  const NodeId lacquerCopy = named(scene().materials, "Red Lacquer.001");
+  const NodeId sphereCopy = named(scene().objects, "Glossy Sphere.001");
+  ASSERT_NE(lacquerCopy, kNoNode);
+  ASSERT_NE(sphereCopy, kNoNode);
+  EXPECT_GE(std::min(lacquerCopy, sphereCopy), next) << "new ids";
+  EXPECT_NE(lacquerCopy, sphereCopy);
+  EXPECT_EQ(scene().object(sphereCopy)->material, lacquer) << "a duplicated object keeps its material";
+  EXPECT_EQ(scene().object(sphereCopy)->mesh, scene().object(sphere)->mesh);
+  std::vector<NodeId> copies{lacquerCopy, sphereCopy};
+  std::sort(copies.begin(), copies.end());
+  EXPECT_EQ(view.selectedNodes(), copies) << "the copies are selected";
+  EXPECT_EQ(view.nodePosition(sphereCopy), view.nodePosition(sphere) + QPointF(30, 30));
+  undo(edits.back());
+  EXPECT_FALSE(scene().material(lacquerCopy));
+  EXPECT_FALSE(scene().object(sphereCopy));
+}
+
+TEST_F(NodeGraph, MarqueeSelectsAndFAndAFrame) {
+  const NodeId checker = named(scene().textures, "Checker");
+  const QPointF p = view.nodePosition(checker);
+  drag(at(p + QPointF(-30, -15)), at(p + QPointF(100, 30)));
+  EXPECT_EQ(view.selectedNodes(), std::vector<NodeId>{checker}) << "the rubber band selects what it touches";
+  const NodeId ground = named(scene().materials, "Ground");
+  const QPointF g = view.nodePosition(ground);
+  drag(at(g + QPointF(-20, -10)), at(g + QPointF(40, 20)), Qt::ShiftModifier);
+  EXPECT_EQ(view.selectedNodes().size(), 2u) << "Shift + rubber band adds";
+
+  view.selectNodes({checker});
+  const qreal zoomAll = view.transform().m11();
+  QTest::keyClick(&view, Qt::Key_F);
+  EXPECT_GT(view.transform().m11(), zoomAll * 1.2) << "framing one node zooms in";
+  const QPoint centre = at(p + QPointF(95, 30));
+  EXPECT_LT((centre - vp()->rect().center()).manhattanLength(), 20) << "around it";
+
+  QTest::keyClick(&view, Qt::Key_A);
+  const QRectF visible = view.mapToScene(vp()->rect()).boundingRect();
+  for (const Object& o : scene().objects) EXPECT_TRUE(visible.contains(view.nodePosition(o.id))) << o.name;
+  EXPECT_TRUE(visible.contains(view.nodePosition(NodeGraphView::kSettingsNode)));
+}
+
+TEST_F(NodeGraph, CopyPasteMakesCopiesWithNewIds) {
+  const NodeId ceramic = named(scene().materials, "Ceramic");
+  click(ceramic);
+  QTest::keyClick(&view, Qt::Key_C, Qt::ControlModifier);
+  QTest::keyClick(&view, Qt::Key_V, Qt::ControlModifier);
+  QTest::keyClick(&view, Qt::Key_V, Qt::ControlModifier);
+  ASSERT_EQ(edits.size(), 2u);
+  const NodeId a = named(scene().materials, "Ceramic.001"), b = named(scene().materials, "Ceramic.002");
+  ASSERT_NE(a, kNoNode);
+  ASSERT_NE(b, kNoNode);
+  EXPECT_NE(a, b);
+  EXPECT_EQ(scene().material(a)->type, scene().material(ceramic)->type);
+  EXPECT_NE(view.nodePosition(a), view.nodePosition(b)) << "pastes do not stack on each other";
+}
+
+}  // namespace
+}  // namespace retile::ui

@@ -1,0 +1,117 @@
+// The real viewport under an X server (xvfb-run): the editor presents through a QVulkanWindow on
+// lavapipe, what the window shows is the frame FrameView composed (grabbed from the swapchain and
+// compared), and input on the Vulkan window reaches the viewport (a click picks an object).
+#include <QApplication>
+#include <QPixmap>
+#include <QScreen>
+#include <QStandardPaths>
+#include <QTemporaryDir>
+#include <QTest>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "main_window.h"
+#include "vulkan_viewport.h"
+
+namespace retile::ui {
+namespace {
+
+std::unique_ptr<MainWindow> makeWindow() {
+  EditorOptions o;
+  o.initialRenderSize = QSize(96, 54);
+  auto w = std::make_unique<MainWindow>(makeDefaultScene(), std::filesystem::path(), o);
+  w->resize(1000, 700);
+  w->show();
+  return w;
+}
+
+bool waitForFrame(MainWindow& w, const std::function<bool(const FrameRecord&)>& pred, int ms = 60000) {
+  return QTest::qWaitFor([&] { return w.viewport()->frame() && pred(*w.viewport()->frame()); }, ms);
+}
+
+TEST(VulkanViewport, ShowsTheComposedFrame) {
+  auto w = makeWindow();
+  VulkanViewport* vw = w->viewport()->vulkanWindow();
+  ASSERT_TRUE(vw) << "expected Vulkan presentation on " << QGuiApplication::platformName().toStdString() << ": "
+                  << w->viewport()->presentation().toStdString();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(vw, 20000));
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 3; }));
+  // Hold the picture still while grabbing: no new frames.
+  w->engine()->submit(PauseCommand{true});
+  QTest::qWait(500);
+  QApplication::processEvents();
+  ASSERT_TRUE(vw->isValid());
+  const QImage expected = w->viewport()->composed().convertToFormat(QImage::Format_RGB32);
+  // What the X server shows in the window (the swapchain's presented image), not a re-render.
+  const QImage shown = vw->screen()->grabWindow(vw->winId()).toImage().convertToFormat(QImage::Format_RGB32);
+  ASSERT_FALSE(shown.isNull()) << "the window could not be read back";
+  ASSERT_EQ(shown.size(), expected.size());
+  double diff = 0, mean = 0, meanSq = 0;
+  const QRectF r = w->viewport()->imageRect();
+  int n = 0;
+  for (int y = 0; y < shown.height(); ++y)
+    for (int x = 0; x < shown.width(); ++x) {
+      QRgb a = shown.pixel(x, y), b = expected.pixel(x, y);
+      diff += std::abs(qRed(a) - qRed(b)) + std::abs(qGreen(a) - qGreen(b)) + std::abs(qBlue(a) - qBlue(b));
+      if (r.contains(x, y)) {
+        double l = qGray(a);
+        mean += l;
+        meanSq += l * l;
+        ++n;
+      }
+    }
+  diff /= 3.0 * shown.width() * shown.height();
+  if (!qEnvironmentVariableIsEmpty("RETILE_TEST_DUMP")) {
+    shown.save(qEnvironmentVariable("RETILE_TEST_DUMP") + "/shown.png");
+    expected.save(qEnvironmentVariable("RETILE_TEST_DUMP") + "/expected.png");
+  }
+  mean /= n;
+  const double stddev = std::sqrt(std::max(0.0, meanSq / n - mean * mean));
+  EXPECT_LT(diff, 1.5) << "mean absolute difference per channel (of 255) between the swapchain and the composed picture";
+  EXPECT_GT(stddev, 10.0) << "the window shows an image, not a flat fill";
+}
+
+TEST(VulkanViewport, AClickOnTheVulkanWindowPicksAnObject) {
+  auto w = makeWindow();
+  VulkanViewport* vw = w->viewport()->vulkanWindow();
+  ASSERT_TRUE(vw);
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(vw, 20000));
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  auto frame = w->viewport()->frame();
+  NodeId sphere = kNoNode;
+  for (const auto& o : w->scene().objects)
+    if (o.name == "Glossy Sphere") sphere = o.id;
+  ASSERT_NE(sphere, kNoNode);
+  // The sphere's pixel nearest its centroid in the object-id output.
+  const auto& ids = frame->image->objectId;
+  double sx = 0, sy = 0;
+  int count = 0;
+  for (int y = 0; y < frame->height; ++y)
+    for (int x = 0; x < frame->width; ++x)
+      if (ids[static_cast<std::size_t>(y * frame->width + x)] == sphere) sx += x, sy += y, ++count;
+  ASSERT_GT(count, 0);
+  const QRectF r = w->viewport()->imageRect();
+  QPoint at(static_cast<int>(r.x() + (sx / count + 0.5) * r.width() / frame->width),
+            static_cast<int>(r.y() + (sy / count + 0.5) * r.height() / frame->height));
+  QTest::mouseClick(vw, Qt::LeftButton, Qt::NoModifier, at);
+  EXPECT_TRUE(QTest::qWaitFor([&] { return w->selection() == sphere; }, 5000)) << "the click reached the viewport";
+}
+
+}  // namespace
+}  // namespace retile::ui
+
+int main(int argc, char** argv) {
+  qputenv("RETILE_NO_PROMPTS", "1");
+  QTemporaryDir recovery;
+  qputenv("RETILE_RECOVERY_DIR", recovery.path().toUtf8());
+  QStandardPaths::setTestModeEnabled(true);
+  if (qEnvironmentVariableIsEmpty("DISPLAY") && qEnvironmentVariableIsEmpty("WAYLAND_DISPLAY")) {
+    std::fprintf(stderr, "gui_vulkan_tests needs a display: run it under xvfb-run (ctest does)\n");
+    return 1;
+  }
+  QApplication app(argc, argv);
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

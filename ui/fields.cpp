@@ -1,0 +1,135 @@
+#include "fields.h"
+
+#include <QColorDialog>
+#include <QContextMenuEvent>
+#include <QKeyEvent>
+#include <QLineEdit>
+#include <QMenu>
+#include <QMouseEvent>
+#include <QStyle>
+#include <QStyleOptionSpinBox>
+
+#include <cmath>
+
+namespace retile::ui {
+
+ScrubField::ScrubField(double value, double min, double max, double defaultValue, int decimals, QWidget* parent)
+    : QDoubleSpinBox(parent), default_(defaultValue), committed_(value) {
+  setRange(min, max);
+  setDecimals(decimals);
+  setSingleStep(std::pow(10.0, -std::min(decimals, 2)));
+  setKeyboardTracking(false);  // typing does not edit until Enter (or focus leaves)
+  setValue(value);
+  setCursor(Qt::SizeHorCursor);
+  setToolTip(tr("Drag to scrub (Shift: finer), click to type, Enter commits, Esc cancels; right-click resets"));
+  // The line edit eats mouse presses; watch them on the spin box instead.
+  lineEdit()->setAttribute(Qt::WA_TransparentForMouseEvents, true);
+  connect(this, &QDoubleSpinBox::valueChanged, this, [this](double v) {
+    if (!silent_) commit(v);
+  });
+}
+
+void ScrubField::commit(double v) {
+  committed_ = v;
+  emit edited(v, scrubbing_);
+}
+
+void ScrubField::mousePressEvent(QMouseEvent* e) {
+  if (e->button() != Qt::LeftButton) return QDoubleSpinBox::mousePressEvent(e);
+  // The arrows keep their usual behaviour.
+  QStyleOptionSpinBox opt;
+  initStyleOption(&opt);
+  const auto hit = style()->hitTestComplexControl(QStyle::CC_SpinBox, &opt, e->position().toPoint(), this);
+  if (hit == QStyle::SC_SpinBoxUp || hit == QStyle::SC_SpinBoxDown) return QDoubleSpinBox::mousePressEvent(e);
+  pressed_ = true;
+  pressAt_ = e->position().toPoint();
+  lastX_ = pressAt_.x();
+}
+
+void ScrubField::mouseMoveEvent(QMouseEvent* e) {
+  if (!pressed_) return QDoubleSpinBox::mouseMoveEvent(e);
+  const int x = e->position().toPoint().x();
+  if (!scrubbing_ && std::abs(x - pressAt_.x()) < 4) return;
+  scrubbing_ = true;
+  const double step = singleStep() * ((e->modifiers() & Qt::ShiftModifier) ? 0.1 : 1.0);
+  const int dx = x - lastX_;
+  lastX_ = x;
+  if (dx != 0) setValue(value() + dx * step);
+}
+
+void ScrubField::mouseReleaseEvent(QMouseEvent* e) {
+  if (!pressed_) return QDoubleSpinBox::mouseReleaseEvent(e);
+  pressed_ = false;
+  if (scrubbing_) {
+    scrubbing_ = false;
+    emit scrubFinished();
+    return;
+  }
+  // A click without a drag: type a value.
+  lineEdit()->setFocus();
+  lineEdit()->selectAll();
+}
+
+void ScrubField::keyPressEvent(QKeyEvent* e) {
+  if (e->key() == Qt::Key_Escape) {
+    silent_ = true;
+    setValue(committed_);  // drops the typed text
+    silent_ = false;
+    clearFocus();
+    return;
+  }
+  QDoubleSpinBox::keyPressEvent(e);
+}
+
+void ScrubField::focusInEvent(QFocusEvent* e) {
+  committed_ = value();
+  QDoubleSpinBox::focusInEvent(e);
+}
+
+void ScrubField::contextMenuEvent(QContextMenuEvent* e) {
+  QMenu menu(this);
+  QAction* reset = menu.addAction(tr("Reset to default (%1)").arg(default_));
+  if (menu.exec(e->globalPos()) == reset) setValue(default_);
+}
+
+ColorField::ColorField(QColor value, QColor defaultValue, QWidget* parent)
+    : QPushButton(parent), default_(defaultValue) {
+  setColor(value);
+  connect(this, &QPushButton::clicked, this, [this] {
+    // Non-modal: the render follows the dialog's colour live; the session is one undo step.
+    auto* dialog = new QColorDialog(color_, this);
+    dialog->setAttribute(Qt::WA_DeleteOnClose);
+    QColor start = color_;
+    connect(dialog, &QColorDialog::currentColorChanged, this, [this](const QColor& c) {
+      if (!c.isValid() || c == color_) return;
+      setColor(c);
+      emit edited(c, true);
+    });
+    connect(dialog, &QColorDialog::finished, this, [this, start](int result) {
+      if (result != QDialog::Accepted && color_ != start) {
+        setColor(start);
+        emit edited(start, true);
+      }
+      emit dragFinished();
+    });
+    dialog->open();
+  });
+}
+
+void ColorField::setColor(QColor c) {
+  color_ = c;
+  setText(c.name());
+  // Readable text on any swatch.
+  setStyleSheet(QString("background-color: %1; color: %2").arg(c.name(), c.lightnessF() > 0.55 ? "black" : "white"));
+}
+
+void ColorField::contextMenuEvent(QContextMenuEvent* e) {
+  QMenu menu(this);
+  QAction* reset = menu.addAction(tr("Reset to default (%1)").arg(default_.name()));
+  if (menu.exec(e->globalPos()) == reset && default_ != color_) {
+    setColor(default_);
+    emit edited(default_, false);
+  }
+}
+
+}  // namespace retile::ui

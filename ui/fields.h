@@ -1,0 +1,64 @@
+// Parameter editors with the conventions artists bring from Blender, Houdini and Katana: drag a
+// number field to scrub (Shift: ten times finer), click to type, Enter commits, Esc cancels,
+// "Reset to default" on the context menu; a colour swatch whose whole dialog session is one edit.
+// GUI thread only. Each field owns nothing but its widgets; the caller turns its signals into
+// undoable edits (a scrub reports its start and end so a whole drag becomes one undo step).
+#pragma once
+
+#include <QColor>
+#include <QDoubleSpinBox>
+#include <QPushButton>
+
+namespace retile::ui {
+
+class ScrubField : public QDoubleSpinBox {
+  Q_OBJECT
+ public:
+  ScrubField(double value, double min, double max, double defaultValue, int decimals, QWidget* parent = nullptr);
+  double defaultValue() const { return default_; }
+  bool scrubbing() const { return scrubbing_; }
+
+ signals:
+  // A committed value: typed and entered, stepped, reset, or one step of a scrub.
+  void edited(double value, bool scrubbing);
+  void scrubFinished();
+
+ protected:
+  void mousePressEvent(QMouseEvent* e) override;
+  void mouseMoveEvent(QMouseEvent* e) override;
+  void mouseReleaseEvent(QMouseEvent* e) override;
+  void keyPressEvent(QKeyEvent* e) override;
+  void focusInEvent(QFocusEvent* e) override;
+  void contextMenuEvent(QContextMenuEvent* e) override;
+
+ private:
+  void commit(double v);
+
+  double default_;
+  double committed_;  // the value Esc returns to
+  bool pressed_ = false, scrubbing_ = false;
+  QPoint pressAt_;
+  int lastX_ = 0;
+  bool silent_ = false;
+};
+
+class ColorField : public QPushButton {
+  Q_OBJECT
+ public:
+  ColorField(QColor value, QColor defaultValue, QWidget* parent = nullptr);
+  QColor color() const { return color_; }
+  void setColor(QColor c);
+
+ signals:
+  // Live while the dialog is open (dragging = true), and once more when it closes.
+  void edited(QColor color, bool dragging);
+  void dragFinished();
+
+ protected:
+  void contextMenuEvent(QContextMenuEvent* e) override;
+
+ private:
+  QColor color_, default_;
+};
+
+}  // namespace retile::ui

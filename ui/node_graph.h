@@ -1,0 +1,161 @@
+// The node graph: a QGraphicsView over the document drawn as nodes (textures | materials | objects,
+// then camera, render settings and lights) with links for assignments (a material to an object, a
+// texture to a material's albedo, roughness or alpha). The view never changes the document itself:
+// every gesture that would (link, unlink, create, delete, duplicate, rename, paste) becomes a
+// GraphEdit handed to the owner through editRequested, which applies it as one undo step and calls
+// setDocument again. Node positions and the selection are view state, kept by id across refreshes.
+//
+// Ownership: the view keeps a copy of the scene it shows (meshes are shared, so the copy is cheap)
+// and owns its graphics items; items are rebuilt on every setDocument, so nothing outside the view
+// holds them. GUI thread only.
+#pragma once
+
+#include <QGraphicsView>
+#include <QPointer>
+#include <QString>
+
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "retile/edit.h"
+
+class QGraphicsPathItem;
+class QGraphicsRectItem;
+class QLineEdit;
+
+namespace retile::ui {
+
+// An edit the graph asks for: (before, after) pairs that form one undo step. Applying the afters
+// in order does it; applying the befores in reverse order undoes it. Adding a node is
+// (RemoveNode{id}, AddX{...}); removing is the reverse, preceded by steps that clear the references
+// to the node (SetObject with material = kNoNode, ...) so that undo restores them.
+struct GraphEdit {
+  std::vector<std::pair<Edit, Edit>> steps;
+  QString text;
+};
+
+class GraphNodeItem;
+class NodeSearchPopup;
+
+class NodeGraphView : public QGraphicsView {
+  Q_OBJECT
+ public:
+  // Camera and render settings are singletons without a NodeId; their nodes use these.
+  static constexpr NodeId kCameraNode = ~NodeId{0};
+  static constexpr NodeId kSettingsNode = ~NodeId{0} - 1;
+
+  explicit NodeGraphView(QWidget* parent = nullptr);
+  ~NodeGraphView() override;
+
+  // Brings the graph up to date with the document (call after every applied edit). Keeps node
+  // positions and the selection by id; nodes seen for the first time go to the bottom of their column.
+  void setDocument(const Scene& scene);
+  const Scene& document() const { return scene_; }
+  // Forgets the remembered positions and lays everything out in columns again (after opening a
+  // file, whose ids may coincide with the old document's).
+  void resetLayout();
+  // From the outliner or the viewport: selects the object's node (kNoNode: nothing) without emitting.
+  void setSelectedObject(NodeId id);
+  void selectNodes(const std::vector<NodeId>& ids);  // programmatic, without emitting
+  std::vector<NodeId> selectedNodes() const;
+  bool hasNode(NodeId id) const;
+
+  // The gestures, callable from menus and tests. Each returns false when there is nothing to do or
+  // the edit would be refused; otherwise it has emitted editRequested.
+  // link(material, object, "material"); link(texture, material, "albedo" | "roughness" | "alpha").
+  bool link(NodeId from, NodeId to, const QString& input);
+  bool unlink(NodeId to, const QString& input);
+  NodeId linkSource(NodeId to, const QString& input) const;  // kNoNode when the input is free
+  // "Material", "Texture" (a checker), "Light", "Spot Light", "Directional Light".
+  bool createNode(const QString& type, QPointF scenePos);
+  static QStringList creatableTypes();
+  bool deleteSelected();     // camera and settings nodes stay
+  bool duplicateSelected();  // materials, objects, lights
+  void copySelected();       // materials and lights
+  bool paste();
+  bool renameNode(NodeId id, const QString& name);
+  // The id the next created node takes: the document's next id (Document::apply(AddX) reserves it,
+  // so the owner need not). Several nodes made in one edit take consecutive ids from here.
+  NodeId nextNewId() const { return scene_.peekNextId(); }
+
+  QPointF nodePosition(NodeId id) const;  // scene coordinates of the node's top-left; (0, 0) if absent
+  QPointF socketScenePos(NodeId id, const QString& socket, bool output) const;
+
+  void openNodeSearch(QPointF scenePos);  // the Tab / right-click menu
+  void startRename(NodeId id);            // the F2 inline editor
+  void frameSelected();                   // F (all when nothing is selected)
+  void frameAll();                        // A
+
+ signals:
+  void editRequested(const retile::ui::GraphEdit& edit);  // the owner applies it as one undo step
+  void objectSelected(quint64 id);                          // the user selected an object's node
+
+ protected:
+  bool event(QEvent* e) override;
+  void keyPressEvent(QKeyEvent* e) override;
+  void mousePressEvent(QMouseEvent* e) override;
+  void mouseMoveEvent(QMouseEvent* e) override;
+  void mouseReleaseEvent(QMouseEvent* e) override;
+  void mouseDoubleClickEvent(QMouseEvent* e) override;
+  void wheelEvent(QWheelEvent* e) override;
+  void showEvent(QShowEvent* e) override;
+  void drawBackground(QPainter* p, const QRectF& rect) override;
+
+ private:
+  struct Link {
+    NodeId from = kNoNode, to = kNoNode;
+    QString input;
+    QGraphicsPathItem* item = nullptr;
+  };
+  struct SocketHit {
+    GraphNodeItem* node = nullptr;
+    QString socket;
+    bool output = false;
+  };
+  enum class Drag { None, Link, Move, Marquee, Pan };
+
+  void rebuild();
+  GraphNodeItem* nodeAt(QPointF scenePos) const;
+  SocketHit socketAt(QPointF scenePos) const;
+  const Link* linkInto(NodeId to, const QString& input) const;
+  bool accepts(NodeId from, NodeId to, const QString& input) const;
+  void updateLinkPaths();
+  void finishLinkDrag(QPointF scenePos);
+  void setSelection(const std::vector<NodeId>& ids);
+  bool request(GraphEdit edit);
+  void frameRect(QRectF r);
+
+  Scene scene_;
+  bool hasDocument_ = false;
+  bool framed_ = false;
+  std::unordered_map<NodeId, GraphNodeItem*> nodes_;
+  std::unordered_map<NodeId, QPointF> positions_;
+  std::vector<Link> links_;
+  std::vector<NodeId> pendingSelection_;  // nodes an edit creates, selected once they appear
+
+  Drag drag_ = Drag::None;
+  QPoint pressPos_, lastPos_;        // viewport pixels
+  QPointF pressScene_;
+  NodeId pressedNode_ = kNoNode;
+  bool moved_ = false;
+  Qt::KeyboardModifiers pressModifiers_;
+  std::vector<std::pair<NodeId, QPointF>> moveStart_;
+  NodeId linkFrom_ = kNoNode;        // the output end of the link being dragged
+  NodeId detachedTo_ = kNoNode;      // a picked-up link's old input, or kNoNode for a new link
+  QString detachedInput_;
+  QGraphicsPathItem* dragLink_ = nullptr;
+  QGraphicsRectItem* marquee_ = nullptr;
+  std::vector<NodeId> marqueeBase_;  // the selection a Shift/Ctrl marquee adds to
+
+  NodeSearchPopup* search_ = nullptr;
+  QPointF searchScenePos_;
+  QPointer<QLineEdit> rename_;
+
+  std::vector<Material> copiedMaterials_;
+  std::vector<Light> copiedLights_;
+  std::vector<QPointF> copiedPositions_;  // materials then lights
+  int pasteCount_ = 0;
+};
+
+}  // namespace retile::ui

@@ -1,0 +1,395 @@
+#include "property_panel.h"
+
+#include <QComboBox>
+#include <QFormLayout>
+#include <QHBoxLayout>
+#include <QLabel>
+#include <QSlider>
+#include <QSpinBox>
+
+#include <algorithm>
+#include <cmath>
+
+#include "fields.h"
+
+namespace retile::ui {
+
+namespace {
+
+QColor toQColor(Vec3 c) {
+  auto ch = [](float v) { return std::clamp(static_cast<int>(std::lround(v * 255.0f)), 0, 255); };
+  return QColor(ch(c.x), ch(c.y), ch(c.z));
+}
+
+Vec3 fromQColor(const QColor& c) {
+  return Vec3{static_cast<float>(c.redF()), static_cast<float>(c.greenF()), static_cast<float>(c.blueF())};
+}
+
+float& axisOf(Vec3& v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
+
+// Colours above 1 (emission, bright skies) edit as a swatch of the normalised colour times a strength.
+float peak(Vec3 c) { return std::max({c.x, c.y, c.z}); }
+
+}  // namespace
+
+// Adds typed rows to the form; each field's edits carry the panel's drag id while scrubbing.
+class PropertyPanel::Builder {
+ public:
+  Builder(PropertyPanel* panel, QFormLayout* form) : p_(panel), form_(form) {}
+
+  void header(const QString& text) {
+    auto* l = new QLabel(QString("<b>%1</b>").arg(text.toHtmlEscaped()), p_->body_);
+    form_->addRow(l);
+  }
+  void label(const QString& name, const QString& text) { form_->addRow(name, new QLabel(text, p_->body_)); }
+
+  ScrubField* number(const QString& name, const QString& objectName, double value, double min, double max, double def,
+                     int decimals, std::function<void(double, int)> apply) {
+    auto* f = new ScrubField(value, min, max, def, decimals, p_->body_);
+    f->setObjectName(objectName);
+    connectField(f, std::move(apply));
+    form_->addRow(name, f);
+    return f;
+  }
+
+  void vec3(const QString& name, const QString& objectName, Vec3 value, double step, std::function<void(int, double, int)> apply) {
+    auto* row = new QWidget(p_->body_);
+    auto* l = new QHBoxLayout(row);
+    l->setContentsMargins(0, 0, 0, 0);
+    for (int axis = 0; axis < 3; ++axis) {
+      auto* f = new ScrubField(axisOf(value, axis), -1e5, 1e5, 0.0, 3, row);
+      f->setSingleStep(step);
+      f->setObjectName(QString("%1%2").arg(objectName).arg(axis));
+      connectField(f, [apply, axis](double v, int drag) { apply(axis, v, drag); });
+      l->addWidget(f);
+    }
+    form_->addRow(name, row);
+  }
+
+  ColorField* color(const QString& name, const QString& objectName, Vec3 value, Vec3 def, std::function<void(Vec3, int)> apply) {
+    auto* f = new ColorField(toQColor(value), toQColor(def), p_->body_);
+    f->setObjectName(objectName);
+    PropertyPanel* panel = p_;
+    QObject::connect(f, &ColorField::edited, f, [panel, apply](QColor c, bool dragging) {
+      apply(fromQColor(c), dragging ? panel->drag_ : 0);
+    });
+    QObject::connect(f, &ColorField::dragFinished, f, [panel] { ++panel->drag_; });
+    form_->addRow(name, f);
+    return f;
+  }
+
+  QComboBox* choice(const QString& name, const QString& objectName, const QStringList& items, int index,
+                    std::function<void(int)> apply) {
+    auto* c = new QComboBox(p_->body_);
+    c->setObjectName(objectName);
+    c->addItems(items);
+    c->setCurrentIndex(index);
+    QObject::connect(c, &QComboBox::currentIndexChanged, c, [apply](int i) { apply(i); });
+    form_->addRow(name, c);
+    return c;
+  }
+
+  void connectField(ScrubField* f, std::function<void(double, int)> apply) {
+    // The builder lives only while the panel builds: the connections capture the panel.
+    PropertyPanel* panel = p_;
+    QObject::connect(f, &ScrubField::edited, f, [panel, apply](double v, bool scrubbing) { apply(v, scrubbing ? panel->drag_ : 0); });
+    QObject::connect(f, &ScrubField::scrubFinished, f, [panel] { ++panel->drag_; });
+  }
+
+ private:
+  PropertyPanel* p_;
+  QFormLayout* form_;
+};
+
+PropertyPanel::PropertyPanel(SceneRef scene, Push push, QWidget* parent)
+    : QScrollArea(parent), scene_(std::move(scene)), push_(std::move(push)) {
+  setWidgetResizable(true);
+  setFrameShape(QFrame::NoFrame);
+  rebuild();
+}
+
+void PropertyPanel::setTarget(PropertyTarget t) {
+  target_ = t;
+  rebuild();
+}
+
+void PropertyPanel::rebuildLater() {
+  // Not from inside a field's signal: rebuilding deletes the field.
+  QMetaObject::invokeMethod(this, [this] { rebuild(); }, Qt::QueuedConnection);
+}
+
+void PropertyPanel::rebuild() {
+  // A fresh body each time: rows of the old target must not outlive it (their lambdas hold ids).
+  body_ = new QWidget;
+  form_ = new QFormLayout(body_);
+  form_->setFieldGrowthPolicy(QFormLayout::AllNonFixedFieldsGrow);
+  Builder b(this, form_);
+  const Scene& s = scene_();
+  switch (target_.kind) {
+    case PropertyTarget::Kind::Object:
+      if (const Object* o = s.object(target_.id)) {
+        buildObject(b, *o);
+        if (const Material* m = s.material(o->material)) buildMaterial(b, *m);
+      }
+      break;
+    case PropertyTarget::Kind::Material:
+      if (const Material* m = s.material(target_.id)) buildMaterial(b, *m);
+      break;
+    case PropertyTarget::Kind::Light:
+      if (const Light* l = s.light(target_.id)) buildLight(b, *l);
+      break;
+    case PropertyTarget::Kind::Camera: buildCamera(b); break;
+    case PropertyTarget::Kind::Environment: buildEnvironment(b); break;
+    case PropertyTarget::Kind::Render: buildRender(b); break;
+    case PropertyTarget::Kind::None: break;
+  }
+  if (form_->rowCount() == 0)
+    form_->addRow(new QLabel(tr("Click an object in the viewport, or anything in the outliner or the node graph."), body_));
+  setWidget(body_);  // deletes the previous body
+}
+
+void PropertyPanel::buildObject(Builder& b, const Object& o) {
+  const NodeId id = o.id;
+  auto edit = [this, id](const QString& what, int drag, const std::function<void(Object&)>& change) {
+    const Object* cur = scene_().object(id);
+    if (!cur) return;
+    Object after = *cur;
+    change(after);
+    push_(SetObject{*cur}, SetObject{after}, what, drag);
+  };
+  b.header(tr("Object: %1").arg(QString::fromStdString(o.name)));
+  // Position moves the object and keeps its rotation and scale.
+  b.vec3(tr("Position"), "position", o.transform.transformPoint(Vec3{0.0f}), 0.01, [edit](int axis, double v, int drag) {
+    edit(tr("Move"), drag, [&](Object& x) {
+      Vec3 p = x.transform.transformPoint(Vec3{0.0f});
+      Vec3 d{0.0f};
+      axisOf(d, axis) = static_cast<float>(v) - axisOf(p, axis);
+      x.transform = Mat4::translate(d) * x.transform;
+    });
+  });
+  QStringList names{tr("(none)")};
+  std::vector<NodeId> ids{kNoNode};
+  int current = 0;
+  for (const Material& m : scene_().materials) {
+    if (m.id == o.material) current = static_cast<int>(ids.size());
+    names << QString::fromStdString(m.name);
+    ids.push_back(m.id);
+  }
+  b.choice(tr("Material"), "materialAssignment", names, current, [edit, ids](int i) {
+    if (i < 0 || i >= static_cast<int>(ids.size())) return;
+    NodeId m = ids[static_cast<std::size_t>(i)];
+    edit(tr("Assign material"), 0, [m](Object& x) { x.material = m; });
+  });
+}
+
+void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
+  const NodeId id = m.id;
+  auto edit = [this, id](const QString& what, int drag, const std::function<void(Material&)>& change) {
+    const Material* cur = scene_().material(id);
+    if (!cur) return;
+    Material after = *cur;
+    change(after);
+    push_(SetMaterial{*cur}, SetMaterial{after}, what, drag);
+  };
+  const Material defaults;
+  b.header(tr("Material: %1").arg(QString::fromStdString(m.name)));
+  QStringList types;
+  for (int t = 0; t < kMaterialTypeCount; ++t) types << materialTypeName(static_cast<MaterialType>(t));
+  b.choice(tr("Type"), "materialType", types, static_cast<int>(m.type), [this, edit](int i) {
+    edit(tr("Material type"), 0, [i](Material& x) { x.type = static_cast<MaterialType>(i); });
+    rebuildLater();  // the type decides which fields apply
+  });
+  b.color(tr("Albedo"), "albedo", m.albedo, defaults.albedo, [edit](Vec3 c, int drag) {
+    edit(tr("Albedo"), drag, [c](Material& x) { x.albedo = c; });
+  });
+  const bool rough = m.type == MaterialType::RoughPlastic || m.type == MaterialType::RoughConductor ||
+                     m.type == MaterialType::RoughDielectric || m.type == MaterialType::OrenNayar;
+  if (rough || m.type == MaterialType::Lambert || m.type == MaterialType::Plastic) {
+    // A slider as well as the field: the gesture look-dev artists use most.
+    auto* row = new QWidget(body_);
+    auto* l = new QHBoxLayout(row);
+    l->setContentsMargins(0, 0, 0, 0);
+    auto* slider = new QSlider(Qt::Horizontal, row);
+    slider->setObjectName("roughnessSlider");
+    slider->setRange(0, 1000);
+    slider->setValue(static_cast<int>(std::lround(m.roughness * 1000)));
+    auto* field = new ScrubField(m.roughness, 0.0, 1.0, defaults.roughness, 3, row);
+    field->setObjectName("roughness");
+    l->addWidget(slider, 1);
+    l->addWidget(field);
+    QObject::connect(slider, &QSlider::valueChanged, slider, [this, slider, field, edit](int v) {
+      QSignalBlocker block(field);
+      field->setValue(v / 1000.0);
+      edit(tr("Roughness"), slider->isSliderDown() ? drag_ : 0, [v](Material& x) { x.roughness = std::max(0.001f, v / 1000.0f); });
+    });
+    QObject::connect(slider, &QSlider::sliderReleased, slider, [this] { ++drag_; });
+    b.connectField(field, [slider, edit](double v, int drag) {
+      QSignalBlocker block(slider);
+      slider->setValue(static_cast<int>(std::lround(v * 1000)));
+      edit(tr("Roughness"), drag, [v](Material& x) { x.roughness = std::max(0.001f, static_cast<float>(v)); });
+    });
+    form_->addRow(tr("Roughness"), row);
+  }
+  if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic || m.type == MaterialType::Dielectric ||
+      m.type == MaterialType::RoughDielectric || m.type == MaterialType::ThinSheet) {
+    b.number(tr("IOR"), "ior", m.ior, 1.0, 4.0, defaults.ior, 3, [edit](double v, int drag) {
+      edit(tr("IOR"), drag, [v](Material& x) { x.ior = static_cast<float>(v); });
+    });
+  }
+  if (m.type == MaterialType::Conductor || m.type == MaterialType::RoughConductor) {
+    QStringList metals;
+    for (const auto& n : conductorNames()) metals << QString::fromStdString(n);
+    b.choice(tr("Metal"), "metal", metals, std::max(0, static_cast<int>(metals.indexOf(QString::fromStdString(m.metal)))),
+             [edit, metals](int i) {
+               std::string name = metals.value(i).toStdString();
+               edit(tr("Metal"), 0, [&](Material& x) {
+                 x.metal = name;
+                 conductorIor(name, &x.eta, &x.k);
+               });
+             });
+  }
+  const float strength = peak(m.emission);
+  const Vec3 tint = strength > 0 ? m.emission * (1.0f / strength) : Vec3{1.0f};
+  b.color(tr("Emission colour"), "emissionColor", tint, Vec3{1.0f}, [this, id, edit](Vec3 c, int drag) {
+    const Material* cur = scene_().material(id);
+    float s = cur ? peak(cur->emission) : 0.0f;
+    edit(tr("Emission colour"), drag, [c, s](Material& x) { x.emission = c * s; });
+  });
+  b.number(tr("Emission"), "emission", strength, 0.0, 1e5, 0.0, 2, [this, id, edit](double v, int drag) {
+    const Material* cur = scene_().material(id);
+    if (!cur) return;
+    float s = peak(cur->emission);
+    Vec3 t = s > 0 ? cur->emission * (1.0f / s) : Vec3{1.0f};
+    edit(tr("Emission"), drag, [t, v](Material& x) { x.emission = t * static_cast<float>(v); });
+  });
+  b.number(tr("Alpha"), "alpha", m.alpha, 0.0, 1.0, 1.0, 3, [edit](double v, int drag) {
+    edit(tr("Alpha"), drag, [v](Material& x) { x.alpha = static_cast<float>(v); });
+  });
+}
+
+void PropertyPanel::buildLight(Builder& b, const Light& l) {
+  const NodeId id = l.id;
+  auto edit = [this, id](const QString& what, int drag, const std::function<void(Light&)>& change) {
+    const Light* cur = scene_().light(id);
+    if (!cur) return;
+    Light after = *cur;
+    change(after);
+    push_(SetLight{*cur}, SetLight{after}, what, drag);
+  };
+  const Light defaults;
+  b.header(tr("Light: %1").arg(QString::fromStdString(l.name)));
+  b.choice(tr("Type"), "lightType", {tr("point"), tr("spot"), tr("directional")}, static_cast<int>(l.type), [this, edit](int i) {
+    edit(tr("Light type"), 0, [i](Light& x) { x.type = static_cast<LightType>(i); });
+    rebuildLater();
+  });
+  b.color(tr("Colour"), "lightColor", l.color, defaults.color, [edit](Vec3 c, int drag) {
+    edit(tr("Light colour"), drag, [c](Light& x) { x.color = c; });
+  });
+  b.number(tr("Intensity"), "intensity", l.intensity, 0.0, 1e6, defaults.intensity, 3, [edit](double v, int drag) {
+    edit(tr("Light intensity"), drag, [v](Light& x) { x.intensity = static_cast<float>(v); });
+  });
+  if (l.type != LightType::Directional)
+    b.vec3(tr("Position"), "lightPosition", l.position, 0.01, [edit](int axis, double v, int drag) {
+      edit(tr("Move light"), drag, [&](Light& x) { axisOf(x.position, axis) = static_cast<float>(v); });
+    });
+  if (l.type != LightType::Point)
+    b.vec3(tr("Direction"), "lightDirection", l.direction, 0.01, [edit](int axis, double v, int drag) {
+      edit(tr("Aim light"), drag, [&](Light& x) {
+        Vec3 d = x.direction;
+        axisOf(d, axis) = static_cast<float>(v);
+        if (length(d) > 1e-6f) x.direction = d;  // a zero direction is refused, not sent
+      });
+    });
+  if (l.type == LightType::Spot) {
+    b.number(tr("Cone half angle"), "spotAngle", degrees(l.spotAngle), 0.5, 89.0, degrees(defaults.spotAngle), 1,
+             [edit](double v, int drag) { edit(tr("Spot angle"), drag, [v](Light& x) { x.spotAngle = radians(static_cast<float>(v)); }); });
+    b.number(tr("Blend"), "spotBlend", l.spotBlend, 0.0, 1.0, defaults.spotBlend, 3,
+             [edit](double v, int drag) { edit(tr("Spot blend"), drag, [v](Light& x) { x.spotBlend = static_cast<float>(v); }); });
+  }
+}
+
+void PropertyPanel::buildCamera(Builder& b) {
+  auto edit = [this](const QString& what, int drag, const std::function<void(Camera&)>& change) {
+    Camera after = scene_().camera;
+    change(after);
+    push_(SetCamera{scene_().camera}, SetCamera{after}, what, drag);
+  };
+  const Camera& c = scene_().camera;
+  b.header(tr("Camera"));
+  b.vec3(tr("Position"), "cameraPosition", c.position, 0.01, [edit](int axis, double v, int drag) {
+    edit(tr("Camera position"), drag, [&](Camera& x) { axisOf(x.position, axis) = static_cast<float>(v); });
+  });
+  b.vec3(tr("Looks at"), "cameraTarget", c.target, 0.01, [edit](int axis, double v, int drag) {
+    edit(tr("Camera target"), drag, [&](Camera& x) { axisOf(x.target, axis) = static_cast<float>(v); });
+  });
+  b.number(tr("Vertical field of view"), "fov", degrees(c.verticalFov), 1.0, 170.0, 40.0, 1, [edit](double v, int drag) {
+    edit(tr("Field of view"), drag, [v](Camera& x) { x.verticalFov = radians(static_cast<float>(v)); });
+  });
+}
+
+void PropertyPanel::buildEnvironment(Builder& b) {
+  auto edit = [this](const QString& what, int drag, const std::function<void(Environment&)>& change) {
+    Environment after = scene_().environment;
+    change(after);
+    push_(SetEnvironment{scene_().environment}, SetEnvironment{after}, what, drag);
+  };
+  const Environment& e = scene_().environment;
+  const Environment defaults;
+  b.header(tr("Environment"));
+  QStringList types{tr("constant"), tr("map"), tr("sky")};
+  if (e.type != EnvironmentType::Map && e.map == kNoNode) types.removeAt(1);
+  int index = e.type == EnvironmentType::Constant ? 0 : e.type == EnvironmentType::Sky ? types.size() - 1 : 1;
+  b.choice(tr("Type"), "environmentType", types, index, [this, edit, types](int i) {
+    QString t = types.value(i);
+    EnvironmentType type = t == tr("sky") ? EnvironmentType::Sky : t == tr("map") ? EnvironmentType::Map : EnvironmentType::Constant;
+    edit(tr("Environment type"), 0, [type](Environment& x) { x.type = type; });
+    rebuildLater();
+  });
+  b.number(tr("Intensity"), "environmentIntensity", e.intensity, 0.0, 1e4, defaults.intensity, 3, [edit](double v, int drag) {
+    edit(tr("Environment intensity"), drag, [v](Environment& x) { x.intensity = static_cast<float>(v); });
+  });
+  if (e.type != EnvironmentType::Sky) {
+    b.color(tr("Colour"), "environmentColor", e.color, Vec3{1.0f}, [edit](Vec3 c, int drag) {
+      edit(tr("Environment colour"), drag, [c](Environment& x) { x.color = c; });
+    });
+  }
+  if (e.type == EnvironmentType::Map)
+    b.number(tr("Rotation"), "environmentRotation", degrees(e.rotation), -360.0, 360.0, 0.0, 1, [edit](double v, int drag) {
+      edit(tr("Environment rotation"), drag, [v](Environment& x) { x.rotation = radians(static_cast<float>(v)); });
+    });
+  if (e.type == EnvironmentType::Sky) {
+    b.color(tr("Zenith"), "zenith", e.zenith, defaults.zenith, [edit](Vec3 c, int drag) {
+      edit(tr("Sky zenith"), drag, [c](Environment& x) { x.zenith = c; });
+    });
+    b.color(tr("Horizon"), "horizon", e.horizon, defaults.horizon, [edit](Vec3 c, int drag) {
+      edit(tr("Sky horizon"), drag, [c](Environment& x) { x.horizon = c; });
+    });
+    b.color(tr("Ground"), "ground", e.ground, defaults.ground, [edit](Vec3 c, int drag) {
+      edit(tr("Sky ground"), drag, [c](Environment& x) { x.ground = c; });
+    });
+  }
+}
+
+void PropertyPanel::buildRender(Builder& b) {
+  auto edit = [this](const QString& what, int drag, const std::function<void(RenderSettings&)>& change) {
+    RenderSettings before = scene_().settings, after = before;
+    change(after);
+    // The engine renders at the viewport's size; a settings edit must not resize it.
+    if (!renderSize_.isEmpty()) {
+      before.width = after.width = renderSize_.width();
+      before.height = after.height = renderSize_.height();
+    }
+    push_(SetRenderSettings{before}, SetRenderSettings{after}, what, drag);
+  };
+  const RenderSettings& r = scene_().settings;
+  b.header(tr("Render settings"));
+  b.number(tr("Max bounces"), "maxBounces", r.maxBounces, 0, 1024, RenderSettings{}.maxBounces, 0, [edit](double v, int drag) {
+    edit(tr("Max bounces"), drag, [v](RenderSettings& x) { x.maxBounces = static_cast<int>(v); });
+  });
+  b.number(tr("Seed"), "seed", r.seed, 0, 1e9, 0, 0, [edit](double v, int drag) {
+    edit(tr("Seed"), drag, [v](RenderSettings& x) { x.seed = static_cast<std::uint32_t>(v); });
+  });
+  b.label(tr("Resolution"), tr("%1 x %2 (the viewport's size times the render scale)").arg(renderSize_.width()).arg(renderSize_.height()));
+}
+
+}  // namespace retile::ui

@@ -1,0 +1,58 @@
+// The properties dock: typed editors for whatever the outliner, viewport or node graph points at
+// (an object with its material, a material, a light, the camera, the environment, the render
+// settings). Every change is an undoable edit pushed through the owner; a scrub or a colour
+// dialog session is one undo step. GUI thread only; the panel holds no scene state of its own:
+// it reads the owner's document whenever it builds or edits.
+#pragma once
+
+#include <QScrollArea>
+
+#include <functional>
+
+#include "retile/edit.h"
+
+class QFormLayout;
+
+namespace retile::ui {
+
+struct PropertyTarget {
+  enum class Kind { None, Object, Material, Light, Camera, Environment, Render } kind = Kind::None;
+  NodeId id = kNoNode;
+  bool operator==(const PropertyTarget&) const = default;
+};
+
+class PropertyPanel : public QScrollArea {
+  Q_OBJECT
+ public:
+  // `push` applies an edit as an undo step; edits with the same dragId > 0 merge.
+  using Push = std::function<void(const Edit& before, const Edit& after, const QString& text, int dragId)>;
+  using SceneRef = std::function<const Scene&()>;
+  PropertyPanel(SceneRef scene, Push push, QWidget* parent = nullptr);
+
+  void setTarget(PropertyTarget t);
+  PropertyTarget target() const { return target_; }
+  // Rebuilds the editors from the document (after undo, redo or a structural change).
+  void rebuild();
+  void rebuildLater();
+  // Render settings edits keep the engine's current resolution (the viewport owns it).
+  void setRenderSize(QSize s) { renderSize_ = s; }
+
+ private:
+  class Builder;
+  void buildObject(Builder& b, const Object& o);
+  void buildMaterial(Builder& b, const Material& m);
+  void buildLight(Builder& b, const Light& l);
+  void buildCamera(Builder& b);
+  void buildEnvironment(Builder& b);
+  void buildRender(Builder& b);
+
+  SceneRef scene_;
+  Push push_;
+  PropertyTarget target_;
+  QSize renderSize_;
+  QWidget* body_ = nullptr;
+  QFormLayout* form_ = nullptr;
+  int drag_ = 1000000;  // drag ids of this panel: far from the viewport's
+};
+
+}  // namespace retile::ui
