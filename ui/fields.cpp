@@ -21,6 +21,9 @@ ScrubField::ScrubField(double value, double min, double max, double defaultValue
   setKeyboardTracking(false);  // typing does not edit until Enter (or focus leaves)
   setValue(value);
   setCursor(Qt::SizeHorCursor);
+  // The range's widest text would make vector rows wider than a dock: let the layout decide.
+  setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
+  setMinimumWidth(56);
   setToolTip(tr("Drag to scrub (Shift: finer), click to type, Enter commits, Esc cancels; right-click resets"));
   // The line edit eats mouse presses; watch them on the spin box instead.
   lineEdit()->setAttribute(Qt::WA_TransparentForMouseEvents, true);
@@ -94,6 +97,8 @@ void ScrubField::contextMenuEvent(QContextMenuEvent* e) {
 
 ColorField::ColorField(QColor value, QColor defaultValue, QWidget* parent)
     : QPushButton(parent), default_(defaultValue) {
+  setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
+  setMinimumWidth(56);
   setColor(value);
   connect(this, &QPushButton::clicked, this, [this] {
     // Non-modal: the render follows the dialog's colour live; the session is one undo step.

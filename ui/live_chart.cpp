@@ -28,7 +28,7 @@ QChartView* makeView(QChart* chart, QWidget* parent) {
   chart->setBackgroundRoundness(0);
   auto* v = new QChartView(chart, parent);
   v->setRenderHint(QPainter::Antialiasing);
-  v->setMinimumHeight(140);
+  v->setMinimumHeight(110);
   return v;
 }
 
@@ -65,7 +65,10 @@ LiveChart::LiveChart(QWidget* parent) : QWidget(parent) {
   samplesPerSecond_->attachAxis(rateAxis_);
   frameMs_->attachAxis(timeAxis_);
   frameMs_->attachAxis(msAxis_);
-  layout->addWidget(makeView(chart, this), 1);
+  // Side by side: the bottom dock is wide and short.
+  auto* charts = new QHBoxLayout;
+  charts->addWidget(makeView(chart, this), 1);
+  layout->addLayout(charts, 1);
 
   auto* errChart = new QChart;
   errChart->setTitle(tr("Relative RMSE against the reference"));
@@ -80,7 +83,7 @@ LiveChart::LiveChart(QWidget* parent) : QWidget(parent) {
   errChart->addAxis(errAxis_, Qt::AlignLeft);
   error_->attachAxis(errTimeAxis_);
   error_->attachAxis(errAxis_);
-  layout->addWidget(makeView(errChart, this), 1);
+  charts->addWidget(makeView(errChart, this), 1);
 
   auto* row = new QHBoxLayout;
   referenceButton_ = new QPushButton(tr("Render reference"), this);

@@ -22,6 +22,7 @@
 #include <QFileDialog>
 #include <QFormLayout>
 #include <QGroupBox>
+#include <QScrollArea>
 #include <QVBoxLayout>
 #include <QHBoxLayout>
 #include <QHeaderView>
@@ -383,11 +384,18 @@ void MainWindow::buildDocks() {
 
   renderPanel_ = new PropertyPanel([this]() -> const Scene& { return doc_.scene(); }, push, settingsPanel);
   renderPanel_->setTarget({PropertyTarget::Kind::Render, kNoNode});
+  renderPanel_->setMinimumHeight(130);
   sl->addWidget(renderPanel_, 1);
   auto* methodDock = new QDockWidget(tr("Render settings"), this);
   methodDock->setObjectName("renderSettings");
-  methodDock->setWidget(settingsPanel);
-  addDockWidget(Qt::RightDockWidgetArea, methodDock);
+  // Scrolls rather than forcing the window taller than small screens.
+  auto* settingsScroll = new QScrollArea(this);
+  settingsScroll->setWidgetResizable(true);
+  settingsScroll->setFrameShape(QFrame::NoFrame);
+  settingsScroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  settingsScroll->setWidget(settingsPanel);
+  methodDock->setWidget(settingsScroll);
+  addDockWidget(Qt::LeftDockWidgetArea, methodDock);
 
   // The pixel inspector: linear values under the cursor; Ctrl+drag a region for its statistics.
   inspector_ = new QLabel(tr("Hover the image for linear values; Ctrl+drag a region for its mean, min and max."), this);
@@ -399,6 +407,8 @@ void MainWindow::buildDocks() {
   inspectorDock->setObjectName("inspectorDock");
   inspectorDock->setWidget(inspector_);
   addDockWidget(Qt::LeftDockWidgetArea, inspectorDock);
+  tabifyDockWidget(methodDock, inspectorDock);
+  methodDock->raise();
 
   log_ = new QPlainTextEdit(this);
   log_->setReadOnly(true);
@@ -442,6 +452,13 @@ void MainWindow::buildDocks() {
   tabifyDockWidget(graphDock, chartDock);
   tabifyDockWidget(graphDock, logDock);
   graphDock->raise();
+  // The viewport keeps most of the window; the panels take what they need.
+  // (After the first layout: before it, the docks have no sizes to take from.)
+  QTimer::singleShot(0, this, [this, outlinerDock, propDock, graphDock] {
+    resizeDocks({outlinerDock, propDock}, {300, 360}, Qt::Horizontal);
+    resizeDocks({graphDock}, {230}, Qt::Vertical);
+    graph_->frameAll();
+  });
 }
 
 void MainWindow::sendMethod() {

@@ -105,6 +105,7 @@ PropertyPanel::PropertyPanel(SceneRef scene, Push push, QWidget* parent)
     : QScrollArea(parent), scene_(std::move(scene)), push_(std::move(push)) {
   setWidgetResizable(true);
   setFrameShape(QFrame::NoFrame);
+  setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);  // fields narrow to the dock instead
   rebuild();
 }
 
@@ -215,6 +216,8 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     slider->setValue(static_cast<int>(std::lround(m.roughness * 1000)));
     auto* field = new ScrubField(m.roughness, 0.0, 1.0, defaults.roughness, 3, row);
     field->setObjectName("roughness");
+    field->setSizePolicy(QSizePolicy::Fixed, QSizePolicy::Fixed);
+    field->setFixedWidth(72);
     l->addWidget(slider, 1);
     l->addWidget(field);
     QObject::connect(slider, &QSlider::valueChanged, slider, [this, slider, field, edit](int v) {
