@@ -89,6 +89,55 @@ void FrameView::setWipe(double x) {
   refresh();
 }
 
+void FrameView::setTool(Tool t) {
+  tool_ = t;
+  refresh();
+}
+
+void FrameView::setGizmo(const Gizmo& g) {
+  gizmo_ = g;
+  refresh();
+}
+
+QPointF FrameView::toWidget(QPointF px) const {
+  QRectF r = imageRect();
+  if (!frame_) return r.topLeft();
+  return {r.x() + px.x() * r.width() / frame_->width, r.y() + px.y() * r.height() / frame_->height};
+}
+
+void FrameView::drawGizmo(QPainter& p) const {
+  if (!gizmo_.visible || tool_ == Tool::Select || !frame_) return;
+  static const QColor axisColor[3] = {QColor(240, 70, 70), QColor(90, 220, 90), QColor(80, 140, 255)};
+  const QPointF o = toWidget(gizmo_.origin);
+  p.setRenderHint(QPainter::Antialiasing, true);
+  if (tool_ == Tool::Rotate) {
+    p.setPen(QPen(axisColor[1], 2.5));
+    p.setBrush(Qt::NoBrush);
+    p.drawEllipse(o, 34, 12);
+    p.drawText(o + QPointF(38, 4), tr("drag: turn about y"));
+    return;
+  }
+  for (int a = 0; a < 3; ++a) {
+    const QPointF e = toWidget(gizmo_.axisEnd[a]);
+    p.setPen(QPen(axisColor[a], 2.5));
+    p.drawLine(o, e);
+    p.setBrush(axisColor[a]);
+    if (tool_ == Tool::Scale) {
+      p.drawRect(QRectF(e - QPointF(4, 4), QSizeF(8, 8)));
+    } else {
+      QPointF d = e - o;
+      double len = std::hypot(d.x(), d.y());
+      if (len < 1) continue;
+      QPointF u = d / len, n(-u.y(), u.x());
+      QPolygonF head({e + u * 9, e + n * 5, e - n * 5});
+      p.drawPolygon(head);
+    }
+  }
+  p.setBrush(Qt::white);
+  p.setPen(Qt::NoPen);
+  p.drawEllipse(o, 3.5, 3.5);
+}
+
 QRectF FrameView::imageRect() const {
   if (image_.isNull()) return rect();
   double s = std::min(width() / static_cast<double>(image_.width()), height() / static_cast<double>(image_.height()));
@@ -144,6 +193,7 @@ void FrameView::compose(QPainter& p, const QRect& area) const {
     p.drawImage(r, image_);
   }
   drawOverlays(p, r);
+  drawGizmo(p);
   if (compare_ != Compare::Off && snapshotUsable) {
     p.setFont(QFont(font().family(), 11, QFont::Bold));
     p.setPen(QColor(255, 255, 255));
@@ -298,6 +348,21 @@ void FrameView::mousePressEvent(QMouseEvent* e) {
     return;
   }
   if (!frame_ || !frame_->image || e->button() != Qt::LeftButton) return;
+  if (tool_ == Tool::Move && gizmo_.visible) {
+    // A press near an arrow drags along that world axis.
+    const QPointF o = toWidget(gizmo_.origin), pos = e->position();
+    for (int a = 0; a < 3; ++a) {
+      const QPointF d = toWidget(gizmo_.axisEnd[a]) - o;
+      const double len2 = d.x() * d.x() + d.y() * d.y();
+      if (len2 < 4) continue;
+      const double t = std::clamp(((pos.x() - o.x()) * d.x() + (pos.y() - o.y()) * d.y()) / len2, 0.0, 1.0);
+      if (t > 0.25 && std::hypot(pos.x() - (o.x() + t * d.x()), pos.y() - (o.y() + t * d.y())) < 7) {
+        drag_ = Drag::Axis;
+        dragAxis_ = a;
+        return;
+      }
+    }
+  }
   QRectF r = imageRect();
   if (!r.contains(e->position())) return;
   double u = (e->position().x() - r.x()) / r.width(), v = (e->position().y() - r.y()) / r.height();
@@ -311,8 +376,8 @@ void FrameView::mousePressEvent(QMouseEvent* e) {
   std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(frame_->width) + static_cast<std::size_t>(x);
   quint64 id = i < ids.size() ? static_cast<quint64>(ids[i]) : 0;
   // Pressing on the selection starts moving it; anywhere else picks.
-  if (id != 0 && id == selected_) {
-    drag_ = Drag::Object;
+  if (id != 0 && id == selected_ && tool_ != Tool::Select) {
+    drag_ = tool_ == Tool::Rotate ? Drag::Rotate : tool_ == Tool::Scale ? Drag::Scale : Drag::Object;
     return;
   }
   emit objectPicked(id);
@@ -345,6 +410,13 @@ void FrameView::mouseMoveEvent(QMouseEvent* e) {
     case Drag::Orbit: emit orbitDragged(d); break;
     case Drag::Pan: emit panDragged(d); break;
     case Drag::Dolly: emit dollyDragged(-d.y() / 200.0); break;
+    case Drag::Rotate: emit rotateDragged(d.x()); break;
+    case Drag::Scale: emit scaleDragged(d.x()); break;
+    case Drag::Axis: {
+      QRectF r = imageRect();
+      if (frame_ && r.width() > 0) emit axisDragged(dragAxis_, QPointF(d.x() * frame_->width / r.width(), d.y() * frame_->height / r.height()));
+      break;
+    }
     case Drag::Object: {
       QRectF r = imageRect();
       if (frame_ && r.width() > 0) emit objectDragged(QPointF(d.x() * frame_->width / r.width(), d.y() * frame_->height / r.height()));

@@ -52,6 +52,18 @@ class FrameView : public QWidget {
   Compare compare() const { return compare_; }
   void setWipe(double x);
 
+  // Q/W/E/R: what a left drag on the selection does. The gizmo (image pixels) is the selection's
+  // origin and the ends of its world x, y and z axes, placed by the owner from the camera.
+  enum class Tool { Select, Move, Rotate, Scale };
+  struct Gizmo {
+    bool visible = false;
+    QPointF origin;
+    QPointF axisEnd[3];
+  };
+  void setTool(Tool t);
+  Tool tool() const { return tool_; }
+  void setGizmo(const Gizmo& g);
+
   // The presenting Vulkan window, or nullptr when this widget paints (and why, for the log).
   VulkanViewport* vulkanWindow() const { return vulkan_; }
   QString presentation() const { return presentation_; }
@@ -66,7 +78,10 @@ class FrameView : public QWidget {
   void orbitDragged(QPointF delta);       // Alt + left
   void panDragged(QPointF delta);         // Alt + middle
   void dollyDragged(double amount);       // Alt + right, or the wheel (positive: closer)
-  void objectDragged(QPointF imageDelta);  // left drag starting on the selection: image pixels
+  void objectDragged(QPointF imageDelta);  // Move tool, left drag starting on the selection: image pixels
+  void axisDragged(int axis, QPointF imageDelta);  // Move tool, drag of a gizmo arrow
+  void rotateDragged(double pixels);              // Rotate tool: horizontal drag turns about world y
+  void scaleDragged(double pixels);               // Scale tool: horizontal drag scales uniformly
   void dragFinished();
   // Pixel inspector: linear values under the cursor, and the statistics of a Ctrl+drag region
   // (image pixels, inclusive-exclusive).
@@ -94,7 +109,12 @@ class FrameView : public QWidget {
   OverlaySettings overlays_;
   DisplaySettings display_;
   bool paused_ = false;
-  enum class Drag { None, Orbit, Pan, Dolly, Object, Region, Wipe } drag_ = Drag::None;
+  enum class Drag { None, Orbit, Pan, Dolly, Object, Axis, Rotate, Scale, Region, Wipe } drag_ = Drag::None;
+  int dragAxis_ = 0;
+  Tool tool_ = Tool::Move;
+  Gizmo gizmo_;
+  QPointF toWidget(QPointF imagePixel) const;
+  void drawGizmo(QPainter& p) const;
   QPointF last_, regionStart_;
   QRect region_;  // the inspected region in image pixels
   quint64 selected_ = 0;

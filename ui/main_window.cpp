@@ -141,6 +141,37 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
     after.transform = Mat4::translate(right * static_cast<float>(d.x() * k) - up * static_cast<float>(d.y() * k)) * o->transform;
     edit(SetObject{*o}, SetObject{after}, tr("Move %1").arg(QString::fromStdString(o->name)), dragCounter_ + 1);
   });
+  // The gizmo: drag an arrow to move along a world axis; E and R turn and scale about the origin.
+  connect(view_, &FrameView::axisDragged, this, [this](int axis, QPointF d) {
+    const Object* o = doc_.scene().object(selection_);
+    const FrameView::Gizmo& g = gizmo_;
+    if (!o || !g.visible) return;
+    const QPointF dir = g.axisEnd[axis] - g.origin;  // image pixels per gizmoLength_ world units
+    const double len2 = dir.x() * dir.x() + dir.y() * dir.y();
+    if (len2 < 1e-6) return;
+    const float t = static_cast<float>((d.x() * dir.x() + d.y() * dir.y()) / len2) * gizmoLength_;
+    Vec3 step{0.0f};
+    (axis == 0 ? step.x : axis == 1 ? step.y : step.z) = t;
+    Object after = *o;
+    after.transform = Mat4::translate(step) * o->transform;
+    edit(SetObject{*o}, SetObject{after}, tr("Move %1 along %2").arg(QString::fromStdString(o->name)).arg(QChar('x' + axis)),
+         dragCounter_ + 1);
+  });
+  auto aboutOrigin = [this](const Mat4& m, const QString& what) {
+    const Object* o = doc_.scene().object(selection_);
+    if (!o) return;
+    const Vec3 at = o->transform.transformPoint(Vec3{0.0f});
+    Object after = *o;
+    after.transform = Mat4::translate(at) * m * Mat4::translate(at * -1.0f) * o->transform;
+    edit(SetObject{*o}, SetObject{after}, what.arg(QString::fromStdString(o->name)), dragCounter_ + 1);
+  };
+  connect(view_, &FrameView::rotateDragged, this, [aboutOrigin](double px) {
+    aboutOrigin(Mat4::rotateY(static_cast<float>(px * 0.01)), tr("Rotate %1"));
+  });
+  connect(view_, &FrameView::scaleDragged, this, [aboutOrigin](double px) {
+    const float s = static_cast<float>(std::exp(px * 0.005));
+    aboutOrigin(Mat4::scale(Vec3{s, s, s}), tr("Scale %1"));
+  });
   setAcceptDrops(true);
   // Autosave every 5 minutes ($RETILE_AUTOSAVE_SECONDS overrides) to rotating recovery files.
   auto* autosaveTimer = new QTimer(this);
@@ -219,6 +250,19 @@ void MainWindow::buildMenus() {
   toggle(tr("Tiles served this &frame"), &OverlaySettings::served);
   toggle(tr("Point of change and &focus points"), &OverlaySettings::markers);
   toggle(tr("&Legend"), &OverlaySettings::legend);
+
+  QMenu* tools = menuBar()->addMenu(tr("&Tools"));
+  auto* toolGroup = new QActionGroup(this);
+  auto tool = [&](const QString& name, FrameView::Tool t, Qt::Key key) {
+    QAction* a = tools->addAction(name, QKeySequence(key), this, [this, t] { view_->setTool(t); });
+    a->setCheckable(true);
+    a->setChecked(t == view_->tool());
+    toolGroup->addAction(a);
+  };
+  tool(tr("&Select (Q)"), FrameView::Tool::Select, Qt::Key_Q);
+  tool(tr("&Move (W): drag the selection or a gizmo arrow"), FrameView::Tool::Move, Qt::Key_W);
+  tool(tr("&Rotate (E): drag turns about y"), FrameView::Tool::Rotate, Qt::Key_E);
+  tool(tr("S&cale (R): drag scales"), FrameView::Tool::Scale, Qt::Key_R);
 
   QMenu* compare = menuBar()->addMenu(tr("&Compare"));
   compare->addAction(tr("Take &snapshot (B)"), QKeySequence(Qt::CTRL | Qt::Key_B), this, [this] {
@@ -513,6 +557,7 @@ void MainWindow::onFrame() {
   for (const auto& e : engine_->takeErrors()) log(QString::fromStdString(e));
   if (!frame) return;
   view_->showFrame(frame);
+  updateGizmo();
   chart_->addFrame(*frame);
   ++framesSeen_;
   qint64 now = QDateTime::currentMSecsSinceEpoch();
@@ -560,6 +605,31 @@ bool MainWindow::applyToDocument(const Edit& e) {
   return true;
 }
 
+void MainWindow::updateGizmo() {
+  FrameView::Gizmo g;
+  const Object* o = doc_.scene().object(selection_);
+  auto frame = view_->frame();
+  if (o && frame) {
+    const Camera& c = doc_.scene().camera;
+    const Vec3 at = o->transform.transformPoint(Vec3{0.0f});
+    // A fixed share of the view: arrows keep their on-screen size as the camera moves.
+    gizmoLength_ = 0.12f * length(at - c.position) * std::tan(c.verticalFov * 0.5f) * 2.0f;
+    auto origin = projectToImage(c, frame->width, frame->height, at);
+    if (origin && gizmoLength_ > 0) {
+      g.visible = true;
+      g.origin = QPointF(origin->x, origin->y);
+      for (int a = 0; a < 3; ++a) {
+        Vec3 e{0.0f};
+        (a == 0 ? e.x : a == 1 ? e.y : e.z) = gizmoLength_;
+        auto end = projectToImage(c, frame->width, frame->height, at + e);
+        g.axisEnd[a] = end ? QPointF(end->x, end->y) : g.origin;
+      }
+    }
+  }
+  gizmo_ = g;
+  view_->setGizmo(g);
+}
+
 void MainWindow::refreshGraph() {
   // Coalesced: a drag applies an edit per mouse move, the graph needs only the last state.
   if (graphRefreshQueued_ || !graph_) return;
@@ -580,6 +650,7 @@ void MainWindow::select(NodeId object) {
   view_->setSelected(object);
   engine_->submit(SelectCommand{object});
   if (graph_) graph_->setSelectedObject(object);
+  updateGizmo();
   if (object != kNoNode) panel_->setTarget({PropertyTarget::Kind::Object, object});
   else if (panel_->target().kind == PropertyTarget::Kind::Object) panel_->setTarget({});
   {

@@ -76,6 +76,7 @@ class MainWindow : public QMainWindow {
   // Asks to save unsaved changes; false when the user cancels.
   bool maybeSave();
   void refreshGraph();
+  void updateGizmo();
   void replaceDocument(Scene scene, const std::filesystem::path& file);
   void buildDocks();
   void startEngine(Scene scene);
@@ -110,6 +111,8 @@ class MainWindow : public QMainWindow {
   PropertyPanel* renderPanel_ = nullptr;
   class NodeGraphView* graph_ = nullptr;
   bool graphRefreshQueued_ = false;
+  FrameView::Gizmo gizmo_;
+  float gizmoLength_ = 0.0f;  // world length of the gizmo's arrows
   QLabel* inspector_ = nullptr;
   class LiveChart* chart_ = nullptr;
   QString pixelText_, regionText_;

@@ -374,6 +374,72 @@ TEST(Editor, LinkingADifferentMaterialInTheNodeGraphChangesTheObjectsMaterial) {
   EXPECT_EQ(w->scene().object(sphere)->material, before) << "one undo step restores the assignment";
 }
 
+
+TEST(Editor, TheMoveGizmoDragsAlongOneAxisAndEAndRTurnAndScale) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  FrameView* v = w->viewport();
+  w->engine()->submit(PauseCommand{true});  // the gizmo stays where the test measured it
+  QTest::qWait(200);
+  QTest::keyClick(w.get(), Qt::Key_W);
+  ASSERT_EQ(v->tool(), FrameView::Tool::Move);
+  auto frame = v->frame();
+  const QRectF r = v->imageRect();
+  auto widget = [&](QPointF px) {
+    return QPoint(static_cast<int>(r.x() + px.x() * r.width() / frame->width), static_cast<int>(r.y() + px.y() * r.height() / frame->height));
+  };
+  // The gizmo is placed from the camera: project the x arrow the same way and drag along it.
+  const Mat4 start = w->scene().object(sphere)->transform;
+  const Vec3 origin = start.transformPoint(Vec3{0.0f});
+  auto o = projectToImage(w->scene().camera, frame->width, frame->height, origin);
+  ASSERT_TRUE(o.has_value());
+  // Drag from 80 % along the x arrow, further along it.
+  const float len = 0.12f * length(origin - w->scene().camera.position) * std::tan(w->scene().camera.verticalFov * 0.5f) * 2.0f;
+  auto xe = projectToImage(w->scene().camera, frame->width, frame->height, origin + Vec3{len, 0, 0});
+  ASSERT_TRUE(xe.has_value());
+  QPoint from = widget(QPointF(o->x + 0.8 * (xe->x - o->x), o->y + 0.8 * (xe->y - o->y)));
+  QPoint dir = widget(QPointF(xe->x, xe->y)) - widget(QPointF(o->x, o->y));
+  QTest::mousePress(v, Qt::LeftButton, Qt::NoModifier, from);
+  for (int i = 1; i <= 4; ++i) QTest::mouseMove(v, from + dir * i / 4);
+  QTest::mouseRelease(v, Qt::LeftButton, Qt::NoModifier, from + dir);
+  const Vec3 moved = w->scene().object(sphere)->transform.transformPoint(Vec3{0.0f});
+  EXPECT_GT(moved.x - origin.x, 0.5f * len) << "dragging the x arrow by its length moves about that far along x";
+  EXPECT_NEAR(moved.y, origin.y, 1e-4f) << "and not along y";
+  EXPECT_NEAR(moved.z, origin.z, 1e-4f) << "or z";
+  w->undoStack()->undo();
+  EXPECT_TRUE(w->scene().object(sphere)->transform == start) << "one undo step";
+
+  // R: a drag to the right on the object scales it up about its origin.
+  QTest::keyClick(w.get(), Qt::Key_R);
+  ASSERT_EQ(v->tool(), FrameView::Tool::Scale);
+  QPoint on = widget(QPointF(o->x, o->y));
+  QTest::mousePress(v, Qt::LeftButton, Qt::NoModifier, on);
+  for (int i = 1; i <= 4; ++i) QTest::mouseMove(v, on + QPoint(10 * i, 0));
+  QTest::mouseRelease(v, Qt::LeftButton, Qt::NoModifier, on + QPoint(40, 0));
+  const Mat4 scaled = w->scene().object(sphere)->transform;
+  EXPECT_GT(length(scaled.transformVector(Vec3{1, 0, 0})), length(start.transformVector(Vec3{1, 0, 0})) * 1.1f);
+  EXPECT_LT(length(scaled.transformPoint(Vec3{0.0f}) - origin), 1e-4f) << "about the object's origin";
+  w->undoStack()->undo();
+  // E: turns about y.
+  QTest::keyClick(w.get(), Qt::Key_E);
+  QTest::mousePress(v, Qt::LeftButton, Qt::NoModifier, on);
+  for (int i = 1; i <= 4; ++i) QTest::mouseMove(v, on + QPoint(10 * i, 0));
+  QTest::mouseRelease(v, Qt::LeftButton, Qt::NoModifier, on + QPoint(40, 0));
+  const Vec3 xAxis = w->scene().object(sphere)->transform.transformVector(Vec3{1, 0, 0});
+  const Vec3 x0 = start.transformVector(Vec3{1, 0, 0});
+  EXPECT_LT(dot(normalize(xAxis), normalize(x0)), 0.99f) << "the object turned";
+  EXPECT_NEAR(xAxis.y, x0.y, 1e-4f) << "about the vertical";
+  // Q: a drag on the selection changes nothing.
+  QTest::keyClick(w.get(), Qt::Key_Q);
+  const Mat4 q0 = w->scene().object(sphere)->transform;
+  QTest::mousePress(v, Qt::LeftButton, Qt::NoModifier, on);
+  QTest::mouseMove(v, on + QPoint(30, 0));
+  QTest::mouseRelease(v, Qt::LeftButton, Qt::NoModifier, on + QPoint(30, 0));
+  EXPECT_TRUE(w->scene().object(sphere)->transform == q0);
+}
+
 }  // namespace
 }  // namespace retile::ui
 
