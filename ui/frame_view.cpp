@@ -207,6 +207,24 @@ void FrameView::compose(QPainter& p, const QRect& area) const {
       p.drawText(r.adjusted(10, 8, -10, -8), Qt::AlignTop | Qt::AlignLeft, tr("B: snapshot"));
     }
   }
+  if (frame_) {
+    // The render region: what the record says the engine renders, and the one being drawn.
+    const double sx = r.width() / frame_->width, sy = r.height() / frame_->height;
+    auto toRect = [&](QRect q) { return QRectF(r.x() + q.x() * sx, r.y() + q.y() * sy, q.width() * sx, q.height() * sy); };
+    const RegionRect& rr = frame_->region;
+    p.setBrush(Qt::NoBrush);
+    if (!rr.empty()) {
+      QRectF box = toRect(QRect(rr.x, rr.y, rr.width, rr.height));
+      p.setPen(QPen(QColor(255, 150, 30), 2, Qt::DashLine));
+      p.drawRect(box);
+      p.setFont(QFont(font().family(), 9, QFont::Bold));
+      p.drawText(box.adjusted(4, 2, -4, -2), Qt::AlignTop | Qt::AlignLeft, tr("render region"));
+    }
+    if (!draft_.isEmpty()) {
+      p.setPen(QPen(QColor(255, 150, 30), 1.5));
+      p.drawRect(toRect(draft_));
+    }
+  }
   if (!region_.isEmpty() && frame_) {
     const double sx = r.width() / frame_->width, sy = r.height() / frame_->height;
     p.setPen(QPen(QColor(255, 255, 255), 1, Qt::DashLine));
@@ -369,7 +387,10 @@ void FrameView::mousePressEvent(QMouseEvent* e) {
   int x = std::clamp(static_cast<int>(u * frame_->width), 0, frame_->width - 1);
   int y = std::clamp(static_cast<int>(v * frame_->height), 0, frame_->height - 1);
   if (e->modifiers() & Qt::ShiftModifier) {
-    emit focusPlaced(QPointF(u * frame_->width, v * frame_->height));
+    // A click places a focus point; a drag draws a render region (decided on release).
+    drag_ = Drag::RenderRegion;
+    regionStart_ = e->position();
+    draft_ = QRect();
     return;
   }
   const auto& ids = frame_->image->objectId;
@@ -402,6 +423,14 @@ void FrameView::mouseMoveEvent(QMouseEvent* e) {
       }
       break;
     }
+    case Drag::RenderRegion: {
+      QPoint a = imagePixel(regionStart_), b = imagePixel(e->position());
+      if (a.x() >= 0 && b.x() >= 0) {
+        draft_ = QRect(a, b).normalized();
+        refresh();
+      }
+      break;
+    }
     case Drag::Wipe: {
       QRectF r = imageRect();
       if (r.width() > 0) setWipe((e->position().x() - r.x()) / r.width());
@@ -426,7 +455,22 @@ void FrameView::mouseMoveEvent(QMouseEvent* e) {
   }
 }
 
-void FrameView::mouseReleaseEvent(QMouseEvent*) {
+void FrameView::mouseReleaseEvent(QMouseEvent* e) {
+  if (drag_ == Drag::RenderRegion) {
+    drag_ = Drag::None;
+    const QPointF d = e->position() - regionStart_;
+    if (std::hypot(d.x(), d.y()) < 4 || draft_.width() < 2 || draft_.height() < 2) {
+      QRectF r = imageRect();
+      if (frame_ && r.width() > 0)
+        emit focusPlaced(QPointF((regionStart_.x() - r.x()) / r.width() * frame_->width,
+                                 (regionStart_.y() - r.y()) / r.height() * frame_->height));
+    } else {
+      emit renderRegionDrawn(draft_);
+    }
+    draft_ = QRect();
+    refresh();
+    return;
+  }
   if (drag_ != Drag::None && drag_ != Drag::Region && drag_ != Drag::Wipe) emit dragFinished();
   drag_ = Drag::None;
 }

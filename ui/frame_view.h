@@ -86,6 +86,8 @@ class FrameView : public QWidget {
   // Pixel inspector: linear values under the cursor, and the statistics of a Ctrl+drag region
   // (image pixels, inclusive-exclusive).
   void pixelInspected(QPoint pixel, QVector3D linear);
+  // Shift+drag: a render region in image pixels (Shift+click without a drag: focusPlaced).
+  void renderRegionDrawn(QRect region);
   void regionInspected(QRect region, QVector3D mean, QVector3D min, QVector3D max);
 
  protected:
@@ -109,7 +111,8 @@ class FrameView : public QWidget {
   OverlaySettings overlays_;
   DisplaySettings display_;
   bool paused_ = false;
-  enum class Drag { None, Orbit, Pan, Dolly, Object, Axis, Rotate, Scale, Region, Wipe } drag_ = Drag::None;
+  enum class Drag { None, Orbit, Pan, Dolly, Object, Axis, Rotate, Scale, Region, RenderRegion, Wipe } drag_ = Drag::None;
+  QRect draft_;  // a render region being drawn (image pixels)
   int dragAxis_ = 0;
   Tool tool_ = Tool::Move;
   Gizmo gizmo_;

@@ -141,6 +141,10 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
     after.transform = Mat4::translate(right * static_cast<float>(d.x() * k) - up * static_cast<float>(d.y() * k)) * o->transform;
     edit(SetObject{*o}, SetObject{after}, tr("Move %1").arg(QString::fromStdString(o->name)), dragCounter_ + 1);
   });
+  connect(view_, &FrameView::renderRegionDrawn, this, [this](QRect r) {
+    engine_->submit(RegionCommand{RegionRect{r.x(), r.y(), r.width(), r.height()}});
+    log(tr("render region %1x%2 at %3, %4 (Render > Clear render region, or Ctrl+Alt+R)").arg(r.width()).arg(r.height()).arg(r.x()).arg(r.y()));
+  });
   // The gizmo: drag an arrow to move along a world axis; E and R turn and scale about the origin.
   connect(view_, &FrameView::axisDragged, this, [this](int axis, QPointF d) {
     const Object* o = doc_.scene().object(selection_);
@@ -297,6 +301,10 @@ void MainWindow::buildMenus() {
       updateRenderSize();
     });
   }
+  render->addAction(tr("&Clear render region"), QKeySequence(Qt::CTRL | Qt::ALT | Qt::Key_R), this, [this] {
+    engine_->submit(RegionCommand{});
+    log(tr("render region cleared: the whole image renders"));
+  });
   QAction* pause = render->addAction(tr("&Pause / resume"));
   pause->setShortcut(Qt::Key_Escape);
   connect(pause, &QAction::triggered, this, [this] {

@@ -205,7 +205,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   });
   const bool rough = m.type == MaterialType::RoughPlastic || m.type == MaterialType::RoughConductor ||
                      m.type == MaterialType::RoughDielectric || m.type == MaterialType::OrenNayar;
-  if (rough || m.type == MaterialType::Lambert || m.type == MaterialType::Plastic) {
+  if (rough) {  // smooth types ignore roughness: no field that does nothing
     // A slider as well as the field: the gesture look-dev artists use most.
     auto* row = new QWidget(body_);
     auto* l = new QHBoxLayout(row);

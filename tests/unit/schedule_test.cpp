@@ -187,6 +187,44 @@ TEST(Scheduler, GlobalUpdateRestartsEveryTileThenRefines) {
   EXPECT_TRUE(again.chunks.front().restart);
 }
 
+TEST(Scheduler, ARenderRegionTracesOnlyItsTilesWithTheBudgetAndNoPixelTwice) {
+  TileGrid g(96, 64, 16);  // 6 x 4 tiles
+  TileScheduler s(g);
+  s.nextFrame();
+  std::vector<char> region(static_cast<std::size_t>(g.count()), 0);
+  for (int t : {g.index(1, 1), g.index(2, 1), g.index(1, 2), g.index(2, 2)}) region[static_cast<std::size_t>(t)] = 1;
+  s.setRegion(region);
+  auto check = [&](const FramePlan& p, const char* what) {
+    SCOPED_TRACE(what);
+    std::vector<unsigned char> hit(static_cast<std::size_t>(g.pixels()), 0);
+    for (const auto& c : p.chunks) {
+      EXPECT_TRUE(region[static_cast<std::size_t>(c.tile)]) << "tile " << c.tile << " is outside the region";
+      for (int y = c.rect.y; y < c.rect.y + c.rect.height; ++y)
+        for (int x = c.rect.x; x < c.rect.x + c.rect.width; ++x) {
+          auto& v = hit[static_cast<std::size_t>(y) * 96u + static_cast<std::size_t>(x)];
+          EXPECT_EQ(v, 0) << "pixel served twice";
+          v = 1;
+        }
+    }
+    EXPECT_LE(p.samples, g.pixels());
+    EXPECT_GE(p.samples, g.pixels() * 9 / 10) << "the region gets (about) the whole budget";
+  };
+  FramePlan refine = s.nextFrame();
+  EXPECT_EQ(refine.mode, AccumMode::Refinement);
+  check(refine, "refinement");
+  EXPECT_EQ(refine.chunks.size(), 4u) << "each region tile once";
+  EXPECT_EQ(refine.chunks.front().quality, 6) << "6 times the samples: the region is a sixth of the image";
+  s.startPass(spiralOrder(g, 0), 8, g.count(), false, 1);
+  EXPECT_EQ(s.queueLength(), 4u) << "a pass skips tiles outside the region";
+  check(s.nextFrame(), "incremental");
+  s.globalUpdate();
+  check(s.nextFrame(), "global update");
+  s.setRegion({});
+  s.globalUpdate();
+  FramePlan whole = s.nextFrame();
+  EXPECT_EQ(whole.chunks.size(), static_cast<std::size_t>(g.count())) << "clearing the region renders everything again";
+}
+
 TEST(Scheduler, SampleIndicesNeverRepeatForAPixel) {
   TileGrid g(48, 32, 16);
   TileScheduler s(g);

@@ -30,7 +30,8 @@ struct FocusCommand { std::vector<FocusPoint> focus; };
 struct MethodCommand { MethodSettings method; };
 struct ResizeCommand { int width = 0, height = 0; };
 struct PauseCommand { bool paused = false; };  // paused: no frames; resuming keeps the samples
-using Command = std::variant<Edit, SelectCommand, FocusCommand, MethodCommand, ResizeCommand, PauseCommand>;
+struct RegionCommand { RegionRect region; };  // a render region; empty: the whole image
+using Command = std::variant<Edit, SelectCommand, FocusCommand, MethodCommand, ResizeCommand, PauseCommand, RegionCommand>;
 
 // Commands in arrival order. A command of the same kind and target as one still queued replaces
 // it (a slider drag becomes its newest value), unless an add or remove was queued after it.

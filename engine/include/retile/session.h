@@ -20,6 +20,12 @@
 
 namespace retile {
 
+// A rectangle of pixels (y down); width or height 0: none.
+struct RegionRect {
+  int x = 0, y = 0, width = 0, height = 0;
+  bool empty() const { return width <= 0 || height <= 0; }
+};
+
 // Everything about one published frame. Immutable once published; shared between threads.
 struct FrameRecord {
   std::uint64_t frame = 0;            // frames rendered by the session, from 1
@@ -38,6 +44,7 @@ struct FrameRecord {
   std::vector<std::uint8_t> tileClass;  // indirection: 0 high, 1 middle, 2 low, 3 rest; else empty
   std::vector<float> tileSamples;     // per tile: mean samples per pixel since its last restart
   std::vector<int> servedTiles;       // tiles traced this frame, in order
+  RegionRect region;                  // the render region (empty: the whole image is rendered)
   std::size_t queueLength = 0;        // tiles in the current pass
   std::size_t queueServed = 0;        // tiles of the pass finished
   std::uint64_t samples = 0;          // samples traced this frame: always width x height
@@ -75,6 +82,9 @@ class RenderSession {
   std::string setMethod(const MethodSettings& method);
   void resize(int width, int height);
   void setMaxBounces(int maxBounces);
+  // A render region: only tiles it touches are traced, with the whole budget (see TileScheduler);
+  // an empty rectangle renders the whole image again. A resize clears it.
+  void setRegion(RegionRect region);
   // The document version of the scene the session was made from (frames report it until an edit).
   void setDocumentVersion(std::uint64_t version);
 

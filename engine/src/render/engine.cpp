@@ -26,6 +26,20 @@ std::uint64_t commandKey(const Command& c) {
 
 bool structural(const Command& c) { return commandKey(c) == 0; }
 
+// Every tile that is rendered (all, or those the render region touches) has `spp` samples.
+bool regionConverged(const FrameRecord& f, int spp) {
+  for (std::size_t t = 0; t < f.tileSamples.size(); ++t) {
+    if (!f.region.empty() && f.cols > 0) {
+      int x = static_cast<int>(t) % f.cols * f.tileSize, y = static_cast<int>(t) / f.cols * f.tileSize;
+      bool touches = x < f.region.x + f.region.width && f.region.x < x + f.tileSize && y < f.region.y + f.region.height &&
+                     f.region.y < y + f.tileSize;
+      if (!touches) continue;
+    }
+    if (f.tileSamples[t] < static_cast<float>(spp)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 void EditQueue::push(Command command, std::uint64_t version) {
@@ -158,6 +172,8 @@ void Engine::run() {
                 session->resize(c.width, c.height);
               } else if constexpr (std::is_same_v<T, PauseCommand>) {
                 paused = c.paused;
+              } else if constexpr (std::is_same_v<T, RegionCommand>) {
+                session->setRegion(c.region);
               }
             },
             entry.command);
@@ -167,8 +183,7 @@ void Engine::run() {
     }
     if (stop_) break;
     bool converged = options_.maxSamplesPerPixel > 0 && last && !changed && last->mode == "refinement" &&
-                     !last->tileSamples.empty() &&
-                     *std::min_element(last->tileSamples.begin(), last->tileSamples.end()) >= options_.maxSamplesPerPixel;
+                     !last->tileSamples.empty() && regionConverged(*last, options_.maxSamplesPerPixel);
     if (paused || converged) {
       queue_.waitForWork(std::chrono::milliseconds(100));
       continue;

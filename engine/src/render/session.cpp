@@ -67,8 +67,24 @@ struct RenderSession::Impl {
   // Change policy: the probe frame's point of change.
   bool awaitingProbe = false;
   std::shared_ptr<const RenderImage> lastImage;
+  RegionRect region;  // the render region in pixels (empty: the whole image)
 
   explicit Impl(const RendererOptions& o) : renderer(o) {}
+
+  // Marks the tiles the region touches (the scheduler forgets it on a new grid).
+  void applyRegion() {
+    const TileGrid& g = scheduler.grid();
+    std::vector<char> mask;
+    if (!region.empty()) {
+      mask.assign(static_cast<std::size_t>(g.count()), 0);
+      for (int t = 0; t < g.count(); ++t) {
+        TileRect r = g.rect(t);
+        mask[static_cast<std::size_t>(t)] = r.x < region.x + region.width && region.x < r.x + r.width &&
+                                            r.y < region.y + region.height && region.y < r.y + r.height;
+      }
+    }
+    scheduler.setRegion(std::move(mask));
+  }
 };
 
 RenderSession::RenderSession(Scene scene, MethodSettings method, const RendererOptions& options)
@@ -103,6 +119,17 @@ void RenderSession::resize(int width, int height) {
   impl_->countFramesLeft = selection_ != kNoNode ? method_.indirectionFrames : 0;
   impl_->awaitingProbe = false;
   impl_->lastImage.reset();
+  impl_->region = {};  // its pixels meant another image size
+}
+
+void RenderSession::setRegion(RegionRect region) {
+  // Clamped to the image; nothing left means no region.
+  int x0 = std::clamp(region.x, 0, impl_->width), y0 = std::clamp(region.y, 0, impl_->height);
+  int x1 = std::clamp(region.x + std::max(0, region.width), 0, impl_->width);
+  int y1 = std::clamp(region.y + std::max(0, region.height), 0, impl_->height);
+  impl_->region = RegionRect{x0, y0, x1 - x0, y1 - y0};
+  if (impl_->region.empty()) impl_->region = {};
+  impl_->applyRegion();
 }
 
 void RenderSession::setMaxBounces(int maxBounces) {
@@ -119,6 +146,7 @@ std::string RenderSession::setMethod(const MethodSettings& method) {
     // The accumulation stays valid; only the tiles change. Restart cleanly all the same, so
     // per-tile records describe the new grid.
     impl_->scheduler.reset(TileGrid(impl_->width, impl_->height, method_.tileSize));
+    impl_->applyRegion();
     impl_->haveCounts = false;
   } else {
     impl_->scheduler.globalUpdate();
@@ -407,6 +435,7 @@ FrameRecord RenderSession::renderFrame(bool readImage) {
     for (TileClass c : d.plan.classes) rec.tileClass.push_back(static_cast<std::uint8_t>(c));
   rec.tileSamples.assign(d.scheduler.tileSamples().begin(), d.scheduler.tileSamples().end());
   rec.servedTiles = plan.servedTiles;
+  rec.region = d.region;
   rec.queueLength = d.scheduler.queueLength();
   rec.queueServed = d.scheduler.queueServed();
   rec.samples = stats.samples;

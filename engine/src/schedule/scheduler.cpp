@@ -16,6 +16,7 @@ const char* accumModeName(AccumMode m) {
 
 void TileScheduler::reset(const TileGrid& grid) {
   grid_ = grid;
+  region_.clear();
   auto n = static_cast<std::size_t>(grid.count());
   samples_.assign(n, 0.0);
   nextIndex_.assign(n, 0);
@@ -38,11 +39,29 @@ void TileScheduler::globalUpdate() {
 
 void TileScheduler::probe() { pendingProbe_ = true; }
 
+void TileScheduler::setRegion(std::vector<char> tiles) {
+  if (static_cast<int>(tiles.size()) != grid_.count() || std::none_of(tiles.begin(), tiles.end(), [](char c) { return c; }))
+    tiles.clear();
+  region_ = std::move(tiles);
+  // A pass keeps its order; tiles outside the region drop out of it.
+  if (!region_.empty() && pos_ < queue_.size()) {
+    std::vector<int> q(queue_.begin(), queue_.begin() + static_cast<std::ptrdiff_t>(pos_));
+    std::vector<PassTile> p(pass_.begin(), pass_.begin() + static_cast<std::ptrdiff_t>(pos_));
+    for (std::size_t i = pos_; i < queue_.size(); ++i)
+      if (inRegion(queue_[i])) {
+        q.push_back(queue_[i]);
+        p.push_back(pass_[i]);
+      }
+    queue_ = std::move(q);
+    pass_ = std::move(p);
+  }
+}
+
 void TileScheduler::startPass(std::vector<int> order, int quality, int prioritized, bool smooth, int staleCap) {
   std::vector<char> seen(static_cast<std::size_t>(grid_.count()), 0);
   queue_.clear();
   for (int t : order)
-    if (t >= 0 && t < grid_.count() && !seen[static_cast<std::size_t>(t)]) {
+    if (t >= 0 && t < grid_.count() && !seen[static_cast<std::size_t>(t)] && inRegion(t)) {
       seen[static_cast<std::size_t>(t)] = 1;
       queue_.push_back(t);
     }
@@ -107,6 +126,8 @@ void TileScheduler::fillRemainder(FramePlan& plan, std::int64_t remainder, const
     used[static_cast<std::size_t>(t)] = 1;
   };
   // 1. Tiles the pass has finished: their sums are fresh, extra samples only help.
+  for (int t = 0; t < grid_.count(); ++t)
+    if (!inRegion(t)) used[static_cast<std::size_t>(t)] = 1;  // outside the render region
   for (auto it = finished_.rbegin(); it != finished_.rend() && remainder > 0; ++it)
     if (!used[static_cast<std::size_t>(*it)]) strip(*it, false, 0);
   // 2. Tiles still queued. One not yet started restarts its strip pixels (its whole-tile chunk
@@ -131,9 +152,16 @@ FramePlan TileScheduler::nextFrame() {
   const int n = grid_.count();
   std::vector<char> served(static_cast<std::size_t>(n), 0);
 
+  // With a render region, the region's share of the budget per tile and frame.
+  std::int64_t regionPixels = 0;
+  for (int t = 0; t < n && !region_.empty(); ++t)
+    if (inRegion(t)) regionPixels += grid_.rect(t).pixels();
+  const int regionQuality = regionPixels > 0 ? static_cast<int>(std::max<std::int64_t>(1, budget / regionPixels)) : 1;
+
   if (pendingGlobal_ || pendingProbe_) {
     plan.mode = pendingGlobal_ ? AccumMode::GlobalUpdate : AccumMode::Probe;
     for (int t = 0; t < n; ++t) {
+      if (!inRegion(t)) continue;
       if (plan.mode == AccumMode::Probe) {
         // Traced and compared, never accumulated: the tile's sums and indices stay as they are.
         TileChunk c;
@@ -144,7 +172,7 @@ FramePlan TileScheduler::nextFrame() {
         plan.servedTiles.push_back(t);
         plan.samples += c.rect.pixels();
       } else {
-        emit(plan, t, grid_.rect(t), 1, true, 0, true);
+        emit(plan, t, grid_.rect(t), regionQuality, true, 0, true);
       }
     }
     if (pendingGlobal_) {
@@ -175,7 +203,18 @@ FramePlan TileScheduler::nextFrame() {
     finished_.push_back(t);
     ++pos_;
   }
-  if (!passActive()) {
+  if (!passActive() && !region_.empty()) {
+    // Refinement inside a render region: every region tile once, at the region's share.
+    for (int t = 0; t < n; ++t) {
+      if (!inRegion(t) || served[static_cast<std::size_t>(t)]) continue;
+      std::int64_t pixels = grid_.rect(t).pixels();
+      int k = static_cast<int>(std::min<std::int64_t>(regionQuality, remaining / pixels));
+      if (k <= 0) break;
+      emit(plan, t, grid_.rect(t), k, false, 0, true);
+      served[static_cast<std::size_t>(t)] = 1;
+      remaining -= pixels * k;
+    }
+  } else if (!passActive()) {
     // Continuous refinement: every tile at 1 spp, round robin, so that a full frame is exactly
     // one pass over the image.
     int visited = 0;

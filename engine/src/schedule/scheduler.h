@@ -53,6 +53,11 @@ class TileScheduler {
   void startPass(std::vector<int> order, int quality, int prioritized, bool smooth, int staleCap);
 
   FramePlan nextFrame();
+  // A render region: only the marked tiles are traced (empty: every tile). Frames then spend the
+  // budget on the region (about W x H / region pixels spp per tile, each tile once per frame,
+  // so a frame traces at most W x H samples); passes skip tiles outside it.
+  void setRegion(std::vector<char> tiles);
+  bool inRegion(int tile) const { return region_.empty() || region_[static_cast<std::size_t>(tile)]; }
 
   const TileGrid& grid() const { return grid_; }
   AccumMode mode() const;
@@ -71,6 +76,7 @@ class TileScheduler {
     bool started = false;
   };
   void emit(FramePlan& plan, int tile, TileRect rect, int quality, bool restart, int cap, bool wholeTile);
+  std::vector<char> region_;
   void fillRemainder(FramePlan& plan, std::int64_t remainder, const std::vector<char>& served);
 
   TileGrid grid_;
