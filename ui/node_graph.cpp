@@ -206,18 +206,32 @@ class EditBuilder {
 };
 
 // An inline editor that can be cancelled with Escape (QLineEdit alone only knows "finished").
+// Every key typed into it is its own: QLineEdit lets Escape, Return and keys it has no use for
+// through, as shortcut overrides to the window (Escape pauses the render) and as key presses to
+// its parent, the graph (Ctrl+D would duplicate, F2 restart the rename).
 class RenameEdit : public QLineEdit {
  public:
   using QLineEdit::QLineEdit;
   std::function<void()> cancelled;
 
  protected:
+  bool event(QEvent* e) override {
+    if (e->type() == QEvent::ShortcutOverride) {
+      const int key = static_cast<QKeyEvent*>(e)->key();
+      if (key == Qt::Key_Escape || key == Qt::Key_Return || key == Qt::Key_Enter) {
+        e->accept();
+        return true;
+      }
+    }
+    return QLineEdit::event(e);
+  }
   void keyPressEvent(QKeyEvent* e) override {
     if (e->key() == Qt::Key_Escape && cancelled) {
       cancelled();
       return;
     }
     QLineEdit::keyPressEvent(e);
+    e->accept();
   }
 };
 
@@ -425,6 +439,7 @@ QStringList NodeGraphView::creatableTypes() {
 
 void NodeGraphView::setDocument(const Scene& scene) {
   scene_ = scene;
+  ++documentCount_;
   hasDocument_ = true;
   rebuild();
   if (!framed_ && isVisible()) {
@@ -434,6 +449,15 @@ void NodeGraphView::setDocument(const Scene& scene) {
 }
 
 void NodeGraphView::resetLayout() {
+  // The new file's ids may coincide with the old one's, so nothing held by id may carry over: a
+  // kept selection would pick unrelated nodes, an open rename would rename one on its focus loss,
+  // and a pasted material would link to whatever texture now has its old texture's id. The copied
+  // materials and lights themselves stay: pasting them into another file is useful.
+  if (QLineEdit* open = rename_) static_cast<RenameEdit&>(*open).cancelled();
+  pendingSelection_.clear();
+  setSelection({});
+  for (Material& m : copiedMaterials_) m.albedoTexture = m.roughnessTexture = m.alphaTexture = kNoNode;
+  pasteCount_ = 0;
   positions_.clear();
   rebuild();
   frameAll();
@@ -556,7 +580,9 @@ void NodeGraphView::setSelection(const std::vector<NodeId>& ids) {
 }
 
 void NodeGraphView::setSelectedObject(NodeId id) {
-  setSelection(id != kNoNode && nodes_.count(id) ? std::vector<NodeId>{id} : std::vector<NodeId>{});
+  auto it = nodes_.find(id);
+  if (it != nodes_.end() && it->second->isSelected()) return;
+  setSelection(id != kNoNode && it != nodes_.end() ? std::vector<NodeId>{id} : std::vector<NodeId>{});
 }
 
 void NodeGraphView::selectNodes(const std::vector<NodeId>& ids) { setSelection(ids); }
@@ -639,9 +665,18 @@ QString nameOf(const Scene& s, NodeId id) {
 
 }  // namespace
 
-bool NodeGraphView::request(GraphEdit edit) {
+bool NodeGraphView::request(GraphEdit edit, const Scene& result) {
   if (edit.steps.empty()) return false;
+  const unsigned count = documentCount_;
   emit editRequested(edit);
+  // The main window refreshes through a queued setDocument; until it arrives, a second gesture
+  // (two quick creates, two renames) would build on the old scene, reusing an id or taking stale
+  // befores. Show the result now; the owner's refresh brings the same scene. An owner that
+  // refreshed synchronously has already said what the document is.
+  if (documentCount_ == count) {
+    scene_ = result;
+    rebuild();
+  }
   return true;
 }
 
@@ -649,7 +684,7 @@ bool NodeGraphView::link(NodeId from, NodeId to, const QString& input) {
   if (!accepts(from, to, input)) return false;
   EditBuilder b(scene_);
   if (!b.assign(to, input, from)) return false;
-  return request(b.finish(tr("Link %1 to %2 %3").arg(nameOf(scene_, from), nameOf(scene_, to), input)));
+  return request(b.finish(tr("Link %1 to %2 %3").arg(nameOf(scene_, from), nameOf(scene_, to), input)), b.scene());
 }
 
 bool NodeGraphView::unlink(NodeId to, const QString& input) {
@@ -657,7 +692,7 @@ bool NodeGraphView::unlink(NodeId to, const QString& input) {
   if (!l) return false;
   EditBuilder b(scene_);
   if (!b.assign(to, input, kNoNode)) return false;
-  return request(b.finish(tr("Unlink %1 %2").arg(nameOf(scene_, to), input)));
+  return request(b.finish(tr("Unlink %1 %2").arg(nameOf(scene_, to), input)), b.scene());
 }
 
 bool NodeGraphView::createNode(const QString& type, QPointF scenePos) {
@@ -694,7 +729,7 @@ bool NodeGraphView::createNode(const QString& type, QPointF scenePos) {
   if (!b.ok()) return false;
   positions_[id] = scenePos;
   pendingSelection_ = {id};
-  return request(b.finish(tr("Add %1").arg(type)));
+  return request(b.finish(tr("Add %1").arg(type)), b.scene());
 }
 
 bool NodeGraphView::deleteSelected() {
@@ -714,7 +749,7 @@ bool NodeGraphView::deleteSelected() {
     if (!b.remove(n->id)) return false;
   const QString text = chosen.size() == 1 ? tr("Delete %1").arg(nameOf(scene_, chosen.front()->id))
                                           : tr("Delete %1 nodes").arg(chosen.size());
-  return request(b.finish(text));
+  return request(b.finish(text), b.scene());
 }
 
 bool NodeGraphView::duplicateSelected() {
@@ -747,7 +782,8 @@ bool NodeGraphView::duplicateSelected() {
   if (made.empty()) return false;
   pendingSelection_ = made;
   return request(b.finish(made.size() == 1 ? tr("Duplicate %1").arg(nameOf(b.scene(), made.front()))
-                                            : tr("Duplicate %1 nodes").arg(made.size())));
+                                            : tr("Duplicate %1 nodes").arg(made.size())),
+                 b.scene());
 }
 
 void NodeGraphView::copySelected() {
@@ -793,7 +829,7 @@ bool NodeGraphView::paste() {
   }
   ++pasteCount_;
   pendingSelection_ = made;
-  return request(b.finish(tr("Paste %n node(s)", nullptr, static_cast<int>(made.size()))));
+  return request(b.finish(tr("Paste %n node(s)", nullptr, static_cast<int>(made.size()))), b.scene());
 }
 
 bool NodeGraphView::renameNode(NodeId id, const QString& name) {
@@ -812,13 +848,13 @@ bool NodeGraphView::renameNode(NodeId id, const QString& name) {
   rename(scene_.light(id));
   rename(scene_.texture(id));
   if (!changed) return false;
-  return request(b.finish(tr("Rename %1 to %2").arg(nameOf(scene_, id), name.trimmed())));
+  return request(b.finish(tr("Rename %1 to %2").arg(nameOf(scene_, id), name.trimmed())), b.scene());
 }
 
 void NodeGraphView::startRename(NodeId id) {
   auto it = nodes_.find(id);
-  if (it == nodes_.end() || !it->second->deletable()) return;
-  if (rename_) rename_->deleteLater();
+  // One editor at a time: the open one keeps what has been typed into it (and the focus).
+  if (it == nodes_.end() || !it->second->deletable() || rename_) return;
   const GraphNodeItem* n = it->second;
   auto* editor = new RenameEdit(viewport());
   editor->setObjectName(QStringLiteral("nodeRename"));
@@ -832,6 +868,7 @@ void NodeGraphView::startRename(NodeId id) {
   auto done = std::make_shared<bool>(false);
   auto close = [this, editor, done] {
     *done = true;
+    rename_ = nullptr;
     editor->hide();
     editor->deleteLater();
     setFocus();
@@ -962,7 +999,22 @@ void NodeGraphView::keyPressEvent(QKeyEvent* e) {
 }
 
 void NodeGraphView::mousePressEvent(QMouseEvent* e) {
+  // A second button in the middle of a drag would start another gesture over the first one's state
+  // and leave its dashed link or rubber band on screen: the drag owns the mouse until it ends.
+  if (drag_ != Drag::None && e->button() != dragButton_) {
+    e->accept();
+    return;
+  }
+  if (drag_ != Drag::None) {
+    // The dragging button pressed again: its release went elsewhere (a modal dialog took it). Drop
+    // the stale drag without acting on it rather than ignore the mouse from now on.
+    drag_ = Drag::None;
+    dragLink_->hide();
+    marquee_->hide();
+    for (Link& l : links_) l.item->show();
+  }
   setFocus(Qt::MouseFocusReason);
+  dragButton_ = e->button();
   pressPos_ = lastPos_ = e->pos();
   pressScene_ = mapToScene(e->pos());
   pressModifiers_ = e->modifiers();
@@ -1083,6 +1135,7 @@ void NodeGraphView::mouseMoveEvent(QMouseEvent* e) {
 }
 
 void NodeGraphView::mouseReleaseEvent(QMouseEvent* e) {
+  if (e->button() != dragButton_) return;  // another button than the one dragging: see mousePressEvent
   const Drag d = drag_;
   drag_ = Drag::None;
   switch (d) {
@@ -1120,12 +1173,12 @@ void NodeGraphView::finishLinkDrag(QPointF scenePos) {
   EditBuilder b(scene_);
   b.assign(oldTo, oldInput, kNoNode);
   if (!b.assign(t.node->id, t.socket, from)) return;
-  request(b.finish(tr("Move link to %1 %2").arg(nameOf(scene_, t.node->id), t.socket)));
+  request(b.finish(tr("Move link to %1 %2").arg(nameOf(scene_, t.node->id), t.socket)), b.scene());
 }
 
 void NodeGraphView::mouseDoubleClickEvent(QMouseEvent* e) {
   const QPointF sp = mapToScene(e->pos());
-  if (e->button() == Qt::LeftButton && !socketAt(sp).node)
+  if (e->button() == Qt::LeftButton && drag_ == Drag::None && !socketAt(sp).node)
     if (GraphNodeItem* n = nodeAt(sp)) {
       startRename(n->id);
       return;

@@ -53,9 +53,12 @@ class NodeGraphView : public QGraphicsView {
   void setDocument(const Scene& scene);
   const Scene& document() const { return scene_; }
   // Forgets the remembered positions and lays everything out in columns again (after opening a
-  // file, whose ids may coincide with the old document's).
+  // file, whose ids may coincide with the old document's). Everything else held by id goes too: the
+  // selection, an open rename and the copied materials' texture links.
   void resetLayout();
   // From the outliner or the viewport: selects the object's node (kNoNode: nothing) without emitting.
+  // An object already among the selected nodes leaves the selection alone: the owner echoes
+  // objectSelected back here, and that must not undo a Shift-click or break up a group drag.
   void setSelectedObject(NodeId id);
   void selectNodes(const std::vector<NodeId>& ids);  // programmatic, without emitting
   std::vector<NodeId> selectedNodes() const;
@@ -83,7 +86,7 @@ class NodeGraphView : public QGraphicsView {
   QPointF socketScenePos(NodeId id, const QString& socket, bool output) const;
 
   void openNodeSearch(QPointF scenePos);  // the Tab / right-click menu
-  void startRename(NodeId id);            // the F2 inline editor
+  void startRename(NodeId id);            // the F2 inline editor; nothing while one is open
   void frameSelected();                   // F (all when nothing is selected)
   void frameAll();                        // A
 
@@ -123,10 +126,13 @@ class NodeGraphView : public QGraphicsView {
   void updateLinkPaths();
   void finishLinkDrag(QPointF scenePos);
   void setSelection(const std::vector<NodeId>& ids);
-  bool request(GraphEdit edit);
+  // Emits the edit; `result` is the scene it makes (the EditBuilder's), shown until the owner's
+  // setDocument arrives so that a second gesture before then builds on the first.
+  bool request(GraphEdit edit, const Scene& result);
   void frameRect(QRectF r);
 
   Scene scene_;
+  unsigned documentCount_ = 0;  // setDocument calls, to tell whether the owner refreshed synchronously
   bool hasDocument_ = false;
   bool framed_ = false;
   std::unordered_map<NodeId, GraphNodeItem*> nodes_;
@@ -135,6 +141,7 @@ class NodeGraphView : public QGraphicsView {
   std::vector<NodeId> pendingSelection_;  // nodes an edit creates, selected once they appear
 
   Drag drag_ = Drag::None;
+  Qt::MouseButton dragButton_ = Qt::NoButton;  // only its release ends the drag
   QPoint pressPos_, lastPos_;        // viewport pixels
   QPointF pressScene_;
   NodeId pressedNode_ = kNoNode;
@@ -150,7 +157,7 @@ class NodeGraphView : public QGraphicsView {
 
   NodeSearchPopup* search_ = nullptr;
   QPointF searchScenePos_;
-  QPointer<QLineEdit> rename_;
+  QPointer<QLineEdit> rename_;  // while a rename is open (null once it is closed)
 
   std::vector<Material> copiedMaterials_;
   std::vector<Light> copiedLights_;

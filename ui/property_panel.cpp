@@ -3,7 +3,10 @@
 #include <QComboBox>
 #include <QFormLayout>
 #include <QHBoxLayout>
+#include <QFileDialog>
 #include <QLabel>
+#include <QLineEdit>
+#include <QToolButton>
 #include <QSlider>
 #include <QSpinBox>
 
@@ -88,6 +91,8 @@ class PropertyPanel::Builder {
     form_->addRow(name, c);
     return c;
   }
+
+  void row(const QString& name, QWidget* w) { form_->addRow(name, w); }
 
   void connectField(ScrubField* f, std::function<void(double, int)> apply) {
     // The builder lives only while the panel builds: the connections capture the panel.
@@ -251,6 +256,35 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
                });
              });
   }
+  // Texture slots: which texture feeds each input, and for file textures the file itself.
+  struct Slot {
+    const char* label;
+    const char* name;
+    NodeId Material::*field;
+  };
+  for (const Slot& slot : {Slot{"Albedo texture", "albedoTexture", &Material::albedoTexture},
+                           Slot{"Roughness texture", "roughnessTexture", &Material::roughnessTexture},
+                           Slot{"Alpha texture", "alphaTexture", &Material::alphaTexture}}) {
+    if (slot.field == &Material::roughnessTexture && !rough) continue;
+    QStringList names{tr("(none)")};
+    std::vector<NodeId> ids{kNoNode};
+    int current = 0;
+    for (const Texture& t : scene_().textures) {
+      if (t.id == m.*slot.field) current = static_cast<int>(ids.size());
+      names << QString::fromStdString(t.name);
+      ids.push_back(t.id);
+    }
+    auto field = slot.field;
+    b.choice(tr(slot.label), slot.name, names, current, [this, edit, ids, field](int i) {
+      if (i < 0 || i >= static_cast<int>(ids.size())) return;
+      NodeId t = ids[static_cast<std::size_t>(i)];
+      edit(tr("Assign texture"), 0, [t, field](Material& x) { x.*field = t; });
+      rebuildLater();
+    });
+    const Texture* tex = scene_().texture(m.*slot.field);
+    if (tex && tex->kind == TextureKind::File) texturePath(b, *tex, QString("%1Path").arg(slot.name));
+  }
+
   const float strength = peak(m.emission);
   const Vec3 tint = strength > 0 ? m.emission * (1.0f / strength) : Vec3{1.0f};
   b.color(tr("Emission colour"), "emissionColor", tint, Vec3{1.0f}, [this, id, edit](Vec3 c, int drag) {
@@ -268,6 +302,36 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   b.number(tr("Alpha"), "alpha", m.alpha, 0.0, 1.0, 1.0, 3, [edit](double v, int drag) {
     edit(tr("Alpha"), drag, [v](Material& x) { x.alpha = static_cast<float>(v); });
   });
+}
+
+void PropertyPanel::texturePath(Builder& b, const Texture& t, const QString& objectName) {
+  auto* row = new QWidget(body_);
+  auto* l = new QHBoxLayout(row);
+  l->setContentsMargins(0, 0, 0, 0);
+  auto* path = new QLineEdit(QString::fromStdString(t.path.string()), row);
+  path->setObjectName(objectName);
+  path->setToolTip(tr("The texture's file (relative paths resolve against the scene's folder); Enter applies"));
+  auto* browse = new QToolButton(row);
+  browse->setText("...");
+  l->addWidget(path, 1);
+  l->addWidget(browse);
+  const NodeId id = t.id;
+  auto apply = [this, id](const QString& file) {
+    const Texture* cur = scene_().texture(id);
+    if (!cur || file.toStdString() == cur->path.string()) return;
+    Texture after = *cur;
+    after.path = file.toStdString();
+    push_(SetTexture{*cur}, SetTexture{after}, tr("Texture file"), 0);
+  };
+  QObject::connect(path, &QLineEdit::returnPressed, path, [path, apply] { apply(path->text()); });
+  QObject::connect(browse, &QToolButton::clicked, browse, [this, path, apply] {
+    QString f = QFileDialog::getOpenFileName(this, tr("Texture file"), path->text(),
+                                             tr("Images (*.png *.jpg *.jpeg *.exr *.hdr *.tif *.tiff *.tga *.bmp);;All files (*)"));
+    if (f.isEmpty()) return;
+    path->setText(f);
+    apply(f);
+  });
+  b.row(tr("  file (%1)").arg(QString::fromStdString(t.name)), row);
 }
 
 void PropertyPanel::buildLight(Builder& b, const Light& l) {

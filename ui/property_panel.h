@@ -42,6 +42,7 @@ class PropertyPanel : public QScrollArea {
   void buildObject(Builder& b, const Object& o);
   void buildMaterial(Builder& b, const Material& m);
   void buildLight(Builder& b, const Light& l);
+  void texturePath(Builder& b, const Texture& t, const QString& objectName);
   void buildCamera(Builder& b);
   void buildEnvironment(Builder& b);
   void buildRender(Builder& b);

@@ -6,6 +6,7 @@
 #include <QDoubleSpinBox>
 #include <QTemporaryDir>
 #include <QLabel>
+#include <QLineEdit>
 #include <QPushButton>
 #include <QElapsedTimer>
 #include <QTest>
@@ -18,6 +19,7 @@
 
 #include "fields.h"
 #include "live_chart.h"
+#include "editor_support.h"
 #include "main_window.h"
 #include "node_graph.h"
 #include "retile/io.h"
@@ -26,18 +28,8 @@
 namespace retile::ui {
 namespace {
 
-std::unique_ptr<MainWindow> makeWindow() {
-  EditorOptions o;
-  o.initialRenderSize = QSize(96, 54);
-  auto w = std::make_unique<MainWindow>(makeDefaultScene(), std::filesystem::path(), o);
-  w->resize(1000, 700);
-  w->show();
-  return w;
-}
-
-bool waitForFrame(MainWindow& w, const std::function<bool(const FrameRecord&)>& pred, int ms = 60000) {
-  return QTest::qWaitFor([&] { return w.viewport()->frame() && pred(*w.viewport()->frame()); }, ms);
-}
+using test::makeWindow;
+using test::waitForFrame;
 
 NodeId objectNamed(const Scene& s, const std::string& name) {
   for (const auto& o : s.objects)
@@ -512,6 +504,20 @@ TEST(Editor, LivingRoomWalkThrough) {
   EXPECT_NEAR(s.material(wood)->roughness, 0.01f, 1e-6f);
   std::uint64_t version = w->documentVersion();
   ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version && !f.servedTiles.empty(); }, 60000));
+
+  // The table's wood is a file texture: its path is editable; a missing file is a substitute,
+  // not a failure.
+  auto* path = w->findChild<QLineEdit*>("albedoTexturePath");
+  ASSERT_TRUE(path);
+  EXPECT_TRUE(path->text().contains("wood5")) << path->text().toStdString();
+  path->setText("textures/no-such-wood.png");
+  emit path->returnPressed();
+  const NodeId woodTexture = s.material(wood)->albedoTexture;
+  EXPECT_EQ(s.texture(woodTexture)->path.string(), "textures/no-such-wood.png");
+  version = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; }, 60000)) << "frames keep coming";
+  w->undoStack()->undo();
+  EXPECT_TRUE(s.texture(woodTexture)->path.string().find("wood5") != std::string::npos);
 
   const NodeId vase = biggest("Glass");
   ASSERT_NE(vase, kNoNode) << "a glass vase is in view";

@@ -2,6 +2,11 @@
 // link and unlink, keys delete, duplicate, rename, copy and paste, Tab searches and creates. Each
 // requested GraphEdit is applied to a Document (its afters in order) and the graph refreshed, as
 // the main window does; undo is the befores in reverse order.
+#include <QAction>
+#include <QApplication>
+#include <QGraphicsPathItem>
+#include <QGraphicsRectItem>
+#include <QGraphicsScene>
 #include <QLineEdit>
 #include <QListWidget>
 #include <QSignalSpy>
@@ -78,6 +83,35 @@ class NodeGraph : public ::testing::Test {
     QTest::mouseRelease(vp(), Qt::LeftButton, mods, to);
   }
   void click(NodeId id, Qt::KeyboardModifiers mods = {}) { QTest::mouseClick(vp(), Qt::LeftButton, mods, header(id)); }
+
+  // The open inline rename editor (closed ones linger until their deferred delete), or null.
+  QLineEdit* renameEditor() {
+    QCoreApplication::processEvents();
+    QLineEdit* open = nullptr;
+    for (auto* e : view.findChildren<QLineEdit*>("nodeRename"))
+      if (e->isVisible()) {
+        EXPECT_FALSE(open) << "two rename editors open";
+        open = e;
+      }
+    return open;
+  }
+  // The transient items: the dashed link that follows the mouse and the rubber band.
+  bool dragLinkShown() {
+    for (QGraphicsItem* i : view.scene()->items())
+      if (auto* p = qgraphicsitem_cast<QGraphicsPathItem*>(i))
+        if (p->isVisible() && p->pen().style() == Qt::DashLine) return true;
+    return false;
+  }
+  bool marqueeShown() {
+    for (QGraphicsItem* i : view.scene()->items())
+      if (auto* r = qgraphicsitem_cast<QGraphicsRectItem*>(i))
+        if (r->isVisible()) return true;
+    return false;
+  }
+  bool searchShown() {
+    auto* search = view.findChild<QLineEdit*>("nodeSearch");
+    return search && search->isVisible();
+  }
 
   Document doc{makeDefaultScene()};
   NodeGraphView view;
@@ -329,6 +363,193 @@ TEST_F(NodeGraph, CopyPasteMakesCopiesWithNewIds) {
   EXPECT_NE(a, b);
   EXPECT_EQ(scene().material(a)->type, scene().material(ceramic)->type);
   EXPECT_NE(view.nodePosition(a), view.nodePosition(b)) << "pastes do not stack on each other";
+}
+
+TEST_F(NodeGraph, RenameEditorKeepsItsKeysFromTheGraphAndTheWindow) {
+  // The main window pauses the render on Escape; the editor's Escape and Return are its own.
+  view.activateWindow();
+  ASSERT_TRUE(QTest::qWaitForWindowActive(&view));
+  QAction pause, other;
+  pause.setShortcut(Qt::Key_Escape);
+  other.setShortcut(Qt::Key_Return);
+  view.addAction(&pause);
+  view.addAction(&other);
+  QSignalSpy paused(&pause, &QAction::triggered), returned(&other, &QAction::triggered);
+  QTest::keyClick(&view, Qt::Key_Escape);
+  ASSERT_EQ(paused.count(), 1) << "the window shortcut works outside the editor";
+
+  const NodeId sphere = named(scene().objects, "Glossy Sphere");
+  view.setSelectedObject(sphere);
+  QTest::keyClick(&view, Qt::Key_F2);
+  QLineEdit* editor = renameEditor();
+  ASSERT_TRUE(editor);
+  QTest::keyClicks(editor, "Oops");
+  QTest::keyClick(editor, Qt::Key_D, Qt::ControlModifier);
+  EXPECT_TRUE(edits.empty()) << "Ctrl+D in the editor does not duplicate the node";
+  QTest::keyClick(editor, Qt::Key_F2);
+  EXPECT_EQ(renameEditor(), editor) << "F2 in the editor does not restart the rename";
+  EXPECT_EQ(QApplication::focusWidget(), editor);
+  QTest::keyClick(editor, Qt::Key_Escape);
+  EXPECT_EQ(paused.count(), 1) << "Escape cancels the rename instead of pausing";
+  EXPECT_FALSE(renameEditor());
+  EXPECT_TRUE(edits.empty());
+  EXPECT_EQ(scene().object(sphere)->name, "Glossy Sphere");
+
+  QTest::keyClick(&view, Qt::Key_F2);
+  editor = renameEditor();
+  ASSERT_TRUE(editor);
+  editor->selectAll();
+  QTest::keyClicks(editor, "Hero Sphere");
+  QTest::keyClick(editor, Qt::Key_Return);
+  EXPECT_EQ(returned.count(), 0) << "Return commits the rename";
+  ASSERT_EQ(edits.size(), 1u);
+  EXPECT_EQ(scene().object(sphere)->name, "Hero Sphere");
+  EXPECT_FALSE(renameEditor());
+}
+
+TEST_F(NodeGraph, AnOwnerEchoingTheObjectSelectionKeepsAMultiSelection) {
+  // The main window answers objectSelected with setSelectedObject, as for the outliner and viewport.
+  QObject::connect(&view, &NodeGraphView::objectSelected, &view,
+                   [this](quint64 id) { view.setSelectedObject(static_cast<NodeId>(id)); });
+  const NodeId lacquer = named(scene().materials, "Red Lacquer");
+  const NodeId sphere = named(scene().objects, "Glossy Sphere");
+  const NodeId cup = named(scene().objects, "Cup");
+  click(lacquer);
+  click(sphere, Qt::ShiftModifier);
+  std::vector<NodeId> pair{lacquer, sphere};
+  std::sort(pair.begin(), pair.end());
+  EXPECT_EQ(view.selectedNodes(), pair) << "Shift-click on an object node adds it";
+
+  // Dragging the group by the object's node moves both.
+  const QPointF lacquerAt = view.nodePosition(lacquer), sphereAt = view.nodePosition(sphere);
+  drag(header(sphere), header(sphere) + QPoint(60, 40));
+  EXPECT_EQ(view.selectedNodes(), pair);
+  EXPECT_GT(view.nodePosition(sphere).x() - sphereAt.x(), 40);
+  EXPECT_GT(view.nodePosition(lacquer).x() - lacquerAt.x(), 40) << "the material moves with the object";
+
+  // From elsewhere, an object not in the selection still replaces it.
+  view.setSelectedObject(cup);
+  EXPECT_EQ(view.selectedNodes(), std::vector<NodeId>{cup});
+  view.setSelectedObject(kNoNode);
+  EXPECT_TRUE(view.selectedNodes().empty());
+}
+
+TEST_F(NodeGraph, ASecondButtonDuringADragDoesNotEndOrLeaveIt) {
+  const NodeId sphere = named(scene().objects, "Glossy Sphere");
+  const NodeId steel = named(scene().materials, "Brushed Steel");
+  const QPoint from = at(view.socketScenePos(steel, "material", true));
+  const QPoint to = at(view.socketScenePos(sphere, "material", false));
+  const QPoint mid = (from + to) / 2;
+  QTest::mousePress(vp(), Qt::LeftButton, {}, from);
+  QTest::mouseMove(vp(), mid);
+  QTest::mousePress(vp(), Qt::RightButton, {}, mid);
+  QTest::mouseRelease(vp(), Qt::RightButton, {}, mid);
+  EXPECT_FALSE(searchShown()) << "no node menu in the middle of a link drag";
+  EXPECT_TRUE(dragLinkShown()) << "the link is still being dragged";
+  QTest::mouseMove(vp(), to);
+  QTest::mouseRelease(vp(), Qt::LeftButton, {}, to);
+  EXPECT_FALSE(dragLinkShown());
+  ASSERT_EQ(edits.size(), 1u);
+  EXPECT_EQ(scene().object(sphere)->material, steel) << "the left release still links";
+
+  // A drag whose release never arrived (a modal dialog took it) ends at the next press of its button.
+  const NodeId lacquer = named(scene().materials, "Red Lacquer");
+  QTest::mousePress(vp(), Qt::LeftButton, {}, at(view.socketScenePos(lacquer, "material", true)));
+  QTest::mouseMove(vp(), mid);
+  ASSERT_TRUE(dragLinkShown());
+  QTest::mousePress(vp(), Qt::LeftButton, {}, header(sphere));
+  EXPECT_FALSE(dragLinkShown()) << "the stale link drag is dropped";
+  QTest::mouseRelease(vp(), Qt::LeftButton, {}, header(sphere));
+  EXPECT_EQ(edits.size(), 1u) << "without linking";
+  EXPECT_EQ(view.selectedNodes(), std::vector<NodeId>{sphere}) << "the new press is a click on the sphere";
+}
+
+TEST_F(NodeGraph, AMiddleClickDuringARubberBandNeitherPansNorEndsIt) {
+  const NodeId checker = named(scene().textures, "Checker");
+  const QPointF p = view.nodePosition(checker);
+  const QPoint a = at(p + QPointF(-30, -15)), b = at(p + QPointF(100, 30));
+  const QTransform t = view.viewportTransform();
+  QTest::mousePress(vp(), Qt::LeftButton, {}, a);
+  QTest::mouseMove(vp(), (a + b) / 2);
+  QTest::mousePress(vp(), Qt::MiddleButton, {}, (a + b) / 2);
+  QTest::mouseMove(vp(), b);
+  QTest::mouseRelease(vp(), Qt::MiddleButton, {}, b);
+  EXPECT_EQ(view.viewportTransform().dx(), t.dx()) << "no pan";
+  EXPECT_EQ(view.viewportTransform().dy(), t.dy()) << "no pan";
+  EXPECT_TRUE(marqueeShown());
+  QTest::mouseRelease(vp(), Qt::LeftButton, {}, b);
+  EXPECT_FALSE(marqueeShown());
+  EXPECT_EQ(view.selectedNodes(), std::vector<NodeId>{checker});
+}
+
+TEST_F(NodeGraph, GesturesBeforeTheOwnersQueuedRefreshBuildOnEachOther) {
+  // The main window refreshes the graph through a queued call; so does this owner.
+  QObject::disconnect(&view, &NodeGraphView::editRequested, nullptr, nullptr);
+  QObject::connect(&view, &NodeGraphView::editRequested, &view, [this](const GraphEdit& e) {
+    for (const auto& [before, after] : e.steps) {
+      auto r = doc.apply(after);
+      EXPECT_TRUE(r.ok()) << e.text.toStdString() << ": " << (r.ok() ? std::string() : r.error());
+    }
+    edits.push_back(e);
+    QMetaObject::invokeMethod(&view, [this] { view.setDocument(doc.scene()); }, Qt::QueuedConnection);
+  });
+  const std::size_t materials = scene().materials.size();
+  ASSERT_TRUE(view.createNode("Material", {0, 0}));
+  ASSERT_TRUE(view.createNode("Material", {0, 300}));
+  ASSERT_EQ(scene().materials.size(), materials + 2) << "the second node took a fresh id";
+  const Material& first = scene().materials[materials];
+  const Material& second = scene().materials[materials + 1];
+  EXPECT_NE(first.id, second.id);
+  EXPECT_NE(first.name, second.name);
+  const NodeId made = second.id;
+
+  // The second rename's before is the first's after: undoing it alone brings the first back.
+  ASSERT_TRUE(view.renameNode(made, "First"));
+  ASSERT_TRUE(view.renameNode(made, "Second"));
+  EXPECT_EQ(scene().material(made)->name, "Second");
+  ASSERT_EQ(edits.back().steps.size(), 1u);
+  ASSERT_TRUE(doc.apply(edits.back().steps.front().first).ok());
+  EXPECT_EQ(scene().material(made)->name, "First");
+
+  QCoreApplication::processEvents();
+  EXPECT_EQ(describe(view.document()), describe(scene()));
+  EXPECT_TRUE(view.hasNode(made));
+  EXPECT_EQ(view.nodePosition(made), QPointF(0, 300));
+}
+
+TEST_F(NodeGraph, OpeningAnotherFileForgetsTheOldDocumentsIds) {
+  // Copy a textured material, keep a selection and a rename open, then open a file whose ids coincide.
+  const NodeId checkered = named(scene().materials, "Checkered");
+  const NodeId checker = named(scene().textures, "Checker");
+  ASSERT_EQ(scene().material(checkered)->albedoTexture, checker);
+  view.activateWindow();
+  ASSERT_TRUE(QTest::qWaitForWindowActive(&view));
+  click(checkered);
+  QTest::keyClick(&view, Qt::Key_C, Qt::ControlModifier);
+  const NodeId sphere = named(scene().objects, "Glossy Sphere");
+  view.selectNodes({checkered, sphere});
+  QTest::keyClick(&view, Qt::Key_F2);
+  QLineEdit* editor = renameEditor();
+  ASSERT_TRUE(editor);
+  QTest::keyClicks(editor, "Typed before opening");
+
+  Scene other = makeDefaultScene();
+  for (Texture& t : other.textures)
+    if (t.id == checker) t.name = "Bricks";  // another file's texture that happens to share the id
+  doc = Document(std::move(other));
+  view.setDocument(doc.scene());  // what MainWindow::replaceDocument does
+  view.resetLayout();
+  EXPECT_TRUE(view.selectedNodes().empty()) << "the old selection's ids mean other nodes now";
+  EXPECT_FALSE(renameEditor()) << "the rename was of the old document's node";
+  view.setFocus();
+  QCoreApplication::processEvents();
+  EXPECT_TRUE(edits.empty()) << "nothing renamed in the new document";
+
+  // The copied material pastes into the new file, without the old file's texture.
+  ASSERT_TRUE(view.paste());
+  const NodeId pasted = named(scene().materials, "Checkered.001");
+  ASSERT_NE(pasted, kNoNode);
+  EXPECT_EQ(scene().material(pasted)->albedoTexture, kNoNode);
 }
 
 }  // namespace

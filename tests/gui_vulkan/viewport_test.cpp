@@ -12,24 +12,15 @@
 
 #include <cmath>
 
+#include "editor_support.h"
 #include "main_window.h"
 #include "vulkan_viewport.h"
 
 namespace retile::ui {
 namespace {
 
-std::unique_ptr<MainWindow> makeWindow() {
-  EditorOptions o;
-  o.initialRenderSize = QSize(96, 54);
-  auto w = std::make_unique<MainWindow>(makeDefaultScene(), std::filesystem::path(), o);
-  w->resize(1000, 700);
-  w->show();
-  return w;
-}
-
-bool waitForFrame(MainWindow& w, const std::function<bool(const FrameRecord&)>& pred, int ms = 60000) {
-  return QTest::qWaitFor([&] { return w.viewport()->frame() && pred(*w.viewport()->frame()); }, ms);
-}
+using test::makeWindow;
+using test::waitForFrame;
 
 TEST(VulkanViewport, ShowsTheComposedFrame) {
   auto w = makeWindow();
