@@ -162,6 +162,7 @@ void FrameView::refresh() {
 void FrameView::resizeEvent(QResizeEvent*) {
   if (container_) container_->setGeometry(rect());
   refresh();
+  emit resized();
 }
 
 void FrameView::paintEvent(QPaintEvent*) {

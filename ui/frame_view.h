@@ -83,6 +83,7 @@ class FrameView : public QWidget {
   void rotateDragged(double pixels);              // Rotate tool: horizontal drag turns about world y
   void scaleDragged(double pixels);               // Scale tool: horizontal drag scales uniformly
   void dragFinished();
+  void resized();
   // Pixel inspector: linear values under the cursor, and the statistics of a Ctrl+drag region
   // (image pixels, inclusive-exclusive).
   void pixelInspected(QPoint pixel, QVector3D linear);

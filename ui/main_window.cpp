@@ -164,7 +164,7 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
   auto aboutOrigin = [this](const Mat4& m, const QString& what) {
     const Object* o = doc_.scene().object(selection_);
     if (!o) return;
-    const Vec3 at = o->transform.transformPoint(Vec3{0.0f});
+    const Vec3 at = pivot(*o);
     Object after = *o;
     after.transform = Mat4::translate(at) * m * Mat4::translate(at * -1.0f) * o->transform;
     edit(SetObject{*o}, SetObject{after}, what.arg(QString::fromStdString(o->name)), dragCounter_ + 1);
@@ -176,6 +176,12 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
     const float s = static_cast<float>(std::exp(px * 0.005));
     aboutOrigin(Mat4::scale(Vec3{s, s, s}), tr("Scale %1"));
   });
+  // The render size follows the viewport (docks moved, window resized), once the size settles:
+  // every resize restarts the accumulation.
+  resizeTimer_.setSingleShot(true);
+  resizeTimer_.setInterval(150);
+  connect(&resizeTimer_, &QTimer::timeout, this, [this] { updateRenderSize(); });
+  connect(view_, &FrameView::resized, this, [this] { resizeTimer_.start(); });
   setAcceptDrops(true);
   // Autosave every 5 minutes ($RETILE_AUTOSAVE_SECONDS overrides) to rotating recovery files.
   auto* autosaveTimer = new QTimer(this);
@@ -317,7 +323,7 @@ void MainWindow::buildMenus() {
 
 void MainWindow::buildDocks() {
   outliner_ = new QTreeWidget(this);
-  outliner_->setHeaderLabels({tr("Name"), tr("Kind")});
+  outliner_->setHeaderLabels({tr("Name"), tr("Material / kind")});
   outliner_->header()->setSectionResizeMode(0, QHeaderView::Stretch);
   connect(outliner_, &QTreeWidget::itemSelectionChanged, this, [this] {
     auto items = outliner_->selectedItems();
@@ -613,13 +619,24 @@ bool MainWindow::applyToDocument(const Edit& e) {
   return true;
 }
 
+Vec3 MainWindow::pivot(const Object& o) const {
+  // Imported meshes often sit in world space under an identity transform: the centre of the
+  // object's bounds is where an artist expects the gizmo and the pivot.
+  const Mesh* m = doc_.scene().mesh(o.mesh);
+  if (m && m->geometry) {
+    Bounds3 b = transformBounds(o.transform, m->geometry->bounds());
+    if (!b.empty()) return b.center();
+  }
+  return o.transform.transformPoint(Vec3{0.0f});
+}
+
 void MainWindow::updateGizmo() {
   FrameView::Gizmo g;
   const Object* o = doc_.scene().object(selection_);
   auto frame = view_->frame();
   if (o && frame) {
     const Camera& c = doc_.scene().camera;
-    const Vec3 at = o->transform.transformPoint(Vec3{0.0f});
+    const Vec3 at = pivot(*o);
     // A fixed share of the view: arrows keep their on-screen size as the camera moves.
     gizmoLength_ = 0.12f * length(at - c.position) * std::tan(c.verticalFov * 0.5f) * 2.0f;
     auto origin = projectToImage(c, frame->width, frame->height, at);
@@ -681,7 +698,9 @@ void MainWindow::rebuildOutliner() {
   };
   QTreeWidgetItem* objects = group(tr("Objects"));
   for (const Object& o : s.objects) {
-    auto* it = new QTreeWidgetItem(objects, {QString::fromStdString(o.name), tr("object")});
+    // Imported objects are often named after their mesh files: the material says what they are.
+    const Material* m = s.material(o.material);
+    auto* it = new QTreeWidgetItem(objects, {QString::fromStdString(o.name), m ? QString::fromStdString(m->name) : tr("object")});
     it->setData(0, kIdRole, static_cast<qulonglong>(o.id));
     it->setData(0, kKindRole, static_cast<int>(PropertyTarget::Kind::Object));
     it->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsEditable | Qt::ItemIsUserCheckable);
@@ -881,7 +900,7 @@ void MainWindow::frameSelected() {
 
 void MainWindow::resizeEvent(QResizeEvent* e) {
   QMainWindow::resizeEvent(e);
-  updateRenderSize();
+  resizeTimer_.start();
 }
 
 }  // namespace retile::ui

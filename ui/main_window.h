@@ -6,6 +6,7 @@
 
 #include <QElapsedTimer>
 #include <QMainWindow>
+#include <QTimer>
 #include <QUndoStack>
 
 #include <filesystem>
@@ -77,6 +78,7 @@ class MainWindow : public QMainWindow {
   bool maybeSave();
   void refreshGraph();
   void updateGizmo();
+  Vec3 pivot(const Object& o) const;  // where the gizmo sits and rotation/scale turn about
   void replaceDocument(Scene scene, const std::filesystem::path& file);
   void buildDocks();
   void startEngine(Scene scene);
@@ -112,6 +114,7 @@ class MainWindow : public QMainWindow {
   class NodeGraphView* graph_ = nullptr;
   bool graphRefreshQueued_ = false;
   FrameView::Gizmo gizmo_;
+  QTimer resizeTimer_;
   float gizmoLength_ = 0.0f;  // world length of the gizmo's arrows
   QLabel* inspector_ = nullptr;
   class LiveChart* chart_ = nullptr;

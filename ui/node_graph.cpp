@@ -11,6 +11,7 @@
 #include <QListWidget>
 #include <QMouseEvent>
 #include <QPainter>
+#include <QPainterPathStroker>
 #include <QRegularExpression>
 #include <QScrollBar>
 #include <QVBoxLayout>
@@ -18,6 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <set>
 
 namespace retile::ui {
@@ -69,6 +71,11 @@ NodeId Material::*textureSlot(const QString& input) {
   if (input == QLatin1String("roughness")) return &Material::roughnessTexture;
   if (input == QLatin1String("alpha")) return &Material::alphaTexture;
   return nullptr;
+}
+
+// A link about to take a dropped node stands out from the others: thicker and brighter.
+QPen linkPen(const QString& input, bool highlighted) {
+  return highlighted ? QPen(socketColor(input).lighter(145), 5) : QPen(socketColor(input), 2.5);
 }
 
 QPainterPath linkPath(QPointF a, QPointF b) {
@@ -549,7 +556,7 @@ void NodeGraphView::rebuild() {
 
   auto addLink = [&](NodeId from, NodeId to, const QString& input) {
     if (!nodes_.count(from) || !nodes_.count(to)) return;
-    auto* item = scene()->addPath(QPainterPath(), QPen(socketColor(input), 2.5));
+    auto* item = scene()->addPath(QPainterPath(), linkPen(input, false));
     item->setZValue(0);
     links_.push_back({from, to, input, item});
   };
@@ -653,6 +660,41 @@ bool NodeGraphView::accepts(NodeId from, NodeId to, const QString& input) const 
   return isTextureInput(input) && scene_.texture(from) && scene_.material(to);
 }
 
+const NodeGraphView::Link* NodeGraphView::insertTarget() const {
+  // A lone node only: a group carried across a link is being moved out of the way.
+  if (moveStart_.size() != 1) return nullptr;
+  auto it = nodes_.find(moveStart_.front().first);
+  if (it == nodes_.end()) return nullptr;
+  const GraphNodeItem* n = it->second;
+  // Slightly inside the box: a node dropped overlapping a neighbour only touches the neighbour's
+  // link where it leaves the output socket on the box's edge, and that is not a drop on the link.
+  const QRectF body = n->mapRectToScene(QRectF(0, 0, kNodeWidth, n->height()).adjusted(2, 2, -2, -2));
+  // The stroke, not the path: an open curve's path also "contains" the area between it and its chord.
+  QPainterPathStroker stroker;
+  stroker.setWidth(1);
+  const Link* best = nullptr;
+  qreal bestDist = std::numeric_limits<qreal>::max();
+  for (const Link& l : links_) {
+    // The node's own links move with it and always touch its box.
+    if (l.from == n->id || l.to == n->id || !accepts(n->id, l.to, l.input)) continue;
+    const QPainterPath path = l.item->path();
+    if (!stroker.createStroke(path).intersects(body)) continue;
+    // Several links under one box: the one passing closest to its middle is the one aimed at.
+    qreal dist = std::numeric_limits<qreal>::max();
+    for (int i = 0; i <= 32; ++i) dist = std::min(dist, QLineF(body.center(), path.pointAtPercent(i / 32.0)).length());
+    if (dist < bestDist) {
+      bestDist = dist;
+      best = &l;
+    }
+  }
+  return best;
+}
+
+void NodeGraphView::highlightLink(const Link* target) {
+  // Every link, not just the previous target: a refresh in the middle of a drag rebuilds the items.
+  for (const Link& l : links_) l.item->setPen(linkPen(l.input, &l == target));
+}
+
 namespace {
 
 QString nameOf(const Scene& s, NodeId id) {
@@ -693,6 +735,15 @@ bool NodeGraphView::unlink(NodeId to, const QString& input) {
   EditBuilder b(scene_);
   if (!b.assign(to, input, kNoNode)) return false;
   return request(b.finish(tr("Unlink %1 %2").arg(nameOf(scene_, to), input)), b.scene());
+}
+
+bool NodeGraphView::insertDropped(const Link& target) {
+  const NodeId node = moveStart_.front().first, to = target.to;
+  const QString input = target.input;  // `target` goes with the rebuild that request() may do
+  EditBuilder b(scene_);
+  if (!b.assign(to, input, node)) return false;
+  return request(b.finish(tr("Insert %1 into %2.%3").arg(nameOf(scene_, node), nameOf(scene_, to), input)),
+                 b.scene());
 }
 
 bool NodeGraphView::createNode(const QString& type, QPointF scenePos) {
@@ -1012,6 +1063,7 @@ void NodeGraphView::mousePressEvent(QMouseEvent* e) {
     dragLink_->hide();
     marquee_->hide();
     for (Link& l : links_) l.item->show();
+    highlightLink(nullptr);
   }
   setFocus(Qt::MouseFocusReason);
   dragButton_ = e->button();
@@ -1119,6 +1171,7 @@ void NodeGraphView::mouseMoveEvent(QMouseEvent* e) {
         positions_[id] = start + d;
       }
       updateLinkPaths();
+      highlightLink(insertTarget());  // what a release here would do
       break;
     }
     case Drag::Marquee: {
@@ -1142,11 +1195,15 @@ void NodeGraphView::mouseReleaseEvent(QMouseEvent* e) {
     case Drag::None:
     case Drag::Pan: break;
     case Drag::Link: finishLinkDrag(mapToScene(e->pos())); break;
-    case Drag::Move:
+    case Drag::Move: {
       // A click (no drag) on one of several selected nodes selects just it.
       if (!moved_ && !(pressModifiers_ & (Qt::ShiftModifier | Qt::ControlModifier)) && nodes_.count(pressedNode_))
         setSelection({pressedNode_});
+      const Link* target = moved_ ? insertTarget() : nullptr;
+      highlightLink(nullptr);
+      if (target) insertDropped(*target);
       break;
+    }
     case Drag::Marquee: marquee_->hide(); break;
   }
 }

@@ -1,9 +1,15 @@
 // The node graph: a QGraphicsView over the document drawn as nodes (textures | materials | objects,
 // then camera, render settings and lights) with links for assignments (a material to an object, a
 // texture to a material's albedo, roughness or alpha). The view never changes the document itself:
-// every gesture that would (link, unlink, create, delete, duplicate, rename, paste) becomes a
-// GraphEdit handed to the owner through editRequested, which applies it as one undo step and calls
-// setDocument again. Node positions and the selection are view state, kept by id across refreshes.
+// every gesture that would (link, unlink, create, delete, duplicate, rename, paste, drop a node on a
+// link) becomes a GraphEdit handed to the owner through editRequested, which applies it as one undo
+// step and calls setDocument again. Node positions and the selection are view state, kept by id
+// across refreshes.
+//
+// Dropping a node on a link inserts it: a lone node dragged (left button) and released with its box
+// over a link whose input takes the node's output (a material over a material -> object link, a
+// texture over a texture -> material link) becomes that input's source. There are no pass-through
+// nodes, so the old source simply loses the link. The link is highlighted while a release would do this.
 //
 // Ownership: the view keeps a copy of the scene it shows (meshes are shared, so the copy is cheap)
 // and owns its graphics items; items are rebuilt on every setDocument, so nothing outside the view
@@ -123,6 +129,10 @@ class NodeGraphView : public QGraphicsView {
   SocketHit socketAt(QPointF scenePos) const;
   const Link* linkInto(NodeId to, const QString& input) const;
   bool accepts(NodeId from, NodeId to, const QString& input) const;
+  // The link the node being moved would be inserted into if released now, or null (see the top).
+  const Link* insertTarget() const;
+  void highlightLink(const Link* target);  // null: none
+  bool insertDropped(const Link& target);  // re-points target's input to the moved node
   void updateLinkPaths();
   void finishLinkDrag(QPointF scenePos);
   void setSelection(const std::vector<NodeId>& ids);

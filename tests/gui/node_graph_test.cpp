@@ -102,6 +102,22 @@ class NodeGraph : public ::testing::Test {
         if (p->isVisible() && p->pen().style() == Qt::DashLine) return true;
     return false;
   }
+  // Links drawn thicker than the rest: the one a dropped node would be inserted into.
+  int highlightedLinks() {
+    int n = 0;
+    for (QGraphicsItem* i : view.scene()->items())
+      if (auto* p = qgraphicsitem_cast<QGraphicsPathItem*>(i))
+        if (p->isVisible() && p->pen().style() == Qt::SolidLine && p->pen().widthF() > 3) ++n;
+    return n;
+  }
+  // The middle of the link into `to`'s input (the curve is symmetric, so the middle of its ends).
+  QPointF linkMiddle(NodeId to, const QString& input) {
+    const NodeId from = view.linkSource(to, input);
+    const QString output = input == "material" ? "material" : "texture";
+    return (view.socketScenePos(from, output, true) + view.socketScenePos(to, input, false)) / 2;
+  }
+  // Inside every node's box, away from its sockets.
+  QPoint body(NodeId id) { return at(view.nodePosition(id) + QPointF(95, 40)); }
   bool marqueeShown() {
     for (QGraphicsItem* i : view.scene()->items())
       if (auto* r = qgraphicsitem_cast<QGraphicsRectItem*>(i))
@@ -550,6 +566,84 @@ TEST_F(NodeGraph, OpeningAnotherFileForgetsTheOldDocumentsIds) {
   const NodeId pasted = named(scene().materials, "Checkered.001");
   ASSERT_NE(pasted, kNoNode);
   EXPECT_EQ(scene().material(pasted)->albedoTexture, kNoNode);
+}
+
+TEST_F(NodeGraph, DroppingANodeOnALinkItFitsInsertsIt) {
+  const Scene original = scene();
+  const NodeId sphere = named(scene().objects, "Glossy Sphere");
+  const NodeId steel = named(scene().materials, "Brushed Steel");
+  const NodeId lacquer = scene().object(sphere)->material;
+  const NodeId panel = named(scene().objects, "Steel Panel");
+  ASSERT_NE(lacquer, steel);
+  ASSERT_EQ(scene().object(panel)->material, steel);
+
+  // Carry the steel material onto the lacquer -> sphere link: the link lights up before the release.
+  const QPoint from = body(steel), to = at(linkMiddle(sphere, "material"));
+  QTest::mousePress(vp(), Qt::LeftButton, {}, from);
+  for (int i = 1; i <= 6; ++i) QTest::mouseMove(vp(), from + (to - from) * i / 6);
+  EXPECT_EQ(highlightedLinks(), 1) << "the link the node would go into stands out";
+  QTest::mouseRelease(vp(), Qt::LeftButton, {}, to);
+  EXPECT_EQ(highlightedLinks(), 0);
+  ASSERT_EQ(edits.size(), 1u);
+  EXPECT_EQ(edits.back().text, "Insert Brushed Steel into Glossy Sphere.material");
+  EXPECT_EQ(edits.back().steps.size(), 1u);
+  EXPECT_EQ(scene().object(sphere)->material, steel) << "the link's input now takes the dropped node";
+  EXPECT_EQ(view.linkSource(sphere, "material"), steel);
+  EXPECT_EQ(scene().object(panel)->material, steel) << "the node's own links stay";
+  EXPECT_LT(QLineF(view.mapToScene(body(steel)), view.mapToScene(to)).length(), 4.0) << "it stays where dropped";
+  undo(edits.back());
+  EXPECT_EQ(describe(scene()), describe(original));
+  EXPECT_EQ(view.linkSource(sphere, "material"), lacquer);
+
+  // A texture onto a texture -> material link; a new checker, since the one there is the link's source.
+  const NodeId checker = named(scene().textures, "Checker");
+  const NodeId checkered = named(scene().materials, "Checkered");
+  ASSERT_EQ(view.linkSource(checkered, "albedo"), checker);
+  ASSERT_TRUE(view.createNode("Texture", view.nodePosition(checker) + QPointF(0, 200)));  // below it, in the clear
+  const NodeId made = scene().textures.back().id;
+  drag(body(made), at(linkMiddle(checkered, "albedo")));
+  ASSERT_EQ(edits.size(), 3u);
+  EXPECT_EQ(scene().material(checkered)->albedoTexture, made);
+  EXPECT_EQ(edits.back().text, "Insert Checker.001 into Checkered.albedo");
+
+  // The source of the link it is dropped on has nothing to insert.
+  drag(body(made), body(made) + QPoint(10, 10));
+  EXPECT_EQ(edits.size(), 3u);
+}
+
+TEST_F(NodeGraph, DroppingANodeOnALinkThatDoesNotTakeItOnlyMovesIt) {
+  const Scene original = scene();
+  const NodeId sphere = named(scene().objects, "Glossy Sphere");
+  const NodeId checker = named(scene().textures, "Checker");
+  const QPoint from = body(checker), to = at(linkMiddle(sphere, "material"));
+  QTest::mousePress(vp(), Qt::LeftButton, {}, from);
+  for (int i = 1; i <= 6; ++i) QTest::mouseMove(vp(), from + (to - from) * i / 6);
+  EXPECT_EQ(highlightedLinks(), 0) << "a texture does not fit an object's material input";
+  QTest::mouseRelease(vp(), Qt::LeftButton, {}, to);
+  EXPECT_TRUE(edits.empty());
+  EXPECT_EQ(describe(scene()), describe(original));
+  EXPECT_LT(QLineF(view.mapToScene(body(checker)), view.mapToScene(to)).length(), 4.0) << "but it moved";
+}
+
+TEST_F(NodeGraph, DraggingASelectionOverALinkOnlyMovesIt) {
+  const Scene original = scene();
+  const NodeId sphere = named(scene().objects, "Glossy Sphere");
+  const NodeId steel = named(scene().materials, "Brushed Steel");
+  const NodeId cup = named(scene().objects, "Cup");
+  ASSERT_LT(steel, cup) << "steel leads the selection, so inserting 'the first moved node' would insert it";
+  click(cup);
+  click(steel, Qt::ShiftModifier);
+  ASSERT_EQ(view.selectedNodes().size(), 2u);
+  const QPointF cupAt = view.nodePosition(cup);
+  const QPoint from = body(steel), to = at(linkMiddle(sphere, "material"));
+  QTest::mousePress(vp(), Qt::LeftButton, {}, from);
+  for (int i = 1; i <= 6; ++i) QTest::mouseMove(vp(), from + (to - from) * i / 6);
+  EXPECT_EQ(highlightedLinks(), 0) << "a group is not inserted";
+  QTest::mouseRelease(vp(), Qt::LeftButton, {}, to);
+  EXPECT_TRUE(edits.empty());
+  EXPECT_EQ(describe(scene()), describe(original));
+  EXPECT_LT(QLineF(view.mapToScene(body(steel)), view.mapToScene(to)).length(), 4.0);
+  EXPECT_NE(view.nodePosition(cup), cupAt) << "the whole selection moved";
 }
 
 }  // namespace
