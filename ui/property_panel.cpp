@@ -156,13 +156,7 @@ void PropertyPanel::rebuild() {
 
 void PropertyPanel::buildObject(Builder& b, const Object& o) {
   const NodeId id = o.id;
-  auto edit = [this, id](const QString& what, int drag, const std::function<void(Object&)>& change) {
-    const Object* cur = scene_().object(id);
-    if (!cur) return;
-    Object after = *cur;
-    change(after);
-    push_(SetObject{*cur}, SetObject{after}, what, drag);
-  };
+  auto edit = nodeEdit<Object, SetObject>(id, [](const Scene& sc, NodeId i) { return sc.object(i); });
   b.header(tr("Object: %1").arg(QString::fromStdString(o.name)));
   // Position moves the object and keeps its rotation and scale.
   b.vec3(tr("Position"), "position", o.transform.transformPoint(Vec3{0.0f}), 0.01, [edit](int axis, double v, int drag) {
@@ -190,13 +184,7 @@ void PropertyPanel::buildObject(Builder& b, const Object& o) {
 
 void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   const NodeId id = m.id;
-  auto edit = [this, id](const QString& what, int drag, const std::function<void(Material&)>& change) {
-    const Material* cur = scene_().material(id);
-    if (!cur) return;
-    Material after = *cur;
-    change(after);
-    push_(SetMaterial{*cur}, SetMaterial{after}, what, drag);
-  };
+  auto edit = nodeEdit<Material, SetMaterial>(id, [](const Scene& sc, NodeId i) { return sc.material(i); });
   const Material defaults;
   b.header(tr("Material: %1").arg(QString::fromStdString(m.name)));
   QStringList types;
@@ -336,13 +324,7 @@ void PropertyPanel::texturePath(Builder& b, const Texture& t, const QString& obj
 
 void PropertyPanel::buildLight(Builder& b, const Light& l) {
   const NodeId id = l.id;
-  auto edit = [this, id](const QString& what, int drag, const std::function<void(Light&)>& change) {
-    const Light* cur = scene_().light(id);
-    if (!cur) return;
-    Light after = *cur;
-    change(after);
-    push_(SetLight{*cur}, SetLight{after}, what, drag);
-  };
+  auto edit = nodeEdit<Light, SetLight>(id, [](const Scene& sc, NodeId i) { return sc.light(i); });
   const Light defaults;
   b.header(tr("Light: %1").arg(QString::fromStdString(l.name)));
   b.choice(tr("Type"), "lightType", {tr("point"), tr("spot"), tr("directional")}, static_cast<int>(l.type), [this, edit](int i) {

@@ -39,6 +39,18 @@ class PropertyPanel : public QScrollArea {
 
  private:
   class Builder;
+  // An editor of node `id`: reads the node from the document when called (never a stale copy),
+  // applies `change` and pushes Wrap{before} -> Wrap{after} as an undoable edit.
+  template <class Node, class Wrap, class Get>
+  auto nodeEdit(NodeId id, Get get) {
+    return [this, id, get](const QString& what, int drag, const std::function<void(Node&)>& change) {
+      const Node* cur = get(scene_(), id);
+      if (!cur) return;
+      Node after = *cur;
+      change(after);
+      push_(Wrap{*cur}, Wrap{after}, what, drag);
+    };
+  }
   void buildObject(Builder& b, const Object& o);
   void buildMaterial(Builder& b, const Material& m);
   void buildLight(Builder& b, const Light& l);
