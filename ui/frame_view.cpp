@@ -258,6 +258,18 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
       p.fillRect(tileRect(t), priorityColor(pr));
     }
   }
+  if (overlays_.classes && static_cast<int>(f.tileClass.size()) == tiles) {
+    // Hatched, so they read on top of the heat map: what the selected object touches directly
+    // (high), through reflections or shadows (middle), and barely (low).
+    static const QColor classColor[3] = {QColor(255, 40, 40), QColor(255, 200, 0), QColor(60, 140, 255)};
+    for (int t = 0; t < tiles; ++t) {
+      int c = f.tileClass[static_cast<std::size_t>(t)];
+      if (c > 2) continue;
+      p.fillRect(tileRect(t), QBrush(classColor[c], Qt::BDiagPattern));
+      p.setPen(QPen(classColor[c], 1.5));
+      p.drawRect(tileRect(t).adjusted(1, 1, -1, -1));
+    }
+  }
   QFont small(font().family(), std::max(6, static_cast<int>(f.tileSize * sy / 3.2)));
   p.setFont(small);
   if (overlays_.order && static_cast<int>(f.tilePriority.size()) == tiles && f.queueLength > 1) {
@@ -308,6 +320,16 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
     p.drawText(QRectF(box.x() + 10, box.y() + 50, 210, 14), tr("+ point of change"));
     p.setPen(QColor(80, 255, 120));
     p.drawText(QRectF(box.x() + 120, box.y() + 50, 110, 14), tr("o focus point"));
+    if (overlays_.classes && !f.tileClass.empty()) {
+      QRectF extra(box.x(), box.y() - 20, box.width(), 18);
+      p.fillRect(extra, QColor(0, 0, 0, 170));
+      p.setPen(QColor(255, 60, 60));
+      p.drawText(extra.adjusted(10, 2, 0, 0), tr("high"));
+      p.setPen(QColor(255, 200, 0));
+      p.drawText(extra.adjusted(50, 2, 0, 0), tr("middle"));
+      p.setPen(QColor(90, 160, 255));
+      p.drawText(extra.adjusted(105, 2, 0, 0), tr("low (indirection classes)"));
+    }
     p.setPen(Qt::lightGray);
     p.drawText(QRectF(box.x() + 10, box.y() + 62, 210, 14),
                tr("%1, %2: %3/%4 tiles").arg(QString::fromStdString(f.method), QString::fromStdString(f.mode))

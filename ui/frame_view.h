@@ -25,6 +25,7 @@ struct OverlaySettings {
   bool served = true;     // tiles traced this frame, outlined
   bool markers = true;    // point of change and focus points
   bool legend = true;
+  bool classes = false;   // indirection classes: high, middle, low (indirection methods only)
 };
 
 class FrameView : public QWidget {

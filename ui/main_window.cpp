@@ -255,6 +255,7 @@ void MainWindow::buildMenus() {
     });
   };
   toggle(tr("Tile &priority heat map"), &OverlaySettings::priority);
+  toggle(tr("&Indirection classes (high / middle / low)"), &OverlaySettings::classes);
   toggle(tr("Tile &order numbers"), &OverlaySettings::order);
   toggle(tr("&Samples per tile"), &OverlaySettings::samples);
   toggle(tr("Tiles served this &frame"), &OverlaySettings::served);
@@ -339,8 +340,26 @@ void MainWindow::buildDocks() {
   });
   connect(outliner_, &QTreeWidget::itemChanged, this, [this](QTreeWidgetItem* item, int column) {
     NodeId id = static_cast<NodeId>(item->data(0, kIdRole).toULongLong());
+    if (column != 0) return;
+    const std::string name = item->text(0).toStdString();
+    const bool shown = item->checkState(0) == Qt::Checked;
+    if (const Material* m = doc_.scene().material(id)) {
+      if (name.empty() || name == m->name) return;
+      Material after = *m;
+      after.name = name;
+      edit(SetMaterial{*m}, SetMaterial{after}, tr("Rename material"));
+      return;
+    }
+    if (const Light* l = doc_.scene().light(id)) {
+      if ((name.empty() || name == l->name) && shown == l->visible) return;
+      Light after = *l;
+      if (!name.empty()) after.name = name;
+      after.visible = shown;
+      edit(SetLight{*l}, SetLight{after}, shown != l->visible ? tr("Show/hide %1").arg(item->text(0)) : tr("Rename light"));
+      return;
+    }
     const Object* o = doc_.scene().object(id);
-    if (!o || column != 0) return;
+    if (!o) return;
     Object after = *o;
     after.name = item->text(0).toStdString();
     after.visible = item->checkState(0) == Qt::Checked;
@@ -614,7 +633,15 @@ bool MainWindow::applyToDocument(const Edit& e) {
     return false;
   }
   engine_->submit(e, doc_.version());
-  if (!std::holds_alternative<SetMaterial>(e)) rebuildOutliner();  // names, visibility, membership
+  // Names, visibility, membership, materials shown beside objects. Deferred: the edit may come
+  // from the outliner's own itemChanged, whose item a rebuild deletes.
+  if (!outlinerRefreshQueued_) {
+    outlinerRefreshQueued_ = true;
+    QMetaObject::invokeMethod(this, [this] {
+      outlinerRefreshQueued_ = false;
+      rebuildOutliner();
+    }, Qt::QueuedConnection);
+  }
   refreshGraph();
   return true;
 }
@@ -712,12 +739,15 @@ void MainWindow::rebuildOutliner() {
     auto* it = new QTreeWidgetItem(materials, {QString::fromStdString(m.name), materialTypeName(m.type)});
     it->setData(0, kIdRole, static_cast<qulonglong>(m.id));
     it->setData(0, kKindRole, static_cast<int>(PropertyTarget::Kind::Material));
+    it->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsEditable);
   }
   QTreeWidgetItem* lights = group(tr("Lights"));
   for (const Light& l : s.lights) {
     auto* it = new QTreeWidgetItem(lights, {QString::fromStdString(l.name), tr("light")});
     it->setData(0, kIdRole, static_cast<qulonglong>(l.id));
     it->setData(0, kKindRole, static_cast<int>(PropertyTarget::Kind::Light));
+    it->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsEditable | Qt::ItemIsUserCheckable);
+    it->setCheckState(0, l.visible ? Qt::Checked : Qt::Unchecked);
   }
   QTreeWidgetItem* scene = group(tr("Scene"));
   auto single = [&](const QString& name, PropertyTarget::Kind kind) {

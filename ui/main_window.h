@@ -113,6 +113,7 @@ class MainWindow : public QMainWindow {
   PropertyPanel* renderPanel_ = nullptr;
   class NodeGraphView* graph_ = nullptr;
   bool graphRefreshQueued_ = false;
+  bool outlinerRefreshQueued_ = false;
   FrameView::Gizmo gizmo_;
   QTimer resizeTimer_;
   float gizmoLength_ = 0.0f;  // world length of the gizmo's arrows

@@ -5,6 +5,7 @@
 #include <QStandardPaths>
 #include <QDoubleSpinBox>
 #include <QTemporaryDir>
+#include <QComboBox>
 #include <QLabel>
 #include <QLineEdit>
 #include <QPushButton>
@@ -242,6 +243,16 @@ TEST(Editor, CameraEnvironmentAndRenderSettingsHavePanels) {
       }
     return false;
   };
+  // Materials rename in the outliner too (the edit arrives from the item's own change signal).
+  for (QTreeWidgetItemIterator it(w->outliner()); *it; ++it)
+    if ((*it)->text(0) == "Red Lacquer") {
+      (*it)->setText(0, "Cherry Lacquer");
+      break;
+    }
+  bool renamed = false;
+  for (const auto& m : w->scene().materials) renamed = renamed || m.name == "Cherry Lacquer";
+  EXPECT_TRUE(renamed);
+  QTest::qWait(50);  // the outliner rebuilds on the next turn of the event loop
   ASSERT_TRUE(pick("Camera"));
   auto* fov = w->properties()->findChild<ScrubField*>("fov");
   ASSERT_TRUE(fov);
@@ -588,6 +599,38 @@ TEST(Editor, ShiftDragDrawsARenderRegionAndShiftClickPlacesAFocusPoint) {
   QTest::mouseClick(v, Qt::LeftButton, Qt::ShiftModifier, a);
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& fr) { return fr.focus.size() == 1; }));
   EXPECT_NEAR(v->frame()->focus[0].x, 0.1 * f->width, 2.0);
+}
+
+
+TEST(Editor, TheIndirectionClassesOverlayShowsTheClassesOfTheSelectedObject) {
+  auto w = makeWindow();
+  auto* method = w->findChild<QComboBox*>("method");
+  ASSERT_TRUE(method);
+  method->setCurrentText("indirection");
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  // The counters are gathered over a few frames; then an edit plans the classes.
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.method == "indirection" && f.frame >= 8; }));
+  Object o = *w->scene().object(sphere), moved = o;
+  moved.transform = Mat4::translate({0.02f, 0, 0}) * o.transform;
+  w->edit(SetObject{o}, SetObject{moved}, "move");
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return !f.tileClass.empty(); }));
+  w->engine()->submit(PauseCommand{true});
+  QTest::qWait(200);
+  FrameView* v = w->viewport();
+  OverlaySettings only{false, false, false, false, false, false, true};
+  v->setOverlays(only);
+  const QImage with = v->composed();
+  only.classes = false;
+  v->setOverlays(only);
+  const QImage without = v->composed();
+  int red = 0;
+  for (int y = 0; y < with.height(); ++y)
+    for (int x = 0; x < with.width(); ++x) {
+      QColor a = with.pixelColor(x, y), b = without.pixelColor(x, y);
+      if (a != b && a.red() > 200 && a.green() < 90 && a.blue() < 90) ++red;
+    }
+  EXPECT_GT(red, 20) << "high tiles outlined in red where the sphere is";
 }
 
 }  // namespace
