@@ -54,7 +54,8 @@ LiveChart::LiveChart(QWidget* parent) : QWidget(parent) {
   chart->addSeries(samplesPerSecond_);
   chart->addSeries(frameMs_);
   timeAxis_ = new QValueAxis(chart);
-  timeAxis_->setTitleText(tr("s"));
+  timeAxis_->setTitleText(tr("seconds since the editor started"));
+  timeAxis_->setLabelFormat("%.0f");
   timeAxis_->setRange(-kWindowSeconds, 0);
   rateAxis_ = new QValueAxis(chart);
   msAxis_ = new QValueAxis(chart);
@@ -77,6 +78,8 @@ LiveChart::LiveChart(QWidget* parent) : QWidget(parent) {
   errChart->addSeries(error_);
   errTimeAxis_ = new QValueAxis(errChart);
   errTimeAxis_->setRange(-kWindowSeconds, 0);
+  errTimeAxis_->setTitleText(tr("seconds since the editor started"));
+  errTimeAxis_->setLabelFormat("%.0f");
   errAxis_ = new QValueAxis(errChart);
   errAxis_->setLabelFormat("%.3f");
   errChart->addAxis(errTimeAxis_, Qt::AlignBottom);
