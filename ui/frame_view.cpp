@@ -95,6 +95,8 @@ void FrameView::setTool(Tool t) {
 }
 
 void FrameView::setGizmo(const Gizmo& g) {
+  // Called after every frame: compose again only when the gizmo moved.
+  if (g == gizmo_) return;
   gizmo_ = g;
   refresh();
 }
@@ -404,11 +406,9 @@ void FrameView::mousePressEvent(QMouseEvent* e) {
       }
     }
   }
-  QRectF r = imageRect();
-  if (!r.contains(e->position())) return;
-  double u = (e->position().x() - r.x()) / r.width(), v = (e->position().y() - r.y()) / r.height();
-  int x = std::clamp(static_cast<int>(u * frame_->width), 0, frame_->width - 1);
-  int y = std::clamp(static_cast<int>(v * frame_->height), 0, frame_->height - 1);
+  const QPoint px = imagePixel(e->position());
+  if (px.x() < 0) return;
+  const int x = px.x(), y = px.y();
   if (e->modifiers() & Qt::ShiftModifier) {
     // A click places a focus point; a drag draws a render region (decided on release).
     drag_ = Drag::RenderRegion;

@@ -9,6 +9,7 @@
 #include <QVector3D>
 #include <QWidget>
 
+#include <algorithm>
 #include <memory>
 
 #include "retile/image.h"
@@ -60,6 +61,9 @@ class FrameView : public QWidget {
     bool visible = false;
     QPointF origin;
     QPointF axisEnd[3];
+    bool operator==(const Gizmo& o) const {
+      return visible == o.visible && origin == o.origin && std::equal(axisEnd, axisEnd + 3, o.axisEnd);
+    }
   };
   void setTool(Tool t);
   Tool tool() const { return tool_; }

@@ -322,6 +322,14 @@ void MainWindow::buildMenus() {
   });
 }
 
+QDockWidget* MainWindow::addDock(const QString& title, const char* name, QWidget* content, Qt::DockWidgetArea area) {
+  auto* dock = new QDockWidget(title, this);
+  dock->setObjectName(name);  // saved layouts find docks by name
+  dock->setWidget(content);
+  addDockWidget(area, dock);
+  return dock;
+}
+
 void MainWindow::buildDocks() {
   outliner_ = new QTreeWidget(this);
   outliner_->setHeaderLabels({tr("Name"), tr("Material / kind")});
@@ -366,19 +374,13 @@ void MainWindow::buildDocks() {
     if (after.name == o->name && after.visible == o->visible) return;
     edit(SetObject{*o}, SetObject{after}, after.visible != o->visible ? tr("Show/hide %1").arg(item->text(0)) : tr("Rename object"));
   });
-  auto* outlinerDock = new QDockWidget(tr("Outliner"), this);
-  outlinerDock->setObjectName("outliner");
-  outlinerDock->setWidget(outliner_);
-  addDockWidget(Qt::LeftDockWidgetArea, outlinerDock);
+  auto* outlinerDock = addDock(tr("Outliner"), "outliner", outliner_, Qt::LeftDockWidgetArea);
 
   auto push = [this](const Edit& before, const Edit& after, const QString& text, int dragId) { edit(before, after, text, dragId); };
   auto sceneRef = [this]() -> const Scene& { return doc_.scene(); };
   panel_ = new PropertyPanel(sceneRef, push, this);
   panel_->setObjectName("propertyPanel");
-  auto* propDock = new QDockWidget(tr("Properties"), this);
-  propDock->setObjectName("properties");
-  propDock->setWidget(panel_);
-  addDockWidget(Qt::RightDockWidgetArea, propDock);
+  auto* propDock = addDock(tr("Properties"), "properties", panel_, Qt::RightDockWidgetArea);
 
   // Render settings: the method and its parameters, the display transform (display only: no
   // samples are lost), and the scene's render settings.
@@ -463,16 +465,13 @@ void MainWindow::buildDocks() {
   renderPanel_->setTarget({PropertyTarget::Kind::Render, kNoNode});
   renderPanel_->setMinimumHeight(130);
   sl->addWidget(renderPanel_, 1);
-  auto* methodDock = new QDockWidget(tr("Render settings"), this);
-  methodDock->setObjectName("renderSettings");
   // Scrolls rather than forcing the window taller than small screens.
   auto* settingsScroll = new QScrollArea(this);
   settingsScroll->setWidgetResizable(true);
   settingsScroll->setFrameShape(QFrame::NoFrame);
   settingsScroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
   settingsScroll->setWidget(settingsPanel);
-  methodDock->setWidget(settingsScroll);
-  addDockWidget(Qt::LeftDockWidgetArea, methodDock);
+  auto* methodDock = addDock(tr("Render settings"), "renderSettings", settingsScroll, Qt::LeftDockWidgetArea);
 
   // The pixel inspector: linear values under the cursor; Ctrl+drag a region for its statistics.
   inspector_ = new QLabel(tr("Hover the image for linear values; Ctrl+drag a region for its mean, min and max."), this);
@@ -480,20 +479,14 @@ void MainWindow::buildDocks() {
   inspector_->setWordWrap(true);
   inspector_->setTextInteractionFlags(Qt::TextSelectableByMouse);
   inspector_->setAlignment(Qt::AlignTop | Qt::AlignLeft);
-  auto* inspectorDock = new QDockWidget(tr("Pixel inspector"), this);
-  inspectorDock->setObjectName("inspectorDock");
-  inspectorDock->setWidget(inspector_);
-  addDockWidget(Qt::LeftDockWidgetArea, inspectorDock);
+  auto* inspectorDock = addDock(tr("Pixel inspector"), "inspectorDock", inspector_, Qt::LeftDockWidgetArea);
   tabifyDockWidget(methodDock, inspectorDock);
   methodDock->raise();
 
   log_ = new QPlainTextEdit(this);
   log_->setReadOnly(true);
   log_->setMaximumBlockCount(2000);
-  auto* logDock = new QDockWidget(tr("Log"), this);
-  logDock->setObjectName("log");
-  logDock->setWidget(log_);
-  addDockWidget(Qt::BottomDockWidgetArea, logDock);
+  auto* logDock = addDock(tr("Log"), "log", log_, Qt::BottomDockWidgetArea);
 
   graph_ = new NodeGraphView(this);
   graph_->setObjectName("nodeGraph");
@@ -501,17 +494,12 @@ void MainWindow::buildDocks() {
   connect(graph_, &NodeGraphView::editRequested, this, [this](const GraphEdit& g) {
     // One undo step for the whole gesture (a delete clears references before removing).
     undo_.beginMacro(g.text);
-    for (const auto& [before, after] : g.steps)
-      undo_.push(new EditCommand(before, after, g.text, [this](const Edit& e) { return applyToDocument(e); }));
+    for (const auto& [before, after] : g.steps) edit(before, after, g.text);
     undo_.endMacro();
-    refreshGraph();
     panel_->rebuild();
   });
   connect(graph_, &NodeGraphView::objectSelected, this, [this](quint64 id) { select(static_cast<NodeId>(id)); });
-  auto* graphDock = new QDockWidget(tr("Node graph"), this);
-  graphDock->setObjectName("nodeGraphDock");
-  graphDock->setWidget(graph_);
-  addDockWidget(Qt::BottomDockWidgetArea, graphDock);
+  auto* graphDock = addDock(tr("Node graph"), "nodeGraphDock", graph_, Qt::BottomDockWidgetArea);
 
   chart_ = new LiveChart(this);
   chart_->setObjectName("liveChart");
@@ -522,10 +510,7 @@ void MainWindow::buildDocks() {
     chart_->renderReference(s, doc_.version(), 256);
     log(tr("rendering a 256 spp reference of the current state in the background"));
   });
-  auto* chartDock = new QDockWidget(tr("Live chart"), this);
-  chartDock->setObjectName("chartDock");
-  chartDock->setWidget(chart_);
-  addDockWidget(Qt::BottomDockWidgetArea, chartDock);
+  auto* chartDock = addDock(tr("Live chart"), "chartDock", chart_, Qt::BottomDockWidgetArea);
   tabifyDockWidget(graphDock, chartDock);
   tabifyDockWidget(graphDock, logDock);
   graphDock->raise();

@@ -27,6 +27,7 @@ class QSpinBox;
 class QCheckBox;
 class QWidget;
 class QMenu;
+class QDockWidget;
 
 namespace retile::ui {
 
@@ -81,6 +82,7 @@ class MainWindow : public QMainWindow {
   Vec3 pivot(const Object& o) const;  // where the gizmo sits and rotation/scale turn about
   void replaceDocument(Scene scene, const std::filesystem::path& file);
   void buildDocks();
+  QDockWidget* addDock(const QString& title, const char* name, QWidget* content, Qt::DockWidgetArea area);
   void startEngine(Scene scene);
   void rebuildOutliner();
   void rebuildProperties();

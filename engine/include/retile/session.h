@@ -24,6 +24,10 @@ namespace retile {
 struct RegionRect {
   int x = 0, y = 0, width = 0, height = 0;
   bool empty() const { return width <= 0 || height <= 0; }
+  // Whether the rectangle (x, y, w, h) shares a pixel with this region.
+  bool overlaps(int ox, int oy, int ow, int oh) const {
+    return ox < x + width && x < ox + ow && oy < y + height && y < oy + oh;
+  }
 };
 
 // Everything about one published frame. Immutable once published; shared between threads.

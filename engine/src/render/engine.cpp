@@ -31,9 +31,7 @@ bool regionConverged(const FrameRecord& f, int spp) {
   for (std::size_t t = 0; t < f.tileSamples.size(); ++t) {
     if (!f.region.empty() && f.cols > 0) {
       int x = static_cast<int>(t) % f.cols * f.tileSize, y = static_cast<int>(t) / f.cols * f.tileSize;
-      bool touches = x < f.region.x + f.region.width && f.region.x < x + f.tileSize && y < f.region.y + f.region.height &&
-                     f.region.y < y + f.tileSize;
-      if (!touches) continue;
+      if (!f.region.overlaps(x, y, f.tileSize, f.tileSize)) continue;
     }
     if (f.tileSamples[t] < static_cast<float>(spp)) return false;
   }

@@ -79,8 +79,7 @@ struct RenderSession::Impl {
       mask.assign(static_cast<std::size_t>(g.count()), 0);
       for (int t = 0; t < g.count(); ++t) {
         TileRect r = g.rect(t);
-        mask[static_cast<std::size_t>(t)] = r.x < region.x + region.width && region.x < r.x + r.width &&
-                                            r.y < region.y + region.height && region.y < r.y + r.height;
+        mask[static_cast<std::size_t>(t)] = region.overlaps(r.x, r.y, r.width, r.height);
       }
     }
     scheduler.setRegion(std::move(mask));
