@@ -62,6 +62,8 @@ int benchThroughput(const std::vector<std::string>& argv) {
     sum.seconds += s.seconds;
     sum.maxLoopIterations = std::max(sum.maxLoopIterations, s.maxLoopIterations);
     sum.cutPaths += s.cutPaths;
+    sum.loopIterations += s.loopIterations;
+    sum.pathsPerInvocation = s.pathsPerInvocation;
   }
   double wall = std::chrono::duration<double>(Clock::now() - start).count();
   double sec = sum.seconds;
@@ -82,6 +84,9 @@ int benchThroughput(const std::vector<std::string>& argv) {
               renderer.lastTlasSeconds());
   std::printf("loop iterations %u at most in one invocation (lavapipe's limit 65535); %llu paths cut short\n",
               sum.maxLoopIterations, static_cast<unsigned long long>(sum.cutPaths));
+  std::printf("paths          %.1f loop iterations each, %.0f per invocation (last frame)\n",
+              static_cast<double>(sum.loopIterations) / static_cast<double>(std::max<std::uint64_t>(sum.samples, 1)),
+              sum.pathsPerInvocation);
   std::printf("device memory  %.3f MiB scene data, %.1f bytes per triangle\n",
               static_cast<double>(renderer.sceneDeviceBytes()) / (1 << 20),
               tris ? static_cast<double>(renderer.sceneDeviceBytes()) / static_cast<double>(tris) : 0.0);

@@ -75,10 +75,30 @@ int findItem(uint slot) {
   return lo;
 }
 
-void main() {
-  uint local = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * uint(kTraceWorkgroup) + gl_LocalInvocationID.x;
-  if (local >= push.slotCount) return;
-  uint slot = push.slotOffset + local;
+// One path's state between segments. An invocation carries one path at a time and starts the
+// next of its slots as soon as the current path ends (path regeneration): lavapipe runs eight
+// invocations in lock-step, and without regeneration the lanes whose paths ended early would
+// idle until the longest of the eight had finished (a third of the lanes in the Cornell box).
+struct Path {
+  uint slot;
+  Rng rng;
+  vec3 ro, rd;
+  vec3 L, beta;
+  float etaScale;
+  bool specular;  // the last bounce was a delta lobe (the camera ray counts as one)
+  float prevPdf;
+  vec3 prevPos;
+  int depth;
+  int selBase;
+  vec3 auxAlbedo, auxNormal;
+  float auxDepth;
+  int auxInstance;
+  bool auxDone;
+};
+
+uint primaryRays = 0u, bounceRays = 0u, shadowRays = 0u;
+
+Path startPath(uint slot) {
   WorkItem item = items[findItem(slot)];
   uint inItem = slot - item.info.y;
   uint pixels = uint(item.rect.z * item.rect.w);
@@ -87,193 +107,231 @@ void main() {
   int px = item.rect.x + int(p % uint(item.rect.z));
   int py = item.rect.y + int(p / uint(item.rect.z));
   uint width = frame.image.x, height = frame.image.y;
-  uint pixelIndex = uint(py) * width + uint(px);
-  Rng rng = rngInit(pixelIndex, item.info.z + rep, frame.image.z);
+  Path path;
+  path.slot = slot;
+  path.rng = rngInit(uint(py) * width + uint(px), item.info.z + rep, frame.image.z);
 
   // Every sample jitters its own primary ray over the pixel (box filter).
-  vec2 jitter = rand2(rng);
+  vec2 jitter = rand2(path.rng);
   vec2 ndc = vec2((float(px) + jitter.x) / float(width), (float(py) + jitter.y) / float(height)) * 2.0 - 1.0;
   float tanHalf = frame.cameraPosition.w;
-  vec3 rd = normalize(frame.cameraForward.xyz + ndc.x * tanHalf * frame.cameraRight.w * frame.cameraRight.xyz -
+  path.rd = normalize(frame.cameraForward.xyz + ndc.x * tanHalf * frame.cameraRight.w * frame.cameraRight.xyz -
                       ndc.y * tanHalf * frame.cameraUp.xyz);
-  vec3 ro = frame.cameraPosition.xyz;
+  path.ro = frame.cameraPosition.xyz;
+  path.L = vec3(0.0);
+  path.beta = vec3(1.0);
+  path.etaScale = 1.0;
+  path.specular = true;
+  path.prevPdf = 0.0;
+  path.prevPos = path.ro;
+  path.depth = 0;
+  path.selBase = selectionBase(px, py);
+  path.auxAlbedo = vec3(0.0);
+  path.auxNormal = vec3(0.0);
+  path.auxDepth = kInfinity;
+  path.auxInstance = 0;
+  path.auxDone = false;
+  return path;
+}
 
-  int selBase = selectionBase(px, py);
+// A non-finite sample is traced (it counts against the budget) but weighted 0, so one bad path
+// cannot poison a pixel's sum; the accumulator counts only weighted samples.
+void finishPath(Path path) {
+  bool valid = !(any(isnan(path.L)) || any(isinf(path.L)));
+  samples[path.slot] = valid ? vec4(path.L, 1.0) : vec4(0.0);
+  aux[path.slot * 2u] = vec4(path.auxAlbedo, path.auxDepth);
+  aux[path.slot * 2u + 1u] = vec4(path.auxNormal, intBitsToFloat(path.auxInstance));
+}
+
+// Traces one segment of the path and shades its hit: emission, next-event estimation and the
+// next direction. Returns false when the path has ended.
+bool extendPath(inout Path path) {
   int selected = int(frame.work.z) - 1;
-
-  vec3 L = vec3(0.0);
-  vec3 beta = vec3(1.0);
-  float etaScale = 1.0;
-  bool specular = true;  // the camera ray counts as specular: emitters it sees get full weight
-  float prevPdf = 0.0;
-  vec3 prevPos = ro;
-  int depth = 0;
   int maxBounces = int(frame.image.w);
-  uint primaryRays = 0u, bounceRays = 0u, shadowRays = 0u;
+  vec3 ro = path.ro, rd = path.rd;
+  Hit hit = traceRay(ro, rd, kInfinity, false, rand(path.rng));
+  if (path.depth == 0) primaryRays++; else bounceRays++;
+  if (path.selBase >= 0 && hit.prim >= 0 && hit.instance == selected) {
+    // Direct hits, then reflections weighted (maxBounces + 1) / depth: 4, 2, 1 at 3 bounces.
+    if (path.depth == 0) atomicAdd(selectionCounts[path.selBase], 1u);
+    else atomicAdd(selectionCounts[path.selBase + 1], uint(max(maxBounces + 1, 1) / path.depth));
+  }
 
-  vec3 auxAlbedo = vec3(0.0), auxNormal = vec3(0.0);
-  float auxDepth = kInfinity;
-  int auxInstance = 0;
-  bool auxDone = false;
-
-  bool cut = false;
-  for (;;) {
-    loopIterations++;
-    if (loopIterations > kLoopBudget) {
-      cut = true;
-      break;
+  if (hit.prim < 0) {
+    vec3 Le = envRadiance(rd);
+    if (path.specular) {
+      path.L += path.beta * Le;
+    } else {
+      float lightPdf = frame.lightPick.y * envPdf(rd);
+      path.L += path.beta * Le * powerHeuristic(path.prevPdf, lightPdf);
     }
-    Hit hit = traceRay(ro, rd, kInfinity, false, rand(rng));
-    if (depth == 0) primaryRays++; else bounceRays++;
-    if (selBase >= 0 && hit.prim >= 0 && hit.instance == selected) {
-      // Direct hits, then reflections weighted (maxBounces + 1) / depth: 4, 2, 1 at 3 bounces.
-      if (depth == 0) atomicAdd(selectionCounts[selBase], 1u);
-      else atomicAdd(selectionCounts[selBase + 1], uint(max(maxBounces + 1, 1) / depth));
+    return false;
+  }
+
+  int ibase = hit.instance * kInstanceTexels;
+  vec4 r0 = texelFetch(uInstances, ibase), r1 = texelFetch(uInstances, ibase + 1), r2 = texelFetch(uInstances, ibase + 2);
+  vec4 info = texelFetch(uInstances, ibase + 3);
+  vec4 info2 = texelFetch(uInstances, ibase + 4);
+  int instFlags = floatBitsToInt(info2.y);
+  vec3 pos = ro + hit.t * rd;
+
+  // Normals go to world space with the inverse transpose, i.e. the transposed world-to-object rows.
+  vec3 e1 = texelFetch(uTris, hit.prim * kTriTexels + 1).xyz;
+  vec3 e2 = texelFetch(uTris, hit.prim * kTriTexels + 2).xyz;
+  vec3 ngObj = cross(e1, e2);
+  vec3 ng = normalize(r0.xyz * ngObj.x + r1.xyz * ngObj.y + r2.xyz * ngObj.z);
+  vec4 s0 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 0);
+  vec4 s1 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 1);
+  vec4 s2 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 2);
+  vec4 s3 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 3);
+  float bw = 1.0 - hit.u - hit.v;
+  vec2 uv = bw * vec2(s0.w, s1.w) + hit.u * vec2(s2.w, s3.x) + hit.v * s3.yz;
+  vec3 ns = ng;
+  if (s3.w > 0.5) {
+    vec3 nObj = bw * s0.xyz + hit.u * s1.xyz + hit.v * s2.xyz;
+    vec3 n = r0.xyz * nObj.x + r1.xyz * nObj.y + r2.xyz * nObj.z;
+    if (dot(n, n) > 0.0) {
+      ns = normalize(n);
+      // Shading normals from files may disagree with the winding; the winding decides the front.
+      if (dot(ns, ng) < 0.0) ns = -ns;
     }
+  }
 
-    if (hit.prim < 0) {
-      vec3 Le = envRadiance(rd);
-      if (specular) {
-        L += beta * Le;
-      } else {
-        float lightPdf = frame.lightPick.y * envPdf(rd);
-        L += beta * Le * powerHeuristic(prevPdf, lightPdf);
-      }
-      break;
+  Material m = fetchMaterial(floatBitsToInt(info.z), uv);
+  vec3 wo = -rd;
+  bool frontFace = dot(ng, wo) > 0.0;
+
+  if ((instFlags & kInstanceEmissive) != 0 && frontFace) {
+    if (path.specular) {
+      path.L += path.beta * m.emission;
+    } else {
+      int emitter = floatBitsToInt(info.w) + (hit.prim - floatBitsToInt(info.y));
+      float lightPdf = emitterPdf(emitter, path.prevPos, pos, dot(ng, wo));
+      path.L += path.beta * m.emission * powerHeuristic(path.prevPdf, lightPdf);
     }
+  }
 
-    int ibase = hit.instance * kInstanceTexels;
-    vec4 r0 = texelFetch(uInstances, ibase), r1 = texelFetch(uInstances, ibase + 1), r2 = texelFetch(uInstances, ibase + 2);
-    vec4 info = texelFetch(uInstances, ibase + 3);
-    vec4 info2 = texelFetch(uInstances, ibase + 4);
-    int instFlags = floatBitsToInt(info2.y);
-    vec3 pos = ro + hit.t * rd;
+  if (isMat(m.type, kMatNull)) return false;  // an emitter that does not reflect: the path ends here
 
-    // Normals go to world space with the inverse transpose, i.e. the transposed world-to-object rows.
-    vec3 e1 = texelFetch(uTris, hit.prim * kTriTexels + 1).xyz;
-    vec3 e2 = texelFetch(uTris, hit.prim * kTriTexels + 2).xyz;
-    vec3 ngObj = cross(e1, e2);
-    vec3 ng = normalize(r0.xyz * ngObj.x + r1.xyz * ngObj.y + r2.xyz * ngObj.z);
-    vec4 s0 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 0);
-    vec4 s1 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 1);
-    vec4 s2 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 2);
-    vec4 s3 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 3);
-    float bw = 1.0 - hit.u - hit.v;
-    vec2 uv = bw * vec2(s0.w, s1.w) + hit.u * vec2(s2.w, s3.x) + hit.v * s3.yz;
-    vec3 ns = ng;
-    if (s3.w > 0.5) {
-      vec3 nObj = bw * s0.xyz + hit.u * s1.xyz + hit.v * s2.xyz;
-      vec3 n = r0.xyz * nObj.x + r1.xyz * nObj.y + r2.xyz * nObj.z;
-      if (dot(n, n) > 0.0) {
-        ns = normalize(n);
-        // Shading normals from files may disagree with the winding; the winding decides the front.
-        if (dot(ns, ng) < 0.0) ns = -ns;
-      }
-    }
+  if (!path.auxDone) {
+    path.auxDone = true;
+    path.auxAlbedo = m.albedo;
+    path.auxNormal = frontFace ? ns : -ns;
+    path.auxDepth = length(pos - frame.cameraPosition.xyz);
+    path.auxInstance = floatBitsToInt(info2.x);
+  }
 
-    Material m = fetchMaterial(floatBitsToInt(info.z), uv);
-    vec3 wo = -rd;
-    bool frontFace = dot(ng, wo) > 0.0;
+  if (path.depth >= maxBounces) return false;
 
-    if ((instFlags & kInstanceEmissive) != 0 && frontFace) {
-      if (specular) {
-        L += beta * m.emission;
-      } else {
-        int emitter = floatBitsToInt(info.w) + (hit.prim - floatBitsToInt(info.y));
-        float lightPdf = emitterPdf(emitter, prevPos, pos, dot(ng, wo));
-        L += beta * m.emission * powerHeuristic(prevPdf, lightPdf);
-      }
-    }
-
-    if (m.type == kMatNull) break;  // an emitter that does not reflect: the path ends here
-
-    if (!auxDone) {
-      auxDone = true;
-      auxAlbedo = m.albedo;
-      auxNormal = frontFace ? ns : -ns;
-      auxDepth = length(pos - frame.cameraPosition.xyz);
-      auxInstance = floatBitsToInt(info2.x);
-    }
-
-    if (depth >= maxBounces) break;
-
-    // Shading frame. Opaque materials are two-sided: flip to the viewer's side.
-    bool transmissive = isTransmissive(m);
-    vec3 ngs = ng, nss = ns;
-    if (!transmissive && !frontFace) {
-      ngs = -ng;
-      nss = -ns;
-    }
-    vec3 t, b;
+  // Shading frame. Opaque materials are two-sided: flip to the viewer's side.
+  bool transmissive = isTransmissive(m);
+  vec3 ngs = ng, nss = ns;
+  if (!transmissive && !frontFace) {
+    ngs = -ng;
+    nss = -ns;
+  }
+  vec3 t, b;
+  makeFrame(nss, t, b);
+  vec3 woL = toLocal(wo, t, b, nss);
+  if (!transmissive && woL.z <= 0.0) {
+    // The interpolated normal faces away from the viewer: shade with the geometric one.
+    nss = ngs;
     makeFrame(nss, t, b);
-    vec3 woL = toLocal(wo, t, b, nss);
-    if (!transmissive && woL.z <= 0.0) {
-      // The interpolated normal faces away from the viewer: shade with the geometric one.
-      nss = ngs;
-      makeFrame(nss, t, b);
-      woL = toLocal(wo, t, b, nss);
-    }
+    woL = toLocal(wo, t, b, nss);
+  }
 
-    // Next-event estimation with multiple importance sampling.
-    if (!isDeltaMaterial(m) && (frame.lightPick.x + frame.lightPick.y + frame.lightPick.z) > 0.0) {
-      vec3 lu = vec3(rand(rng), rand(rng), rand(rng));
-      LightSample ls = sampleLight(pos, lu);
-      if (ls.pdf > 0.0 && maxComponent(ls.radiance) > 0.0) {
-        float sideL = dot(ls.dir, ngs);
-        bool sameSide = sideL > 0.0;
-        if (sameSide || transmissive) {
-          float bsdfPdf;
-          vec3 f = bsdfEval(m, woL, toLocal(ls.dir, t, b, nss), bsdfPdf);
-          if (maxComponent(f) > 0.0) {
-            vec3 origin = offsetRay(pos, sideL > 0.0 ? ngs : -ngs);
-            float tMax = ls.dist >= kInfinity ? kInfinity : ls.dist * (1.0 - 1e-4);
-            shadowRays++;
-            Hit sh = traceRay(origin, ls.dir, tMax, true, rand(rng));
-            if (selBase >= 0 && sh.prim >= 0 && sh.instance == selected) atomicAdd(selectionCounts[selBase + 2], 1u);
-            if (sh.prim < 0) {
-              float w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, bsdfPdf);
-              L += beta * f * ls.radiance * (w / ls.pdf);
-            }
+  // Next-event estimation with multiple importance sampling.
+  if (!isDeltaMaterial(m) && (frame.lightPick.x + frame.lightPick.y + frame.lightPick.z) > 0.0) {
+    vec3 lu = vec3(rand(path.rng), rand(path.rng), rand(path.rng));
+    LightSample ls = sampleLight(pos, lu);
+    if (ls.pdf > 0.0 && maxComponent(ls.radiance) > 0.0) {
+      float sideL = dot(ls.dir, ngs);
+      bool sameSide = sideL > 0.0;
+      if (sameSide || transmissive) {
+        float bsdfPdf;
+        vec3 f = bsdfEval(m, woL, toLocal(ls.dir, t, b, nss), bsdfPdf);
+        if (maxComponent(f) > 0.0) {
+          vec3 origin = offsetRay(pos, sideL > 0.0 ? ngs : -ngs);
+          float tMax = ls.dist >= kInfinity ? kInfinity : ls.dist * (1.0 - 1e-4);
+          shadowRays++;
+          Hit sh = traceRay(origin, ls.dir, tMax, true, rand(path.rng));
+          if (path.selBase >= 0 && sh.prim >= 0 && sh.instance == selected) atomicAdd(selectionCounts[path.selBase + 2], 1u);
+          if (sh.prim < 0) {
+            float w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, bsdfPdf);
+            path.L += path.beta * f * ls.radiance * (w / ls.pdf);
           }
         }
       }
     }
-
-    // Continue the path by sampling the BSDF.
-    BsdfSample bs = bsdfSample(m, woL, vec3(rand(rng), rand(rng), rand(rng)));
-    if (maxComponent(bs.weight) <= 0.0 || any(isnan(bs.weight))) break;
-    vec3 wi = toWorld(bs.wi, t, b, nss);
-    float sideI = dot(wi, ngs);
-    // A reflected direction must leave on the viewer's side of the true surface, a transmitted
-    // one on the other side; otherwise the shading normal lied and the path would leak.
-    if (bs.transmitted ? sideI >= 0.0 : sideI <= 0.0) break;
-    beta *= bs.weight;
-    // Roulette must not see the 1/eta^2 radiance scaling inside glass as lost energy.
-    if (bs.transmitted && m.type != kMatThinSheet) etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
-    specular = bs.delta;
-    prevPdf = bs.pdf;
-    prevPos = pos;
-    ro = offsetRay(pos, sideI > 0.0 ? ngs : -ngs);
-    rd = wi;
-    depth++;
-
-    // Russian roulette after a few bounces, keeping the expected value.
-    if (depth > 3) {
-      float q = max(0.05, 1.0 - maxComponent(beta * etaScale));
-      if (rand(rng) < q) break;
-      beta /= 1.0 - q;
-    }
   }
 
-  // A non-finite sample is traced (it counts against the budget) but weighted 0, so one bad path
-  // cannot poison a pixel's sum; the accumulator counts only weighted samples.
-  bool valid = !(any(isnan(L)) || any(isinf(L)));
-  samples[slot] = valid ? vec4(L, 1.0) : vec4(0.0);
-  aux[slot * 2u] = vec4(auxAlbedo, auxDepth);
-  aux[slot * 2u + 1u] = vec4(auxNormal, intBitsToFloat(auxInstance));
+  // Continue the path by sampling the BSDF.
+  BsdfSample bs = bsdfSample(m, woL, vec3(rand(path.rng), rand(path.rng), rand(path.rng)));
+  if (maxComponent(bs.weight) <= 0.0 || any(isnan(bs.weight))) return false;
+  vec3 wi = toWorld(bs.wi, t, b, nss);
+  float sideI = dot(wi, ngs);
+  // A reflected direction must leave on the viewer's side of the true surface, a transmitted
+  // one on the other side; otherwise the shading normal lied and the path would leak.
+  if (bs.transmitted ? sideI >= 0.0 : sideI <= 0.0) return false;
+  path.beta *= bs.weight;
+  // Roulette must not see the 1/eta^2 radiance scaling inside glass as lost energy.
+  if (bs.transmitted && !isMat(m.type, kMatThinSheet)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
+  path.specular = bs.delta;
+  path.prevPdf = bs.pdf;
+  path.prevPos = pos;
+  path.ro = offsetRay(pos, sideI > 0.0 ? ngs : -ngs);
+  path.rd = wi;
+  path.depth++;
+
+  // Russian roulette after a few bounces, keeping the expected value.
+  if (path.depth > 3) {
+    float q = max(0.05, 1.0 - maxComponent(path.beta * path.etaScale));
+    if (rand(path.rng) < q) return false;
+    path.beta /= 1.0 - q;
+  }
+  return true;
+}
+
+void main() {
+  uint invocation = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * uint(kTraceWorkgroup) + gl_LocalInvocationID.x;
+  if (invocation >= push.invocations) return;
+  // This invocation's slots are invocation, invocation + invocations, ...: neighbouring lanes
+  // start on neighbouring pixels.
+  uint next = invocation;
+  Path path;
+  bool alive = false;
+  uint cutPaths = 0u;
+  for (;;) {
+    loopIterations++;
+    if (!alive) {
+      if (next >= push.slotCount) break;
+      path = startPath(push.slotOffset + next);
+      next += push.invocations;
+      alive = true;
+    }
+    if (loopIterations > kLoopBudget) {
+      // Out of loop budget: the path ends as it stands and the slots not yet started are
+      // weighted 0 (traced, so they count against the budget, but never accumulated).
+      cutPaths++;
+      finishPath(path);
+      for (; next < push.slotCount; next += push.invocations) {
+        cutPaths++;
+        uint slot = push.slotOffset + next;
+        samples[slot] = vec4(0.0);
+        aux[slot * 2u] = vec4(0.0, 0.0, 0.0, kInfinity);
+        aux[slot * 2u + 1u] = vec4(0.0);
+      }
+      break;
+    }
+    if (!extendPath(path)) {
+      finishPath(path);
+      alive = false;
+    }
+  }
   atomicAdd(rayCounts[0], primaryRays);
   atomicAdd(rayCounts[1], bounceRays);
   atomicAdd(rayCounts[2], shadowRays);
   atomicMax(rayCounts[3], loopIterations);
-  if (cut) atomicAdd(rayCounts[4], 1u);
+  atomicAdd(rayCounts[5], (loopIterations + kLoopIterationUnit / 2u) / kLoopIterationUnit);
+  if (cutPaths > 0u) atomicAdd(rayCounts[4], cutPaths);
 }

@@ -53,6 +53,7 @@ RT_CONST(int, kEnvMap, 2)
 
 RT_CONST(int, kTraceWorkgroup, 64)
 RT_CONST(int, kStatsCount, 8)  // counters the trace pass writes (see trace.comp)
+RT_CONST(uint, kLoopIterationUnit, 16u)  // the loop-iteration sum counts in these units, so 32 bits suffice
 RT_CONST(int, kAccumulateWorkgroup, 64)
 RT_CONST(int, kMaxWorkItems, 65536)
 
@@ -87,8 +88,8 @@ RT_CONST(int, kSelectionCounters, 3) // per tile: direct hits, weighted reflecti
 struct TracePush {
   uint slotOffset;   // first slot of this dispatch (dispatches are split by size)
   uint slotCount;    // slots in this dispatch
+  uint invocations;  // invocations launched; each traces slots i, i + invocations, ...
   uint pad0;
-  uint pad1;
 };
 
 struct AccumulatePush {

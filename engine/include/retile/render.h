@@ -54,6 +54,8 @@ struct FrameStats {
   // lavapipe stops an invocation's loops after 65535 iterations in all; paths end before that.
   std::uint32_t maxLoopIterations = 0;  // the most any one invocation ran (a per-lane lower bound)
   std::uint64_t cutPaths = 0;           // paths ended early to stay under that limit
+  std::uint64_t loopIterations = 0;     // over all invocations, to the nearest 16 per invocation
+  double pathsPerInvocation = 0;        // each invocation traces this many paths one after another
 };
 
 struct RenderRequest {

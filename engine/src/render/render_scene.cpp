@@ -256,6 +256,7 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
 
 void RenderSceneBuilder::packMaterials(const Scene& scene) {
   data_.materials.clear();
+  data_.materialTypes = 0;
   materialIndex_.clear();
   auto pack = [&](const Material& m) {
     Vec3 eta = m.eta, k = m.k;
@@ -268,6 +269,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
       roughness = std::max(roughness, 1e-3f);
     if (m.type == MaterialType::OrenNayar) roughness = std::clamp(m.roughness, 0.0f, kPi / 2);
     data_.materials.push_back(v4(max(m.albedo, Vec3{0.0f}), bitsOf(type)));
+    data_.materialTypes |= 1u << type;
     float ior = std::clamp(m.ior, 1.0001f, 10.0f);
     // Diffuse light inside a plastic coating reflects back this fraction at the boundary
     // (Jensen et al.'s polynomial fit of the internal diffuse Fresnel reflectance).

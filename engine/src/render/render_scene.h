@@ -61,6 +61,7 @@ struct RenderSceneData {
   std::uint64_t triangleCount = 0;     // unique (per mesh) triangles
   std::uint64_t instancedTriangles = 0;
   bool alphaTested = false;            // some instance needs the cut-out test during traversal
+  std::uint32_t materialTypes = 0;     // bit kMat... of each material type present
 
   std::uint32_t tlasRoot() const { return static_cast<std::uint32_t>(blasNodes.size()); }
   std::uint64_t deviceBytes() const;
