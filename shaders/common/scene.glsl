@@ -19,7 +19,7 @@ layout(set = 0, binding = 10) uniform samplerBuffer uEmitterAlias;
 layout(set = 0, binding = 11) uniform samplerBuffer uDeltaLights;
 layout(set = 0, binding = 12) uniform samplerBuffer uEnvCdf;
 
-// Two levels of BVH plus the instance marker; the builder bounds each level's depth.
+// Two levels of BVH; the builder bounds each level's depth.
 const int kStackSize = 48;
 
 // Alpha-tested geometry needs a texture lookup inside traversal, which costs lavapipe a factor of
@@ -136,17 +136,11 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
   vec3 o = origin, d = dir, invD = safeInverse(dir);
   int instance = -1;
   int instFlags = 0;
-  int triOffset = 0;
+  int instanceSp = -1;  // stack depth on entering the current instance: popping back to it leaves
 
   for (;;) {
     loopIterations++;
-    if (node == -1) {
-      // Marker: back from an instance to world space.
-      o = origin;
-      d = dir;
-      invD = safeInverse(dir);
-      instance = -1;
-    } else if (node <= -2) {
+    if (node <= -2) {
       // Enter an instance: transform the ray (t is preserved because d is not renormalised).
       instance = -node - 2;
       int base = instance * kInstanceTexels;
@@ -156,8 +150,7 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
       o = vec3(dot(r0.xyz, origin) + r0.w, dot(r1.xyz, origin) + r1.w, dot(r2.xyz, origin) + r2.w);
       d = vec3(dot(r0.xyz, dir), dot(r1.xyz, dir), dot(r2.xyz, dir));
       invD = safeInverse(d);
-      triOffset = floatBitsToInt(info.y);
-      if (sp < kStackSize) stack[sp++] = -1;
+      instanceSp = sp;
       node = floatBitsToInt(info.x);
     }
     if (node >= 0) {
@@ -220,6 +213,14 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
       }
       if (hl) { node = ln; continue; }
       if (hr) { node = rn; continue; }
+    }
+    if (sp == instanceSp) {
+      // Back from the instance to world space.
+      o = origin;
+      d = dir;
+      invD = safeInverse(dir);
+      instance = -1;
+      instanceSp = -1;
     }
     if (sp == 0) break;
     node = stack[--sp];
