@@ -120,6 +120,25 @@ vec3 safeInverse(vec3 d) {
               abs(d.z) > eps ? 1.0 / d.z : (d.z >= 0.0 ? 1e30 : -1e30));
 }
 
+// The traversal stack. lavapipe turns each access to a per-invocation array at a varying index
+// into a loop over the eight lanes with a branch per lane, so the top eight entries live in
+// variables (shifted on push and pop, which is a few vector moves) and only deeper ones go to
+// the array. Macros, not functions: an inout array parameter is copied in and out on every call.
+#define STACK_PUSH(v)                                                                              \
+  {                                                                                                \
+    if (stackSize >= 8) stackDeep[stackSize - 8] = st7;                                            \
+    st7 = st6; st6 = st5; st5 = st4; st4 = st3; st3 = st2; st2 = st1; st1 = st0;                  \
+    st0 = (v);                                                                                     \
+    stackSize++;                                                                                   \
+  }
+#define STACK_POP(v)                                                                               \
+  {                                                                                                \
+    v = st0;                                                                                       \
+    st0 = st1; st1 = st2; st2 = st3; st3 = st4; st4 = st5; st5 = st6; st6 = st7;                  \
+    stackSize--;                                                                                   \
+    if (stackSize >= 8) st7 = stackDeep[stackSize - 8];                                            \
+  }
+
 // Closest hit (anyHit == false) or any opaque hit (anyHit == true, for shadow rays).
 Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
   Hit hit;
@@ -130,8 +149,9 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
   hit.v = 0.0;
   if (frame.scene.y == 0) return hit;
 
-  int stack[kStackSize];
-  int sp = 0;
+  int st0 = 0, st1 = 0, st2 = 0, st3 = 0, st4 = 0, st5 = 0, st6 = 0, st7 = 0;
+  int stackSize = 0;
+  int stackDeep[kStackSize];
   int node = frame.scene.x;  // TLAS root
   vec3 o = origin, d = dir, invD = safeInverse(dir);
   int instance = -1;
@@ -150,7 +170,7 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
       o = vec3(dot(r0.xyz, origin) + r0.w, dot(r1.xyz, origin) + r1.w, dot(r2.xyz, origin) + r2.w);
       d = vec3(dot(r0.xyz, dir), dot(r1.xyz, dir), dot(r2.xyz, dir));
       invD = safeInverse(d);
-      instanceSp = sp;
+      instanceSp = stackSize;
       node = floatBitsToInt(info.x);
     }
     if (node >= 0) {
@@ -207,14 +227,14 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
       int rn = rc == 0 ? ri : -ri - 2;
       if (hl && hr) {
         bool leftFirst = tl <= tr;
-        if (sp < kStackSize) stack[sp++] = leftFirst ? rn : ln;
+        if (stackSize < kStackSize + 8) STACK_PUSH(leftFirst ? rn : ln);
         node = leftFirst ? ln : rn;
         continue;
       }
       if (hl) { node = ln; continue; }
       if (hr) { node = rn; continue; }
     }
-    if (sp == instanceSp) {
+    if (stackSize == instanceSp) {
       // Back from the instance to world space.
       o = origin;
       d = dir;
@@ -222,8 +242,8 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
       instance = -1;
       instanceSp = -1;
     }
-    if (sp == 0) break;
-    node = stack[--sp];
+    if (stackSize == 0) break;
+    STACK_POP(node);
   }
   return hit;
 }
