@@ -17,9 +17,11 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 int benchThroughput(const std::vector<std::string>& argv) {
-  auto args = parseArgs(argv, {"--size", "--frames", "--max-bounces"});
+  auto args = parseArgs(argv, {"--size", "--frames", "--max-bounces", "--paths"});
   if (!args || args->positional.size() != 1) {
-    std::fprintf(stderr, "usage: retile bench throughput SCENE [--size WxH] [--frames N] [--max-bounces B]\n");
+    std::fprintf(stderr,
+                 "usage: retile bench throughput SCENE [--size WxH] [--frames N] [--max-bounces B] [--paths P]\n"
+                 "  --paths P  paths per trace invocation (default: chosen from the last frame's cost)\n");
     return 2;
   }
   int w = 256, h = 256, frames = 16, bounces = -1;
@@ -37,6 +39,12 @@ int benchThroughput(const std::vector<std::string>& argv) {
     if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
     bounces = v.value();
   }
+  FrameOptions options;
+  if (args->has("--paths")) {
+    auto v = parseInt("--paths", args->get("--paths"), 1, 1 << 20);
+    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
+    options.pathsPerInvocation = v.value();
+  }
   auto loaded = loadScene(args->positional[0]);
   if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
 
@@ -48,13 +56,13 @@ int benchThroughput(const std::vector<std::string>& argv) {
   renderer.resize(w, h);
   // One frame to warm up (pipeline creation, first-touch of buffers), not measured.
   TileWork all{0, 0, w, h, 1, 0, true};
-  renderer.renderFrame({all});
+  renderer.renderFrame({all}, options);
   FrameStats sum;
   auto start = Clock::now();
   for (int f = 0; f < frames; ++f) {
     all.sampleBase = static_cast<std::uint32_t>(f + 1);
     all.restart = false;
-    FrameStats s = renderer.renderFrame({all});
+    FrameStats s = renderer.renderFrame({all}, options);
     sum.samples += s.samples;
     sum.primaryRays += s.primaryRays;
     sum.bounceRays += s.bounceRays;
@@ -82,7 +90,8 @@ int benchThroughput(const std::vector<std::string>& argv) {
   std::printf("frame time     %.1f ms (device), %.1f ms (wall)\n", sec / frames * 1e3, wall / frames * 1e3);
   std::printf("scene upload   %.3f s (BVH bottom level %.3f s, top level %.4f s)\n", setup, renderer.lastBlasSeconds(),
               renderer.lastTlasSeconds());
-  std::printf("loop iterations %u at most in one invocation (lavapipe's limit 65535); %llu paths cut short\n",
+  std::printf("loop iterations %u at most in one invocation (paths stop at 30000; lavapipe's limit is near 32767); "
+              "%llu paths cut short\n",
               sum.maxLoopIterations, static_cast<unsigned long long>(sum.cutPaths));
   std::printf("paths          %.1f loop iterations each, %.0f per invocation (last frame)\n",
               static_cast<double>(sum.loopIterations) / static_cast<double>(std::max<std::uint64_t>(sum.samples, 1)),

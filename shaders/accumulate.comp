@@ -47,6 +47,7 @@ void main() {
   vec3 albedo = vec3(0.0), normal = vec3(0.0);
   float depth = 1e30;
   float instance = intBitsToFloat(0);
+  bool haveInstance = false;
   for (uint r = 0u; r < item.info.x; ++r) {
     uint slot = item.info.y + r * pixels + p;
     vec4 s = samples[slot];
@@ -55,11 +56,15 @@ void main() {
     lost = (t - sum) - y;
     sum = t;
     count += s.w;
+    // Weight 0: a non-finite sample, or a slot the trace pass did not reach; its auxiliary
+    // outputs are left out too.
+    if (s.w == 0.0) continue;
     vec4 a0 = aux[slot * 2u], a1 = aux[slot * 2u + 1u];
     albedo += a0.rgb;
     normal += a1.xyz;
     depth = min(depth, a0.w);
-    if (r == 0u) instance = a1.w;
+    if (!haveInstance) instance = a1.w;
+    haveInstance = true;
   }
 
   bool restart = (item.info.w & kWorkRestart) != 0u;

@@ -4,6 +4,7 @@
 // re-rendering (many items, any q) run the same kernel. Writes per-slot radiance and the first
 // hit's albedo, normal, depth and instance for the accumulate pass.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_vote : require
 
 #include "common/rng.glsl"
 #include "common/bsdf.glsl"
@@ -14,12 +15,16 @@ layout(local_size_x = kTraceWorkgroup) in;
 layout(set = 0, binding = 1, std430) readonly buffer Work { WorkItem items[]; };
 layout(set = 0, binding = 13, std430) writeonly buffer Samples { vec4 samples[]; };
 layout(set = 0, binding = 14, std430) writeonly buffer Aux { vec4 aux[]; };
-// primary, bounce, shadow rays; the most loop iterations of one invocation; paths cut short.
+// primary, bounce, shadow rays; the most loop iterations of one invocation; paths cut short;
+// loop iterations of all invocations, in kLoopIterationUnit.
 layout(set = 0, binding = 15, std430) buffer Stats { uint rayCounts[kStatsCount]; };
 
-// A path ends before its invocation could reach lavapipe's loop limit (65535, see scene.glsl):
-// one more segment with its shadow ray costs well under 5000 iterations in any scene seen.
-const uint kLoopBudget = 60000u;
+// Paths stop before the eight lock-stepped invocations could reach lavapipe's loop limit (see
+// scene.glsl). That limit is 65535 of lavapipe's own counts, and it counts each of our iterations
+// twice (measured: an invocation given 20736 paths was stopped by lavapipe when loopIterations
+// read 32659). One more segment of the eight paths, with their shadow rays, costs well under
+// 2500 of our iterations in any scene seen.
+const uint kLoopBudget = 30000u;
 
 // What the tracer sees of the selected object, per tile (the indirection-aware policy).
 layout(set = 0, binding = 16, std430) buffer Selection { uint selectionCounts[]; };
@@ -69,9 +74,11 @@ vec3 offsetRay(vec3 p, vec3 n) {
 int findItem(uint slot) {
   int lo = 0, hi = int(frame.work.x) - 1;
   while (lo < hi) {
+    loopIterations++;
     int mid = (lo + hi + 1) >> 1;
     if (items[mid].info.y <= slot) lo = mid; else hi = mid - 1;
   }
+  syncLoopIterations();
   return lo;
 }
 
@@ -294,36 +301,33 @@ bool extendPath(inout Path path) {
 
 void main() {
   uint invocation = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * uint(kTraceWorkgroup) + gl_LocalInvocationID.x;
-  if (invocation >= push.invocations) return;
   // This invocation's slots are invocation, invocation + invocations, ...: neighbouring lanes
-  // start on neighbouring pixels.
-  uint next = invocation;
+  // start on neighbouring pixels. Invocations past the end take part in the loop with no slots,
+  // so that every lane of the eight sees every iteration and loopIterations stays exact.
+  uint next = invocation < push.invocations ? invocation : push.slotCount;
   Path path;
   bool alive = false;
   uint cutPaths = 0u;
   for (;;) {
+    syncLoopIterations();
     loopIterations++;
-    if (!alive) {
-      if (next >= push.slotCount) break;
+    if (loopIterations > kLoopBudget) {
+      // Out of loop budget (the same decision in every lane): paths end as they stand, and slots
+      // not yet started keep the weight 0 the renderer cleared them to.
+      if (alive) {
+        cutPaths++;
+        finishPath(path);
+      }
+      if (next < push.slotCount) cutPaths += (push.slotCount - next + push.invocations - 1u) / push.invocations;
+      break;
+    }
+    if (!alive && next < push.slotCount) {
       path = startPath(push.slotOffset + next);
       next += push.invocations;
       alive = true;
     }
-    if (loopIterations > kLoopBudget) {
-      // Out of loop budget: the path ends as it stands and the slots not yet started are
-      // weighted 0 (traced, so they count against the budget, but never accumulated).
-      cutPaths++;
-      finishPath(path);
-      for (; next < push.slotCount; next += push.invocations) {
-        cutPaths++;
-        uint slot = push.slotOffset + next;
-        samples[slot] = vec4(0.0);
-        aux[slot * 2u] = vec4(0.0, 0.0, 0.0, kInfinity);
-        aux[slot * 2u + 1u] = vec4(0.0);
-      }
-      break;
-    }
-    if (!extendPath(path)) {
+    if (subgroupAll(!alive)) break;
+    if (alive && !extendPath(path)) {
       finishPath(path);
       alive = false;
     }
@@ -332,6 +336,6 @@ void main() {
   atomicAdd(rayCounts[1], bounceRays);
   atomicAdd(rayCounts[2], shadowRays);
   atomicMax(rayCounts[3], loopIterations);
-  atomicAdd(rayCounts[5], (loopIterations + kLoopIterationUnit / 2u) / kLoopIterationUnit);
+  if (invocation < push.invocations) atomicAdd(rayCounts[5], (loopIterations + kLoopIterationUnit / 2u) / kLoopIterationUnit);
   if (cutPaths > 0u) atomicAdd(rayCounts[4], cutPaths);
 }

@@ -61,9 +61,11 @@ float envPdf(vec3 d) {
 int searchCdf(int base, int n, float u) {
   int lo = 0, hi = n;  // cdf[base] = 0, cdf[base + n] = 1
   while (hi - lo > 1) {
+    loopIterations++;
     int mid = (lo + hi) >> 1;
     if (texelFetch(uEnvCdf, base + mid).x <= u) lo = mid; else hi = mid;
   }
+  syncLoopIterations();
   return lo;
 }
 

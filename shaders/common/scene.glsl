@@ -3,6 +3,8 @@
 #ifndef RETILE_SCENE_GLSL
 #define RETILE_SCENE_GLSL
 
+#extension GL_KHR_shader_subgroup_arithmetic : require
+
 #include "shared/layouts.h"
 #include "common/sampling.glsl"
 
@@ -30,11 +32,19 @@ const int kStackSize = 48;
 #endif
 const float kInfinity = 1e30;
 
-// lavapipe (gallivm) ends every loop of an invocation once 65535 iterations have run in total,
-// counted over all loops together, silently: a ray cut off there misses what it should hit. Each
-// invocation counts its iterations, and a path stops before it can reach the limit (see
-// kLoopBudget in trace.comp); the renderer reports both. Real GPUs have no such limit.
+// lavapipe (gallivm) runs eight invocations in lock-step and ends every loop of those eight once
+// 65535 loop iterations have run, counted over all loops together, silently: a ray cut off there
+// misses what it should hit. One loop iteration is counted while any of the eight runs it (and,
+// as measured, twice for each iteration counted here). Each
+// invocation keeps that count in loopIterations: it counts its own iterations and, after every
+// loop, takes the maximum over the lanes running with it. That maximum is exact for our loops: a
+// loop's lanes run a prefix of its iterations, no loop nests inside another one except the path
+// loop of trace.comp (which synchronises at its top), and no two lanes run different loops
+// between synchronisations. A path stops before the count can reach the
+// limit (kLoopBudget in trace.comp); the renderer reports both. Real GPUs have no such limit.
 uint loopIterations = 0u;
+
+void syncLoopIterations() { loopIterations = subgroupMax(loopIterations); }
 
 struct Hit {
   float t;
@@ -139,6 +149,49 @@ vec3 safeInverse(vec3 d) {
     if (stackSize >= 8) st7 = stackDeep[stackSize - 8];                                            \
   }
 
+// Records the hit when ray (o, d) meets triangle p of the current instance nearer than hit.t.
+bool hitTriangle(int p, vec3 o, vec3 d, int instance, int instFlags, float rayRandom, inout Hit hit) {
+  vec3 v0 = texelFetch(uTris, p * kTriTexels).xyz;
+  vec3 e1 = texelFetch(uTris, p * kTriTexels + 1).xyz;
+  vec3 e2 = texelFetch(uTris, p * kTriTexels + 2).xyz;
+  vec3 pv = cross(d, e2);
+  float det = dot(e1, pv);
+  if (det == 0.0) return false;
+  float inv = 1.0 / det;
+  vec3 s = o - v0;
+  float uu = dot(s, pv) * inv;
+  if (uu < 0.0 || uu > 1.0) return false;
+  vec3 q = cross(s, e1);
+  float vv = dot(d, q) * inv;
+  if (vv < 0.0 || uu + vv > 1.0) return false;
+  float tt = dot(e2, q) * inv;
+  if (!(tt > 0.0 && tt < hit.t)) return false;
+#if RETILE_ALPHA_TEST
+  if ((instFlags & kInstanceAlphaTested) != 0 && !alphaPasses(instance, p, uu, vv, rayRandom)) return false;
+#endif
+  hit.t = tt;
+  hit.u = uu;
+  hit.v = vv;
+  hit.prim = p;
+  hit.instance = instance;
+  return true;
+}
+
+// Tests the triangles [start, start + count) of the current instance; returns true when an any-hit
+// query is answered. Written out without a loop (leaves hold at most kMaxLeafTriangles = 4), so
+// the traversal loop is the only loop of a query and its lanes run prefixes of its iterations:
+// one synchronisation of loopIterations after it is exact.
+bool intersectLeaf(int start, int count, vec3 o, vec3 d, int instance, int instFlags, bool anyHit, float rayRandom,
+                   inout Hit hit) {
+  bool h0 = hitTriangle(start, o, d, instance, instFlags, rayRandom, hit);
+  if (h0 && anyHit) return true;
+  bool h1 = count > 1 && hitTriangle(start + 1, o, d, instance, instFlags, rayRandom, hit);
+  if (h1 && anyHit) return true;
+  bool h2 = count > 2 && hitTriangle(start + 2, o, d, instance, instFlags, rayRandom, hit);
+  if (h2 && anyHit) return true;
+  return count > 3 && hitTriangle(start + 3, o, d, instance, instFlags, rayRandom, hit) && anyHit;
+}
+
 // Closest hit (anyHit == false) or any opaque hit (anyHit == true, for shadow rays).
 Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
   Hit hit;
@@ -183,44 +236,19 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
       float tl, tr;
       bool hl = lc >= 0 && slabTest(a.xyz, b.xyz, o, invD, hit.t, tl);
       bool hr = rc >= 0 && slabTest(c.xyz, e.xyz, o, invD, hit.t, tr);
-      // Leaves: in the TLAS a leaf is one instance (pushed as an entry); in a BLAS, triangles.
-      for (int side = 0; side < 2; ++side) {
-        bool h = side == 0 ? hl : hr;
-        int cnt = side == 0 ? lc : rc;
-        if (!h || cnt <= 0) continue;
-        int start = side == 0 ? li : ri;
-        if (instance < 0) {
-          // Turned into an entry below, ordered like an inner node.
-          continue;
+      // Leaves: in a BLAS, triangles tested here; in the TLAS, one instance, visited below like
+      // an inner node.
+      if (instance >= 0) {
+        bool answered = false;
+        if (hl && lc > 0) {
+          answered = intersectLeaf(li, lc, o, d, instance, instFlags, anyHit, rayRandom, hit);
+          hl = false;
         }
-        for (int p = start; p < start + cnt; ++p) {
-          loopIterations++;
-          vec3 v0 = texelFetch(uTris, p * kTriTexels).xyz;
-          vec3 e1 = texelFetch(uTris, p * kTriTexels + 1).xyz;
-          vec3 e2 = texelFetch(uTris, p * kTriTexels + 2).xyz;
-          vec3 pv = cross(d, e2);
-          float det = dot(e1, pv);
-          if (det == 0.0) continue;
-          float inv = 1.0 / det;
-          vec3 s = o - v0;
-          float uu = dot(s, pv) * inv;
-          if (uu < 0.0 || uu > 1.0) continue;
-          vec3 q = cross(s, e1);
-          float vv = dot(d, q) * inv;
-          if (vv < 0.0 || uu + vv > 1.0) continue;
-          float tt = dot(e2, q) * inv;
-          if (!(tt > 0.0 && tt < hit.t)) continue;
-#if RETILE_ALPHA_TEST
-          if ((instFlags & kInstanceAlphaTested) != 0 && !alphaPasses(instance, p, uu, vv, rayRandom)) continue;
-#endif
-          hit.t = tt;
-          hit.u = uu;
-          hit.v = vv;
-          hit.prim = p;
-          hit.instance = instance;
-          if (anyHit) return hit;
+        if (!answered && hr && rc > 0) {
+          answered = intersectLeaf(ri, rc, o, d, instance, instFlags, anyHit, rayRandom, hit);
+          hr = false;
         }
-        if (side == 0) hl = false; else hr = false;
+        if (answered) break;
       }
       // Children to visit: inner nodes, or (in the TLAS) instance entries.
       int ln = lc == 0 ? li : -li - 2;
@@ -245,6 +273,7 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
     if (stackSize == 0) break;
     STACK_POP(node);
   }
+  syncLoopIterations();
   return hit;
 }
 

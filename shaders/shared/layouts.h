@@ -25,6 +25,8 @@ RT_CONST(int, kTextureTexels, 3)    // offset w h kind | on.rgb resU | off.rgb r
 RT_CONST(int, kEmitterTexels, 5)    // v0.xyz area | e1.xyz instance | e2.xyz - | radiance.rgb pick pdf | normal.xyz -
 RT_CONST(int, kDeltaLightTexels, 4) // position.xyz type | direction.xyz cosOuter | intensity.rgb cosInner | -
 
+RT_CONST(int, kMaxLeafTriangles, 4)  // render/bvh.h maxLeafSize for mesh BVHs; trace.comp unrolls its leaf test
+
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceEmissive, 4)
 

@@ -223,5 +223,67 @@ TEST(TracePass, SameSeedSameImageOtherSeedOtherNoise) {
   EXPECT_NE(a.color, c.color);
 }
 
+// One frame of the default scene traced with `paths` paths per invocation.
+RenderImage traceWithPaths(Renderer& r, int w, int h, int paths, FrameStats* stats) {
+  r.resize(w, h);
+  FrameOptions options;
+  options.pathsPerInvocation = paths;
+  *stats = r.renderFrame({{0, 0, w, h, 1, 0, true}}, options);
+  return r.readback();
+}
+
+TEST(TracePass, PathsPerInvocationDoNotChangeAnySample) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const int w = 48, h = 27;
+  r->setScene(makeDefaultScene());
+  FrameStats one, many;
+  RenderImage a = traceWithPaths(*r, w, h, 1, &one);
+  RenderImage b = traceWithPaths(*r, w, h, 24, &many);
+  EXPECT_EQ(one.cutPaths, 0u);
+  EXPECT_EQ(many.cutPaths, 0u);
+  EXPECT_DOUBLE_EQ(many.pathsPerInvocation, 24.0);
+  EXPECT_EQ(a.color, b.color) << "a sample depends on (pixel, sample index, seed), not on who traces it";
+  EXPECT_EQ(a.normal, b.normal);
+}
+
+// lavapipe silently ends the loops of eight lock-stepped invocations after 65535 iterations.
+// One invocation given every path of the frame must stop itself first: the paths it finished are
+// exactly right, the rest are weighted 0, and it says how many it cut.
+TEST(TracePass, AnInvocationOutOfLoopBudgetStopsCleanly) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const int w = 192, h = 108, n = w * h;
+  r->setScene(makeDefaultScene());
+  // Fill every sample slot with another seed's values first: a slot the invocation left unwritten
+  // would pass for a traced one when the reference below writes the same values.
+  FrameStats ref, all, other;
+  r->setSeed(99);
+  traceWithPaths(*r, w, h, 1, &other);
+  r->setSeed(0);
+  RenderImage b = traceWithPaths(*r, w, h, n, &all);
+  RenderImage a = traceWithPaths(*r, w, h, 1, &ref);
+  ASSERT_GT(all.cutPaths, 0u) << "the frame should need more than lavapipe's limit in one invocation";
+  EXPECT_LE(all.maxLoopIterations, 65535u);
+  int traced = 0, untraced = 0, differing = 0;
+  for (int i = 0; i < n; ++i) {
+    if (b.sampleCount[static_cast<std::size_t>(i)] == 0.0f) {
+      ++untraced;
+      continue;
+    }
+    ++traced;
+    for (int c = 0; c < 3; ++c)
+      if (a.color[static_cast<std::size_t>(i * 3 + c)] != b.color[static_cast<std::size_t>(i * 3 + c)]) {
+        ++differing;
+        break;
+      }
+  }
+  EXPECT_GT(traced, 100);
+  EXPECT_GT(untraced, 0);
+  // Cut: the slots never started, and the path in flight (if any) when the budget ran out, which
+  // ends as it stands. Every other path is exact.
+  auto inFlight = static_cast<int>(all.cutPaths) - untraced;
+  EXPECT_TRUE(inFlight == 0 || inFlight == 1) << all.cutPaths << " cut, " << untraced << " untraced";
+  EXPECT_LE(differing, inFlight);
+}
+
 }  // namespace
 }  // namespace retile

@@ -36,6 +36,9 @@ struct TileWork {
 struct FrameOptions {
   bool accumulate = true;    // false: trace only (a probe); readbackFrameLuminance() gives the result
   int selectionTileSize = 0; // > 0: count what the tracer sees of the selection per tile of this size
+  // Paths each trace invocation runs one after another; 0 chooses from the last frame's cost.
+  // Fixed by tests and benchmarks: which invocation traces a sample never changes its value.
+  int pathsPerInvocation = 0;
 };
 
 // Per tile of the counting tile size, summed over frames until read: primary hits on the selected
@@ -51,7 +54,8 @@ struct FrameStats {
   std::uint64_t bounceRays = 0;
   std::uint64_t shadowRays = 0;
   double seconds = 0;              // wall time of trace + accumulate on the device
-  // lavapipe stops an invocation's loops after 65535 iterations in all; paths end before that.
+  // lavapipe stops the loops of eight lock-stepped invocations after about 32767 of the loop
+  // iterations the trace pass counts (trace.comp); paths end before that, at 30000.
   std::uint32_t maxLoopIterations = 0;  // the most any one invocation ran (a per-lane lower bound)
   std::uint64_t cutPaths = 0;           // paths ended early to stay under that limit
   std::uint64_t loopIterations = 0;     // over all invocations, to the nearest 16 per invocation

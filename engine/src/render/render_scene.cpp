@@ -209,6 +209,8 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
     std::vector<Bounds3> boxes(n);
     for (std::size_t i = 0; i < n; ++i)
       for (int k = 0; k < 3; ++k) boxes[i].grow(g.positions[g.indices[i * 3 + static_cast<std::size_t>(k)]]);
+    // trace.comp unrolls the leaf test for at most kMaxLeafTriangles.
+    static_assert(BvhBuildOptions{}.maxLeafSize <= gpu::kMaxLeafTriangles);
     e.bvh = buildBvh(boxes);
     e.triangles.resize(n * gpu::kTriTexels);
     e.shading.resize(n * gpu::kTriShadeTexels);

@@ -39,13 +39,14 @@ std::uint32_t groupsFor(std::uint64_t invocations, std::uint32_t local, std::uin
 }
 
 // Each trace invocation runs several paths one after another (trace.comp), so its eight
-// lock-stepped lanes rarely wait for the longest path: on the Cornell box 64 paths per invocation
-// trace 1.4 times as many samples per second as one. The count stays well under lavapipe's loop
-// limit, judged by the last frame's loop iterations per path, and leaves enough invocations for
-// every thread of the device.
+// lock-stepped lanes rarely wait for the longest path: on the Cornell box 128 paths per
+// invocation trace about 1.5 times as many samples per second as one. The count is chosen from
+// the last frame's loop iterations per path to stay clear of lavapipe's loop limit (in the
+// Cornell box and the living room the busiest invocation ran 1.2-1.3 times the mean), and leaves
+// enough invocations for every thread of the device.
 std::uint64_t traceInvocations(std::uint64_t slots, double iterationsPerPath) {
-  constexpr double kIterationTarget = 16000;  // a quarter of the limit: one path may run far longer than the mean
-  constexpr std::uint64_t kMaxPathsPerInvocation = 64, kMinInvocations = 1024;
+  constexpr double kIterationTarget = 15000;  // half of trace.comp's kLoopBudget
+  constexpr std::uint64_t kMaxPathsPerInvocation = 128, kMinInvocations = 512;
   auto paths = static_cast<std::uint64_t>(std::clamp(kIterationTarget / std::max(iterationsPerPath, 1.0), 1.0,
                                                      static_cast<double>(kMaxPathsPerInvocation)));
   return std::max(std::min(slots, kMinInvocations), (slots + paths - 1) / paths);
@@ -360,9 +361,16 @@ struct Renderer::Impl {
     std::uint32_t zero[gpu::kStatsCount] = {};
     stats.upload(zero, sizeof zero);
 
-    std::uint64_t invocations = traceInvocations(slots, iterationsPerPath);
+    std::uint64_t invocations =
+        options.pathsPerInvocation > 0
+            ? (slots + static_cast<std::uint64_t>(options.pathsPerInvocation) - 1) / static_cast<std::uint64_t>(options.pathsPerInvocation)
+            : traceInvocations(slots, iterationsPerPath);
     auto start = std::chrono::steady_clock::now();
     ctx.submitAndWait([&](VkCommandBuffer cb) {
+      // A slot the trace pass does not reach (its invocation ran out of loop budget) must read as
+      // weight 0, not as the last frame's sample.
+      vkCmdFillBuffer(cb, samples.handle(), 0, static_cast<VkDeviceSize>(slots) * sizeof(gpu::vec4), 0);
+      vk::computeBarrier(cb);
       gpu::TracePush tp{0, static_cast<std::uint32_t>(slots), static_cast<std::uint32_t>(invocations), 0};
       std::uint32_t gy;
       std::uint32_t gx = groupsFor(invocations, gpu::kTraceWorkgroup, &gy);
