@@ -134,7 +134,9 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
     const Camera& c = doc_.scene().camera;
     Vec3 fwd = normalize(c.target - c.position);
     Vec3 right = normalize(cross(fwd, c.up)), up = cross(right, fwd);
-    Vec3 at = o->transform.transformPoint(Vec3{0.0f});
+    // The object follows the cursor at the depth of its bounds' centre, the point the gizmo and the
+    // pivot use: imported meshes often sit far from their transform's origin.
+    Vec3 at = pivot(*o);
     float depth = std::max(0.01f, dot(at - c.position, fwd));
     float k = 2.0f * depth * std::tan(c.verticalFov * 0.5f) / static_cast<float>(frame->height);
     Object after = *o;
