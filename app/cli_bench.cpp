@@ -90,9 +90,9 @@ int benchThroughput(const std::vector<std::string>& argv) {
   std::printf("frame time     %.1f ms (device), %.1f ms (wall)\n", sec / frames * 1e3, wall / frames * 1e3);
   std::printf("scene upload   %.3f s (BVH bottom level %.3f s, top level %.4f s)\n", setup, renderer.lastBlasSeconds(),
               renderer.lastTlasSeconds());
-  std::printf("loop iterations %u at most in one invocation (paths stop at 30000; lavapipe's limit is near 32767); "
+  std::printf("loop iterations %u at most in one invocation (paths stop at %u; lavapipe's limit is near 32767); "
               "%llu paths cut short\n",
-              sum.maxLoopIterations, static_cast<unsigned long long>(sum.cutPaths));
+              sum.maxLoopIterations, kTraceLoopBudget, static_cast<unsigned long long>(sum.cutPaths));
   std::printf("paths          %.1f loop iterations each, %.0f per invocation (last frame)\n",
               static_cast<double>(sum.loopIterations) / static_cast<double>(std::max<std::uint64_t>(sum.samples, 1)),
               sum.pathsPerInvocation);

@@ -19,12 +19,11 @@ layout(set = 0, binding = 14, std430) writeonly buffer Aux { vec4 aux[]; };
 // loop iterations of all invocations, in kLoopIterationUnit.
 layout(set = 0, binding = 15, std430) buffer Stats { uint rayCounts[kStatsCount]; };
 
-// Paths stop before the eight lock-stepped invocations could reach lavapipe's loop limit (see
-// scene.glsl). That limit is 65535 of lavapipe's own counts, and it counts each of our iterations
-// twice (measured: an invocation given 20736 paths was stopped by lavapipe when loopIterations
-// read 32659). One more segment of the eight paths, with their shadow rays, costs well under
-// 2500 of our iterations in any scene seen.
-const uint kLoopBudget = 30000u;
+// kLoopBudget (layouts.h): paths stop before the eight lock-stepped invocations could reach
+// lavapipe's loop limit (see scene.glsl). That limit is 65535 of lavapipe's own counts, and it
+// counts each of our iterations twice (measured: an invocation given 20736 paths was stopped by
+// lavapipe when loopIterations read 32659). One more segment of the eight paths, with their
+// shadow rays, costs well under 2500 of our iterations in any scene seen.
 
 // What the tracer sees of the selected object, per tile (the indirection-aware policy).
 layout(set = 0, binding = 16, std430) buffer Selection { uint selectionCounts[]; };

@@ -55,6 +55,8 @@ RT_CONST(int, kEnvMap, 2)
 
 RT_CONST(int, kTraceWorkgroup, 64)
 RT_CONST(int, kStatsCount, 8)  // counters the trace pass writes (see trace.comp)
+// The trace pass stops its paths once its loop-iteration count passes this (see trace.comp).
+RT_CONST(uint, kLoopBudget, 30000u)
 RT_CONST(uint, kLoopIterationUnit, 16u)  // the loop-iteration sum counts in these units, so 32 bits suffice
 RT_CONST(int, kAccumulateWorkgroup, 64)
 RT_CONST(int, kMaxWorkItems, 65536)

@@ -48,6 +48,10 @@ struct SelectionCounts {
   std::vector<std::uint32_t> direct, reflection, shadow;
 };
 
+// The trace pass stops its paths once its loop-iteration count passes this (trace.comp; the
+// shaders' kLoopBudget, which renderer.cpp checks against it).
+inline constexpr std::uint32_t kTraceLoopBudget = 30000;
+
 struct FrameStats {
   std::uint64_t samples = 0;       // path samples traced this frame
   std::uint64_t primaryRays = 0;
@@ -55,9 +59,9 @@ struct FrameStats {
   std::uint64_t shadowRays = 0;
   double seconds = 0;              // wall time of trace + accumulate on the device
   // lavapipe stops the loops of eight lock-stepped invocations after about 32767 of the loop
-  // iterations the trace pass counts (trace.comp); paths end before that, at 30000.
-  std::uint32_t maxLoopIterations = 0;  // the most any one invocation ran (a per-lane lower bound)
-  std::uint64_t cutPaths = 0;           // paths ended early to stay under that limit
+  // iterations the trace pass counts (trace.comp); paths end before that, at kTraceLoopBudget.
+  std::uint32_t maxLoopIterations = 0;  // the most any one invocation counted (exact for its eight)
+  std::uint64_t cutPaths = 0;           // paths ended early, and slots never started, to stay under it
   std::uint64_t loopIterations = 0;     // over all invocations, to the nearest 16 per invocation
   double pathsPerInvocation = 0;        // each invocation traces this many paths one after another
 };

@@ -44,8 +44,12 @@ std::uint32_t groupsFor(std::uint64_t invocations, std::uint32_t local, std::uin
 // the last frame's loop iterations per path to stay clear of lavapipe's loop limit (in the
 // Cornell box and the living room the busiest invocation ran 1.2-1.3 times the mean), and leaves
 // enough invocations for every thread of the device.
-std::uint64_t traceInvocations(std::uint64_t slots, double iterationsPerPath) {
-  constexpr double kIterationTarget = 15000;  // half of trace.comp's kLoopBudget
+static_assert(kTraceLoopBudget == gpu::kLoopBudget, "render.h and shaders/shared/layouts.h disagree");
+
+// `fixedPaths` > 0 overrides the choice (FrameOptions::pathsPerInvocation).
+std::uint64_t traceInvocations(std::uint64_t slots, double iterationsPerPath, int fixedPaths) {
+  if (fixedPaths > 0) return (slots + static_cast<std::uint64_t>(fixedPaths) - 1) / static_cast<std::uint64_t>(fixedPaths);
+  constexpr double kIterationTarget = gpu::kLoopBudget / 2;
   constexpr std::uint64_t kMaxPathsPerInvocation = 128, kMinInvocations = 512;
   auto paths = static_cast<std::uint64_t>(std::clamp(kIterationTarget / std::max(iterationsPerPath, 1.0), 1.0,
                                                      static_cast<double>(kMaxPathsPerInvocation)));
@@ -361,10 +365,7 @@ struct Renderer::Impl {
     std::uint32_t zero[gpu::kStatsCount] = {};
     stats.upload(zero, sizeof zero);
 
-    std::uint64_t invocations =
-        options.pathsPerInvocation > 0
-            ? (slots + static_cast<std::uint64_t>(options.pathsPerInvocation) - 1) / static_cast<std::uint64_t>(options.pathsPerInvocation)
-            : traceInvocations(slots, iterationsPerPath);
+    std::uint64_t invocations = traceInvocations(slots, iterationsPerPath, options.pathsPerInvocation);
     auto start = std::chrono::steady_clock::now();
     ctx.submitAndWait([&](VkCommandBuffer cb) {
       // A slot the trace pass does not reach (its invocation ran out of loop budget) must read as
