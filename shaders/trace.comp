@@ -13,11 +13,11 @@
 layout(local_size_x = kTraceWorkgroup) in;
 
 layout(set = 0, binding = 1, std430) readonly buffer Work { WorkItem items[]; };
-layout(set = 0, binding = 13, std430) writeonly buffer Samples { vec4 samples[]; };
-layout(set = 0, binding = 14, std430) writeonly buffer Aux { vec4 aux[]; };
+layout(set = 0, binding = 12, std430) writeonly buffer Samples { vec4 samples[]; };
+layout(set = 0, binding = 13, std430) writeonly buffer Aux { vec4 aux[]; };
 // primary, bounce, shadow rays; the most loop iterations of one invocation; paths cut short;
 // loop iterations of all invocations, in kLoopIterationUnit.
-layout(set = 0, binding = 15, std430) buffer Stats { uint rayCounts[kStatsCount]; };
+layout(set = 0, binding = 14, std430) buffer Stats { uint rayCounts[kStatsCount]; };
 
 // kLoopBudget (layouts.h): paths stop before the eight lock-stepped invocations could reach
 // lavapipe's loop limit (see scene.glsl). That limit is 65535 of lavapipe's own counts, and it
@@ -26,7 +26,7 @@ layout(set = 0, binding = 15, std430) buffer Stats { uint rayCounts[kStatsCount]
 // shadow rays, costs well under 2500 of our iterations in any scene seen.
 
 // What the tracer sees of the selected object, per tile (the indirection-aware policy).
-layout(set = 0, binding = 16, std430) buffer Selection { uint selectionCounts[]; };
+layout(set = 0, binding = 15, std430) buffer Selection { uint selectionCounts[]; };
 
 layout(push_constant) uniform Push { TracePush push; };
 
@@ -182,8 +182,8 @@ bool extendPath(inout Path path) {
   vec3 pos = ro + hit.t * rd;
 
   // Normals go to world space with the inverse transpose, i.e. the transposed world-to-object rows.
-  vec3 e1 = texelFetch(uTris, hit.prim * kTriTexels + 1).xyz;
-  vec3 e2 = texelFetch(uTris, hit.prim * kTriTexels + 2).xyz;
+  vec3 e1 = texelFetch(uTraversal, hit.prim * kTriTexels + 1).xyz;
+  vec3 e2 = texelFetch(uTraversal, hit.prim * kTriTexels + 2).xyz;
   vec3 ngObj = cross(e1, e2);
   vec3 ng = normalize(r0.xyz * ngObj.x + r1.xyz * ngObj.y + r2.xyz * ngObj.z);
   vec4 s0 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 0);

@@ -9,17 +9,17 @@
 #include "common/sampling.glsl"
 
 layout(set = 0, binding = 0, std140) uniform Frame { FrameUniforms frame; };
-layout(set = 0, binding = 2) uniform samplerBuffer uNodes;
-layout(set = 0, binding = 3) uniform samplerBuffer uTris;
-layout(set = 0, binding = 4) uniform samplerBuffer uTriShade;
-layout(set = 0, binding = 5) uniform samplerBuffer uInstances;
-layout(set = 0, binding = 6) uniform samplerBuffer uMaterials;
-layout(set = 0, binding = 7) uniform samplerBuffer uTexInfo;
-layout(set = 0, binding = 8) uniform samplerBuffer uTexels;
-layout(set = 0, binding = 9) uniform samplerBuffer uEmitters;
-layout(set = 0, binding = 10) uniform samplerBuffer uEmitterAlias;
-layout(set = 0, binding = 11) uniform samplerBuffer uDeltaLights;
-layout(set = 0, binding = 12) uniform samplerBuffer uEnvCdf;
+// Triangles, BVH nodes and instance records, addressed by items (layouts.h).
+layout(set = 0, binding = 2) uniform samplerBuffer uTraversal;
+layout(set = 0, binding = 3) uniform samplerBuffer uTriShade;
+layout(set = 0, binding = 4) uniform samplerBuffer uInstances;
+layout(set = 0, binding = 5) uniform samplerBuffer uMaterials;
+layout(set = 0, binding = 6) uniform samplerBuffer uTexInfo;
+layout(set = 0, binding = 7) uniform samplerBuffer uTexels;
+layout(set = 0, binding = 8) uniform samplerBuffer uEmitters;
+layout(set = 0, binding = 9) uniform samplerBuffer uEmitterAlias;
+layout(set = 0, binding = 10) uniform samplerBuffer uDeltaLights;
+layout(set = 0, binding = 11) uniform samplerBuffer uEnvCdf;
 
 // Two levels of BVH; the builder bounds each level's depth.
 const int kStackSize = 48;
@@ -149,50 +149,14 @@ vec3 safeInverse(vec3 d) {
     if (stackSize >= 8) st7 = stackDeep[stackSize - 8];                                            \
   }
 
-// Records the hit when ray (o, d) meets triangle p of the current instance nearer than hit.t.
-bool hitTriangle(int p, vec3 o, vec3 d, int instance, int instFlags, float rayRandom, inout Hit hit) {
-  vec3 v0 = texelFetch(uTris, p * kTriTexels).xyz;
-  vec3 e1 = texelFetch(uTris, p * kTriTexels + 1).xyz;
-  vec3 e2 = texelFetch(uTris, p * kTriTexels + 2).xyz;
-  vec3 pv = cross(d, e2);
-  float det = dot(e1, pv);
-  if (det == 0.0) return false;
-  float inv = 1.0 / det;
-  vec3 s = o - v0;
-  float uu = dot(s, pv) * inv;
-  if (uu < 0.0 || uu > 1.0) return false;
-  vec3 q = cross(s, e1);
-  float vv = dot(d, q) * inv;
-  if (vv < 0.0 || uu + vv > 1.0) return false;
-  float tt = dot(e2, q) * inv;
-  if (!(tt > 0.0 && tt < hit.t)) return false;
-#if RETILE_ALPHA_TEST
-  if ((instFlags & kInstanceAlphaTested) != 0 && !alphaPasses(instance, p, uu, vv, rayRandom)) return false;
-#endif
-  hit.t = tt;
-  hit.u = uu;
-  hit.v = vv;
-  hit.prim = p;
-  hit.instance = instance;
-  return true;
-}
-
-// Tests the triangles [start, start + count) of the current instance; returns true when an any-hit
-// query is answered. Written out without a loop (leaves hold at most kMaxLeafTriangles = 4), so
-// the traversal loop is the only loop of a query and its lanes run prefixes of its iterations:
-// one synchronisation of loopIterations after it is exact.
-bool intersectLeaf(int start, int count, vec3 o, vec3 d, int instance, int instFlags, bool anyHit, float rayRandom,
-                   inout Hit hit) {
-  bool h0 = hitTriangle(start, o, d, instance, instFlags, rayRandom, hit);
-  if (h0 && anyHit) return true;
-  bool h1 = count > 1 && hitTriangle(start + 1, o, d, instance, instFlags, rayRandom, hit);
-  if (h1 && anyHit) return true;
-  bool h2 = count > 2 && hitTriangle(start + 2, o, d, instance, instFlags, rayRandom, hit);
-  if (h2 && anyHit) return true;
-  return count > 3 && hitTriangle(start + 3, o, d, instance, instFlags, rayRandom, hit) && anyHit;
-}
-
 // Closest hit (anyHit == false) or any opaque hit (anyHit == true, for shadow rays).
+//
+// lavapipe (Mesa 22.3) runs both sides of every branch with lanes masked off: an if skips no
+// code, even when no lane takes it. A loop iteration therefore costs all the code in its body,
+// whichever step each lane is at. So one iteration does one step of any kind (visit a node's two
+// children, test one triangle, or enter an instance), and all three read their record through
+// the same four texel fetches of the one traversal buffer. Testing up to two leaves of four
+// triangles in the visiting iteration, as before, made every iteration pay for 24 fetches.
 Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
   Hit hit;
   hit.t = tMax;
@@ -205,7 +169,7 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
   int st0 = 0, st1 = 0, st2 = 0, st3 = 0, st4 = 0, st5 = 0, st6 = 0, st7 = 0;
   int stackSize = 0;
   int stackDeep[kStackSize];
-  int node = frame.scene.x;  // TLAS root
+  int item = frame.scene.x;  // the instance BVH's root
   vec3 o = origin, d = dir, invD = safeInverse(dir);
   int instance = -1;
   int instFlags = 0;
@@ -213,65 +177,71 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
 
   for (;;) {
     loopIterations++;
-    if (node <= -2) {
+    int at = item >> kItemOffsetShift;
+    int kind = item & 3;
+    vec4 r0 = texelFetch(uTraversal, at), r1 = texelFetch(uTraversal, at + 1);
+    vec4 r2 = texelFetch(uTraversal, at + 2), r3 = texelFetch(uTraversal, at + 3);
+    int next = -1;
+    if (kind == kItemNode) {
+      int left = floatBitsToInt(r0.w), right = floatBitsToInt(r2.w);
+      float tl, tr;
+      bool hl = left >= 0 && slabTest(r0.xyz, r1.xyz, o, invD, hit.t, tl);
+      bool hr = right >= 0 && slabTest(r2.xyz, r3.xyz, o, invD, hit.t, tr);
+      if (hl && hr) {
+        bool leftFirst = tl <= tr;
+        if (stackSize < kStackSize + 8) STACK_PUSH(leftFirst ? right : left);
+        next = leftFirst ? left : right;
+      } else {
+        next = hl ? left : (hr ? right : -1);
+      }
+    } else if (kind == kItemTriangles) {
+      // Moeller-Trumbore against v0 = r0.xyz, e1 = r1.xyz, e2 = r2.xyz.
+      vec3 pv = cross(d, r2.xyz);
+      float det = dot(r1.xyz, pv);
+      float inv = 1.0 / det;
+      vec3 s = o - r0.xyz;
+      float uu = dot(s, pv) * inv;
+      vec3 q = cross(s, r1.xyz);
+      float vv = dot(d, q) * inv;
+      float tt = dot(r2.xyz, q) * inv;
+      bool found = det != 0.0 && uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < hit.t;
+      int p = floatBitsToInt(r0.w);
+#if RETILE_ALPHA_TEST
+      if (found && (instFlags & kInstanceAlphaTested) != 0) found = alphaPasses(instance, p, uu, vv, rayRandom);
+#endif
+      if (found) {
+        hit.t = tt;
+        hit.u = uu;
+        hit.v = vv;
+        hit.prim = p;
+        hit.instance = instance;
+        if (anyHit) break;
+      }
+      // The rest of the leaf: one triangle further on, one fewer to go.
+      if ((item & 12) != 0) next = item + ((kTriTexels << kItemOffsetShift) - 4);
+    } else {
       // Enter an instance: transform the ray (t is preserved because d is not renormalised).
-      instance = -node - 2;
-      int base = instance * kInstanceTexels;
-      vec4 r0 = texelFetch(uInstances, base), r1 = texelFetch(uInstances, base + 1), r2 = texelFetch(uInstances, base + 2);
-      vec4 info = texelFetch(uInstances, base + 3);
-      instFlags = floatBitsToInt(texelFetch(uInstances, base + 4).y);
+      instance = floatBitsToInt(r3.y);
+      instFlags = floatBitsToInt(r3.z);
       o = vec3(dot(r0.xyz, origin) + r0.w, dot(r1.xyz, origin) + r1.w, dot(r2.xyz, origin) + r2.w);
       d = vec3(dot(r0.xyz, dir), dot(r1.xyz, dir), dot(r2.xyz, dir));
       invD = safeInverse(d);
       instanceSp = stackSize;
-      node = floatBitsToInt(info.x);
+      next = floatBitsToInt(r3.x);
     }
-    if (node >= 0) {
-      vec4 a = texelFetch(uNodes, node * kNodeTexels + 0);
-      vec4 b = texelFetch(uNodes, node * kNodeTexels + 1);
-      vec4 c = texelFetch(uNodes, node * kNodeTexels + 2);
-      vec4 e = texelFetch(uNodes, node * kNodeTexels + 3);
-      int li = floatBitsToInt(a.w), lc = floatBitsToInt(b.w);
-      int ri = floatBitsToInt(c.w), rc = floatBitsToInt(e.w);
-      float tl, tr;
-      bool hl = lc >= 0 && slabTest(a.xyz, b.xyz, o, invD, hit.t, tl);
-      bool hr = rc >= 0 && slabTest(c.xyz, e.xyz, o, invD, hit.t, tr);
-      // Leaves: in a BLAS, triangles tested here; in the TLAS, one instance, visited below like
-      // an inner node.
-      if (instance >= 0) {
-        bool answered = false;
-        if (hl && lc > 0) {
-          answered = intersectLeaf(li, lc, o, d, instance, instFlags, anyHit, rayRandom, hit);
-          hl = false;
-        }
-        if (!answered && hr && rc > 0) {
-          answered = intersectLeaf(ri, rc, o, d, instance, instFlags, anyHit, rayRandom, hit);
-          hr = false;
-        }
-        if (answered) break;
+    if (next < 0) {
+      if (stackSize == instanceSp) {
+        // Back from the instance to world space.
+        o = origin;
+        d = dir;
+        invD = safeInverse(dir);
+        instance = -1;
+        instanceSp = -1;
       }
-      // Children to visit: inner nodes, or (in the TLAS) instance entries.
-      int ln = lc == 0 ? li : -li - 2;
-      int rn = rc == 0 ? ri : -ri - 2;
-      if (hl && hr) {
-        bool leftFirst = tl <= tr;
-        if (stackSize < kStackSize + 8) STACK_PUSH(leftFirst ? rn : ln);
-        node = leftFirst ? ln : rn;
-        continue;
-      }
-      if (hl) { node = ln; continue; }
-      if (hr) { node = rn; continue; }
+      if (stackSize == 0) break;
+      STACK_POP(next);
     }
-    if (stackSize == instanceSp) {
-      // Back from the instance to world space.
-      o = origin;
-      d = dir;
-      invD = safeInverse(dir);
-      instance = -1;
-      instanceSp = -1;
-    }
-    if (stackSize == 0) break;
-    STACK_POP(node);
+    item = next;
   }
   syncLoopIterations();
   return hit;

@@ -16,8 +16,9 @@ struct alignas(16) ivec4 { std::int32_t x, y, z, w; };
 #endif
 
 // Texels (RGBA32F) per record in the read-only scene buffers.
-RT_CONST(int, kNodeTexels, 4)       // render/bvh.h: both child boxes per node
-RT_CONST(int, kTriTexels, 3)        // v0, e1 = v1 - v0, e2 = v2 - v0 (object space)
+RT_CONST(int, kNodeTexels, 4)       // left.min.xyz left item | left.max.xyz - | right.min.xyz right item | right.max.xyz -
+RT_CONST(int, kTriTexels, 3)        // v0.xyz triangle index | e1 = v1 - v0 | e2 = v2 - v0 (object space)
+RT_CONST(int, kInstanceRecordTexels, 4)  // world-to-object rows 0..2 | root item, instance, flags, -
 RT_CONST(int, kTriShadeTexels, 4)   // n0.xyz uv0.x | n1.xyz uv0.y | n2.xyz uv1.x | uv1.y uv2.xy hasNormals
 RT_CONST(int, kInstanceTexels, 5)   // world-to-object rows 0..2 | blasRoot triOffset material emitterOffset | objectIndex+1 flags
 RT_CONST(int, kMaterialTexels, 5)   // see render/render_scene.cpp packMaterial
@@ -25,7 +26,16 @@ RT_CONST(int, kTextureTexels, 3)    // offset w h kind | on.rgb resU | off.rgb r
 RT_CONST(int, kEmitterTexels, 5)    // v0.xyz area | e1.xyz instance | e2.xyz - | radiance.rgb pick pdf | normal.xyz -
 RT_CONST(int, kDeltaLightTexels, 4) // position.xyz type | direction.xyz cosOuter | intensity.rgb cosInner | -
 
-RT_CONST(int, kMaxLeafTriangles, 4)  // render/bvh.h maxLeafSize for mesh BVHs; trace.comp unrolls its leaf test
+// The traversal buffer holds every triangle (packed triangle p at texel p * kTriTexels), then the
+// mesh BVHs, the instance BVH and one record per instance. An item names one record of it:
+// texel offset << kItemOffsetShift | (triangles - 1) << 2 | kind, or -1 for none. A run of up to
+// kMaxLeafTriangles consecutive triangles is one item (a BVH leaf).
+RT_CONST(int, kItemNode, 0)
+RT_CONST(int, kItemTriangles, 1)
+RT_CONST(int, kItemInstance, 2)
+RT_CONST(int, kItemOffsetShift, 4)
+RT_CONST(int, kMaxLeafTriangles, 4)  // render/bvh.h maxLeafSize for mesh BVHs
+RT_CONST(int, kMaxTraversalTexels, 134217728)  // 2^27: items stay positive; also lavapipe's texel-buffer limit
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceEmissive, 4)

@@ -9,6 +9,7 @@
 
 #include "core/files.h"
 #include "io/image_io.h"
+#include "retile/error.h"
 #include "retile/log.h"
 
 namespace retile {
@@ -48,6 +49,33 @@ std::vector<vec4> aliasTable(const std::vector<float>& weights) {
   for (std::uint32_t i : large) table[i] = {1.0f, bitsOf(static_cast<std::int32_t>(i)), 0, 0};
   for (std::uint32_t i : small) table[i] = {1.0f, bitsOf(static_cast<std::int32_t>(i)), 0, 0};
   return table;
+}
+
+// The item naming `count` records of `kind` at texel `offset` of the traversal buffer (layouts.h).
+std::int32_t traversalItem(std::int64_t offset, int kind, std::int32_t count) {
+  if (offset + 4 > gpu::kMaxTraversalTexels)
+    throw Error(cat("the scene needs more than ", gpu::kMaxTraversalTexels / 1048576,
+                    " M texels of BVH and triangle data, the most one buffer can hold; split it into fewer triangles"));
+  return static_cast<std::int32_t>((offset << gpu::kItemOffsetShift) | ((count - 1) << 2) | kind);
+}
+
+// Appends `nodes` (render/bvh.h, child indices local to them) to `out`, a part of the traversal
+// buffer that starts at its texel `outBase`: inner children become node items, leaves whatever
+// `leafItem(index, count)` names.
+template <class LeafItem>
+void appendNodes(std::vector<vec4>& out, const std::vector<GpuBvhNode>& nodes, std::int64_t outBase, LeafItem leafItem) {
+  std::int64_t base = outBase + static_cast<std::int64_t>(out.size());
+  auto child = [&](std::int32_t index, std::int32_t count) {
+    if (count < 0) return std::int32_t{-1};
+    if (count == 0) return traversalItem(base + static_cast<std::int64_t>(index) * gpu::kNodeTexels, gpu::kItemNode, 1);
+    return leafItem(index, count);
+  };
+  for (const GpuBvhNode& n : nodes) {
+    out.push_back({n.lmin[0], n.lmin[1], n.lmin[2], bitsOf(child(n.left, n.leftCount))});
+    out.push_back({n.lmax[0], n.lmax[1], n.lmax[2], 0});
+    out.push_back({n.rmin[0], n.rmin[1], n.rmin[2], bitsOf(child(n.right, n.rightCount))});
+    out.push_back({n.rmax[0], n.rmax[1], n.rmax[2], 0});
+  }
 }
 
 std::string textureSignature(const Texture& t, const std::filesystem::path& base) {
@@ -141,7 +169,7 @@ float halfToFloat(std::uint16_t h) {
 
 std::uint64_t RenderSceneData::deviceBytes() const {
   auto v = [](const auto& x) { return static_cast<std::uint64_t>(x.size() * sizeof(x[0])); };
-  return v(blasNodes) + v(tlasNodes) + v(triangles) + v(triangleShading) + v(instances) + v(materials) +
+  return v(meshTraversal) + v(topTraversal) + v(triangleShading) + v(instances) + v(materials) +
          v(textureInfo) + v(texels) + v(emitters) + v(emitterAlias) + v(deltaLights) + v(environmentCdf);
 }
 
@@ -209,7 +237,7 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
     std::vector<Bounds3> boxes(n);
     for (std::size_t i = 0; i < n; ++i)
       for (int k = 0; k < 3; ++k) boxes[i].grow(g.positions[g.indices[i * 3 + static_cast<std::size_t>(k)]]);
-    // trace.comp unrolls the leaf test for at most kMaxLeafTriangles.
+    // A leaf's item carries its triangle count in two bits (layouts.h).
     static_assert(BvhBuildOptions{}.maxLeafSize <= gpu::kMaxLeafTriangles);
     e.bvh = buildBvh(boxes);
     e.triangles.resize(n * gpu::kTriTexels);
@@ -234,25 +262,28 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
   }
   std::erase_if(meshes_, [](const auto& kv) { return !kv.second.used; });
 
-  data_.blasNodes.clear();
-  data_.triangles.clear();
+  // Triangles first, at texel 3p for packed triangle p, so that shading finds a hit's edges
+  // from its index alone; then the BVHs, whose leaves name triangle runs.
+  data_.meshTraversal.clear();
   data_.triangleShading.clear();
   data_.triangleCount = 0;
   for (auto& [key, e] : meshes_) {
-    e.nodeOffset = static_cast<std::uint32_t>(data_.blasNodes.size());
-    e.triOffset = static_cast<std::uint32_t>(data_.triangles.size() / gpu::kTriTexels);
-    for (GpuBvhNode n : e.bvh.nodes) {
-      auto fix = [&](std::int32_t& idx, std::int32_t count) {
-        if (count == 0) idx += static_cast<std::int32_t>(e.nodeOffset);
-        else if (count > 0) idx += static_cast<std::int32_t>(e.triOffset);
-      };
-      fix(n.left, n.leftCount);
-      fix(n.right, n.rightCount);
-      data_.blasNodes.push_back(n);
+    e.triOffset = static_cast<std::uint32_t>(data_.triangleCount);
+    for (std::size_t p = 0; p < e.bvh.primOrder.size(); ++p) {
+      data_.meshTraversal.push_back(e.triangles[p * 3]);
+      data_.meshTraversal.back().w = bitsOf(static_cast<std::int32_t>(e.triOffset + p));
+      data_.meshTraversal.push_back(e.triangles[p * 3 + 1]);
+      data_.meshTraversal.push_back(e.triangles[p * 3 + 2]);
     }
-    data_.triangles.insert(data_.triangles.end(), e.triangles.begin(), e.triangles.end());
     data_.triangleShading.insert(data_.triangleShading.end(), e.shading.begin(), e.shading.end());
     data_.triangleCount += e.bvh.primOrder.size();
+  }
+  for (auto& [key, e] : meshes_) {
+    auto base = static_cast<std::int64_t>(data_.meshTraversal.size());
+    e.rootItem = traversalItem(base, gpu::kItemNode, 1);
+    appendNodes(data_.meshTraversal, e.bvh.nodes, 0, [&](std::int32_t index, std::int32_t count) {
+      return traversalItem((static_cast<std::int64_t>(e.triOffset) + index) * gpu::kTriTexels, gpu::kItemTriangles, count);
+    });
   }
 }
 
@@ -312,12 +343,16 @@ void RenderSceneBuilder::packInstances(const Scene& scene) {
   BvhBuildOptions opt;
   opt.maxLeafSize = 1;  // a TLAS leaf is one instance: traversal enters its BVH directly
   Bvh tlas = buildBvh(boxes, opt);
-  auto offset = static_cast<std::int32_t>(data_.blasNodes.size());
-  data_.tlasNodes = tlas.nodes;
-  for (GpuBvhNode& n : data_.tlasNodes) {
-    if (n.leftCount == 0) n.left += offset;
-    if (n.rightCount == 0) n.right += offset;
-  }
+  // The top part of the traversal buffer: the instance BVH, then one record per instance (in
+  // the BVH's packed order, which is also the instance index).
+  auto base = static_cast<std::int64_t>(data_.meshTraversal.size());
+  auto records = base + static_cast<std::int64_t>(tlas.nodes.size()) * gpu::kNodeTexels;
+  data_.topTraversal.clear();
+  data_.tlasRoot = traversalItem(base, gpu::kItemNode, 1);
+  appendNodes(data_.topTraversal, tlas.nodes, base, [&](std::int32_t index, std::int32_t count) {
+    RETILE_ASSERT(count == 1, cat("a top-level leaf of ", count, " instances"));
+    return traversalItem(records + static_cast<std::int64_t>(index) * gpu::kInstanceRecordTexels, gpu::kItemInstance, 1);
+  });
   data_.instances.clear();
   data_.instanceObject.clear();
   data_.bounds = tlas.bounds;
@@ -331,13 +366,21 @@ void RenderSceneBuilder::packInstances(const Scene& scene) {
     if (mat && mat->emissive()) flags |= gpu::kInstanceEmissive;
     if (flags & gpu::kInstanceAlphaTested) data_.alphaTested = true;
     Mat4 inv = c.object->transform.inverse();
-    for (int r = 0; r < 3; ++r) data_.instances.push_back({inv.m[r][0], inv.m[r][1], inv.m[r][2], inv.m[r][3]});
-    data_.instances.push_back(ints(static_cast<std::int32_t>(c.mesh->nodeOffset), static_cast<std::int32_t>(c.mesh->triOffset),
+    auto instance = static_cast<std::int32_t>(data_.instanceObject.size());
+    for (int r = 0; r < 3; ++r) {
+      data_.instances.push_back({inv.m[r][0], inv.m[r][1], inv.m[r][2], inv.m[r][3]});
+      data_.topTraversal.push_back(data_.instances.back());
+    }
+    data_.topTraversal.push_back(ints(c.mesh->rootItem, instance, flags, 0));
+    data_.instances.push_back(ints(c.mesh->rootItem, static_cast<std::int32_t>(c.mesh->triOffset),
                                    materialIndex(c.object->material), -1));
-    data_.instances.push_back(ints(static_cast<std::int32_t>(data_.instanceObject.size() + 1), flags, 0, 0));
+    data_.instances.push_back(ints(instance + 1, flags, 0, 0));
     data_.instanceObject.push_back(c.object->id);
     data_.instancedTriangles += c.mesh->bvh.primOrder.size();
   }
+  RETILE_ASSERT(records + static_cast<std::int64_t>(cands.size()) * gpu::kInstanceRecordTexels ==
+                    base + static_cast<std::int64_t>(data_.topTraversal.size()),
+                "instance records out of place");
 }
 
 void RenderSceneBuilder::packEmitters(const Scene& scene) {

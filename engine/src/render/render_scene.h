@@ -27,8 +27,8 @@ using gpu::vec4;
 
 // Which arrays changed in the last update, so the uploader copies only those.
 enum DirtyArrays : std::uint32_t {
-  kDirtyGeometry = 1u << 0,   // blasNodes, triangles, triangleShading
-  kDirtyInstances = 1u << 1,  // instances, tlasNodes
+  kDirtyGeometry = 1u << 0,   // meshTraversal, triangleShading
+  kDirtyInstances = 1u << 1,  // instances, topTraversal
   kDirtyMaterials = 1u << 2,
   kDirtyTextures = 1u << 3,   // textureInfo, texels
   kDirtyEmitters = 1u << 4,   // emitters, emitterAlias, deltaLights
@@ -37,9 +37,12 @@ enum DirtyArrays : std::uint32_t {
 };
 
 struct RenderSceneData {
-  std::vector<GpuBvhNode> blasNodes;   // every mesh BVH, concatenated
-  std::vector<GpuBvhNode> tlasNodes;   // instance BVH; its node indices are offset by blasNodes.size()
-  std::vector<vec4> triangles;         // kTriTexels per triangle
+  // The traversal buffer (layouts.h), in two parts so that moving an object re-uploads only the
+  // second: every triangle then every mesh BVH; the instance BVH then the instance records. Its
+  // items hold offsets into the whole buffer, the second part starting after the first.
+  std::vector<vec4> meshTraversal;
+  std::vector<vec4> topTraversal;
+  std::int32_t tlasRoot = -1;          // item of the instance BVH's root
   std::vector<vec4> triangleShading;   // kTriShadeTexels per triangle
   std::vector<vec4> instances;         // kInstanceTexels per instance
   std::vector<vec4> materials;         // kMaterialTexels per material
@@ -63,7 +66,6 @@ struct RenderSceneData {
   bool alphaTested = false;            // some instance needs the cut-out test during traversal
   std::uint32_t materialTypes = 0;     // bit kMat... of each material type present
 
-  std::uint32_t tlasRoot() const { return static_cast<std::uint32_t>(blasNodes.size()); }
   std::uint64_t deviceBytes() const;
 };
 
@@ -84,10 +86,10 @@ class RenderSceneBuilder {
   struct MeshEntry {
     std::shared_ptr<const MeshGeometry> geometry;  // keeps the key alive
     Bvh bvh;
-    std::vector<vec4> triangles;
+    std::vector<vec4> triangles;   // kTriTexels per triangle, packed order (w of the first unset)
     std::vector<vec4> shading;
-    std::uint32_t nodeOffset = 0;  // in data_.blasNodes
-    std::uint32_t triOffset = 0;   // in triangles (packed order)
+    std::int32_t rootItem = -1;    // in data_.meshTraversal
+    std::uint32_t triOffset = 0;   // global index of its first packed triangle
     bool used = false;
   };
   // Decoding is the slow part of a texture update; bitmaps of unchanged textures are kept.

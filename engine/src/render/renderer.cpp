@@ -26,9 +26,9 @@ constexpr VkBufferUsageFlags kStorageUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
 
 // Binding numbers of trace.comp (shaders/common/scene.glsl and trace.comp).
 enum TraceBinding : std::uint32_t {
-  kBindFrame = 0, kBindWork = 1, kBindNodes = 2, kBindTris = 3, kBindTriShade = 4, kBindInstances = 5,
-  kBindMaterials = 6, kBindTexInfo = 7, kBindTexels = 8, kBindEmitters = 9, kBindAlias = 10,
-  kBindDelta = 11, kBindEnvCdf = 12, kBindSamples = 13, kBindAux = 14, kBindStats = 15, kBindSelection = 16,
+  kBindFrame = 0, kBindWork = 1, kBindTraversal = 2, kBindTriShade = 3, kBindInstances = 4, kBindMaterials = 5,
+  kBindTexInfo = 6, kBindTexels = 7, kBindEmitters = 8, kBindAlias = 9, kBindDelta = 10, kBindEnvCdf = 11,
+  kBindSamples = 12, kBindAux = 13, kBindStats = 14, kBindSelection = 15,
 };
 
 std::uint32_t groupsFor(std::uint64_t invocations, std::uint32_t local, std::uint32_t* groupsY) {
@@ -67,7 +67,7 @@ struct Renderer::Impl {
   RenderSceneBuilder builder;
 
   Buffer frameUbo, work, stats, selection;
-  Buffer nodes, tris, triShade, instances, materials, texInfo, texels, emitters, alias, delta, envCdf;
+  Buffer traversal, triShade, instances, materials, texInfo, texels, emitters, alias, delta, envCdf;
   Buffer samples, aux, accum, accumAux;
 
   Camera camera;
@@ -112,25 +112,24 @@ struct Renderer::Impl {
   void upload(std::uint32_t dirty) {
     const RenderSceneData& d = builder.data();
     if (dirty & (kDirtyGeometry | kDirtyInstances)) {
-      VkDeviceSize blasBytes = d.blasNodes.size() * sizeof(GpuBvhNode);
-      VkDeviceSize need = blasBytes + d.tlasNodes.size() * sizeof(GpuBvhNode);
-      if (dirty & kDirtyGeometry || !nodes.valid() || nodes.size() < need) {
-        // Room for the top level to grow, so that adding objects does not re-upload mesh BVHs.
-        std::vector<GpuBvhNode> all;
-        all.reserve(d.blasNodes.size() + 2 * d.tlasNodes.size() + 64);
-        all.insert(all.end(), d.blasNodes.begin(), d.blasNodes.end());
-        all.insert(all.end(), d.tlasNodes.begin(), d.tlasNodes.end());
-        all.resize(all.capacity());
-        uploadArray(nodes, all, "BVH nodes");
+      VkDeviceSize meshBytes = d.meshTraversal.size() * sizeof(gpu::vec4);
+      VkDeviceSize need = meshBytes + d.topTraversal.size() * sizeof(gpu::vec4);
+      if (dirty & kDirtyGeometry || !traversal.valid() || traversal.size() < need) {
+        // Room for the top part to grow, so that adding objects does not re-upload the meshes.
+        std::vector<gpu::vec4> all;
+        all.reserve(d.meshTraversal.size() + 2 * d.topTraversal.size() + 256);
+        all.insert(all.end(), d.meshTraversal.begin(), d.meshTraversal.end());
+        all.insert(all.end(), d.topTraversal.begin(), d.topTraversal.end());
+        all.resize(std::min<std::size_t>(all.capacity(), gpu::kMaxTraversalTexels));
+        uploadArray(traversal, all, "BVH and triangles");
       } else {
-        // Only the top level changed: copy it alone, after the mesh BVHs. The cost of moving an
+        // Only the top level changed: copy it alone, after the meshes. The cost of moving an
         // object does not depend on the size of any mesh.
-        nodes.upload(d.tlasNodes.data(), d.tlasNodes.size() * sizeof(GpuBvhNode), blasBytes);
+        traversal.upload(d.topTraversal.data(), d.topTraversal.size() * sizeof(gpu::vec4), meshBytes);
       }
     }
     if (dirty & kDirtyGeometry) {
       iterationsPerPath = kUnknownIterationsPerPath;  // another scene may cost far more per path
-      uploadArray(tris, d.triangles, "triangles");
       uploadArray(triShade, d.triangleShading, "triangle shading data");
     }
     if (dirty & kDirtyInstances) uploadArray(instances, d.instances, "instances");
@@ -157,7 +156,7 @@ struct Renderer::Impl {
       slot = std::make_unique<vk::ComputePipeline>(
           ctx, "trace.comp",
           std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::UniformTexel, Binding::UniformTexel,
-                               Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel,
+                               Binding::UniformTexel, Binding::UniformTexel,
                                Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel,
                                Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel, Binding::Storage,
                                Binding::Storage, Binding::Storage, Binding::Storage},
@@ -176,8 +175,7 @@ struct Renderer::Impl {
   void bindTrace(vk::ComputePipeline& t) {
     t.bind(kBindFrame, frameUbo);
     t.bind(kBindWork, work);
-    t.bind(kBindNodes, nodes, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(kBindTris, tris, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(kBindTraversal, traversal, VK_FORMAT_R32G32B32A32_SFLOAT);
     t.bind(kBindTriShade, triShade, VK_FORMAT_R32G32B32A32_SFLOAT);
     t.bind(kBindInstances, instances, VK_FORMAT_R32G32B32A32_SFLOAT);
     t.bind(kBindMaterials, materials, VK_FORMAT_R32G32B32A32_SFLOAT);
@@ -315,7 +313,7 @@ struct Renderer::Impl {
     u.cameraForward = {forward.x, forward.y, forward.z, 0};
     u.image = {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height), seed,
                static_cast<std::uint32_t>(std::max(maxBounces, 0))};
-    u.scene = {static_cast<std::int32_t>(d.tlasRoot()), static_cast<std::int32_t>(d.instanceObject.size()),
+    u.scene = {d.tlasRoot, static_cast<std::int32_t>(d.instanceObject.size()),
                static_cast<std::int32_t>(d.emitters.size() / gpu::kEmitterTexels),
                static_cast<std::int32_t>(d.deltaLights.size() / gpu::kDeltaLightTexels)};
     u.lightPick = {d.lightPick[0], d.lightPick[1], d.lightPick[2], 0};
