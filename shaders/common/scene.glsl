@@ -131,12 +131,16 @@ vec3 safeInverse(vec3 d) {
 }
 
 // The traversal stack. lavapipe turns each access to a per-invocation array at a varying index
-// into a loop over the eight lanes with a branch per lane, so the top eight entries live in
-// variables (shifted on push and pop, which is a few vector moves) and only deeper ones go to
-// the array. Macros, not functions: an inout array parameter is copied in and out on every call.
+// into a loop over the eight lanes with a branch per lane on the lane's mask, so the top eight
+// entries live in variables (shifted on push and pop, which is a few vector moves) and only
+// deeper ones go to the array. traceRay touches the array once per iteration outside any branch,
+// whatever the step: it reads the entry a pop would need and writes st7 to the slot a push would
+// fill. The write is harmless when nothing is pushed (that slot is above the top), and with it
+// outside every branch the lanes' masks are all set and the per-lane branches predictable;
+// inside the push branch they were not, and the two accesses took about a quarter of the time.
+// Macros, not functions: an inout array parameter is copied in and out on every call.
 #define STACK_PUSH(v)                                                                              \
   {                                                                                                \
-    if (stackSize >= 8) stackDeep[stackSize - 8] = st7;                                            \
     st7 = st6; st6 = st5; st5 = st4; st4 = st3; st3 = st2; st2 = st1; st1 = st0;                  \
     st0 = (v);                                                                                     \
     stackSize++;                                                                                   \
@@ -146,7 +150,7 @@ vec3 safeInverse(vec3 d) {
     v = st0;                                                                                       \
     st0 = st1; st1 = st2; st2 = st3; st3 = st4; st4 = st5; st5 = st6; st6 = st7;                  \
     stackSize--;                                                                                   \
-    if (stackSize >= 8) st7 = stackDeep[stackSize - 8];                                            \
+    if (stackSize >= 8) st7 = below;                                                               \
   }
 
 // Closest hit (anyHit == false) or any opaque hit (anyHit == true, for shadow rays).
@@ -168,7 +172,7 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
 
   int st0 = 0, st1 = 0, st2 = 0, st3 = 0, st4 = 0, st5 = 0, st6 = 0, st7 = 0;
   int stackSize = 0;
-  int stackDeep[kStackSize];
+  int stackDeep[kStackSize + 1];  // the last slot takes the spill of a full stack
   int item = frame.scene.x;  // the instance BVH's root
   vec3 o = origin, d = dir, invD = safeInverse(dir);
   int instance = -1;
@@ -177,6 +181,8 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
 
   for (;;) {
     loopIterations++;
+    int below = stackDeep[clamp(stackSize - 9, 0, kStackSize)];  // what a pop restores into st7
+    stackDeep[clamp(stackSize - 8, 0, kStackSize)] = st7;        // what a push moves out of st7
     int at = item >> kItemOffsetShift;
     int kind = item & 3;
     vec4 r0 = texelFetch(uTraversal, at), r1 = texelFetch(uTraversal, at + 1);
