@@ -52,8 +52,8 @@ Material fetchMaterial(int index, vec2 uv) {
   m.k = t3.xyz;
   m.emission = t4.rgb;
   int albedoTex = floatBitsToInt(t2.w), roughTex = floatBitsToInt(t3.w);
-  if (albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
-  if (roughTex >= 0) m.roughness = max(m.roughness * sampleTexture(roughTex, uv).r, 1e-3);
+  if (hasFeature(kFeatureTextures) && albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
+  if (hasFeature(kFeatureTextures) && roughTex >= 0) m.roughness = max(m.roughness * sampleTexture(roughTex, uv).r, 1e-3);
   return m;
 }
 
@@ -140,11 +140,12 @@ Path startPath(uint slot) {
   return path;
 }
 
-// A non-finite sample is traced (it counts against the budget) but weighted 0, so one bad path
+// Writes the path's sample and first-hit outputs to its slot, weighted 1 once it has ended. A
+// non-finite sample is traced (it counts against the budget) but weighted 0, so one bad path
 // cannot poison a pixel's sum; the accumulator counts only weighted samples.
-void finishPath(Path path) {
+void writeSample(Path path, bool ended) {
   bool valid = !(any(isnan(path.L)) || any(isinf(path.L)));
-  samples[path.slot] = valid ? vec4(path.L, 1.0) : vec4(0.0);
+  samples[path.slot] = valid ? vec4(path.L, ended ? 1.0 : 0.0) : vec4(0.0);
   aux[path.slot * 2u] = vec4(path.auxAlbedo, path.auxDepth);
   aux[path.slot * 2u + 1u] = vec4(path.auxNormal, intBitsToFloat(path.auxInstance));
 }
@@ -207,7 +208,7 @@ bool extendPath(inout Path path) {
   vec3 wo = -rd;
   bool frontFace = dot(ng, wo) > 0.0;
 
-  if ((instFlags & kInstanceEmissive) != 0 && frontFace) {
+  if (hasFeature(kFeatureEmitters) && (instFlags & kInstanceEmissive) != 0 && frontFace) {
     if (path.specular) {
       path.L += path.beta * m.emission;
     } else {
@@ -304,7 +305,14 @@ void main() {
   // start on neighbouring pixels. Invocations past the end take part in the loop with no slots,
   // so that every lane of the eight sees every iteration and loopIterations stays exact.
   uint next = invocation < push.invocations ? invocation : push.slotCount;
+  // Until its first path starts, a lane writes to the spare slot past the frame's last.
   Path path;
+  path.slot = frame.work.y;
+  path.L = vec3(0.0);
+  path.auxAlbedo = vec3(0.0);
+  path.auxNormal = vec3(0.0);
+  path.auxDepth = kInfinity;
+  path.auxInstance = 0;
   bool alive = false;
   uint cutPaths = 0u;
   for (;;) {
@@ -315,7 +323,7 @@ void main() {
       // not yet started keep the weight 0 the renderer cleared them to.
       if (alive) {
         cutPaths++;
-        finishPath(path);
+        writeSample(path, true);
       }
       if (next < push.slotCount) cutPaths += (push.slotCount - next + push.invocations - 1u) / push.invocations;
       break;
@@ -326,10 +334,11 @@ void main() {
       alive = true;
     }
     if (subgroupAll(!alive)) break;
-    if (alive && !extendPath(path)) {
-      finishPath(path);
-      alive = false;
-    }
+    if (alive && !extendPath(path)) alive = false;
+    // Every lane writes its path's state every iteration, the ended ones included (again): a
+    // store outside any branch keeps lavapipe's per-lane store branches predictable, where one
+    // made only by the lanes whose paths ended mispredicts. A path's last write is its result.
+    writeSample(path, !alive);
   }
   atomicAdd(rayCounts[0], primaryRays);
   atomicAdd(rayCounts[1], bounceRays);

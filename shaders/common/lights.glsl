@@ -36,16 +36,16 @@ vec3 envTexelRadiance(ivec2 t) {
 
 vec3 envRadiance(vec3 d) {
   int type = frame.environment.x;
-  if (type == kEnvConstant) return frame.environmentTint.rgb;
-  if (type == kEnvMap) return envTexelRadiance(envTexel(directionToEnvUv(d)));
+  if (hasFeature(kFeatureEnvConstant) && type == kEnvConstant) return frame.environmentTint.rgb;
+  if (hasFeature(kFeatureEnvMap) && type == kEnvMap) return envTexelRadiance(envTexel(directionToEnvUv(d)));
   return vec3(0.0);
 }
 
 // Density (solid angle) with which sampleEnvironment picks direction d.
 float envPdf(vec3 d) {
   int type = frame.environment.x;
-  if (type == kEnvConstant) return 1.0 / (4.0 * PI);
-  if (type != kEnvMap) return 0.0;
+  if (hasFeature(kFeatureEnvConstant) && type == kEnvConstant) return 1.0 / (4.0 * PI);
+  if (!hasFeature(kFeatureEnvMap) || type != kEnvMap) return 0.0;
   vec2 uv = directionToEnvUv(d);
   ivec2 t = envTexel(uv);
   float norm = texelFetch(uEnvCdf, 0).x;
@@ -71,7 +71,7 @@ int searchCdf(int base, int n, float u) {
 
 vec3 sampleEnvironment(vec2 u, out vec3 radiance, out float pdf) {
   int type = frame.environment.x;
-  if (type == kEnvConstant) {
+  if (!hasFeature(kFeatureEnvMap) || type == kEnvConstant) {
     radiance = frame.environmentTint.rgb;
     pdf = 1.0 / (4.0 * PI);
     return sampleUniformSphere(u);
@@ -109,7 +109,7 @@ LightSample sampleLight(vec3 p, vec3 u) {
   ls.pdf = 0.0;
   ls.delta = false;
   float pe = frame.lightPick.x, pv = frame.lightPick.y;
-  if (u.z < pe) {
+  if (hasFeature(kFeatureEmitters) && u.z < pe) {
     int n = frame.scene.z;
     float scaled = u.x * float(n);
     int i = min(int(scaled), n - 1);
@@ -135,14 +135,14 @@ LightSample sampleLight(vec3 p, vec3 u) {
     ls.pdf = pe * t3.w * d2 / (cosL * t0.w);
     return ls;
   }
-  if (u.z < pe + pv) {
+  if (hasFeature(kFeatureEnvConstant | kFeatureEnvMap) && u.z < pe + pv) {
     float pdf;
     ls.dir = sampleEnvironment(u.xy, ls.radiance, pdf);
     ls.pdf = pv * pdf;
     return ls;
   }
   int n = frame.scene.w;
-  if (n == 0) return ls;
+  if (!hasFeature(kFeatureDeltaLights) || n == 0) return ls;
   int i = min(int(u.x * float(n)), n - 1);
   vec4 a = texelFetch(uDeltaLights, i * kDeltaLightTexels);
   vec4 b = texelFetch(uDeltaLights, i * kDeltaLightTexels + 1);

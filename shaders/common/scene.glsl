@@ -32,6 +32,15 @@ const int kStackSize = 48;
 #endif
 const float kInfinity = 1e30;
 
+// The scene's features (kFeature... in layouts.h). lavapipe runs every branch, taken or not (see
+// traceRay), so code for what the scene lacks would cost every path segment: the renderer
+// compiles a kernel per feature set, and a feature's code sits behind hasFeature, which the
+// compiler folds away.
+#ifndef RETILE_FEATURES
+#define RETILE_FEATURES kFeatureAll
+#endif
+bool hasFeature(int feature) { return (RETILE_FEATURES & feature) != 0; }
+
 // lavapipe (gallivm) runs eight invocations in lock-step and ends every loop of those eight once
 // 65535 loop iterations have run, counted over all loops together, silently: a ray cut off there
 // misses what it should hit. One loop iteration is counted while any of the eight runs it (and,

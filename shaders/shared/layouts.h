@@ -37,6 +37,15 @@ RT_CONST(int, kItemOffsetShift, 4)
 RT_CONST(int, kMaxLeafTriangles, 4)  // render/bvh.h maxLeafSize for mesh BVHs
 RT_CONST(int, kMaxTraversalTexels, 134217728)  // 2^27: items stay positive; also lavapipe's texel-buffer limit
 
+// What a scene has besides geometry and materials (RenderSceneData::features). The renderer
+// compiles the trace kernel without the code for what a scene lacks (see scene.glsl).
+RT_CONST(int, kFeatureTextures, 1)       // some material reads an albedo or roughness texture
+RT_CONST(int, kFeatureEnvConstant, 2)
+RT_CONST(int, kFeatureEnvMap, 4)
+RT_CONST(int, kFeatureEmitters, 8)       // emissive triangles
+RT_CONST(int, kFeatureDeltaLights, 16)   // point, spot and directional lights
+RT_CONST(int, kFeatureAll, 31)
+
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceEmissive, 4)
 

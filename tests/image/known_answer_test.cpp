@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "gpu_support.h"
+#include "retile/edit.h"
 #include "scene/primitives.h"
 #include "test_support.h"
 
@@ -120,6 +121,45 @@ TEST(KnownAnswer, InverseSquareFalloffOfASmallLight) {
   double expectedNear = 100.0 * 0.0025 / (kPi * 1.0);
   EXPECT_NEAR(near, expectedNear, expectedNear * 0.02);
   EXPECT_NEAR(near / far, 4.0, 0.08);
+}
+
+// The renderer compiles the trace kernel for the lights a scene has (kFeature... in layouts.h).
+// Lights and sky brought in and taken out by edits must each light the plane as they should.
+TEST(KnownAnswer, LightsAndSkyAddUpAsEditsBringThemInAndTakeThemOut) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(16, 16);
+  s.camera.position = {0, 0.5f, 0};
+  s.camera.target = {0, 0, 0};
+  s.camera.up = {0, 0, -1};
+  s.camera.verticalFov = radians(2);
+  s.settings.maxBounces = 1;
+  Material m;
+  m.albedo = Vec3{0.5f};
+  NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, m), Mat4::scale({1000, 1, 1000}));
+  r->setScene(s);
+  RenderRequest req;
+  req.samplesPerPixel = 64;
+  req.seed = 1;
+  EXPECT_EQ(meanOver(r->render(req), plane), 0.0) << "no light, no sky";
+
+  Light bulb;
+  bulb.id = s.newId();
+  bulb.position = {0, 1, 0};
+  bulb.intensity = 2.0f;
+  s.lights.push_back(bulb);
+  r->updateScene(s, kUpdateLights);
+  // Straight below a point light of intensity I at height 1: albedo / pi * I.
+  const double fromBulb = 0.5 / kPi * 2.0;
+  EXPECT_NEAR(meanOver(r->render(req), plane), fromBulb, fromBulb * 0.01);
+
+  s.environment.color = Vec3{2.0f};
+  r->updateScene(s, kUpdateEnvironment);
+  // A uniform sky of radiance Le adds albedo * Le.
+  EXPECT_NEAR(meanOver(r->render(req), plane), fromBulb + 1.0, 0.02);
+
+  s.lights.clear();
+  r->updateScene(s, kUpdateLights);
+  EXPECT_NEAR(meanOver(r->render(req), plane), 1.0, 0.02);
 }
 
 TEST(KnownAnswer, EveryMaterialGivesOnlyFiniteSamples) {

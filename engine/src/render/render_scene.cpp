@@ -173,6 +173,16 @@ std::uint64_t RenderSceneData::deviceBytes() const {
          v(textureInfo) + v(texels) + v(emitters) + v(emitterAlias) + v(deltaLights) + v(environmentCdf);
 }
 
+std::uint32_t RenderSceneData::features() const {
+  std::uint32_t f = 0;
+  if (materialTextures) f |= gpu::kFeatureTextures;
+  if (environmentType == gpu::kEnvConstant) f |= gpu::kFeatureEnvConstant;
+  if (environmentType == gpu::kEnvMap) f |= gpu::kFeatureEnvMap;
+  if (!emitters.empty()) f |= gpu::kFeatureEmitters;
+  if (!deltaLights.empty()) f |= gpu::kFeatureDeltaLights;
+  return f;
+}
+
 int RenderSceneBuilder::textureIndex(NodeId id) const {
   auto it = textureIndex_.find(id);
   return it == textureIndex_.end() ? -1 : it->second;
@@ -290,6 +300,7 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
 void RenderSceneBuilder::packMaterials(const Scene& scene) {
   data_.materials.clear();
   data_.materialTypes = 0;
+  data_.materialTextures = false;
   materialIndex_.clear();
   auto pack = [&](const Material& m) {
     Vec3 eta = m.eta, k = m.k;
@@ -308,6 +319,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     // (Jensen et al.'s polynomial fit of the internal diffuse Fresnel reflectance).
     float fdrInt = -1.4399f / (ior * ior) + 0.7099f / ior + 0.6681f + 0.0636f * ior;
     data_.materials.push_back({roughness, ior, std::clamp(m.alpha, 0.0f, 1.0f), std::clamp(fdrInt, 0.0f, 1.0f)});
+    if (textureIndex(m.albedoTexture) >= 0 || textureIndex(m.roughnessTexture) >= 0) data_.materialTextures = true;
     data_.materials.push_back(v4(eta, bitsOf(textureIndex(m.albedoTexture))));
     data_.materials.push_back(v4(k, bitsOf(textureIndex(m.roughnessTexture))));
     data_.materials.push_back(v4(max(m.emission, Vec3{0.0f}), bitsOf(textureIndex(m.alphaTexture))));

@@ -65,6 +65,9 @@ struct RenderSceneData {
   std::uint64_t instancedTriangles = 0;
   bool alphaTested = false;            // some instance needs the cut-out test during traversal
   std::uint32_t materialTypes = 0;     // bit kMat... of each material type present
+  bool materialTextures = false;       // some material reads an albedo or roughness texture
+
+  std::uint32_t features() const;      // kFeature... (layouts.h) of what the arrays hold
 
   std::uint64_t deviceBytes() const;
 };

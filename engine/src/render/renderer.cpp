@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <tuple>
 
 #include "render/render_scene.h"
 #include "retile/log.h"
@@ -60,8 +61,9 @@ std::uint64_t traceInvocations(std::uint64_t slots, double iterationsPerPath, in
 
 struct Renderer::Impl {
   vk::Context ctx;
-  // By (alpha-tested geometry, material types): each scene runs a kernel without the code it lacks.
-  std::map<std::pair<bool, std::uint32_t>, std::unique_ptr<vk::ComputePipeline>> traceVariants;
+  // By (alpha-tested geometry, material types, features): each scene runs a kernel without the
+  // code it lacks.
+  std::map<std::tuple<bool, std::uint32_t, std::uint32_t>, std::unique_ptr<vk::ComputePipeline>> traceVariants;
   vk::ComputePipeline* trace = nullptr;
   std::unique_ptr<vk::ComputePipeline> accumulate;
   RenderSceneBuilder builder;
@@ -144,14 +146,14 @@ struct Renderer::Impl {
       uploadArray(alias, d.emitterAlias, "emitter alias table");
       uploadArray(delta, d.deltaLights, "delta lights");
     }
-    selectTrace(d.alphaTested, d.materialTypes);
+    selectTrace(d.alphaTested, d.materialTypes, d.features());
     bindAll();
   }
 
   // Picks the trace kernel the scene needs, compiling it on first use (about 0.3 s on lavapipe,
   // on the render thread; the SPIR-V is cached on disk).
-  void selectTrace(bool alpha, std::uint32_t materialTypes) {
-    auto& slot = traceVariants[{alpha, materialTypes}];
+  void selectTrace(bool alpha, std::uint32_t materialTypes, std::uint32_t features) {
+    auto& slot = traceVariants[{alpha, materialTypes, features}];
     if (!slot) {
       slot = std::make_unique<vk::ComputePipeline>(
           ctx, "trace.comp",
@@ -162,7 +164,8 @@ struct Renderer::Impl {
                                Binding::Storage, Binding::Storage, Binding::Storage},
           static_cast<std::uint32_t>(sizeof(gpu::TracePush)),
           std::vector<vk::ShaderDefine>{{"RETILE_ALPHA_TEST", alpha ? "1" : "0"},
-                                        {"RETILE_MATERIALS", std::to_string(materialTypes)}});
+                                        {"RETILE_MATERIALS", std::to_string(materialTypes)},
+                                        {"RETILE_FEATURES", std::to_string(features)}});
     }
     trace = slot.get();
   }
@@ -350,7 +353,7 @@ struct Renderer::Impl {
     FrameStats fs;
     if (items.empty()) return fs;
     RETILE_ASSERT(slots < (1ull << 32), cat("a frame of ", slots, " samples"));
-    ensureSampleCapacity(slots);
+    ensureSampleCapacity(slots + 1);  // the trace pass's spare slot (trace.comp)
     VkDeviceSize workBytes = items.size() * sizeof(gpu::WorkItem);
     if (work.size() < workBytes) {
       work = Buffer(ctx, workBytes * 2, kStorageUsage, true, "work items");
