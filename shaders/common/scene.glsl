@@ -183,7 +183,8 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
   int stackSize = 0;
   int stackDeep[kStackSize + 1];  // the last slot takes the spill of a full stack
   int item = frame.scene.x;  // the instance BVH's root
-  vec3 o = origin, d = dir, invD = safeInverse(dir);
+  vec3 invDir = safeInverse(dir);
+  vec3 o = origin, d = dir, invD = invDir;
   int instance = -1;
   int instFlags = 0;
   int instanceSp = -1;  // stack depth on entering the current instance: popping back to it leaves
@@ -249,7 +250,7 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
         // Back from the instance to world space.
         o = origin;
         d = dir;
-        invD = safeInverse(dir);
+        invD = invDir;
         instance = -1;
         instanceSp = -1;
       }
