@@ -21,8 +21,8 @@ layout(set = 0, binding = 9) uniform samplerBuffer uEmitterAlias;
 layout(set = 0, binding = 10) uniform samplerBuffer uDeltaLights;
 layout(set = 0, binding = 11) uniform samplerBuffer uEnvCdf;
 
-// Two levels of BVH; the builder bounds each level's depth.
-const int kStackSize = 48;
+// Traversal stack entries, over both levels of BVH; the builder bounds each level's depth.
+const int kStackSize = 56;
 
 // Alpha-tested geometry needs a texture lookup inside traversal, which costs lavapipe a factor of
 // about three even when no instance uses it, so the renderer compiles it in only for scenes
@@ -139,29 +139,6 @@ vec3 safeInverse(vec3 d) {
               abs(d.z) > eps ? 1.0 / d.z : (d.z >= 0.0 ? 1e30 : -1e30));
 }
 
-// The traversal stack. lavapipe turns each access to a per-invocation array at a varying index
-// into a loop over the eight lanes with a branch per lane on the lane's mask, so the top eight
-// entries live in variables (shifted on push and pop, which is a few vector moves) and only
-// deeper ones go to the array. traceRay touches the array once per iteration outside any branch,
-// whatever the step: it reads the entry a pop would need and writes st7 to the slot a push would
-// fill. The write is harmless when nothing is pushed (that slot is above the top), and with it
-// outside every branch the lanes' masks are all set and the per-lane branches predictable;
-// inside the push branch they were not, and the two accesses took about a quarter of the time.
-// Macros, not functions: an inout array parameter is copied in and out on every call.
-#define STACK_PUSH(v)                                                                              \
-  {                                                                                                \
-    st7 = st6; st6 = st5; st5 = st4; st4 = st3; st3 = st2; st2 = st1; st1 = st0;                  \
-    st0 = (v);                                                                                     \
-    stackSize++;                                                                                   \
-  }
-#define STACK_POP(v)                                                                               \
-  {                                                                                                \
-    v = st0;                                                                                       \
-    st0 = st1; st1 = st2; st2 = st3; st3 = st4; st4 = st5; st5 = st6; st6 = st7;                  \
-    stackSize--;                                                                                   \
-    if (stackSize >= 8) st7 = below;                                                               \
-  }
-
 // Closest hit (anyHit == false) or any opaque hit (anyHit == true, for shadow rays).
 //
 // lavapipe (Mesa 22.3) runs both sides of every branch with lanes masked off: an if skips no
@@ -179,9 +156,18 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
   hit.v = 0.0;
   if (frame.scene.y == 0) return hit;
 
-  int st0 = 0, st1 = 0, st2 = 0, st3 = 0, st4 = 0, st5 = 0, st6 = 0, st7 = 0;
+  // The traversal stack: its top entry in a variable, the ones below it in an array. lavapipe
+  // turns an access to a per-invocation array at a varying index into a loop over the eight
+  // lanes with a branch per lane on the lane's mask. So each iteration reads and writes the
+  // array once, outside any branch, whatever the step: it reads the entry a pop would bring to
+  // the top and writes the top to the slot a push would move it to. That write is harmless when
+  // nothing is pushed (the slot is above the array's part of the stack), and outside every
+  // branch the masks are full and the per-lane branches predictable; inside the push branch
+  // they mispredicted, and the two accesses took a quarter of the time. Keeping the top eight
+  // entries in variables instead cost registers (spilled) and shifts on every push and pop.
+  int top = 0;
   int stackSize = 0;
-  int stackDeep[kStackSize + 1];  // the last slot takes the spill of a full stack
+  int stackBelow[kStackSize];  // entries under the top; the last slot takes the spill of a full stack
   int item = frame.scene.x;  // the instance BVH's root
   vec3 invDir = safeInverse(dir);
   vec3 o = origin, d = dir, invD = invDir;
@@ -191,8 +177,8 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
 
   for (;;) {
     loopIterations++;
-    int below = stackDeep[clamp(stackSize - 9, 0, kStackSize)];  // what a pop restores into st7
-    stackDeep[clamp(stackSize - 8, 0, kStackSize)] = st7;        // what a push moves out of st7
+    int below = stackBelow[clamp(stackSize - 2, 0, kStackSize - 1)];  // the top after a pop
+    stackBelow[clamp(stackSize - 1, 0, kStackSize - 1)] = top;       // where a push moves the top
     int at = item >> kItemOffsetShift;
     int kind = item & 3;
     vec4 r0 = texelFetch(uTraversal, at), r1 = texelFetch(uTraversal, at + 1);
@@ -205,7 +191,10 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
       bool hr = right >= 0 && slabTest(r2.xyz, r3.xyz, o, invD, hit.t, tr);
       if (hl && hr) {
         bool leftFirst = tl <= tr;
-        if (stackSize < kStackSize + 8) STACK_PUSH(leftFirst ? right : left);
+        if (stackSize < kStackSize) {
+          top = leftFirst ? right : left;
+          stackSize++;
+        }
         next = leftFirst ? left : right;
       } else {
         next = hl ? left : (hr ? right : -1);
@@ -255,7 +244,9 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
         instanceSp = -1;
       }
       if (stackSize == 0) break;
-      STACK_POP(next);
+      next = top;
+      top = below;
+      stackSize--;
     }
     item = next;
   }
