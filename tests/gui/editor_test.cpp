@@ -119,6 +119,61 @@ TEST(Editor, CameraNavigationAndDraggingTheSelectionAreSingleUndoSteps) {
   EXPECT_LT(length(undone - before), 1e-5f) << "the whole drag is one undo step";
 }
 
+// Screen-plane dragging moves the object at the depth of its bounds' centre, so a mesh whose
+// transform origin lies far behind its geometry (common in imported files) still follows the
+// cursor; taking the depth of the origin made this one run twice as fast as the cursor.
+TEST(Editor, DraggingAMeshFarFromItsOriginKeepsItUnderTheCursor) {
+  Scene scene = makeDefaultScene();
+  NodeId sphere = objectNamed(scene, "Glossy Sphere");
+  Object* o = scene.object(sphere);
+  ASSERT_NE(o, nullptr);
+  const Camera cam = scene.camera;
+  const Vec3 fwd = normalize(cam.target - cam.position);
+  // Shift the geometry and the origin apart: the sphere stays where it was, its origin moves
+  // four units further from the camera.
+  const float scale = 0.45f;  // the default scene's sphere scale
+  auto shifted = std::make_shared<MeshGeometry>(*scene.mesh(o->mesh)->geometry);
+  for (Vec3& p : shifted->positions) p = p - fwd * (4.0f / scale);
+  scene.mesh(o->mesh)->geometry = shifted;
+  o->transform = Mat4::translate(fwd * 4.0f) * o->transform;
+
+  EditorOptions options;
+  options.initialRenderSize = QSize(96, 54);
+  auto w = std::make_unique<MainWindow>(scene, std::filesystem::path(), options);
+  w->resize(1000, 700);
+  w->show();
+  w->select(sphere);
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 3; }));
+  FrameView* v = w->viewport();
+  auto frame = v->frame();
+  QRectF r = v->imageRect();
+  QPoint on(-1, -1);
+  for (int y = 0; y < frame->height && on.x() < 0; ++y)
+    for (int x = 0; x < frame->width; ++x)
+      if (frame->image->objectId[static_cast<std::size_t>(y * frame->width + x)] == sphere) {
+        on = QPoint(static_cast<int>(r.x() + (x + 0.5) * r.width() / frame->width), static_cast<int>(r.y() + (y + 0.5) * r.height() / frame->height));
+        break;
+      }
+  ASSERT_GE(on.x(), 0) << "the sphere is in view";
+
+  // Horizontal image coordinate (pixels) of the sphere's centre.
+  const Vec3 centre = shifted->bounds().center();
+  auto imageX = [&] {
+    Vec3 p = w->scene().object(sphere)->transform.transformPoint(centre) - cam.position;
+    Vec3 right = normalize(cross(fwd, cam.up));
+    float aspect = static_cast<float>(frame->width) / static_cast<float>(frame->height);
+    float ndc = dot(p, right) / (dot(p, fwd) * std::tan(cam.verticalFov * 0.5f) * aspect);
+    return (ndc + 1.0f) * 0.5f * static_cast<float>(frame->width);
+  };
+  const float before = imageX();
+  QTest::mousePress(v, Qt::LeftButton, Qt::NoModifier, on);
+  for (int i = 1; i <= 4; ++i) QTest::mouseMove(v, on + QPoint(10 * i, 0));
+  QTest::mouseRelease(v, Qt::LeftButton, Qt::NoModifier, on + QPoint(40, 0));
+  const float moved = imageX() - before;
+  const float cursor = 40.0f * static_cast<float>(frame->width) / static_cast<float>(r.width());
+  EXPECT_NEAR(moved, cursor, 0.1f * cursor) << "the sphere moved " << moved << " image pixels for the cursor's " << cursor;
+}
+
 TEST(Editor, OverlaysDrawOverTheImage) {
   auto w = makeWindow();
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
