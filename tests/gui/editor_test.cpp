@@ -76,6 +76,18 @@ TEST(Editor, EditFromThePropertiesReRendersAroundTheObjectAndUndoes) {
   EXPECT_FLOAT_EQ(w->scene().material(material)->roughness, 0.6f);
 }
 
+// A widget point over a pixel of the shown frame whose first hit is `object`; (-1, -1) if none.
+QPoint pointShowing(const FrameView& v, NodeId object) {
+  auto frame = v.frame();
+  QRectF r = v.imageRect();
+  for (int y = 0; y < frame->height; ++y)
+    for (int x = 0; x < frame->width; ++x)
+      if (frame->image->objectId[static_cast<std::size_t>(y * frame->width + x)] == object)
+        return QPoint(static_cast<int>(r.x() + (x + 0.5) * r.width() / frame->width),
+                      static_cast<int>(r.y() + (y + 0.5) * r.height() / frame->height));
+  return QPoint(-1, -1);
+}
+
 TEST(Editor, CameraNavigationAndDraggingTheSelectionAreSingleUndoSteps) {
   auto w = makeWindow();
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
@@ -97,16 +109,7 @@ TEST(Editor, CameraNavigationAndDraggingTheSelectionAreSingleUndoSteps) {
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
   w->select(sphere);
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 3; }));
-  auto frame = v->frame();
-  QRectF r = v->imageRect();
-  // A pixel showing the sphere: search the object ids.
-  QPoint on(-1, -1);
-  for (int y = 0; y < frame->height && on.x() < 0; ++y)
-    for (int x = 0; x < frame->width; ++x)
-      if (frame->image->objectId[static_cast<std::size_t>(y * frame->width + x)] == sphere) {
-        on = QPoint(static_cast<int>(r.x() + (x + 0.5) * r.width() / frame->width), static_cast<int>(r.y() + (y + 0.5) * r.height() / frame->height));
-        break;
-      }
+  QPoint on = pointShowing(*v, sphere);
   ASSERT_GE(on.x(), 0);
   Vec3 before = w->scene().object(sphere)->transform.transformPoint(Vec3{0.0f});
   QTest::mousePress(v, Qt::LeftButton, Qt::NoModifier, on);
@@ -147,13 +150,7 @@ TEST(Editor, DraggingAMeshFarFromItsOriginKeepsItUnderTheCursor) {
   FrameView* v = w->viewport();
   auto frame = v->frame();
   QRectF r = v->imageRect();
-  QPoint on(-1, -1);
-  for (int y = 0; y < frame->height && on.x() < 0; ++y)
-    for (int x = 0; x < frame->width; ++x)
-      if (frame->image->objectId[static_cast<std::size_t>(y * frame->width + x)] == sphere) {
-        on = QPoint(static_cast<int>(r.x() + (x + 0.5) * r.width() / frame->width), static_cast<int>(r.y() + (y + 0.5) * r.height() / frame->height));
-        break;
-      }
+  QPoint on = pointShowing(*v, sphere);
   ASSERT_GE(on.x(), 0) << "the sphere is in view";
 
   // Horizontal image coordinate (pixels) of the sphere's centre.
