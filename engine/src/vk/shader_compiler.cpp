@@ -61,12 +61,27 @@ fs::path cacheDirectory() {
   return {};
 }
 
+// What besides the sources and defines decides the SPIR-V: the glslang release, the GLSL version
+// and targets, and the code generator's options. All of it goes into the cache key, so that a
+// change to any of it is not answered with SPIR-V made the old way.
+constexpr int kGlslVersion = 460;
+constexpr glslang::EShTargetClientVersion kVulkanTarget = glslang::EShTargetVulkan_1_2;
+constexpr glslang::EShTargetLanguageVersion kSpirvTarget = glslang::EShTargetSpv_1_5;
+constexpr bool kOptimize = true;
+
+std::string compileConfiguration() {
+  return cat("glslang ", GLSLANG_VERSION_MAJOR, ".", GLSLANG_VERSION_MINOR, ".", GLSLANG_VERSION_PATCH, " glsl ",
+             kGlslVersion, " vulkan ", static_cast<int>(kVulkanTarget), " spirv ", static_cast<int>(kSpirvTarget),
+             kOptimize ? " optimized" : " unoptimized");
+}
+
 }  // namespace
 
 std::vector<std::uint32_t> compileComputeShader(const std::string& entry, const std::vector<ShaderDefine>& defines) {
   std::string preamble;
   for (const auto& d : defines) preamble += cat("#define ", d.name, " ", d.value, "\n");
-  std::uint64_t key = fnv1a64(preamble, fnv1a64(entry, sourcesHash()));
+  static const std::string configuration = compileConfiguration();
+  std::uint64_t key = fnv1a64(configuration, fnv1a64(preamble, fnv1a64(entry, sourcesHash())));
   fs::path dir = cacheDirectory();
   fs::path cached = dir.empty() ? fs::path() : dir / cat(fs::path(entry).stem().string(), "-", std::hex, key, ".spv");
 
@@ -98,17 +113,17 @@ std::vector<std::uint32_t> compileComputeShader(const std::string& entry, const 
     shader.setStringsWithLengthsAndNames(texts, nullptr, names, 1);
     shader.setPreamble(preamble.c_str());
     shader.setEnvInput(glslang::EShSourceGlsl, EShLangCompute, glslang::EShClientVulkan, 100);
-    shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_2);
-    shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_5);
+    shader.setEnvClient(glslang::EShClientVulkan, kVulkanTarget);
+    shader.setEnvTarget(glslang::EShTargetSpv, kSpirvTarget);
     EmbeddedIncluder includer;
     auto messages = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
-    if (!shader.parse(GetDefaultResources(), 460, false, messages, includer))
+    if (!shader.parse(GetDefaultResources(), kGlslVersion, false, messages, includer))
       throw Error(cat("compiling shader '", entry, "':\n", shader.getInfoLog()));
     glslang::TProgram program;
     program.addShader(&shader);
     if (!program.link(messages)) throw Error(cat("linking shader '", entry, "':\n", program.getInfoLog()));
     glslang::SpvOptions options;
-    options.disableOptimizer = false;
+    options.disableOptimizer = !kOptimize;
     glslang::GlslangToSpv(*program.getIntermediate(EShLangCompute), spirv, &options);
   }
 
