@@ -126,9 +126,14 @@ bool alphaPasses(int instance, int prim, float u, float v, float rayRandom) {
 bool slabTest(vec3 bmin, vec3 bmax, vec3 o, vec3 invD, float tMax, out float tNear) {
   vec3 t0 = (bmin - o) * invD;
   vec3 t1 = (bmax - o) * invD;
-  vec3 lo = min(t0, t1), hi = max(t0, t1);
-  tNear = max(max(lo.x, lo.y), max(lo.z, 0.0));
-  float tFar = min(min(hi.x, hi.y), min(hi.z, tMax));
+  // Selects rather than min and max: lavapipe gives those NaN semantics at three instructions
+  // each, and no NaN reaches here (safeInverse keeps invD finite).
+  bvec3 swap = lessThan(t1, t0);
+  vec3 lo = mix(t0, t1, swap), hi = mix(t1, t0, swap);
+  float a = lo.x > lo.y ? lo.x : lo.y, b = lo.z > 0.0 ? lo.z : 0.0;
+  tNear = a > b ? a : b;
+  float c = hi.x < hi.y ? hi.x : hi.y, e = hi.z < tMax ? hi.z : tMax;
+  float tFar = c < e ? c : e;
   return tNear <= tFar;
 }
 
