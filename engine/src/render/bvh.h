@@ -1,12 +1,13 @@
 // Bounding volume hierarchies on the CPU, packed for the GPU. Pure computation: no Vulkan, any
 // thread, testable without a device.
 //
-// GPU node layout (four RGBA32F texels, 64 bytes): each node stores the boxes of both children,
-// so one fetch decides which children a ray enters and in which order.
-//   texel 0: left.min.xyz,  left index        texel 2: right.min.xyz, right index
-//   texel 1: left.max.xyz,  left count        texel 3: right.max.xyz, right count
+// Node layout of the builder's output (64 bytes): each node stores the boxes of both children,
+// so one visit decides which children a ray enters and in which order.
+//   lmin left | lmax leftCount | rmin right | rmax rightCount
 // count > 0: a leaf of `count` primitives starting at `index` (in the packed primitive order);
 // count == 0: an inner node at `index`; count < 0: an empty slot (its box never hits).
+// render/render_scene.cpp packs these nodes into the traversal buffer the shader reads, with the
+// children as items (shaders/shared/layouts.h).
 #pragma once
 
 #include <cstdint>

@@ -54,8 +54,8 @@ std::vector<vec4> aliasTable(const std::vector<float>& weights) {
 // The item naming `count` records of `kind` at texel `offset` of the traversal buffer (layouts.h).
 std::int32_t traversalItem(std::int64_t offset, int kind, std::int32_t count) {
   if (offset + 4 > gpu::kMaxTraversalTexels)
-    throw Error(cat("the scene needs more than ", gpu::kMaxTraversalTexels / 1048576,
-                    " M texels of BVH and triangle data, the most one buffer can hold; split it into fewer triangles"));
+    throw Error(cat("the scene's triangles and BVHs need more than ", gpu::kMaxTraversalTexels / 1048576,
+                    " M texels (about 27 M triangles), more than the renderer's one traversal buffer holds"));
   return static_cast<std::int32_t>((offset << gpu::kItemOffsetShift) | ((count - 1) << 2) | kind);
 }
 
