@@ -69,6 +69,7 @@ int benchThroughput(const std::vector<std::string>& argv) {
     sum.shadowRays += s.shadowRays;
     sum.seconds += s.seconds;
     sum.maxLoopIterations = std::max(sum.maxLoopIterations, s.maxLoopIterations);
+    sum.maxSegmentIterations = std::max(sum.maxSegmentIterations, s.maxSegmentIterations);
     sum.cutPaths += s.cutPaths;
     sum.loopIterations += s.loopIterations;
     sum.pathsPerInvocation = s.pathsPerInvocation;
@@ -91,8 +92,9 @@ int benchThroughput(const std::vector<std::string>& argv) {
   std::printf("scene upload   %.3f s (BVH bottom level %.3f s, top level %.4f s)\n", setup, renderer.lastBlasSeconds(),
               renderer.lastTlasSeconds());
   std::printf("loop iterations %u at most in one invocation (paths stop at %u; lavapipe's limit is near 32767); "
-              "%llu paths cut short\n",
-              sum.maxLoopIterations, kTraceLoopBudget, static_cast<unsigned long long>(sum.cutPaths));
+              "%llu paths cut short; %u at most in one path segment\n",
+              sum.maxLoopIterations, kTraceLoopBudget, static_cast<unsigned long long>(sum.cutPaths),
+              sum.maxSegmentIterations);
   std::printf("paths          %.1f loop iterations each, %.0f per invocation (last frame)\n",
               static_cast<double>(sum.loopIterations) / static_cast<double>(std::max<std::uint64_t>(sum.samples, 1)),
               sum.pathsPerInvocation);

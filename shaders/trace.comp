@@ -16,14 +16,16 @@ layout(set = 0, binding = 1, std430) readonly buffer Work { WorkItem items[]; };
 layout(set = 0, binding = 12, std430) writeonly buffer Samples { vec4 samples[]; };
 layout(set = 0, binding = 13, std430) writeonly buffer Aux { vec4 aux[]; };
 // primary, bounce, shadow rays; the most loop iterations of one invocation; paths cut short;
-// loop iterations of all invocations, in kLoopIterationUnit.
+// loop iterations of all invocations, in kLoopIterationUnit; the most of one path segment.
 layout(set = 0, binding = 14, std430) buffer Stats { uint rayCounts[kStatsCount]; };
 
 // kLoopBudget (layouts.h): paths stop before the eight lock-stepped invocations could reach
 // lavapipe's loop limit (see scene.glsl). That limit is 65535 of lavapipe's own counts, and it
 // counts each of our iterations twice (measured: an invocation given 20736 paths was stopped by
 // lavapipe when loopIterations read 32659). One more segment of the eight paths, with their
-// shadow rays, costs well under 2500 of our iterations in any scene seen.
+// shadow rays, cost at most 465 of our iterations in the scenes measured (the living room;
+// `retile bench throughput` prints it); should a scene's segments be longer, the paths stop
+// earlier, when twice the longest segment so far would pass kLoopLimit.
 
 // What the tracer sees of the selected object, per tile (the indirection-aware policy).
 layout(set = 0, binding = 15, std430) buffer Selection { uint selectionCounts[]; };
@@ -251,6 +253,10 @@ bool extendPath(inout Path path) {
   if (!isDeltaMaterial(m) && (frame.lightPick.x + frame.lightPick.y + frame.lightPick.z) > 0.0) {
     vec3 lu = vec3(rand(path.rng), rand(path.rng), rand(path.rng));
     LightSample ls = sampleLight(pos, lu);
+    // Only some of these lanes ran the sky map's search loops, and only some trace a shadow ray:
+    // all of them take the count here, or a lane that searched but traces no shadow ray would
+    // carry iterations the shadow ray's lanes never see.
+    syncLoopIterations();
     if (ls.pdf > 0.0 && maxComponent(ls.radiance) > 0.0) {
       float sideL = dot(ls.dir, ngs);
       bool sameSide = sideL > 0.0;
@@ -315,10 +321,11 @@ void main() {
   path.auxInstance = 0;
   bool alive = false;
   uint cutPaths = 0u;
+  uint maxSegment = 0u;
   for (;;) {
     syncLoopIterations();
     loopIterations++;
-    if (loopIterations > kLoopBudget) {
+    if (loopIterations > kLoopBudget || loopIterations + 2u * maxSegment > kLoopLimit) {
       // Out of loop budget (the same decision in every lane): paths end as they stand, and slots
       // not yet started keep the weight 0 the renderer cleared them to.
       if (alive) {
@@ -333,8 +340,14 @@ void main() {
       next += push.invocations;
       alive = true;
     }
+    // Only the lanes that started a path ran findItem's loop; every lane takes its count here,
+    // before the extension ray's loop, which the others may run longest.
+    syncLoopIterations();
     if (subgroupAll(!alive)) break;
+    uint segmentStart = loopIterations;
     if (alive && !extendPath(path)) alive = false;
+    syncLoopIterations();
+    maxSegment = max(maxSegment, loopIterations - segmentStart);
     // Every lane writes its path's state every iteration, the ended ones included (again): a
     // store outside any branch keeps lavapipe's per-lane store branches predictable, where one
     // made only by the lanes whose paths ended mispredicts. A path's last write is its result.
@@ -346,4 +359,5 @@ void main() {
   atomicMax(rayCounts[3], loopIterations);
   if (invocation < push.invocations) atomicAdd(rayCounts[5], (loopIterations + kLoopIterationUnit / 2u) / kLoopIterationUnit);
   if (cutPaths > 0u) atomicAdd(rayCounts[4], cutPaths);
+  atomicMax(rayCounts[6], maxSegment);
 }

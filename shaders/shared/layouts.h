@@ -76,6 +76,9 @@ RT_CONST(int, kTraceWorkgroup, 64)
 RT_CONST(int, kStatsCount, 8)  // counters the trace pass writes (see trace.comp)
 // The trace pass stops its paths once its loop-iteration count passes this (see trace.comp).
 RT_CONST(uint, kLoopBudget, 30000u)
+// Below lavapipe's limit (it stopped an invocation when the count read 32659): paths also stop
+// when twice the longest segment so far would not fit under this.
+RT_CONST(uint, kLoopLimit, 32000u)
 RT_CONST(uint, kLoopIterationUnit, 16u)  // the loop-iteration sum counts in these units, so 32 bits suffice
 RT_CONST(int, kAccumulateWorkgroup, 64)
 RT_CONST(int, kMaxWorkItems, 65536)

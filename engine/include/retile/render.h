@@ -63,6 +63,9 @@ struct FrameStats {
   std::uint32_t maxLoopIterations = 0;  // the most any one invocation counted (exact for its eight)
   std::uint64_t cutPaths = 0;           // paths ended early, and slots never started, to stay under it
   std::uint64_t loopIterations = 0;     // over all invocations, to the nearest 16 per invocation
+  // The most one path segment (a ray, its shading and shadow ray, for the eight) counted: paths
+  // stop when the count passes kTraceLoopBudget, so this must stay below the ~2700 left to the limit.
+  std::uint32_t maxSegmentIterations = 0;
   double pathsPerInvocation = 0;        // each invocation traces this many paths one after another
 };
 

@@ -394,6 +394,7 @@ struct Renderer::Impl {
     fs.shadowRays = counts[2];
     fs.maxLoopIterations = counts[3];
     fs.cutPaths = counts[4];
+    fs.maxSegmentIterations = counts[6];
     fs.loopIterations = static_cast<std::uint64_t>(counts[5]) * gpu::kLoopIterationUnit;
     fs.pathsPerInvocation = static_cast<double>(slots) / static_cast<double>(invocations);
     if (slots > 0) iterationsPerPath = static_cast<double>(fs.loopIterations) / static_cast<double>(slots);
