@@ -21,10 +21,10 @@ layout(set = 0, binding = 9) uniform samplerBuffer uEmitterAlias;
 layout(set = 0, binding = 10) uniform samplerBuffer uDeltaLights;
 layout(set = 0, binding = 11) uniform samplerBuffer uEnvCdf;
 
-// Traversal stack entries, over both levels of BVH. The builder keeps a level's depth under 40
-// plus log2 of its leaves (SAH, then median splits past depth 40): under 64 for anything the
-// traversal buffer can hold, so two levels never need more than 128. The array's size costs
-// memory only; each iteration touches one entry.
+// Traversal stack entries, over both levels of BVH. The builder keeps a level's depth within 40
+// plus log2 of its primitives (SAH, then median splits past depth 40): at most 65 levels, so 64
+// entries, for the 27 M triangles the traversal buffer can hold, and 128 for two levels. The
+// array's size costs memory only; each iteration touches one entry.
 const int kStackSize = 128;
 
 // Alpha-tested geometry needs a texture lookup inside traversal, which costs lavapipe a factor of
