@@ -170,10 +170,11 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
   // lanes with a branch per lane on the lane's mask. So each iteration reads and writes the
   // array once, outside any branch, whatever the step: it reads the entry a pop would bring to
   // the top and writes the top to the slot a push would move it to. That write is harmless when
-  // nothing is pushed (the slot is above the array's part of the stack), and outside every
-  // branch the masks are full and the per-lane branches predictable; inside the push branch
-  // they mispredicted, and the two accesses took a quarter of the time. Keeping the top eight
-  // entries in variables instead cost registers (spilled) and shifts on every push and pop.
+  // nothing is pushed (the slot is above the array's part of the stack). Outside every branch a
+  // lane's mask changes only when its query ends, so the per-lane branches predict well; inside
+  // the push branch they mispredicted, and the two accesses took a quarter of the time. Keeping
+  // the top eight entries in variables instead cost registers (spilled) and shifts on every push
+  // and pop.
   int top = 0;
   int stackSize = 0;
   int stackBelow[kStackSize];  // entries under the top; the last slot takes the spill of a full stack
