@@ -99,9 +99,8 @@ struct Path {
   int depth;
   int selBase;
   vec3 auxAlbedo, auxNormal;
-  float auxDepth;
+  float auxDepth;  // kInfinity until the first hit that reflects
   int auxInstance;
-  bool auxDone;
 };
 
 uint primaryRays = 0u, bounceRays = 0u, shadowRays = 0u;
@@ -138,7 +137,6 @@ Path startPath(uint slot) {
   path.auxNormal = vec3(0.0);
   path.auxDepth = kInfinity;
   path.auxInstance = 0;
-  path.auxDone = false;
   return path;
 }
 
@@ -222,8 +220,7 @@ bool extendPath(inout Path path) {
 
   if (isMat(m.type, kMatNull)) return false;  // an emitter that does not reflect: the path ends here
 
-  if (!path.auxDone) {
-    path.auxDone = true;
+  if (path.auxDepth >= kInfinity) {
     path.auxAlbedo = m.albedo;
     path.auxNormal = frontFace ? ns : -ns;
     path.auxDepth = length(pos - frame.cameraPosition.xyz);
@@ -322,8 +319,9 @@ void main() {
   bool alive = false;
   uint cutPaths = 0u;
   uint maxSegment = 0u;
+  // Every lane's count is the eight's here: the last synchronisation of an iteration (after the
+  // segment) is also the first of the next.
   for (;;) {
-    syncLoopIterations();
     loopIterations++;
     if (loopIterations > kLoopBudget || loopIterations + 2u * maxSegment > kLoopLimit) {
       // Out of loop budget (the same decision in every lane): paths end as they stand, and slots

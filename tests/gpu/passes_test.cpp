@@ -339,6 +339,28 @@ TEST(TracePass, PathsPerInvocationDoNotChangeAnySample) {
   EXPECT_EQ(a.normal, b.normal);
 }
 
+// Pixels of `cut` (a frame whose invocations ran out of loop budget) that were traced, that were
+// not (no samples), and that were traced but differ from `reference` in colour.
+struct TracedComparison {
+  int traced = 0, untraced = 0, differing = 0;
+};
+TracedComparison compareTraced(const RenderImage& reference, const RenderImage& cut) {
+  TracedComparison c;
+  for (std::size_t i = 0; i < cut.sampleCount.size(); ++i) {
+    if (cut.sampleCount[i] == 0.0f) {
+      ++c.untraced;
+      continue;
+    }
+    ++c.traced;
+    for (std::size_t k = 0; k < 3; ++k)
+      if (reference.color[i * 3 + k] != cut.color[i * 3 + k]) {
+        ++c.differing;
+        break;
+      }
+  }
+  return c;
+}
+
 // lavapipe silently ends the loops of eight lock-stepped invocations after 65535 iterations.
 // One invocation given every path of the frame must stop itself first: the paths it finished are
 // exactly right, the rest are weighted 0, and it says how many it cut.
@@ -356,19 +378,7 @@ TEST(TracePass, AnInvocationOutOfLoopBudgetStopsCleanly) {
   RenderImage a = traceWithPaths(*r, w, h, 1, &ref);
   ASSERT_GT(all.cutPaths, 0u) << "the frame should need more than lavapipe's limit in one invocation";
   EXPECT_LE(all.maxLoopIterations, 65535u);
-  int traced = 0, untraced = 0, differing = 0;
-  for (int i = 0; i < n; ++i) {
-    if (b.sampleCount[static_cast<std::size_t>(i)] == 0.0f) {
-      ++untraced;
-      continue;
-    }
-    ++traced;
-    for (int c = 0; c < 3; ++c)
-      if (a.color[static_cast<std::size_t>(i * 3 + c)] != b.color[static_cast<std::size_t>(i * 3 + c)]) {
-        ++differing;
-        break;
-      }
-  }
+  auto [traced, untraced, differing] = compareTraced(a, b);
   EXPECT_GT(traced, 100);
   EXPECT_GT(untraced, 0);
   // Cut: the slots never started, and the path in flight (if any) when the budget ran out, which
@@ -402,19 +412,10 @@ TEST(TracePass, EightLanesOutOfLoopBudgetOverManyTilesStopCleanly) {
   RenderImage b = trace(n / 8, 0, &all);
   RenderImage a = trace(1, 0, &ref);
   ASSERT_GT(all.cutPaths, 0u) << "the frame should need more than lavapipe's limit in one subgroup";
-  int traced = 0, differing = 0;
-  for (int i = 0; i < n; ++i) {
-    if (b.sampleCount[static_cast<std::size_t>(i)] == 0.0f) continue;
-    ++traced;
-    for (int c = 0; c < 3; ++c)
-      if (a.color[static_cast<std::size_t>(i * 3 + c)] != b.color[static_cast<std::size_t>(i * 3 + c)]) {
-        ++differing;
-        break;
-      }
-  }
-  EXPECT_GT(traced, 800);
+  TracedComparison c = compareTraced(a, b);
+  EXPECT_GT(c.traced, 800);
   // At most the eight paths in flight when the budget ran out differ; every other path is exact.
-  EXPECT_LE(differing, 8) << differing << " of " << traced << " traced pixels differ from the reference";
+  EXPECT_LE(c.differing, 8) << c.differing << " of " << c.traced << " traced pixels differ from the reference";
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 #include "main_window.h"
 #include "node_graph.h"
 #include "retile/io.h"
+#include "retile/session.h"
 #include "test_support.h"
 
 namespace retile::ui {
@@ -156,11 +157,8 @@ TEST(Editor, DraggingAMeshFarFromItsOriginKeepsItUnderTheCursor) {
   // Horizontal image coordinate (pixels) of the sphere's centre.
   const Vec3 centre = shifted->bounds().center();
   auto imageX = [&] {
-    Vec3 p = w->scene().object(sphere)->transform.transformPoint(centre) - cam.position;
-    Vec3 right = normalize(cross(fwd, cam.up));
-    float aspect = static_cast<float>(frame->width) / static_cast<float>(frame->height);
-    float ndc = dot(p, right) / (dot(p, fwd) * std::tan(cam.verticalFov * 0.5f) * aspect);
-    return (ndc + 1.0f) * 0.5f * static_cast<float>(frame->width);
+    auto px = projectToImage(cam, frame->width, frame->height, w->scene().object(sphere)->transform.transformPoint(centre));
+    return px ? px->x : -1e9f;
   };
   const float before = imageX();
   QTest::mousePress(v, Qt::LeftButton, Qt::NoModifier, on);

@@ -384,7 +384,7 @@ void RenderSceneBuilder::packInstances(const Scene& scene) {
       data_.topTraversal.push_back(data_.instances.back());
     }
     data_.topTraversal.push_back(ints(c.mesh->rootItem, instance, flags, 0));
-    data_.instances.push_back(ints(c.mesh->rootItem, static_cast<std::int32_t>(c.mesh->triOffset),
+    data_.instances.push_back(ints(0, static_cast<std::int32_t>(c.mesh->triOffset),
                                    materialIndex(c.object->material), -1));
     data_.instances.push_back(ints(instance + 1, flags, 0, 0));
     data_.instanceObject.push_back(c.object->id);
