@@ -51,7 +51,7 @@ bool hasFeature(int feature) { return (RETILE_FEATURES & feature) != 0; }
 // invocation keeps that count in loopIterations: it counts its own iterations and, after every
 // loop, takes the maximum over the lanes running with it. That maximum is exact for our loops: a
 // loop's lanes run a prefix of its iterations, no loop nests inside another one except the path
-// loop of trace.comp (which synchronises at its top), and every lane that ran a loop takes part
+// loop of trace.comp (which synchronises after each segment), and every lane that ran a loop takes part
 // in the next synchronisation (trace.comp synchronises where lanes part ways: after starting
 // paths, which only some lanes do, and after the light sample). A path stops before the count can reach the
 // limit (kLoopBudget in trace.comp); the renderer reports both. Real GPUs have no such limit.
