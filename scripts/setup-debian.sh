@@ -3,15 +3,20 @@
 # already present are skipped, so running it twice costs one dpkg query.
 set -euo pipefail
 
+# zlib1g-dev: Debian's Assimp CMake package names libz.so in its link interface, but libassimp-dev
+# does not depend on zlib1g-dev, so a fresh machine fails at the link step without it.
+# locales: the locale sources that localedef compiles, for the tests that run under a comma-decimal
+# locale (de_DE) as an artist in much of Europe does.
 packages=(
   build-essential cmake ninja-build pkg-config git
   qt6-base-dev qt6-base-dev-tools qt6-charts-dev libqt6opengl6-dev libgl-dev
   libvulkan-dev vulkan-tools mesa-vulkan-drivers vulkan-validationlayers
   glslang-dev glslang-tools spirv-tools
-  libassimp-dev
+  libassimp-dev zlib1g-dev
   libopenimageio-dev openimageio-tools
   libopencolorio-dev
   libgtest-dev libgmock-dev
+  locales
   xvfb xauth libxkbcommon-x11-0 libxcb-cursor0 libxcb-icccm4 libxcb-image0 libxcb-keysyms1
   libxcb-randr0 libxcb-render-util0 libxcb-shape0 libxcb-xinerama0 libxcb-xkb1 fonts-dejavu-core
 )
