@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <filesystem>
 #include <cstdio>
 #include <iostream>
 
+#include "core/numbers.h"
 #include "retile/log.h"
 
 namespace retile::cli {
@@ -57,6 +59,13 @@ Result<int> parseInt(const std::string& option, const std::string& text, int lo,
     return Result<int>::failure(cat(option, ": '", text, "' is not a whole number"));
   if (v < lo || v > hi) return Result<int>::failure(cat(option, ": ", v, " is outside ", lo, "..", hi));
   return v;
+}
+
+Result<double> parseNumber(const std::string& option, const std::string& text, double lo, double hi) {
+  auto v = numbers::toDouble(text);
+  if (!v || !std::isfinite(*v)) return Result<double>::failure(cat(option, ": '", text, "' is not a number"));
+  if (*v < lo || *v > hi) return Result<double>::failure(cat(option, ": ", text, " is outside ", lo, "..", hi));
+  return *v;
 }
 
 Result<bool> parseSize(const std::string& text, int* width, int* height) {

@@ -20,6 +20,7 @@ struct Args {
 Result<Args> parseArgs(const std::vector<std::string>& argv, const std::vector<std::string>& known,
                        const std::vector<std::string>& flags = {});
 Result<int> parseInt(const std::string& option, const std::string& text, int lo, int hi);
+Result<double> parseNumber(const std::string& option, const std::string& text, double lo, double hi);
 Result<bool> parseSize(const std::string& text, int* width, int* height);
 
 // "default" is the built-in scene; anything else a file any importer reads.

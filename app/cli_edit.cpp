@@ -77,7 +77,11 @@ int runEdit(const std::vector<std::string>& argv) {
       !intOpt("--reference", 1, 1 << 20, &reference) || !intOpt("--block", 1, 64, &block))
     return 2;
   double threshold = 0.01;
-  if (args->has("--threshold")) threshold = std::atof(args->get("--threshold").c_str());
+  if (args->has("--threshold")) {
+    auto v = parseNumber("--threshold", args->get("--threshold"), 0, 1e30);
+    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
+    threshold = v.value();
+  }
   method.smooth = args->has("--smooth");
   if (std::string bad = validateMethodSettings(method); !bad.empty()) return usage(bad), 2;
 

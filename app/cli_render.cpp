@@ -36,12 +36,9 @@ int runRender(const std::vector<std::string>& argv) {
   DisplaySettings display;
   display.view = args->get("--view", "Standard");
   if (args->has("--exposure")) {
-    try {
-      display.exposure = std::stof(args->get("--exposure"));
-    } catch (const std::exception&) {
-      std::fprintf(stderr, "error: --exposure: '%s' is not a number\n", args->get("--exposure").c_str());
-      return 2;
-    }
+    auto v = parseNumber("--exposure", args->get("--exposure"), -64, 64);
+    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
+    display.exposure = static_cast<float>(v.value());
   }
   std::filesystem::path out = args->get("--out", "retile-render.png");
   std::string ext = out.extension().string();

@@ -227,6 +227,30 @@ TEST(Editor, SaveOpenRoundTripAndABrokenFileKeepsTheScene) {
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 1; })) << "and keeps rendering";
 }
 
+TEST(Editor, UnderACommaDecimalLocaleOpensTheSharedSceneAndSavesWhatReadsBackUnderC) {
+  RETILE_SHARED_OR_SKIP(box, "scenes/cornell-box/scene.json");
+  QTemporaryDir dir;
+  std::filesystem::path file = (dir.path() + "/box.retile").toStdString();
+  std::string shown;
+  {
+    retile::test::ScopedCommaLocale comma;  // what QApplication sets up under LC_ALL=de_DE.UTF-8
+    ASSERT_TRUE(comma.active()) << comma.error();
+    auto w = makeWindow();
+    ASSERT_TRUE(w->openFile(box)) << w->lastError().toStdString();
+    ASSERT_FALSE(w->scene().objects.empty());
+    Object o = w->scene().objects.front();
+    Object moved = o;
+    moved.transform.m[0][3] += 0.125f;
+    w->edit(SetObject{o}, SetObject{moved}, "move");
+    ASSERT_TRUE(w->saveTo(file)) << w->lastError().toStdString();
+    shown = nativeSceneToString(w->scene());
+    ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 1; })) << "and renders";
+  }
+  auto back = loadNativeScene(file);
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_TRUE(nativeSceneToString(back->scene) == shown) << "the scene read under C is the one the editor saved";
+}
+
 TEST(Editor, AutosaveRotatesAndACleanCloseLeavesNothingToRecover) {
   auto w = makeWindow();
   EXPECT_FALSE(w->autosave()) << "nothing changed yet";

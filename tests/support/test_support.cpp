@@ -1,7 +1,9 @@
 #include "test_support.h"
 
 #include <atomic>
+#include <clocale>
 #include <cmath>
+#include <cstdlib>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
@@ -28,6 +30,41 @@ fs::path tempDir() {
   fs::create_directories(p);
   return p;
 }
+
+fs::path commaLocaleDir(std::string* error) {
+  fs::path dir = fs::temp_directory_path() / "retile-test-locales";
+  if (fs::exists(dir / "de_DE.UTF-8" / "LC_NUMERIC")) return dir;
+  // Compiled beside the final place and renamed, so a concurrent suite never sees half a locale.
+  fs::path staging = fs::temp_directory_path() / ("retile-test-locales-" + std::to_string(::getpid()));
+  fs::remove_all(staging);
+  fs::create_directories(staging);
+  std::string cmd = "localedef -i de_DE -f UTF-8 '" + (staging / "de_DE.UTF-8").string() + "' >/dev/null 2>&1";
+  int rc = std::system(cmd.c_str());
+  if (!fs::exists(staging / "de_DE.UTF-8" / "LC_NUMERIC")) {
+    *error = "localedef could not make de_DE.UTF-8 (exit " + std::to_string(rc) +
+             "); install the 'locales' package (scripts/setup-debian.sh does)";
+    fs::remove_all(staging);
+    return {};
+  }
+  std::error_code ec;
+  fs::rename(staging, dir, ec);
+  fs::remove_all(staging);  // when another suite won the race
+  return dir;
+}
+
+ScopedCommaLocale::ScopedCommaLocale() {
+  previous_ = std::setlocale(LC_ALL, nullptr);
+  fs::path dir = commaLocaleDir(&error_);
+  if (dir.empty()) return;
+  ::setenv("LOCPATH", dir.c_str(), 1);
+  if (!std::setlocale(LC_ALL, "de_DE.UTF-8")) {
+    error_ = "setlocale(LC_ALL, \"de_DE.UTF-8\") failed with LOCPATH=" + dir.string();
+    return;
+  }
+  if (std::strtod("0,5", nullptr) != 0.5) error_ = "de_DE.UTF-8 is active but strtod does not read \"0,5\" as 0.5";
+}
+
+ScopedCommaLocale::~ScopedCommaLocale() { std::setlocale(LC_ALL, previous_.c_str()); }
 
 NodeId addMaterial(Scene& s, Material m) {
   m.id = s.newId();

@@ -22,6 +22,28 @@ std::filesystem::path sharedPath(const std::string& relative);
 
 std::filesystem::path tempDir();  // a fresh directory per test
 
+// A comma-decimal locale (de_DE.UTF-8), compiled once by localedef into a folder of its own, so
+// the tests need neither root nor a locale the machine happens to have. Point LOCPATH at the
+// folder and set LC_ALL=de_DE.UTF-8 to run a child under it. Empty, with `error` set, when
+// localedef is missing (scripts/setup-debian.sh installs the `locales` package it needs).
+std::filesystem::path commaLocaleDir(std::string* error);
+
+// Switches this process's C locale to de_DE.UTF-8 for the object's lifetime, as Qt does at start-up
+// from the environment, and checks that the C library now reads "0,5" as a half.
+class ScopedCommaLocale {
+ public:
+  ScopedCommaLocale();
+  ~ScopedCommaLocale();
+  ScopedCommaLocale(const ScopedCommaLocale&) = delete;
+  ScopedCommaLocale& operator=(const ScopedCommaLocale&) = delete;
+  bool active() const { return error_.empty(); }
+  const std::string& error() const { return error_; }
+
+ private:
+  std::string previous_;
+  std::string error_;
+};
+
 // Scene building blocks.
 NodeId addMaterial(Scene& s, Material m);
 NodeId addMeshObject(Scene& s, const std::string& name, std::shared_ptr<const MeshGeometry> g, NodeId material,

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "core/numbers.h"
 #include "retile/log.h"
 
 namespace retile::json {
@@ -204,13 +205,13 @@ class Parser {
       if (pos_ < s_.size() && (s_[pos_] == '+' || s_[pos_] == '-')) ++pos_;
       if (digits() == 0) return setError("malformed number: no exponent digits");
     }
-    std::string text(s_.substr(start, pos_ - start));
-    char* end = nullptr;
-    double d = std::strtod(text.c_str(), &end);
-    if (end != text.c_str() + text.size()) return setError("malformed number");
+    std::string_view text = s_.substr(start, pos_ - start);
+    auto d = numbers::toDouble(text);
+    if (!d) return setError("malformed number");
     // Overflow to infinity is an error: no scene value needs it and it poisons the renderer.
-    if (!std::isfinite(d)) return setError(cat("number out of range: ", text));
-    out = Value(d);
+    // Underflow reads as zero, as every other JSON reader does.
+    if (!std::isfinite(*d)) return setError(cat("number out of range: ", text));
+    out = Value(*d);
     return true;
   }
 
@@ -317,18 +318,6 @@ void writeString(std::string& out, const std::string& s) {
   out += '"';
 }
 
-void writeNumber(std::string& out, double d) {
-  char buf[32];
-  if (d == std::floor(d) && std::abs(d) < 1e15) {
-    std::snprintf(buf, sizeof buf, "%.0f", d);
-  } else {
-    // Shortest of 9 or 17 significant digits that reads back exactly.
-    std::snprintf(buf, sizeof buf, "%.9g", d);
-    if (std::strtod(buf, nullptr) != d) std::snprintf(buf, sizeof buf, "%.17g", d);
-  }
-  out += buf;
-}
-
 bool isFlat(const Value& v) {
   if (!v.isArray()) return false;
   if (v.asArray().size() > 16) return false;
@@ -346,7 +335,7 @@ void writeValue(std::string& out, const Value& v, bool pretty, int indent) {
   switch (v.type()) {
     case Value::Type::kNull: out += "null"; break;
     case Value::Type::kBool: out += v.asBool() ? "true" : "false"; break;
-    case Value::Type::kNumber: writeNumber(out, v.asNumber()); break;
+    case Value::Type::kNumber: numbers::append(out, v.asNumber()); break;
     case Value::Type::kString: writeString(out, v.asString()); break;
     case Value::Type::kArray: {
       const Array& a = v.asArray();

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "core/files.h"
+#include "core/numbers.h"
 #include "retile/io.h"
 #include "retile/log.h"
 
@@ -30,26 +31,11 @@ struct Cursor {
     skipSpace();
     // from_chars rejects a leading '+', which some exporters write.
     if (p < end && *p == '+') ++p;
-    auto r = std::from_chars(p, end, v);
-    if (r.ec == std::errc::result_out_of_range) {
-      // Denormals and overflow: keep going, the sanitizer drops non-finite vertices.
-      v = std::numeric_limits<float>::infinity();
-      while (p < end && *p != ' ' && *p != '\t' && *p != '\n' && *p != '\r') ++p;
-      return true;
-    }
-    if (r.ec != std::errc()) {
-      // "nan", "inf" spelled in any case: accept so the sanitizer can count them.
-      std::string_view rest(p, static_cast<std::size_t>(std::min<std::ptrdiff_t>(end - p, 4)));
-      std::string low = lowercase(rest);
-      if (low.rfind("nan", 0) == 0 || low.rfind("inf", 0) == 0 || low.rfind("-nan", 0) == 0 ||
-          low.rfind("-inf", 0) == 0) {
-        v = std::numeric_limits<float>::quiet_NaN();
-        while (p < end && *p != ' ' && *p != '\t' && *p != '\n' && *p != '\r') ++p;
-        return true;
-      }
-      return false;
-    }
-    p = r.ptr;
+    // An underflow (1e-50) reads as 0 and an overflow as infinity; "nan" and "inf" read as
+    // themselves, and the sanitizer drops non-finite vertices and counts them.
+    const char* next = numbers::read(p, end, &v);
+    if (!next) return false;
+    p = next;
     return true;
   }
   bool readInt(long& v) {
