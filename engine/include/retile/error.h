@@ -20,6 +20,13 @@ class Error : public std::runtime_error {
   explicit Error(const std::string& what) : std::runtime_error(what) {}
 };
 
+// The machine has no Vulkan driver or no device that can run the renderer: a Renderer cannot be
+// made at all (as opposed to a device that fails while working). Tests skip on it outside CI.
+class NoDeviceError : public Error {
+ public:
+  using Error::Error;
+};
+
 // Thrown by RETILE_ASSERT: a broken invariant inside the engine.
 class AssertionError : public Error {
  public:

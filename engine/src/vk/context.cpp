@@ -105,7 +105,7 @@ Context::Context(const DeviceChoice& choiceIn) {
   ici.ppEnabledExtensionNames = extensions.data();
   VkResult r = vkCreateInstance(&ici, nullptr, &instance_);
   if (r == VK_ERROR_INCOMPATIBLE_DRIVER)
-    throw Error("Vulkan: no Vulkan 1.2 driver found (on Debian, install mesa-vulkan-drivers for the CPU driver lavapipe)");
+    throw NoDeviceError("Vulkan: no Vulkan 1.2 driver found (on Debian, install mesa-vulkan-drivers for the CPU driver lavapipe)");
   checkVk(r, "creating the Vulkan instance");
 
   if (!layers.empty()) {
@@ -147,7 +147,7 @@ Context::Context(const DeviceChoice& choiceIn) {
       }
   }
   if (usable.empty())
-    throw Error("Vulkan: no device with Vulkan 1.2 compute found (on Debian, install mesa-vulkan-drivers for lavapipe)");
+    throw NoDeviceError("Vulkan: no device with Vulkan 1.2 compute found (on Debian, install mesa-vulkan-drivers for lavapipe)");
   std::stable_sort(usable.begin(), usable.end(), [](const Candidate& a, const Candidate& b) {
     return typeRank(a.props.deviceType) < typeRank(b.props.deviceType);
   });
