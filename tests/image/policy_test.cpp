@@ -96,7 +96,13 @@ TEST(Policies, SmoothTransitionDecaysAsDocumented) {
   // keeps the weight C / (C + n). With Q = 1 every frame adds one sample: n = frames.
   RETILE_RENDERER_OR_SKIP(probe);
   probe.reset();
+  // The sky (radiance 1) behind the box instead of the wall: an environment edit changes every
+  // pixel without touching any object's place on screen, so only the box's tiles restart.
   WallScene ws = wallScene(40, 24);
+  for (Object& o : ws.scene.objects)
+    if (o.id != ws.box) o.visible = false;
+  ws.scene.environment.type = EnvironmentType::Constant;
+  ws.scene.environment.color = Vec3{1.0f};
   MethodSettings m;
   m.kind = MethodKind::Spiral;
   m.tileSize = 8;
@@ -108,10 +114,10 @@ TEST(Policies, SmoothTransitionDecaysAsDocumented) {
   // Move the box: the tiles it leaves and enters restart; the rest keep 4 stale samples of 1.
   Object box = *s.scene().object(ws.box);
   box.transform = Mat4::translate({0.1f, 0, 0}) * box.transform;
-  Material wall = materialOf(s.scene(), ws.wallMaterial);
-  wall.emission = Vec3{3.0f};
-  ASSERT_TRUE(s.applyEdit(SetMaterial{wall}).ok());
-  ASSERT_TRUE(s.applyEdit(SetObject{box}).ok());
+  Environment sky = s.scene().environment;
+  sky.color = Vec3{3.0f};
+  ASSERT_TRUE(s.applyEdit(SetEnvironment{sky}).ok());
+  ASSERT_TRUE(s.applyEdit(SetObject{box}).ok());  // planned together with the sky: one pass
   // The right edge's tiles are never touched by the box: they decay as documented. First wait
   // for the pass to reach them (their 20 stale samples are then capped to 4).
   const std::size_t i = static_cast<std::size_t>(10 * 40 + 39);

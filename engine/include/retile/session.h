@@ -42,6 +42,7 @@ struct FrameRecord {
   int tileSize = 0, cols = 0, rows = 0;
   int quality = 0;                    // Q of the current pass (automatic Q resolved)
   Vec2 pointOfChange{0.0f};           // image position of the last edit's point of change
+  std::vector<Vec2> pointsOfChange;   // of every edit of the last batch (planned together)
   std::vector<Vec2> focus;            // focus points in use (followed ones moved)
   NodeId selection = kNoNode;
   std::vector<float> tilePriority;    // per tile: 1 at the head of the queue to 0 at its end; -1 unqueued
@@ -70,14 +71,16 @@ class RenderSession {
 
   std::string deviceName() const;
   const Scene& scene() const { return scene_; }
-  const MethodSettings& method() const { return method_; }
+  const MethodSettings& method() const;  // the focus points as the planner moved them
   NodeId selection() const { return selection_; }
   // What uploading the scene warned about (missing textures and their substitutes).
   const std::vector<std::string>& sceneWarnings() const { return sceneWarnings_; }
 
   // Applies an edit to the session's scene and the renderer (in place: a transform touches only
-  // instance data and the top-level BVH), then restarts the queue from the edit's point of change
-  // (or resets globally: camera, resolution, global method). Fails leaving everything unchanged.
+  // instance data and the top-level BVH) and measures what it changed on screen. The next frame
+  // plans once for every edit applied since the last (schedule/planner.h): the queue restarts from
+  // their points of change, or everything resets (camera, resolution, global method). Fails
+  // leaving everything unchanged.
   Result<std::uint32_t> applyEdit(const Edit& edit, std::uint64_t documentVersion = 0);
   void select(NodeId object);
   // Focus points for the focus policies (at most 3 are used).
@@ -101,7 +104,6 @@ class RenderSession {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   Scene scene_;
-  MethodSettings method_;
   NodeId selection_ = kNoNode;
   std::vector<std::string> sceneWarnings_;
 };

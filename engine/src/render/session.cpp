@@ -6,6 +6,7 @@
 #include <map>
 
 #include "retile/log.h"
+#include "schedule/planner.h"
 #include "schedule/policies.h"
 #include "schedule/scheduler.h"
 
@@ -14,7 +15,6 @@ namespace retile {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr int kMaxAutomaticQuality = 256;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
 struct CameraFrame {
@@ -50,22 +50,13 @@ std::optional<Vec2> projectToImage(const Camera& camera, int width, int height, 
 struct RenderSession::Impl {
   Renderer renderer;
   TileScheduler scheduler;
+  Planner planner;
   int width = 0, height = 0;
   std::uint64_t frame = 0;
   std::uint64_t documentVersion = 0;
   std::map<NodeId, Bounds3> meshBounds;  // object-space bounds, so an edit never walks a mesh
-
-  Vec2 poc{0.0f};
-  // Indirection: counters gathered over a few full frames, the plan made from them, and the
-  // point of change when it was made (for following the object's motion during a drag).
-  int countFramesLeft = 0;
-  SelectionCounts counts;
-  bool haveCounts = false;
-  IndirectionPlan plan;
-  Vec2 planPoc{0.0f};
-  bool passFromEdit = false;  // a pass is running because of an edit (recount when it drains)
-  // Change policy: the probe frame's point of change.
-  bool awaitingProbe = false;
+  std::vector<EditFacts> batch;          // edits applied since the last frame, planned together
+  NodeId counting = kNoNode;             // the object the renderer's counters describe
   std::shared_ptr<const RenderImage> lastImage;
   RegionRect region;  // the render region in pixels (empty: the whole image)
 
@@ -84,14 +75,39 @@ struct RenderSession::Impl {
     }
     scheduler.setRegion(std::move(mask));
   }
+
+  void newGrid(int tileSize) {
+    TileGrid grid(width, height, tileSize);
+    scheduler.reset(grid);
+    planner.setGrid(grid);
+    batch.clear();  // measured on the old grid; the reset restarts everything anyway
+  }
+
+  void execute(const Plan& p) {
+    switch (p.kind) {
+      case PlanKind::None: break;
+      case PlanKind::GlobalUpdate: scheduler.globalUpdate(); break;
+      case PlanKind::Probe: scheduler.probe(); break;
+      case PlanKind::Pass: scheduler.startPass(p.order, p.quality, p.prioritized, p.smooth, p.staleCap); break;
+    }
+  }
+
+  // The renderer counts what the planner wants counted; a new target starts from zero.
+  void syncCounting() {
+    if (planner.countTarget() == counting) return;
+    counting = planner.countTarget();
+    renderer.setSelection(counting);
+    renderer.takeSelectionCounts();
+  }
 };
 
 RenderSession::RenderSession(Scene scene, MethodSettings method, const RendererOptions& options)
-    : impl_(std::make_unique<Impl>(options)), scene_(std::move(scene)), method_(std::move(method)) {
-  if (std::string bad = validateMethodSettings(method_); !bad.empty()) {
+    : impl_(std::make_unique<Impl>(options)), scene_(std::move(scene)) {
+  if (std::string bad = validateMethodSettings(method); !bad.empty()) {
     logWarning("method settings: ", bad, "; using the defaults");
-    method_ = MethodSettings{};
+    method = MethodSettings{};
   }
+  impl_->planner.setMethod(method);
   for (const Mesh& m : scene_.meshes)
     if (m.geometry) impl_->meshBounds[m.id] = m.geometry->bounds();
   sceneWarnings_ = impl_->renderer.setScene(scene_);
@@ -103,6 +119,7 @@ RenderSession::RenderSession(Scene scene, MethodSettings method, const RendererO
 RenderSession::~RenderSession() = default;
 
 std::string RenderSession::deviceName() const { return impl_->renderer.deviceName(); }
+const MethodSettings& RenderSession::method() const { return impl_->planner.method(); }
 
 void RenderSession::resize(int width, int height) {
   width = std::clamp(width, 1, 16384);
@@ -112,11 +129,7 @@ void RenderSession::resize(int width, int height) {
   scene_.settings.width = width;
   scene_.settings.height = height;
   impl_->renderer.resize(width, height);
-  impl_->scheduler.reset(TileGrid(width, height, method_.tileSize));
-  impl_->poc = {width * 0.5f, height * 0.5f};
-  impl_->haveCounts = false;
-  impl_->countFramesLeft = selection_ != kNoNode ? method_.indirectionFrames : 0;
-  impl_->awaitingProbe = false;
+  impl_->newGrid(method().tileSize);
   impl_->lastImage.reset();
   impl_->region = {};  // its pixels meant another image size
 }
@@ -139,34 +152,26 @@ void RenderSession::setMaxBounces(int maxBounces) {
 
 std::string RenderSession::setMethod(const MethodSettings& method) {
   if (std::string bad = validateMethodSettings(method); !bad.empty()) return bad;
-  bool newGrid = method.tileSize != method_.tileSize;
-  method_ = method;
+  bool newGrid = method.tileSize != this->method().tileSize;
+  impl_->planner.setMethod(method);
   if (newGrid) {
     // The accumulation stays valid; only the tiles change. Restart cleanly all the same, so
     // per-tile records describe the new grid.
-    impl_->scheduler.reset(TileGrid(impl_->width, impl_->height, method_.tileSize));
+    impl_->newGrid(method.tileSize);
     impl_->applyRegion();
-    impl_->haveCounts = false;
   } else {
     impl_->scheduler.globalUpdate();
   }
-  impl_->countFramesLeft = selection_ != kNoNode ? method_.indirectionFrames : 0;
   return {};
 }
 
 void RenderSession::select(NodeId object) {
   if (object != kNoNode && !scene_.object(object)) object = kNoNode;
   selection_ = object;
-  impl_->renderer.setSelection(object);
-  impl_->haveCounts = false;
-  impl_->renderer.takeSelectionCounts();  // discard counts of the previous selection
-  impl_->countFramesLeft = object != kNoNode ? method_.indirectionFrames : 0;
+  impl_->planner.select(object);
 }
 
-void RenderSession::setFocus(std::vector<FocusPoint> focus) {
-  if (focus.size() > 3) focus.resize(3);
-  method_.focus = std::move(focus);
-}
+void RenderSession::setFocus(std::vector<FocusPoint> focus) { impl_->planner.setFocus(std::move(focus)); }
 
 namespace {
 
@@ -197,13 +202,18 @@ TileRect screenRect(const Camera& cam, int w, int h, const Bounds3& b) {
   return {ix0, iy0, ix1 - ix0, iy1 - iy0};
 }
 
+std::optional<Vec2> projectedCentre(const Camera& cam, int w, int h, const Bounds3& b) {
+  if (b.empty()) return std::nullopt;
+  return projectToImage(cam, w, h, b.center());
+}
+
 }  // namespace
 
 void RenderSession::setDocumentVersion(std::uint64_t version) { impl_->documentVersion = version; }
 
 Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t documentVersion) {
   Impl& d = *impl_;
-  // Where the edit's target was, before: the smooth transition prioritizes old and new places.
+  // Where the edit's targets were, before: a pass prioritizes their old and new places.
   std::vector<NodeId> targets;
   NodeId target = editTarget(edit);
   if (const auto* m = std::get_if<SetMaterial>(&edit)) {
@@ -225,7 +235,9 @@ Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t d
   // Coalesced commands may arrive out of version order: the record shows the newest applied.
   d.documentVersion = std::max(d.documentVersion, documentVersion);
   if (selection_ != kNoNode && !scene_.object(selection_)) select(kNoNode);
+  if (d.planner.countTarget() != kNoNode && !scene_.object(d.planner.countTarget())) d.planner.select(selection_);
 
+  EditFacts facts;
   if (flags & kUpdateSettings) {
     d.renderer.setMaxBounces(scene_.settings.maxBounces);
     d.renderer.setSeed(scene_.settings.seed);
@@ -234,110 +246,29 @@ Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t d
       return flags;
     }
   }
-  // Camera moves and global methods discard everything (the global-update mode).
-  if ((flags & (kUpdateCamera | kUpdateSettings)) || method_.kind == MethodKind::Global) {
-    d.scheduler.globalUpdate();
-    d.poc = {d.width * 0.5f, d.height * 0.5f};
-    d.passFromEdit = false;
-    return flags;
-  }
+  // Camera moves and settings discard everything (the global-update mode).
+  facts.global = (flags & (kUpdateCamera | kUpdateSettings)) != 0;
 
   // The point of change: the centre of the edited objects' bounds, a light's position, or
   // (environment, textures) the image centre.
+  const Camera& cam = scene_.camera;
   Bounds3 after;
   for (NodeId t : targets) after.grow(objectBounds(scene_, d.meshBounds, t));
-  Vec2 centre{d.width * 0.5f, d.height * 0.5f};
-  std::optional<Vec2> poc;
-  if (!after.empty()) poc = projectToImage(scene_.camera, d.width, d.height, after.center());
-  else if (!before.empty()) poc = projectToImage(scene_.camera, d.width, d.height, before.center());
-  else if (const auto* l = std::get_if<SetLight>(&edit); l && l->light.type != LightType::Directional)
-    poc = projectToImage(scene_.camera, d.width, d.height, l->light.position);
-  Vec2 oldPoc = d.poc;
-  d.poc = poc.value_or(centre);
-
-  const TileGrid& grid = d.scheduler.grid();
-  int pocTile = grid.tileAt(d.poc);
-  // Tiles the edit touched directly (its target before and after): first in a smooth pass.
-  std::vector<char> touched(static_cast<std::size_t>(grid.count()), 0);
-  for (const Bounds3& b : {before, after}) {
-    TileRect r = screenRect(scene_.camera, d.width, d.height, b);
-    if (r.pixels() <= 0) continue;
-    for (int t = 0; t < grid.count(); ++t) {
-      TileRect tr = grid.rect(t);
-      if (tr.x < r.x + r.width && r.x < tr.x + tr.width && tr.y < r.y + r.height && r.y < tr.y + tr.height)
-        touched[static_cast<std::size_t>(t)] = 1;
-    }
+  std::optional<Vec2> poc = projectedCentre(cam, d.width, d.height, after);
+  if (!poc) poc = projectedCentre(cam, d.width, d.height, before);
+  if (!poc)
+    if (const auto* l = std::get_if<SetLight>(&edit); l && l->light.type != LightType::Directional)
+      poc = projectToImage(cam, d.width, d.height, l->light.position);
+  facts.pointOfChange = poc.value_or(Vec2{d.width * 0.5f, d.height * 0.5f});
+  for (const Bounds3& b : {before, after})
+    if (TileRect r = screenRect(cam, d.width, d.height, b); r.pixels() > 0) facts.screen.push_back(r);
+  if (targets.size() == 1) {
+    facts.object = targets.front();
+    facts.moved = std::holds_alternative<SetObject>(edit);
+    facts.centreBefore = projectedCentre(cam, d.width, d.height, before);
+    facts.centreAfter = projectedCentre(cam, d.width, d.height, after);
   }
-
-  // Focus points: those following the object move with the point of change.
-  std::vector<int> centers = {pocTile};
-  for (FocusPoint& f : method_.focus) {
-    if (f.follows && poc) f.pixel = Vec2{f.pixel.x + d.poc.x - oldPoc.x, f.pixel.y + d.poc.y - oldPoc.y};
-    centers.push_back(grid.tileAt(f.pixel));
-  }
-
-  std::vector<int> order;
-  int prioritized = 0;
-  int quality = std::max(1, method_.quality);
-  bool indirection = method_.kind == MethodKind::Indirection || method_.kind == MethodKind::IndirectionFocus;
-  std::vector<int> rest = method_.kind == MethodKind::Focus || method_.kind == MethodKind::IndirectionFocus
-                              ? interleavedSpirals(grid, centers)
-                              : spiralOrder(grid, pocTile);
-  if (method_.kind == MethodKind::Change) {
-    d.scheduler.probe();
-    d.awaitingProbe = true;
-    d.passFromEdit = true;
-    return flags;
-  }
-  if (indirection && d.haveCounts && d.counts.tileSize == grid.tileSize()) {
-    IndirectionCounts c{d.counts.direct, d.counts.reflection, d.counts.shadow};
-    IndirectionPlan plan = indirectionPlan(grid, c, grid.tileAt(d.planPoc), rest);
-    bool movedSelection = std::find(targets.begin(), targets.end(), selection_) != targets.end() &&
-                          std::holds_alternative<SetObject>(edit);
-    if (movedSelection) {
-      // During a drag the prioritized tiles follow the object's screen motion, by replacement.
-      Vec2 motion{d.poc.x - d.planPoc.x, d.poc.y - d.planPoc.y};
-      std::vector<int> moved = followMotion(grid, plan.high, motion);
-      std::vector<char> inFront(static_cast<std::size_t>(grid.count()), 0);
-      plan.order.clear();
-      plan.high = moved;
-      for (int t : moved) {
-        plan.order.push_back(t);
-        inFront[static_cast<std::size_t>(t)] = 1;
-      }
-      for (int t : rest)
-        if (!inFront[static_cast<std::size_t>(t)] && touched[static_cast<std::size_t>(t)]) {
-          plan.order.push_back(t);
-          inFront[static_cast<std::size_t>(t)] = 1;
-        }
-      plan.prioritized = static_cast<int>(plan.order.size());
-      for (int t : rest)
-        if (!inFront[static_cast<std::size_t>(t)]) plan.order.push_back(t);
-    }
-    order = plan.order;
-    prioritized = plan.prioritized;
-    // Automatic Q; capped so that a tiny object does not stretch the pass over hundreds of
-    // frames, and the default when the object is out of view (no high tiles at all).
-    if (method_.quality == 0) quality = plan.high.empty() ? 64 : automaticQuality(grid, plan.high, kMaxAutomaticQuality);
-    d.plan = std::move(plan);
-  } else {
-    // Spiral and focus (and indirection before its counters exist): with the smooth transition
-    // the touched tiles go first, restarted; the rest keep capped stale sums.
-    if (method_.smooth) {
-      for (int t : rest)
-        if (touched[static_cast<std::size_t>(t)]) order.push_back(t);
-      prioritized = static_cast<int>(order.size());
-      for (int t : rest)
-        if (!touched[static_cast<std::size_t>(t)]) order.push_back(t);
-    } else {
-      order = rest;
-      prioritized = static_cast<int>(order.size());
-    }
-    if (method_.quality == 0) quality = 64;
-  }
-  if (!method_.smooth) prioritized = static_cast<int>(order.size());
-  d.scheduler.startPass(std::move(order), quality, prioritized, method_.smooth, method_.staleCap);
-  d.passFromEdit = true;
+  d.batch.push_back(std::move(facts));
   return flags;
 }
 
@@ -345,6 +276,10 @@ FrameRecord RenderSession::renderFrame(bool readImage) {
   Impl& d = *impl_;
   auto start = Clock::now();
   const TileGrid& grid = d.scheduler.grid();
+  // One plan for every edit since the last frame; without edits, whatever quiet brings.
+  d.execute(d.batch.empty() ? d.planner.planQuiet(d.scheduler.passActive()) : d.planner.planBatch(d.batch));
+  d.batch.clear();
+  d.syncCounting();
   FramePlan plan = d.scheduler.nextFrame();
   std::vector<TileWork> work;
   work.reserve(plan.chunks.size());
@@ -352,34 +287,25 @@ FrameRecord RenderSession::renderFrame(bool readImage) {
     work.push_back({c.rect.x, c.rect.y, c.rect.width, c.rect.height, c.quality, c.sampleBase, c.restart, c.capStale});
   FrameOptions options;
   options.accumulate = plan.mode != AccumMode::Probe;
-  bool indirection = method_.kind == MethodKind::Indirection || method_.kind == MethodKind::IndirectionFocus;
-  // Count over full frames only (every tile traced once), so that no tile is favoured.
-  bool fullFrame = plan.mode == AccumMode::GlobalUpdate || plan.mode == AccumMode::Refinement;
-  bool counting = indirection && selection_ != kNoNode && d.countFramesLeft > 0 && fullFrame;
+  const bool counting = d.planner.countThisFrame(plan.mode);
   if (counting) options.selectionTileSize = grid.tileSize();
   double scheduleMs = msSince(start);
 
   FrameStats stats = d.renderer.renderFrame(work, options);
 
-  if (counting && --d.countFramesLeft == 0) {
-    d.counts = d.renderer.takeSelectionCounts();
-    d.haveCounts = d.counts.tileSize == grid.tileSize();
-    d.planPoc = d.poc;
-    if (d.haveCounts) {
-      IndirectionCounts c{d.counts.direct, d.counts.reflection, d.counts.shadow};
-      d.plan = indirectionPlan(grid, c, grid.tileAt(d.poc), spiralOrder(grid, grid.tileAt(d.poc)));
-      // The selected object's own centre is where its motion is measured from.
-      if (selection_ != kNoNode) {
-        Bounds3 b = objectBounds(scene_, d.meshBounds, selection_);
-        if (!b.empty())
-          if (auto p = projectToImage(scene_.camera, d.width, d.height, b.center())) d.planPoc = *p;
-      }
+  if (counting && d.planner.frameCounted()) {
+    SelectionCounts c = d.renderer.takeSelectionCounts();
+    if (c.tileSize == grid.tileSize()) {
+      // The object's own centre now is where its later motion is measured from.
+      std::optional<Vec2> centre = projectedCentre(scene_.camera, d.width, d.height,
+                                                   objectBounds(scene_, d.meshBounds, d.counting));
+      d.planner.setCounts(d.counting, IndirectionCounts{c.direct, c.reflection, c.shadow}, centre);
     }
   }
 
   auto readStart = Clock::now();
-  if (plan.mode == AccumMode::Probe && d.awaitingProbe) {
-    // Change-aware priority: tiles whose cheap new estimate differs most from the old image.
+  if (plan.mode == AccumMode::Probe) {
+    // Change-aware priority: per tile, how much the cheap new estimate differs from the old image.
     std::vector<float> now = d.renderer.readbackFrameLuminance();
     std::shared_ptr<const RenderImage> old = d.lastImage;
     if (!old) old = std::make_shared<RenderImage>(d.renderer.readback());
@@ -399,39 +325,28 @@ FrameRecord RenderSession::renderFrame(bool readImage) {
         }
       if (n) diff[static_cast<std::size_t>(t)] = static_cast<float>(std::abs(a - b) / n / (b / n + 0.05));
     }
-    std::vector<int> order = changeOrder(grid, diff, grid.tileAt(d.poc));
-    d.scheduler.startPass(order, std::max(1, method_.quality), static_cast<int>(order.size()), method_.smooth,
-                          method_.staleCap);
-    d.awaitingProbe = false;
-  }
-  if (d.passFromEdit && !d.scheduler.passActive() && plan.mode != AccumMode::Probe) {
-    // The edit has settled: gather fresh counters for the next edit.
-    d.passFromEdit = false;
-    if (indirection && selection_ != kNoNode) {
-      d.renderer.takeSelectionCounts();
-      d.countFramesLeft = method_.indirectionFrames;
-    }
+    d.execute(d.planner.planFromProbe(diff));
   }
 
   FrameRecord rec;
   rec.frame = ++d.frame;
   rec.documentVersion = d.documentVersion;
-  rec.method = methodName(method_.kind);
+  rec.method = methodName(method().kind);
   rec.mode = accumModeName(plan.mode);
-  rec.smooth = method_.smooth;
-  rec.staleCap = method_.staleCap;
+  rec.smooth = method().smooth;
+  rec.staleCap = method().staleCap;
   rec.width = d.width;
   rec.height = d.height;
   rec.tileSize = grid.tileSize();
   rec.cols = grid.cols();
   rec.rows = grid.rows();
   rec.quality = d.scheduler.quality();
-  rec.pointOfChange = d.poc;
-  for (const auto& f : method_.focus) rec.focus.push_back(f.pixel);
+  rec.pointOfChange = d.planner.pointOfChange();
+  rec.pointsOfChange = d.planner.pointsOfChange();
+  for (const auto& f : d.planner.focus()) rec.focus.push_back(f.pixel);
   rec.selection = selection_;
   rec.tilePriority = d.scheduler.priorities();
-  if (indirection && d.haveCounts)
-    for (TileClass c : d.plan.classes) rec.tileClass.push_back(static_cast<std::uint8_t>(c));
+  for (TileClass c : d.planner.classes()) rec.tileClass.push_back(static_cast<std::uint8_t>(c));
   rec.tileSamples.assign(d.scheduler.tileSamples().begin(), d.scheduler.tileSamples().end());
   rec.servedTiles = plan.servedTiles;
   rec.region = d.region;
