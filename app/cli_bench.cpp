@@ -3,9 +3,11 @@
 #include <chrono>
 #include <cstdio>
 #include <random>
+#include <thread>
 
 #include "cli.h"
 #include "render/bvh.h"
+#include "retile/engine.h"
 #include "retile/log.h"
 #include "retile/render.h"
 #include "retile/session.h"
@@ -191,18 +193,90 @@ int benchEdit(const std::vector<std::string>& argv) {
   return 0;
 }
 
+// Frames per second of the render thread as the editor drives it (Engine, newest frame to the
+// mailbox), at rest or while an object is dragged (one move submitted per published frame), for
+// `--seconds` after one second of warm-up.
+int benchFrames(const std::vector<std::string>& argv) {
+  auto args = parseArgs(argv, {"--size", "--seconds", "--method", "--object"}, {"--drag"});
+  if (!args || args->positional.size() != 1) {
+    std::fprintf(stderr,
+                 "usage: retile bench frames SCENE [--size WxH] [--seconds S] [--method NAME] [--drag [--object NAME]]\n");
+    return 2;
+  }
+  auto loaded = loadScene(args->positional[0]);
+  if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
+  Scene scene = loaded->scene;
+  scene.settings.width = 240;
+  scene.settings.height = 135;
+  if (args->has("--size")) {
+    auto r = parseSize(args->get("--size"), &scene.settings.width, &scene.settings.height);
+    if (!r) return std::fprintf(stderr, "error: %s\n", r.error().c_str()), 2;
+  }
+  int seconds = 5;
+  if (args->has("--seconds")) {
+    auto v = parseInt("--seconds", args->get("--seconds"), 1, 3600);
+    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
+    seconds = v.value();
+  }
+  MethodSettings method;
+  if (args->has("--method") && !methodFromName(args->get("--method"), &method.kind))
+    return std::fprintf(stderr, "error: unknown method '%s'\n", args->get("--method").c_str()), 2;
+  const bool drag = args->has("--drag");
+  NodeId dragged = kNoNode;
+  for (const Object& o : scene.objects)
+    if (dragged == kNoNode && (!args->has("--object") || o.name == args->get("--object"))) dragged = o.id;
+  if (drag && dragged == kNoNode) return std::fprintf(stderr, "error: no object to drag\n"), 1;
+  Object moving = dragged != kNoNode ? *scene.object(dragged) : Object{};
+
+  EngineOptions options;
+  options.maxSamplesPerPixel = 0;  // refine for ever: frames must keep coming
+  Engine engine(scene, method, options);
+  engine.start();
+  std::uint64_t seen = 0, version = 0;
+  auto pump = [&](Clock::time_point until) {
+    while (Clock::now() < until) {
+      auto f = engine.latestFrame();
+      if (f && f->frame != seen) {
+        seen = f->frame;
+        if (drag) {
+          moving.transform = Mat4::translate({0.002f, 0, 0}) * moving.transform;
+          engine.submit(SetObject{moving}, ++version);
+        }
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+  };
+  pump(Clock::now() + std::chrono::seconds(1));
+  std::uint64_t first = engine.framesRendered();
+  auto start = Clock::now();
+  pump(start + std::chrono::seconds(seconds));
+  double s = std::chrono::duration<double>(Clock::now() - start).count();
+  std::uint64_t frames = engine.framesRendered() - first;
+  engine.stop();
+  for (const auto& e : engine.takeErrors())
+    if (e.rfind("warning: ", 0) != 0) return std::fprintf(stderr, "error: %s\n", e.c_str()), 1;
+  std::printf("scene          %s at %dx%d, %s%s\n", args->positional[0].c_str(), scene.settings.width,
+              scene.settings.height, methodName(method.kind), drag ? ", dragging an object every frame" : ", at rest");
+  std::printf("frames/s       %.2f (%llu frames in %.1f s)\n", static_cast<double>(frames) / s,
+              static_cast<unsigned long long>(frames), s);
+  return 0;
+}
+
 }  // namespace
 
 int runBench(const std::vector<std::string>& argv) {
   if (argv.empty()) {
-    std::fprintf(stderr, "usage: retile bench throughput SCENE ... | retile bench bvh [--triangles N] | retile bench edit\n");
+    std::fprintf(stderr,
+                 "usage: retile bench throughput SCENE ... | retile bench bvh [--triangles N] | retile bench edit\n"
+                 "       | retile bench frames SCENE ...\n");
     return 2;
   }
   std::vector<std::string> rest(argv.begin() + 1, argv.end());
   if (argv[0] == "throughput") return benchThroughput(rest);
   if (argv[0] == "bvh") return benchBvh(rest);
   if (argv[0] == "edit") return benchEdit(rest);
-  std::fprintf(stderr, "retile bench: unknown benchmark '%s' (throughput, bvh, edit)\n", argv[0].c_str());
+  if (argv[0] == "frames") return benchFrames(rest);
+  std::fprintf(stderr, "retile bench: unknown benchmark '%s' (throughput, bvh, edit, frames)\n", argv[0].c_str());
   return 2;
 }
 

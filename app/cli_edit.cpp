@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 
@@ -151,8 +152,47 @@ int runEdit(const std::vector<std::string>& argv) {
   csv << "frame,step,method,mode,samples,tiles_served,queue_left,quality,ms,schedule_ms,trace_ms,rel_rmse\n";
   const int total = scenario->totalFrames();
   int frame = 0, lastEditFrame = 0, settledFrame = -1;
-  double sumMs = 0, sumScheduleMs = 0;
+  double sumScheduleMs = 0;
   bool exact = true;
+  // Frames are pipelined: frame n+1 is submitted (its edits applied first) before frame n is
+  // read back and written, so the device traces while this thread writes.
+  struct Submitted {
+    std::size_t step;
+    bool edited;
+  };
+  std::deque<Submitted> submitted;
+  auto finishOne = [&]() -> bool {
+    FrameRecord rec = session.finishFrame();
+    Submitted sub = submitted.front();
+    submitted.pop_front();
+    ++frame;
+    if (sub.edited) {
+      lastEditFrame = frame;
+      settledFrame = -1;
+    }
+    exact = exact && rec.samples == static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
+    double err = !ref.empty() && rec.image ? relativeRmse(rec.image->color, ref, w, h, block) : NAN;
+    if (!ref.empty() && frame > lastEditFrame && settledFrame < 0 && err < threshold) settledFrame = frame;
+    if (!ref.empty() && err >= threshold) settledFrame = -1;  // settled means: stays under
+    sumScheduleMs += rec.scheduleMs;
+    char line[512];
+    std::snprintf(line, sizeof line, "%d,%zu,%s,%s,%llu,%zu,%zu,%d,%.3f,%.4f,%.3f,%s\n", frame, sub.step, rec.method.c_str(),
+                  rec.mode.c_str(), static_cast<unsigned long long>(rec.samples), rec.servedTiles.size(),
+                  rec.queueLength - rec.queueServed, rec.quality, rec.frameMs, rec.scheduleMs, rec.traceMs,
+                  std::isnan(err) ? "" : std::to_string(err).c_str());
+    csv << line;
+    if (images && rec.image) {
+      char name[64];
+      std::snprintf(name, sizeof name, "frame_%05d.exr", frame);
+      auto written = writeRenderImage(*rec.image, outDir / name);
+      if (!written) {
+        std::fprintf(stderr, "\nerror: %s\n", written.error().c_str());
+        return false;
+      }
+    }
+    progressBar(rec.method, frame, total, elapsed());
+    return true;
+  };
   t0 = std::chrono::steady_clock::now();
   for (std::size_t si = firstStep; si < scenario->steps.size(); ++si) {
     const ScenarioStep& step = scenario->steps[si];
@@ -167,40 +207,23 @@ int runEdit(const std::vector<std::string>& argv) {
         if (!r) return std::fprintf(stderr, "\nerror: steps[%zu]: %s\n", si, r.error().c_str()), 1;
       }
       if (instant) break;
-      FrameRecord rec = session.renderFrame(images || !ref.empty());
-      ++frame;
-      if (!e->edits.empty()) {
-        lastEditFrame = frame;
-        settledFrame = -1;
-      }
-      exact = exact && rec.samples == static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
-      double err = !ref.empty() && rec.image ? relativeRmse(rec.image->color, ref, w, h, block) : NAN;
-      if (!ref.empty() && frame > lastEditFrame && settledFrame < 0 && err < threshold) settledFrame = frame;
-      if (!ref.empty() && err >= threshold) settledFrame = -1;  // settled means: stays under
-      sumMs += rec.frameMs;
-      sumScheduleMs += rec.scheduleMs;
-      char line[512];
-      std::snprintf(line, sizeof line, "%d,%zu,%s,%s,%llu,%zu,%zu,%d,%.3f,%.4f,%.3f,%s\n", frame, si, rec.method.c_str(),
-                    rec.mode.c_str(), static_cast<unsigned long long>(rec.samples), rec.servedTiles.size(),
-                    rec.queueLength - rec.queueServed, rec.quality, rec.frameMs, rec.scheduleMs, rec.traceMs,
-                    std::isnan(err) ? "" : std::to_string(err).c_str());
-      csv << line;
-      if (images && rec.image) {
-        char name[64];
-        std::snprintf(name, sizeof name, "frame_%05d.exr", frame);
-        auto written = writeRenderImage(*rec.image, outDir / name);
-        if (!written) return std::fprintf(stderr, "\nerror: %s\n", written.error().c_str()), 1;
-      }
-      progressBar(rec.method, frame, total, elapsed());
+      session.submitFrame(images || !ref.empty());
+      submitted.push_back({si, !e->edits.empty()});
+      if (session.framesInFlight() > 1 && !finishOne()) return 1;
     }
   }
+  while (session.framesInFlight() > 0)
+    if (!finishOne()) return 1;
+  const double wallMs = elapsed() * 1e3;
   csv.close();
   std::printf("method         %s%s, T=%d, Q=%s\n", methodName(method.kind), method.smooth ? " (smooth)" : "", method.tileSize,
               method.quality ? std::to_string(method.quality).c_str() : "auto");
   std::printf("frames         %d after %d converging; every frame traced %s %dx%d samples\n", frame, converge,
               exact ? "exactly" : "NOT", w, h);
-  std::printf("scheduling     %.2f %% of frame time (%.3f ms of %.1f ms per frame)\n",
-              sumMs > 0 ? 100.0 * sumScheduleMs / sumMs : 0.0, frame ? sumScheduleMs / frame : 0.0, frame ? sumMs / frame : 0.0);
+  std::printf("frame rate     %.1f frames/s (%.1f ms a frame, wall clock, frames pipelined)\n",
+              wallMs > 0 ? frame * 1e3 / wallMs : 0.0, frame ? wallMs / frame : 0.0);
+  std::printf("scheduling     %.2f %% of frame time (%.3f ms a frame)\n", wallMs > 0 ? 100.0 * sumScheduleMs / wallMs : 0.0,
+              frame ? sumScheduleMs / frame : 0.0);
   if (!ref.empty()) {
     if (settledFrame > 0)
       std::printf("settled        %d frames after the last edit (relative RMSE of %dx%d blocks below %.3g from then on)\n",

@@ -7,6 +7,7 @@
 
 #include "gpu_support.h"
 #include "retile/engine.h"
+#include "retile/session.h"
 #include "test_support.h"
 
 namespace retile {
@@ -32,6 +33,65 @@ Scene smallDefault() {
   s.settings.height = 36;
   s.settings.maxBounces = 3;
   return s;
+}
+
+// Plays the same frames with edits through renderFrame (waiting for each) and pipelined (frame
+// n+1 submitted before n is finished, the edits for n+1 applied in between), and compares.
+TEST(Session, PipelinedFramesEqualFramesWaitedFor) {
+  RETILE_RENDERER_OR_SKIP(probe);
+  probe.reset();
+  for (MethodKind kind : {MethodKind::Change, MethodKind::Indirection}) {
+    SCOPED_TRACE(methodName(kind));
+    MethodSettings m;
+    m.kind = kind;
+    m.tileSize = 8;
+    m.quality = kind == MethodKind::Indirection ? 0 : 4;
+    m.indirectionFrames = 2;
+    Scene scene = smallDefault();
+    NodeId cup = kNoNode;
+    for (const Object& o : scene.objects)
+      if (o.name == "Cup") cup = o.id;
+    auto play = [&](bool pipelined) {
+      RenderSession s(scene, m);
+      s.select(cup);
+      std::vector<FrameRecord> out;
+      for (int f = 0; f < 30; ++f) {
+        if (f >= 6 && f < 12) {  // a short drag, then rest: counters, probe and passes all happen
+          Object o = *s.scene().object(cup);
+          o.transform = Mat4::translate({0.02f, 0, 0}) * o.transform;
+          EXPECT_TRUE(s.applyEdit(SetObject{o}).ok());
+        }
+        if (!pipelined) {
+          out.push_back(s.renderFrame(true));
+          continue;
+        }
+        s.submitFrame(true);
+        if (s.framesInFlight() > 1) out.push_back(s.finishFrame());
+      }
+      while (s.framesInFlight() > 0) out.push_back(s.finishFrame());
+      return out;
+    };
+    std::vector<FrameRecord> waited = play(false), pipelined = play(true);
+    ASSERT_EQ(waited.size(), pipelined.size());
+    int probes = 0;
+    for (std::size_t i = 0; i < waited.size(); ++i) {
+      SCOPED_TRACE(testing::Message() << "frame " << i + 1);
+      EXPECT_EQ(pipelined[i].frame, waited[i].frame);
+      EXPECT_EQ(pipelined[i].mode, waited[i].mode);
+      EXPECT_EQ(pipelined[i].servedTiles, waited[i].servedTiles);
+      EXPECT_EQ(pipelined[i].tileClass, waited[i].tileClass);
+      EXPECT_EQ(pipelined[i].samples, waited[i].samples);
+      ASSERT_TRUE(pipelined[i].image && waited[i].image);
+      EXPECT_TRUE(pipelined[i].image->color == waited[i].image->color) << "the same pixels";
+      EXPECT_TRUE(pipelined[i].image->objectId == waited[i].image->objectId);
+      probes += waited[i].mode == "probe";
+    }
+    if (kind == MethodKind::Change) {
+      EXPECT_EQ(probes, 1) << "one probe, after the drag";
+    } else {
+      EXPECT_FALSE(waited.back().tileClass.empty()) << "counters were gathered";
+    }
+  }
 }
 
 TEST(Engine, FramesFlowAndEditsArriveWithTheirVersion) {

@@ -57,7 +57,8 @@ struct FrameStats {
   std::uint64_t primaryRays = 0;
   std::uint64_t bounceRays = 0;
   std::uint64_t shadowRays = 0;
-  double seconds = 0;              // wall time of trace + accumulate on the device
+  double seconds = 0;              // wall time from submitting the frame until it was seen complete
+                                   // (trace + accumulate on the device, when waited for at once)
   // lavapipe stops the loops of eight lock-stepped invocations after about 32767 of the loop
   // iterations the trace pass counts (trace.comp); paths end before that, at kTraceLoopBudget.
   std::uint32_t maxLoopIterations = 0;  // the most any one invocation counted (exact for its eight)
@@ -67,6 +68,10 @@ struct FrameStats {
   // stop when the count passes kTraceLoopBudget, so this must stay below the ~2700 left to the limit.
   std::uint32_t maxSegmentIterations = 0;
   double pathsPerInvocation = 0;        // each invocation traces this many paths one after another
+};
+
+struct FrameTicket {
+  std::uint64_t id = 0;
 };
 
 struct RenderRequest {
@@ -98,8 +103,16 @@ class Renderer {
   void setSeed(std::uint32_t seed);
 
   // Traces one frame: every tile's pixels get `quality` samples, accumulated as the tile says.
-  // Tiles must not overlap within a frame.
+  // Tiles must not overlap within a frame. Waits for the device.
   FrameStats renderFrame(const std::vector<TileWork>& tiles, const FrameOptions& options = {});
+  // The same, pipelined: returns while the device traces. The frame completes when completeFrame
+  // is called, or when anything else that touches the device is (the next submitFrame, an
+  // update, a read-back): its statistics are kept. With `copyImage`, the accumulated image after
+  // the frame is copied aside on the device, and frameImage converts it on the calling thread
+  // even while the next frame traces; it stays readable until the frame after next is submitted.
+  FrameTicket submitFrame(const std::vector<TileWork>& tiles, const FrameOptions& options, bool copyImage);
+  FrameStats completeFrame(FrameTicket frame);  // waits for it if it is still in flight
+  RenderImage frameImage(FrameTicket frame);
   // Per pixel (row-major), the mean luminance of the last frame's samples; NaN where it traced
   // nothing. For the change-aware policy's probe frame.
   std::vector<float> readbackFrameLuminance();

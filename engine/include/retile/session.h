@@ -95,12 +95,25 @@ class RenderSession {
   // The document version of the scene the session was made from (frames report it until an edit).
   void setDocumentVersion(std::uint64_t version);
 
-  // Plans, traces and accumulates one frame. `readImage`: read the accumulated image back into
-  // the record (the command line and the viewport need it; benchmarks may not).
+  // Plans, traces and accumulates one frame, and waits for it. `readImage`: read the accumulated
+  // image back into the record (the command line and the viewport need it; benchmarks may not).
+  // Not while pipelined frames are unfinished.
   FrameRecord renderFrame(bool readImage = true);
+
+  // The same, pipelined (the render thread, `retile edit`): submitFrame() plans the next frame and
+  // returns while the device traces it; finishFrame() returns the record of the oldest frame not
+  // yet finished, reading its image back (waiting for the device if it still traces). Submitting
+  // frame n+1 before finishing frame n converts n's image while n+1 traces. At most two frames
+  // are unfinished. Edits, selection and settings may come between any two calls: they first
+  // wait for the frame in flight.
+  void submitFrame(bool readImage = true);
+  FrameRecord finishFrame();
+  std::size_t framesInFlight() const;  // submitted and not finished
 
 
  private:
+  // Waits for the frame in flight and takes what planning needs from it (counters, the probe).
+  void completeGpu();
   struct Impl;
   std::unique_ptr<Impl> impl_;
   Scene scene_;

@@ -180,14 +180,8 @@ void Engine::run() {
       }
     }
     if (stop_) break;
-    bool converged = options_.maxSamplesPerPixel > 0 && last && !changed && last->mode == "refinement" &&
-                     !last->tileSamples.empty() && regionConverged(*last, options_.maxSamplesPerPixel);
-    if (paused || converged) {
-      queue_.waitForWork(std::chrono::milliseconds(100));
-      continue;
-    }
-    try {
-      auto rec = std::make_shared<const FrameRecord>(session->renderFrame(true));
+    auto publish = [&](FrameRecord r) {
+      auto rec = std::make_shared<const FrameRecord>(std::move(r));
       last = rec;
       mailbox_.publish(rec);
       ++frames_;
@@ -197,6 +191,19 @@ void Engine::run() {
         cb = callback_;
       }
       if (cb) cb();
+    };
+    bool converged = options_.maxSamplesPerPixel > 0 && last && !changed && last->mode == "refinement" &&
+                     !last->tileSamples.empty() && regionConverged(*last, options_.maxSamplesPerPixel);
+    try {
+      if (paused || converged) {
+        // Show the frame still unfinished before resting.
+        while (session->framesInFlight() > 0) publish(session->finishFrame());
+        queue_.waitForWork(std::chrono::milliseconds(100));
+        continue;
+      }
+      // Pipelined: frame n+1 traces while frame n is read back and published.
+      session->submitFrame(true);
+      if (session->framesInFlight() > 1) publish(session->finishFrame());
     } catch (const std::exception& e) {
       // A failed frame (device lost, out of memory) ends rendering; the document is untouched.
       report(cat("rendering stopped: ", e.what()));

@@ -89,6 +89,23 @@ struct Renderer::Impl {
   int countTileSize = 0;            // tile size the selection buffer is laid out for
   std::vector<gpu::WorkItem> lastItems;  // the last frame's work, for readbackFrameLuminance
 
+  // Pipelined frames: the submitted frame's results land in one of two slots, so that the frame
+  // before it can still be read back (converted) while the device traces.
+  struct Slot {
+    std::uint64_t ticket = 0;
+    bool completed = false;
+    bool hasImage = false;
+    int width = 0, height = 0;
+    Buffer image;                   // host-visible copy of the accumulation, then of its auxiliary part
+    std::vector<NodeId> objects;    // instance -> object when submitted (edits may follow)
+    FrameStats stats;
+    std::uint64_t invocations = 0;
+    std::chrono::steady_clock::time_point submitted;
+  };
+  Slot slots_[2];
+  std::uint64_t nextTicket = 1;
+  std::uint64_t inFlight = 0;  // ticket of the submitted frame not yet completed (0: none)
+
   explicit Impl(const RendererOptions& o) : ctx(vk::DeviceChoice{o.device, o.validation || kDebugValidation}) {
     accumulate = std::make_unique<vk::ComputePipeline>(
         ctx, "accumulate.comp",
@@ -115,6 +132,7 @@ struct Renderer::Impl {
   }
 
   void upload(std::uint32_t dirty) {
+    completeInFlight();  // the frame in flight uses what this touches
     const RenderSceneData& d = builder.data();
     if (dirty & (kDirtyGeometry | kDirtyInstances)) {
       VkDeviceSize meshBytes = d.meshTraversal.size() * sizeof(gpu::vec4);
@@ -221,6 +239,7 @@ struct Renderer::Impl {
   }
 
   void resize(int w, int h) {
+    completeInFlight();  // the frame in flight uses what this touches
     RETILE_ASSERT(w > 0 && h > 0 && w <= 16384 && h <= 16384, cat("size ", w, "x", h));
     width = w;
     height = h;
@@ -260,6 +279,7 @@ struct Renderer::Impl {
   }
 
   SelectionCounts takeSelectionCounts() {
+    completeInFlight();  // the frame in flight uses what this touches
     SelectionCounts c;
     c.tileSize = countTileSize;
     if (countTileSize <= 0 || width <= 0) return c;
@@ -281,6 +301,7 @@ struct Renderer::Impl {
   }
 
   std::vector<float> readbackFrameLuminance() {
+    completeInFlight();  // the frame in flight uses what this touches
     std::vector<float> lum(static_cast<std::size_t>(width) * static_cast<std::size_t>(height),
                            std::numeric_limits<float>::quiet_NaN());
     std::uint64_t slots = 0;
@@ -332,9 +353,10 @@ struct Renderer::Impl {
     frameUbo.upload(&u, sizeof u);
   }
 
-  FrameStats renderFrame(const std::vector<TileWork>& tiles, const FrameOptions& options) {
+  std::uint64_t submitFrame(const std::vector<TileWork>& tiles, const FrameOptions& options, bool copyImage) {
     RETILE_ASSERT(hasScene, "renderFrame before setScene");
     RETILE_ASSERT(width > 0, "renderFrame before resize");
+    completeInFlight();
     std::vector<gpu::WorkItem> items;
     items.reserve(tiles.size());
     std::uint64_t slots = 0, pixels = 0;
@@ -353,42 +375,82 @@ struct Renderer::Impl {
       pixels += n;
       items.push_back(w);
     }
-    FrameStats fs;
-    if (items.empty()) return fs;
     RETILE_ASSERT(slots < (1ull << 32), cat("a frame of ", slots, " samples"));
-    ensureSampleCapacity(slots + 1);  // the trace pass's spare slot (trace.comp)
-    VkDeviceSize workBytes = items.size() * sizeof(gpu::WorkItem);
-    if (work.size() < workBytes) {
-      work = Buffer(ctx, workBytes * 2, kStorageUsage, true, "work items");
-      bindAll();
+    std::uint64_t invocations = 0;
+    if (!items.empty()) {
+      ensureSampleCapacity(slots + 1);  // the trace pass's spare slot (trace.comp)
+      VkDeviceSize workBytes = items.size() * sizeof(gpu::WorkItem);
+      if (work.size() < workBytes) {
+        work = Buffer(ctx, workBytes * 2, kStorageUsage, true, "work items");
+        bindAll();
+      }
+      work.upload(items.data(), workBytes);
+      prepareSelection(options.selectionTileSize);
+      writeFrameUniforms(static_cast<std::uint32_t>(items.size()), slots, options.selectionTileSize);
+      std::uint32_t zero[gpu::kStatsCount] = {};
+      stats.upload(zero, sizeof zero);
+      invocations = traceInvocations(slots, iterationsPerPath, options.pathsPerInvocation);
     }
-    work.upload(items.data(), workBytes);
-    prepareSelection(options.selectionTileSize);
-    writeFrameUniforms(static_cast<std::uint32_t>(items.size()), slots, options.selectionTileSize);
     lastItems = items;
-    std::uint32_t zero[gpu::kStatsCount] = {};
-    stats.upload(zero, sizeof zero);
 
-    std::uint64_t invocations = traceInvocations(slots, iterationsPerPath, options.pathsPerInvocation);
-    auto start = std::chrono::steady_clock::now();
-    ctx.submitAndWait([&](VkCommandBuffer cb) {
-      // A slot the trace pass does not reach (its invocation ran out of loop budget) must read as
-      // weight 0, not as the last frame's sample.
-      vkCmdFillBuffer(cb, samples.handle(), 0, static_cast<VkDeviceSize>(slots) * sizeof(gpu::vec4), 0);
-      vk::computeBarrier(cb);
-      gpu::TracePush tp{0, static_cast<std::uint32_t>(slots), static_cast<std::uint32_t>(invocations), 0};
-      std::uint32_t gy;
-      std::uint32_t gx = groupsFor(invocations, gpu::kTraceWorkgroup, &gy);
-      trace->dispatch(cb, gx, gy, &tp, sizeof tp);
-      vk::computeBarrier(cb);
-      gpu::AccumulatePush ap{0, static_cast<std::uint32_t>(pixels), static_cast<std::uint32_t>(items.size()), 0};
-      gx = groupsFor(pixels, gpu::kAccumulateWorkgroup, &gy);
-      if (options.accumulate) accumulate->dispatch(cb, gx, gy, &ap, sizeof ap);
+    const std::uint64_t ticket = nextTicket++;
+    Slot& slot = slots_[ticket % 2];
+    slot.ticket = ticket;
+    slot.completed = false;
+    slot.hasImage = copyImage;
+    slot.width = width;
+    slot.height = height;
+    slot.stats = FrameStats{};
+    slot.stats.samples = slots;
+    slot.invocations = invocations;
+    const VkDeviceSize imageBytes = static_cast<VkDeviceSize>(width) * static_cast<VkDeviceSize>(height) * 32;
+    if (copyImage) {
+      if (!slot.image.valid() || slot.image.size() != 2 * imageBytes)
+        slot.image = Buffer(ctx, 2 * imageBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, "image read-back");
+      slot.objects = builder.data().instanceObject;
+    }
+    slot.submitted = std::chrono::steady_clock::now();
+    ctx.submit([&](VkCommandBuffer cb) {
+      if (!items.empty()) {
+        // A slot the trace pass does not reach (its invocation ran out of loop budget) must read
+        // as weight 0, not as the last frame's sample.
+        vkCmdFillBuffer(cb, samples.handle(), 0, static_cast<VkDeviceSize>(slots) * sizeof(gpu::vec4), 0);
+        vk::computeBarrier(cb);
+        gpu::TracePush tp{0, static_cast<std::uint32_t>(slots), static_cast<std::uint32_t>(invocations), 0};
+        std::uint32_t gy;
+        std::uint32_t gx = groupsFor(invocations, gpu::kTraceWorkgroup, &gy);
+        trace->dispatch(cb, gx, gy, &tp, sizeof tp);
+        vk::computeBarrier(cb);
+        gpu::AccumulatePush ap{0, static_cast<std::uint32_t>(pixels), static_cast<std::uint32_t>(items.size()), 0};
+        gx = groupsFor(pixels, gpu::kAccumulateWorkgroup, &gy);
+        if (options.accumulate) accumulate->dispatch(cb, gx, gy, &ap, sizeof ap);
+      }
+      if (copyImage) {
+        // The accumulated image, copied while the device is at it: the CPU converts it later,
+        // while the device traces the next frame.
+        vk::computeBarrier(cb);
+        VkBufferCopy c{0, 0, imageBytes};
+        vkCmdCopyBuffer(cb, accum.handle(), slot.image.handle(), 1, &c);
+        c.dstOffset = imageBytes;
+        vkCmdCopyBuffer(cb, accumAux.handle(), slot.image.handle(), 1, &c);
+      }
     });
-    fs.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    inFlight = ticket;
+    return ticket;
+  }
+
+  // Waits for the frame in flight and takes its statistics.
+  void completeInFlight() {
+    if (!inFlight) return;
+    Slot& slot = slots_[inFlight % 2];
+    inFlight = 0;
+    ctx.wait();
+    FrameStats& fs = slot.stats;
+    fs.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - slot.submitted).count();
+    slot.completed = true;
+    if (fs.samples == 0) return;
     std::uint32_t counts[gpu::kStatsCount];
     stats.download(counts, sizeof counts);
-    fs.samples = slots;
     fs.primaryRays = counts[0];
     fs.bounceRays = counts[1];
     fs.shadowRays = counts[2];
@@ -396,26 +458,48 @@ struct Renderer::Impl {
     fs.cutPaths = counts[4];
     fs.maxSegmentIterations = counts[6];
     fs.loopIterations = static_cast<std::uint64_t>(counts[5]) * gpu::kLoopIterationUnit;
-    fs.pathsPerInvocation = static_cast<double>(slots) / static_cast<double>(invocations);
-    if (slots > 0) iterationsPerPath = static_cast<double>(fs.loopIterations) / static_cast<double>(slots);
-    return fs;
+    fs.pathsPerInvocation = static_cast<double>(fs.samples) / static_cast<double>(std::max<std::uint64_t>(slot.invocations, 1));
+    iterationsPerPath = static_cast<double>(fs.loopIterations) / static_cast<double>(fs.samples);
+  }
+
+  Slot& completedSlot(std::uint64_t ticket) {
+    Slot& slot = slots_[ticket % 2];
+    RETILE_ASSERT(slot.ticket == ticket, cat("frame ", ticket, " was overwritten by frame ", slot.ticket));
+    if (ticket == inFlight) completeInFlight();
+    return slot;
+  }
+
+  RenderImage frameImage(std::uint64_t ticket) {
+    Slot& slot = completedSlot(ticket);
+    RETILE_ASSERT(slot.hasImage, cat("frame ", ticket, " was submitted without its image"));
+    auto n = static_cast<std::size_t>(slot.width) * static_cast<std::size_t>(slot.height);
+    // Read through the mapping: the slot is not touched by the frame now in flight.
+    const auto* acc = static_cast<const gpu::vec4*>(slot.image.mapped());
+    return convert(acc, acc + n * 2, slot.width, slot.height, slot.objects);
   }
 
   RenderImage readback() {
-    RenderImage img;
-    img.width = width;
-    img.height = height;
+    completeInFlight();  // the frame in flight uses what this touches
     auto n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
     std::vector<gpu::vec4> acc(n * 2), ax(n * 2);
     accum.download(acc.data(), acc.size() * sizeof(gpu::vec4));
     accumAux.download(ax.data(), ax.size() * sizeof(gpu::vec4));
+    return convert(acc.data(), ax.data(), width, height, builder.data().instanceObject);
+  }
+
+  // Per pixel: accumulation [sum.rgb count, compensation.rgb -] and auxiliary [albedo.rgb depth,
+  // normal.xyz instance] to means.
+  static RenderImage convert(const gpu::vec4* acc, const gpu::vec4* ax, int w, int h, const std::vector<NodeId>& objects) {
+    RenderImage img;
+    img.width = w;
+    img.height = h;
+    auto n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
     img.color.resize(n * 3);
     img.albedo.resize(n * 3);
     img.normal.resize(n * 3);
     img.depth.resize(n);
     img.objectId.resize(n);
     img.sampleCount.resize(n);
-    const auto& objects = builder.data().instanceObject;
     for (std::size_t i = 0; i < n; ++i) {
       const gpu::vec4& s = acc[i * 2];
       const gpu::vec4& comp = acc[i * 2 + 1];
@@ -472,8 +556,13 @@ void Renderer::resize(int width, int height) { impl_->resize(width, height); }
 void Renderer::setMaxBounces(int maxBounces) { impl_->maxBounces = std::max(0, maxBounces); }
 void Renderer::setSeed(std::uint32_t seed) { impl_->seed = seed; }
 FrameStats Renderer::renderFrame(const std::vector<TileWork>& tiles, const FrameOptions& options) {
-  return impl_->renderFrame(tiles, options);
+  return completeFrame(submitFrame(tiles, options, false));
 }
+FrameTicket Renderer::submitFrame(const std::vector<TileWork>& tiles, const FrameOptions& options, bool copyImage) {
+  return FrameTicket{impl_->submitFrame(tiles, options, copyImage)};
+}
+FrameStats Renderer::completeFrame(FrameTicket frame) { return impl_->completedSlot(frame.id).stats; }
+RenderImage Renderer::frameImage(FrameTicket frame) { return impl_->frameImage(frame.id); }
 std::vector<float> Renderer::readbackFrameLuminance() { return impl_->readbackFrameLuminance(); }
 void Renderer::setSelection(NodeId object) { impl_->selectedObject = object; }
 SelectionCounts Renderer::takeSelectionCounts() { return impl_->takeSelectionCounts(); }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <map>
 
 #include "retile/log.h"
@@ -57,7 +58,21 @@ struct RenderSession::Impl {
   std::map<NodeId, Bounds3> meshBounds;  // object-space bounds, so an edit never walks a mesh
   std::vector<EditFacts> batch;          // edits applied since the last frame, planned together
   NodeId counting = kNoNode;             // the object the renderer's counters describe
+  // Frames submitted and not yet finished, oldest first (at most two: one read back while the
+  // next traces). Their records are filled at submission and completed when they finish.
+  struct Pending {
+    FrameTicket ticket;
+    FrameRecord rec;
+    AccumMode mode = AccumMode::Refinement;
+    bool counting = false;
+    bool readImage = false;
+    bool completed = false;  // the device is done and counters and probe are taken
+    FrameStats stats;
+    Clock::time_point start;
+  };
+  std::deque<Pending> pending;
   std::shared_ptr<const RenderImage> lastImage;
+  std::uint64_t lastImageFrame = 0;  // the frame lastImage shows the accumulation after
   RegionRect region;  // the render region in pixels (empty: the whole image)
 
   explicit Impl(const RendererOptions& o) : renderer(o) {}
@@ -122,6 +137,7 @@ std::string RenderSession::deviceName() const { return impl_->renderer.deviceNam
 const MethodSettings& RenderSession::method() const { return impl_->planner.method(); }
 
 void RenderSession::resize(int width, int height) {
+  completeGpu();  // the frame in flight's counters and probe belong to the state it was planned in
   width = std::clamp(width, 1, 16384);
   height = std::clamp(height, 1, 16384);
   impl_->width = width;
@@ -135,6 +151,7 @@ void RenderSession::resize(int width, int height) {
 }
 
 void RenderSession::setRegion(RegionRect region) {
+  completeGpu();  // the frame in flight's counters and probe belong to the state it was planned in
   // Clamped to the image; nothing left means no region.
   int x0 = std::clamp(region.x, 0, impl_->width), y0 = std::clamp(region.y, 0, impl_->height);
   int x1 = std::clamp(region.x + std::max(0, region.width), 0, impl_->width);
@@ -145,12 +162,14 @@ void RenderSession::setRegion(RegionRect region) {
 }
 
 void RenderSession::setMaxBounces(int maxBounces) {
+  completeGpu();  // the frame in flight's counters and probe belong to the state it was planned in
   scene_.settings.maxBounces = std::clamp(maxBounces, 0, 1024);
   impl_->renderer.setMaxBounces(scene_.settings.maxBounces);
   impl_->scheduler.globalUpdate();
 }
 
 std::string RenderSession::setMethod(const MethodSettings& method) {
+  completeGpu();  // the frame in flight's counters and probe belong to the state it was planned in
   if (std::string bad = validateMethodSettings(method); !bad.empty()) return bad;
   bool newGrid = method.tileSize != this->method().tileSize;
   impl_->planner.setMethod(method);
@@ -166,12 +185,16 @@ std::string RenderSession::setMethod(const MethodSettings& method) {
 }
 
 void RenderSession::select(NodeId object) {
+  completeGpu();  // the frame in flight's counters and probe belong to the state it was planned in
   if (object != kNoNode && !scene_.object(object)) object = kNoNode;
   selection_ = object;
   impl_->planner.select(object);
 }
 
-void RenderSession::setFocus(std::vector<FocusPoint> focus) { impl_->planner.setFocus(std::move(focus)); }
+void RenderSession::setFocus(std::vector<FocusPoint> focus) {
+  completeGpu();
+  impl_->planner.setFocus(std::move(focus));
+}
 
 namespace {
 
@@ -212,6 +235,7 @@ std::optional<Vec2> projectedCentre(const Camera& cam, int w, int h, const Bound
 void RenderSession::setDocumentVersion(std::uint64_t version) { impl_->documentVersion = version; }
 
 Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t documentVersion) {
+  completeGpu();  // the frame in flight's counters and probe belong to the state it was planned in
   Impl& d = *impl_;
   // Where the edit's targets were, before: a pass prioritizes their old and new places.
   std::vector<NodeId> targets;
@@ -272,28 +296,15 @@ Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t d
   return flags;
 }
 
-FrameRecord RenderSession::renderFrame(bool readImage) {
+void RenderSession::completeGpu() {
   Impl& d = *impl_;
-  auto start = Clock::now();
+  if (d.pending.empty() || d.pending.back().completed) return;
+  Impl::Pending& p = d.pending.back();
+  p.stats = d.renderer.completeFrame(p.ticket);
+  p.completed = true;
   const TileGrid& grid = d.scheduler.grid();
-  // One plan for every edit since the last frame; without edits, whatever quiet brings.
-  d.execute(d.batch.empty() ? d.planner.planQuiet(d.scheduler.passActive()) : d.planner.planBatch(d.batch));
-  d.batch.clear();
-  d.syncCounting();
-  FramePlan plan = d.scheduler.nextFrame();
-  std::vector<TileWork> work;
-  work.reserve(plan.chunks.size());
-  for (const TileChunk& c : plan.chunks)
-    work.push_back({c.rect.x, c.rect.y, c.rect.width, c.rect.height, c.quality, c.sampleBase, c.restart, c.capStale});
-  FrameOptions options;
-  options.accumulate = plan.mode != AccumMode::Probe;
-  const bool counting = d.planner.countThisFrame(plan.mode);
-  if (counting) options.selectionTileSize = grid.tileSize();
-  double scheduleMs = msSince(start);
 
-  FrameStats stats = d.renderer.renderFrame(work, options);
-
-  if (counting && d.planner.frameCounted()) {
+  if (p.counting && d.planner.frameCounted()) {
     SelectionCounts c = d.renderer.takeSelectionCounts();
     if (c.tileSize == grid.tileSize()) {
       // The object's own centre now is where its later motion is measured from.
@@ -303,12 +314,12 @@ FrameRecord RenderSession::renderFrame(bool readImage) {
     }
   }
 
-  auto readStart = Clock::now();
-  if (plan.mode == AccumMode::Probe) {
-    // Change-aware priority: per tile, how much the cheap new estimate differs from the old image.
+  if (p.mode == AccumMode::Probe && p.rec.width == d.width && p.rec.height == d.height) {
+    // Change-aware priority: per tile, how much the cheap new estimate differs from the image
+    // accumulated before the probe (the probe itself accumulates nothing).
     std::vector<float> now = d.renderer.readbackFrameLuminance();
     std::shared_ptr<const RenderImage> old = d.lastImage;
-    if (!old) old = std::make_shared<RenderImage>(d.renderer.readback());
+    if (!old || d.lastImageFrame + 1 != p.rec.frame) old = std::make_shared<RenderImage>(d.renderer.readback());
     std::vector<float> diff(static_cast<std::size_t>(grid.count()), 0.0f);
     for (int t = 0; t < grid.count(); ++t) {
       TileRect r = grid.rect(t);
@@ -327,8 +338,33 @@ FrameRecord RenderSession::renderFrame(bool readImage) {
     }
     d.execute(d.planner.planFromProbe(diff));
   }
+}
 
-  FrameRecord rec;
+void RenderSession::submitFrame(bool readImage) {
+  Impl& d = *impl_;
+  completeGpu();
+  RETILE_ASSERT(d.pending.size() < 2, cat(d.pending.size(), " frames unfinished: finish one before submitting"));
+  auto start = Clock::now();
+  const TileGrid& grid = d.scheduler.grid();
+  // One plan for every edit since the last frame; without edits, whatever quiet brings.
+  d.execute(d.batch.empty() ? d.planner.planQuiet(d.scheduler.passActive()) : d.planner.planBatch(d.batch));
+  d.batch.clear();
+  d.syncCounting();
+  FramePlan plan = d.scheduler.nextFrame();
+  std::vector<TileWork> work;
+  work.reserve(plan.chunks.size());
+  for (const TileChunk& c : plan.chunks)
+    work.push_back({c.rect.x, c.rect.y, c.rect.width, c.rect.height, c.quality, c.sampleBase, c.restart, c.capStale});
+  FrameOptions options;
+  options.accumulate = plan.mode != AccumMode::Probe;
+  Impl::Pending p;
+  p.mode = plan.mode;
+  p.counting = d.planner.countThisFrame(plan.mode);
+  if (p.counting) options.selectionTileSize = grid.tileSize();
+  p.readImage = readImage;
+  p.start = start;
+
+  FrameRecord& rec = p.rec;
   rec.frame = ++d.frame;
   rec.documentVersion = d.documentVersion;
   rec.method = methodName(method().kind);
@@ -348,20 +384,42 @@ FrameRecord RenderSession::renderFrame(bool readImage) {
   rec.tilePriority = d.scheduler.priorities();
   for (TileClass c : d.planner.classes()) rec.tileClass.push_back(static_cast<std::uint8_t>(c));
   rec.tileSamples.assign(d.scheduler.tileSamples().begin(), d.scheduler.tileSamples().end());
-  rec.servedTiles = plan.servedTiles;
+  rec.servedTiles = std::move(plan.servedTiles);
   rec.region = d.region;
   rec.queueLength = d.scheduler.queueLength();
   rec.queueServed = d.scheduler.queueServed();
-  rec.samples = stats.samples;
-  rec.scheduleMs = scheduleMs;
-  rec.traceMs = stats.seconds * 1e3;
-  if (readImage) {
-    d.lastImage = std::make_shared<RenderImage>(d.renderer.readback());
+  rec.scheduleMs = msSince(start);
+
+  p.ticket = d.renderer.submitFrame(work, options, readImage);
+  d.pending.push_back(std::move(p));
+}
+
+FrameRecord RenderSession::finishFrame() {
+  Impl& d = *impl_;
+  RETILE_ASSERT(!d.pending.empty(), "finishFrame without a submitted frame");
+  if (d.pending.size() == 1) completeGpu();  // else the oldest was completed when the next was submitted
+  Impl::Pending p = std::move(d.pending.front());
+  d.pending.pop_front();
+  auto readStart = Clock::now();
+  FrameRecord rec = std::move(p.rec);
+  rec.samples = p.stats.samples;
+  rec.traceMs = p.stats.seconds * 1e3;
+  if (p.readImage) {
+    d.lastImage = std::make_shared<RenderImage>(d.renderer.frameImage(p.ticket));
+    d.lastImageFrame = rec.frame;
     rec.image = d.lastImage;
   }
   rec.readbackMs = msSince(readStart);
-  rec.frameMs = msSince(start);
+  rec.frameMs = msSince(p.start);
   return rec;
+}
+
+std::size_t RenderSession::framesInFlight() const { return impl_->pending.size(); }
+
+FrameRecord RenderSession::renderFrame(bool readImage) {
+  RETILE_ASSERT(impl_->pending.empty(), "renderFrame while pipelined frames are unfinished");
+  submitFrame(readImage);
+  return finishFrame();
 }
 
 }  // namespace retile

@@ -63,6 +63,7 @@ Buffer::~Buffer() { release(); }
 
 void Buffer::release() {
   if (!ctx_) return;
+  ctx_->wait();  // the submission in flight may still use it
   VkDevice d = ctx_->device();
   if (view_) vkDestroyBufferView(d, view_, nullptr);
   if (buffer_) vkDestroyBuffer(d, buffer_, nullptr);
@@ -78,6 +79,7 @@ void Buffer::upload(const void* data, VkDeviceSize bytes, VkDeviceSize offset) {
   RETILE_ASSERT(offset + bytes <= size_, cat("upload of ", bytes, " bytes at ", offset, " into a buffer of ", size_));
   if (!bytes) return;
   if (mapped_) {
+    ctx_->wait();  // the submission in flight may be reading it
     std::memcpy(static_cast<char*>(mapped_) + offset, data, bytes);
     return;
   }
@@ -93,6 +95,7 @@ void Buffer::download(void* data, VkDeviceSize bytes, VkDeviceSize offset) {
   RETILE_ASSERT(offset + bytes <= size_, cat("download of ", bytes, " bytes at ", offset, " from a buffer of ", size_));
   if (!bytes) return;
   if (mapped_) {
+    ctx_->wait();  // the submission in flight may be writing it
     std::memcpy(data, static_cast<const char*>(mapped_) + offset, bytes);
     return;
   }

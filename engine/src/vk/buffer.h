@@ -28,9 +28,11 @@ class Buffer {
   bool valid() const { return buffer_ != VK_NULL_HANDLE; }
   void* mapped() const { return mapped_; }
 
-  // Copies bytes into the buffer at `offset`, directly when mapped, else through staging.
+  // Copies bytes into the buffer at `offset`, directly when mapped, else through staging. Either
+  // way it first waits for the context's submission in flight, as does destroying the buffer.
   void upload(const void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);
-  // Copies bytes out of the buffer (waits for the device through a staging copy if needed).
+  // Copies bytes out of the buffer, after waiting for the submission in flight. To read a buffer
+  // the submission in flight does not touch, use mapped() instead.
   void download(void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);
   // A texel view of the whole buffer in `format`, created on first use.
   VkBufferView view(VkFormat format);

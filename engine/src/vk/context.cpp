@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 #include "retile/log.h"
@@ -216,30 +217,43 @@ std::uint32_t Context::memoryType(std::uint32_t bits, VkMemoryPropertyFlags want
   throw Error("Vulkan: no suitable memory type for a buffer");
 }
 
-void Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record) {
+void Context::submit(const std::function<void(VkCommandBuffer)>& record) {
+  wait();  // one submission in flight at a time: its fence and command buffer are reused
   VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   ai.commandPool = pool_;
   ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   ai.commandBufferCount = 1;
   VkCommandBuffer cb;
   checkVk(vkAllocateCommandBuffers(device_, &ai, &cb), "allocating a command buffer");
-  struct Free {
-    VkDevice d;
-    VkCommandPool p;
-    VkCommandBuffer c;
-    ~Free() { vkFreeCommandBuffers(d, p, 1, &c); }
-  } freeLater{device_, pool_, cb};
-  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  checkVk(vkBeginCommandBuffer(cb, &bi), "beginning a command buffer");
-  record(cb);
-  checkVk(vkEndCommandBuffer(cb), "ending a command buffer");
-  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  si.commandBufferCount = 1;
-  si.pCommandBuffers = &cb;
-  checkVk(vkResetFences(device_, 1, &fence_), "resetting a fence");
-  checkVk(vkQueueSubmit(queue_, 1, &si, fence_), "submitting work");
-  checkVk(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "waiting for the device");
+  try {
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    checkVk(vkBeginCommandBuffer(cb, &bi), "beginning a command buffer");
+    record(cb);
+    checkVk(vkEndCommandBuffer(cb), "ending a command buffer");
+    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &cb;
+    checkVk(vkResetFences(device_, 1, &fence_), "resetting a fence");
+    checkVk(vkQueueSubmit(queue_, 1, &si, fence_), "submitting work");
+  } catch (...) {
+    vkFreeCommandBuffers(device_, pool_, 1, &cb);
+    throw;
+  }
+  pending_ = cb;
+}
+
+void Context::wait() {
+  if (pending_ == VK_NULL_HANDLE) return;
+  VkCommandBuffer cb = std::exchange(pending_, VK_NULL_HANDLE);
+  VkResult r = vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX);
+  vkFreeCommandBuffers(device_, pool_, 1, &cb);
+  checkVk(r, "waiting for the device");
+}
+
+void Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record) {
+  submit(record);
+  wait();
 }
 
 }  // namespace retile::vk

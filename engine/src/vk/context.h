@@ -37,7 +37,14 @@ class Context {
   // `fallback` flags. Throws when none fits.
   std::uint32_t memoryType(std::uint32_t bits, VkMemoryPropertyFlags wanted, VkMemoryPropertyFlags fallback) const;
 
-  // Records commands into a one-time command buffer, submits it and waits for it.
+  // Records commands into a one-time command buffer and submits it; returns while the device
+  // works. At most one submission is in flight: a second submit waits for the first.
+  void submit(const std::function<void(VkCommandBuffer)>& record);
+  // Waits for the submission in flight, if any. Any call that touches memory the device may be
+  // using (uploads, downloads, reallocations) must wait first.
+  void wait();
+  bool busy() const { return pending_ != VK_NULL_HANDLE; }
+  // submit, then wait.
   void submitAndWait(const std::function<void(VkCommandBuffer)>& record);
 
  private:
@@ -49,6 +56,7 @@ class Context {
   std::uint32_t queueFamily_ = 0;
   VkCommandPool pool_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
+  VkCommandBuffer pending_ = VK_NULL_HANDLE;  // the submission in flight
   VkPhysicalDeviceProperties props_{};
   VkPhysicalDeviceMemoryProperties memProps_{};
   std::string name_;
