@@ -201,6 +201,29 @@ TEST(Planner, IndirectionDragMovesDirectTilesKeepsShadowsAndEveryClass) {
   EXPECT_LE(plan.quality * pixelsOf(g, high), g.pixels());
 }
 
+TEST(Planner, IndirectionPlusFocusRanksClassesThenFocusSpirals) {
+  TileGrid g(320, 180, 16);
+  MethodSettings m = methodOf(MethodKind::IndirectionFocus, 0);
+  m.focus = {{{300, 170}, false}};
+  Planner p(g, m);
+  p.select(kCup);
+  std::vector<int> direct = {g.index(2, 2)};
+  gather(p, kCup, countsOf(g, direct, {}, {}), {40, 40});
+  EditFacts edit;
+  edit.object = kCup;
+  edit.pointOfChange = {40, 40};
+  edit.centreBefore = edit.centreAfter = Vec2{40, 40};
+  Plan plan = p.planBatch({edit});
+  ASSERT_EQ(plan.leading, 1);
+  EXPECT_EQ(plan.order[0], direct[0]);
+  // After the classes, the point of change's and the focus point's spirals take turns.
+  EXPECT_EQ(plan.order[1], g.tileAt({300, 170}));
+  std::vector<int> rest;
+  for (int t : interleavedSpirals(g, {g.tileAt({40, 40}), g.tileAt({300, 170})}))
+    if (t != direct[0]) rest.push_back(t);
+  EXPECT_EQ(std::vector<int>(plan.order.begin() + 1, plan.order.end()), rest);
+}
+
 TEST(Planner, CountersDescribeTheEditsTargetNotTheSelection) {
   // Defect: a light edit while the cup was selected prioritized the cup's tiles.
   TileGrid g(320, 180, 16);
