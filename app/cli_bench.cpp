@@ -193,6 +193,67 @@ int benchEdit(const std::vector<std::string>& argv) {
   return 0;
 }
 
+// The denoiser's cost: the whole frame denoised and composed, against a frame of 1 spp traced and
+// accumulated at the same size (what the denoise variants add to each frame of the global method
+// and of continuous refinement; incremental passes denoise only a growing region, now and then).
+int benchDenoise(const std::vector<std::string>& argv) {
+  auto args = parseArgs(argv, {"--size", "--frames"});
+  if (!args || args->positional.size() > 1) {
+    std::fprintf(stderr, "usage: retile bench denoise [SCENE] [--size WxH] [--frames N]\n");
+    return 2;
+  }
+  int w = 640, h = 360, frames = 15;
+  if (args->has("--size")) {
+    auto r = parseSize(args->get("--size"), &w, &h);
+    if (!r) return std::fprintf(stderr, "error: %s\n", r.error().c_str()), 2;
+  }
+  if (args->has("--frames")) {
+    auto v = parseInt("--frames", args->get("--frames"), 1, 10000);
+    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
+    frames = v.value();
+  }
+  auto loaded = loadScene(args->positional.empty() ? "default" : args->positional[0]);
+  if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
+  Renderer renderer;
+  printRenderWarnings(renderer.setScene(loaded->scene), loaded->warnings);
+  renderer.resize(w, h);
+  FrameOptions denoise;
+  denoise.denoise = wholeFrameDenoise(w, h);
+  FrameOptions composeOnly = denoise;
+  composeOnly.denoise.filter = false;
+  TileWork all{0, 0, w, h, 1, 0, true};
+  // Warm-up: pipelines and buffers are made on first use.
+  renderer.renderFrame({all});
+  renderer.renderFrame({}, denoise);
+  // Interleaved, one of each per round, and the medians: the machine's speed drifts by 10 to 20 %
+  // over minutes, so only figures taken side by side compare.
+  auto ms = [](auto&& what) {
+    auto t0 = Clock::now();
+    what();
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  };
+  std::vector<double> trace, denoised, composed;
+  for (int i = 0; i < frames; ++i) {
+    all.sampleBase = static_cast<std::uint32_t>(i + 1);
+    all.restart = false;
+    trace.push_back(ms([&] { renderer.renderFrame({all}); }));
+    denoised.push_back(ms([&] { renderer.renderFrame({}, denoise); }));
+    composed.push_back(ms([&] { renderer.renderFrame({}, composeOnly); }));
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  double traceMs = median(trace), denoiseMs = median(denoised), composeMs = median(composed);
+  std::printf("image          %dx%d, %s\n", w, h, args->positional.empty() ? "default" : args->positional[0].c_str());
+  std::printf("frame          %.1f ms (1 spp traced and accumulated; medians of %d interleaved rounds)\n", traceMs, frames);
+  std::printf("denoise        %.1f ms (prepare, variance, 5 a-trous iterations, finish, compose)\n", denoiseMs);
+  std::printf("compose        %.1f ms (the compositor alone)\n", composeMs);
+  std::printf("denoise share  %.1f ms a frame at %dx%d: %.0f %% of the %.1f ms frame\n", denoiseMs, w, h,
+              100.0 * denoiseMs / traceMs, traceMs);
+  return 0;
+}
+
 // Frames per second of the render thread as the editor drives it (Engine, newest frame to the
 // mailbox), at rest or while an object is dragged (one move submitted per published frame), for
 // `--seconds` after one second of warm-up.
@@ -268,7 +329,7 @@ int runBench(const std::vector<std::string>& argv) {
   if (argv.empty()) {
     std::fprintf(stderr,
                  "usage: retile bench throughput SCENE ... | retile bench bvh [--triangles N] | retile bench edit\n"
-                 "       | retile bench frames SCENE ...\n");
+                 "       | retile bench frames SCENE ... | retile bench denoise [SCENE] [--size WxH]\n");
     return 2;
   }
   std::vector<std::string> rest(argv.begin() + 1, argv.end());
@@ -276,7 +337,8 @@ int runBench(const std::vector<std::string>& argv) {
   if (argv[0] == "bvh") return benchBvh(rest);
   if (argv[0] == "edit") return benchEdit(rest);
   if (argv[0] == "frames") return benchFrames(rest);
-  std::fprintf(stderr, "retile bench: unknown benchmark '%s' (throughput, bvh, edit, frames)\n", argv[0].c_str());
+  if (argv[0] == "denoise") return benchDenoise(rest);
+  std::fprintf(stderr, "retile bench: unknown benchmark '%s' (throughput, bvh, edit, frames, denoise)\n", argv[0].c_str());
   return 2;
 }
 

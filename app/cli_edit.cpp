@@ -25,6 +25,7 @@ void usage(const std::string& error) {
                "usage: retile edit SCENE --script EDITS.json --method NAME --out-dir DIR [--size WxH] [--tile T]\n"
                "                   [--quality Q|auto] [--smooth] [--stale-cap N] [--converge SPP] [--max-bounces B]\n"
                "                   [--reference SPP] [--block B] [--threshold REL] [--no-images]\n"
+               "                   [--denoise [--denoise-threshold PX] [--no-soft-borders]]\n"
                "methods:");
   for (const auto& n : methodNames()) std::fprintf(stderr, " %s", n.c_str());
   std::fprintf(stderr, "\n");
@@ -52,8 +53,8 @@ Result<Scene> finalState(const Scenario& sc, Scene scene) {
 int runEdit(const std::vector<std::string>& argv) {
   auto args = parseArgs(argv,
                         {"--script", "--method", "--out-dir", "--size", "--tile", "--quality", "--stale-cap", "--converge",
-                         "--max-bounces", "--reference", "--block", "--threshold"},
-                        {"--smooth", "--no-images"});
+                         "--max-bounces", "--reference", "--block", "--threshold", "--denoise-threshold"},
+                        {"--smooth", "--no-images", "--denoise", "--no-soft-borders"});
   if (!args) return usage(args.error()), 2;
   if (args->positional.size() != 1 || !args->has("--script") || !args->has("--method") || !args->has("--out-dir"))
     return usage("SCENE, --script, --method and --out-dir are required"), 2;
@@ -75,7 +76,8 @@ int runEdit(const std::vector<std::string>& argv) {
   int converge = -1, maxBounces = -1, reference = 0, block = 4;
   if (!intOpt("--tile", 8, 32, &method.tileSize) || !intOpt("--stale-cap", 1, 1 << 20, &method.staleCap) ||
       !intOpt("--converge", 0, 1 << 20, &converge) || !intOpt("--max-bounces", 0, 1024, &maxBounces) ||
-      !intOpt("--reference", 1, 1 << 20, &reference) || !intOpt("--block", 1, 64, &block))
+      !intOpt("--reference", 1, 1 << 20, &reference) || !intOpt("--block", 1, 64, &block) ||
+      !intOpt("--denoise-threshold", 0, 16384, &method.denoiseThreshold))
     return 2;
   double threshold = 0.01;
   if (args->has("--threshold")) {
@@ -84,6 +86,10 @@ int runEdit(const std::vector<std::string>& argv) {
     threshold = v.value();
   }
   method.smooth = args->has("--smooth");
+  method.denoise = args->has("--denoise");
+  method.softBorders = !args->has("--no-soft-borders");
+  if (!method.denoise && (args->has("--denoise-threshold") || args->has("--no-soft-borders")))
+    return usage("--denoise-threshold and --no-soft-borders go with --denoise"), 2;
   if (std::string bad = validateMethodSettings(method); !bad.empty()) return usage(bad), 2;
 
   auto loaded = loadScene(args->positional[0]);
@@ -149,7 +155,8 @@ int runEdit(const std::vector<std::string>& argv) {
   }
 
   std::ofstream csv(outDir / "frames.csv");
-  csv << "frame,step,method,mode,samples,tiles_served,queue_left,quality,ms,schedule_ms,trace_ms,rel_rmse\n";
+  csv << "frame,step,method,mode,samples,tiles_served,queue_left,quality,ms,schedule_ms,trace_ms,rel_rmse,"
+         "denoise_regions,denoise_width,denoise_height\n";
   const int total = scenario->totalFrames();
   int frame = 0, lastEditFrame = 0, settledFrame = -1;
   double sumScheduleMs = 0;
@@ -171,15 +178,17 @@ int runEdit(const std::vector<std::string>& argv) {
       settledFrame = -1;
     }
     exact = exact && rec.samples == static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
-    double err = !ref.empty() && rec.image ? relativeRmse(rec.image->color, ref, w, h, block) : NAN;
+    // The error of what the method shows (denoised, when it denoises).
+    double err = !ref.empty() && rec.image ? relativeRmse(rec.image->shown(), ref, w, h, block) : NAN;
     if (!ref.empty() && frame > lastEditFrame && settledFrame < 0 && err < threshold) settledFrame = frame;
     if (!ref.empty() && err >= threshold) settledFrame = -1;  // settled means: stays under
     sumScheduleMs += rec.scheduleMs;
     char line[512];
-    std::snprintf(line, sizeof line, "%d,%zu,%s,%s,%llu,%zu,%zu,%d,%.3f,%.4f,%.3f,%s\n", frame, sub.step, rec.method.c_str(),
-                  rec.mode.c_str(), static_cast<unsigned long long>(rec.samples), rec.servedTiles.size(),
+    const RegionRect outer = rec.denoised.empty() ? RegionRect{} : rec.denoised.back().rect;
+    std::snprintf(line, sizeof line, "%d,%zu,%s,%s,%llu,%zu,%zu,%d,%.3f,%.4f,%.3f,%s,%zu,%d,%d\n", frame, sub.step,
+                  rec.method.c_str(), rec.mode.c_str(), static_cast<unsigned long long>(rec.samples), rec.servedTiles.size(),
                   rec.queueLength - rec.queueServed, rec.quality, rec.frameMs, rec.scheduleMs, rec.traceMs,
-                  std::isnan(err) ? "" : std::to_string(err).c_str());
+                  std::isnan(err) ? "" : std::to_string(err).c_str(), rec.denoised.size(), outer.width, outer.height);
     csv << line;
     if (images && rec.image) {
       char name[64];
@@ -216,7 +225,7 @@ int runEdit(const std::vector<std::string>& argv) {
     if (!finishOne()) return 1;
   const double wallMs = elapsed() * 1e3;
   csv.close();
-  std::printf("method         %s%s, T=%d, Q=%s\n", methodName(method.kind), method.smooth ? " (smooth)" : "", method.tileSize,
+  std::printf("method         %s, T=%d, Q=%s\n", methodLabel(method).c_str(), method.tileSize,
               method.quality ? std::to_string(method.quality).c_str() : "auto");
   std::printf("frames         %d after %d converging; every frame traced %s %dx%d samples\n", frame, converge,
               exact ? "exactly" : "NOT", w, h);

@@ -10,13 +10,15 @@
 namespace retile::cli {
 
 int runRender(const std::vector<std::string>& argv) {
-  auto args = parseArgs(argv, {"--size", "--spp", "--seed", "--max-bounces", "--out", "--view", "--exposure"});
+  auto args = parseArgs(argv, {"--size", "--spp", "--seed", "--max-bounces", "--out", "--view", "--exposure"}, {"--denoise"});
   if (!args || args->positional.size() != 1) {
-    std::fprintf(stderr, "%s%susage: retile render SCENE [--size WxH] [--spp N] [--seed S] [--max-bounces B] [--out FILE]\n",
+    std::fprintf(stderr,
+                 "%s%susage: retile render SCENE [--size WxH] [--spp N] [--seed S] [--max-bounces B] [--denoise] [--out FILE]\n",
                  args ? "" : args.error().c_str(), args ? "" : "\n");
     return 2;
   }
   RenderRequest req;
+  req.denoise = args->has("--denoise");
   if (args->has("--size")) {
     auto r = parseSize(args->get("--size"), &req.width, &req.height);
     if (!r) return std::fprintf(stderr, "error: %s\n", r.error().c_str()), 2;
@@ -70,9 +72,9 @@ int runRender(const std::vector<std::string>& argv) {
     return 1;
   }
   double seconds = elapsed();
-  std::printf("wrote %s (%dx%d, %.0f spp, %.1f s, %.3f M samples/s)\n", std::filesystem::absolute(out).string().c_str(),
+  std::printf("wrote %s (%dx%d, %.0f spp%s, %.1f s, %.3f M samples/s)\n", std::filesystem::absolute(out).string().c_str(),
               image.width, image.height, image.sampleCount.empty() ? 0.0 : static_cast<double>(image.sampleCount[0]),
-              seconds, stats.seconds > 0 ? static_cast<double>(stats.samples) / stats.seconds * 1e-6 : 0.0);
+              req.denoise ? ", denoised" : "", seconds, stats.seconds > 0 ? static_cast<double>(stats.samples) / stats.seconds * 1e-6 : 0.0);
   return 0;
 }
 

@@ -13,9 +13,10 @@ layout(set = 0, binding = 0, std140) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1, std430) readonly buffer Work { WorkItem items[]; };
 layout(set = 0, binding = 2, std430) readonly buffer Samples { vec4 samples[]; };
 layout(set = 0, binding = 3, std430) readonly buffer Aux { vec4 aux[]; };
-// Per pixel: [0] colour sum.rgb, sample count; [1] compensation.rgb, -.
+// Per pixel: [0] colour sum.rgb, sample count; [1] compensation.rgb, sum of squared luminances
+// (the second moment, so the denoiser has every pixel's variance whatever tiles restarted).
 layout(set = 0, binding = 4, std430) buffer Accum { vec4 accum[]; };
-// Per pixel: [0] albedo sum.rgb, depth; [1] normal sum.xyz, instance id.
+// Per pixel (kAuxVec4s): [0] albedo sum.rgb, depth; [1] normal sum.xyz, instance id; [2] emission sum.rgb, -.
 layout(set = 0, binding = 5, std430) buffer AccumAux { vec4 accumAux[]; };
 
 layout(push_constant) uniform Push { AccumulatePush push; };
@@ -44,7 +45,8 @@ void main() {
   precise vec3 sum = vec3(0.0);
   precise vec3 lost = vec3(0.0);
   precise float count = 0.0;
-  vec3 albedo = vec3(0.0), normal = vec3(0.0);
+  precise float squares = 0.0;
+  vec3 albedo = vec3(0.0), normal = vec3(0.0), emission = vec3(0.0);
   float depth = 1e30;
   float instance = intBitsToFloat(0);
   bool haveInstance = false;
@@ -56,12 +58,15 @@ void main() {
     lost = (t - sum) - y;
     sum = t;
     count += s.w;
+    float lum = dot(s.rgb, vec3(0.2126, 0.7152, 0.0722));
+    squares += lum * lum;
     // Weight 0: a non-finite sample, or a slot the trace pass did not reach; its auxiliary
     // outputs are left out too.
     if (s.w == 0.0) continue;
-    vec4 a0 = aux[slot * 2u], a1 = aux[slot * 2u + 1u];
+    vec4 a0 = aux[slot * kAuxVec4s], a1 = aux[slot * kAuxVec4s + 1u], a2 = aux[slot * kAuxVec4s + 2u];
     albedo += a0.rgb;
     normal += a1.xyz;
+    emission += a2.rgb;
     depth = min(depth, a0.w);
     if (!haveInstance) instance = a1.w;
     haveInstance = true;
@@ -70,24 +75,27 @@ void main() {
   bool restart = (item.info.w & kWorkRestart) != 0u;
   vec4 acc = restart ? vec4(0.0) : accum[pixel * 2u];
   vec4 comp = restart ? vec4(0.0) : accum[pixel * 2u + 1u];
-  vec4 aa = restart ? vec4(0.0, 0.0, 0.0, 1e30) : accumAux[pixel * 2u];
-  vec4 an = restart ? vec4(0.0) : accumAux[pixel * 2u + 1u];
+  vec4 aa = restart ? vec4(0.0, 0.0, 0.0, 1e30) : accumAux[pixel * kAuxVec4s];
+  vec4 an = restart ? vec4(0.0) : accumAux[pixel * kAuxVec4s + 1u];
+  vec4 ae = restart ? vec4(0.0) : accumAux[pixel * kAuxVec4s + 2u];
   if (!restart && (item.info.w & kWorkCapStale) != 0u && acc.w > float(item.pixels.y)) {
     // Smooth transition: the stale sums keep the weight of at most `cap` samples, so the old
     // image fades out in a known number of frames instead of after as many as it had samples.
     float keep = float(item.pixels.y) / acc.w;
     acc = vec4(acc.rgb * keep, float(item.pixels.y));
-    comp.rgb *= keep;
+    comp *= keep;
     aa.rgb *= keep;
     an.xyz *= keep;
+    ae.rgb *= keep;
   }
   // Kahan: add (sum - compensation); the new compensation is what the addition lost.
   precise vec3 y = (sum - lost) - comp.rgb;
   precise vec3 t = acc.rgb + y;
   precise vec3 c = (t - acc.rgb) - y;
   accum[pixel * 2u] = vec4(t, acc.w + count);
-  accum[pixel * 2u + 1u] = vec4(c, 0.0);
+  accum[pixel * 2u + 1u] = vec4(c, comp.w + squares);
 
-  accumAux[pixel * 2u] = vec4(aa.rgb + albedo, min(aa.w, depth));
-  accumAux[pixel * 2u + 1u] = vec4(an.xyz + normal, instance);
+  accumAux[pixel * kAuxVec4s] = vec4(aa.rgb + albedo, min(aa.w, depth));
+  accumAux[pixel * kAuxVec4s + 1u] = vec4(an.xyz + normal, instance);
+  accumAux[pixel * kAuxVec4s + 2u] = vec4(ae.rgb + emission, 0.0);
 }

@@ -98,8 +98,15 @@ struct Path {
   vec3 prevPos;
   int depth;
   int selBase;
-  vec3 auxAlbedo, auxNormal;
-  float auxDepth;  // kInfinity until the first hit that reflects
+  // Denoiser guides from the first hit that is not a mirror or glass (guideLooksThrough: so
+  // reflections and what is seen through glass keep their own edges): its albedo times the
+  // throughput of the chain before it, its normal, the distance along the path to it, and the
+  // emission the path collects up to it (the denoiser filters the rest and adds it back, so a
+  // light's edge stays exact). An emitter that does not reflect is such a hit too. The object id
+  // is the first hit's (picking).
+  vec3 auxAlbedo, auxNormal, auxEmission;
+  float auxDepth;  // kInfinity until that hit
+  float travelled; // distance along the path so far
   int auxInstance;
 };
 
@@ -118,8 +125,8 @@ Path startPath(uint slot) {
   path.slot = slot;
   path.rng = rngInit(uint(py) * width + uint(px), item.info.z + rep, frame.image.z);
 
-  // Every sample jitters its own primary ray over the pixel (box filter).
-  vec2 jitter = rand2(path.rng);
+  // Every sample jitters its own primary ray over the pixel (box filter), evenly over the pixel's samples.
+  vec2 jitter = pixelJitter(uint(py) * width + uint(px), item.info.z + rep, frame.image.z);
   vec2 ndc = vec2((float(px) + jitter.x) / float(width), (float(py) + jitter.y) / float(height)) * 2.0 - 1.0;
   float tanHalf = frame.cameraPosition.w;
   path.rd = normalize(frame.cameraForward.xyz + ndc.x * tanHalf * frame.cameraRight.w * frame.cameraRight.xyz -
@@ -135,9 +142,18 @@ Path startPath(uint slot) {
   path.selBase = selectionBase(px, py);
   path.auxAlbedo = vec3(0.0);
   path.auxNormal = vec3(0.0);
+  path.auxEmission = vec3(0.0);
   path.auxDepth = kInfinity;
+  path.travelled = 0.0;
   path.auxInstance = 0;
   return path;
+}
+
+// Surfaces whose reflection or refraction shows other objects' edges: mirrors, smooth glass and
+// metal, and their nearly smooth rough kinds. The denoiser's guides look through them.
+bool guideLooksThrough(Material m) {
+  bool nearlySmooth = (isMat(m.type, kMatRoughConductor) || isMat(m.type, kMatRoughDielectric)) && m.roughness < 0.1;
+  return (isDeltaMaterial(m) && !isMat(m.type, kMatNull)) || nearlySmooth;
 }
 
 // Writes the path's sample and first-hit outputs to its slot, weighted 1 once it has ended. A
@@ -146,8 +162,9 @@ Path startPath(uint slot) {
 void writeSample(Path path, bool ended) {
   bool valid = !(any(isnan(path.L)) || any(isinf(path.L)));
   samples[path.slot] = valid ? vec4(path.L, ended ? 1.0 : 0.0) : vec4(0.0);
-  aux[path.slot * 2u] = vec4(path.auxAlbedo, path.auxDepth);
-  aux[path.slot * 2u + 1u] = vec4(path.auxNormal, intBitsToFloat(path.auxInstance));
+  aux[path.slot * kAuxVec4s] = vec4(path.auxAlbedo, path.auxDepth);
+  aux[path.slot * kAuxVec4s + 1u] = vec4(path.auxNormal, intBitsToFloat(path.auxInstance));
+  aux[path.slot * kAuxVec4s + 2u] = vec4(path.auxEmission, 0.0);
 }
 
 // Traces one segment of the path and shades its hit: emission, next-event estimation and the
@@ -166,12 +183,11 @@ bool extendPath(inout Path path) {
 
   if (hit.prim < 0) {
     vec3 Le = envRadiance(rd);
-    if (path.specular) {
-      path.L += path.beta * Le;
-    } else {
-      float lightPdf = frame.lightPick.y * envPdf(rd);
-      path.L += path.beta * Le * powerHeuristic(path.prevPdf, lightPdf);
-    }
+    vec3 added = path.beta * Le;
+    if (!path.specular) added *= powerHeuristic(path.prevPdf, frame.lightPick.y * envPdf(rd));
+    path.L += added;
+    // The sky seen directly or through mirrors and glass is emission to the denoiser, like a light.
+    if (path.auxDepth >= kInfinity) path.auxEmission += added;
     return false;
   }
 
@@ -208,24 +224,31 @@ bool extendPath(inout Path path) {
   vec3 wo = -rd;
   bool frontFace = dot(ng, wo) > 0.0;
 
-  if (hasFeature(kFeatureEmitters) && (instFlags & kInstanceEmissive) != 0 && frontFace) {
-    if (path.specular) {
-      path.L += path.beta * m.emission;
-    } else {
+  bool emits = hasFeature(kFeatureEmitters) && (instFlags & kInstanceEmissive) != 0 && frontFace;
+  vec3 emitted = vec3(0.0);
+  if (emits) {
+    emitted = path.beta * m.emission;
+    if (!path.specular) {
       int emitter = floatBitsToInt(info.w) + (hit.prim - floatBitsToInt(info.y));
-      float lightPdf = emitterPdf(emitter, path.prevPos, pos, dot(ng, wo));
-      path.L += path.beta * m.emission * powerHeuristic(path.prevPdf, lightPdf);
+      emitted *= powerHeuristic(path.prevPdf, emitterPdf(emitter, path.prevPos, pos, dot(ng, wo)));
+    }
+    path.L += emitted;
+  }
+
+  path.travelled += hit.t;
+  if (path.depth == 0) path.auxInstance = floatBitsToInt(info2.x);
+  bool nullMaterial = isMat(m.type, kMatNull);
+  if (path.auxDepth >= kInfinity) {
+    // Up to and at the guide hit, what the path collects from lights is emission to the denoiser.
+    path.auxEmission += emitted;
+    if (!guideLooksThrough(m)) {
+      path.auxAlbedo = nullMaterial ? vec3(0.0) : path.beta * m.albedo;
+      path.auxNormal = frontFace ? ns : -ns;
+      path.auxDepth = path.travelled;
     }
   }
 
-  if (isMat(m.type, kMatNull)) return false;  // an emitter that does not reflect: the path ends here
-
-  if (path.auxDepth >= kInfinity) {
-    path.auxAlbedo = m.albedo;
-    path.auxNormal = frontFace ? ns : -ns;
-    path.auxDepth = length(pos - frame.cameraPosition.xyz);
-    path.auxInstance = floatBitsToInt(info2.x);
-  }
+  if (nullMaterial) return false;  // an emitter that does not reflect: the path ends here
 
   if (path.depth >= maxBounces) return false;
 
@@ -314,7 +337,9 @@ void main() {
   path.L = vec3(0.0);
   path.auxAlbedo = vec3(0.0);
   path.auxNormal = vec3(0.0);
+  path.auxEmission = vec3(0.0);
   path.auxDepth = kInfinity;
+  path.travelled = 0.0;
   path.auxInstance = 0;
   bool alive = false;
   uint cutPaths = 0u;

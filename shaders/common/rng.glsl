@@ -31,4 +31,16 @@ vec2 rand2(inout Rng r) {
   return vec2(a, rand(r));
 }
 
+// A sample's position in its pixel: the R2 sequence (Roberts, "The unreasonable effectiveness of
+// quasirandom sequences", 2018) over the pixel's sample index, shifted by a random offset per pixel
+// (a Cranley-Patterson rotation, so neighbouring pixels do not share a pattern). Any run of
+// consecutive samples of a pixel covers it far more evenly than independent ones: a light's or a
+// window's edge converges much faster. In 32-bit fixed point, exact for any index.
+vec2 pixelJitter(uint pixel, uint sampleIndex, uint seed) {
+  uint h = pcgHash(pixel ^ pcgHash(seed + 0x85ebca6bu));
+  uvec2 offset = uvec2(h, pcgHash(h));
+  uvec2 x = offset + uvec2(3242174889u, 2447445413u) * sampleIndex;  // 2^32 times (1/phi2, 1/phi2^2)
+  return vec2(x >> 8u) * (1.0 / 16777216.0);
+}
+
 #endif

@@ -81,6 +81,10 @@ RT_CONST(uint, kLoopBudget, 30000u)
 RT_CONST(uint, kLoopLimit, 32000u)
 RT_CONST(uint, kLoopIterationUnit, 16u)  // the loop-iteration sum counts in these units, so 32 bits suffice
 RT_CONST(int, kAccumulateWorkgroup, 64)
+// Auxiliary (guide) outputs, per sample slot and per accumulated pixel: [0] albedo.rgb, depth;
+// [1] normal.xyz, object instance; [2] emission.rgb seen at the guide hit, -. The guides come from
+// the first hit that is not a mirror or glass (see trace.comp).
+RT_CONST(uint, kAuxVec4s, 3u)
 RT_CONST(int, kMaxWorkItems, 65536)
 
 // One frame's constants (std140 uniform block).
@@ -125,7 +129,28 @@ struct AccumulatePush {
   uint pad;
 };
 
+// The denoiser (denoise_*.comp) and the compositor (compose.comp). Per tile, a code says what the
+// displayed image shows there: the raw accumulation (stale: the pass has not re-rendered it yet;
+// fresh: it has), or the denoised layer (a region's frozen result). kTileWrite marks the tiles
+// that take this frame's denoised result into the layer.
+RT_CONST(int, kDenoiseTile, 8)        // workgroups of 8x8 pixels
+RT_CONST(int, kDenoiseIterations, 5)   // a-trous steps 1, 2, 4, 8, 16: a 125-pixel footprint
+RT_CONST(uint, kTileStale, 0u)
+RT_CONST(uint, kTileFresh, 1u)
+RT_CONST(uint, kTileLayer, 2u)
+RT_CONST(uint, kTileKindMask, 0xffffu)  // kind, or kTileLayer + region index: the seam test compares codes
+RT_CONST(uint, kTilePreviousLayer, 0xffffu)  // the layer's result from before the pass
+RT_CONST(uint, kTileFiltered, 0x40000000u)   // its pixels take part in the filter
+RT_CONST(uint, kTileWrite, 0x80000000u)
+
+struct DenoisePush {
+  ivec4 domain;  // x0, y0, width, height: the pixels filtered (the whole image for compose)
+  uvec4 image;   // width, height, a-trous step, feather width in pixels (compose; 0: none)
+  uvec4 tiles;   // tile size, tile columns, a-trous axis (0: x, 1: y), -
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(DenoisePush) == 48);
 static_assert(sizeof(FrameUniforms) == 11 * 16);
 static_assert(sizeof(WorkItem) == 48);
 static_assert(sizeof(TracePush) == 16);

@@ -235,16 +235,12 @@ std::uint32_t pcgHash(std::uint32_t v) {
   std::uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
   return (word >> 22u) ^ word;
 }
-float nextRandom(std::uint32_t& state) {
-  state = state * 747796405u + 2891336453u;
-  std::uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-  word = (word >> 22u) ^ word;
-  return static_cast<float>(word >> 8) * (1.0f / 16777216.0f);
-}
 CameraRay cameraRay(const Camera& c, int w, int h, int px, int py, std::uint32_t sampleIndex, std::uint32_t seed) {
-  std::uint32_t state = pcgHash(static_cast<std::uint32_t>(py * w + px) ^ pcgHash(sampleIndex ^ pcgHash(seed + 0x9e3779b9u)));
-  float jx = nextRandom(state);
-  float jy = nextRandom(state);
+  // rng.glsl pixelJitter: R2 over the sample index, rotated by a per-pixel offset.
+  std::uint32_t hash = pcgHash(static_cast<std::uint32_t>(py * w + px) ^ pcgHash(seed + 0x85ebca6bu));
+  std::uint32_t ox = hash + 3242174889u * sampleIndex, oy = pcgHash(hash) + 2447445413u * sampleIndex;
+  float jx = static_cast<float>(ox >> 8) * (1.0f / 16777216.0f);
+  float jy = static_cast<float>(oy >> 8) * (1.0f / 16777216.0f);
   Vec3 forward = normalize(c.target - c.position);
   Vec3 right = normalize(cross(forward, c.up));
   Vec3 up = cross(right, forward);

@@ -22,6 +22,11 @@ struct RenderImage {
   std::vector<float> depth;          // distance to the first hit; +inf for the background
   std::vector<NodeId> objectId;      // object of the first hit; kNoNode for the background
   std::vector<float> sampleCount;    // samples accumulated per pixel
+  std::vector<float> moment2;        // mean of the samples' squared luminance (with the mean: variance)
+  // RGB as displayed: the denoised layer and the raw accumulation composed with soft borders
+  // (DenoiseWork). Empty when nothing was composed: then `color` is what is shown.
+  std::vector<float> display;
+  const std::vector<float>& shown() const { return display.empty() ? color : display; }
 };
 
 struct DisplaySettings {
@@ -30,7 +35,8 @@ struct DisplaySettings {
   float gamma = 1.0f;             // extra display gamma after the view transform
 };
 
-// EXR: linear half-float R,G,B plus albedo.*, N.*, Z and id channels. PNG: 8-bit through the
+// EXR: linear half-float R,G,B (the shown image: denoised when it was) plus raw.* (the
+// accumulation, when denoised), albedo.*, N.*, Z and id channels. PNG: 8-bit through the
 // display transform. Chosen by extension; written atomically (temporary file, then rename).
 Result<bool> writeRenderImage(const RenderImage& image, const std::filesystem::path& file,
                               const DisplaySettings& display = {});

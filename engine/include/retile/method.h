@@ -37,7 +37,18 @@ struct MethodSettings {
                          // frames of fresh samples at q each is staleCap / (staleCap + n q)
   std::vector<FocusPoint> focus;  // up to 3
   int indirectionFrames = 4;      // frames over which the indirection counters are gathered
+  // Denoising (schedule/denoise_regions.h): the global method and continuous refinement denoise
+  // the whole frame each frame; a pass denoises a growing region, re-sized when its width or
+  // height grew by more than the threshold (pixels) since the last re-size.
+  bool denoise = false;
+  int denoiseThreshold = 200;
+  bool softBorders = true;  // with denoise: seams between tiles showing different things blend
+  static constexpr int kFeatherPixels = 4;  // over this many pixels each side
 };
+
+// "spiral", "spiral+smooth", "global+denoise", "indirection+focus+smooth+denoise": the method and
+// its options, as reports and frame records name it.
+std::string methodLabel(const MethodSettings& s);
 
 // Checks ranges; returns an empty string when the settings are usable, else what is wrong.
 std::string validateMethodSettings(const MethodSettings& s);

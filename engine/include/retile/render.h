@@ -33,12 +33,40 @@ struct TileWork {
   int capStale = 0;  // > 0 (and not restart): first scale the sums down to at most this many samples
 };
 
+// What a tile of the displayed image shows (DenoiseWork::tileCodes): the raw accumulation, either
+// not yet re-rendered by the current pass (stale) or re-rendered (fresh), or the denoised layer
+// (kShowLayer + the index of the region whose result it holds, or kShowPreviousLayer: the result
+// from before the pass). Or-ed in: kShowWriteLayer makes the tile take this frame's denoised
+// result into the layer; kShowFiltered lets its pixels take part in this frame's filter.
+enum TileShows : std::uint32_t {
+  kShowStale = 0,
+  kShowFresh = 1,
+  kShowLayer = 2,
+  kShowPreviousLayer = 0xffff,
+  kShowFiltered = 0x40000000u,
+  kShowWriteLayer = 0x80000000u,
+};
+
+// The denoiser and the compositor in one frame (schedule/denoise_regions.h decides what).
+struct DenoiseWork {
+  bool compose = false;  // compose the displayed image (RenderImage::display) from the codes below
+  bool filter = false;   // denoise the domain first (into the layer, for tiles with kShowWriteLayer)
+  int x = 0, y = 0, width = 0, height = 0;  // the domain, pixels
+  int tileSize = 16;
+  std::vector<std::uint32_t> tileCodes;  // per tile of tileSize: TileShows
+  int featherPixels = 0;  // soft borders: seams between tiles showing different things blend over this
+};
+
+// The whole image denoised (global + denoise, continuous refinement, `retile render --denoise`).
+DenoiseWork wholeFrameDenoise(int width, int height, int tileSize = 16);
+
 struct FrameOptions {
   bool accumulate = true;    // false: trace only (a probe); readbackFrameLuminance() gives the result
   int selectionTileSize = 0; // > 0: count what the tracer sees of the selection per tile of this size
   // Paths each trace invocation runs one after another; 0 chooses from the last frame's cost.
   // Fixed by tests and benchmarks: which invocation traces a sample never changes its value.
   int pathsPerInvocation = 0;
+  DenoiseWork denoise;  // after accumulating (a probe composes nothing)
 };
 
 // Per tile of the counting tile size, summed over frames until read: primary hits on the selected
@@ -79,6 +107,7 @@ struct RenderRequest {
   int samplesPerPixel = 0;         // 0: the scene's settings
   int maxBounces = -1;             // -1: the scene's settings
   std::uint32_t seed = 0;
+  bool denoise = false;            // the result's display is the whole frame denoised
 };
 
 class Renderer {

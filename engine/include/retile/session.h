@@ -30,11 +30,17 @@ struct RegionRect {
   }
 };
 
+// A denoised region of the displayed image (schedule/denoise_regions.h).
+struct DenoisedRegion {
+  RegionRect rect;
+  std::uint64_t age = 0;  // frames since it was denoised (0: this frame)
+};
+
 // Everything about one published frame. Immutable once published; shared between threads.
 struct FrameRecord {
   std::uint64_t frame = 0;            // frames rendered by the session, from 1
   std::uint64_t documentVersion = 0;  // of the last edit applied before this frame
-  std::string method;                 // methodName()
+  std::string method;                 // methodLabel(): "spiral", "spiral+smooth+denoise", ...
   std::string mode;                   // accumulator mode: global-update, incremental, refinement, probe
   bool smooth = false;
   int staleCap = 0;
@@ -50,6 +56,7 @@ struct FrameRecord {
   std::vector<float> tileSamples;     // per tile: mean samples per pixel since its last restart
   std::vector<int> servedTiles;       // tiles traced this frame, in order
   RegionRect region;                  // the render region (empty: the whole image is rendered)
+  std::vector<DenoisedRegion> denoised;  // stacked denoised regions, oldest (innermost) first; empty: none
   std::size_t queueLength = 0;        // tiles in the current pass
   std::size_t queueServed = 0;        // tiles of the pass finished
   std::uint64_t samples = 0;          // samples traced this frame: always width x height

@@ -118,7 +118,8 @@ Result<bool> writeRenderImage(const RenderImage& image, const fs::path& file, co
   std::string ext = extensionLower(file);
   if (image.width <= 0 || image.height <= 0) return R::failure(cat(file.string(), ": nothing to write (empty image)"));
   auto pixels = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
-  if (image.color.size() != pixels * 3) return R::failure(cat(file.string(), ": image data is incomplete"));
+  if (image.color.size() != pixels * 3 || !(image.display.empty() || image.display.size() == pixels * 3))
+    return R::failure(cat(file.string(), ": image data is incomplete"));
   fs::path tmp = temporarySibling(file);
   auto fail = [&](const std::string& why) {
     std::error_code ec;
@@ -131,6 +132,11 @@ Result<bool> writeRenderImage(const RenderImage& image, const fs::path& file, co
     bool aux = image.albedo.size() == pixels * 3 && image.normal.size() == pixels * 3 && image.depth.size() == pixels &&
                image.objectId.size() == pixels;
     if (aux) names.insert(names.end(), {"albedo.R", "albedo.G", "albedo.B", "N.X", "N.Y", "N.Z", "Z", "id"});
+    // Denoised: R, G, B are what is shown; the accumulation (unbiased, noisy) follows as raw.*.
+    const bool denoised = image.display.size() == pixels * 3;
+    const std::size_t rawAt = names.size();
+    if (denoised) names.insert(names.end(), {"raw.R", "raw.G", "raw.B"});
+    const std::vector<float>& shown = image.shown();
     OIIO::ImageSpec spec(image.width, image.height, static_cast<int>(names.size()), OIIO::TypeDesc::HALF);
     spec.channelnames = names;
     spec.channelformats.assign(names.size(), OIIO::TypeDesc::HALF);
@@ -144,7 +150,9 @@ Result<bool> writeRenderImage(const RenderImage& image, const fs::path& file, co
     std::vector<float> data(pixels * names.size());
     for (std::size_t p = 0; p < pixels; ++p) {
       float* o = &data[p * names.size()];
-      for (int c = 0; c < 3; ++c) o[c] = image.color[p * 3 + static_cast<std::size_t>(c)];
+      for (int c = 0; c < 3; ++c) o[c] = shown[p * 3 + static_cast<std::size_t>(c)];
+      if (denoised)
+        for (int c = 0; c < 3; ++c) o[rawAt + static_cast<std::size_t>(c)] = image.color[p * 3 + static_cast<std::size_t>(c)];
       if (!aux) continue;
       for (int c = 0; c < 3; ++c) {
         o[3 + c] = image.albedo[p * 3 + static_cast<std::size_t>(c)];
@@ -160,7 +168,7 @@ Result<bool> writeRenderImage(const RenderImage& image, const fs::path& file, co
   } else if (ext == "png") {
     std::vector<std::uint8_t> rgba(pixels * 4);
     try {
-      ColorConfig::get()->toDisplay8(image.color.data(), pixels, display, rgba.data());
+      ColorConfig::get()->toDisplay8(image.shown().data(), pixels, display, rgba.data());
     } catch (const std::exception& e) {
       return fail(e.what());
     }

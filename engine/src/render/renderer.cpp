@@ -7,6 +7,7 @@
 #include <map>
 #include <tuple>
 
+#include "render/denoiser.h"
 #include "render/render_scene.h"
 #include "retile/log.h"
 #include "shared/layouts.h"
@@ -69,6 +70,8 @@ struct Renderer::Impl {
   std::map<std::tuple<bool, std::uint32_t, std::uint32_t>, std::unique_ptr<vk::ComputePipeline>> traceVariants;
   vk::ComputePipeline* trace = nullptr;
   std::unique_ptr<vk::ComputePipeline> accumulate;
+  Denoiser denoiser{ctx};
+  bool displayCurrent = false;  // the denoiser's display matches the accumulation (readback takes it)
   RenderSceneBuilder builder;
 
   Buffer frameUbo, work, stats, selection;
@@ -95,8 +98,9 @@ struct Renderer::Impl {
     std::uint64_t ticket = 0;
     bool completed = false;
     bool hasImage = false;
+    bool hasDisplay = false;
     int width = 0, height = 0;
-    Buffer image;                   // host-visible copy of the accumulation, then of its auxiliary part
+    Buffer image;                   // host-visible copies: accumulation, its auxiliary part, the display
     std::vector<NodeId> objects;    // instance -> object when submitted (edits may follow)
     FrameStats stats;
     std::uint64_t invocations = 0;
@@ -234,7 +238,7 @@ struct Renderer::Impl {
     VkDeviceSize need = std::max<std::uint64_t>(slots, 1) * 16;
     if (samples.valid() && samples.size() >= need) return;
     samples = Buffer(ctx, need, kStorageUsage, false, "samples");
-    aux = Buffer(ctx, need * 2, kStorageUsage, false, "auxiliary samples");
+    aux = Buffer(ctx, need * gpu::kAuxVec4s, kStorageUsage, false, "auxiliary samples");
     bindAll();
   }
 
@@ -244,15 +248,19 @@ struct Renderer::Impl {
     width = w;
     height = h;
     countTileSize = 0;  // the counters' layout follows the image
-    VkDeviceSize bytes = static_cast<VkDeviceSize>(w) * static_cast<VkDeviceSize>(h) * 32;
-    accum = Buffer(ctx, bytes, kStorageUsage, false, "accumulation");
-    accumAux = Buffer(ctx, bytes, kStorageUsage, false, "auxiliary accumulation");
+    const VkDeviceSize pixels = static_cast<VkDeviceSize>(w) * static_cast<VkDeviceSize>(h);
+    // Written by the accumulate pass, read by the denoiser through texel views.
+    constexpr VkBufferUsageFlags kAccumUsage = kStorageUsage | kTexelUsage;
+    accum = Buffer(ctx, pixels * 2 * sizeof(gpu::vec4), kAccumUsage, false, "accumulation");
+    accumAux = Buffer(ctx, pixels * gpu::kAuxVec4s * sizeof(gpu::vec4), kAccumUsage, false, "auxiliary accumulation");
     ctx.submitAndWait([&](VkCommandBuffer cb) {
       vkCmdFillBuffer(cb, accum.handle(), 0, VK_WHOLE_SIZE, 0);
       vkCmdFillBuffer(cb, accumAux.handle(), 0, VK_WHOLE_SIZE, 0);
     });
     ensureSampleCapacity(static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h));
     bindAll();
+    denoiser.resize(w, h, accum, accumAux);
+    displayCurrent = false;
   }
 
   std::uint32_t selectedInstance() const {
@@ -392,21 +400,29 @@ struct Renderer::Impl {
       invocations = traceInvocations(slots, iterationsPerPath, options.pathsPerInvocation);
     }
     lastItems = items;
+    const bool compose = options.denoise.compose && options.accumulate;
+    if (compose) denoiser.prepare(options.denoise);
+    if (options.accumulate && !items.empty()) displayCurrent = compose;
+    else if (compose) displayCurrent = true;
 
     const std::uint64_t ticket = nextTicket++;
     Slot& slot = slots_[ticket % 2];
     slot.ticket = ticket;
     slot.completed = false;
     slot.hasImage = copyImage;
+    slot.hasDisplay = copyImage && displayCurrent;
     slot.width = width;
     slot.height = height;
     slot.stats = FrameStats{};
     slot.stats.samples = slots;
     slot.invocations = invocations;
-    const VkDeviceSize imageBytes = static_cast<VkDeviceSize>(width) * static_cast<VkDeviceSize>(height) * 32;
+    const VkDeviceSize pixelCount = static_cast<VkDeviceSize>(width) * static_cast<VkDeviceSize>(height);
+    const VkDeviceSize imageBytes = pixelCount * 2 * sizeof(gpu::vec4);
+    const VkDeviceSize auxBytes = pixelCount * gpu::kAuxVec4s * sizeof(gpu::vec4);
+    const VkDeviceSize displayBytes = pixelCount * sizeof(gpu::vec4);
     if (copyImage) {
-      if (!slot.image.valid() || slot.image.size() != 2 * imageBytes)
-        slot.image = Buffer(ctx, 2 * imageBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, "image read-back");
+      if (!slot.image.valid() || slot.image.size() != imageBytes + auxBytes + displayBytes)
+        slot.image = Buffer(ctx, imageBytes + auxBytes + displayBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, "image read-back");
       slot.objects = builder.data().instanceObject;
     }
     slot.submitted = std::chrono::steady_clock::now();
@@ -425,14 +441,19 @@ struct Renderer::Impl {
         gx = groupsFor(pixels, gpu::kAccumulateWorkgroup, &gy);
         if (options.accumulate) accumulate->dispatch(cb, gx, gy, &ap, sizeof ap);
       }
+      if (compose) denoiser.record(cb, options.denoise);
       if (copyImage) {
         // The accumulated image, copied while the device is at it: the CPU converts it later,
         // while the device traces the next frame.
         vk::computeBarrier(cb);
         VkBufferCopy c{0, 0, imageBytes};
         vkCmdCopyBuffer(cb, accum.handle(), slot.image.handle(), 1, &c);
-        c.dstOffset = imageBytes;
-        vkCmdCopyBuffer(cb, accumAux.handle(), slot.image.handle(), 1, &c);
+        VkBufferCopy a{0, imageBytes, auxBytes};
+        vkCmdCopyBuffer(cb, accumAux.handle(), slot.image.handle(), 1, &a);
+        if (slot.hasDisplay) {
+          VkBufferCopy d{0, imageBytes + auxBytes, displayBytes};
+          vkCmdCopyBuffer(cb, denoiser.display().handle(), slot.image.handle(), 1, &d);
+        }
       }
     });
     inFlight = ticket;
@@ -475,21 +496,30 @@ struct Renderer::Impl {
     auto n = static_cast<std::size_t>(slot.width) * static_cast<std::size_t>(slot.height);
     // Read through the mapping: the slot is not touched by the frame now in flight.
     const auto* acc = static_cast<const gpu::vec4*>(slot.image.mapped());
-    return convert(acc, acc + n * 2, slot.width, slot.height, slot.objects);
+    return convert(acc, acc + n * 2, slot.hasDisplay ? acc + n * (2 + gpu::kAuxVec4s) : nullptr, slot.width, slot.height,
+                   slot.objects);
   }
 
   RenderImage readback() {
     completeInFlight();  // the frame in flight uses what this touches
     auto n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-    std::vector<gpu::vec4> acc(n * 2), ax(n * 2);
+    std::vector<gpu::vec4> acc(n * 2), ax(n * gpu::kAuxVec4s);
     accum.download(acc.data(), acc.size() * sizeof(gpu::vec4));
     accumAux.download(ax.data(), ax.size() * sizeof(gpu::vec4));
-    return convert(acc.data(), ax.data(), width, height, builder.data().instanceObject);
+    std::vector<gpu::vec4> shown;
+    if (displayCurrent) {
+      shown.resize(n);
+      denoiser.display().download(shown.data(), n * sizeof(gpu::vec4));
+    }
+    return convert(acc.data(), ax.data(), displayCurrent ? shown.data() : nullptr, width, height,
+                   builder.data().instanceObject);
   }
 
-  // Per pixel: accumulation [sum.rgb count, compensation.rgb -] and auxiliary [albedo.rgb depth,
-  // normal.xyz instance] to means.
-  static RenderImage convert(const gpu::vec4* acc, const gpu::vec4* ax, int w, int h, const std::vector<NodeId>& objects) {
+  // Per pixel: accumulation [sum.rgb count, compensation.rgb squares] and auxiliary [albedo.rgb
+  // depth, normal.xyz instance, emission.rgb -] to means.
+  // `shown`: the composed display per pixel, or null.
+  static RenderImage convert(const gpu::vec4* acc, const gpu::vec4* ax, const gpu::vec4* shown, int w, int h,
+                             const std::vector<NodeId>& objects) {
     RenderImage img;
     img.width = w;
     img.height = h;
@@ -500,6 +530,8 @@ struct Renderer::Impl {
     img.depth.resize(n);
     img.objectId.resize(n);
     img.sampleCount.resize(n);
+    img.moment2.resize(n);
+    if (shown) img.display.resize(n * 3);
     for (std::size_t i = 0; i < n; ++i) {
       const gpu::vec4& s = acc[i * 2];
       const gpu::vec4& comp = acc[i * 2 + 1];
@@ -511,8 +543,11 @@ struct Renderer::Impl {
       img.color[i * 3 + 1] = static_cast<float>((double(s.y) - comp.y) * invD);
       img.color[i * 3 + 2] = static_cast<float>((double(s.z) - comp.z) * invD);
       img.sampleCount[i] = count;
-      const gpu::vec4& a = ax[i * 2];
-      const gpu::vec4& b = ax[i * 2 + 1];
+      img.moment2[i] = comp.w * inv;
+      if (shown)
+        for (int c = 0; c < 3; ++c) img.display[i * 3 + static_cast<std::size_t>(c)] = (&shown[i].x)[c];
+      const gpu::vec4& a = ax[i * gpu::kAuxVec4s];
+      const gpu::vec4& b = ax[i * gpu::kAuxVec4s + 1];
       img.albedo[i * 3 + 0] = a.x * inv;
       img.albedo[i * 3 + 1] = a.y * inv;
       img.albedo[i * 3 + 2] = a.z * inv;
@@ -598,8 +633,24 @@ RenderImage Renderer::render(const RenderRequest& request, const std::function<b
     sum.cutPaths += fs.cutPaths;
     if (progress && !progress(f + 1, spp)) break;
   }
+  if (request.denoise) {
+    FrameOptions o;
+    o.denoise = wholeFrameDenoise(w, h);
+    renderFrame({}, o);
+  }
   if (total) *total = sum;
   return readback();
+}
+
+DenoiseWork wholeFrameDenoise(int width, int height, int tileSize) {
+  DenoiseWork d;
+  d.compose = d.filter = true;
+  d.width = width;
+  d.height = height;
+  d.tileSize = tileSize;
+  auto tiles = static_cast<std::size_t>((width + tileSize - 1) / tileSize) * static_cast<std::size_t>((height + tileSize - 1) / tileSize);
+  d.tileCodes.assign(tiles, kShowLayer | kShowWriteLayer | kShowFiltered);
+  return d;
 }
 
 }  // namespace retile

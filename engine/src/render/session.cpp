@@ -7,6 +7,7 @@
 #include <map>
 
 #include "retile/log.h"
+#include "schedule/denoise_regions.h"
 #include "schedule/planner.h"
 #include "schedule/policies.h"
 #include "schedule/scheduler.h"
@@ -57,6 +58,9 @@ struct RenderSession::Impl {
   std::uint64_t documentVersion = 0;
   std::map<NodeId, Bounds3> meshBounds;  // object-space bounds, so an edit never walks a mesh
   std::vector<EditFacts> batch;          // edits applied since the last frame, planned together
+  DenoiseRegions denoise;
+  bool newPass = false;                  // a plan started a pass (or a global update) since the last frame
+  std::vector<char> leading;             // per tile: ranked first by the pass's policy
   NodeId counting = kNoNode;             // the object the renderer's counters describe
   // Frames submitted and not yet finished, oldest first (at most two: one read back while the
   // next traces). Their records are filled at submission and completed when they finish.
@@ -95,6 +99,7 @@ struct RenderSession::Impl {
     TileGrid grid(width, height, tileSize);
     scheduler.reset(grid);
     planner.setGrid(grid);
+    denoise.reset(grid);
     batch.clear();  // measured on the old grid; the reset restarts everything anyway
   }
 
@@ -103,9 +108,61 @@ struct RenderSession::Impl {
       case PlanKind::None: break;
       case PlanKind::GlobalUpdate: scheduler.globalUpdate(); break;
       case PlanKind::Probe: scheduler.probe(); break;
-      case PlanKind::Pass: scheduler.startPass(p.order, p.quality, p.prioritized, p.smooth, p.staleCap); break;
+      case PlanKind::Pass:
+        scheduler.startPass(p.order, p.quality, p.prioritized, p.smooth, p.staleCap);
+        leading.assign(static_cast<std::size_t>(scheduler.grid().count()), 0);
+        for (int i = 0; i < p.leading && i < static_cast<int>(p.order.size()); ++i)
+          leading[static_cast<std::size_t>(p.order[static_cast<std::size_t>(i)])] = 1;
+        newPass = true;
+        break;
     }
   }
+
+  // What the denoiser does this frame, and how the displayed image is composed.
+  DenoiseWork denoiseWork(AccumMode mode, std::uint64_t frameNumber, const MethodSettings& m) {
+    const TileGrid& grid = scheduler.grid();
+    DenoiseFrame f;
+    if (mode == AccumMode::GlobalUpdate || mode == AccumMode::Refinement) {
+      f = denoise.wholeFrame(frameNumber);
+    } else if (mode == AccumMode::Incremental) {
+      if (newPass) denoise.restart();
+      // The region grows over the tiles the policy ranked first (indirection: the prioritized
+      // classes), or over every re-rendered tile when it ranked none above its order.
+      bool indirection = m.kind == MethodKind::Indirection || m.kind == MethodKind::IndirectionFocus;
+      bool anyLeading = std::find(leading.begin(), leading.end(), 1) != leading.end();
+      std::vector<char> grows = indirection && anyLeading ? leading : std::vector<char>(static_cast<std::size_t>(grid.count()), 1);
+      f = denoise.incremental(scheduler.startedTiles(), grows, m.denoiseThreshold,
+                              scheduler.queueServed() + 1 >= scheduler.queueLength(), frameNumber);
+    } else {
+      f = denoise.unchanged();
+    }
+    newPass = false;
+    DenoiseWork w;
+    w.compose = true;
+    w.filter = f.filter;
+    w.x = f.domain.x;
+    w.y = f.domain.y;
+    w.width = f.domain.width;
+    w.height = f.domain.height;
+    w.tileSize = grid.tileSize();
+    w.featherPixels = m.softBorders ? MethodSettings::kFeatherPixels : 0;
+    w.tileCodes.resize(f.source.size());
+    for (std::size_t t = 0; t < f.source.size(); ++t) {
+      std::uint32_t code = kShowStale;
+      switch (f.source[t]) {
+        case TileSource::Stale: code = kShowStale; break;
+        case TileSource::Previous: code = kShowPreviousLayer; break;
+        case TileSource::Fresh: code = kShowFresh; break;
+        case TileSource::Region: code = kShowLayer + static_cast<std::uint32_t>(f.region[t]); break;
+      }
+      if (f.write[t]) code |= kShowWriteLayer;
+      if (f.filtered[t]) code |= kShowFiltered;
+      w.tileCodes[t] = code;
+    }
+    lastRegions = std::move(f.regions);
+    return w;
+  }
+  std::vector<DenoiseRegion> lastRegions;  // the stack as of the last planned frame
 
   // The renderer counts what the planner wants counted; a new target starts from zero.
   void syncCounting() {
@@ -357,6 +414,7 @@ void RenderSession::submitFrame(bool readImage) {
     work.push_back({c.rect.x, c.rect.y, c.rect.width, c.rect.height, c.quality, c.sampleBase, c.restart, c.capStale});
   FrameOptions options;
   options.accumulate = plan.mode != AccumMode::Probe;
+  if (method().denoise) options.denoise = d.denoiseWork(plan.mode, d.frame + 1, method());
   Impl::Pending p;
   p.mode = plan.mode;
   p.counting = d.planner.countThisFrame(plan.mode);
@@ -367,7 +425,7 @@ void RenderSession::submitFrame(bool readImage) {
   FrameRecord& rec = p.rec;
   rec.frame = ++d.frame;
   rec.documentVersion = d.documentVersion;
-  rec.method = methodName(method().kind);
+  rec.method = methodLabel(method());
   rec.mode = accumModeName(plan.mode);
   rec.smooth = method().smooth;
   rec.staleCap = method().staleCap;
@@ -386,6 +444,9 @@ void RenderSession::submitFrame(bool readImage) {
   rec.tileSamples.assign(d.scheduler.tileSamples().begin(), d.scheduler.tileSamples().end());
   rec.servedTiles = std::move(plan.servedTiles);
   rec.region = d.region;
+  if (method().denoise)
+    for (const DenoiseRegion& r : d.lastRegions)
+      rec.denoised.push_back({RegionRect{r.rect.x, r.rect.y, r.rect.width, r.rect.height}, rec.frame - r.frame});
   rec.queueLength = d.scheduler.queueLength();
   rec.queueServed = d.scheduler.queueServed();
   rec.scheduleMs = msSince(start);

@@ -24,6 +24,13 @@ bool methodFromName(const std::string& name, MethodKind* out) {
 
 std::vector<std::string> methodNames() { return {std::begin(kNames), std::end(kNames)}; }
 
+std::string methodLabel(const MethodSettings& s) {
+  std::string label = methodName(s.kind);
+  if (s.smooth && s.kind != MethodKind::Global) label += "+smooth";
+  if (s.denoise) label += "+denoise";
+  return label;
+}
+
 std::string validateMethodSettings(const MethodSettings& s) {
   if (s.tileSize != 8 && s.tileSize != 16 && s.tileSize != 32) return cat("tile size must be 8, 16 or 32, not ", s.tileSize);
   if (s.quality < 0 || s.quality > 4096) return cat("quality must be 1..4096 (or 0 for automatic), not ", s.quality);
@@ -34,6 +41,7 @@ std::string validateMethodSettings(const MethodSettings& s) {
   for (const auto& f : s.focus)
     if (!(f.pixel.x == f.pixel.x) || !(f.pixel.y == f.pixel.y)) return "a focus point is NaN";
   if (s.indirectionFrames < 1 || s.indirectionFrames > 64) return "indirection frames must be 1..64";
+  if (s.denoiseThreshold < 0 || s.denoiseThreshold > 16384) return cat("denoise threshold must be 0..16384 pixels, not ", s.denoiseThreshold);
   return {};
 }
 

@@ -89,6 +89,13 @@ std::vector<float> TileScheduler::priorities() const {
   return p;
 }
 
+std::vector<char> TileScheduler::startedTiles() const {
+  std::vector<char> started(static_cast<std::size_t>(grid_.count()), 0);
+  for (std::size_t i = 0; i < queue_.size(); ++i)
+    if (pass_[i].started) started[static_cast<std::size_t>(queue_[i])] = 1;
+  return started;
+}
+
 void TileScheduler::emit(FramePlan& plan, int tile, TileRect rect, int quality, bool restart, int cap, bool wholeTile) {
   auto t = static_cast<std::size_t>(tile);
   TileChunk c;

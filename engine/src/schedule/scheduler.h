@@ -69,6 +69,8 @@ class TileScheduler {
   const std::vector<double>& tileSamples() const { return samples_; }
   // Per tile: 1 for the head of the queue falling linearly to 0 at its end; -1 when unqueued.
   std::vector<float> priorities() const;
+  // Per tile: 1 when the current pass has started re-rendering it.
+  std::vector<char> startedTiles() const;
 
  private:
   struct PassTile {

@@ -1,0 +1,155 @@
+#include "render/denoiser.h"
+
+#include <algorithm>
+#include <tuple>
+
+#include "retile/log.h"
+#include "shared/layouts.h"
+
+namespace retile {
+
+using vk::Binding;
+
+static_assert(kShowStale == gpu::kTileStale && kShowFresh == gpu::kTileFresh && kShowLayer == gpu::kTileLayer &&
+                  kShowPreviousLayer == gpu::kTilePreviousLayer && kShowFiltered == gpu::kTileFiltered &&
+                  kShowWriteLayer == gpu::kTileWrite,
+              "render.h and shaders/shared/layouts.h disagree on the tile codes");
+
+namespace {
+
+constexpr VkBufferUsageFlags kReadWrite = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+constexpr VkFormat kRgba32 = VK_FORMAT_R32G32B32A32_SFLOAT;
+constexpr VkFormat kHalf4 = VK_FORMAT_R16G16B16A16_SFLOAT;  // common/denoise.glsl packColor
+
+// Workgroups of kDenoiseTile x kDenoiseTile pixels over a width x height domain.
+std::uint32_t groups(int width, int height, std::uint32_t* groupsY) {
+  *groupsY = static_cast<std::uint32_t>((height + gpu::kDenoiseTile - 1) / gpu::kDenoiseTile);
+  return static_cast<std::uint32_t>((width + gpu::kDenoiseTile - 1) / gpu::kDenoiseTile);
+}
+
+}  // namespace
+
+Denoiser::Denoiser(vk::Context& ctx) : ctx_(ctx) {}
+Denoiser::~Denoiser() = default;
+
+void Denoiser::resize(int width, int height, vk::Buffer& accum, vk::Buffer& accumAux) {
+  width_ = width;
+  height_ = height;
+  accum_ = &accum;
+  accumAux_ = &accumAux;
+  allocated_ = false;
+  for (vk::Buffer* b : {&a_, &b_, &surface_, &guide_, &moments_, &layer_, &display_}) *b = vk::Buffer();
+}
+
+void Denoiser::allocate() {
+  if (!prepare_) {
+    auto push = static_cast<std::uint32_t>(sizeof(gpu::DenoisePush));
+    using B = Binding;
+    prepare_ = std::make_unique<vk::ComputePipeline>(
+        ctx_, "denoise_prepare.comp",
+        std::vector<B>{B::UniformTexel, B::UniformTexel, B::Storage, B::Storage, B::Storage, B::Storage, B::Storage}, push);
+    variance_ = std::make_unique<vk::ComputePipeline>(
+        ctx_, "denoise_variance.comp",
+        std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
+    // The a-trous iterations ping-pong between two buffers: one pipeline (and descriptor set) each way.
+    for (auto* p : {&atrousAB_, &atrousBA_})
+      *p = std::make_unique<vk::ComputePipeline>(
+          ctx_, "denoise_atrous.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage}, push);
+    finish_ = std::make_unique<vk::ComputePipeline>(
+        ctx_, "denoise_finish.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
+    compose_ = std::make_unique<vk::ComputePipeline>(
+        ctx_, "compose.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
+  }
+  const VkDeviceSize pixels = static_cast<VkDeviceSize>(width_) * static_cast<VkDeviceSize>(height_);
+  const VkDeviceSize px = pixels * sizeof(gpu::vec4);
+  a_ = vk::Buffer(ctx_, pixels * 8, kReadWrite, false, "denoiser ping");
+  b_ = vk::Buffer(ctx_, pixels * 8, kReadWrite, false, "denoiser pong");
+  surface_ = vk::Buffer(ctx_, px, kReadWrite, false, "denoiser surfaces");
+  guide_ = vk::Buffer(ctx_, 2 * px, kReadWrite, false, "denoiser guides");
+  moments_ = vk::Buffer(ctx_, px, kReadWrite, false, "denoiser moments");
+  layer_ = vk::Buffer(ctx_, px, kReadWrite, false, "denoised layer");
+  display_ = vk::Buffer(ctx_, px, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, "displayed image");
+  ctx_.submitAndWait([&](VkCommandBuffer cb) { vkCmdFillBuffer(cb, layer_.handle(), 0, VK_WHOLE_SIZE, 0); });
+
+  prepare_->bind(0, *accum_, kRgba32);
+  prepare_->bind(1, *accumAux_, kRgba32);
+  prepare_->bind(2, a_);
+  prepare_->bind(3, surface_);
+  prepare_->bind(4, guide_);
+  prepare_->bind(5, moments_);
+  variance_->bind(0, a_, kHalf4);
+  variance_->bind(1, surface_, kRgba32);
+  variance_->bind(2, moments_, kRgba32);
+  variance_->bind(3, b_);
+  variance_->bind(4, guide_);
+  for (auto [pipe, from, to] : {std::tuple{atrousBA_.get(), &b_, &a_}, std::tuple{atrousAB_.get(), &a_, &b_}}) {
+    pipe->bind(0, *from, kHalf4);
+    pipe->bind(1, surface_, kRgba32);
+    pipe->bind(2, guide_, kRgba32);
+    pipe->bind(3, *to);
+  }
+  // The variance pass writes b; each iteration goes b->a (along x), a->b (along y): the result is in b.
+  finish_->bind(0, b_, kHalf4);
+  finish_->bind(1, guide_, kRgba32);
+  finish_->bind(3, layer_);
+  compose_->bind(0, *accum_, kRgba32);
+  compose_->bind(1, layer_, kRgba32);
+  compose_->bind(3, display_);
+  allocated_ = true;
+}
+
+void Denoiser::prepare(const DenoiseWork& work) {
+  if (!work.compose) return;
+  if (!allocated_) allocate();
+  int cols = (width_ + work.tileSize - 1) / work.tileSize, rows = (height_ + work.tileSize - 1) / work.tileSize;
+  auto count = static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows);
+  RETILE_ASSERT(work.tileSize > 0 && work.tileCodes.size() == count,
+                cat(work.tileCodes.size(), " tile codes for ", cols, "x", rows, " tiles of ", work.tileSize));
+  VkDeviceSize bytes = std::max<VkDeviceSize>(count * sizeof(std::uint32_t), 16);
+  if (!tiles_.valid() || tiles_.size() < bytes) {
+    tiles_ = vk::Buffer(ctx_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "tile codes");
+    prepare_->bind(6, tiles_);
+    finish_->bind(2, tiles_);
+    compose_->bind(2, tiles_);
+  }
+  tiles_.upload(work.tileCodes.data(), count * sizeof(std::uint32_t));
+}
+
+void Denoiser::record(VkCommandBuffer cb, const DenoiseWork& work) {
+  if (!work.compose) return;
+  gpu::DenoisePush push{};
+  push.image = {static_cast<std::uint32_t>(width_), static_cast<std::uint32_t>(height_), 1,
+                static_cast<std::uint32_t>(std::max(work.featherPixels, 0))};
+  push.tiles = {static_cast<std::uint32_t>(work.tileSize),
+                static_cast<std::uint32_t>((width_ + work.tileSize - 1) / work.tileSize), 0, 0};
+  std::uint32_t gy;
+  if (work.filter) {
+    int x0 = std::clamp(work.x, 0, width_), y0 = std::clamp(work.y, 0, height_);
+    int x1 = std::clamp(work.x + work.width, 0, width_), y1 = std::clamp(work.y + work.height, 0, height_);
+    if (x1 > x0 && y1 > y0) {
+      push.domain = {x0, y0, x1 - x0, y1 - y0};
+      std::uint32_t gx = groups(x1 - x0, y1 - y0, &gy);
+      vk::computeBarrier(cb);
+      prepare_->dispatch(cb, gx, gy, &push, sizeof push);
+      vk::computeBarrier(cb);
+      variance_->dispatch(cb, gx, gy, &push, sizeof push);
+      for (int i = 0; i < gpu::kDenoiseIterations; ++i)
+        for (std::uint32_t axis : {0u, 1u}) {
+          vk::computeBarrier(cb);
+          push.image.z = 1u << i;
+          push.tiles.z = axis;
+          (axis == 0 ? atrousBA_ : atrousAB_)->dispatch(cb, gx, gy, &push, sizeof push);
+        }
+      push.tiles.z = 0;
+      vk::computeBarrier(cb);
+      finish_->dispatch(cb, gx, gy, &push, sizeof push);
+    }
+  }
+  push.domain = {0, 0, width_, height_};
+  push.image.z = 1;
+  vk::computeBarrier(cb);
+  std::uint32_t gx = groups(width_, height_, &gy);
+  compose_->dispatch(cb, gx, gy, &push, sizeof push);
+}
+
+}  // namespace retile

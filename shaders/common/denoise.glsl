@@ -1,0 +1,37 @@
+// Shared by the denoiser's passes and the compositor: which pixel an invocation handles, the
+// demodulation by the guide hit's albedo, and the packed texel the a-trous iterations read.
+#ifndef RETILE_DENOISE_GLSL
+#define RETILE_DENOISE_GLSL
+
+const float kBackgroundDepth = 1e20;  // a pixel whose guides saw no surface
+// Demodulation divides by the albedo, but never by less than this: a channel of a nearly black
+// albedo would otherwise carry its noise, amplified, into its neighbours' average.
+const float kAlbedoFloor = 0.1;
+
+float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
+
+// The invocation's pixel inside push.domain (8x8 workgroups over it: no integer division per
+// pixel, which lavapipe does lane by lane); false past the domain's right or bottom edge (those
+// invocations still run, on the domain's last pixel, and must not write).
+bool domainPixel(out uint index, out ivec2 xy) {
+  ivec2 local = ivec2(gl_GlobalInvocationID.xy);
+  xy = push.domain.xy + min(local, push.domain.zw - 1);
+  index = uint(xy.y) * push.image.x + uint(xy.x);
+  return all(lessThan(local, push.domain.zw));
+}
+
+ivec2 clampToDomain(ivec2 q) { return clamp(q, push.domain.xy, push.domain.xy + push.domain.zw - 1); }
+bool inDomain(ivec2 q) { return all(greaterThanEqual(q, push.domain.xy)) && all(lessThan(q, push.domain.xy + push.domain.zw)); }
+uint pixelIndex(ivec2 q) { return uint(q.y) * push.image.x + uint(q.x); }
+
+vec3 demodulate(vec3 c, vec3 albedo) { return c / max(albedo, vec3(kAlbedoFloor)); }
+vec3 remodulate(vec3 c, vec3 albedo) { return c * max(albedo, vec3(kAlbedoFloor)); }
+
+// The a-trous iterations read the demodulated colour and the standard deviation of the pixel's
+// mean as four halves (one RGBA16F texel, converted by the fetch) and the pixel's normal and depth
+// from the guide texel, which never changes between iterations; they write the halves only.
+uvec2 packColor(vec3 color, float variance) {
+  return uvec2(packHalf2x16(color.rg), packHalf2x16(vec2(color.b, sqrt(max(variance, 0.0)))));
+}
+
+#endif
