@@ -1,5 +1,6 @@
 // `retile [SCENE]`: the editor. The only place the command line meets Qt.
 #include <QApplication>
+#include <QCheckBox>
 #include <QFileInfo>
 #include <QMessageBox>
 #include <QPixmap>
@@ -45,6 +46,8 @@ int runEditor(int argc, char** argv, const std::string& file) {
   // scripts/screenshot.sh: converge a little, select and move an object so that the overlays show
   // a pass in progress, then save the whole window and quit.
   if (qEnvironmentVariableIsSet("RETILE_SCREENSHOT")) {
+    if (qEnvironmentVariableIsSet("RETILE_SCREENSHOT_DENOISE"))
+      if (auto* denoise = window.findChild<QCheckBox*>("denoise")) denoise->setChecked(true);
     auto* timer = new QTimer(&window);
     int settle = qEnvironmentVariableIntValue("RETILE_SCREENSHOT_FRAMES");
     if (settle <= 0) settle = 40;

@@ -59,7 +59,7 @@ QImage FrameView::toDisplay(const RenderImage& img) const {
   QImage q(img.width, img.height, QImage::Format_RGBA8888);
   auto config = ColorConfig::get();
   for (int y = 0; y < img.height; ++y)
-    config->toDisplay8(img.color.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) * 3,
+    config->toDisplay8(img.shown().data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) * 3,
                        static_cast<std::size_t>(img.width), display_, q.scanLine(y));
   return q;
 }
@@ -294,6 +294,22 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
     p.setBrush(Qt::NoBrush);
     for (int t : f.servedTiles) p.drawRect(tileRect(t).adjusted(0.5, 0.5, -0.5, -0.5));
   }
+  if (overlays_.denoised && !f.denoised.empty()) {
+    // Newest (outermost) brightest; each boundary labelled with the frames since it was denoised.
+    const auto n = static_cast<int>(f.denoised.size());
+    for (int i = 0; i < n; ++i) {
+      const DenoisedRegion& d = f.denoised[static_cast<std::size_t>(i)];
+      QColor c = QColor::fromHsvF(0.08, 0.25 + 0.75 * (i + 1) / n, 1.0);
+      QRectF rr(r.x() + d.rect.x * sx, r.y() + d.rect.y * sy, d.rect.width * sx, d.rect.height * sy);
+      p.setPen(QPen(c, 2.0, Qt::DashLine));
+      p.setBrush(Qt::NoBrush);
+      p.drawRect(rr.adjusted(1, 1, -1, -1));
+      QFont lf(font().family(), 8);
+      p.setFont(lf);
+      p.setPen(c);
+      p.drawText(rr.adjusted(4, 3 + 11 * (i % 2), -4, -3), Qt::AlignTop | Qt::AlignLeft, tr("%1").arg(d.age));
+    }
+  }
   if (overlays_.markers) {
     QPointF poc(r.x() + f.pointOfChange.x * sx, r.y() + f.pointOfChange.y * sy);
     p.setPen(QPen(QColor(255, 60, 60), 2.5));
@@ -302,40 +318,51 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
     p.setPen(QPen(QColor(80, 255, 120), 2.5));
     for (const Vec2& fp : f.focus) p.drawEllipse(QPointF(r.x() + fp.x * sx, r.y() + fp.y * sy), 9, 9);
   }
-  if (overlays_.legend) {
-    QFont lf(font().family(), 9);
-    p.setFont(lf);
-    QRectF box(r.x() + 8, r.bottom() - 86, 230, 78);
-    p.fillRect(box, QColor(0, 0, 0, 170));
-    QLinearGradient g(box.x() + 10, 0, box.x() + 150, 0);
-    for (int i = 0; i <= 10; ++i) {
-      QColor c = priorityColor(1.0f - i / 10.0f);
-      c.setAlphaF(1.0);
-      g.setColorAt(i / 10.0, c);
+  if (overlays_.legend) drawLegend(p, r);
+}
+
+// One row per overlay that is on, so nothing is explained that is not drawn and the box grows
+// with its rows instead of other boxes stacking over it.
+void FrameView::drawLegend(QPainter& p, const QRectF& r) const {
+  const FrameRecord& f = *frame_;
+  struct Row {
+    QColor color;
+    QString text;
+    bool gradient = false;
+  };
+  std::vector<Row> rows;
+  if (overlays_.priority) rows.push_back({Qt::white, tr("served first  ...  last (tile priority)"), true});
+  if (overlays_.served) rows.push_back({QColor(80, 220, 255), tr("outlined: tiles traced this frame")});
+  if (overlays_.markers) rows.push_back({QColor(255, 90, 90), tr("+ point of change    o focus point")});
+  if (overlays_.classes && !f.tileClass.empty())
+    rows.push_back({QColor(255, 200, 0), tr("hatched: indirection classes high / middle / low")});
+  if (overlays_.denoised && !f.denoised.empty())
+    rows.push_back({QColor::fromHsvF(0.08, 1.0, 1.0),
+                    tr("dashed: %n denoised region(s), labelled frames since", nullptr, static_cast<int>(f.denoised.size()))});
+  rows.push_back({Qt::lightGray, tr("%1, %2: %3/%4 tiles").arg(QString::fromStdString(f.method), QString::fromStdString(f.mode))
+                                     .arg(f.queueServed).arg(f.queueLength)});
+  QFont lf(font().family(), 9);
+  p.setFont(lf);
+  const double lineH = 15, width = 300;
+  double height = 8;
+  for (const Row& row : rows) height += row.gradient ? lineH + 12 : lineH;
+  QRectF box(r.x() + 8, r.bottom() - height - 8, width, height);
+  p.fillRect(box, QColor(0, 0, 0, 170));
+  double y = box.y() + 5;
+  for (const Row& row : rows) {
+    if (row.gradient) {
+      QLinearGradient g(box.x() + 10, 0, box.x() + 150, 0);
+      for (int i = 0; i <= 10; ++i) {
+        QColor c = priorityColor(1.0f - i / 10.0f);
+        c.setAlphaF(1.0);
+        g.setColorAt(i / 10.0, c);
+      }
+      p.fillRect(QRectF(box.x() + 10, y + 2, 140, 9), g);
+      y += 12;
     }
-    p.fillRect(QRectF(box.x() + 10, box.y() + 8, 140, 10), g);
-    p.setPen(Qt::white);
-    p.drawText(QRectF(box.x() + 10, box.y() + 20, 210, 14), tr("served first  ...  last (tile priority)"));
-    p.setPen(QColor(80, 220, 255));
-    p.drawText(QRectF(box.x() + 10, box.y() + 36, 210, 14), tr("outlined: tiles traced this frame"));
-    p.setPen(QColor(255, 90, 90));
-    p.drawText(QRectF(box.x() + 10, box.y() + 50, 210, 14), tr("+ point of change"));
-    p.setPen(QColor(80, 255, 120));
-    p.drawText(QRectF(box.x() + 120, box.y() + 50, 110, 14), tr("o focus point"));
-    if (overlays_.classes && !f.tileClass.empty()) {
-      QRectF extra(box.x(), box.y() - 20, box.width(), 18);
-      p.fillRect(extra, QColor(0, 0, 0, 170));
-      p.setPen(QColor(255, 60, 60));
-      p.drawText(extra.adjusted(10, 2, 0, 0), tr("high"));
-      p.setPen(QColor(255, 200, 0));
-      p.drawText(extra.adjusted(50, 2, 0, 0), tr("middle"));
-      p.setPen(QColor(90, 160, 255));
-      p.drawText(extra.adjusted(105, 2, 0, 0), tr("low (indirection classes)"));
-    }
-    p.setPen(Qt::lightGray);
-    p.drawText(QRectF(box.x() + 10, box.y() + 62, 210, 14),
-               tr("%1, %2: %3/%4 tiles").arg(QString::fromStdString(f.method), QString::fromStdString(f.mode))
-                   .arg(f.queueServed).arg(f.queueLength));
+    p.setPen(row.color);
+    p.drawText(QRectF(box.x() + 10, y, width - 14, lineH), row.text);
+    y += lineH;
   }
 }
 
@@ -357,7 +384,7 @@ void FrameView::inspectRegion() {
   float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (int y = rr.top(); y <= rr.bottom(); ++y)
     for (int x = rr.left(); x <= rr.right(); ++x) {
-      const float* c = img.color.data() + (static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x)) * 3;
+      const float* c = inspected(img).data() + (static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x)) * 3;
       for (int k = 0; k < 3; ++k) {
         sum[k] += c[k];
         lo[k] = std::min(lo[k], c[k]);
@@ -432,7 +459,7 @@ void FrameView::mouseMoveEvent(QMouseEvent* e) {
   last_ = e->position();
   QPoint px = imagePixel(e->position());
   if (px.x() >= 0 && frame_ && frame_->image) {
-    const float* c = frame_->image->color.data() +
+    const float* c = inspected(*frame_->image).data() +
                      (static_cast<std::size_t>(px.y()) * static_cast<std::size_t>(frame_->width) + static_cast<std::size_t>(px.x())) * 3;
     emit pixelInspected(px, QVector3D(c[0], c[1], c[2]));
   }

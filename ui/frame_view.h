@@ -27,6 +27,7 @@ struct OverlaySettings {
   bool markers = true;    // point of change and focus points
   bool legend = true;
   bool classes = false;   // indirection classes: high, middle, low (indirection methods only)
+  bool denoised = true;   // the denoised regions' boundaries, labelled with their age
 };
 
 class FrameView : public QWidget {
@@ -39,6 +40,10 @@ class FrameView : public QWidget {
   OverlaySettings& overlays() { return overlays_; }
   void setOverlays(const OverlaySettings& o);
   void setPaused(bool paused);
+  // What the pixel inspector reads: the image as shown (denoised, when it is) or the accumulation.
+  enum class Inspect { Shown, Raw };
+  void setInspect(Inspect what) { inspect_ = what; }
+  Inspect inspect() const { return inspect_; }
   // Display-only: exposure, gamma and OCIO view; the accumulated samples are untouched.
   void setDisplay(const DisplaySettings& d);
   const DisplaySettings& display() const { return display_; }
@@ -108,7 +113,9 @@ class FrameView : public QWidget {
   void refresh();
   void compose(QPainter& p, const QRect& area) const;
   void drawOverlays(QPainter& p, const QRectF& r) const;
+  void drawLegend(QPainter& p, const QRectF& r) const;
   QImage toDisplay(const RenderImage& img) const;
+  const std::vector<float>& inspected(const RenderImage& img) const { return inspect_ == Inspect::Raw ? img.color : img.shown(); }
   QPoint imagePixel(QPointF widgetPos) const;
   void inspectRegion();
 
@@ -117,6 +124,7 @@ class FrameView : public QWidget {
   OverlaySettings overlays_;
   DisplaySettings display_;
   bool paused_ = false;
+  Inspect inspect_ = Inspect::Shown;
   enum class Drag { None, Orbit, Pan, Dolly, Object, Axis, Rotate, Scale, Region, RenderRegion, Wipe } drag_ = Drag::None;
   QRect draft_;  // a render region being drawn (image pixels)
   int dragAxis_ = 0;

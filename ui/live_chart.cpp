@@ -127,7 +127,7 @@ void LiveChart::addFrame(const FrameRecord& frame) {
   }
   if (!reference_.empty() && frame.image && frame.documentVersion == refVersion_ && frame.width == refWidth_ &&
       frame.height == refHeight_) {
-    lastError_ = relativeRmse(frame.image->color, reference_, refWidth_, refHeight_, 4);
+    lastError_ = relativeRmse(frame.image->shown(), reference_, refWidth_, refHeight_, 4);
     if (std::isfinite(lastError_)) error_->append(now, lastError_);
     status_->setText(tr("Reference of version %1: relative RMSE %2").arg(refVersion_).arg(lastError_, 0, 'f', 4));
   } else if (!reference_.empty() && frame.documentVersion != refVersion_) {

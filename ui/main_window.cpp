@@ -262,6 +262,7 @@ void MainWindow::buildMenus() {
   toggle(tr("&Samples per tile"), &OverlaySettings::samples);
   toggle(tr("Tiles served this &frame"), &OverlaySettings::served);
   toggle(tr("Point of change and &focus points"), &OverlaySettings::markers);
+  toggle(tr("&Denoised regions"), &OverlaySettings::denoised);
   toggle(tr("&Legend"), &OverlaySettings::legend);
 
   QMenu* tools = menuBar()->addMenu(tr("&Tools"));
@@ -414,6 +415,23 @@ void MainWindow::buildDocks() {
   focusModeBox_->setToolTip(tr("Focus points (up to 3) for the focus methods. Shift+click adds one; 'follows the cursor' "
                                "stands in for an eye tracker."));
   auto* clearFocus = new QPushButton(tr("Clear focus points"), methodBox);
+  denoiseBox_ = new QCheckBox(tr("denoise"), methodBox);
+  denoiseBox_->setObjectName("denoise");
+  denoiseBox_->setChecked(method_.denoise);
+  denoiseBox_->setToolTip(tr("Show the image denoised: the whole frame during refinement, a growing region during a pass. "
+                             "The samples themselves are untouched (the pixel inspector can read either)."));
+  denoiseThresholdBox_ = new QSpinBox(methodBox);
+  denoiseThresholdBox_->setObjectName("denoiseThreshold");
+  denoiseThresholdBox_->setRange(0, 16384);
+  denoiseThresholdBox_->setSuffix(tr(" px"));
+  denoiseThresholdBox_->setValue(method_.denoiseThreshold);
+  denoiseThresholdBox_->setToolTip(tr("The denoised region is re-sized when its width or height has grown by more than this"));
+  softBordersBox_ = new QCheckBox(tr("soft borders"), methodBox);
+  softBordersBox_->setObjectName("softBorders");
+  softBordersBox_->setChecked(method_.softBorders);
+  softBordersBox_->setToolTip(tr("Blend the seams between fresh and stale tiles and between denoised regions over a few pixels"));
+  denoiseThresholdBox_->setEnabled(method_.denoise);
+  softBordersBox_->setEnabled(method_.denoise);
   mf->addRow(tr("Policy"), methodBox_);
   mf->addRow(tr("Tile size T"), tileBox_);
   mf->addRow(tr("Quality Q"), qualityBox_);
@@ -421,11 +439,17 @@ void MainWindow::buildDocks() {
   mf->addRow(tr("Stale cap C"), staleBox_);
   mf->addRow(tr("Focus"), focusModeBox_);
   mf->addRow(QString(), clearFocus);
+  mf->addRow(QString(), denoiseBox_);
+  mf->addRow(tr("Denoise threshold"), denoiseThresholdBox_);
+  mf->addRow(QString(), softBordersBox_);
   connect(methodBox_, &QComboBox::currentTextChanged, this, [this] { sendMethod(); });
   connect(tileBox_, &QComboBox::currentIndexChanged, this, [this] { sendMethod(); });
   connect(qualityBox_, &QSpinBox::valueChanged, this, [this] { sendMethod(); });
   connect(smoothBox_, &QCheckBox::toggled, this, [this] { sendMethod(); });
   connect(staleBox_, &QSpinBox::valueChanged, this, [this] { sendMethod(); });
+  connect(denoiseBox_, &QCheckBox::toggled, this, [this] { sendMethod(); });
+  connect(denoiseThresholdBox_, &QSpinBox::valueChanged, this, [this] { sendMethod(); });
+  connect(softBordersBox_, &QCheckBox::toggled, this, [this] { sendMethod(); });
   connect(clearFocus, &QPushButton::clicked, this, [this] {
     method_.focus.clear();
     engine_->submit(FocusCommand{method_.focus});
@@ -476,12 +500,23 @@ void MainWindow::buildDocks() {
   auto* methodDock = addDock(tr("Render settings"), "renderSettings", settingsScroll, Qt::LeftDockWidgetArea);
 
   // The pixel inspector: linear values under the cursor; Ctrl+drag a region for its statistics.
-  inspector_ = new QLabel(tr("Hover the image for linear values; Ctrl+drag a region for its mean, min and max."), this);
+  auto* inspectorPanel = new QWidget(this);
+  auto* il = new QVBoxLayout(inspectorPanel);
+  auto* inspectSource = new QComboBox(inspectorPanel);
+  inspectSource->setObjectName("inspectSource");
+  inspectSource->addItems({tr("Read the image as shown"), tr("Read the raw accumulation")});
+  inspectSource->setToolTip(tr("With denoising the image shown is a view; the accumulated samples are kept as they are"));
+  connect(inspectSource, &QComboBox::currentIndexChanged, this, [this](int i) {
+    view_->setInspect(i == 1 ? FrameView::Inspect::Raw : FrameView::Inspect::Shown);
+  });
+  inspector_ = new QLabel(tr("Hover the image for linear values; Ctrl+drag a region for its mean, min and max."), inspectorPanel);
   inspector_->setObjectName("inspector");
   inspector_->setWordWrap(true);
   inspector_->setTextInteractionFlags(Qt::TextSelectableByMouse);
   inspector_->setAlignment(Qt::AlignTop | Qt::AlignLeft);
-  auto* inspectorDock = addDock(tr("Pixel inspector"), "inspectorDock", inspector_, Qt::LeftDockWidgetArea);
+  il->addWidget(inspectSource);
+  il->addWidget(inspector_, 1);
+  auto* inspectorDock = addDock(tr("Pixel inspector"), "inspectorDock", inspectorPanel, Qt::LeftDockWidgetArea);
   tabifyDockWidget(methodDock, inspectorDock);
   methodDock->raise();
 
@@ -532,7 +567,12 @@ void MainWindow::sendMethod() {
   m.quality = qualityBox_->value();
   m.smooth = smoothBox_->isChecked();
   m.staleCap = staleBox_->value();
+  m.denoise = denoiseBox_->isChecked();
+  m.denoiseThreshold = denoiseThresholdBox_->value();
+  m.softBorders = softBordersBox_->isChecked();
   staleBox_->setEnabled(m.smooth);
+  denoiseThresholdBox_->setEnabled(m.denoise);
+  softBordersBox_->setEnabled(m.denoise);
   if (m.quality == 0 && m.kind != MethodKind::Indirection && m.kind != MethodKind::IndirectionFocus) m.quality = 64;
   if (std::string bad = validateMethodSettings(m); !bad.empty()) {
     log(tr("method: %1").arg(QString::fromStdString(bad)));
@@ -540,8 +580,9 @@ void MainWindow::sendMethod() {
   }
   method_ = m;
   engine_->submit(MethodCommand{method_});
-  log(tr("method %1, T=%2, Q=%3%4").arg(methodName(m.kind)).arg(m.tileSize).arg(m.quality ? QString::number(m.quality) : tr("auto"),
-                                                                                      m.smooth ? tr(", smooth") : QString()));
+  log(tr("method %1, T=%2, Q=%3%4").arg(QString::fromStdString(methodLabel(m))).arg(m.tileSize)
+          .arg(m.quality ? QString::number(m.quality) : tr("auto"),
+               m.denoise ? tr(", denoise threshold %1 px").arg(m.denoiseThreshold) : QString()));
 }
 
 void MainWindow::updateRenderSize() {

@@ -130,6 +130,9 @@ class MainWindow : public QMainWindow {
   QComboBox* tileBox_ = nullptr;
   QSpinBox* qualityBox_ = nullptr;
   QCheckBox* smoothBox_ = nullptr;
+  QCheckBox* denoiseBox_ = nullptr;
+  QSpinBox* denoiseThresholdBox_ = nullptr;
+  QCheckBox* softBordersBox_ = nullptr;
   QLabel* status_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   int autosaveSlot_ = 0;

@@ -5,7 +5,9 @@
 #include <QStandardPaths>
 #include <QDoubleSpinBox>
 #include <QTemporaryDir>
+#include <QCheckBox>
 #include <QComboBox>
+#include <QSpinBox>
 #include <QLabel>
 #include <QLineEdit>
 #include <QPushButton>
@@ -197,6 +199,66 @@ TEST(Editor, OverlaysDrawOverTheImage) {
     }
   EXPECT_GT(red, 20) << "the point-of-change cross";
   EXPECT_GT(changed, drawn.width() * drawn.height() / 10) << "the heat map covers the queued tiles";
+}
+
+TEST(Editor, TheDenoiseSettingsReachTheEngineAndTheRegionBoundariesDraw) {
+  auto w = makeWindow();  // 96 x 54
+  auto* denoise = w->findChild<QCheckBox*>("denoise");
+  auto* threshold = w->findChild<QSpinBox*>("denoiseThreshold");
+  ASSERT_TRUE(denoise && threshold);
+  EXPECT_FALSE(threshold->isEnabled()) << "the threshold goes with the denoiser";
+  threshold->setValue(16);
+  denoise->setChecked(true);
+  EXPECT_TRUE(threshold->isEnabled());
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) {
+    return f.method == "spiral+denoise" && f.mode == "refinement" && f.image->display.size() == f.image->color.size();
+  })) << "the engine denoises: the whole frame during refinement";
+
+  NodeId cup = objectNamed(w->scene(), "Cup");
+  Object o = *w->scene().object(cup);
+  Object moved = o;
+  moved.transform = Mat4::translate({0, 0.05f, 0}) * o.transform;
+  w->edit(SetObject{o}, SetObject{moved}, "move");
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.mode == "incremental" && f.denoised.size() >= 2; }))
+      << "a pass stacks growing regions (16 px threshold)";
+  const FrameRecord f = *w->viewport()->frame();
+  const RegionRect inner = f.denoised.front().rect, outer = f.denoised.back().rect;
+  EXPECT_GT(outer.width * outer.height, inner.width * inner.height);
+
+  OverlaySettings off{false, false, false, false, false, false};
+  off.denoised = false;
+  OverlaySettings regions = off;
+  regions.denoised = true;
+  w->viewport()->showFrame(w->viewport()->frame());  // hold this frame for both pictures
+  w->viewport()->setOverlays(off);
+  QImage plain = w->viewport()->composed();
+  w->viewport()->setOverlays(regions);
+  QImage drawn = w->viewport()->composed();
+  ASSERT_EQ(plain.size(), drawn.size());
+  // The outermost boundary's top edge, in widget pixels: the dashed orange line crosses it.
+  QRectF ir = w->viewport()->imageRect();
+  int y = static_cast<int>(ir.y() + (outer.y + 0.05) * ir.height() / f.height) + 1;
+  int orange = 0;
+  for (int x = static_cast<int>(ir.x() + outer.x * ir.width() / f.width) + 2;
+       x < static_cast<int>(ir.x() + (outer.x + outer.width) * ir.width() / f.width) - 2; ++x) {
+    QColor a = plain.pixelColor(x, y), b = drawn.pixelColor(x, y);
+    if (a != b && b.red() > 200 && b.blue() < b.red() - 40) ++orange;
+  }
+  EXPECT_GT(orange, 5) << "the region's boundary is drawn";
+
+  // The inspector reads the shown (denoised) image or the raw samples.
+  auto* source = w->findChild<QComboBox*>("inspectSource");
+  auto* inspector = w->findChild<QLabel*>("inspector");
+  ASSERT_TRUE(source && inspector);
+  QPoint at = ir.center().toPoint();
+  QTest::mouseMove(w->viewport(), at);
+  QString shown = inspector->text();
+  source->setCurrentIndex(1);
+  QTest::mouseMove(w->viewport(), at + QPoint(1, 0));
+  QTest::mouseMove(w->viewport(), at);
+  QString raw = inspector->text();
+  EXPECT_TRUE(shown.startsWith("pixel")) << shown.toStdString();
+  EXPECT_NE(shown, raw) << "the denoised value and the sample mean differ";
 }
 
 TEST(Editor, SaveOpenRoundTripAndABrokenFileKeepsTheScene) {
