@@ -15,11 +15,12 @@ void usage() {
                "usage:\n"
                "  retile [SCENE]                      opens the editor (the built-in scene without SCENE)\n"
                "  retile render SCENE [--size WxH] [--spp N] [--seed S] [--max-bounces B] [--out FILE.exr|png]\n"
-               "                      [--view Standard|Filmic] [--exposure STOPS]\n"
+               "                      [--view Standard|Filmic] [--exposure STOPS] [--denoise]\n"
                "  retile edit SCENE --script EDITS.json --method NAME --out-dir DIR [--size WxH] [--tile T]\n"
-               "                    [--quality Q|auto] [--smooth] [--converge SPP] [--reference SPP]\n"
+               "                    [--quality Q|auto] [--smooth] [--stale-cap N] [--converge SPP] [--reference SPP]\n"
+               "                    [--denoise [--denoise-threshold PX] [--no-soft-borders]] [--no-images]\n"
                "  retile bench throughput SCENE [--size WxH] [--frames N] [--max-bounces B]\n"
-               "  retile bench bvh [--triangles N]\n"
+               "  retile bench bvh [--triangles N] | edit | frames SCENE [--drag] | denoise [SCENE] [--size WxH]\n"
                "  retile import FILE\n"
                "SCENE is a file (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default'.\n");
 }

@@ -1,9 +1,9 @@
 #version 460
-// Denoiser, pass 3 of 4, run kDenoiseIterations times with the step doubling (1, 2, 4, ...), each
-// time once along x and once along y: one iteration of the edge-avoiding a-trous wavelet filter
-// (the spatial part of SVGF, Schied et al. 2017) with the 5x5 B-spline kernel applied as its two
-// separable 5-tap halves, 10 taps instead of 25 (on lavapipe the taps are the cost), whose taps are
-// weighted down across normals (cos^128), depths and luminances. The luminance weight is scaled by the filtered variance of the pixel's mean, so as
+// Denoiser, pass 3 of 4, run kDenoiseIterations times with the step doubling (1, 2, 4, ...): one
+// iteration of the edge-avoiding a-trous wavelet filter (the spatial part of SVGF, Schied et al.
+// 2017), a 5x5 B-spline kernel whose taps are weighted down across normals (cos^128), depths and
+// luminances. (Its two separable 5-tap halves cost a quarter less on lavapipe but streak along
+// the rows on flat floors.) The luminance weight is scaled by the filtered variance of the pixel's mean, so as
 // samples accumulate and the variance falls, the filter stops blurring and the result goes to the
 // accumulated image. Taps outside the domain take no part.
 #extension GL_GOOGLE_include_directive : require
@@ -38,7 +38,7 @@ void main() {
   // The variance at the pixel, blurred 3x3 in the first pass (a single pixel's estimate is
   // itself noisy); later passes read variances the filter has already smoothed.
   float deviation = c.w;
-  int blur = step == 1 && push.tiles.z == 0u ? 1 : 0;
+  int blur = step == 1 ? 1 : 0;
   if (blur > 0) {
     deviation = 0.0;
     for (int dy = -blur; dy <= blur; ++dy)
@@ -54,28 +54,29 @@ void main() {
   // are constants of the unrolled loop.
   float depthScale = 1.0 / ((kSigmaDepth * max(gradient, 0.0) + 1e-3 * max(s.w, 0.0)) * float(step) + 1e-6);
 
-  ivec2 axis = push.tiles.z == 0u ? ivec2(1, 0) : ivec2(0, 1);
   float sumW = 1.0;
   vec3 sum = c.rgb;
   float sumVar = c.w * c.w;
-  [[unroll]] for (int k = -2; k <= 2; ++k) {
-    if (k == 0) continue;
-    ivec2 q = xy + axis * (k * step);
-    int qi = int(pixelIndex(clampToDomain(q)));
-    vec4 cq = texelFetch(uIn, qi);
-    vec4 sq = texelFetch(uSurface, qi);
-    // cos^128 by seven squarings: lavapipe's pow is an exp and a log per lane.
-    float cosine = max(0.0, dot(s.xyz, sq.xyz));
-    cosine *= cosine; cosine *= cosine; cosine *= cosine; cosine *= cosine;
-    cosine *= cosine; cosine *= cosine; cosine *= cosine;
-    bool bothBackground = background && sq.w >= kBackgroundDepth;
-    // The depth and luminance terms share one exp.
-    float e = abs(s.w - sq.w) * depthScale / float(abs(k)) + abs(lumP - luminance(cq.rgb)) * lumScale;
-    float w = (inDomain(q) ? kKernel[abs(k)] / kKernel[0] : 0.0) * (bothBackground ? 1.0 : cosine) * exp(-e);
-    sumW += w;
-    sum += w * cq.rgb;
-    sumVar += w * w * cq.w * cq.w;
-  }
+  [[unroll]] for (int dy = -2; dy <= 2; ++dy)
+    [[unroll]] for (int dx = -2; dx <= 2; ++dx) {
+      if (dx == 0 && dy == 0) continue;
+      ivec2 q = xy + ivec2(dx, dy) * step;
+      int qi = int(pixelIndex(clampToDomain(q)));
+      vec4 cq = texelFetch(uIn, qi);
+      vec4 sq = texelFetch(uSurface, qi);
+      // cos^128 by seven squarings: lavapipe's pow is an exp and a log per lane.
+      float cosine = max(0.0, dot(s.xyz, sq.xyz));
+      cosine *= cosine; cosine *= cosine; cosine *= cosine; cosine *= cosine;
+      cosine *= cosine; cosine *= cosine; cosine *= cosine;
+      bool bothBackground = background && sq.w >= kBackgroundDepth;
+      // The depth and luminance terms share one exp.
+      float e = abs(s.w - sq.w) * depthScale * inversesqrt(float(dx * dx + dy * dy)) + abs(lumP - luminance(cq.rgb)) * lumScale;
+      float w = (inDomain(q) ? kKernel[abs(dx)] * kKernel[abs(dy)] / (kKernel[0] * kKernel[0]) : 0.0) *
+                (bothBackground ? 1.0 : cosine) * exp(-e);
+      sumW += w;
+      sum += w * cq.rgb;
+      sumVar += w * w * cq.w * cq.w;
+    }
   if (!live) return;
   outColors[p] = packColor(sum / sumW, sumVar / (sumW * sumW));
 }

@@ -146,7 +146,7 @@ RT_CONST(uint, kTileWrite, 0x80000000u)
 struct DenoisePush {
   ivec4 domain;  // x0, y0, width, height: the pixels filtered (the whole image for compose)
   uvec4 image;   // width, height, a-trous step, feather width in pixels (compose; 0: none)
-  uvec4 tiles;   // tile size, tile columns, a-trous axis (0: x, 1: y), -
+  uvec4 tiles;   // tile size, tile columns, -, -
 };
 
 #ifdef __cplusplus

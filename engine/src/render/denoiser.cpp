@@ -88,8 +88,9 @@ void Denoiser::allocate() {
     pipe->bind(2, guide_, kRgba32);
     pipe->bind(3, *to);
   }
-  // The variance pass writes b; each iteration goes b->a (along x), a->b (along y): the result is in b.
-  finish_->bind(0, b_, kHalf4);
+  // kDenoiseIterations is odd: the variance pass writes b, the iterations go b->a, a->b, ..., b->a.
+  static_assert(gpu::kDenoiseIterations % 2 == 1);
+  finish_->bind(0, a_, kHalf4);
   finish_->bind(1, guide_, kRgba32);
   finish_->bind(3, layer_);
   compose_->bind(0, *accum_, kRgba32);
@@ -133,14 +134,11 @@ void Denoiser::record(VkCommandBuffer cb, const DenoiseWork& work) {
       prepare_->dispatch(cb, gx, gy, &push, sizeof push);
       vk::computeBarrier(cb);
       variance_->dispatch(cb, gx, gy, &push, sizeof push);
-      for (int i = 0; i < gpu::kDenoiseIterations; ++i)
-        for (std::uint32_t axis : {0u, 1u}) {
-          vk::computeBarrier(cb);
-          push.image.z = 1u << i;
-          push.tiles.z = axis;
-          (axis == 0 ? atrousBA_ : atrousAB_)->dispatch(cb, gx, gy, &push, sizeof push);
-        }
-      push.tiles.z = 0;
+      for (int i = 0; i < gpu::kDenoiseIterations; ++i) {
+        vk::computeBarrier(cb);
+        push.image.z = 1u << i;
+        (i % 2 == 0 ? atrousBA_ : atrousAB_)->dispatch(cb, gx, gy, &push, sizeof push);
+      }
       vk::computeBarrier(cb);
       finish_->dispatch(cb, gx, gy, &push, sizeof push);
     }
