@@ -66,11 +66,22 @@ void ScrubField::mouseReleaseEvent(QMouseEvent* e) {
   if (scrubbing_) {
     scrubbing_ = false;
     emit scrubFinished();
+    clearFocus();  // the keyboard goes back to the window: Ctrl+Z undoes the scrub
     return;
   }
   // A click without a drag: type a value.
+  typing_ = true;
   lineEdit()->setFocus();
   lineEdit()->selectAll();
+}
+
+bool ScrubField::event(QEvent* e) {
+  // Outside typing, shortcuts (Ctrl+Z, B, A, W...) win over the spin box's own key handling.
+  if (e->type() == QEvent::ShortcutOverride && !typing_) {
+    e->ignore();
+    return true;
+  }
+  return QDoubleSpinBox::event(e);
 }
 
 void ScrubField::keyPressEvent(QKeyEvent* e) {
@@ -78,15 +89,28 @@ void ScrubField::keyPressEvent(QKeyEvent* e) {
     silent_ = true;
     setValue(committed_);  // drops the typed text
     silent_ = false;
+    typing_ = false;
     clearFocus();
     return;
   }
+  if (e->key() == Qt::Key_Return || e->key() == Qt::Key_Enter) {
+    QDoubleSpinBox::keyPressEvent(e);
+    typing_ = false;
+    return;
+  }
+  // A digit, a sign or an editing key from the keyboard starts typing (Tab brings the focus here).
+  if (!e->text().isEmpty() || e->key() == Qt::Key_Backspace || e->key() == Qt::Key_Delete) typing_ = true;
   QDoubleSpinBox::keyPressEvent(e);
 }
 
 void ScrubField::focusInEvent(QFocusEvent* e) {
   committed_ = value();
   QDoubleSpinBox::focusInEvent(e);
+}
+
+void ScrubField::focusOutEvent(QFocusEvent* e) {
+  typing_ = false;
+  QDoubleSpinBox::focusOutEvent(e);
 }
 
 void ScrubField::contextMenuEvent(QContextMenuEvent* e) {

@@ -1,6 +1,8 @@
 // Parameter editors with the conventions artists bring from Blender, Houdini and Katana: drag a
 // number field to scrub (Shift: ten times finer), click to type, Enter commits, Esc cancels,
 // "Reset to default" on the context menu; a colour swatch whose whole dialog session is one edit.
+// A field keeps the keyboard only while a value is typed into it: after a scrub, Ctrl+Z, B and
+// the other shortcuts go to the window.
 // GUI thread only. Each field owns nothing but its widgets; the caller turns its signals into
 // undoable edits (a scrub reports its start and end so a whole drag becomes one undo step).
 #pragma once
@@ -29,6 +31,8 @@ class ScrubField : public QDoubleSpinBox {
   void mouseReleaseEvent(QMouseEvent* e) override;
   void keyPressEvent(QKeyEvent* e) override;
   void focusInEvent(QFocusEvent* e) override;
+  void focusOutEvent(QFocusEvent* e) override;
+  bool event(QEvent* e) override;
   void contextMenuEvent(QContextMenuEvent* e) override;
 
  private:
@@ -40,6 +44,7 @@ class ScrubField : public QDoubleSpinBox {
   QPoint pressAt_;
   int lastX_ = 0;
   bool silent_ = false;
+  bool typing_ = false;  // a value is being typed: the field keeps Ctrl+Z, letters and the like
 };
 
 class ColorField : public QPushButton {

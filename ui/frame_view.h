@@ -73,6 +73,9 @@ class FrameView : public QWidget {
   void setTool(Tool t);
   Tool tool() const { return tool_; }
   void setGizmo(const Gizmo& g);
+  const Gizmo& gizmo() const { return gizmo_; }
+  // A point in the widget over an image position (the inverse of picking's mapping).
+  QPointF widgetPoint(QPointF imagePixel) const { return toWidget(imagePixel); }
 
   // The presenting Vulkan window, or nullptr when this widget paints (and why, for the log).
   VulkanViewport* vulkanWindow() const { return vulkan_; }

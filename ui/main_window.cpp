@@ -33,6 +33,7 @@
 #include <QPlainTextEdit>
 #include <QPushButton>
 #include <QSlider>
+#include <QScopedValueRollback>
 #include <QSpinBox>
 #include <QStatusBar>
 #include <QTreeWidget>
@@ -241,9 +242,6 @@ void MainWindow::buildMenus() {
   redo->setShortcut(QKeySequence::Redo);
   editMenu->addAction(undo);
   editMenu->addAction(redo);
-  // The panels show the undone value (not during a drag: rebuilding would drop the slider).
-  connect(undo, &QAction::triggered, this, [this] { rebuildProperties(); });
-  connect(redo, &QAction::triggered, this, [this] { rebuildProperties(); });
 
   QMenu* viewMenu = menuBar()->addMenu(tr("&Overlays"));
   auto toggle = [&](const QString& name, bool OverlaySettings::*field) {
@@ -344,7 +342,9 @@ void MainWindow::buildDocks() {
     qulonglong id = items[0]->data(0, kIdRole).toULongLong(&ok);
     auto kind = static_cast<PropertyTarget::Kind>(items[0]->data(0, kKindRole).toInt());
     if (kind == PropertyTarget::Kind::Object) {
-      if (ok && id && doc_.scene().object(static_cast<NodeId>(id)) && id != selection_) select(static_cast<NodeId>(id));
+      if (!ok || !id || !doc_.scene().object(static_cast<NodeId>(id))) return;
+      if (id != selection_) select(static_cast<NodeId>(id));
+      else panel_->setTarget({PropertyTarget::Kind::Object, static_cast<NodeId>(id)});  // back from the camera, say
     } else if (kind != PropertyTarget::Kind::None) {
       panel_->setTarget({kind, static_cast<NodeId>(id)});
     }
@@ -379,7 +379,11 @@ void MainWindow::buildDocks() {
   });
   auto* outlinerDock = addDock(tr("Outliner"), "outliner", outliner_, Qt::LeftDockWidgetArea);
 
-  auto push = [this](const Edit& before, const Edit& after, const QString& text, int dragId) { edit(before, after, text, dragId); };
+  auto push = [this](const Edit& before, const Edit& after, const QString& text, int dragId) {
+    // The panel shows its own edits already; rebuilding it would drop the field being scrubbed.
+    QScopedValueRollback<bool> fromPanel(panelEdit_, true);
+    edit(before, after, text, dragId);
+  };
   auto sceneRef = [this]() -> const Scene& { return doc_.scene(); };
   panel_ = new PropertyPanel(sceneRef, push, this);
   panel_->setObjectName("propertyPanel");
@@ -671,6 +675,9 @@ bool MainWindow::applyToDocument(const Edit& e) {
     }, Qt::QueuedConnection);
   }
   refreshGraph();
+  // Everything else that changes what the panel shows (a drag in the viewport, the node graph,
+  // undo and redo) refreshes it.
+  if (!panelEdit_ && panel_->shows(e)) panel_->rebuildLater();
   return true;
 }
 

@@ -130,6 +130,7 @@ class MainWindow : public QMainWindow {
   QComboBox* tileBox_ = nullptr;
   QSpinBox* qualityBox_ = nullptr;
   QCheckBox* smoothBox_ = nullptr;
+  bool panelEdit_ = false;  // the edit being applied comes from the properties panel itself
   QCheckBox* denoiseBox_ = nullptr;
   QSpinBox* denoiseThresholdBox_ = nullptr;
   QCheckBox* softBordersBox_ = nullptr;

@@ -121,7 +121,31 @@ void PropertyPanel::setTarget(PropertyTarget t) {
 
 void PropertyPanel::rebuildLater() {
   // Not from inside a field's signal: rebuilding deletes the field.
-  QMetaObject::invokeMethod(this, [this] { rebuild(); }, Qt::QueuedConnection);
+  if (rebuildQueued_) return;
+  rebuildQueued_ = true;
+  QMetaObject::invokeMethod(this, [this] {
+    rebuildQueued_ = false;
+    rebuild();
+  }, Qt::QueuedConnection);
+}
+
+bool PropertyPanel::shows(const Edit& e) const {
+  using K = PropertyTarget::Kind;
+  const NodeId id = editTarget(e);
+  switch (target_.kind) {
+    case K::Object: {
+      if (id == target_.id) return true;
+      const Object* o = scene_().object(target_.id);
+      return o && (std::holds_alternative<SetMaterial>(e) || std::holds_alternative<RemoveNode>(e)) && id == o->material;
+    }
+    case K::Material:
+    case K::Light: return id == target_.id;
+    case K::Camera: return std::holds_alternative<SetCamera>(e);
+    case K::Environment: return std::holds_alternative<SetEnvironment>(e);
+    case K::Render: return std::holds_alternative<SetRenderSettings>(e);
+    case K::None: return false;
+  }
+  return false;
 }
 
 void PropertyPanel::rebuild() {

@@ -33,7 +33,10 @@ class PropertyPanel : public QScrollArea {
   PropertyTarget target() const { return target_; }
   // Rebuilds the editors from the document (after undo, redo or a structural change).
   void rebuild();
+  // Once, after the current event: edits arriving in a burst (a drag) rebuild the panel once.
   void rebuildLater();
+  // Whether `e` changes something the panel shows (its target, or an object's material).
+  bool shows(const Edit& e) const;
   // Render settings edits keep the engine's current resolution (the viewport owns it).
   void setRenderSize(QSize s) { renderSize_ = s; }
 
@@ -66,6 +69,7 @@ class PropertyPanel : public QScrollArea {
   QWidget* body_ = nullptr;
   QFormLayout* form_ = nullptr;
   int drag_ = 1000000;  // drag ids of this panel: far from the viewport's
+  bool rebuildQueued_ = false;
 };
 
 }  // namespace retile::ui

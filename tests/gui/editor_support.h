@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 
+#include "frame_view.h"
 #include "main_window.h"
 
 namespace retile::ui::test {
@@ -23,6 +24,24 @@ inline std::unique_ptr<MainWindow> makeWindow() {
 // Spins the event loop until the newest frame the viewport shows satisfies `pred`.
 inline bool waitForFrame(MainWindow& w, const std::function<bool(const FrameRecord&)>& pred, int ms = 60000) {
   return QTest::qWaitFor([&] { return w.viewport()->frame() && pred(*w.viewport()->frame()); }, ms);
+}
+
+inline NodeId objectNamed(const Scene& s, const std::string& name) {
+  for (const auto& o : s.objects)
+    if (o.name == name) return o.id;
+  return kNoNode;
+}
+
+// A widget point over a pixel of the viewport's newest frame that shows `object`; (-1, -1) if none.
+inline QPoint pointShowing(const FrameView& v, NodeId object) {
+  auto frame = v.frame();
+  QRectF r = v.imageRect();
+  for (int y = 0; y < frame->height; ++y)
+    for (int x = 0; x < frame->width; ++x)
+      if (frame->image->objectId[static_cast<std::size_t>(y * frame->width + x)] == object)
+        return QPoint(static_cast<int>(r.x() + (x + 0.5) * r.width() / frame->width),
+                      static_cast<int>(r.y() + (y + 0.5) * r.height() / frame->height));
+  return QPoint(-1, -1);
 }
 
 }  // namespace retile::ui::test

@@ -33,13 +33,10 @@ namespace retile::ui {
 namespace {
 
 using test::makeWindow;
+using test::objectNamed;
+using test::pointShowing;
 using test::waitForFrame;
 
-NodeId objectNamed(const Scene& s, const std::string& name) {
-  for (const auto& o : s.objects)
-    if (o.name == name) return o.id;
-  return kNoNode;
-}
 
 TEST(Editor, EditFromThePropertiesReRendersAroundTheObjectAndUndoes) {
   auto w = makeWindow();
@@ -80,16 +77,6 @@ TEST(Editor, EditFromThePropertiesReRendersAroundTheObjectAndUndoes) {
 }
 
 // A widget point over a pixel of the shown frame whose first hit is `object`; (-1, -1) if none.
-QPoint pointShowing(const FrameView& v, NodeId object) {
-  auto frame = v.frame();
-  QRectF r = v.imageRect();
-  for (int y = 0; y < frame->height; ++y)
-    for (int x = 0; x < frame->width; ++x)
-      if (frame->image->objectId[static_cast<std::size_t>(y * frame->width + x)] == object)
-        return QPoint(static_cast<int>(r.x() + (x + 0.5) * r.width() / frame->width),
-                      static_cast<int>(r.y() + (y + 0.5) * r.height() / frame->height));
-  return QPoint(-1, -1);
-}
 
 TEST(Editor, CameraNavigationAndDraggingTheSelectionAreSingleUndoSteps) {
   auto w = makeWindow();
