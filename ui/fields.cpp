@@ -125,21 +125,26 @@ ColorField::ColorField(QColor value, QColor defaultValue, QWidget* parent)
   setMinimumWidth(56);
   setColor(value);
   connect(this, &QPushButton::clicked, this, [this] {
-    // Non-modal: the render follows the dialog's colour live; the session is one undo step.
-    auto* dialog = new QColorDialog(color_, this);
+    // Non-modal: the render follows the dialog's colour live; the session is one undo step, or
+    // none when cancelled. The dialog belongs to the window, not to this field, so the swatch's
+    // style sheet does not paint the dialog in the swatch colour.
+    auto* dialog = new QColorDialog(color_, window());
     dialog->setAttribute(Qt::WA_DeleteOnClose);
-    QColor start = color_;
+    dialog->setObjectName("colorDialog");
+    connect(this, &QObject::destroyed, dialog, &QWidget::close);
+    const QColor start = color_;
     connect(dialog, &QColorDialog::currentColorChanged, this, [this](const QColor& c) {
       if (!c.isValid() || c == color_) return;
       setColor(c);
-      emit edited(c, true);
+      emit previewed(c);
     });
     connect(dialog, &QColorDialog::finished, this, [this, start](int result) {
-      if (result != QDialog::Accepted && color_ != start) {
+      if (result == QDialog::Accepted && color_ != start) {
+        emit committed(color_);
+      } else {
         setColor(start);
-        emit edited(start, true);
+        emit cancelled();
       }
-      emit dragFinished();
     });
     dialog->open();
   });
@@ -157,7 +162,7 @@ void ColorField::contextMenuEvent(QContextMenuEvent* e) {
   QAction* reset = menu.addAction(tr("Reset to default (%1)").arg(default_.name()));
   if (menu.exec(e->globalPos()) == reset && default_ != color_) {
     setColor(default_);
-    emit edited(default_, false);
+    emit committed(default_);
   }
 }
 

@@ -55,9 +55,12 @@ class ColorField : public QPushButton {
   void setColor(QColor c);
 
  signals:
-  // Live while the dialog is open (dragging = true), and once more when it closes.
-  void edited(QColor color, bool dragging);
-  void dragFinished();
+  // While the dialog is open, each colour tried (to show, not to keep); then, when it closes,
+  // committed (accepted with another colour, or reset from the menu) or cancelled (the tried colours
+  // are to be taken back: nothing was changed).
+  void previewed(QColor color);
+  void committed(QColor color);
+  void cancelled();
 
  protected:
   void contextMenuEvent(QContextMenuEvent* e) override;

@@ -115,8 +115,8 @@ void FrameView::drawGizmo(QPainter& p) const {
   if (tool_ == Tool::Rotate) {
     p.setPen(QPen(axisColor[1], 2.5));
     p.setBrush(Qt::NoBrush);
-    p.drawEllipse(o, 34, 12);
-    p.drawText(o + QPointF(38, 4), tr("drag: turn about y"));
+    p.drawEllipse(o, kRingRadiusX, kRingRadiusY);
+    p.drawText(o + QPointF(kRingRadiusX + 4, 4), tr("drag: turn about y"));
     return;
   }
   for (int a = 0; a < 3; ++a) {
@@ -418,18 +418,29 @@ void FrameView::mousePressEvent(QMouseEvent* e) {
     return;
   }
   if (!frame_ || !frame_->image || e->button() != Qt::LeftButton) return;
-  if (tool_ == Tool::Move && gizmo_.visible) {
-    // A press near an arrow drags along that world axis.
+  // The gizmo's handles take the press before whatever lies behind them.
+  if (gizmo_.visible && tool_ != Tool::Select) {
     const QPointF o = toWidget(gizmo_.origin), pos = e->position();
-    for (int a = 0; a < 3; ++a) {
-      const QPointF d = toWidget(gizmo_.axisEnd[a]) - o;
-      const double len2 = d.x() * d.x() + d.y() * d.y();
-      if (len2 < 4) continue;
-      const double t = std::clamp(((pos.x() - o.x()) * d.x() + (pos.y() - o.y()) * d.y()) / len2, 0.0, 1.0);
-      if (t > 0.25 && std::hypot(pos.x() - (o.x() + t * d.x()), pos.y() - (o.y() + t * d.y())) < 7) {
-        drag_ = Drag::Axis;
-        dragAxis_ = a;
+    if (tool_ == Tool::Rotate) {
+      // The ring (drawn 34 x 12 px about the origin) and the band around it.
+      const double ex = (pos.x() - o.x()) / kRingRadiusX, ey = (pos.y() - o.y()) / kRingRadiusY;
+      if (std::hypot(ex, ey) < 1.5) {
+        drag_ = Drag::Rotate;
         return;
+      }
+    } else {
+      for (int a = 0; a < 3; ++a) {
+        const QPointF d = toWidget(gizmo_.axisEnd[a]) - o;
+        const double len2 = d.x() * d.x() + d.y() * d.y();
+        if (len2 < 4) continue;
+        const double t = std::clamp(((pos.x() - o.x()) * d.x() + (pos.y() - o.y()) * d.y()) / len2, 0.0, 1.0);
+        // Move: an arrow drags along its world axis; Scale: any axis or its box scales.
+        const double minT = tool_ == Tool::Move ? 0.25 : 0.0;
+        if (t > minT && std::hypot(pos.x() - (o.x() + t * d.x()), pos.y() - (o.y() + t * d.y())) < 7) {
+          drag_ = tool_ == Tool::Move ? Drag::Axis : Drag::Scale;
+          dragAxis_ = a;
+          return;
+        }
       }
     }
   }

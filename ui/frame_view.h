@@ -74,6 +74,7 @@ class FrameView : public QWidget {
   Tool tool() const { return tool_; }
   void setGizmo(const Gizmo& g);
   const Gizmo& gizmo() const { return gizmo_; }
+  static constexpr double kRingRadiusX = 34, kRingRadiusY = 12;  // the rotate tool's ring, widget pixels
   // A point in the widget over an image position (the inverse of picking's mapping).
   QPointF widgetPoint(QPointF imagePixel) const { return toWidget(imagePixel); }
 

@@ -385,7 +385,12 @@ void MainWindow::buildDocks() {
     edit(before, after, text, dragId);
   };
   auto sceneRef = [this]() -> const Scene& { return doc_.scene(); };
-  panel_ = new PropertyPanel(sceneRef, push, this);
+  // A colour tried in the dialog: shown in the document and the render, not an undo step.
+  auto preview = [this](const Edit& e) {
+    QScopedValueRollback<bool> fromPanel(panelEdit_, true);
+    applyToDocument(e);
+  };
+  panel_ = new PropertyPanel(sceneRef, push, preview, this);
   panel_->setObjectName("propertyPanel");
   auto* propDock = addDock(tr("Properties"), "properties", panel_, Qt::RightDockWidgetArea);
 
@@ -491,7 +496,7 @@ void MainWindow::buildDocks() {
   connect(gamma, &ScrubField::edited, this, applyDisplay);
   sl->addWidget(displayBox);
 
-  renderPanel_ = new PropertyPanel([this]() -> const Scene& { return doc_.scene(); }, push, settingsPanel);
+  renderPanel_ = new PropertyPanel([this]() -> const Scene& { return doc_.scene(); }, push, preview, settingsPanel);
   renderPanel_->setTarget({PropertyTarget::Kind::Render, kNoNode});
   renderPanel_->setMinimumHeight(130);
   sl->addWidget(renderPanel_, 1);

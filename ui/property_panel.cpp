@@ -73,10 +73,9 @@ class PropertyPanel::Builder {
     auto* f = new ColorField(toQColor(value), toQColor(def), p_->body_);
     f->setObjectName(objectName);
     PropertyPanel* panel = p_;
-    QObject::connect(f, &ColorField::edited, f, [panel, apply](QColor c, bool dragging) {
-      apply(fromQColor(c), dragging ? panel->drag_ : 0);
-    });
-    QObject::connect(f, &ColorField::dragFinished, f, [panel] { ++panel->drag_; });
+    QObject::connect(f, &ColorField::previewed, f, [apply](QColor c) { apply(fromQColor(c), kPreview); });
+    QObject::connect(f, &ColorField::committed, f, [apply](QColor c) { apply(fromQColor(c), kCommit); });
+    QObject::connect(f, &ColorField::cancelled, f, [panel] { panel->cancelPreview(); });
     form_->addRow(name, f);
     return f;
   }
@@ -106,8 +105,8 @@ class PropertyPanel::Builder {
   QFormLayout* form_;
 };
 
-PropertyPanel::PropertyPanel(SceneRef scene, Push push, QWidget* parent)
-    : QScrollArea(parent), scene_(std::move(scene)), push_(std::move(push)) {
+PropertyPanel::PropertyPanel(SceneRef scene, Push push, Preview preview, QWidget* parent)
+    : QScrollArea(parent), scene_(std::move(scene)), push_(std::move(push)), preview_(std::move(preview)) {
   setWidgetResizable(true);
   setFrameShape(QFrame::NoFrame);
   setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);  // fields narrow to the dock instead
@@ -117,6 +116,23 @@ PropertyPanel::PropertyPanel(SceneRef scene, Push push, QWidget* parent)
 void PropertyPanel::setTarget(PropertyTarget t) {
   target_ = t;
   rebuild();
+}
+
+void PropertyPanel::send(const Edit& before, const Edit& after, const QString& what, int drag) {
+  if (drag == kPreview) {
+    if (!previewBefore_) previewBefore_ = before;
+    preview_(after);
+  } else if (drag == kCommit) {
+    push_(previewBefore_.value_or(before), after, what, 0);
+    previewBefore_.reset();
+  } else {
+    push_(before, after, what, drag);
+  }
+}
+
+void PropertyPanel::cancelPreview() {
+  if (previewBefore_) preview_(*previewBefore_);
+  previewBefore_.reset();
 }
 
 void PropertyPanel::rebuildLater() {
@@ -333,7 +349,7 @@ void PropertyPanel::texturePath(Builder& b, const Texture& t, const QString& obj
     if (!cur || file.toStdString() == cur->path.string()) return;
     Texture after = *cur;
     after.path = file.toStdString();
-    push_(SetTexture{*cur}, SetTexture{after}, tr("Texture file"), 0);
+    send(SetTexture{*cur}, SetTexture{after}, tr("Texture file"), 0);
   };
   QObject::connect(path, &QLineEdit::returnPressed, path, [path, apply] { apply(path->text()); });
   QObject::connect(browse, &QToolButton::clicked, browse, [this, path, apply] {
@@ -385,7 +401,7 @@ void PropertyPanel::buildCamera(Builder& b) {
   auto edit = [this](const QString& what, int drag, const std::function<void(Camera&)>& change) {
     Camera after = scene_().camera;
     change(after);
-    push_(SetCamera{scene_().camera}, SetCamera{after}, what, drag);
+    send(SetCamera{scene_().camera}, SetCamera{after}, what, drag);
   };
   const Camera& c = scene_().camera;
   b.header(tr("Camera"));
@@ -404,7 +420,7 @@ void PropertyPanel::buildEnvironment(Builder& b) {
   auto edit = [this](const QString& what, int drag, const std::function<void(Environment&)>& change) {
     Environment after = scene_().environment;
     change(after);
-    push_(SetEnvironment{scene_().environment}, SetEnvironment{after}, what, drag);
+    send(SetEnvironment{scene_().environment}, SetEnvironment{after}, what, drag);
   };
   const Environment& e = scene_().environment;
   const Environment defaults;
@@ -452,7 +468,7 @@ void PropertyPanel::buildRender(Builder& b) {
       before.width = after.width = renderSize_.width();
       before.height = after.height = renderSize_.height();
     }
-    push_(SetRenderSettings{before}, SetRenderSettings{after}, what, drag);
+    send(SetRenderSettings{before}, SetRenderSettings{after}, what, drag);
   };
   const RenderSettings& r = scene_().settings;
   b.header(tr("Render settings"));

@@ -8,6 +8,7 @@
 #include <QScrollArea>
 
 #include <functional>
+#include <optional>
 
 #include "retile/edit.h"
 
@@ -27,7 +28,9 @@ class PropertyPanel : public QScrollArea {
   // `push` applies an edit as an undo step; edits with the same dragId > 0 merge.
   using Push = std::function<void(const Edit& before, const Edit& after, const QString& text, int dragId)>;
   using SceneRef = std::function<const Scene&()>;
-  PropertyPanel(SceneRef scene, Push push, QWidget* parent = nullptr);
+  // `preview` shows an edit without making it an undo step (a colour tried in the dialog).
+  using Preview = std::function<void(const Edit&)>;
+  PropertyPanel(SceneRef scene, Push push, Preview preview, QWidget* parent = nullptr);
 
   void setTarget(PropertyTarget t);
   PropertyTarget target() const { return target_; }
@@ -51,9 +54,14 @@ class PropertyPanel : public QScrollArea {
       if (!cur) return;
       Node after = *cur;
       change(after);
-      push_(Wrap{*cur}, Wrap{after}, what, drag);
+      send(Wrap{*cur}, Wrap{after}, what, drag);
     };
   }
+  // Drag ids of a colour dialog's session: tried colours are previewed, the last one committed as
+  // one step from the colour before the dialog.
+  static constexpr int kPreview = -1, kCommit = -2;
+  void send(const Edit& before, const Edit& after, const QString& what, int drag);
+  void cancelPreview();
   void buildObject(Builder& b, const Object& o);
   void buildMaterial(Builder& b, const Material& m);
   void buildLight(Builder& b, const Light& l);
@@ -64,6 +72,8 @@ class PropertyPanel : public QScrollArea {
 
   SceneRef scene_;
   Push push_;
+  Preview preview_;
+  std::optional<Edit> previewBefore_;  // the value before a colour dialog's first preview
   PropertyTarget target_;
   QSize renderSize_;
   QWidget* body_ = nullptr;

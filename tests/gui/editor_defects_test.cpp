@@ -2,6 +2,7 @@
 // user would, each failing on the editor before its fix.
 #include <QApplication>
 #include <QCheckBox>
+#include <QColorDialog>
 #include <QComboBox>
 #include <QLabel>
 #include <QSpinBox>
@@ -90,6 +91,105 @@ TEST(EditorDefects, ShortcutsWorkAfterScrubbingAField) {
   const int steps = w->undoStack()->index();
   QTest::keyClick(QApplication::focusWidget(), Qt::Key_Z, Qt::ControlModifier);
   EXPECT_EQ(w->undoStack()->index(), steps) << "no undo while typing";
+}
+
+// 3. The rotate ring and the scale handles could not be grabbed: the press picked what was behind.
+TEST(EditorDefects, TheGizmosRotateAndScaleHandlesTakeThePress) {
+  auto w = makeWindow();
+  NodeId cup = objectNamed(w->scene(), "Cup");
+  w->select(cup);
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 3; }));
+  FrameView* v = w->viewport();
+  auto drag = [&](QPoint from) {
+    QTest::mousePress(v, Qt::LeftButton, Qt::NoModifier, from);
+    for (int i = 1; i <= 4; ++i) QTest::mouseMove(v, from + QPoint(8 * i, 0));
+    QTest::mouseRelease(v, Qt::LeftButton, Qt::NoModifier, from + QPoint(32, 0));
+  };
+  const Mat4 start = w->scene().object(cup)->transform;
+  // The ring's rightmost point: the background or another object lies behind it.
+  v->setTool(FrameView::Tool::Rotate);
+  QPoint ring = (v->widgetPoint(v->gizmo().origin) + QPointF(FrameView::kRingRadiusX, 0)).toPoint();
+  drag(ring);
+  const Mat4 turned = w->scene().object(cup)->transform;
+  EXPECT_GT(std::abs(turned.m[0][2] - start.m[0][2]), 0.05f) << "the cup turned about y";
+  EXPECT_EQ(w->selection(), cup) << "the press did not pick another object";
+  // The scale tool's box at the end of the x axis.
+  v->setTool(FrameView::Tool::Scale);
+  const FrameView::Gizmo& g = v->gizmo();
+  QPoint box = v->widgetPoint(g.axisEnd[0]).toPoint();
+  const float before = length(Vec3{turned.m[0][0], turned.m[1][0], turned.m[2][0]});
+  drag(box);
+  const Mat4 scaled = w->scene().object(cup)->transform;
+  EXPECT_GT(length(Vec3{scaled.m[0][0], scaled.m[1][0], scaled.m[2][0]}), before * 1.05f) << "the cup grew";
+  EXPECT_EQ(w->selection(), cup);
+}
+
+QColorDialog* openColorDialog(MainWindow& w, const char* field) {
+  auto* swatch = w.findChild<ColorField*>(field);
+  if (!swatch) return nullptr;
+  swatch->click();
+  return w.findChild<QColorDialog*>();
+}
+
+// 5. The colour dialog painted itself in the swatch's colour (white text on lime).
+TEST(EditorDefects, TheColourDialogKeepsItsOwnColours) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  const NodeId material = w->scene().object(sphere)->material;
+  Material lime = *w->scene().material(material);
+  lime.albedo = Vec3{0.0f, 1.0f, 0.0f};
+  w->edit(SetMaterial{*w->scene().material(material)}, SetMaterial{lime}, "lime");
+  w->select(sphere);
+  QTest::qWait(50);  // the panel rebuilds after the edit
+  QColorDialog* dialog = openColorDialog(*w, "albedo");
+  ASSERT_TRUE(dialog);
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(dialog));
+  QImage shot = dialog->grab().toImage();
+  int limePixels = 0;
+  for (int y = 0; y < shot.height(); ++y)
+    for (int x = 0; x < shot.width(); ++x) {
+      QColor c = shot.pixelColor(x, y);
+      limePixels += c.green() > 240 && c.red() < 20 && c.blue() < 20;
+    }
+  EXPECT_LT(limePixels, shot.width() * shot.height() / 10) << "only the colour's own preview is lime";
+  dialog->reject();
+}
+
+// 6. Cancelling the colour dialog left an empty undo step and cleared Redo.
+TEST(EditorDefects, CancellingTheColourDialogLeavesTheUndoHistoryAsItWas) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  const NodeId material = w->scene().object(sphere)->material;
+  w->select(sphere);
+  // Something to redo.
+  Material rougher = *w->scene().material(material);
+  rougher.roughness = 0.8f;
+  w->edit(SetMaterial{*w->scene().material(material)}, SetMaterial{rougher}, "rougher");
+  w->undoStack()->undo();
+  ASSERT_TRUE(w->undoStack()->canRedo());
+  const int count = w->undoStack()->count(), index = w->undoStack()->index();
+  const Vec3 start = w->scene().material(material)->albedo;
+  QTest::qWait(50);
+  QColorDialog* dialog = openColorDialog(*w, "albedo");
+  ASSERT_TRUE(dialog);
+  dialog->setCurrentColor(QColor(255, 0, 0));
+  EXPECT_GT(w->scene().material(material)->albedo.x, 0.99f) << "the tried colour shows";
+  dialog->reject();
+  EXPECT_EQ(w->scene().material(material)->albedo, start) << "cancel takes it back";
+  EXPECT_EQ(w->undoStack()->count(), count) << "no undo step";
+  EXPECT_EQ(w->undoStack()->index(), index);
+  EXPECT_TRUE(w->undoStack()->canRedo()) << "and Redo still works";
+
+  // Accepting after trying several colours is one step from the colour before the dialog.
+  dialog = openColorDialog(*w, "albedo");
+  ASSERT_TRUE(dialog);
+  dialog->setCurrentColor(QColor(255, 0, 0));
+  dialog->setCurrentColor(QColor(0, 0, 255));
+  dialog->accept();
+  EXPECT_GT(w->scene().material(material)->albedo.z, 0.99f);
+  EXPECT_EQ(w->undoStack()->index(), index + 1);
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().material(material)->albedo, start);
 }
 
 // 14. Outliner: Ground, then Camera, then Ground again left Properties on the camera.
