@@ -8,7 +8,10 @@
 #include "shared/layouts.h"
 #include "common/sampling.glsl"
 
-layout(set = 0, binding = 0, std140) uniform Frame { FrameUniforms frame; };
+// A storage buffer, not a uniform buffer: lavapipe (Mesa 22.3) "inlines" uniform-buffer values that
+// decide branches into a fresh copy of the shader at every bind, and never frees the copies (the
+// process grew by 1.9 MB a frame, whatever the image size).
+layout(set = 0, binding = 0, std430) readonly buffer Frame { FrameUniforms frame; };
 // Triangles, BVH nodes and instance records, addressed by items (layouts.h).
 layout(set = 0, binding = 2) uniform samplerBuffer uTraversal;
 layout(set = 0, binding = 3) uniform samplerBuffer uTriShade;

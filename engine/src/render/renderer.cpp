@@ -116,7 +116,8 @@ struct Renderer::Impl {
         std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::Storage, Binding::Storage, Binding::Storage,
                              Binding::Storage},
         static_cast<std::uint32_t>(sizeof(gpu::AccumulatePush)));
-    frameUbo = Buffer(ctx, sizeof(gpu::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true, "frame constants");
+    frameUbo = Buffer(ctx, sizeof(gpu::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                      true, "frame constants");
     stats = Buffer(ctx, gpu::kStatsCount * sizeof(std::uint32_t), kStorageUsage, true, "ray statistics");
     selection = Buffer(ctx, 16, kStorageUsage, true, "selection counters");
     work = Buffer(ctx, sizeof(gpu::WorkItem) * 64, kStorageUsage, true, "work items");
@@ -182,7 +183,7 @@ struct Renderer::Impl {
     if (!slot) {
       slot = std::make_unique<vk::ComputePipeline>(
           ctx, "trace.comp",
-          std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::UniformTexel, Binding::UniformTexel,
+          std::vector<Binding>{Binding::Storage, Binding::Storage, Binding::UniformTexel, Binding::UniformTexel,
                                Binding::UniformTexel, Binding::UniformTexel,
                                Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel,
                                Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel, Binding::Storage,
