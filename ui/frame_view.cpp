@@ -253,7 +253,7 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
     return QRectF(r.x() + x0 * sx, r.y() + y0 * sy, (x1 - x0) * sx, (y1 - y0) * sy);
   };
   const int tiles = f.cols * f.rows;
-  if (overlays_.priority && static_cast<int>(f.tilePriority.size()) == tiles) {
+  if (heatMapShown() && static_cast<int>(f.tilePriority.size()) == tiles) {
     for (int t = 0; t < tiles; ++t) {
       float pr = f.tilePriority[static_cast<std::size_t>(t)];
       if (pr < 0) continue;
@@ -272,22 +272,27 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
       p.drawRect(tileRect(t).adjusted(1, 1, -1, -1));
     }
   }
-  QFont small(font().family(), std::max(6, static_cast<int>(f.tileSize * sy / 3.2)));
-  p.setFont(small);
+  const TileLabels labels = tileLabels(tileRect(0));
+  p.setFont(labels.font);
+  const QFontMetricsF metrics(labels.font);
+  auto label = [&](const QRectF& box, Qt::Alignment align, const QString& text) {
+    // A label that does not fit its share of the tile is left out rather than overprinted.
+    if (metrics.horizontalAdvance(text) <= box.width()) p.drawText(box, align, text);
+  };
   if (overlays_.order && static_cast<int>(f.tilePriority.size()) == tiles && f.queueLength > 1) {
     p.setPen(Qt::white);
     for (int t = 0; t < tiles; ++t) {
       float pr = f.tilePriority[static_cast<std::size_t>(t)];
       if (pr < 0) continue;
       int rank = static_cast<int>(std::lround((1.0f - pr) * static_cast<float>(f.queueLength - 1))) + 1;
-      p.drawText(tileRect(t), Qt::AlignCenter, QString::number(rank));
+      label(labels.order.translated(tileRect(t).topLeft() - tileRect(0).topLeft()), labels.orderAlign, QString::number(rank));
     }
   }
   if (overlays_.samples && static_cast<int>(f.tileSamples.size()) == tiles) {
     p.setPen(QColor(180, 255, 180));
     for (int t = 0; t < tiles; ++t)
-      p.drawText(tileRect(t).adjusted(2, 1, -2, -1), Qt::AlignBottom | Qt::AlignRight,
-                 QString::number(static_cast<int>(f.tileSamples[static_cast<std::size_t>(t)])));
+      label(labels.samples.translated(tileRect(t).topLeft() - tileRect(0).topLeft()), labels.samplesAlign,
+            QString::number(static_cast<int>(f.tileSamples[static_cast<std::size_t>(t)])));
   }
   if (overlays_.served && static_cast<int>(f.servedTiles.size()) < tiles) {
     p.setPen(QPen(QColor(80, 220, 255), 1.5));
@@ -321,17 +326,28 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
   if (overlays_.legend) drawLegend(p, r);
 }
 
+FrameView::TileLabels FrameView::tileLabels(const QRectF& tile) const {
+  // With both labels on, the order takes the top half of the tile and the samples the bottom half.
+  TileLabels l;
+  const bool both = overlays_.order && overlays_.samples;
+  const QRectF inner = tile.adjusted(2, 1, -2, -1);
+  const double h = both ? inner.height() / 2 : inner.height();
+  l.font = QFont(font().family());
+  l.font.setPixelSize(std::max(6, static_cast<int>(std::min(h * 0.8, tile.height() / 3.2))));
+  l.order = both ? QRectF(inner.x(), inner.y(), inner.width(), h) : inner;
+  l.samples = both ? QRectF(inner.x(), inner.y() + h, inner.width(), h) : inner;
+  l.orderAlign = both ? Qt::AlignLeft | Qt::AlignTop : Qt::AlignCenter;
+  l.samplesAlign = Qt::AlignRight | Qt::AlignBottom;
+  return l;
+}
+
 // One row per overlay that is on, so nothing is explained that is not drawn and the box grows
 // with its rows instead of other boxes stacking over it.
-void FrameView::drawLegend(QPainter& p, const QRectF& r) const {
+std::vector<FrameView::LegendRow> FrameView::legendRows() const {
+  std::vector<LegendRow> rows;
+  if (!frame_) return rows;
   const FrameRecord& f = *frame_;
-  struct Row {
-    QColor color;
-    QString text;
-    bool gradient = false;
-  };
-  std::vector<Row> rows;
-  if (overlays_.priority) rows.push_back({Qt::white, tr("served first  ...  last (tile priority)"), true});
+  if (heatMapShown()) rows.push_back({Qt::white, tr("served first  ...  last (tile priority)"), true});
   if (overlays_.served) rows.push_back({QColor(80, 220, 255), tr("outlined: tiles traced this frame")});
   if (overlays_.markers) rows.push_back({QColor(255, 90, 90), tr("+ point of change    o focus point")});
   if (overlays_.classes && !f.tileClass.empty())
@@ -341,27 +357,45 @@ void FrameView::drawLegend(QPainter& p, const QRectF& r) const {
                     tr("dashed: %n denoised region(s), labelled frames since", nullptr, static_cast<int>(f.denoised.size()))});
   rows.push_back({Qt::lightGray, tr("%1, %2: %3/%4 tiles").arg(QString::fromStdString(f.method), QString::fromStdString(f.mode))
                                      .arg(f.queueServed).arg(f.queueLength)});
+  return rows;
+}
+
+QRectF FrameView::legendRect(const QRectF& r) const {
+  double height = 8;
+  for (const LegendRow& row : legendRows()) height += row.gradient ? kLegendLine + 12 : kLegendLine;
+  // Narrower in a narrow viewport (the rows are elided), never outside the image.
+  const double width = std::max(120.0, std::min(kLegendWidth, r.width() - 16));
+  return QRectF(r.x() + 8, std::max(r.y() + 8, r.bottom() - height - 8), width, height);
+}
+
+bool FrameView::heatMapShown() const {
+  // Outside a pass every tile has the same standing: a heat map would only tint the picture.
+  return overlays_.priority && frame_ && frame_->mode != "refinement";
+}
+
+void FrameView::drawLegend(QPainter& p, const QRectF& r) const {
+  const std::vector<LegendRow> rows = legendRows();
   QFont lf(font().family(), 9);
   p.setFont(lf);
-  const double lineH = 15, width = 300;
-  double height = 8;
-  for (const Row& row : rows) height += row.gradient ? lineH + 12 : lineH;
-  QRectF box(r.x() + 8, r.bottom() - height - 8, width, height);
+  const QRectF box = legendRect(r);
+  const double lineH = kLegendLine, width = box.width();
   p.fillRect(box, QColor(0, 0, 0, 170));
   double y = box.y() + 5;
-  for (const Row& row : rows) {
+  for (const LegendRow& row : rows) {
     if (row.gradient) {
-      QLinearGradient g(box.x() + 10, 0, box.x() + 150, 0);
+      const double ramp = std::min(140.0, width - 20);
+      QLinearGradient g(box.x() + 10, 0, box.x() + 10 + ramp, 0);
       for (int i = 0; i <= 10; ++i) {
         QColor c = priorityColor(1.0f - i / 10.0f);
         c.setAlphaF(1.0);
         g.setColorAt(i / 10.0, c);
       }
-      p.fillRect(QRectF(box.x() + 10, y + 2, 140, 9), g);
+      p.fillRect(QRectF(box.x() + 10, y + 2, ramp, 9), g);
       y += 12;
     }
     p.setPen(row.color);
-    p.drawText(QRectF(box.x() + 10, y, width - 14, lineH), row.text);
+    p.drawText(QRectF(box.x() + 10, y, width - 14, lineH),
+               p.fontMetrics().elidedText(row.text, Qt::ElideRight, static_cast<int>(width - 14)));
     y += lineH;
   }
 }

@@ -84,6 +84,25 @@ class FrameView : public QWidget {
   // The picture exactly as presented: image, overlays and banners at the widget's size.
   QImage composed() const;
 
+  // The overlays' layout, for drawing and for tests: the legend's rows (one per overlay that is
+  // on) and its box inside the image rectangle `r`; where a tile's order number and sample count go.
+  struct LegendRow {
+    QColor color;
+    QString text;
+    bool gradient = false;  // the heat map's colour ramp above the text
+  };
+  std::vector<LegendRow> legendRows() const;
+  static constexpr double kLegendLine = 15, kLegendWidth = 300;  // widget pixels
+  // The priority heat map is drawn: it is on and the frame belongs to a pass.
+  bool heatMapShown() const;
+  QRectF legendRect(const QRectF& r) const;
+  struct TileLabels {
+    QFont font;
+    QRectF order, samples;
+    Qt::Alignment orderAlign, samplesAlign;
+  };
+  TileLabels tileLabels(const QRectF& tile) const;
+
  signals:
   void objectPicked(quint64 object);  // 0: nothing under the cursor
   void focusPlaced(QPointF imagePixel);

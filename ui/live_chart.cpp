@@ -1,6 +1,7 @@
 #include "live_chart.h"
 
 #include <QChart>
+#include <QGraphicsLayout>
 #include <QChartView>
 #include <QDateTime>
 #include <QLabel>
@@ -22,13 +23,23 @@ namespace {
 
 constexpr double kWindowSeconds = 60.0;
 
+// The bottom dock is wide and short: no chart titles or axis titles (the legend says what each
+// line is), small labels and few ticks, so the plot gets the height and no label is cut to "...".
 QChartView* makeView(QChart* chart, QWidget* parent) {
-  chart->setMargins(QMargins(2, 2, 2, 2));
+  chart->setMargins(QMargins(0, 0, 0, 0));
+  chart->layout()->setContentsMargins(0, 0, 0, 0);
   chart->legend()->setAlignment(Qt::AlignTop);
+  QFont small = chart->legend()->font();
+  small.setPointSizeF(std::max(7.0, small.pointSizeF() - 1));
+  chart->legend()->setFont(small);
   chart->setBackgroundRoundness(0);
+  for (QAbstractAxis* axis : chart->axes()) {
+    axis->setLabelsFont(small);
+    if (auto* value = qobject_cast<QValueAxis*>(axis)) value->setTickCount(4);
+  }
   auto* v = new QChartView(chart, parent);
   v->setRenderHint(QPainter::Antialiasing);
-  v->setMinimumHeight(110);
+  v->setMinimumHeight(150);
   return v;
 }
 
@@ -46,16 +57,14 @@ LiveChart::LiveChart(QWidget* parent) : QWidget(parent) {
   layout->setContentsMargins(2, 2, 2, 2);
 
   auto* chart = new QChart;
-  chart->setTitle(tr("Throughput (last minute)"));
   samplesPerSecond_ = new QLineSeries(chart);
-  samplesPerSecond_->setName(tr("M samples/s"));
+  samplesPerSecond_->setName(tr("M samples/s (left)"));
   frameMs_ = new QLineSeries(chart);
-  frameMs_->setName(tr("frame ms"));
+  frameMs_->setName(tr("frame ms (right), last minute"));
   chart->addSeries(samplesPerSecond_);
   chart->addSeries(frameMs_);
   timeAxis_ = new QValueAxis(chart);
-  timeAxis_->setTitleText(tr("seconds since the editor started"));
-  timeAxis_->setLabelFormat("%.0f");
+  timeAxis_->setLabelFormat("%.0f s");
   timeAxis_->setRange(-kWindowSeconds, 0);
   rateAxis_ = new QValueAxis(chart);
   msAxis_ = new QValueAxis(chart);
@@ -68,25 +77,24 @@ LiveChart::LiveChart(QWidget* parent) : QWidget(parent) {
   frameMs_->attachAxis(msAxis_);
   // Side by side: the bottom dock is wide and short.
   auto* charts = new QHBoxLayout;
-  charts->addWidget(makeView(chart, this), 1);
   layout->addLayout(charts, 1);
 
   auto* errChart = new QChart;
-  errChart->setTitle(tr("Relative RMSE against the reference"));
   error_ = new QLineSeries(errChart);
-  error_->setName(tr("relative RMSE (4x4 blocks)"));
+  error_->setName(tr("relative RMSE against the reference (4x4 blocks)"));
   errChart->addSeries(error_);
   errTimeAxis_ = new QValueAxis(errChart);
   errTimeAxis_->setRange(-kWindowSeconds, 0);
-  errTimeAxis_->setTitleText(tr("seconds since the editor started"));
-  errTimeAxis_->setLabelFormat("%.0f");
+  errTimeAxis_->setLabelFormat("%.0f s");
   errAxis_ = new QValueAxis(errChart);
   errAxis_->setLabelFormat("%.3f");
   errChart->addAxis(errTimeAxis_, Qt::AlignBottom);
   errChart->addAxis(errAxis_, Qt::AlignLeft);
   error_->attachAxis(errTimeAxis_);
   error_->attachAxis(errAxis_);
+  charts->addWidget(makeView(chart, this), 1);
   charts->addWidget(makeView(errChart, this), 1);
+  charts_ = {chart, errChart};
 
   auto* row = new QHBoxLayout;
   referenceButton_ = new QPushButton(tr("Render reference"), this);

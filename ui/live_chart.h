@@ -40,6 +40,8 @@ class LiveChart : public QWidget {
   double lastError() const { return lastError_; }
   int errorPoints() const;
   int throughputPoints() const;
+  // The two charts (throughput, error), for their layout.
+  const std::vector<QChart*>& charts() const { return charts_; }
 
  signals:
   void referenceRequested();  // the button: the owner calls renderReference with its document
@@ -56,6 +58,7 @@ class LiveChart : public QWidget {
   QValueAxis* msAxis_ = nullptr;
   QValueAxis* errTimeAxis_ = nullptr;
   QValueAxis* errAxis_ = nullptr;
+  std::vector<QChart*> charts_;
   QLabel* status_ = nullptr;
   QPushButton* referenceButton_ = nullptr;
   qint64 start_ = 0;

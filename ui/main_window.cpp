@@ -34,6 +34,7 @@
 #include <QPushButton>
 #include <QSlider>
 #include <QScopedValueRollback>
+#include <QScrollBar>
 #include <QSpinBox>
 #include <QStatusBar>
 #include <QTreeWidget>
@@ -61,7 +62,6 @@ constexpr int kKindRole = Qt::UserRole + 2;  // a PropertyTarget::Kind
 
 MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions options, QWidget* parent)
     : QMainWindow(parent), options_(options), doc_(std::move(scene)), file_(std::move(file)) {
-  setWindowTitle(file_.empty() ? tr("Retile - built-in scene") : tr("Retile - %1").arg(QString::fromStdString(file_.filename().string())));
   view_ = new FrameView(this);
   setCentralWidget(view_);
   buildDocks();
@@ -194,6 +194,8 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
   QDir().mkpath(recoveryDirectory());
   QFile lock(recoveryDirectory() + "/session.lock");
   if (lock.open(QIODevice::WriteOnly)) lock.write(QByteArray::number(QCoreApplication::applicationPid()));
+  connect(&undo_, &QUndoStack::cleanChanged, this, [this] { updateTitle(); });
+  updateTitle();
   resize(1280, 800);
   startEngine(doc_.scene());
   rebuildOutliner();
@@ -221,17 +223,12 @@ void MainWindow::buildMenus() {
   recentMenu_ = file->addMenu(tr("Open &Recent"));
   connect(recentMenu_, &QMenu::aboutToShow, this, [this] { rebuildRecentMenu(); });
   file->addAction(tr("&Save"), QKeySequence::Save, this, [this] {
-    if (file_.empty() || file_.extension() != ".retile") {
-      QString f = QFileDialog::getSaveFileName(this, tr("Save scene"), QString(), tr("Retile scenes (*.retile)"));
-      if (!f.isEmpty()) saveTo(f.toStdString());
-    } else {
-      saveTo(file_);
-    }
+    // Imported files (glTF, scene.json) are not overwritten in another format: ask for a .retile.
+    if (file_.empty() || file_.extension() != ".retile") saveAs();
+    else saveTo(file_);
   });
-  file->addAction(tr("Save &As..."), QKeySequence::SaveAs, this, [this] {
-    QString f = QFileDialog::getSaveFileName(this, tr("Save scene as"), QString(), tr("Retile scenes (*.retile)"));
-    if (!f.isEmpty()) saveTo(f.toStdString());
-  });
+  // Spelled out: QKeySequence::SaveAs is empty on desktops without a key theme.
+  file->addAction(tr("Save &As..."), QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_S), this, [this] { saveAs(); });
   file->addSeparator();
   file->addAction(tr("&Quit"), QKeySequence::Quit, this, &QWidget::close);
 
@@ -408,10 +405,21 @@ void MainWindow::buildDocks() {
   for (int t : {8, 16, 32}) tileBox_->addItem(QString::number(t), t);
   tileBox_->setCurrentText(QString::number(method_.tileSize));
   qualityBox_ = new QSpinBox(methodBox);
-  qualityBox_->setRange(0, 4096);
-  qualityBox_->setSpecialValueText(tr("auto"));
-  qualityBox_->setValue(method_.quality);
-  qualityBox_->setToolTip(tr("Samples per pixel of a served tile; auto (0) fits all high-priority tiles in one frame (indirection)"));
+  qualityBox_->setObjectName("quality");
+  qualityBox_->setRange(1, 4096);
+  qualityBox_->setValue(std::max(1, method_.quality));
+  qualityBox_->setKeyboardTracking(false);  // a typed Q applies on Enter, not at every digit
+  qualityBox_->setToolTip(tr("Samples per pixel of a served tile"));
+  qualityAuto_ = new QCheckBox(tr("auto"), methodBox);
+  qualityAuto_->setObjectName("qualityAuto");
+  qualityAuto_->setChecked(method_.quality == 0);
+  qualityAuto_->setEnabled(method_.kind == MethodKind::Indirection || method_.kind == MethodKind::IndirectionFocus);
+  qualityAuto_->setToolTip(tr("Indirection methods: the largest Q at which every high-priority tile fits in one frame"));
+  auto* qualityRow = new QWidget(methodBox);
+  auto* ql = new QHBoxLayout(qualityRow);
+  ql->setContentsMargins(0, 0, 0, 0);
+  ql->addWidget(qualityBox_, 1);
+  ql->addWidget(qualityAuto_);
   smoothBox_ = new QCheckBox(tr("smooth transition"), methodBox);
   staleBox_ = new QSpinBox(methodBox);
   staleBox_->setObjectName("staleCap");
@@ -443,7 +451,7 @@ void MainWindow::buildDocks() {
   softBordersBox_->setEnabled(method_.denoise);
   mf->addRow(tr("Policy"), methodBox_);
   mf->addRow(tr("Tile size T"), tileBox_);
-  mf->addRow(tr("Quality Q"), qualityBox_);
+  mf->addRow(tr("Quality Q"), qualityRow);
   mf->addRow(QString(), smoothBox_);
   mf->addRow(tr("Stale cap C"), staleBox_);
   mf->addRow(tr("Focus"), focusModeBox_);
@@ -454,6 +462,7 @@ void MainWindow::buildDocks() {
   connect(methodBox_, &QComboBox::currentTextChanged, this, [this] { sendMethod(); });
   connect(tileBox_, &QComboBox::currentIndexChanged, this, [this] { sendMethod(); });
   connect(qualityBox_, &QSpinBox::valueChanged, this, [this] { sendMethod(); });
+  connect(qualityAuto_, &QCheckBox::toggled, this, [this] { sendMethod(); });
   connect(smoothBox_, &QCheckBox::toggled, this, [this] { sendMethod(); });
   connect(staleBox_, &QSpinBox::valueChanged, this, [this] { sendMethod(); });
   connect(denoiseBox_, &QCheckBox::toggled, this, [this] { sendMethod(); });
@@ -562,8 +571,16 @@ void MainWindow::buildDocks() {
   graphDock->raise();
   // The viewport keeps most of the window; the panels take what they need.
   // (After the first layout: before it, the docks have no sizes to take from.)
-  QTimer::singleShot(0, this, [this, outlinerDock, propDock, graphDock] {
-    resizeDocks({outlinerDock, propDock}, {300, 360}, Qt::Horizontal);
+  // Every drop-down and number field keeps its arrows: they shrink to a few characters (the
+  // text elides) before the panel gets narrower than they need.
+  for (QComboBox* c : settingsPanel->findChildren<QComboBox*>()) {
+    c->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
+    c->setMinimumContentsLength(6);
+  }
+  QTimer::singleShot(0, this, [this, outlinerDock, propDock, graphDock, settingsScroll] {
+    const int left = std::max(330, settingsScroll->widget()->minimumSizeHint().width() +
+                                       settingsScroll->verticalScrollBar()->sizeHint().width() + 8);
+    resizeDocks({outlinerDock, propDock}, {left, 360}, Qt::Horizontal);
     resizeDocks({graphDock}, {230}, Qt::Vertical);
     graph_->frameAll();
   });
@@ -573,7 +590,10 @@ void MainWindow::sendMethod() {
   MethodSettings m = method_;
   methodFromName(methodBox_->currentText().toStdString(), &m.kind);
   m.tileSize = tileBox_->currentData().toInt();
-  m.quality = qualityBox_->value();
+  const bool indirection = m.kind == MethodKind::Indirection || m.kind == MethodKind::IndirectionFocus;
+  qualityAuto_->setEnabled(indirection);
+  m.quality = indirection && qualityAuto_->isChecked() ? 0 : qualityBox_->value();
+  qualityBox_->setEnabled(m.quality != 0);
   m.smooth = smoothBox_->isChecked();
   m.staleCap = staleBox_->value();
   m.denoise = denoiseBox_->isChecked();
@@ -582,7 +602,6 @@ void MainWindow::sendMethod() {
   staleBox_->setEnabled(m.smooth);
   denoiseThresholdBox_->setEnabled(m.denoise);
   softBordersBox_->setEnabled(m.denoise);
-  if (m.quality == 0 && m.kind != MethodKind::Indirection && m.kind != MethodKind::IndirectionFocus) m.quality = 64;
   if (std::string bad = validateMethodSettings(m); !bad.empty()) {
     log(tr("method: %1").arg(QString::fromStdString(bad)));
     return;
@@ -594,12 +613,16 @@ void MainWindow::sendMethod() {
                m.denoise ? tr(", denoise threshold %1 px").arg(m.denoiseThreshold) : QString()));
 }
 
+QSize MainWindow::desiredRenderSize() const {
+  if (!options_.initialRenderSize.isEmpty()) return options_.initialRenderSize;
+  // The viewport's size (and so its aspect: the image fills it) at the render scale.
+  const QSize v = view_->size();
+  const int k = std::max(1, options_.renderScale);
+  return QSize(std::max(64, v.width() / k), std::max(36, v.height() / k));
+}
+
 void MainWindow::updateRenderSize() {
-  QSize size = options_.initialRenderSize;
-  if (size.isEmpty()) {
-    QSize v = view_->size();
-    size = QSize(std::max(64, v.width() / std::max(1, options_.renderScale)), std::max(36, v.height() / std::max(1, options_.renderScale)));
-  }
+  const QSize size = desiredRenderSize();
   if (size == renderSize_) return;
   renderSize_ = size;
   if (engine_) engine_->submit(ResizeCommand{size.width(), size.height()});
@@ -607,8 +630,7 @@ void MainWindow::updateRenderSize() {
 
 void MainWindow::startEngine(Scene scene) {
   if (engine_) engine_->stop();
-  QSize size = options_.initialRenderSize;
-  if (size.isEmpty()) size = QSize(std::max(64, 1000 / std::max(1, options_.renderScale)), std::max(36, 560 / std::max(1, options_.renderScale)));
+  const QSize size = desiredRenderSize();
   renderSize_ = size;
   scene.settings.width = size.width();
   scene.settings.height = size.height();
@@ -651,7 +673,13 @@ void MainWindow::onFrame() {
 }
 
 void MainWindow::log(const QString& line) {
+  // The same warning from the importer and again from the renderer is one warning.
+  if (line.startsWith("warning: ")) {
+    if (loggedWarnings_.contains(line)) return;
+    loggedWarnings_.insert(line);
+  }
   log_->appendPlainText(QDateTime::currentDateTime().toString("HH:mm:ss  ") + line);
+  log_->verticalScrollBar()->setValue(log_->verticalScrollBar()->maximum());  // the newest entry shows
 }
 
 void MainWindow::showError(const QString& title, const QString& message) {
@@ -888,7 +916,8 @@ void MainWindow::replaceDocument(Scene scene, const std::filesystem::path& file)
   undo_.clear();
   selection_ = kNoNode;
   method_.focus.clear();
-  setWindowTitle(file.empty() ? tr("Retile - built-in scene") : tr("Retile - %1").arg(QString::fromStdString(file.filename().string())));
+  updateTitle();
+  loggedWarnings_.clear();
   startEngine(doc_.scene());
   rebuildOutliner();
   panel_->setTarget({});
@@ -912,6 +941,21 @@ bool MainWindow::maybeSave() {
   return saveTo(target);
 }
 
+bool MainWindow::saveAs() {
+  QFileDialog dialog(this, tr("Save scene as"), QString(), tr("Retile scenes (*.retile)"));
+  dialog.setObjectName("saveAsDialog");
+  dialog.setAcceptMode(QFileDialog::AcceptSave);
+  dialog.setDefaultSuffix("retile");
+  if (dialog.exec() != QDialog::Accepted || dialog.selectedFiles().isEmpty()) return false;
+  return saveTo(dialog.selectedFiles().front().toStdString());
+}
+
+void MainWindow::updateTitle() {
+  const QString name = file_.empty() ? tr("built-in scene") : QString::fromStdString(file_.filename().string());
+  setWindowTitle(tr("%1[*] - Retile").arg(name));
+  setWindowModified(!undo_.isClean());
+}
+
 bool MainWindow::saveTo(const std::filesystem::path& file) {
   auto r = saveNativeScene(doc_.scene(), file);
   if (!r) {
@@ -920,6 +964,7 @@ bool MainWindow::saveTo(const std::filesystem::path& file) {
   }
   file_ = file;
   undo_.setClean();
+  updateTitle();
   rememberRecent(file);
   log(tr("saved %1").arg(QString::fromStdString(file.string())));
   return true;

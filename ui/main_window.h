@@ -6,6 +6,7 @@
 
 #include <QElapsedTimer>
 #include <QMainWindow>
+#include <QSet>
 #include <QTimer>
 #include <QUndoStack>
 
@@ -45,6 +46,10 @@ class MainWindow : public QMainWindow {
   // Opens a scene file; on failure shows the error and keeps the current scene. Returns success.
   bool openFile(const std::filesystem::path& file);
   bool saveTo(const std::filesystem::path& file);
+  // Appends a line to the Log dock (a warning is logged once per document).
+  void log(const QString& line);
+  // Asks for a .retile file (the "saveAsDialog") and saves there.
+  bool saveAs();
 
   const Scene& scene() const { return doc_.scene(); }
   std::uint64_t documentVersion() const { return doc_.version(); }
@@ -88,10 +93,11 @@ class MainWindow : public QMainWindow {
   void rebuildProperties();
   void onFrame();
   void sendMethod();
-  void log(const QString& line);
   void showError(const QString& title, const QString& message);
   bool applyToDocument(const Edit& e);
   void updateRenderSize();
+  QSize desiredRenderSize() const;
+  void updateTitle();  // the file's name, and [*] while there are unsaved changes
   void rememberRecent(const std::filesystem::path& file);
   void rebuildRecentMenu();
   void editCamera(const std::function<void(Camera&)>& change, const QString& what);
@@ -130,7 +136,9 @@ class MainWindow : public QMainWindow {
   QComboBox* tileBox_ = nullptr;
   QSpinBox* qualityBox_ = nullptr;
   QCheckBox* smoothBox_ = nullptr;
+  QCheckBox* qualityAuto_ = nullptr;
   bool panelEdit_ = false;  // the edit being applied comes from the properties panel itself
+  QSet<QString> loggedWarnings_;  // of the current document: each is logged once
   QCheckBox* denoiseBox_ = nullptr;
   QSpinBox* denoiseThresholdBox_ = nullptr;
   QCheckBox* softBordersBox_ = nullptr;

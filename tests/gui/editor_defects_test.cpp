@@ -1,12 +1,22 @@
 // The editor as an artist meets it (issue 13): one test per defect found by trying it as a new
 // user would, each failing on the editor before its fix.
+#include <QAbstractAxis>
 #include <QApplication>
+#include <QChart>
 #include <QCheckBox>
 #include <QColorDialog>
 #include <QComboBox>
+#include <QDockWidget>
+#include <QFileDialog>
+#include <QFontMetricsF>
 #include <QLabel>
+#include <QLineEdit>
+#include <QPlainTextEdit>
+#include <QScrollBar>
 #include <QSpinBox>
+#include <QTemporaryDir>
 #include <QTest>
+#include <QTimer>
 #include <QTreeWidget>
 
 #include <gtest/gtest.h>
@@ -14,6 +24,8 @@
 #include "editor_support.h"
 #include "fields.h"
 #include "frame_view.h"
+#include "live_chart.h"
+#include "test_support.h"
 #include "main_window.h"
 
 namespace retile::ui {
@@ -190,6 +202,231 @@ TEST(EditorDefects, CancellingTheColourDialogLeavesTheUndoHistoryAsItWas) {
   EXPECT_EQ(w->undoStack()->index(), index + 1);
   w->undoStack()->undo();
   EXPECT_EQ(w->scene().material(material)->albedo, start);
+}
+
+// Brightly saturated pixels (the heat map's ramp, the classes' yellow) inside `box` of `img`.
+int saturatedPixels(const QImage& img, const QRectF& box) {
+  int n = 0;
+  for (int y = static_cast<int>(box.top()); y < static_cast<int>(box.bottom()); ++y)
+    for (int x = static_cast<int>(box.left()); x < static_cast<int>(box.right()); ++x) {
+      if (!img.rect().contains(x, y)) continue;
+      QColor c = img.pixelColor(x, y);
+      n += c.hsvSaturationF() > 0.85 && c.valueF() > 0.85;
+    }
+  return n;
+}
+
+// 7 and 8. The classes' legend was cut off behind the main legend; the legend showed the heat
+// map's colour ramp with the heat map off. The heat map itself tinted the whole picture while it
+// refined, outside any pass.
+TEST(EditorDefects, TheLegendExplainsWhatIsDrawnAndNothingElse) {
+  auto w = makeWindow();
+  w->resize(1280, 800);
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  FrameView* v = w->viewport();
+  auto refining = std::make_shared<FrameRecord>(*v->frame());
+  refining->mode = "refinement";
+  auto inPass = std::make_shared<FrameRecord>(*refining);
+  inPass->mode = "incremental";
+  OverlaySettings o;
+  o.priority = false;
+  o.legend = true;
+  v->setOverlays(o);
+  v->showFrame(inPass);
+  QRectF box = v->legendRect(v->imageRect());
+  EXPECT_EQ(saturatedPixels(v->composed(), box), 0) << "no colour ramp without the heat map";
+  for (const auto& row : v->legendRows()) EXPECT_FALSE(row.gradient);
+  o.priority = true;
+  v->setOverlays(o);
+  box = v->legendRect(v->imageRect());
+  EXPECT_GT(saturatedPixels(v->composed(), box), 50) << "the ramp with it";
+  v->showFrame(refining);
+  EXPECT_FALSE(v->heatMapShown()) << "no heat map outside a pass";
+  EXPECT_EQ(saturatedPixels(v->composed(), v->legendRect(v->imageRect())), 0);
+
+  // Indirection with counters: the classes' row is in the legend's one box, inside the image.
+  MethodSettings m;
+  m.kind = MethodKind::Indirection;
+  m.quality = 0;
+  m.indirectionFrames = 1;
+  w->engine()->submit(MethodCommand{m});
+  w->select(objectNamed(w->scene(), "Cup"));
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return !f.tileClass.empty(); }));
+  v->showFrame(v->frame());
+  o.classes = true;
+  v->setOverlays(o);
+  bool listed = false;
+  for (const auto& row : v->legendRows()) listed = listed || row.text.contains("indirection classes");
+  EXPECT_TRUE(listed);
+  box = v->legendRect(v->imageRect());
+  EXPECT_TRUE(v->imageRect().contains(box)) << "the whole legend is inside the image: " << box.x() << "," << box.y() << " "
+                                             << box.width() << "x" << box.height() << " in " << v->imageRect().x() << ","
+                                             << v->imageRect().y() << " " << v->imageRect().width() << "x"
+                                             << v->imageRect().height();
+  double needed = 8;
+  for (const auto& row : v->legendRows()) needed += FrameView::kLegendLine + (row.gradient ? 12 : 0);
+  EXPECT_GE(box.height(), needed) << "and tall enough for its rows";
+}
+
+// 9. Tile order numbers and samples per tile printed on top of each other.
+TEST(EditorDefects, OrderNumbersAndSampleCountsDoNotOverlap) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  FrameView* v = w->viewport();
+  OverlaySettings o;
+  o.order = true;
+  o.samples = true;
+  v->setOverlays(o);
+  for (double tile : {16.0, 24.0, 40.0, 96.0}) {
+    SCOPED_TRACE(tile);
+    FrameView::TileLabels l = v->tileLabels(QRectF(10, 10, tile, tile));
+    EXPECT_FALSE(l.order.intersects(l.samples)) << "each label has its own part of the tile";
+    QFontMetricsF fm(l.font);
+    EXPECT_LE(fm.height(), l.order.height() + 1) << "a line of the font fits its part";
+    EXPECT_TRUE(QRectF(10, 10, tile, tile).contains(l.order.united(l.samples)));
+  }
+}
+
+// 10. At 1280x800 and 1600x1000 drop-downs and number fields lost their arrows; Q's "auto" was
+// found only by stepping below 1; a typed Q applied at every digit.
+TEST(EditorDefects, TheRenderSettingsFitAndQHasAnAutoSwitch) {
+  auto w = makeWindow();
+  for (QSize size : {QSize(1280, 800), QSize(1600, 1000)}) {
+    SCOPED_TRACE(testing::Message() << size.width() << "x" << size.height());
+    w->resize(size);
+    QTest::qWait(200);  // the docks settle
+    auto* dock = w->findChild<QDockWidget*>("renderSettings");
+    ASSERT_TRUE(dock);
+    dock->raise();
+    QTest::qWait(50);
+    int checked = 0;
+    for (QComboBox* c : dock->findChildren<QComboBox*>()) {
+      if (!c->isVisibleTo(dock)) continue;
+      EXPECT_GE(c->width(), c->minimumSizeHint().width()) << c->objectName().toStdString();
+      ++checked;
+    }
+    for (QAbstractSpinBox* b : dock->findChildren<QAbstractSpinBox*>()) {
+      if (!b->isVisibleTo(dock)) continue;
+      EXPECT_GE(b->width(), b->minimumSizeHint().width()) << b->objectName().toStdString();
+      ++checked;
+    }
+    EXPECT_GT(checked, 5);
+  }
+  auto* method = w->findChild<QComboBox*>("method");
+  auto* q = w->findChild<QSpinBox*>("quality");
+  auto* qAuto = w->findChild<QCheckBox*>("qualityAuto");
+  ASSERT_TRUE(method && q && qAuto);
+  EXPECT_EQ(q->minimum(), 1);
+  EXPECT_FALSE(qAuto->isEnabled()) << "automatic Q is the indirection methods'";
+  method->setCurrentText("indirection");
+  EXPECT_TRUE(qAuto->isEnabled());
+  qAuto->setChecked(true);
+  EXPECT_FALSE(q->isEnabled());
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.method == "indirection"; }));
+  qAuto->setChecked(false);
+  EXPECT_FALSE(q->keyboardTracking()) << "a typed value applies on Enter";
+}
+
+// 11 and 12. Ctrl+Shift+S did nothing; the title never showed the file's name or unsaved changes.
+TEST(EditorDefects, SaveAsHasItsShortcutAndTheTitleShowsTheFileAndChanges) {
+  auto w = makeWindow();
+  QApplication::setActiveWindow(w.get());
+  ASSERT_TRUE(QTest::qWaitForWindowActive(w.get()));
+  EXPECT_TRUE(w->windowTitle().contains("built-in scene"));
+  EXPECT_FALSE(w->isWindowModified());
+  NodeId cup = objectNamed(w->scene(), "Cup");
+  Object o = *w->scene().object(cup), renamed = o;
+  renamed.name = "Teacup";
+  w->edit(SetObject{o}, SetObject{renamed}, "rename");
+  EXPECT_TRUE(w->isWindowModified()) << "unsaved changes are marked";
+  QTemporaryDir dir;
+  const QString path = dir.path() + "/cups";  // the dialog adds .retile
+  // Answers the dialog when it is up; a dialog that does not close is rejected, so a failure
+  // cannot hang the suite.
+  bool dialogSeen = false, dialogClosed = false;
+  QTimer poll;
+  int polls = 0;
+  QObject::connect(&poll, &QTimer::timeout, [&] {
+    auto* dialog = qobject_cast<QFileDialog*>(QApplication::activeModalWidget());
+    if (dialog && dialog->objectName() == "saveAsDialog" && !dialogSeen) {
+      dialogSeen = true;
+      dialog->setDirectory(dir.path());
+      if (auto* name = dialog->findChild<QLineEdit*>("fileNameEdit")) name->setText("cups");
+      static_cast<QDialog*>(dialog)->accept();  // QFileDialog::accept is protected
+      dialogClosed = !dialog->isVisible();
+      if (!dialogClosed) dialog->reject();
+    } else if (dialog && ++polls > 100) {
+      dialog->reject();
+    }
+  });
+  poll.start(50);
+  QTest::keyClick(w.get(), Qt::Key_S, Qt::ControlModifier | Qt::ShiftModifier);
+  poll.stop();
+  EXPECT_TRUE(dialogClosed) << "the dialog takes the name";
+  EXPECT_TRUE(dialogSeen) << "Ctrl+Shift+S asks where to save";
+  EXPECT_TRUE(QFile::exists(path + ".retile"));
+  EXPECT_TRUE(w->windowTitle().startsWith("cups.retile")) << w->windowTitle().toStdString();
+  EXPECT_FALSE(w->isWindowModified());
+}
+
+// 13. After File > Open or New the image was letterboxed (a fixed size), after a resize cropped.
+TEST(EditorDefects, AfterNewTheImageFillsTheViewport) {
+  EditorOptions o;  // the render size follows the viewport
+  o.renderScale = 4;
+  auto w = std::make_unique<MainWindow>(makeDefaultScene(), std::filesystem::path(), o);
+  w->resize(1200, 640);
+  w->show();
+  QTest::qWait(400);  // the docks and the render size settle
+  QApplication::setActiveWindow(w.get());
+  ASSERT_TRUE(QTest::qWaitForWindowActive(w.get()));
+  QTest::keyClick(w.get(), Qt::Key_N, Qt::ControlModifier);  // a new document
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  FrameView* v = w->viewport();
+  const double viewAspect = static_cast<double>(v->width()) / v->height();
+  const double imageAspect = static_cast<double>(v->frame()->width) / v->frame()->height;
+  EXPECT_NEAR(imageAspect, viewAspect, 0.05 * viewAspect) << "the image has the viewport's shape";
+  EXPECT_GT(v->imageRect().width(), 0.97 * v->width());
+  EXPECT_GT(v->imageRect().height(), 0.97 * v->height());
+}
+
+// 15. The live chart was cramped: labels "...", plots about 40 px tall.
+TEST(EditorDefects, TheLiveChartHasRoomForItsPlotsAndLabels) {
+  auto w = makeWindow();
+  w->resize(1280, 800);
+  auto* chartDock = w->findChild<QDockWidget*>("chartDock");
+  ASSERT_TRUE(chartDock);
+  chartDock->raise();
+  QTest::qWait(300);
+  auto* chart = w->findChild<LiveChart*>();
+  ASSERT_TRUE(chart);
+  ASSERT_EQ(chart->charts().size(), 2u);
+  for (QChart* c : chart->charts()) {
+    EXPECT_GE(c->plotArea().height(), 80) << "the plot";
+    for (QAbstractAxis* a : c->axes()) EXPECT_FALSE(a->labelsTruncated()) << "no label is cut to ...";
+  }
+}
+
+// 16. The log did not follow new entries, and a missing file was reported twice.
+TEST(EditorDefects, TheLogFollowsNewEntriesAndSaysEachWarningOnce) {
+  RETILE_SHARED_OR_SKIP(room, "scenes/living-room/scene.json");
+  auto w = makeWindow();
+  auto* logDock = w->findChild<QDockWidget*>("log");
+  ASSERT_TRUE(logDock);
+  logDock->raise();
+  ASSERT_TRUE(w->openFile(room)) << w->lastError().toStdString();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  QTest::qWait(100);
+  auto* log = qobject_cast<QPlainTextEdit*>(logDock->widget());
+  ASSERT_TRUE(log);
+  const QStringList lines = log->toPlainText().split('\n');
+  QStringList warnings;
+  for (const QString& line : lines)
+    if (line.contains("warning:")) warnings << line.mid(line.indexOf("warning:"));
+  ASSERT_FALSE(warnings.isEmpty()) << "the room's sky map is missing";
+  EXPECT_EQ(warnings.removeDuplicates(), 0) << "each warning once";
+  for (int i = 0; i < 60; ++i) w->log(QString("entry %1").arg(i));
+  QScrollBar* bar = log->verticalScrollBar();
+  EXPECT_EQ(bar->value(), bar->maximum()) << "the newest entry shows";
 }
 
 // 14. Outliner: Ground, then Camera, then Ground again left Properties on the camera.

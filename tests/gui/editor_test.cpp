@@ -102,9 +102,10 @@ TEST(Editor, CameraNavigationAndDraggingTheSelectionAreSingleUndoSteps) {
   QPoint on = pointShowing(*v, sphere);
   ASSERT_GE(on.x(), 0);
   Vec3 before = w->scene().object(sphere)->transform.transformPoint(Vec3{0.0f});
+  const int step = std::max(10, static_cast<int>(v->imageRect().width() / 20));  // a fifth of the image in all
   QTest::mousePress(v, Qt::LeftButton, Qt::NoModifier, on);
-  for (int i = 1; i <= 4; ++i) QTest::mouseMove(v, on + QPoint(10 * i, 0));
-  QTest::mouseRelease(v, Qt::LeftButton, Qt::NoModifier, on + QPoint(40, 0));
+  for (int i = 1; i <= 4; ++i) QTest::mouseMove(v, on + QPoint(step * i, 0));
+  QTest::mouseRelease(v, Qt::LeftButton, Qt::NoModifier, on + QPoint(4 * step, 0));
   Vec3 after = w->scene().object(sphere)->transform.transformPoint(Vec3{0.0f});
   EXPECT_GT(length(after - before), 0.05f) << "dragging the selection moves it";
   w->undoStack()->undo();
