@@ -1,7 +1,9 @@
 #include "frame_view.h"
 
+#include <QDateTime>
 #include <QMouseEvent>
 #include <QPainter>
+#include <QTimer>
 #include <QWindow>
 
 #include <algorithm>
@@ -76,7 +78,14 @@ void FrameView::takeSnapshot() {
   if (!frame_ || !frame_->image) return;
   snapshotLinear_ = frame_->image;  // frames are immutable once published: sharing is enough
   snapshot_ = image_;
+  showNotice(tr("Snapshot taken: B shows it, A the live render"));
+}
+
+void FrameView::showNotice(const QString& text, int ms) {
+  notice_ = text;
+  noticeUntil_ = QDateTime::currentMSecsSinceEpoch() + ms;
   refresh();
+  QTimer::singleShot(ms + 20, this, [this] { refresh(); });  // and gone when its time is up
 }
 
 void FrameView::setCompare(Compare c) {
@@ -197,6 +206,14 @@ void FrameView::compose(QPainter& p, const QRect& area) const {
   }
   drawOverlays(p, r);
   drawGizmo(p);
+  if (!notice_.isEmpty() && QDateTime::currentMSecsSinceEpoch() < noticeUntil_) {
+    // A short confirmation where the artist is looking (Ctrl+B has no other visible effect).
+    p.setFont(QFont(font().family(), 10, QFont::Bold));
+    const QRectF box(r.center().x() - 180, r.y() + 12, 360, 26);
+    p.fillRect(box, QColor(0, 0, 0, 190));
+    p.setPen(Qt::white);
+    p.drawText(box, Qt::AlignCenter, notice_);
+  }
   if (compare_ != Compare::Off && snapshotUsable) {
     p.setFont(QFont(font().family(), 11, QFont::Bold));
     p.setPen(QColor(255, 255, 255));

@@ -55,6 +55,9 @@ class FrameView : public QWidget {
   enum class Compare { Off, Toggle, Wipe };
   void takeSnapshot();
   bool hasSnapshot() const { return !snapshot_.isNull(); }
+  // A line over the top of the image for `ms`, confirming what a key did.
+  void showNotice(const QString& text, int ms = 2500);
+  QString notice() const { return notice_; }
   void setCompare(Compare c);
   Compare compare() const { return compare_; }
   void setWipe(double x);
@@ -161,6 +164,8 @@ class FrameView : public QWidget {
   std::shared_ptr<const RenderImage> snapshotLinear_;
   QImage snapshot_;
   Compare compare_ = Compare::Off;
+  QString notice_;
+  qint64 noticeUntil_ = 0;
   double wipe_ = 0.5;
   VulkanViewport* vulkan_ = nullptr;
   QWidget* container_ = nullptr;

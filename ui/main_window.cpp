@@ -279,11 +279,18 @@ void MainWindow::buildMenus() {
     log(tr("snapshot taken: B in the A/B compare"));
   });
   auto* modes = new QActionGroup(this);
-  auto mode = [&](const QString& name, FrameView::Compare c, const QKeySequence& key) {
-    QAction* a = compare->addAction(name, key, this, [this, c] {
+  auto mode = [&, modes](const QString& name, FrameView::Compare c, const QKeySequence& key) {
+    QAction* a = compare->addAction(name, key, this, [this, c, modes] {
+      if (c == FrameView::Compare::Off && graph_ && graph_->mouseOver()) {
+        // A acts on the panel under the mouse: over the node graph it frames the graph.
+        graph_->frameAll();
+        for (QAction* m : modes->actions()) m->setChecked(m->data().toInt() == static_cast<int>(view_->compare()));
+        return;
+      }
       if (!view_->hasSnapshot()) log(tr("compare: take a snapshot first (Ctrl+B)"));
       view_->setCompare(c);
     });
+    a->setData(static_cast<int>(c));
     a->setCheckable(true);
     a->setChecked(c == FrameView::Compare::Off);
     modes->addAction(a);
@@ -777,7 +784,10 @@ void MainWindow::select(NodeId object) {
     QSignalBlocker block(outliner_);
     outliner_->clearSelection();
     for (QTreeWidgetItemIterator it(outliner_); *it; ++it)
-      if ((*it)->data(0, kIdRole).toULongLong() == object && object != kNoNode) (*it)->setSelected(true);
+      if ((*it)->data(0, kIdRole).toULongLong() == object && object != kNoNode) {
+        (*it)->setSelected(true);
+        outliner_->scrollToItem(*it);  // an object picked in the viewport shows in a long list
+      }
   }
 }
 
@@ -984,7 +994,8 @@ void MainWindow::closeEvent(QCloseEvent* e) {
 
 void MainWindow::keyPressEvent(QKeyEvent* e) {
   if (e->key() == Qt::Key_F && !(e->modifiers() & Qt::ControlModifier)) {
-    frameSelected();
+    if (graph_ && graph_->mouseOver()) graph_->frameSelected();  // the panel under the mouse
+    else frameSelected();
     return;
   }
   QMainWindow::keyPressEvent(e);

@@ -17,9 +17,11 @@
 #include <QVBoxLayout>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 #include <set>
 
 namespace retile::ui {
@@ -535,21 +537,26 @@ void NodeGraphView::rebuild() {
     n->swatch = displayColor(l.color);
   }
 
-  // Nodes seen before keep their place; new ones go below the lowest node of their column.
-  qreal next[4] = {0, 0, 0, 0};
+  if (positions_.empty()) layOut(order);
+  // Nodes seen before keep their place; new ones go below the lowest node of their kind's last column.
+  std::map<int, QPointF> below;  // per column kind: where the next node goes
   for (GraphNodeItem* n : order) {
     auto it = positions_.find(n->id);
     if (it == positions_.end()) continue;
     n->setPos(it->second);
     const int c = columnOf(n->kind);
-    if (std::abs(it->second.x() - c * kColumnStep) < kNodeWidth)
-      next[c] = std::max(next[c], it->second.y() + n->height() + kRowGap);
+    const QPointF bottom(it->second.x(), it->second.y() + n->height() + kRowGap);
+    auto b = below.find(c);
+    if (b == below.end() || bottom.x() > b->second.x() + kNodeWidth ||
+        (std::abs(bottom.x() - b->second.x()) < kNodeWidth && bottom.y() > b->second.y()))
+      below[c] = bottom;
   }
   for (GraphNodeItem* n : order) {
     if (positions_.count(n->id)) continue;
     const int c = columnOf(n->kind);
-    const QPointF p(c * kColumnStep, next[c]);
-    next[c] += n->height() + kRowGap;
+    auto b = below.find(c);
+    const QPointF p = b != below.end() ? b->second : QPointF(c * kColumnStep, 0);
+    below[c] = QPointF(p.x(), p.y() + n->height() + kRowGap);
     positions_[n->id] = p;
     n->setPos(p);
   }
@@ -568,6 +575,64 @@ void NodeGraphView::rebuild() {
 
   setSelection(selection);
   updateLinkPaths();
+}
+
+void NodeGraphView::layOut(const std::vector<GraphNodeItem*>& nodes) {
+  // Columns by kind (textures, materials, objects, the rest), each in the order of what it feeds,
+  // so that links run mostly level: materials as the scene lists them, objects by their material,
+  // textures by the first material that uses them. A kind too tall for the panel's shape wraps
+  // into more columns; a big scene (the living room has about 90 nodes) fills the panel instead of
+  // making one thin column.
+  std::unordered_map<NodeId, std::size_t> materialRank, textureRank;
+  for (std::size_t i = 0; i < scene_.materials.size(); ++i) {
+    const Material& m = scene_.materials[i];
+    materialRank[m.id] = i;
+    for (NodeId t : {m.albedoTexture, m.roughnessTexture, m.alphaTexture})
+      if (t != kNoNode && !textureRank.count(t)) textureRank[t] = i;
+  }
+  auto rank = [&](const GraphNodeItem* n) -> std::size_t {
+    constexpr std::size_t kLast = std::numeric_limits<std::size_t>::max();
+    switch (n->kind) {
+      case NodeKind::Texture: {
+        auto it = textureRank.find(n->id);
+        return it == textureRank.end() ? kLast : it->second;
+      }
+      case NodeKind::Object: {
+        const Object* o = scene_.object(n->id);
+        auto it = o ? materialRank.find(o->material) : materialRank.end();
+        return it == materialRank.end() ? kLast : it->second;
+      }
+      default: return 0;
+    }
+  };
+  std::array<std::vector<GraphNodeItem*>, 4> columns;
+  for (GraphNodeItem* n : nodes) columns[static_cast<std::size_t>(columnOf(n->kind))].push_back(n);
+  double area = 0, tallest = 0;
+  for (auto& column : columns) {
+    std::stable_sort(column.begin(), column.end(),
+                     [&](const GraphNodeItem* a, const GraphNodeItem* b) { return rank(a) < rank(b); });
+    for (const GraphNodeItem* n : column) {
+      area += (n->height() + kRowGap) * kColumnStep;
+      tallest = std::max<double>(tallest, n->height() + kRowGap);
+    }
+  }
+  // The panel's shape (a wide strip below the viewport, unless the artist made it otherwise).
+  const double aspect = std::clamp(height() > 50 ? static_cast<double>(width()) / height() : 4.0, 1.0, 8.0);
+  const double maxHeight = std::max({std::sqrt(area / aspect), 4.0 * tallest, 400.0});
+  qreal x = 0;
+  for (const auto& column : columns) {
+    if (column.empty()) continue;
+    qreal y = 0;
+    for (GraphNodeItem* n : column) {
+      if (y > 0 && y + n->height() > maxHeight) {
+        x += kColumnStep;
+        y = 0;
+      }
+      positions_[n->id] = QPointF(x, y);
+      y += n->height() + kRowGap;
+    }
+    x += kColumnStep + kRowGap;  // a little more room between kinds than between a kind's columns
+  }
 }
 
 void NodeGraphView::updateLinkPaths() {
@@ -590,6 +655,8 @@ void NodeGraphView::setSelectedObject(NodeId id) {
   auto it = nodes_.find(id);
   if (it != nodes_.end() && it->second->isSelected()) return;
   setSelection(id != kNoNode && it != nodes_.end() ? std::vector<NodeId>{id} : std::vector<NodeId>{});
+  // What the artist picked in the viewport comes into view here, at the zoom the graph has.
+  if (it != nodes_.end()) ensureVisible(it->second->sceneBoundingRect(), 40, 30);
 }
 
 void NodeGraphView::selectNodes(const std::vector<NodeId>& ids) { setSelection(ids); }
@@ -986,16 +1053,26 @@ bool graphKey(const QKeyEvent* k) {
   if (mods == Qt::ControlModifier)
     return k->key() == Qt::Key_D || k->key() == Qt::Key_C || k->key() == Qt::Key_V;
   if (mods == Qt::NoModifier)
-    return k->key() == Qt::Key_Tab || k->key() == Qt::Key_F || k->key() == Qt::Key_A || k->key() == Qt::Key_F2 ||
-           k->key() == Qt::Key_Delete || k->key() == Qt::Key_Backspace;
+    return k->key() == Qt::Key_Tab || k->key() == Qt::Key_F2 || k->key() == Qt::Key_Delete ||
+           k->key() == Qt::Key_Backspace;
   return false;
+}
+
+bool framingKey(const QKeyEvent* k) {
+  return (k->modifiers() & ~Qt::KeypadModifier) == Qt::NoModifier && (k->key() == Qt::Key_F || k->key() == Qt::Key_A);
 }
 
 }  // namespace
 
+bool NodeGraphView::mouseOver() const {
+  return isVisible() && (viewport()->underMouse() || viewport()->rect().contains(viewport()->mapFromGlobal(QCursor::pos())));
+}
+
 bool NodeGraphView::event(QEvent* e) {
+  // F and A frame the panel under the mouse: here while the mouse is over the graph, the
+  // viewport's framing and compare otherwise, wherever the keyboard focus is.
   if (e->type() == QEvent::ShortcutOverride &&
-      (graphKey(static_cast<QKeyEvent*>(e)) ||
+      (graphKey(static_cast<QKeyEvent*>(e)) || (framingKey(static_cast<QKeyEvent*>(e)) && mouseOver()) ||
        (drag_ == Drag::Link && static_cast<QKeyEvent*>(e)->key() == Qt::Key_Escape))) {
     e->accept();
     return true;
@@ -1024,8 +1101,12 @@ void NodeGraphView::keyPressEvent(QKeyEvent* e) {
     }
   } else if (mods == Qt::NoModifier) {
     switch (e->key()) {
-      case Qt::Key_F: frameSelected(); return;
-      case Qt::Key_A: frameAll(); return;
+      case Qt::Key_F:
+      case Qt::Key_A:
+        if (!mouseOver()) break;  // the window frames the viewport
+        if (e->key() == Qt::Key_F) frameSelected();
+        else frameAll();
+        return;
       case Qt::Key_Delete:
       case Qt::Key_Backspace: deleteSelected(); return;
       case Qt::Key_F2:
@@ -1131,9 +1212,10 @@ void NodeGraphView::mousePressEvent(QMouseEvent* e) {
     return;
   }
 
+  // A click on empty canvas keeps the selection (it is often the viewport's object); a marquee
+  // drag replaces it, or adds to it with Shift or Ctrl.
   marqueeBase_.clear();
   if (e->modifiers() & (Qt::ShiftModifier | Qt::ControlModifier)) marqueeBase_ = selectedNodes();
-  else setSelection({});
   marquee_->setRect(QRectF(pressScene_, QSizeF()));
   marquee_->show();
   drag_ = Drag::Marquee;
@@ -1175,6 +1257,7 @@ void NodeGraphView::mouseMoveEvent(QMouseEvent* e) {
       break;
     }
     case Drag::Marquee: {
+      if (!moved_) break;  // still a click
       const QRectF r = QRectF(pressScene_, sp).normalized();
       marquee_->setRect(r);
       std::vector<NodeId> ids = marqueeBase_;

@@ -95,6 +95,7 @@ class NodeGraphView : public QGraphicsView {
   void startRename(NodeId id);            // the F2 inline editor; nothing while one is open
   void frameSelected();                   // F (all when nothing is selected)
   void frameAll();                        // A
+  bool mouseOver() const;                 // F and A act on the graph only then
 
  signals:
   void editRequested(const retile::ui::GraphEdit& edit);  // the owner applies it as one undo step
@@ -125,6 +126,7 @@ class NodeGraphView : public QGraphicsView {
   enum class Drag { None, Link, Move, Marquee, Pan };
 
   void rebuild();
+  void layOut(const std::vector<GraphNodeItem*>& nodes);  // fresh positions for every node
   GraphNodeItem* nodeAt(QPointF scenePos) const;
   SocketHit socketAt(QPointF scenePos) const;
   const Link* linkInto(NodeId to, const QString& input) const;

@@ -59,12 +59,24 @@ class PropertyPanel::Builder {
     auto* row = new QWidget(p_->body_);
     auto* l = new QHBoxLayout(row);
     l->setContentsMargins(0, 0, 0, 0);
+    static const char* const kAxisName[3] = {"X", "Y", "Z"};
+    static const QColor kAxisColor[3] = {QColor(220, 70, 70), QColor(70, 170, 70), QColor(80, 120, 230)};
     for (int axis = 0; axis < 3; ++axis) {
+      // Labelled in the gizmo's axis colours, so a field reads without counting.
+      auto* label = new QLabel(QString::fromLatin1(kAxisName[axis]), row);
+      label->setStyleSheet(QString("color: %1; font-weight: bold;").arg(kAxisColor[axis].name()));
+      label->setSizePolicy(QSizePolicy::Fixed, QSizePolicy::Preferred);
+      l->addWidget(label);
       auto* f = new ScrubField(axisOf(value, axis), -1e5, 1e5, 0.0, 3, row);
+      // Three to a row in a narrow panel: no arrows (the field is dragged or typed), and the
+      // width shared out rather than sized for the longest number the range allows.
+      f->setButtonSymbols(QAbstractSpinBox::NoButtons);
+      f->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
+      f->setMinimumWidth(f->fontMetrics().horizontalAdvance("-000.000") + 8);
       f->setSingleStep(step);
       f->setObjectName(QString("%1%2").arg(objectName).arg(axis));
       connectField(f, [apply, axis](double v, int drag) { apply(axis, v, drag); });
-      l->addWidget(f);
+      l->addWidget(f, 1);
     }
     form_->addRow(name, row);
   }
@@ -205,6 +217,25 @@ void PropertyPanel::buildObject(Builder& b, const Object& o) {
       Vec3 d{0.0f};
       axisOf(d, axis) = static_cast<float>(v) - axisOf(p, axis);
       x.transform = Mat4::translate(d) * x.transform;
+    });
+  });
+  // Rotation and scale about the object's origin, as the gizmo turns and scales it. A sheared
+  // transform (rare in imported files) loses its shear when one of them is edited.
+  const Trs trs = decompose(o.transform);
+  b.vec3(tr("Rotation"), "rotation", trs.rotationDegrees, 1.0, [edit](int axis, double v, int drag) {
+    edit(tr("Rotate"), drag, [&](Object& x) {
+      Trs t = decompose(x.transform);
+      axisOf(t.rotationDegrees, axis) = static_cast<float>(v);
+      x.transform = compose(t);
+    });
+  });
+  b.vec3(tr("Scale"), "scale", trs.scale, 0.01, [edit](int axis, double v, int drag) {
+    edit(tr("Scale"), drag, [&](Object& x) {
+      Trs t = decompose(x.transform);
+      // Never zero: a flat object cannot be scaled back up.
+      const double magnitude = std::max(std::abs(v), 1e-4);
+      axisOf(t.scale, axis) = static_cast<float>(v < 0 ? -magnitude : magnitude);
+      x.transform = compose(t);
     });
   });
   QStringList names{tr("(none)")};

@@ -21,12 +21,17 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
+#include <string>
+
 #include "editor_support.h"
 #include "fields.h"
 #include "frame_view.h"
 #include "live_chart.h"
 #include "test_support.h"
 #include "main_window.h"
+#include "node_graph.h"
+#include "retile/io.h"
 
 namespace retile::ui {
 namespace {
@@ -445,6 +450,163 @@ TEST(EditorDefects, OutlinerAndPropertiesStayInStep) {
   tree->setCurrentItem(ground);
   EXPECT_TRUE(w->findChild<ScrubField*>("position0")) << "back to the object";
   EXPECT_FALSE(w->findChild<ScrubField*>("cameraPosition0"));
+}
+
+// A scene with many materials and objects, like an imported room (the living room has about 90
+// nodes), made here so the test needs no shared file.
+Scene manyNodes(int pairs) {
+  Scene s = makeDefaultScene();
+  const Object model = s.objects.front();
+  for (int i = 0; i < pairs; ++i) {
+    Material m;
+    m.id = s.newId();
+    m.name = "Material " + std::to_string(i);
+    s.materials.push_back(m);
+    Object o = model;
+    o.id = s.newId();
+    o.name = "Object " + std::to_string(i);
+    o.material = m.id;
+    s.objects.push_back(o);
+  }
+  return s;
+}
+
+// 4. The living room's graph was a thin column and a bundle of links: big graphs are laid out
+// in wrapped columns grouped by kind, in about the panel's shape.
+TEST(EditorDefects, ABigGraphIsLaidOutInThePanelsShape) {
+  NodeGraphView view;
+  view.resize(1200, 260);  // the graph panel below the viewport
+  view.show();
+  const Scene s = manyNodes(40);
+  view.setDocument(s);
+  double minX = 1e9, maxX = -1e9, minY = 1e9, maxY = -1e9;
+  std::set<std::pair<int, int>> places;
+  auto span = [&](NodeId id) {
+    const QPointF p = view.nodePosition(id);
+    minX = std::min(minX, p.x()), maxX = std::max(maxX, p.x());
+    minY = std::min(minY, p.y()), maxY = std::max(maxY, p.y());
+    EXPECT_TRUE(places.insert({static_cast<int>(p.x()), static_cast<int>(p.y())}).second) << "one node per place";
+  };
+  double lastMaterialX = -1e9, firstObjectX = 1e9, lastTextureX = -1e9, firstMaterialX = 1e9;
+  for (const Texture& t : s.textures) span(t.id), lastTextureX = std::max(lastTextureX, view.nodePosition(t.id).x());
+  for (const Material& m : s.materials) {
+    span(m.id);
+    lastMaterialX = std::max(lastMaterialX, view.nodePosition(m.id).x());
+    firstMaterialX = std::min(firstMaterialX, view.nodePosition(m.id).x());
+  }
+  for (const Object& o : s.objects) span(o.id), firstObjectX = std::min(firstObjectX, view.nodePosition(o.id).x());
+  EXPECT_LT(lastTextureX, firstMaterialX) << "textures, then materials";
+  EXPECT_LT(lastMaterialX, firstObjectX) << "then objects, each kind in its own columns";
+  EXPECT_GT(maxX - minX, 2.0 * (maxY - minY)) << "wider than tall, like the panel: " << maxX - minX << " x " << maxY - minY;
+}
+
+// 4. Picking an object in the viewport brings its node into the graph's view; a click on empty
+// canvas keeps the selection.
+TEST(EditorDefects, TheGraphShowsWhatThePickSelectsAndAnEmptyClickKeepsIt) {
+  NodeGraphView view;
+  view.resize(600, 240);
+  view.show();
+  const Scene s = manyNodes(40);
+  view.setDocument(s);
+  view.scale(2.5, 2.5);  // zoomed in, as an artist working on a few nodes
+  const NodeId last = s.objects.back().id;
+  view.setSelectedObject(last);
+  const QPoint at = view.mapFromScene(view.nodePosition(last) + QPointF(20, 10));
+  EXPECT_TRUE(view.viewport()->rect().contains(at)) << "the picked object's node is in view";
+  ASSERT_EQ(view.selectedNodes(), std::vector<NodeId>{last});
+  QPoint empty(-1, -1);
+  for (int y = 5; y < view.viewport()->height() && empty.x() < 0; y += 10)
+    for (int x = 5; x < view.viewport()->width(); x += 10)
+      if (!view.itemAt(QPoint(x, y))) {
+        empty = QPoint(x, y);
+        break;
+      }
+  ASSERT_GE(empty.x(), 0);
+  QTest::mouseClick(view.viewport(), Qt::LeftButton, Qt::NoModifier, empty);
+  EXPECT_EQ(view.selectedNodes(), std::vector<NodeId>{last}) << "a click on empty canvas keeps the selection";
+}
+
+// 4. F and A act on the panel under the mouse, wherever the keyboard focus is.
+TEST(EditorDefects, FAndAActOnThePanelUnderTheMouse) {
+  auto w = makeWindow();
+  w->resize(1280, 800);
+  QApplication::setActiveWindow(w.get());
+  ASSERT_TRUE(QTest::qWaitForWindowActive(w.get()));
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  NodeGraphView* graph = w->graph();
+  FrameView* v = w->viewport();
+  graph->scale(4, 4);
+  const double zoomed = graph->transform().m11();
+  QTest::mouseMove(graph->viewport(), graph->viewport()->rect().center());
+  ASSERT_TRUE(graph->mouseOver());
+  v->setFocus();  // the keyboard on the viewport, the mouse over the graph
+  QTest::keyClick(v, Qt::Key_A);
+  EXPECT_LT(graph->transform().m11(), zoomed) << "A frames the whole graph";
+  EXPECT_EQ(v->compare(), FrameView::Compare::Off);
+
+  w->select(objectNamed(w->scene(), "Cup"));
+  const Camera camera = w->scene().camera;
+  graph->scale(3, 3);
+  const double before = graph->transform().m11();
+  QTest::keyClick(v, Qt::Key_F);
+  EXPECT_NE(graph->transform().m11(), before) << "F frames the graph's selection";
+  EXPECT_EQ(length(w->scene().camera.position - camera.position), 0.0f) << "and leaves the camera";
+
+  QTest::mouseMove(v, v->rect().center());
+  ASSERT_FALSE(graph->mouseOver());
+  graph->setFocus();  // the keyboard on the graph, the mouse over the viewport
+  const double graphZoom = graph->transform().m11();
+  QTest::keyClick(graph, Qt::Key_F);
+  EXPECT_GT(length(w->scene().camera.position - camera.position), 1e-4f) << "F frames the viewport's selection";
+  EXPECT_EQ(graph->transform().m11(), graphZoom);
+}
+
+// Day-one expectations: Ctrl+B says what it did; X/Y/Z labels and rotation and scale fields in
+// Properties; the outliner scrolls to an object picked in the viewport.
+TEST(EditorDefects, SnapshotFeedbackTransformFieldsAndOutlinerScroll) {
+  auto w = makeWindow();
+  QApplication::setActiveWindow(w.get());
+  ASSERT_TRUE(QTest::qWaitForWindowActive(w.get()));
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  QTest::keyClick(w.get(), Qt::Key_B, Qt::ControlModifier);
+  EXPECT_TRUE(w->viewport()->notice().contains("Snapshot")) << "Ctrl+B confirms it took the snapshot";
+
+  const NodeId cup = objectNamed(w->scene(), "Cup");
+  w->select(cup);
+  ASSERT_TRUE(QTest::qWaitFor([&] { return w->findChild<ScrubField*>("rotation1") != nullptr; }, 2000));
+  auto* panel = w->findChild<ScrubField*>("position0")->parentWidget();
+  int axisLabels = 0;
+  for (QLabel* l : panel->findChildren<QLabel*>()) axisLabels += l->text() == "X" || l->text() == "Y" || l->text() == "Z";
+  EXPECT_EQ(axisLabels, 3) << "the position row labels its fields";
+  const Vec3 origin = w->scene().object(cup)->transform.transformPoint(Vec3{0.0f});
+  emit w->findChild<ScrubField*>("rotation1")->edited(90.0, false);  // typed and entered
+  Trs t = decompose(w->scene().object(cup)->transform);
+  EXPECT_NEAR(t.rotationDegrees.y, 90.0f, 1e-3f);
+  ASSERT_TRUE(QTest::qWaitFor([&] { return w->findChild<ScrubField*>("scale0") != nullptr; }, 2000));
+  emit w->findChild<ScrubField*>("scale0")->edited(2.0, false);
+  t = decompose(w->scene().object(cup)->transform);
+  EXPECT_NEAR(t.scale.x, 2.0f, 1e-4f);
+  EXPECT_NEAR(t.rotationDegrees.y, 90.0f, 1e-3f) << "scaling keeps the rotation";
+  EXPECT_LT(length(w->scene().object(cup)->transform.transformPoint(Vec3{0.0f}) - origin), 1e-4f) << "and the position";
+  w->undoStack()->undo();
+  w->undoStack()->undo();
+  t = decompose(w->scene().object(cup)->transform);
+  EXPECT_NEAR(t.rotationDegrees.y, 0.0f, 1e-3f) << "each is an undo step";
+
+  // A long outliner: the picked object scrolls into view.
+  w->resize(1000, 500);
+  ASSERT_TRUE(w->openFile([&] {
+    const auto file = retile::test::tempDir() / "many.retile";
+    EXPECT_TRUE(saveNativeScene(manyNodes(60), file).ok());
+    return file;
+  }()));
+  QTest::qWait(100);
+  auto* tree = w->findChild<QTreeWidget*>();
+  const NodeId last = objectNamed(w->scene(), "Object 59");
+  w->select(last);
+  QTreeWidgetItem* item = outlinerItem(*w, "Object 59");
+  ASSERT_TRUE(item);
+  EXPECT_TRUE(tree->viewport()->rect().intersects(tree->visualItemRect(item))) << "the outliner shows the pick";
 }
 
 }  // namespace

@@ -98,4 +98,16 @@ struct Mat4 {
 
 Bounds3 transformBounds(const Mat4& m, const Bounds3& b);
 
+// A transform as an artist edits it: translate * rotateZ * rotateY * rotateX * scale, angles in
+// degrees. decompose() reads any affine transform so (shear, which compose() cannot make, is
+// dropped; a mirrored transform gets a negative x scale); compose(decompose(m)) is m for every
+// transform without shear.
+struct Trs {
+  Vec3 translation{0.0f};
+  Vec3 rotationDegrees{0.0f};  // about x, then y, then z
+  Vec3 scale{1.0f};
+};
+Trs decompose(const Mat4& m);
+Mat4 compose(const Trs& t);
+
 }  // namespace retile

@@ -1,5 +1,8 @@
 #include "retile/math.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace retile {
 
 Mat4 Mat4::translate(Vec3 t) {
@@ -137,6 +140,41 @@ Mat4 Mat4::inverse() const {
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) r.m[i][j] = static_cast<float>(a[i][j + 4]);
   return r;
+}
+
+Trs decompose(const Mat4& m) {
+  Trs t;
+  t.translation = m.translation();
+  Vec3 col[3];
+  for (int j = 0; j < 3; ++j) col[j] = Vec3{m.m[0][j], m.m[1][j], m.m[2][j]};
+  t.scale = Vec3{length(col[0]), length(col[1]), length(col[2])};
+  if (dot(cross(col[0], col[1]), col[2]) < 0.0f) t.scale.x = -t.scale.x;  // mirrored
+  float r[3][3];
+  for (int j = 0; j < 3; ++j) {
+    const float s = j == 0 ? t.scale.x : j == 1 ? t.scale.y : t.scale.z;
+    const Vec3 c = s != 0.0f ? col[j] / s : Vec3{j == 0 ? 1.0f : 0.0f, j == 1 ? 1.0f : 0.0f, j == 2 ? 1.0f : 0.0f};
+    r[0][j] = c.x;
+    r[1][j] = c.y;
+    r[2][j] = c.z;
+  }
+  // R = Rz(c) Ry(b) Rx(a): r[2][0] = -sin b.
+  const float sb = std::clamp(-r[2][0], -1.0f, 1.0f);
+  const float b = std::asin(sb);
+  float a, c;
+  if (std::abs(sb) < 0.99999f) {
+    a = std::atan2(r[2][1], r[2][2]);
+    c = std::atan2(r[1][0], r[0][0]);
+  } else {  // gimbal lock: only a - c (or a + c) is defined; put it all in c
+    a = 0.0f;
+    c = std::atan2(-r[0][1], r[1][1]);
+  }
+  t.rotationDegrees = Vec3{degrees(a), degrees(b), degrees(c)};
+  return t;
+}
+
+Mat4 compose(const Trs& t) {
+  return Mat4::translate(t.translation) * Mat4::rotateZ(radians(t.rotationDegrees.z)) *
+         Mat4::rotateY(radians(t.rotationDegrees.y)) * Mat4::rotateX(radians(t.rotationDegrees.x)) * Mat4::scale(t.scale);
 }
 
 Bounds3 transformBounds(const Mat4& m, const Bounds3& b) {
