@@ -7,6 +7,8 @@
 #include <QUndoCommand>
 
 #include <functional>
+#include <utility>
+#include <vector>
 
 #include "retile/edit.h"
 
@@ -19,6 +21,9 @@ class EditCommand : public QUndoCommand {
   using Apply = std::function<bool(const Edit&)>;
   // `dragId` > 0 lets consecutive commands of the same target and drag merge.
   EditCommand(Edit before, Edit after, const QString& text, Apply apply, int dragId = 0);
+  // Several targets in one step (a multi-selection moved together): applied in order, undone in
+  // reverse; a drag merges when it touches the same targets.
+  EditCommand(std::vector<std::pair<Edit, Edit>> steps, const QString& text, Apply apply, int dragId = 0);
 
   void redo() override;
   void undo() override;
@@ -26,7 +31,7 @@ class EditCommand : public QUndoCommand {
   bool mergeWith(const QUndoCommand* other) override;
 
  private:
-  Edit before_, after_;
+  std::vector<std::pair<Edit, Edit>> steps_;  // before, after
   Apply apply_;
   int dragId_;
 };

@@ -262,6 +262,26 @@ void FrameView::compose(QPainter& p, const QRect& area) const {
 void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
   if (!frame_) return;
   const FrameRecord& f = *frame_;
+  if (selection_.size() > 1 && f.image) {
+    // Outlined pixel by pixel from the frame's object ids: which objects a move will take along.
+    if (outlineOf_ != f.image.get()) {
+      outlineOf_ = f.image.get();
+      const auto& ids = f.image->objectId;
+      outline_ = QImage(f.width, f.height, QImage::Format_ARGB32_Premultiplied);
+      outline_.fill(Qt::transparent);
+      auto selected = [&](int x, int y) {
+        if (x < 0 || y < 0 || x >= f.width || y >= f.height) return false;
+        const quint64 id = ids[static_cast<std::size_t>(y) * static_cast<std::size_t>(f.width) + static_cast<std::size_t>(x)];
+        return id != 0 && std::find(selection_.begin(), selection_.end(), id) != selection_.end();
+      };
+      if (ids.size() == static_cast<std::size_t>(f.width) * static_cast<std::size_t>(f.height))
+        for (int y = 0; y < f.height; ++y)
+          for (int x = 0; x < f.width; ++x)
+            if (selected(x, y) && !(selected(x - 1, y) && selected(x + 1, y) && selected(x, y - 1) && selected(x, y + 1)))
+              outline_.setPixel(x, y, qRgb(255, 160, 40));
+    }
+    p.drawImage(r, outline_);
+  }
   const double sx = r.width() / f.width, sy = r.height() / f.height;
   auto tileRect = [&](int t) {
     int c = t % f.cols, row = t / f.cols;
@@ -509,7 +529,7 @@ void FrameView::mousePressEvent(QMouseEvent* e) {
   std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(frame_->width) + static_cast<std::size_t>(x);
   quint64 id = i < ids.size() ? static_cast<quint64>(ids[i]) : 0;
   // Pressing on the selection starts moving it; anywhere else picks.
-  if (id != 0 && id == selected_ && tool_ != Tool::Select) {
+  if (id != 0 && std::find(selection_.begin(), selection_.end(), id) != selection_.end() && tool_ != Tool::Select) {
     drag_ = tool_ == Tool::Rotate ? Drag::Rotate : tool_ == Tool::Scale ? Drag::Scale : Drag::Object;
     return;
   }
@@ -583,8 +603,29 @@ void FrameView::mouseReleaseEvent(QMouseEvent* e) {
     refresh();
     return;
   }
+  if (drag_ == Drag::Region) {
+    // Ctrl+click (no drag) on an object adds it to the selection or takes it out.
+    const QPointF d = e->position() - regionStart_;
+    const QPoint px = imagePixel(regionStart_);
+    if (std::hypot(d.x(), d.y()) < 4 && px.x() >= 0 && frame_ && frame_->image) {
+      const auto& ids = frame_->image->objectId;
+      const std::size_t i = static_cast<std::size_t>(px.y()) * static_cast<std::size_t>(frame_->width) + static_cast<std::size_t>(px.x());
+      if (i < ids.size() && ids[i] != 0) {
+        drag_ = Drag::None;
+        emit objectToggled(static_cast<quint64>(ids[i]));
+        return;
+      }
+    }
+  }
   if (drag_ != Drag::None && drag_ != Drag::Region && drag_ != Drag::Wipe) emit dragFinished();
   drag_ = Drag::None;
+}
+
+void FrameView::setSelection(std::vector<quint64> objects, quint64 primary) {
+  selection_ = std::move(objects);
+  selected_ = primary;
+  outlineOf_ = nullptr;
+  refresh();
 }
 
 void FrameView::wheelEvent(QWheelEvent* e) {

@@ -108,6 +108,7 @@ class FrameView : public QWidget {
 
  signals:
   void objectPicked(quint64 object);  // 0: nothing under the cursor
+  void objectToggled(quint64 object);  // Ctrl+click on an object: into or out of the selection
   void focusPlaced(QPointF imagePixel);
   // Drags, in widget pixels since the last event. A drag starts with a press and ends with the
   // release (dragFinished), so a whole drag can be one undo step.
@@ -160,7 +161,10 @@ class FrameView : public QWidget {
   void drawGizmo(QPainter& p) const;
   QPointF last_, regionStart_;
   QRect region_;  // the inspected region in image pixels
-  quint64 selected_ = 0;
+  quint64 selected_ = 0;              // the primary selection
+  std::vector<quint64> selection_;    // all selected objects
+  mutable QImage outline_;            // the multi-selection's outline, at the frame's resolution
+  mutable const void* outlineOf_ = nullptr;  // the image record it was made for
   std::shared_ptr<const RenderImage> snapshotLinear_;
   QImage snapshot_;
   Compare compare_ = Compare::Off;
@@ -172,7 +176,11 @@ class FrameView : public QWidget {
   QString presentation_;
 
  public:
-  void setSelected(quint64 object) { selected_ = object; }
+  void setSelected(quint64 object) { setSelection(object ? std::vector<quint64>{object} : std::vector<quint64>{}, object); }
+  // Every selected object (a drag on any of them moves them all) and the one that leads; with
+  // more than one, each is outlined.
+  void setSelection(std::vector<quint64> objects, quint64 primary);
+  const std::vector<quint64>& selection() const { return selection_; }
 };
 
 // The heat map's colour for a priority in [0, 1] (1: served first).

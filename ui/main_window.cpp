@@ -69,6 +69,7 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
   status_ = new QLabel(this);
   statusBar()->addPermanentWidget(status_, 1);
   connect(view_, &FrameView::objectPicked, this, [this](quint64 id) { select(static_cast<NodeId>(id)); });
+  connect(view_, &FrameView::objectToggled, this, [this](quint64 id) { toggleSelected(static_cast<NodeId>(id)); });
   connect(view_, &FrameView::focusPlaced, this, [this](QPointF p) {
     if (focusModeBox_->currentIndex() == 2) return;  // the cursor places it
     const bool follows = focusModeBox_->currentIndex() == 1;
@@ -136,13 +137,13 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
     Vec3 fwd = normalize(c.target - c.position);
     Vec3 right = normalize(cross(fwd, c.up)), up = cross(right, fwd);
     // The object follows the cursor at the depth of its bounds' centre, the point the gizmo and the
-    // pivot use: imported meshes often sit far from their transform's origin.
+    // pivot use: imported meshes often sit far from their transform's origin. The rest of a
+    // multi-selection moves with it.
     Vec3 at = pivot(*o);
     float depth = std::max(0.01f, dot(at - c.position, fwd));
     float k = 2.0f * depth * std::tan(c.verticalFov * 0.5f) / static_cast<float>(frame->height);
-    Object after = *o;
-    after.transform = Mat4::translate(right * static_cast<float>(d.x() * k) - up * static_cast<float>(d.y() * k)) * o->transform;
-    edit(SetObject{*o}, SetObject{after}, tr("Move %1").arg(QString::fromStdString(o->name)), dragCounter_ + 1);
+    const Mat4 move = Mat4::translate(right * static_cast<float>(d.x() * k) - up * static_cast<float>(d.y() * k));
+    editSelected([&](Object& x) { x.transform = move * x.transform; }, tr("Move %1"));
   });
   connect(view_, &FrameView::renderRegionDrawn, this, [this](QRect r) {
     engine_->submit(RegionCommand{RegionRect{r.x(), r.y(), r.width(), r.height()}});
@@ -159,18 +160,19 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
     const float t = static_cast<float>((d.x() * dir.x() + d.y() * dir.y()) / len2) * gizmoLength_;
     Vec3 step{0.0f};
     (axis == 0 ? step.x : axis == 1 ? step.y : step.z) = t;
-    Object after = *o;
-    after.transform = Mat4::translate(step) * o->transform;
-    edit(SetObject{*o}, SetObject{after}, tr("Move %1 along %2").arg(QString::fromStdString(o->name)).arg(QChar('x' + axis)),
-         dragCounter_ + 1);
+    editSelected([&](Object& x) { x.transform = Mat4::translate(step) * x.transform; },
+                 tr("Move %2 along %1").arg(QChar('x' + axis)));
   });
   auto aboutOrigin = [this](const Mat4& m, const QString& what) {
-    const Object* o = doc_.scene().object(selection_);
-    if (!o) return;
-    const Vec3 at = pivot(*o);
-    Object after = *o;
-    after.transform = Mat4::translate(at) * m * Mat4::translate(at * -1.0f) * o->transform;
-    edit(SetObject{*o}, SetObject{after}, what.arg(QString::fromStdString(o->name)), dragCounter_ + 1);
+    // A multi-selection turns and scales as a group, about the centre of its pivots.
+    Vec3 at{0.0f};
+    int n = 0;
+    for (NodeId id : selected_)
+      if (const Object* o = doc_.scene().object(id)) at = at + pivot(*o), ++n;
+    if (n == 0) return;
+    at = at / static_cast<float>(n);
+    const Mat4 about = Mat4::translate(at) * m * Mat4::translate(at * -1.0f);
+    editSelected([&](Object& x) { x.transform = about * x.transform; }, what);
   };
   connect(view_, &FrameView::rotateDragged, this, [aboutOrigin](double px) {
     aboutOrigin(Mat4::rotateY(static_cast<float>(px * 0.01)), tr("Rotate %1"));
@@ -339,9 +341,23 @@ void MainWindow::buildDocks() {
   outliner_ = new QTreeWidget(this);
   outliner_->setHeaderLabels({tr("Name"), tr("Material / kind")});
   outliner_->header()->setSectionResizeMode(0, QHeaderView::Stretch);
+  outliner_->setSelectionMode(QAbstractItemView::ExtendedSelection);  // Ctrl+click adds objects
   connect(outliner_, &QTreeWidget::itemSelectionChanged, this, [this] {
     auto items = outliner_->selectedItems();
     if (items.isEmpty()) return;
+    std::vector<NodeId> objects;
+    for (QTreeWidgetItem* item : items)
+      if (static_cast<PropertyTarget::Kind>(item->data(0, kKindRole).toInt()) == PropertyTarget::Kind::Object)
+        objects.push_back(static_cast<NodeId>(item->data(0, kIdRole).toULongLong()));
+    if (objects.size() > 1) {
+      // The current item leads when it is one of them (the one just Ctrl+clicked).
+      const auto current = static_cast<NodeId>(outliner_->currentItem() ? outliner_->currentItem()->data(0, kIdRole).toULongLong() : 0);
+      selected_ = objects;
+      selection_ = std::find(objects.begin(), objects.end(), current) != objects.end() ? current : objects.back();
+      applySelection();
+      return;
+    }
+    if (items.size() > 1) items = {outliner_->currentItem() ? outliner_->currentItem() : items[0]};
     bool ok = false;
     qulonglong id = items[0]->data(0, kIdRole).toULongLong(&ok);
     auto kind = static_cast<PropertyTarget::Kind>(items[0]->data(0, kKindRole).toInt());
@@ -773,22 +789,68 @@ void MainWindow::edit(const Edit& before, const Edit& after, const QString& text
 
 void MainWindow::select(NodeId object) {
   if (object != kNoNode && !doc_.scene().object(object)) object = kNoNode;
+  selected_.clear();
+  if (object != kNoNode) selected_.push_back(object);
   selection_ = object;
-  view_->setSelected(object);
-  engine_->submit(SelectCommand{object});
-  if (graph_) graph_->setSelectedObject(object);
+  applySelection();
+}
+
+void MainWindow::toggleSelected(NodeId object) {
+  if (!doc_.scene().object(object)) return;
+  auto it = std::find(selected_.begin(), selected_.end(), object);
+  if (it != selected_.end()) {
+    selected_.erase(it);
+    selection_ = selected_.empty() ? kNoNode : selected_.back();  // the last picked leads
+  } else {
+    selected_.push_back(object);
+    selection_ = object;
+  }
+  applySelection();
+}
+
+void MainWindow::applySelection() {
+  // Objects an edit or a new document removed drop out.
+  std::erase_if(selected_, [this](NodeId id) { return !doc_.scene().object(id); });
+  if (!doc_.scene().object(selection_)) selection_ = selected_.empty() ? kNoNode : selected_.back();
+  view_->setSelection(std::vector<quint64>(selected_.begin(), selected_.end()), selection_);
+  // The engine's indirection counters and the gizmo follow the last picked object.
+  engine_->submit(SelectCommand{selection_});
+  if (graph_) {
+    if (selected_.size() > 1) graph_->selectNodes(selected_);
+    else graph_->setSelectedObject(selection_);
+  }
   updateGizmo();
-  if (object != kNoNode) panel_->setTarget({PropertyTarget::Kind::Object, object});
+  if (selection_ != kNoNode) panel_->setTarget({PropertyTarget::Kind::Object, selection_});
   else if (panel_->target().kind == PropertyTarget::Kind::Object) panel_->setTarget({});
   {
     QSignalBlocker block(outliner_);
     outliner_->clearSelection();
-    for (QTreeWidgetItemIterator it(outliner_); *it; ++it)
-      if ((*it)->data(0, kIdRole).toULongLong() == object && object != kNoNode) {
-        (*it)->setSelected(true);
-        outliner_->scrollToItem(*it);  // an object picked in the viewport shows in a long list
-      }
+    for (QTreeWidgetItemIterator it(outliner_); *it; ++it) {
+      const auto id = static_cast<NodeId>((*it)->data(0, kIdRole).toULongLong());
+      if (static_cast<PropertyTarget::Kind>((*it)->data(0, kKindRole).toInt()) != PropertyTarget::Kind::Object ||
+          std::find(selected_.begin(), selected_.end(), id) == selected_.end())
+        continue;
+      (*it)->setSelected(true);
+      if (id == selection_) outliner_->scrollToItem(*it);  // an object picked in the viewport shows in a long list
+    }
   }
+}
+
+void MainWindow::editSelected(const std::function<void(Object&)>& change, const QString& what) {
+  std::vector<std::pair<Edit, Edit>> steps;
+  QString name;
+  for (NodeId id : selected_) {
+    const Object* o = doc_.scene().object(id);
+    if (!o) continue;
+    Object after = *o;
+    change(after);
+    steps.emplace_back(SetObject{*o}, SetObject{after});
+    name = QString::fromStdString(o->name);
+  }
+  if (steps.empty()) return;
+  const QString target = steps.size() == 1 ? name : tr("%n objects", nullptr, static_cast<int>(steps.size()));
+  undo_.push(new EditCommand(std::move(steps), what.arg(target), [this](const Edit& e) { return applyToDocument(e); },
+                             dragCounter_ + 1));
 }
 
 void MainWindow::rebuildOutliner() {
@@ -810,7 +872,7 @@ void MainWindow::rebuildOutliner() {
     it->setData(0, kKindRole, static_cast<int>(PropertyTarget::Kind::Object));
     it->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsEditable | Qt::ItemIsUserCheckable);
     it->setCheckState(0, o.visible ? Qt::Checked : Qt::Unchecked);
-    if (o.id == selection_) it->setSelected(true);
+    if (std::find(selected_.begin(), selected_.end(), o.id) != selected_.end()) it->setSelected(true);
   }
   QTreeWidgetItem* materials = group(tr("Materials"));
   for (const Material& m : s.materials) {
@@ -925,6 +987,7 @@ void MainWindow::replaceDocument(Scene scene, const std::filesystem::path& file)
   file_ = file;
   undo_.clear();
   selection_ = kNoNode;
+  selected_.clear();
   method_.focus.clear();
   updateTitle();
   loggedWarnings_.clear();

@@ -11,7 +11,9 @@
 #include <QUndoStack>
 
 #include <filesystem>
+#include <functional>
 #include <memory>
+#include <vector>
 
 #include "frame_view.h"
 #include "property_panel.h"
@@ -60,7 +62,11 @@ class MainWindow : public QMainWindow {
   class NodeGraphView* graph() { return graph_; }
   Engine* engine() { return engine_.get(); }
   QTreeWidget* outliner() { return outliner_; }
-  NodeId selection() const { return selection_; }
+  NodeId selection() const { return selection_; }  // the last picked object: gizmo, Properties
+  // Every selected object (Ctrl+click in the viewport or the outliner adds and removes); moves,
+  // turns and scales apply to all of them as one undo step.
+  const std::vector<NodeId>& selectedObjects() const { return selected_; }
+  void toggleSelected(NodeId object);
   void select(NodeId object);
   // Applies an edit through the undo stack (dragId > 0 merges a drag into one step).
   void edit(const Edit& before, const Edit& after, const QString& text, int dragId = 0);
@@ -84,6 +90,9 @@ class MainWindow : public QMainWindow {
   bool maybeSave();
   void refreshGraph();
   void updateGizmo();
+  void applySelection();  // shows selected_ and selection_ everywhere (viewport, engine, graph, panel, outliner)
+  // One undo step changing every selected object; `what` has %1 for the object's name or count.
+  void editSelected(const std::function<void(Object&)>& change, const QString& what);
   Vec3 pivot(const Object& o) const;  // where the gizmo sits and rotation/scale turn about
   void replaceDocument(Scene scene, const std::filesystem::path& file);
   void buildDocks();
@@ -109,6 +118,7 @@ class MainWindow : public QMainWindow {
   std::unique_ptr<Engine> engine_;
   QUndoStack undo_;
   NodeId selection_ = kNoNode;
+  std::vector<NodeId> selected_;  // includes selection_
   MethodSettings method_;
   bool paused_ = false;
   int dragCounter_ = 0;

@@ -442,12 +442,12 @@ TEST(EditorDefects, OutlinerAndPropertiesStayInStep) {
   QTreeWidgetItem* ground = outlinerItem(*w, "Ground");
   QTreeWidgetItem* camera = outlinerItem(*w, "Camera");
   ASSERT_TRUE(ground && camera);
-  tree->setCurrentItem(ground);
+  tree->setCurrentItem(ground, 0, QItemSelectionModel::ClearAndSelect);  // a plain click
   EXPECT_TRUE(w->findChild<ScrubField*>("position0")) << "the object's fields";
-  tree->setCurrentItem(camera);
+  tree->setCurrentItem(camera, 0, QItemSelectionModel::ClearAndSelect);
   EXPECT_TRUE(w->findChild<ScrubField*>("cameraPosition0")) << "the camera's fields";
   ground = outlinerItem(*w, "Ground");
-  tree->setCurrentItem(ground);
+  tree->setCurrentItem(ground, 0, QItemSelectionModel::ClearAndSelect);  // a plain click
   EXPECT_TRUE(w->findChild<ScrubField*>("position0")) << "back to the object";
   EXPECT_FALSE(w->findChild<ScrubField*>("cameraPosition0"));
 }
@@ -607,6 +607,47 @@ TEST(EditorDefects, SnapshotFeedbackTransformFieldsAndOutlinerScroll) {
   QTreeWidgetItem* item = outlinerItem(*w, "Object 59");
   ASSERT_TRUE(item);
   EXPECT_TRUE(tree->viewport()->rect().intersects(tree->visualItemRect(item))) << "the outliner shows the pick";
+}
+
+// Day one: Ctrl+click selects several objects (in the viewport and the outliner); a drag moves
+// them all as one undo step.
+TEST(EditorDefects, CtrlClickSelectsSeveralObjectsAndADragMovesThemTogether) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  FrameView* v = w->viewport();
+  const NodeId sphere = objectNamed(w->scene(), "Glossy Sphere"), cup = objectNamed(w->scene(), "Cup");
+  w->select(sphere);
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 3; }));
+  const QPoint onCup = pointShowing(*v, cup), onSphere = pointShowing(*v, sphere);
+  ASSERT_GE(onCup.x(), 0);
+  ASSERT_GE(onSphere.x(), 0);
+  QTest::mouseClick(v, Qt::LeftButton, Qt::ControlModifier, onCup);
+  EXPECT_EQ(w->selectedObjects(), (std::vector<NodeId>{sphere, cup}));
+  EXPECT_EQ(w->selection(), cup) << "the last picked leads (gizmo, Properties)";
+  int outlinedObjects = 0;
+  for (QTreeWidgetItem* item : w->findChild<QTreeWidget*>()->selectedItems())
+    outlinedObjects += item->text(0) == "Cup" || item->text(0) == "Glossy Sphere";
+  EXPECT_EQ(outlinedObjects, 2) << "the outliner shows both";
+
+  const Vec3 sphereAt = w->scene().object(sphere)->transform.translation();
+  const Vec3 cupAt = w->scene().object(cup)->transform.translation();
+  const int step = std::max(10, static_cast<int>(v->imageRect().width() / 20));
+  QTest::mousePress(v, Qt::LeftButton, Qt::NoModifier, onSphere);
+  for (int i = 1; i <= 4; ++i) QTest::mouseMove(v, onSphere + QPoint(step * i, 0));
+  QTest::mouseRelease(v, Qt::LeftButton, Qt::NoModifier, onSphere + QPoint(4 * step, 0));
+  const Vec3 sphereMoved = w->scene().object(sphere)->transform.translation() - sphereAt;
+  const Vec3 cupMoved = w->scene().object(cup)->transform.translation() - cupAt;
+  EXPECT_GT(length(sphereMoved), 0.05f) << "dragging one selected object";
+  EXPECT_LT(length(cupMoved - sphereMoved), 1e-5f) << "moves the other by as much";
+  w->undoStack()->undo();
+  EXPECT_LT(length(w->scene().object(sphere)->transform.translation() - sphereAt), 1e-5f);
+  EXPECT_LT(length(w->scene().object(cup)->transform.translation() - cupAt), 1e-5f) << "one undo step for both";
+
+  QTest::mouseClick(v, Qt::LeftButton, Qt::ControlModifier, onCup);
+  EXPECT_EQ(w->selectedObjects(), std::vector<NodeId>{sphere}) << "Ctrl+click again takes it out";
+  EXPECT_EQ(w->selection(), sphere);
+  w->select(cup);
+  EXPECT_EQ(w->selectedObjects(), std::vector<NodeId>{cup}) << "a plain pick selects just it";
 }
 
 }  // namespace
