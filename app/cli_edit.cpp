@@ -1,16 +1,21 @@
 // `retile edit`: converges a scene, plays a script of timed edits under one method, and writes
 // every frame (EXR) and a per-frame CSV. With --reference, also renders the scene's final state
 // fresh and reports each frame's error against it.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <string>
 
 #include "cli.h"
+#include "retile/color.h"
 #include "retile/image.h"
 #include "retile/log.h"
+#include "retile/metrics.h"
 #include "retile/render.h"
 #include "retile/scenario.h"
 #include "retile/session.h"
@@ -114,8 +119,16 @@ int runEdit(const std::vector<std::string>& argv) {
   const bool images = !args->has("--no-images");
   const int w = scene.settings.width, h = scene.settings.height;
 
-  // The fresh render of the final state, from its own renderer and seed.
-  std::vector<float> ref;
+  // The fresh render of the final state, from its own renderer and seed. The display-referred
+  // copies are what PSNR, SSIM and PSNR-HVS-M compare: the image as a viewer sees it.
+  std::vector<float> ref, refDisplay;
+  const std::shared_ptr<const ColorConfig> colors = reference > 0 ? ColorConfig::get() : nullptr;
+  auto displayed = [&](const std::vector<float>& linear) {
+    std::vector<float> out(linear.size());
+    colors->toDisplayFloat(linear.data(), linear.size() / 3, DisplaySettings{}, out.data());
+    for (float& v : out) v = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+    return out;
+  };
   if (reference > 0) {
     Renderer r;
     r.setScene(final.value());
@@ -130,6 +143,7 @@ int runEdit(const std::vector<std::string>& argv) {
       return true;
     });
     ref = img.color;
+    refDisplay = displayed(ref);
     writeRenderImage(img, outDir / "reference.exr");
   }
 
@@ -156,7 +170,7 @@ int runEdit(const std::vector<std::string>& argv) {
 
   std::ofstream csv(outDir / "frames.csv");
   csv << "frame,step,method,mode,samples,tiles_served,queue_left,quality,ms,schedule_ms,trace_ms,rel_rmse,"
-         "denoise_regions,denoise_width,denoise_height\n";
+         "denoise_regions,denoise_width,denoise_height,psnr,ssim,psnr_hvs_m\n";
   const int total = scenario->totalFrames();
   int frame = 0, lastEditFrame = 0, settledFrame = -1;
   double sumScheduleMs = 0;
@@ -185,10 +199,19 @@ int runEdit(const std::vector<std::string>& argv) {
     sumScheduleMs += rec.scheduleMs;
     char line[512];
     const RegionRect outer = rec.denoised.empty() ? RegionRect{} : rec.denoised.back().rect;
-    std::snprintf(line, sizeof line, "%d,%zu,%s,%s,%llu,%zu,%zu,%d,%.3f,%.4f,%.3f,%s,%zu,%d,%d\n", frame, sub.step,
+    std::string quality = ",,";
+    if (!refDisplay.empty() && rec.image) {
+      const std::vector<float> shown = displayed(rec.image->shown());
+      const MetricImage a{shown.data(), w, h}, r{refDisplay.data(), w, h};
+      char q[96];
+      std::snprintf(q, sizeof q, "%.3f,%.5f,%.3f", psnr(a, r), ssim(a, r), psnrHvsM(a, r));
+      quality = q;
+    }
+    std::snprintf(line, sizeof line, "%d,%zu,%s,%s,%llu,%zu,%zu,%d,%.3f,%.4f,%.3f,%s,%zu,%d,%d,%s\n", frame, sub.step,
                   rec.method.c_str(), rec.mode.c_str(), static_cast<unsigned long long>(rec.samples), rec.servedTiles.size(),
                   rec.queueLength - rec.queueServed, rec.quality, rec.frameMs, rec.scheduleMs, rec.traceMs,
-                  std::isnan(err) ? "" : std::to_string(err).c_str(), rec.denoised.size(), outer.width, outer.height);
+                  std::isnan(err) ? "" : std::to_string(err).c_str(), rec.denoised.size(), outer.width, outer.height,
+                  quality.c_str());
     csv << line;
     if (images && rec.image) {
       char name[64];

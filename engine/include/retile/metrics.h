@@ -1,0 +1,45 @@
+// Image metrics for comparing methods (retile eval): the paper's Fig. 6 reports PSNR and
+// PSNR-HVS-M; RMSE and SSIM are the other usual two.
+//
+// Every function compares an image with a reference of the same size. Both are display-referred
+// RGB (the view transform applied and clamped to [0, 1], as a viewer sees them), 3 floats per
+// pixel, row-major. A mask (one byte per pixel, nullptr: every pixel) restricts the comparison
+// to the pixels where it is not 0, so that the region an edit affected and the rest can be scored
+// apart. Pure functions of their arguments: any thread may call them.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace retile {
+
+struct MetricImage {
+  const float* rgb = nullptr;  // width * height * 3
+  int width = 0, height = 0;
+};
+
+// Mean squared error over the three channels of the masked pixels (0 when no pixel is masked).
+double meanSquaredError(MetricImage a, MetricImage ref, const std::uint8_t* mask = nullptr);
+// sqrt(meanSquaredError).
+double rootMeanSquaredError(MetricImage a, MetricImage ref, const std::uint8_t* mask = nullptr);
+// 10 log10(1 / MSE) in dB, the peak being 1; +infinity for identical images.
+double psnr(MetricImage a, MetricImage ref, const std::uint8_t* mask = nullptr);
+
+// Structural similarity (Z. Wang, A. C. Bovik, H. R. Sheikh, E. P. Simoncelli, "Image quality
+// assessment: from error visibility to structural similarity", IEEE TIP 13(4), 2004, eq. 13):
+// on luma (Rec. 601 weights), with the paper's 11x11 Gaussian window (sigma 1.5), K1 = 0.01,
+// K2 = 0.03 and L = 1, averaged over the windows that fit inside the image whose centre is
+// masked. An image smaller than the window is one window with equal weights. Without the
+// reference code's automatic down-sampling of large images. 1 for identical images.
+double ssim(MetricImage a, MetricImage ref, const std::uint8_t* mask = nullptr);
+
+// PSNR-HVS-M (N. Ponomarenko, F. Silvestri, K. Egiazarian, M. Carli, J. Astola, V. Lukin, "On
+// between-coefficient contrast masking of DCT basis functions", VPQM 2007) on luma in [0, 255]:
+// the difference of each 8x8 block's DCT coefficients, less what the block's own texture masks,
+// weighted by the contrast sensitivity of each coefficient, as 10 log10(255^2 / mean). Blocks are
+// the non-overlapping 8x8 blocks inside the image (as in the authors' code); with a mask, the
+// blocks with at least one masked pixel. `masking` false gives PSNR-HVS (the same without
+// contrast masking), which is never higher. +infinity for identical images or no block.
+double psnrHvsM(MetricImage a, MetricImage ref, const std::uint8_t* mask = nullptr, bool masking = true);
+
+}  // namespace retile

@@ -1,0 +1,116 @@
+// The evaluation's metrics on pairs whose answers are known in closed form, and on the
+// properties each is built for (masking hides error in texture, SSIM sees structure).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "retile/metrics.h"
+
+namespace retile {
+namespace {
+
+struct Image {
+  int width, height;
+  std::vector<float> rgb;
+  Image(int w, int h, float grey) : width(w), height(h), rgb(static_cast<std::size_t>(w) * h * 3, grey) {}
+  MetricImage view() const { return {rgb.data(), width, height}; }
+  void set(int x, int y, float grey) {
+    for (int c = 0; c < 3; ++c) rgb[(static_cast<std::size_t>(y) * width + x) * 3 + c] = grey;
+  }
+  float at(int x, int y) const { return rgb[(static_cast<std::size_t>(y) * width + x) * 3]; }
+};
+
+Image noisy(const Image& base, float amplitude, unsigned seed) {
+  Image out = base;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-amplitude, amplitude);
+  for (int y = 0; y < base.height; ++y)
+    for (int x = 0; x < base.width; ++x) out.set(x, y, std::clamp(base.at(x, y) + u(rng), 0.0f, 1.0f));
+  return out;
+}
+
+TEST(Metrics, PsnrOfAConstantOffsetIsKnown) {
+  const Image ref(32, 24, 0.5f), off(32, 24, 0.6f);
+  EXPECT_NEAR(rootMeanSquaredError(off.view(), ref.view()), 0.1, 1e-6);
+  EXPECT_NEAR(psnr(off.view(), ref.view()), 20.0, 1e-4);  // 10 log10(1 / 0.01)
+  EXPECT_TRUE(std::isinf(psnr(ref.view(), ref.view())));
+}
+
+TEST(Metrics, AMaskScoresOnlyItsPixels) {
+  Image ref(16, 16, 0.5f), a = ref;
+  std::vector<std::uint8_t> left(16 * 16, 0), right(16 * 16, 0);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) {
+      (x < 8 ? left : right)[static_cast<std::size_t>(y) * 16 + x] = 1;
+      if (x >= 8) a.set(x, y, 0.7f);  // only the right half differs
+    }
+  EXPECT_EQ(meanSquaredError(a.view(), ref.view(), left.data()), 0.0);
+  EXPECT_NEAR(rootMeanSquaredError(a.view(), ref.view(), right.data()), 0.2, 1e-6);
+  EXPECT_NEAR(meanSquaredError(a.view(), ref.view()), 0.5 * 0.04, 1e-7);
+  EXPECT_TRUE(std::isinf(psnrHvsM(a.view(), ref.view(), left.data())));
+  EXPECT_TRUE(std::isfinite(psnrHvsM(a.view(), ref.view(), right.data())));
+}
+
+TEST(Metrics, SsimOfFlatImagesIsTheLuminanceTerm) {
+  // Flat images have no variance: SSIM is (2 a b + C1) / (a^2 + b^2 + C1), for any size.
+  for (int size : {8, 40}) {
+    const Image a(size, size, 0.3f), b(size, size, 0.5f);
+    const double c1 = 0.0001, expected = (2 * 0.3 * 0.5 + c1) / (0.09 + 0.25 + c1);
+    EXPECT_NEAR(ssim(a.view(), b.view()), expected, 1e-6) << size;
+    EXPECT_NEAR(ssim(a.view(), a.view()), 1.0, 1e-12);
+  }
+}
+
+TEST(Metrics, SsimSeesStructureThatMseDoesNot) {
+  // A checkerboard and its inverse have the mean of the reference and the same variance: the
+  // luminance and contrast terms are 1 and the structure term is -1.
+  Image board(32, 32, 0.0f), inverse(32, 32, 0.0f);
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) {
+      const bool on = (x / 2 + y / 2) % 2 == 0;
+      board.set(x, y, on ? 0.7f : 0.3f);
+      inverse.set(x, y, on ? 0.3f : 0.7f);
+    }
+  EXPECT_LT(ssim(inverse.view(), board.view()), -0.9);
+  // Noise of the same energy scores better than the inversion, and less noise better still.
+  const Image more = noisy(board, 0.3f, 1), less = noisy(board, 0.05f, 2);
+  EXPECT_GT(ssim(more.view(), board.view()), ssim(inverse.view(), board.view()));
+  EXPECT_GT(ssim(less.view(), board.view()), ssim(more.view(), board.view()));
+  EXPECT_LT(ssim(less.view(), board.view()), 1.0);
+}
+
+TEST(Metrics, PsnrHvsMOfAFlatOffsetIsKnown) {
+  // A flat block's difference is all in its DC coefficient (8 d for an orthonormal DCT), which
+  // is never masked and weighs 1.608443: the mean is (1.608443 d)^2 over the 64 coefficients.
+  const Image ref(24, 16, 100.0f / 255.0f), off(24, 16, 110.0f / 255.0f);
+  const double d = 10.0, expected = 10.0 * std::log10(255.0 * 255.0 / std::pow(1.608443 * d, 2));
+  EXPECT_NEAR(psnrHvsM(off.view(), ref.view()), expected, 1e-3);
+  EXPECT_NEAR(psnrHvsM(off.view(), ref.view(), nullptr, false), expected, 1e-3) << "nothing to mask on flat blocks";
+  EXPECT_TRUE(std::isinf(psnrHvsM(ref.view(), ref.view())));
+  const Image tiny(7, 7, 0.2f);
+  EXPECT_TRUE(std::isinf(psnrHvsM(tiny.view(), tiny.view()))) << "no whole block";
+}
+
+TEST(Metrics, TextureMasksSmallErrors) {
+  // The same small noise on a flat image and on a busy texture: PSNR-HVS (no masking) sees
+  // about the same error in both; PSNR-HVS-M forgives it in the texture, and never scores below
+  // PSNR-HVS.
+  Image flat(64, 64, 0.5f), texture(64, 64, 0.5f);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> busy(0.2f, 0.8f);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) texture.set(x, y, busy(rng));
+  const Image flatNoisy = noisy(flat, 0.02f, 3), textureNoisy = noisy(texture, 0.02f, 3);
+  const double hvsFlat = psnrHvsM(flatNoisy.view(), flat.view(), nullptr, false);
+  const double hvsTexture = psnrHvsM(textureNoisy.view(), texture.view(), nullptr, false);
+  const double mFlat = psnrHvsM(flatNoisy.view(), flat.view()), mTexture = psnrHvsM(textureNoisy.view(), texture.view());
+  EXPECT_NEAR(hvsFlat, hvsTexture, 1.0);
+  EXPECT_GE(mFlat, hvsFlat);
+  EXPECT_GE(mTexture, hvsTexture);
+  EXPECT_GT(mTexture - hvsTexture, mFlat - hvsFlat + 3.0) << "texture hides error";
+}
+
+}  // namespace
+}  // namespace retile
