@@ -93,6 +93,7 @@ class TungstenImporter {
     if (error_.empty()) error_ = cat(file_.string(), ": ", where, ": ", what);
   }
   void warn(const std::string& what) { out_.warnings.push_back(cat(file_.filename().string(), ": ", what)); }
+  std::set<std::string> undefinedWarned_;  // undefined bsdf names already reported
 
   bool number(const Value& obj, const char* key, float* out, const std::string& where) {
     const Value* v = obj.find(key);
@@ -191,13 +192,33 @@ class TungstenImporter {
     return r;
   }
 
-  Material bsdf(const Value& v, const std::string& where, int depth = 0) {
+  // `emitter`: the primitive carries emission, so an undefined name there stands for Tungsten's
+  // null bsdf (published Bitterli-derived files name "null" or "NULL" for their lights without
+  // defining it).
+  Material bsdf(const Value& v, const std::string& where, int depth = 0, bool emitter = false) {
     Material m;
     m.albedo = Vec3{1.0f};  // Tungsten's default albedo
     if (v.isString()) {
       auto it = named_.find(v.asString());
-      if (it == named_.end()) problem(where, cat("bsdf '", v.asString(), "' is not defined (before this point)"));
-      else m = it->second;
+      if (it != named_.end()) return it->second;
+      // An undefined name should not cost the artist the whole file: the surface gets a stand-in
+      // and the warning names what was missing, once per name.
+      const std::string& name = v.asString();
+      if (emitter) {
+        m.type = MaterialType::Null;
+        m.name = name;
+      } else {
+        // One grey stand-in per name, shared like a defined bsdf, so the artist fixes it once.
+        m.type = MaterialType::Lambert;
+        m.albedo = Vec3{0.5f};
+        m.name = name;
+        m.id = out_.scene.newId();
+        named_[name] = m;
+        out_.scene.materials.push_back(m);
+      }
+      if (undefinedWarned_.insert(cat(name, emitter)).second)
+        warn(cat(where, ": bsdf '", name, "' is not defined; ",
+                 emitter ? "the emitter is drawn by its emission only (a null bsdf)" : "drawn as grey diffuse"));
       return m;
     }
     if (!v.isObject()) {
@@ -669,7 +690,7 @@ class TungstenImporter {
     if (const Value* b = p.find("bsdf")) {
       // An array names one bsdf per material index; OBJ meshes carry index 0.
       const Value& first = b->isArray() && !b->asArray().empty() ? b->asArray()[0] : *b;
-      mat = bsdf(first, where + ".bsdf");
+      mat = bsdf(first, where + ".bsdf", 0, p.find("emission") || p.find("power"));
       if (!ok()) return;
     }
     Vec3 emission{0.0f};
