@@ -129,22 +129,34 @@ int runEdit(const std::vector<std::string>& argv) {
     for (float& v : out) v = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
     return out;
   };
+  std::vector<std::uint8_t> affected, rest;  // the pixels the script changed, and the others
   if (reference > 0) {
     Renderer r;
-    r.setScene(final.value());
-    RenderRequest req;
-    req.width = w;
-    req.height = h;
-    req.samplesPerPixel = reference;
-    req.seed = 0x5eed;
-    auto t0 = std::chrono::steady_clock::now();
-    RenderImage img = r.render(req, [&](int done, int total) {
-      progressBar("reference", done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-      return true;
-    });
+    auto renderReference = [&](const Scene& state, const char* what) {
+      r.setScene(state);
+      RenderRequest req;
+      req.width = w;
+      req.height = h;
+      req.samplesPerPixel = reference;
+      req.seed = 0x5eed;
+      auto t0 = std::chrono::steady_clock::now();
+      return r.render(req, [&](int done, int total) {
+        progressBar(what, done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        return true;
+      });
+    };
+    RenderImage img = renderReference(final.value(), "reference");
     ref = img.color;
     refDisplay = displayed(ref);
     writeRenderImage(img, outDir / "reference.exr");
+    // The starting state's reference too: where the two differ beyond their noise is the region
+    // the edits affected, scored apart from the rest.
+    RenderImage start = renderReference(scene, "reference before");
+    affected = affectedPixels(start, img);
+    rest.resize(affected.size());
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < affected.size(); ++i) count += affected[i], rest[i] = !affected[i];
+    std::fprintf(stderr, "affected region: %zu of %zu pixels\n", count, affected.size());
   }
 
   RenderSession session(scene, method);
@@ -170,7 +182,8 @@ int runEdit(const std::vector<std::string>& argv) {
 
   std::ofstream csv(outDir / "frames.csv");
   csv << "frame,step,method,mode,samples,tiles_served,queue_left,quality,ms,schedule_ms,trace_ms,rel_rmse,"
-         "denoise_regions,denoise_width,denoise_height,psnr,ssim,psnr_hvs_m\n";
+         "denoise_regions,denoise_width,denoise_height,psnr,ssim,psnr_hvs_m,rmse_affected,rmse_rest,psnr_affected,"
+         "psnr_rest\n";
   const int total = scenario->totalFrames();
   int frame = 0, lastEditFrame = 0, settledFrame = -1;
   double sumScheduleMs = 0;
@@ -197,15 +210,21 @@ int runEdit(const std::vector<std::string>& argv) {
     if (!ref.empty() && frame > lastEditFrame && settledFrame < 0 && err < threshold) settledFrame = frame;
     if (!ref.empty() && err >= threshold) settledFrame = -1;  // settled means: stays under
     sumScheduleMs += rec.scheduleMs;
-    char line[512];
+    char line[768];
     const RegionRect outer = rec.denoised.empty() ? RegionRect{} : rec.denoised.back().rect;
-    std::string quality = ",,";
+    std::string quality = ",,,,,,";
     if (!refDisplay.empty() && rec.image) {
       const std::vector<float> shown = displayed(rec.image->shown());
       const MetricImage a{shown.data(), w, h}, r{refDisplay.data(), w, h};
-      char q[96];
-      std::snprintf(q, sizeof q, "%.3f,%.5f,%.3f", psnr(a, r), ssim(a, r), psnrHvsM(a, r));
+      char q[192];
+      std::snprintf(q, sizeof q, "%.3f,%.5f,%.3f,%.5f,%.5f,%.3f,%.3f", psnr(a, r), ssim(a, r), psnrHvsM(a, r),
+                    rootMeanSquaredError(a, r, affected.data()), rootMeanSquaredError(a, r, rest.data()),
+                    psnr(a, r, affected.data()), psnr(a, r, rest.data()));
       quality = q;
+      if (std::find(affected.begin(), affected.end(), 1) == affected.end()) {  // nothing changed: no affected scores
+        quality = quality.substr(0, quality.find(',', quality.find(',', quality.find(',') + 1) + 1) + 1) + "," +
+                  std::to_string(rootMeanSquaredError(a, r)) + ",," + std::to_string(psnr(a, r));
+      }
     }
     std::snprintf(line, sizeof line, "%d,%zu,%s,%s,%llu,%zu,%zu,%d,%.3f,%.4f,%.3f,%s,%zu,%d,%d,%s\n", frame, sub.step,
                   rec.method.c_str(), rec.mode.c_str(), static_cast<unsigned long long>(rec.samples), rec.servedTiles.size(),

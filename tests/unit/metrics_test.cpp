@@ -112,5 +112,42 @@ TEST(Metrics, TextureMasksSmallErrors) {
   EXPECT_GT(mTexture - hvsTexture, mFlat - hvsFlat + 3.0) << "texture hides error";
 }
 
+// The affected region: what changed beyond both references' noise, not the noise itself.
+TEST(Metrics, TheAffectedRegionIsWhatChangedBeyondNoise) {
+  std::mt19937 rng(11);
+  std::normal_distribution<float> jitter(0.0f, 1.0f);
+  auto reference = [&](bool edited) {
+    RenderImage im;
+    im.width = 20;
+    im.height = 10;
+    const std::size_t n = 200;
+    const float spp = 64, sigma = 0.1f;  // per sample: the means have 0.0125, their difference 0.018
+    im.color.resize(3 * n);
+    im.moment2.resize(n);
+    im.sampleCount.assign(n, spp);
+    for (std::size_t i = 0; i < n; ++i) {
+      const int x = static_cast<int>(i % 20);
+      float value = 0.5f + (edited && x >= 15 ? 0.15f : 0.0f);  // the edit brightens the right quarter
+      value += jitter(rng) * sigma / std::sqrt(spp);           // the mean's own noise
+      for (int c = 0; c < 3; ++c) im.color[3 * i + c] = value;
+      im.moment2[i] = value * value + sigma * sigma;
+    }
+    return im;
+  };
+  const RenderImage before = reference(false), after = reference(true);
+  const std::vector<std::uint8_t> mask = affectedPixels(before, after);
+  int inside = 0, outside = 0;
+  for (std::size_t i = 0; i < mask.size(); ++i) (i % 20 >= 15 ? inside : outside) += mask[i];
+  EXPECT_EQ(inside, 50) << "every changed pixel: 0.15 is more than 4 standard errors (0.071) plus noise";
+  EXPECT_LE(outside, 1) << "noise alone marks (almost) nothing at 4 standard errors";
+  // Without statistics only the relative threshold applies.
+  RenderImage bare = before, bareAfter = after;
+  bare.moment2.clear();
+  bareAfter.moment2.clear();
+  int marked = 0;
+  for (std::uint8_t m : affectedPixels(bare, bareAfter)) marked += m;
+  EXPECT_GT(marked, 50);
+}
+
 }  // namespace
 }  // namespace retile

@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "retile/image.h"
+
 namespace retile {
 
 struct MetricImage {
@@ -41,5 +43,13 @@ double ssim(MetricImage a, MetricImage ref, const std::uint8_t* mask = nullptr);
 // blocks with at least one masked pixel. `masking` false gives PSNR-HVS (the same without
 // contrast masking), which is never higher. +infinity for identical images or no block.
 double psnrHvsM(MetricImage a, MetricImage ref, const std::uint8_t* mask = nullptr, bool masking = true);
+
+// The pixels an edit changed: where two converged references, of the scene before the edit and
+// after it, differ in luminance by more than `z` standard errors of their two means (each from
+// the reference's per-pixel variance, moment2 - mean^2, over its sample count) and by more than
+// `relative` of the brighter of the two. 1 marks a changed pixel. Both references are linear
+// renders of the same size with moment2 and sampleCount (Renderer::render fills them).
+std::vector<std::uint8_t> affectedPixels(const RenderImage& before, const RenderImage& after, double z = 4.0,
+                                         double relative = 0.01);
 
 }  // namespace retile

@@ -221,4 +221,28 @@ double psnrHvsM(MetricImage a, MetricImage ref, const std::uint8_t* mask, bool m
   return toDecibels(sum / (64.0 * static_cast<double>(blocks)), 255.0);
 }
 
+std::vector<std::uint8_t> affectedPixels(const RenderImage& before, const RenderImage& after, double z, double relative) {
+  RETILE_ASSERT(before.width == after.width && before.height == after.height, "references of the same size");
+  const std::size_t n = static_cast<std::size_t>(before.width) * static_cast<std::size_t>(before.height);
+  RETILE_ASSERT(before.color.size() == 3 * n && after.color.size() == 3 * n, "references with colour");
+  auto lum = [](const RenderImage& im, std::size_t i) {
+    return 0.2126 * im.color[3 * i] + 0.7152 * im.color[3 * i + 1] + 0.0722 * im.color[3 * i + 2];
+  };
+  // The variance of a reference's mean at a pixel; 0 when it lacks the statistics (then only
+  // the relative threshold applies).
+  auto varianceOfMean = [n](const RenderImage& im, std::size_t i, double mean) {
+    if (im.moment2.size() != n || im.sampleCount.size() != n || im.sampleCount[i] <= 1) return 0.0;
+    return std::max(0.0, im.moment2[i] - mean * mean) / im.sampleCount[i];
+  };
+  std::vector<std::uint8_t> mask(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a = lum(before, i), b = lum(after, i);
+    if (!std::isfinite(a) || !std::isfinite(b)) continue;
+    const double noise = z * std::sqrt(varianceOfMean(before, i, a) + varianceOfMean(after, i, b));
+    const double d = std::abs(a - b);
+    mask[i] = d > noise && d > relative * std::max(a, b);
+  }
+  return mask;
+}
+
 }  // namespace retile
