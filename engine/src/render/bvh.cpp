@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <thread>
 
 #include "retile/error.h"
@@ -17,8 +18,33 @@ struct BuildNode {
   std::int32_t left = -1, right = -1;  // children in the build array; -1 for leaves
 };
 
+// Any float must build (a hostile file's coordinates reach here: NaN, infinities, 1e38): boxes
+// are made finite (NaN to 0, infinities to the largest float) and ordered (lo <= hi), centroids
+// are computed without overflow, and bins are chosen in double precision with NaN-safe clamping,
+// so no float ever indexes out of range or breaks the sort's ordering.
+float finite(float v) {
+  if (std::isnan(v)) return 0.0f;
+  return std::clamp(v, -std::numeric_limits<float>::max(), std::numeric_limits<float>::max());
+}
+
+Bounds3 finiteBox(const Bounds3& b) {
+  Bounds3 r;
+  for (int k = 0; k < 3; ++k) {
+    const float a = finite(b.lo[k]), c = finite(b.hi[k]);
+    r.lo[k] = std::min(a, c);
+    r.hi[k] = std::max(a, c);
+  }
+  return r;
+}
+
+int binOf(float c, double lo, double scale, int bins) {
+  const double t = (static_cast<double>(c) - lo) * scale;
+  if (!(t > 0.0)) return 0;  // NaN too
+  return t >= bins - 1 ? bins - 1 : static_cast<int>(t);
+}
+
 struct Builder {
-  std::span<const Bounds3> boxes;
+  std::vector<Bounds3> boxes;
   std::vector<Vec3> centroids;
   std::vector<std::uint32_t>& order;
   const BvhBuildOptions& opt;
@@ -26,9 +52,13 @@ struct Builder {
   int maxDepth = 0;
 
   Builder(std::span<const Bounds3> b, std::vector<std::uint32_t>& o, const BvhBuildOptions& op)
-      : boxes(b), order(o), opt(op) {
+      : order(o), opt(op) {
+    boxes.reserve(b.size());
     centroids.resize(b.size());
-    for (std::size_t i = 0; i < b.size(); ++i) centroids[i] = b[i].center();
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      boxes.push_back(finiteBox(b[i]));
+      centroids[i] = boxes[i].lo * 0.5f + boxes[i].hi * 0.5f;  // (lo + hi) / 2 could overflow
+    }
   }
 
   // Returns the split position in [start, start+count) or start when a leaf is best.
@@ -43,16 +73,16 @@ struct Builder {
     std::array<float, 64> rightArea;
     std::array<std::uint32_t, 64> rightCount;
     for (int axis = 0; axis < 3; ++axis) {
-      float lo = cb.lo[axis], hi = cb.hi[axis];
+      const double lo = cb.lo[axis], hi = cb.hi[axis];
       if (!(hi > lo)) continue;
-      float scale = static_cast<float>(nb) / (hi - lo);
+      const double scale = nb / (hi - lo);
       for (int b = 0; b < nb; ++b) {
         binBounds[static_cast<std::size_t>(b)] = Bounds3{};
         binCount[static_cast<std::size_t>(b)] = 0;
       }
       for (std::uint32_t i = start; i < start + count; ++i) {
         std::uint32_t p = order[i];
-        int b = std::min(nb - 1, static_cast<int>((centroids[p][axis] - lo) * scale));
+        const int b = binOf(centroids[p][axis], lo, scale, nb);
         binBounds[static_cast<std::size_t>(b)].grow(boxes[p]);
         ++binCount[static_cast<std::size_t>(b)];
       }
@@ -88,12 +118,10 @@ struct Builder {
       // All centroids coincide (or SAH found nothing): split the range in the middle.
       return start + count / 2;
     }
-    float lo = cb.lo[bestAxis];
-    float scale = static_cast<float>(nb) / (cb.hi[bestAxis] - lo);
-    auto mid = std::partition(order.begin() + start, order.begin() + start + count, [&](std::uint32_t p) {
-      int b = std::min(nb - 1, static_cast<int>((centroids[p][bestAxis] - lo) * scale));
-      return b <= bestBin;
-    });
+    const double lo = cb.lo[bestAxis];
+    const double scale = nb / (static_cast<double>(cb.hi[bestAxis]) - lo);
+    auto mid = std::partition(order.begin() + start, order.begin() + start + count,
+                              [&](std::uint32_t p) { return binOf(centroids[p][bestAxis], lo, scale, nb) <= bestBin; });
     auto m = static_cast<std::uint32_t>(mid - order.begin());
     if (m == start || m == start + count) m = start + count / 2;
     return m;
