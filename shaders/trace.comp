@@ -32,6 +32,15 @@ layout(set = 0, binding = 15, std430) buffer Selection { uint selectionCounts[];
 
 layout(push_constant) uniform Push { TracePush push; };
 
+// A sample's offset from the pixel centre along one axis for u in [0, 1): the filter's inverse
+// CDF, linear between its 33 tabulated points (layouts.h).
+float filterOffset(float u) {
+  float t = u * float(kFilterWarpSegments);
+  int i = min(int(t), kFilterWarpSegments - 1);
+  float a = frame.filterWarp[i >> 2][i & 3], b = frame.filterWarp[(i + 1) >> 2][(i + 1) & 3];
+  return mix(a, b, t - float(i));
+}
+
 // Index of the counters of the tile holding pixel (px, py), or -1 when not counting.
 int selectionBase(int px, int py) {
   uint t = frame.work.w;
@@ -125,9 +134,12 @@ Path startPath(uint slot) {
   path.slot = slot;
   path.rng = rngInit(uint(py) * width + uint(px), item.info.z + rep, frame.image.z);
 
-  // Every sample jitters its own primary ray over the pixel (box filter), evenly over the pixel's samples.
+  // Every sample jitters its own primary ray, evenly over the pixel's samples, then is placed by
+  // the scene's pixel filter (its inverse CDF per axis): filter importance sampling, so the
+  // accumulation stays a plain mean per pixel.
   vec2 jitter = pixelJitter(uint(py) * width + uint(px), item.info.z + rep, frame.image.z);
-  vec2 ndc = vec2((float(px) + jitter.x) / float(width), (float(py) + jitter.y) / float(height)) * 2.0 - 1.0;
+  vec2 offset = vec2(filterOffset(jitter.x), filterOffset(jitter.y));
+  vec2 ndc = vec2((float(px) + 0.5 + offset.x) / float(width), (float(py) + 0.5 + offset.y) / float(height)) * 2.0 - 1.0;
   float tanHalf = frame.cameraPosition.w;
   path.rd = normalize(frame.cameraForward.xyz + ndc.x * tanHalf * frame.cameraRight.w * frame.cameraRight.xyz -
                       ndc.y * tanHalf * frame.cameraUp.xyz);

@@ -509,6 +509,19 @@ void PropertyPanel::buildRender(Builder& b) {
   b.number(tr("Seed"), "seed", r.seed, 0, 1e9, 0, 0, [edit](double v, int drag) {
     edit(tr("Seed"), drag, [v](RenderSettings& x) { x.seed = static_cast<std::uint32_t>(v); });
   });
+  QStringList filters{tr("Box"), tr("Tent"), tr("Gaussian"), tr("Blackman-Harris")};
+  b.choice(tr("Pixel filter"), "pixelFilter", filters, static_cast<int>(r.pixelFilter), [this, edit](int i) {
+    if (i < 0 || i >= kPixelFilterCount) return;
+    edit(tr("Pixel filter"), 0, [i](RenderSettings& x) {
+      x.pixelFilter = static_cast<PixelFilter>(i);
+      x.filterWidth = defaultFilterWidth(x.pixelFilter);  // each filter at its usual width
+    });
+    rebuildLater();  // the width field shows the new default
+  });
+  b.number(tr("Filter width (px)"), "filterWidth", r.filterWidth, 0.5, 8.0, defaultFilterWidth(r.pixelFilter), 2,
+           [edit](double v, int drag) {
+             edit(tr("Filter width"), drag, [v](RenderSettings& x) { x.filterWidth = static_cast<float>(v); });
+           });
   b.label(tr("Resolution"), tr("%1 x %2 (the viewport's size times the render scale)").arg(renderSize_.width()).arg(renderSize_.height()));
 }
 

@@ -87,7 +87,10 @@ RT_CONST(int, kAccumulateWorkgroup, 64)
 RT_CONST(uint, kAuxVec4s, 3u)
 RT_CONST(int, kMaxWorkItems, 65536)
 
-// One frame's constants (std140 uniform block).
+RT_CONST(int, kFilterWarpSegments, 32)  // the pixel filter's inverse CDF: 33 points, linear between
+
+// One frame's constants (a storage buffer for the trace kernel, a std140 uniform block for the
+// accumulator: the layout is the same).
 struct FrameUniforms {
   vec4 cameraPosition;  // xyz, tan(verticalFov / 2)
   vec4 cameraRight;     // xyz (unit), aspect = width / height
@@ -101,6 +104,9 @@ struct FrameUniforms {
   vec4 sceneSphere;     // bounding sphere: centre xyz, radius
   uvec4 work;           // work item count, total sample slots, selected instance + 1 (0: none),
                         // tile size of the selection counters (0: not counting)
+  // A sample's offset from the pixel centre along each axis, in pixels, for u = i / 32: the
+  // inverse CDF of the scene's pixel filter (filter importance sampling), 33 values, packed.
+  vec4 filterWarp[9];
 };
 
 // A rectangle of pixels that receives q samples each this frame. Slot s of the frame belongs to
@@ -151,7 +157,7 @@ struct DenoisePush {
 
 #ifdef __cplusplus
 static_assert(sizeof(DenoisePush) == 48);
-static_assert(sizeof(FrameUniforms) == 11 * 16);
+static_assert(sizeof(FrameUniforms) == 20 * 16);
 static_assert(sizeof(WorkItem) == 48);
 static_assert(sizeof(TracePush) == 16);
 }  // namespace retile::gpu

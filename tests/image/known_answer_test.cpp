@@ -1,8 +1,10 @@
 // Renders with known answers: each would catch a real bug in sampling, MIS or light transport.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
+#include <tuple>
 #include <utility>
 
 #include "gpu_support.h"
@@ -91,6 +93,40 @@ TEST(KnownAnswer, DiffusePlaneUnderUniformSky) {
   NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, m), Mat4::scale({1000, 1, 1000}));
   RenderImage img = renderScene(*r, s, 128);
   EXPECT_NEAR(meanOver(img, plane), 1.0, 0.01);
+}
+
+// The pixel filter (filter importance sampling): a light's straight edge on a pixel boundary.
+// With a box each pixel sees only its own square; with Tungsten's tent (one pixel each way) the
+// pixel on either side of the edge takes 1/8 from across it (the tent's mass beyond half a pixel).
+TEST(KnownAnswer, PixelFiltersSpreadAnEdgeAsTheyShould) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(32, 8);
+  s.camera.position = {0, 3, 0};
+  s.camera.target = {0, 0, 0};
+  s.camera.up = {0, 0, -1};  // image x is world x: the edge x = 0 is the boundary of columns 15 and 16
+  s.camera.verticalFov = radians(20);
+  s.settings.maxBounces = 0;
+  Material light;
+  light.albedo = Vec3{0.0f};
+  light.emission = Vec3{1.0f};
+  test::addMeshObject(s, "light", makeQuad(), test::addMaterial(s, light),
+                      Mat4::translate({-500, 0, 0}) * Mat4::scale({1000, 1, 2000}));  // x from -1000 to 0
+  auto column = [](const RenderImage& img, int x) {
+    double sum = 0;
+    for (int y = 0; y < img.height; ++y) sum += img.color[(static_cast<std::size_t>(y) * img.width + x) * 3 + 1];
+    return sum / img.height;
+  };
+  for (auto [filter, inner, across] : {std::tuple{PixelFilter::Box, 1.0, 0.0}, std::tuple{PixelFilter::Tent, 0.875, 0.125}}) {
+    SCOPED_TRACE(pixelFilterName(filter));
+    s.settings.pixelFilter = filter;
+    s.settings.filterWidth = defaultFilterWidth(filter);
+    const RenderImage img = renderScene(*r, s, 256);
+    const double a = column(img, 15), b = column(img, 16);
+    EXPECT_NEAR(std::max(a, b), inner, 0.02);
+    EXPECT_NEAR(std::min(a, b), across, 0.02);
+    EXPECT_NEAR(std::max(column(img, 13), column(img, 18)), 1.0, 0.02) << "two pixels away: untouched";
+    EXPECT_NEAR(std::min(column(img, 13), column(img, 18)), 0.0, 0.02);
+  }
 }
 
 double smallLightOnPlane(Renderer& r, float height, NodeId* planeOut) {

@@ -49,6 +49,8 @@ void expectSameScene(const Scene& a, const Scene& b) {
 
 TEST(Native, DefaultSceneRoundTripsLosslessly) {
   Scene s = makeDefaultScene();
+  s.settings.pixelFilter = PixelFilter::BlackmanHarris;
+  s.settings.filterWidth = 1.75f;
   s.lights.push_back(Light{s.newId(), "Key", LightType::Spot, {1, 0.9f, 0.8f}, 3.5f, {1, 2, 3}, {0, -1, 0}, 0.4f, 0.2f, true});
   auto dir = test::tempDir();
   auto file = dir / "scene.retile";
@@ -59,6 +61,8 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   ASSERT_EQ(back->scene.lights.size(), 1u);
   EXPECT_EQ(back->scene.lights[0].type, LightType::Spot);
   EXPECT_EQ(back->scene.lights[0].intensity, 3.5f);
+  EXPECT_EQ(back->scene.settings.pixelFilter, PixelFilter::BlackmanHarris);
+  EXPECT_EQ(back->scene.settings.filterWidth, 1.75f);
   // Saving what was loaded gives the same bytes.
   EXPECT_EQ(nativeSceneToString(s), nativeSceneToString(back->scene));
 }

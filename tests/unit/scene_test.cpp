@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "retile/edit.h"
 #include "test_support.h"
 
@@ -30,6 +32,39 @@ TEST(DefaultScene, HasWhatLookDevNeeds) {
   for (auto& t : s.textures) ids.push_back(t.id);
   std::sort(ids.begin(), ids.end());
   EXPECT_EQ(std::adjacent_find(ids.begin(), ids.end()), ids.end());
+}
+
+// Filter importance sampling draws each sample's offset from the filter's inverse CDF.
+TEST(PixelFilter, WarpsAreInverseCdfs) {
+  constexpr int kSegments = 32;
+  for (int f = 0; f < kPixelFilterCount; ++f) {
+    const auto filter = static_cast<PixelFilter>(f);
+    SCOPED_TRACE(pixelFilterName(filter));
+    PixelFilter parsed;
+    ASSERT_TRUE(parsePixelFilter(pixelFilterName(filter), &parsed));
+    EXPECT_EQ(parsed, filter);
+    const float width = defaultFilterWidth(filter);
+    const std::vector<float> w = pixelFilterWarp(filter, width, kSegments);
+    ASSERT_EQ(w.size(), static_cast<std::size_t>(kSegments) + 1);
+    EXPECT_FLOAT_EQ(w.front(), -0.5f * width);
+    EXPECT_FLOAT_EQ(w.back(), 0.5f * width);
+    for (int i = 0; i < kSegments; ++i) EXPECT_LT(w[i], w[i + 1]) << "monotone";
+    for (int i = 0; i <= kSegments; ++i) EXPECT_NEAR(w[i], -w[kSegments - i], 1e-3f) << "symmetric";
+  }
+  // The box spreads samples evenly over the pixel; the tent's CDF inverts in closed form.
+  const std::vector<float> box = pixelFilterWarp(PixelFilter::Box, 1.0f, kSegments);
+  for (int i = 0; i <= kSegments; ++i) EXPECT_NEAR(box[i], -0.5f + static_cast<float>(i) / kSegments, 1e-4f);
+  const std::vector<float> tent = pixelFilterWarp(PixelFilter::Tent, 2.0f, kSegments);
+  for (int i = 0; i <= kSegments; ++i) {
+    const double u = static_cast<double>(i) / kSegments;
+    const double exact = u < 0.5 ? -1.0 + std::sqrt(2.0 * u) : 1.0 - std::sqrt(2.0 * (1.0 - u));
+    EXPECT_NEAR(tent[i], exact, 2e-3) << u;
+  }
+  // Blackman-Harris is narrow: most samples within a third of its half-width of the centre.
+  const std::vector<float> bh = pixelFilterWarp(PixelFilter::BlackmanHarris, 1.5f, kSegments);
+  EXPECT_LT(bh[kSegments * 3 / 4], 0.75f / 3);
+  PixelFilter unknown;
+  EXPECT_FALSE(parsePixelFilter("mitchell", &unknown));
 }
 
 TEST(Document, EditsAdvanceTheVersionAndReportWhatChanged) {

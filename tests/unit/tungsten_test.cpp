@@ -29,6 +29,8 @@ TEST(Tungsten, CornellBoxMatchesTheObjVersion) {
   EXPECT_EQ(s.settings.width, 1024);
   EXPECT_EQ(s.settings.maxBounces, 63) << "Tungsten counts path segments, we count bounces";
   EXPECT_NEAR(degrees(s.camera.verticalFov), 19.5f, 1e-3f);  // square image: horizontal == vertical
+  EXPECT_EQ(s.settings.pixelFilter, PixelFilter::Tent) << "the scene's reconstruction_filter";
+  EXPECT_EQ(s.settings.filterWidth, 2.0f) << "Tungsten's tent reaches one pixel each way";
 
   // The light: a downward-facing quad 2 cm below the ceiling, corners as in cornell-box.obj.
   const Object* light = objectWithMaterial(s, "Light");

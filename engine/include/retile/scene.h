@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "retile/math.h"
@@ -138,12 +139,26 @@ struct Environment {
   Vec3 ground{0.3f, 0.28f, 0.25f};
 };
 
+// How samples are spread over and around a pixel (filter importance sampling: each sample's
+// position is drawn from the filter, so a pixel's accumulation stays a plain mean and every
+// policy's budget is unchanged). `filterWidth` is the footprint's full width in pixels.
+enum class PixelFilter { Box, Tent, Gaussian, BlackmanHarris };
+constexpr int kPixelFilterCount = 4;
+const char* pixelFilterName(PixelFilter f);  // "box", "tent", "gaussian", "blackman_harris"
+bool parsePixelFilter(std::string_view name, PixelFilter* out);
+float defaultFilterWidth(PixelFilter f);  // box 1, tent 2 (Tungsten's), Gaussian 4, Blackman-Harris 1.5 (Blender's)
+// The filter's inverse CDF along one axis at u = i / segments, i = 0..segments: a sample's offset
+// from the pixel centre in pixels. Separable filters: x and y are drawn independently.
+std::vector<float> pixelFilterWarp(PixelFilter f, float width, int segments);
+
 struct RenderSettings {
   int width = 640;
   int height = 360;
   int maxBounces = 16;  // paths past it carry ~albedo^17 of the light: < 0.5 % in a Cornell box
   int samplesPerPixel = 64;
   std::uint32_t seed = 0;
+  PixelFilter pixelFilter = PixelFilter::Box;
+  float filterWidth = 1.0f;
 };
 
 class Scene {

@@ -174,6 +174,8 @@ std::string nativeSceneToString(const Scene& s) {
   settings.set("max_bounces", s.settings.maxBounces);
   settings.set("spp", s.settings.samplesPerPixel);
   settings.set("seed", s.settings.seed);
+  settings.set("pixel_filter", pixelFilterName(s.settings.pixelFilter));
+  settings.set("filter_width", s.settings.filterWidth);
   root.set("settings", settings);
 
   Value cam(json::Object{});
@@ -326,6 +328,15 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
     int seed = 0;
     r.integer("seed", &seed);
     s.settings.seed = static_cast<std::uint32_t>(seed);
+    // Files from before the pixel filter have none: a box, as they were rendered.
+    std::string filter;
+    r.string("pixel_filter", &filter);
+    if (!filter.empty() && !parsePixelFilter(filter, &s.settings.pixelFilter))
+      r.problem("pixel_filter", cat("unknown filter '", filter, "' (box, tent, gaussian, blackman_harris)"));
+    s.settings.filterWidth = defaultFilterWidth(s.settings.pixelFilter);
+    r.number("filter_width", &s.settings.filterWidth);
+    if (!(s.settings.filterWidth > 0.0f && s.settings.filterWidth <= 16.0f))
+      r.problem("filter_width", "expected a width in pixels within (0, 16]");
   }
   if (const Value* v = root.find("camera")) {
     Reader r(&error, "camera", v);

@@ -432,6 +432,17 @@ class TungstenImporter {
       s.settings.width = 1000;
       s.settings.height = 563;
     }
+    // Tungsten's default filter is the tent; the scene's author saw every edge through it.
+    s.settings.pixelFilter = PixelFilter::Tent;
+    if (const Value* f = c.find("reconstruction_filter"); f && f->isString()) {
+      if (f->asString() == "dirac") {
+        s.settings.pixelFilter = PixelFilter::Box;
+        warn("camera: reconstruction filter 'dirac' is rendered as a box filter");
+      } else if (!parsePixelFilter(f->asString(), &s.settings.pixelFilter)) {
+        warn(cat("camera: reconstruction filter '", f->asString(), "' is not supported; rendered with a tent"));
+      }
+    }
+    s.settings.filterWidth = s.settings.pixelFilter == PixelFilter::Gaussian ? 4.0f : defaultFilterWidth(s.settings.pixelFilter);
     float fov = 60;
     number(c, "fov", &fov, where);
     if (!(fov > 0 && fov < 180)) return problem(where, "fov must be between 0 and 180 degrees");

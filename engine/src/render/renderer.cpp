@@ -87,6 +87,10 @@ struct Renderer::Impl {
   int maxBounces = 8;
   std::uint32_t seed = 0;
   RenderSettings sceneSettings;
+  // The pixel filter's inverse CDF, recomputed when the scene's filter changes.
+  std::vector<float> warp;
+  PixelFilter warpFilter = PixelFilter::Box;
+  float warpWidth = 0.0f;
   bool hasScene = false;
   NodeId selectedObject = kNoNode;
   int countTileSize = 0;            // tile size the selection buffer is laid out for
@@ -359,6 +363,15 @@ struct Renderer::Impl {
     u.sceneSphere = {c.x, c.y, c.z, d.bounds.empty() ? 1.0f : 0.5f * length(d.bounds.extent())};
     std::uint32_t sel = countTile > 0 ? selectedInstance() : 0u;
     u.work = {itemCount, static_cast<std::uint32_t>(slots), sel, sel ? static_cast<std::uint32_t>(countTile) : 0u};
+    if (warpFilter != sceneSettings.pixelFilter || warpWidth != sceneSettings.filterWidth || warp.empty()) {
+      warpFilter = sceneSettings.pixelFilter;
+      warpWidth = sceneSettings.filterWidth;
+      warp = pixelFilterWarp(warpFilter, warpWidth, gpu::kFilterWarpSegments);
+    }
+    for (std::size_t i = 0; i < warp.size(); ++i) {
+      gpu::vec4& v = u.filterWarp[i / 4];
+      (i % 4 == 0 ? v.x : i % 4 == 1 ? v.y : i % 4 == 2 ? v.z : v.w) = warp[i];
+    }
     frameUbo.upload(&u, sizeof u);
   }
 

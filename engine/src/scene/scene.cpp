@@ -1,9 +1,79 @@
 #include "retile/scene.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <numbers>
 
 namespace retile {
+
+const char* pixelFilterName(PixelFilter f) {
+  switch (f) {
+    case PixelFilter::Box: return "box";
+    case PixelFilter::Tent: return "tent";
+    case PixelFilter::Gaussian: return "gaussian";
+    case PixelFilter::BlackmanHarris: return "blackman_harris";
+  }
+  return "box";
+}
+
+bool parsePixelFilter(std::string_view name, PixelFilter* out) {
+  for (int i = 0; i < kPixelFilterCount; ++i)
+    if (name == pixelFilterName(static_cast<PixelFilter>(i))) {
+      *out = static_cast<PixelFilter>(i);
+      return true;
+    }
+  return false;
+}
+
+float defaultFilterWidth(PixelFilter f) {
+  switch (f) {
+    case PixelFilter::Box: return 1.0f;
+    case PixelFilter::Tent: return 2.0f;
+    case PixelFilter::Gaussian: return 4.0f;
+    case PixelFilter::BlackmanHarris: return 1.5f;
+  }
+  return 1.0f;
+}
+
+std::vector<float> pixelFilterWarp(PixelFilter f, float width, int segments) {
+  const double radius = 0.5 * std::clamp(static_cast<double>(width), 0.01, 16.0);
+  std::vector<float> warp(static_cast<std::size_t>(segments) + 1);
+  // The filter's weight at offset x in [-radius, radius].
+  auto weight = [&](double x) {
+    const double t = x / radius;  // -1..1
+    switch (f) {
+      case PixelFilter::Box: return 1.0;
+      case PixelFilter::Tent: return std::max(0.0, 1.0 - std::abs(t));
+      case PixelFilter::Gaussian: return std::exp(-0.5 * (3.0 * t) * (3.0 * t));  // +-3 sigma across the width
+      case PixelFilter::BlackmanHarris: {
+        const double a = std::numbers::pi * (t + 1.0);  // 0..2 pi across the width
+        return std::max(0.0, 0.35875 - 0.48829 * std::cos(a) + 0.14128 * std::cos(2 * a) - 0.01168 * std::cos(3 * a));
+      }
+    }
+    return 1.0;
+  };
+  // Tabulate the CDF finely and invert it at u = i / segments.
+  constexpr int kFine = 4096;
+  std::vector<double> cdf(kFine + 1, 0.0);
+  for (int k = 0; k < kFine; ++k) {
+    const double x0 = -radius + 2 * radius * k / kFine, x1 = -radius + 2 * radius * (k + 1) / kFine;
+    cdf[static_cast<std::size_t>(k) + 1] = cdf[static_cast<std::size_t>(k)] + 0.5 * (weight(x0) + weight(x1)) * (x1 - x0);
+  }
+  for (double& c : cdf) c /= cdf.back();
+  std::size_t k = 0;
+  for (int i = 0; i <= segments; ++i) {
+    const double u = static_cast<double>(i) / segments;
+    while (k + 1 < cdf.size() - 1 && cdf[k + 1] < u) ++k;
+    const double span = cdf[k + 1] - cdf[k];
+    const double frac = span > 0 ? std::clamp((u - cdf[k]) / span, 0.0, 1.0) : 0.0;
+    warp[static_cast<std::size_t>(i)] = static_cast<float>(-radius + 2 * radius * (k + frac) / kFine);
+  }
+  warp.front() = static_cast<float>(-radius);
+  warp.back() = static_cast<float>(radius);
+  return warp;
+}
+
 
 Bounds3 MeshGeometry::bounds() const {
   Bounds3 b;
