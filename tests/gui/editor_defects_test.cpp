@@ -650,5 +650,26 @@ TEST(EditorDefects, CtrlClickSelectsSeveralObjectsAndADragMovesThemTogether) {
   EXPECT_EQ(w->selectedObjects(), std::vector<NodeId>{cup}) << "a plain pick selects just it";
 }
 
+// The pixel filter is a render setting: chosen in Properties, it reaches the engine as one undo
+// step and restarts the accumulation (samples are placed differently).
+TEST(EditorDefects, ThePixelFilterIsARenderSettingWithUndo) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  QTreeWidgetItem* settings = outlinerItem(*w, "Render settings");
+  ASSERT_TRUE(settings);
+  w->findChild<QTreeWidget*>()->setCurrentItem(settings, 0, QItemSelectionModel::ClearAndSelect);
+  auto* filter = w->findChild<QComboBox*>("pixelFilter");
+  ASSERT_TRUE(filter);
+  EXPECT_EQ(filter->currentIndex(), static_cast<int>(PixelFilter::Box)) << "the built-in scene's";
+  filter->setCurrentIndex(static_cast<int>(PixelFilter::BlackmanHarris));
+  EXPECT_EQ(w->scene().settings.pixelFilter, PixelFilter::BlackmanHarris);
+  EXPECT_EQ(w->scene().settings.filterWidth, 1.5f) << "at its usual width";
+  const std::uint64_t version = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; }));
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().settings.pixelFilter, PixelFilter::Box);
+  EXPECT_EQ(w->scene().settings.filterWidth, 1.0f);
+}
+
 }  // namespace
 }  // namespace retile::ui
