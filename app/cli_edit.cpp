@@ -130,6 +130,7 @@ int runEdit(const std::vector<std::string>& argv) {
     return out;
   };
   std::vector<std::uint8_t> affected, rest;  // the pixels the script changed, and the others
+  std::size_t affectedCount = 0;
   if (reference > 0) {
     Renderer r;
     auto renderReference = [&](const Scene& state, const char* what) {
@@ -154,9 +155,8 @@ int runEdit(const std::vector<std::string>& argv) {
     RenderImage start = renderReference(scene, "reference before");
     affected = affectedPixels(start, img);
     rest.resize(affected.size());
-    std::size_t count = 0;
-    for (std::size_t i = 0; i < affected.size(); ++i) count += affected[i], rest[i] = !affected[i];
-    std::fprintf(stderr, "affected region: %zu of %zu pixels\n", count, affected.size());
+    for (std::size_t i = 0; i < affected.size(); ++i) affectedCount += affected[i], rest[i] = !affected[i];
+    std::fprintf(stderr, "affected region: %zu of %zu pixels\n", affectedCount, affected.size());
   }
 
   RenderSession session(scene, method);
@@ -212,25 +212,25 @@ int runEdit(const std::vector<std::string>& argv) {
     sumScheduleMs += rec.scheduleMs;
     char line[768];
     const RegionRect outer = rec.denoised.empty() ? RegionRect{} : rec.denoised.back().rect;
-    std::string quality = ",,,,,,";
+    std::string scores = ",,,,,,";
     if (!refDisplay.empty() && rec.image) {
       const std::vector<float> shown = displayed(rec.image->shown());
       const MetricImage a{shown.data(), w, h}, r{refDisplay.data(), w, h};
       char q[192];
-      std::snprintf(q, sizeof q, "%.3f,%.5f,%.3f,%.5f,%.5f,%.3f,%.3f", psnr(a, r), ssim(a, r), psnrHvsM(a, r),
-                    rootMeanSquaredError(a, r, affected.data()), rootMeanSquaredError(a, r, rest.data()),
-                    psnr(a, r, affected.data()), psnr(a, r, rest.data()));
-      quality = q;
-      if (std::find(affected.begin(), affected.end(), 1) == affected.end()) {  // nothing changed: no affected scores
-        quality = quality.substr(0, quality.find(',', quality.find(',', quality.find(',') + 1) + 1) + 1) + "," +
-                  std::to_string(rootMeanSquaredError(a, r)) + ",," + std::to_string(psnr(a, r));
-      }
+      if (affectedCount > 0)
+        std::snprintf(q, sizeof q, "%.3f,%.5f,%.3f,%.5f,%.5f,%.3f,%.3f", psnr(a, r), ssim(a, r), psnrHvsM(a, r),
+                      rootMeanSquaredError(a, r, affected.data()), rootMeanSquaredError(a, r, rest.data()),
+                      psnr(a, r, affected.data()), psnr(a, r, rest.data()));
+      else  // nothing changed: no affected scores, the rest is the whole image
+        std::snprintf(q, sizeof q, "%.3f,%.5f,%.3f,,%.5f,,%.3f", psnr(a, r), ssim(a, r), psnrHvsM(a, r),
+                      rootMeanSquaredError(a, r), psnr(a, r));
+      scores = q;
     }
     std::snprintf(line, sizeof line, "%d,%zu,%s,%s,%llu,%zu,%zu,%d,%.3f,%.4f,%.3f,%s,%zu,%d,%d,%s\n", frame, sub.step,
                   rec.method.c_str(), rec.mode.c_str(), static_cast<unsigned long long>(rec.samples), rec.servedTiles.size(),
                   rec.queueLength - rec.queueServed, rec.quality, rec.frameMs, rec.scheduleMs, rec.traceMs,
                   std::isnan(err) ? "" : std::to_string(err).c_str(), rec.denoised.size(), outer.width, outer.height,
-                  quality.c_str());
+                  scores.c_str());
     csv << line;
     if (images && rec.image) {
       char name[64];

@@ -517,7 +517,6 @@ void FrameView::mousePressEvent(QMouseEvent* e) {
   }
   const QPoint px = imagePixel(e->position());
   if (px.x() < 0) return;
-  const int x = px.x(), y = px.y();
   if (e->modifiers() & Qt::ShiftModifier) {
     // A click places a focus point; a drag draws a render region (decided on release).
     drag_ = Drag::RenderRegion;
@@ -525,9 +524,7 @@ void FrameView::mousePressEvent(QMouseEvent* e) {
     draft_ = QRect();
     return;
   }
-  const auto& ids = frame_->image->objectId;
-  std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(frame_->width) + static_cast<std::size_t>(x);
-  quint64 id = i < ids.size() ? static_cast<quint64>(ids[i]) : 0;
+  const quint64 id = objectAt(px);
   // Pressing on the selection starts moving it; anywhere else picks.
   if (id != 0 && std::find(selection_.begin(), selection_.end(), id) != selection_.end() && tool_ != Tool::Select) {
     drag_ = tool_ == Tool::Rotate ? Drag::Rotate : tool_ == Tool::Scale ? Drag::Scale : Drag::Object;
@@ -606,19 +603,22 @@ void FrameView::mouseReleaseEvent(QMouseEvent* e) {
   if (drag_ == Drag::Region) {
     // Ctrl+click (no drag) on an object adds it to the selection or takes it out.
     const QPointF d = e->position() - regionStart_;
-    const QPoint px = imagePixel(regionStart_);
-    if (std::hypot(d.x(), d.y()) < 4 && px.x() >= 0 && frame_ && frame_->image) {
-      const auto& ids = frame_->image->objectId;
-      const std::size_t i = static_cast<std::size_t>(px.y()) * static_cast<std::size_t>(frame_->width) + static_cast<std::size_t>(px.x());
-      if (i < ids.size() && ids[i] != 0) {
-        drag_ = Drag::None;
-        emit objectToggled(static_cast<quint64>(ids[i]));
-        return;
-      }
+    if (const quint64 id = objectAt(imagePixel(regionStart_)); std::hypot(d.x(), d.y()) < 4 && id != 0) {
+      drag_ = Drag::None;
+      emit objectToggled(id);
+      return;
     }
   }
   if (drag_ != Drag::None && drag_ != Drag::Region && drag_ != Drag::Wipe) emit dragFinished();
   drag_ = Drag::None;
+}
+
+quint64 FrameView::objectAt(QPoint imagePixel) const {
+  if (!frame_ || !frame_->image || imagePixel.x() < 0 || imagePixel.y() < 0) return 0;
+  const auto& ids = frame_->image->objectId;
+  const std::size_t i =
+      static_cast<std::size_t>(imagePixel.y()) * static_cast<std::size_t>(frame_->width) + static_cast<std::size_t>(imagePixel.x());
+  return i < ids.size() ? static_cast<quint64>(ids[i]) : 0;
 }
 
 void FrameView::setSelection(std::vector<quint64> objects, quint64 primary) {

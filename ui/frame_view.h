@@ -144,6 +144,7 @@ class FrameView : public QWidget {
   QImage toDisplay(const RenderImage& img) const;
   const std::vector<float>& inspected(const RenderImage& img) const { return inspect_ == Inspect::Raw ? img.color : img.shown(); }
   QPoint imagePixel(QPointF widgetPos) const;
+  quint64 objectAt(QPoint imagePixel) const;  // the object of the shown frame's first hit there; 0: none
   void inspectRegion();
 
   std::shared_ptr<const FrameRecord> frame_;

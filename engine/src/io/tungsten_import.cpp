@@ -442,7 +442,7 @@ class TungstenImporter {
         warn(cat("camera: reconstruction filter '", f->asString(), "' is not supported; rendered with a tent"));
       }
     }
-    s.settings.filterWidth = s.settings.pixelFilter == PixelFilter::Gaussian ? 4.0f : defaultFilterWidth(s.settings.pixelFilter);
+    s.settings.filterWidth = defaultFilterWidth(s.settings.pixelFilter);  // Tungsten's widths
     float fov = 60;
     number(c, "fov", &fov, where);
     if (!(fov > 0 && fov < 180)) return problem(where, "fov must be between 0 and 180 degrees");
