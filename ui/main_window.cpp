@@ -363,7 +363,7 @@ void MainWindow::buildDocks() {
     auto kind = static_cast<PropertyTarget::Kind>(items[0]->data(0, kKindRole).toInt());
     if (kind == PropertyTarget::Kind::Object) {
       if (!ok || !id || !doc_.scene().object(static_cast<NodeId>(id))) return;
-      if (id != selection_) select(static_cast<NodeId>(id));
+      if (id != selection_ || selected_.size() > 1) select(static_cast<NodeId>(id));  // a plain click ends a multi-selection
       else panel_->setTarget({PropertyTarget::Kind::Object, static_cast<NodeId>(id)});  // back from the camera, say
     } else if (kind != PropertyTarget::Kind::None) {
       panel_->setTarget({kind, static_cast<NodeId>(id)});

@@ -648,6 +648,13 @@ TEST(EditorDefects, CtrlClickSelectsSeveralObjectsAndADragMovesThemTogether) {
   EXPECT_EQ(w->selection(), sphere);
   w->select(cup);
   EXPECT_EQ(w->selectedObjects(), std::vector<NodeId>{cup}) << "a plain pick selects just it";
+
+  // In the outliner: Ctrl+click adds, a plain click on the leading object selects just it.
+  auto* tree = w->findChild<QTreeWidget*>();
+  tree->setCurrentItem(outlinerItem(*w, "Glossy Sphere"), 0, QItemSelectionModel::Select);
+  EXPECT_EQ(w->selectedObjects(), (std::vector<NodeId>{cup, sphere}));
+  tree->setCurrentItem(outlinerItem(*w, "Glossy Sphere"), 0, QItemSelectionModel::ClearAndSelect);
+  EXPECT_EQ(w->selectedObjects(), std::vector<NodeId>{sphere});
 }
 
 // The pixel filter is a render setting: chosen in Properties, it reaches the engine as one undo
