@@ -19,6 +19,8 @@ void usage() {
                "  retile edit SCENE --script EDITS.json --method NAME --out-dir DIR [--size WxH] [--tile T]\n"
                "                    [--quality Q|auto] [--smooth] [--stale-cap N] [--converge SPP] [--reference SPP]\n"
                "                    [--denoise [--denoise-threshold PX] [--no-soft-borders]] [--no-images]\n"
+               "  retile eval [SCENE ...] --out-dir DIR [--quick] [--size WxH] [--methods LIST] [--scenarios LIST]\n"
+               "                    [--script FILE ...] [--reference-spp N] [--every K] [--converge SPP] [--target REL]\n"
                "  retile bench throughput SCENE [--size WxH] [--frames N] [--max-bounces B]\n"
                "  retile bench bvh [--triangles N] | edit | frames SCENE [--drag] | denoise [SCENE] [--size WxH]\n"
                "  retile import FILE\n"
@@ -43,6 +45,7 @@ int main(int argc, char** argv) {
     if (cmd == "bench") return retile::cli::runBench(rest);
     if (cmd == "import") return retile::cli::runImport(rest);
     if (cmd == "edit") return retile::cli::runEdit(rest);
+    if (cmd == "eval") return retile::cli::runEval(rest);
     std::fprintf(stderr, "retile: unknown command '%s'\n", cmd.c_str());
     usage();
     return 2;

@@ -9,7 +9,7 @@ set -euo pipefail
 # locale (de_DE) as an artist in much of Europe does.
 packages=(
   build-essential cmake ninja-build pkg-config git
-  qt6-base-dev qt6-base-dev-tools qt6-charts-dev libqt6opengl6-dev libgl-dev
+  qt6-base-dev qt6-base-dev-tools qt6-charts-dev qt6-svg-dev libqt6opengl6-dev libgl-dev
   libvulkan-dev vulkan-tools mesa-vulkan-drivers vulkan-validationlayers
   glslang-dev glslang-tools spirv-tools
   libassimp-dev zlib1g-dev

@@ -47,8 +47,10 @@ double psnrHvsM(MetricImage a, MetricImage ref, const std::uint8_t* mask = nullp
 // The pixels an edit changed: where two converged references, of the scene before the edit and
 // after it, differ in luminance by more than `z` standard errors of their two means (each from
 // the reference's per-pixel variance, moment2 - mean^2, over its sample count) and by more than
-// `relative` of the brighter of the two. 1 marks a changed pixel. Both references are linear
-// renders of the same size with moment2 and sampleCount (Renderer::render fills them).
+// `relative` of the brighter of the two; and every pixel of an aligned 4x4 block whose block means
+// pass the same test (pooling finds small changes spread over many noisy pixels). 1 marks a
+// changed pixel. Both references are linear renders of the same size with moment2 and
+// sampleCount (Renderer::render fills them).
 std::vector<std::uint8_t> affectedPixels(const RenderImage& before, const RenderImage& after, double z = 4.0,
                                          double relative = 0.01);
 

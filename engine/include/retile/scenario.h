@@ -20,6 +20,7 @@
 // for the others. Pure data and parsing: any thread.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -66,7 +67,10 @@ struct StepEdits {
 Result<StepEdits> stepEdits(const ScenarioStep& step, int frameInStep, const Scene& scene, NodeId selection);
 
 // Relative RMSE of two images' luminance after averaging b x b pixel blocks (b = 1: per pixel):
-// sqrt(mean((a - r)^2)) / mean(r). Blocks tame the noise both renders still carry.
-double relativeRmse(const std::vector<float>& rgbA, const std::vector<float>& rgbRef, int width, int height, int block);
+// sqrt(mean((a - r)^2)) / mean(r). Blocks tame the noise both renders still carry. With a mask (a
+// byte per pixel), only masked pixels count: a block is the mean of its masked pixels, and blocks
+// without one are left out.
+double relativeRmse(const std::vector<float>& rgbA, const std::vector<float>& rgbRef, int width, int height, int block,
+                    const std::uint8_t* mask = nullptr);
 
 }  // namespace retile

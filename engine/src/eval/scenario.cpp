@@ -251,7 +251,8 @@ Result<StepEdits> stepEdits(const ScenarioStep& step, int frameInStep, const Sce
   return out;
 }
 
-double relativeRmse(const std::vector<float>& a, const std::vector<float>& ref, int width, int height, int block) {
+double relativeRmse(const std::vector<float>& a, const std::vector<float>& ref, int width, int height, int block,
+                    const std::uint8_t* mask) {
   block = std::max(block, 1);
   if (a.size() != ref.size() || a.size() < static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3) return NAN;
   double se = 0, sum = 0;
@@ -259,14 +260,19 @@ double relativeRmse(const std::vector<float>& a, const std::vector<float>& ref, 
   for (int by = 0; by + block <= height; by += block)
     for (int bx = 0; bx + block <= width; bx += block) {
       double la = 0, lr = 0;
+      int count = 0;
       for (int y = by; y < by + block; ++y)
         for (int x = bx; x < bx + block; ++x) {
-          std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * 3;
+          std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+          if (mask && !mask[p]) continue;
+          std::size_t i = p * 3;
           la += 0.2126 * a[i] + 0.7152 * a[i + 1] + 0.0722 * a[i + 2];
           lr += 0.2126 * ref[i] + 0.7152 * ref[i + 1] + 0.0722 * ref[i + 2];
+          ++count;
         }
-      la /= block * block;
-      lr /= block * block;
+      if (count == 0) continue;
+      la /= count;
+      lr /= count;
       se += (la - lr) * (la - lr);
       sum += lr;
       ++n;

@@ -1,0 +1,361 @@
+// `retile eval`: every method through the same scenarios, scored against cached references, and
+// a report an artist or a reviewer reads offline: metrics.csv, summary.csv, charts (PNG and SVG),
+// strips of frames with the overlays, and index.html tying them together.
+#include <QApplication>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "cli.h"
+#include "core/files.h"
+#include "eval_report.h"
+#include "retile/eval.h"
+#include "retile/log.h"
+
+namespace retile::cli {
+
+namespace {
+
+void usage(const std::string& error) {
+  if (!error.empty()) std::fprintf(stderr, "error: %s\n", error.c_str());
+  std::fprintf(stderr,
+               "usage: retile eval [SCENE ...] --out-dir DIR [--quick] [--size WxH] [--methods LIST] [--scenarios LIST]\n"
+               "                   [--script FILE ...] [--reference-spp N] [--every K] [--converge SPP] [--target REL]\n"
+               "SCENE defaults to 'default'. LIST is comma-separated.\n"
+               "scenarios: fig6, material, light, camera, drag (default: all), plus each --script\n"
+               "methods (default):");
+  for (const auto& m : eval::defaultMethods()) std::fprintf(stderr, " %s", m.c_str());
+  std::fprintf(stderr, "\n         any of");
+  for (const auto& n : methodNames()) std::fprintf(stderr, " %s", n.c_str());
+  std::fprintf(stderr, " with +smooth and/or +denoise\n");
+}
+
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+std::string html(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '<') o += "&lt;";
+    else if (c == '>') o += "&gt;";
+    else if (c == '&') o += "&amp;";
+    else if (c == '"') o += "&quot;";
+    else o += c;
+  }
+  return o;
+}
+
+std::string fixed(double v, int decimals) {
+  if (std::isnan(v)) return "–";
+  if (std::isinf(v)) return "∞";
+  char b[32];
+  std::snprintf(b, sizeof b, "%.*f", decimals, v);
+  return b;
+}
+
+// A name safe in a file name: letters, digits, '-' and '_'.
+std::string slug(const std::string& s) {
+  std::string o;
+  for (char c : s) o += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' ? c : '_';
+  return o;
+}
+
+struct ScenarioResult {
+  std::string scene, sceneSlug;
+  eval::Case scenario;
+  std::size_t affected = 0, pixels = 0;
+  std::vector<eval::Run> runs;
+  std::vector<eval::Summary> summaries;
+  std::vector<int> stripFrames;
+  std::vector<ui::StripRow> strip;
+  std::vector<std::string> charts;  // file bases, relative to the output directory
+};
+
+}  // namespace
+
+int runEval(const std::vector<std::string>& argv) {
+  auto args = parseArgs(argv, {"--out-dir", "--size", "--methods", "--scenarios", "--script", "--reference-spp", "--every",
+                               "--converge", "--target"},
+                        {"--quick"});
+  if (!args) return usage(args.error()), 2;
+  if (!args->has("--out-dir")) return usage("--out-dir is required"), 2;
+  eval::Options opt = args->has("--quick") ? eval::Options::quick() : eval::Options{};
+  if (args->has("--size")) {
+    auto r = parseSize(args->get("--size"), &opt.width, &opt.height);
+    if (!r) return usage(r.error()), 2;
+  }
+  for (auto [name, lo, hi, out] : {std::tuple{"--reference-spp", 1, 1 << 20, &opt.referenceSpp},
+                                   std::tuple{"--every", 1, 100000, &opt.every},
+                                   std::tuple{"--converge", 0, 1 << 20, &opt.converge}}) {
+    if (!args->has(name)) continue;
+    auto v = parseInt(name, args->get(name), lo, hi);
+    if (!v) return usage(v.error()), 2;
+    *out = v.value();
+  }
+  if (args->has("--target")) {
+    auto v = parseNumber("--target", args->get("--target"), 1e-6, 10);
+    if (!v) return usage(v.error()), 2;
+    opt.target = v.value();
+  }
+  std::vector<std::string> methodLabels = args->has("--methods") ? splitList(args->get("--methods")) : eval::defaultMethods();
+  std::vector<MethodSettings> methods;
+  for (const auto& label : methodLabels) {
+    auto m = eval::parseMethodLabel(label);
+    if (!m) return usage(m.error()), 2;
+    methods.push_back(m.value());
+  }
+  std::vector<std::string> scenarioNames;
+  if (args->has("--scenarios")) {
+    scenarioNames = splitList(args->get("--scenarios"));
+    const auto known = eval::builtInScenarioNames();
+    for (const auto& n : scenarioNames)
+      if (std::find(known.begin(), known.end(), n) == known.end())
+        return usage(cat("unknown scenario '", n, "' (fig6, material, light, camera, drag; scripts go with --script)")), 2;
+  }
+  std::vector<Scenario> scripts;
+  for (const auto& [k, v] : args->options)
+    if (k == "--script") {
+      auto s = loadScenario(v);
+      if (!s) return std::fprintf(stderr, "error: %s\n", s.error().c_str()), 1;
+      scripts.push_back(s.value());
+    }
+  // Only scripts were asked for: no built-in scenario unless named.
+  if (!scripts.empty() && !args->has("--scenarios")) scenarioNames = {"none"};
+  std::vector<std::string> sceneNames = args->positional.empty() ? std::vector<std::string>{"default"} : args->positional;
+
+  const std::filesystem::path out = args->get("--out-dir");
+  std::error_code ec;
+  std::filesystem::create_directories(out / "charts", ec);
+  std::filesystem::create_directories(out / "strips", ec);
+  if (ec) return std::fprintf(stderr, "error: cannot create %s: %s\n", out.string().c_str(), ec.message().c_str()), 1;
+
+  // The charts and strips are drawn with Qt offscreen: no display is needed, and the viewport
+  // paints itself instead of asking for a Vulkan surface.
+  qputenv("QT_QPA_PLATFORM", "offscreen");
+  qputenv("RETILE_VIEWPORT", "widget");
+  int qtArgc = 1;
+  char qtName[] = "retile";
+  char* qtArgv[] = {qtName, nullptr};
+  QApplication app(qtArgc, qtArgv);
+
+  eval::References refs(out / "references", opt.referenceSpp);
+  std::ofstream metrics(out / "metrics.csv");
+  metrics << eval::metricsCsvHeader();
+  std::vector<ScenarioResult> results;
+  std::vector<std::string> notes;
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  auto seconds = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+
+  // Everything is planned first, so the progress bar knows the whole run's frames.
+  struct Job {
+    std::string sceneName;
+    eval::Case scenario;
+    eval::Plan plan;
+  };
+  std::vector<Job> jobs;
+  for (const auto& sceneName : sceneNames) {
+    auto loaded = loadScene(sceneName);
+    if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
+    for (const auto& w : loaded->warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    Scene scene = loaded->scene;
+    scene.settings.width = opt.width;
+    scene.settings.height = opt.height;
+    std::vector<std::string> skipped;
+    std::vector<eval::Case> cases = eval::builtInScenarios(scene, opt, scenarioNames, &skipped);
+    for (const auto& s : skipped) notes.push_back(cat(sceneName, ": scenario ", s));
+    for (const Scenario& s : scripts) cases.push_back({s.name, "A script: " + s.name, s});
+    for (auto& c : cases) {
+      auto plan = eval::planScenario(c.script, scene, opt.every);
+      if (!plan) {
+        notes.push_back(cat(sceneName, ": scenario ", c.name, " left out: ", plan.error()));
+        std::fprintf(stderr, "warning: %s: %s: %s\n", sceneName.c_str(), c.name.c_str(), plan.error().c_str());
+        continue;
+      }
+      jobs.push_back({sceneName, c, std::move(plan.value())});
+    }
+  }
+  if (jobs.empty()) return std::fprintf(stderr, "error: no scenario to play\n"), 1;
+  for (const auto& n : notes) std::fprintf(stderr, "note: %s\n", n.c_str());
+
+  int totalFrames = 0, doneFrames = 0;
+  for (const Job& j : jobs)
+    totalFrames += static_cast<int>(methods.size()) * (j.plan.converge + static_cast<int>(j.plan.frames.size()));
+
+  for (Job& job : jobs) {
+    ScenarioResult res;
+    res.scene = job.sceneName;
+    res.sceneSlug = slug(std::filesystem::path(job.sceneName).parent_path().filename().string().empty()
+                             ? std::filesystem::path(job.sceneName).stem().string()
+                             : std::filesystem::path(job.sceneName).parent_path().filename().string() + "-" +
+                                   std::filesystem::path(job.sceneName).stem().string());
+    if (job.sceneName == "default") res.sceneSlug = "default";
+    res.scenario = job.scenario;
+    const std::string label = cat(res.sceneSlug, " ", job.scenario.name);
+    const auto refStart = Clock::now();
+    auto targets = eval::prepareTargets(job.plan, refs, [&](int done, int total) {
+      progressBar(label + " references", done, total, std::chrono::duration<double>(Clock::now() - refStart).count());
+    });
+    if (!targets) return std::fprintf(stderr, "\nerror: %s\n", targets.error().c_str()), 1;
+    res.affected = targets->affectedCount;
+    res.pixels = static_cast<std::size_t>(opt.width) * static_cast<std::size_t>(opt.height);
+    const int frames = static_cast<int>(job.plan.frames.size());
+    for (int f : {1, 10, job.plan.lastEditFrame + 10, frames})
+      if (f >= 1 && f <= frames && std::find(res.stripFrames.begin(), res.stripFrames.end(), f) == res.stripFrames.end())
+        res.stripFrames.push_back(f);
+    std::sort(res.stripFrames.begin(), res.stripFrames.end());
+    const int scale = std::max(1, 240 / std::max(opt.width, 1));
+    for (const MethodSettings& m : methods) {
+      ui::StripRow row;
+      row.label = QString::fromStdString(methodLabel(m));
+      doneFrames += job.plan.converge;
+      auto run = eval::runMethod(job.plan, targets.value(), m, [&](const FrameRecord& rec, const eval::FrameScore& s) {
+        progressBar("eval", ++doneFrames, totalFrames, seconds());
+        if (std::find(res.stripFrames.begin(), res.stripFrames.end(), s.frame) != res.stripFrames.end())
+          row.cells.push_back(ui::frameWithOverlays(rec, scale));
+        return true;
+      });
+      if (!run) return std::fprintf(stderr, "\nerror: %s %s: %s\n", label.c_str(), methodLabel(m).c_str(), run.error().c_str()), 1;
+      run->scene = res.sceneSlug;
+      run->scenario = job.scenario.name;
+      for (const auto& f : run->frames) metrics << eval::metricsCsvRow(run.value(), f);
+      metrics.flush();
+      if (!run->exactBudget) notes.push_back(cat(label, " ", run->method, ": a frame did not trace exactly W x H samples"));
+      res.summaries.push_back(eval::summarize(run.value(), opt.target));
+      res.runs.push_back(std::move(run.value()));
+      res.strip.push_back(std::move(row));
+    }
+    results.push_back(std::move(res));
+  }
+  metrics.close();
+  std::fprintf(stderr, "references: %d rendered, %d reused from %s\n", refs.rendered(), refs.reused(),
+               (out / "references").string().c_str());
+
+  // summary.csv and the table on the terminal.
+  std::string summaryCsv = eval::summaryCsvHeader();
+  for (const auto& r : results)
+    for (const auto& s : r.summaries) summaryCsv += eval::summaryCsvRow(s);
+  if (auto w = writeFileAtomic(out / "summary.csv", summaryCsv); !w) return std::fprintf(stderr, "error: %s\n", w.error().c_str()), 1;
+
+  // Charts and strips.
+  int chartsWritten = 0;
+  for (auto& r : results) {
+    const std::string base = cat(r.sceneSlug, "-", slug(r.scenario.name));
+    std::vector<ui::ChartLine> whole, affected;
+    std::vector<ui::ChartPoint> tradeoff;
+    for (std::size_t i = 0; i < r.runs.size(); ++i) {
+      const eval::Run& run = r.runs[i];
+      ui::ChartLine a{QString::fromStdString(run.method), {}}, b{QString::fromStdString(run.method), {}};
+      for (const auto& f : run.frames) {
+        if (!f.scored()) continue;
+        a.points.emplace_back(f.ms, f.psnr);
+        b.points.emplace_back(f.ms, r.affected > 0 ? f.psnrAffected : f.psnr);
+      }
+      whole.push_back(std::move(a));
+      affected.push_back(std::move(b));
+      const eval::Summary& s = r.summaries[i];
+      const double at10 = r.affected > 0 ? s.psnrAffectedAt[1] : s.psnrAt[1];
+      const bool reached = s.framesToTarget >= 0;
+      const double x = reached ? s.msToTarget : (run.frames.empty() ? NAN : run.frames.back().ms);
+      tradeoff.push_back({QString::fromStdString(run.method + (reached ? "" : " (not reached)")), QPointF(x, at10)});
+    }
+    const QString title = QString::fromStdString(cat(r.scene, ": ", r.scenario.name));
+    const QString timeAxis = QStringLiteral("wall clock since the first edit (ms)");
+    struct Chart {
+      std::string name;
+      Result<bool> written;
+    };
+    std::vector<Chart> made;
+    made.push_back({base + "-psnr", ui::writeLineChart(out / "charts" / (base + "-psnr"), title + " — PSNR, whole image",
+                                                       timeAxis, "PSNR (dB)", whole, true)});
+    made.push_back({base + "-affected",
+                    ui::writeLineChart(out / "charts" / (base + "-affected"),
+                                       title + (r.affected > 0 ? " — PSNR, affected region" : " — PSNR (nothing changed)"),
+                                       timeAxis, "PSNR (dB)", affected, true)});
+    made.push_back({base + "-tradeoff",
+                    ui::writePointChart(out / "charts" / (base + "-tradeoff"), title + " — speed against accuracy",
+                                        QString::fromStdString(cat("time to ", opt.target * 100,
+                                                                   " % relative RMSE in the affected region (ms)")),
+                                        "PSNR of the affected region at frame 10 (dB)", tradeoff)});
+    for (auto& c : made) {
+      if (!c.written) return std::fprintf(stderr, "error: %s\n", c.written.error().c_str()), 1;
+      r.charts.push_back(c.name);
+      ++chartsWritten;
+    }
+    std::vector<QString> captions;
+    for (int f : r.stripFrames) captions.push_back(QStringLiteral("frame %1").arg(f));
+    auto strip = ui::writeStrip(out / "strips" / (base + ".png"), captions, r.strip);
+    if (!strip) return std::fprintf(stderr, "error: %s\n", strip.error().c_str()), 1;
+  }
+
+  // index.html: readable offline, everything relative.
+  std::string page =
+      "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>Retile evaluation</title>\n"
+      "<style>body{font:14px/1.45 sans-serif;margin:2em auto;max-width:1200px;color:#222}"
+      "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:3px 7px;text-align:right}"
+      "th{background:#f2f2f2}td:first-child,th:first-child{text-align:left}img{max-width:100%}"
+      ".note{color:#555}</style></head><body>\n<h1>Retile evaluation</h1>\n";
+  page += cat("<p>", opt.width, "x", opt.height, ", every method on the same budget (", opt.width, "x", opt.height,
+              " samples a frame), references of ", opt.referenceSpp,
+              " spp. Scored: frame 1, every ", opt.every,
+              "th frame while edits arrive, every frame at rest. PSNR, SSIM and PSNR-HVS-M compare display-referred "
+              "images (sRGB view, clamped); the <em>affected region</em> is where the scenario's references differ from "
+              "the start beyond their noise. Time to target: from frame 1 until the affected region's relative RMSE "
+              "(linear luminance, 4x4 blocks) stays at or below ",
+              opt.target * 100, " %.</p>\n");
+  page += "<p>Data: <a href=\"metrics.csv\">metrics.csv</a> (every frame), <a href=\"summary.csv\">summary.csv</a>.</p>\n";
+  for (const auto& n : notes) page += "<p class=\"note\">" + html(n) + "</p>\n";
+  for (const auto& r : results) {
+    const std::string base = cat(r.sceneSlug, "-", slug(r.scenario.name));
+    page += cat("<h2>", html(r.scene), ": ", html(r.scenario.name), "</h2>\n<p>", html(r.scenario.description),
+                " Affected region: ", r.affected, " of ", r.pixels, " pixels.</p>\n");
+    page += "<table><tr><th>method</th>";
+    for (int f : eval::Summary::kAt) page += cat("<th>PSNR @", f, "</th>");
+    for (int f : eval::Summary::kAt) page += cat("<th>affected @", f, "</th>");
+    page += "<th>frames to target</th><th>ms to target</th></tr>\n";
+    for (const auto& s : r.summaries) {
+      page += "<tr><td>" + html(s.method) + "</td>";
+      for (double v : s.psnrAt) page += "<td>" + fixed(v, 2) + "</td>";
+      for (double v : s.psnrAffectedAt) page += "<td>" + fixed(v, 2) + "</td>";
+      page += s.framesToTarget >= 0 ? cat("<td>", s.framesToTarget, "</td><td>", fixed(s.msToTarget, 0), "</td>")
+                                    : std::string("<td>not reached</td><td>–</td>");
+      page += "</tr>\n";
+    }
+    page += "</table>\n";
+    for (const auto& c : r.charts)
+      page += cat("<p><a href=\"charts/", c, ".svg\"><img src=\"charts/", c, ".png\" alt=\"", c, "\"></a></p>\n");
+    page += cat("<p>Frames ");
+    for (std::size_t i = 0; i < r.stripFrames.size(); ++i) page += cat(i ? ", " : "", r.stripFrames[i]);
+    page += cat(" with the overlays: tiles traced that frame outlined, queue priority as a heat map, the point of "
+                "change and focus points marked, denoised regions framed.</p>\n<p><img src=\"strips/",
+                base, ".png\" alt=\"strip\"></p>\n");
+  }
+  page += "</body></html>\n";
+  if (auto w = writeFileAtomic(out / "index.html", page); !w) return std::fprintf(stderr, "error: %s\n", w.error().c_str()), 1;
+
+  std::printf("%-10s %-10s %-22s %9s %9s %9s %9s %9s %9s %9s\n", "scene", "scenario", "method", "psnr@1", "psnr@10",
+              "psnr@100", "aff@1", "aff@10", "aff@100", "target ms");
+  for (const auto& r : results)
+    for (const auto& s : r.summaries)
+      std::printf("%-10s %-10s %-22s %9s %9s %9s %9s %9s %9s %9s\n", s.scene.c_str(), s.scenario.c_str(), s.method.c_str(),
+                  fixed(s.psnrAt[0], 2).c_str(), fixed(s.psnrAt[1], 2).c_str(), fixed(s.psnrAt[2], 2).c_str(),
+                  fixed(s.psnrAffectedAt[0], 2).c_str(), fixed(s.psnrAffectedAt[1], 2).c_str(),
+                  fixed(s.psnrAffectedAt[2], 2).c_str(),
+                  s.framesToTarget >= 0 ? fixed(s.msToTarget, 0).c_str() : "not");
+  std::printf("wrote %s (%d charts, %zu strips) in %.0f s\n", (out / "index.html").string().c_str(), chartsWritten,
+              results.size(), seconds());
+  return 0;
+}
+
+}  // namespace retile::cli

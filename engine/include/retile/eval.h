@@ -1,0 +1,168 @@
+// `retile eval`: every method through the same scenarios on the same per-frame budget, scored
+// frame by frame against converged references (retile/metrics.h), summarised per method.
+//
+// The pieces: built-in scenarios that fit any scene (the paper's Fig. 6 move, a material, a light
+// and a camera edit, a continuous drag); a plan that plays a scenario on a copy of the scene and
+// says which frames are scored and against which state; references of those states cached on disk
+// by content; one method's run; the summary. The report (charts, strips, HTML) is drawn by the
+// app with Qt (ui/eval_report.h). Planning and summaries are pure; References and runMethod use
+// the GPU and block the calling thread. One thread at a time per object.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "retile/error.h"
+#include "retile/image.h"
+#include "retile/method.h"
+#include "retile/scenario.h"
+#include "retile/scene.h"
+#include "retile/session.h"
+
+namespace retile::eval {
+
+struct Options {
+  int width = 320, height = 180;
+  int referenceSpp = 2048;
+  int every = 10;        // while edits arrive, frames 1, k, 2k, ... are scored; at rest every frame
+  int converge = 1024;   // spp before the first edit (the Fig. 6 protocol's)
+  int moveFrames = 100;  // Fig. 6: +0.005 in y per frame for this many frames
+  int restFrames = 100;  // then this many frames without an edit (every other scenario too)
+  int dragFrames = 60;
+  int cameraFrames = 30;
+  double target = 0.02;  // relative RMSE of the affected region that counts as "reached"
+  // 96x54, 64 spp to converge, 20 frames of move and 30 at rest, references of 512 spp, target 5 %.
+  static Options quick();
+};
+
+struct Case {
+  std::string name;         // "fig6", "material", ... or the script's file name
+  std::string description;  // one sentence for the report
+  Scenario script;
+};
+
+std::vector<std::string> builtInScenarioNames();  // fig6, material, light, camera, drag
+// The built-in scenarios for `scene`, in that order, restricted to `names` (empty: all). The
+// edited object is the one an artist would pick: the visible, non-emissive object nearest the
+// image centre among those covering 0.2 % to 25 % of it. A scenario the scene cannot play (no
+// light, no object) is left out and `skipped` says why.
+std::vector<Case> builtInScenarios(const Scene& scene, const Options& options, const std::vector<std::string>& names,
+                                   std::vector<std::string>* skipped);
+// The object builtInScenarios edits, or kNoNode.
+NodeId pickSubject(const Scene& scene);
+
+// "spiral", "global+denoise", "indirection+focus+smooth" (methodLabel's names) to settings:
+// indirection methods take automatic Q, as the editor offers them.
+Result<MethodSettings> parseMethodLabel(const std::string& label);
+// global, spiral, focus, indirection, change, spiral+smooth, global+denoise, spiral+denoise.
+std::vector<std::string> defaultMethods();
+
+// A scenario played on a copy of the scene, frame by frame, without rendering.
+struct Plan {
+  Scene start;                           // the scene before the first frame
+  NodeId selection = kNoNode;            // set up before converging (leading select steps)
+  std::optional<std::vector<FocusPoint>> focus;
+  int converge = 0;
+  struct Frame {
+    std::vector<Edit> edits;             // applied before the frame is traced
+    std::optional<NodeId> select;
+    std::optional<std::vector<FocusPoint>> focus;
+    int state = -1;                      // index into states when the frame is scored, else -1
+  };
+  std::vector<Frame> frames;             // frame f (from 1) is frames[f - 1]
+  std::vector<Scene> states;             // the scene as each scored frame shows it
+  int lastEditFrame = 0;                 // 0: the scenario edits nothing
+};
+// Scores frame 1, every `every`-th frame and every frame from the last edit on.
+Result<Plan> planScenario(const Scenario& script, const Scene& scene, int every);
+
+// Converged references on disk under `dir`, one per distinct scene state, keyed by the scene's
+// content (geometry, materials, lights, camera, settings), the sample count and the renderer's
+// shaders, so a second run renders none of them again.
+class References {
+ public:
+  References(std::filesystem::path dir, int spp);
+  // The reference of `state` (color, moment2 and sampleCount filled), from disk or rendered.
+  Result<RenderImage> get(const Scene& state, const std::function<void(int done, int total)>& progress = {});
+  static std::string key(const Scene& state, int spp);
+  int rendered() const { return rendered_; }
+  int reused() const { return reused_; }
+
+ private:
+  std::filesystem::path dir_;
+  int spp_;
+  int rendered_ = 0, reused_ = 0;
+  struct Gpu;
+  std::shared_ptr<Gpu> gpu_;  // made on the first render
+};
+
+// A scenario's references, ready to score against: per state the linear image and its display-
+// referred copy, and the affected region (pixels whose reference changed beyond noise from the
+// start in any scored state) with its complement.
+struct Targets {
+  int width = 0, height = 0;
+  std::vector<std::vector<float>> linear, display;  // per plan state
+  std::vector<std::uint8_t> affected, rest;
+  std::size_t affectedCount = 0;
+};
+Result<Targets> prepareTargets(const Plan& plan, References& refs,
+                               const std::function<void(int done, int total)>& progress = {});
+
+// One frame's figures. Scores are NaN on frames that are not scored (and affected ones when the
+// scenario changed no pixel).
+struct FrameScore {
+  int frame = 0;
+  double frameMs = 0;         // this frame's wall clock: plan, trace, denoise, read-back
+  double ms = 0;              // since frame 1 began, this frame included
+  std::uint64_t samples = 0;  // traced since frame 1 began
+  std::string mode;
+  int quality = 0;
+  std::size_t servedTiles = 0, denoiseRegions = 0;
+  double rmse = NAN, psnr = NAN, ssim = NAN, psnrHvsM = NAN;
+  double rmseAffected = NAN, rmseRest = NAN, psnrAffected = NAN, psnrRest = NAN;
+  double relRmse = NAN, relRmseAffected = NAN;  // linear luminance, 4x4 blocks (relativeRmse)
+  bool scored() const { return psnr == psnr; }
+};
+
+struct Run {
+  std::string scene, scenario, method;
+  std::vector<FrameScore> frames;
+  int lastEditFrame = 0;
+  bool exactBudget = true;  // every frame traced exactly width x height samples
+  double convergeMs = 0;
+};
+
+// Scores an image (linear RGB, the size of the targets) against a plan state.
+void scoreFrame(const Targets& targets, int state, const std::vector<float>& linear, FrameScore* score);
+
+// Converges `plan.converge` frames, then plays the plan with `method`, scoring each frame.
+// `onFrame` sees every played frame's record and score; returning false stops the run.
+Result<Run> runMethod(const Plan& plan, const Targets& targets, const MethodSettings& method,
+                      const std::function<bool(const FrameRecord&, const FrameScore&)>& onFrame = {});
+
+// Per method and scenario: PSNR (whole image and affected region) and relative RMSE of the
+// affected region at frames 1, 10, 100 and 200 (NaN where the run is shorter or the frame was not
+// scored), and the time to the target: from frame 1 to the first scored frame from which the
+// affected region's relative RMSE stays at or below it (the whole image's when nothing changed).
+struct Summary {
+  std::string scene, scenario, method;
+  static constexpr int kAt[4] = {1, 10, 100, 200};
+  double psnrAt[4] = {NAN, NAN, NAN, NAN};
+  double psnrAffectedAt[4] = {NAN, NAN, NAN, NAN};
+  double relAffectedAt[4] = {NAN, NAN, NAN, NAN};
+  int framesToTarget = -1;  // -1: not reached within the run
+  double msToTarget = NAN;
+};
+Summary summarize(const Run& run, double target);
+
+// metrics.csv and summary.csv, header first.
+std::string metricsCsvHeader();
+std::string metricsCsvRow(const Run& run, const FrameScore& f);
+std::string summaryCsvHeader();
+std::string summaryCsvRow(const Summary& s);
+
+}  // namespace retile::eval

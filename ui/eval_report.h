@@ -1,0 +1,48 @@
+// The pictures of `retile eval`'s report: charts drawn with Qt Charts and written as PNG and SVG,
+// and strips of frames with the editor's tile and denoise overlays (FrameView). Needs a
+// QApplication (the offscreen platform will do); GUI thread only.
+#pragma once
+
+#include <QImage>
+#include <QPointF>
+#include <QString>
+
+#include <filesystem>
+#include <vector>
+
+#include "retile/error.h"
+#include "retile/session.h"
+
+namespace retile::ui {
+
+struct ChartLine {
+  QString name;
+  std::vector<QPointF> points;
+};
+
+struct ChartPoint {
+  QString label;
+  QPointF at;
+};
+
+// Writes `base`.png and `base`.svg: a line per entry (error against time, one per method).
+Result<bool> writeLineChart(const std::filesystem::path& base, const QString& title, const QString& xTitle,
+                            const QString& yTitle, const std::vector<ChartLine>& lines, bool logX = false);
+// The same with one labelled point per entry (the speed-against-accuracy chart).
+Result<bool> writePointChart(const std::filesystem::path& base, const QString& title, const QString& xTitle,
+                             const QString& yTitle, const std::vector<ChartPoint>& points);
+
+// A frame as the viewport shows it with the tile overlays (served tiles, priorities, markers,
+// denoised regions), `scale` times the image size, without the legend.
+QImage frameWithOverlays(const FrameRecord& frame, int scale);
+
+// A grid of pictures: a row per method (label on the left), a column per chosen frame (caption
+// above), written as PNG.
+struct StripRow {
+  QString label;
+  std::vector<QImage> cells;
+};
+Result<bool> writeStrip(const std::filesystem::path& file, const std::vector<QString>& captions,
+                        const std::vector<StripRow>& rows);
+
+}  // namespace retile::ui
