@@ -18,6 +18,89 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// One warm-up frame (pipeline creation, first touch of buffers), then `frames` frames of 1 spp
+// over the whole image; their statistics summed, and their wall clock (warm-up excluded).
+FrameStats traceFrames(Renderer& renderer, int w, int h, int frames, const FrameOptions& options,
+                       double* wallSeconds = nullptr) {
+  TileWork all{0, 0, w, h, 1, 0, true};
+  renderer.renderFrame({all}, options);
+  const auto start = Clock::now();
+  FrameStats sum;
+  for (int f = 0; f < frames; ++f) {
+    all.sampleBase = static_cast<std::uint32_t>(f + 1);
+    all.restart = false;
+    FrameStats s = renderer.renderFrame({all}, options);
+    sum.samples += s.samples;
+    sum.primaryRays += s.primaryRays;
+    sum.bounceRays += s.bounceRays;
+    sum.shadowRays += s.shadowRays;
+    sum.seconds += s.seconds;
+    sum.maxLoopIterations = std::max(sum.maxLoopIterations, s.maxLoopIterations);
+    sum.maxSegmentIterations = std::max(sum.maxSegmentIterations, s.maxSegmentIterations);
+    sum.cutPaths += s.cutPaths;
+    sum.loopIterations += s.loopIterations;
+    sum.pathsPerInvocation = s.pathsPerInvocation;
+  }
+  if (wallSeconds) *wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return sum;
+}
+
+// Throughput against triangle count: the built-in scene plus one sphere tessellated to N
+// triangles filling a good part of the view, N from 16 k to 2 M. Samples/s should fall slowly
+// (a BVH is logarithmic) and bytes per triangle stay flat.
+int benchScale(const std::vector<std::string>& argv) {
+  auto args = parseArgs(argv, {"--size", "--frames"});
+  if (!args) return std::fprintf(stderr, "usage: retile bench scale [--size WxH] [--frames N]\n"), 2;
+  int w = 320, h = 180, frames = 16;
+  if (args->has("--size")) {
+    auto r = parseSize(args->get("--size"), &w, &h);
+    if (!r) return std::fprintf(stderr, "error: %s\n", r.error().c_str()), 2;
+  }
+  if (args->has("--frames")) {
+    auto v = parseInt("--frames", args->get("--frames"), 1, 100000);
+    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
+    frames = v.value();
+  }
+  std::printf("%10s %12s %10s %12s %14s %12s\n", "triangles", "samples/s", "vs first", "upload s", "device MiB",
+              "bytes/tri");
+  double first = 0;
+  for (int rings : {64, 158, 354, 500, 708}) {  // 4 rings^2 triangles: ~16 k, 100 k, 500 k, 1 M, 2 M
+    Scene scene = makeDefaultScene();
+    Mesh mesh;
+    mesh.id = scene.newId();
+    mesh.name = "dense sphere";
+    mesh.geometry = makeSphere(rings, 2 * rings);
+    scene.meshes.push_back(mesh);
+    Material mat;
+    mat.id = scene.newId();
+    mat.name = "dense material";
+    mat.type = MaterialType::RoughPlastic;
+    scene.materials.push_back(mat);
+    Object o;
+    o.id = scene.newId();
+    o.name = "dense";
+    o.mesh = mesh.id;
+    o.material = mat.id;
+    o.transform = Mat4::translate({0.2f, 0.6f, 0.6f}) * Mat4::scale(Vec3{0.6f});
+    scene.objects.push_back(o);
+    Renderer renderer;
+    auto t0 = Clock::now();
+    renderer.setScene(scene);
+    const double upload = std::chrono::duration<double>(Clock::now() - t0).count();
+    renderer.setMaxBounces(scene.settings.maxBounces);
+    renderer.resize(w, h);
+    FrameStats sum = traceFrames(renderer, w, h, frames, FrameOptions{});
+    const double rate = static_cast<double>(sum.samples) / sum.seconds;
+    if (first == 0) first = rate;
+    const auto tris = renderer.sceneTriangles();
+    std::printf("%10llu %10.3f M %9.2fx %12.2f %14.1f %12.1f\n", static_cast<unsigned long long>(tris), rate * 1e-6,
+                rate / first, upload, static_cast<double>(renderer.sceneDeviceBytes()) / (1 << 20),
+                static_cast<double>(renderer.sceneDeviceBytes()) / static_cast<double>(tris));
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
 int benchThroughput(const std::vector<std::string>& argv) {
   auto args = parseArgs(argv, {"--size", "--frames", "--max-bounces", "--paths"});
   if (!args || args->positional.size() != 1) {
@@ -56,27 +139,8 @@ int benchThroughput(const std::vector<std::string>& argv) {
   double setup = std::chrono::duration<double>(Clock::now() - t0).count();
   renderer.setMaxBounces(bounces >= 0 ? bounces : loaded->scene.settings.maxBounces);
   renderer.resize(w, h);
-  // One frame to warm up (pipeline creation, first-touch of buffers), not measured.
-  TileWork all{0, 0, w, h, 1, 0, true};
-  renderer.renderFrame({all}, options);
-  FrameStats sum;
-  auto start = Clock::now();
-  for (int f = 0; f < frames; ++f) {
-    all.sampleBase = static_cast<std::uint32_t>(f + 1);
-    all.restart = false;
-    FrameStats s = renderer.renderFrame({all}, options);
-    sum.samples += s.samples;
-    sum.primaryRays += s.primaryRays;
-    sum.bounceRays += s.bounceRays;
-    sum.shadowRays += s.shadowRays;
-    sum.seconds += s.seconds;
-    sum.maxLoopIterations = std::max(sum.maxLoopIterations, s.maxLoopIterations);
-    sum.maxSegmentIterations = std::max(sum.maxSegmentIterations, s.maxSegmentIterations);
-    sum.cutPaths += s.cutPaths;
-    sum.loopIterations += s.loopIterations;
-    sum.pathsPerInvocation = s.pathsPerInvocation;
-  }
-  double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  double wall = 0;
+  FrameStats sum = traceFrames(renderer, w, h, frames, options, &wall);
   double sec = sum.seconds;
   auto tris = renderer.sceneTriangles();
   std::printf("scene          %s (%llu triangles)\n", args->positional[0].c_str(), static_cast<unsigned long long>(tris));
@@ -329,7 +393,8 @@ int runBench(const std::vector<std::string>& argv) {
   if (argv.empty()) {
     std::fprintf(stderr,
                  "usage: retile bench throughput SCENE ... | retile bench bvh [--triangles N] | retile bench edit\n"
-                 "       | retile bench frames SCENE ... | retile bench denoise [SCENE] [--size WxH]\n");
+                 "       | retile bench frames SCENE ... | retile bench denoise [SCENE] [--size WxH]\n"
+                 "       | retile bench scale [--size WxH] [--frames N]\n");
     return 2;
   }
   std::vector<std::string> rest(argv.begin() + 1, argv.end());
@@ -338,7 +403,8 @@ int runBench(const std::vector<std::string>& argv) {
   if (argv[0] == "edit") return benchEdit(rest);
   if (argv[0] == "frames") return benchFrames(rest);
   if (argv[0] == "denoise") return benchDenoise(rest);
-  std::fprintf(stderr, "retile bench: unknown benchmark '%s' (throughput, bvh, edit, frames, denoise)\n", argv[0].c_str());
+  if (argv[0] == "scale") return benchScale(rest);
+  std::fprintf(stderr, "retile bench: unknown benchmark '%s' (throughput, bvh, edit, frames, denoise, scale)\n", argv[0].c_str());
   return 2;
 }
 

@@ -3,6 +3,8 @@
 // strips of frames with the overlays, and index.html tying them together.
 #include <QApplication>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -27,6 +29,7 @@ void usage(const std::string& error) {
   std::fprintf(stderr,
                "usage: retile eval [SCENE ...] --out-dir DIR [--quick] [--size WxH] [--methods LIST] [--scenarios LIST]\n"
                "                   [--script FILE ...] [--reference-spp N] [--every K] [--converge SPP] [--target REL]\n"
+               "       retile eval [SCENE ...] --stability --out-dir DIR [--quick] [--size WxH] [--cases LIST] [--methods LIST]\n"
                "SCENE defaults to 'default'. LIST is comma-separated.\n"
                "scenarios: fig6, material, light, camera, drag (default: all), plus each --script\n"
                "methods (default):");
@@ -82,12 +85,81 @@ struct ScenarioResult {
   std::vector<std::string> charts;  // file bases, relative to the output directory
 };
 
+int runStability(const std::vector<std::string>& sceneNames, const std::vector<std::string>& cases,
+                 const eval::StabilityOptions& options, const std::filesystem::path& out) {
+  const auto known = eval::stabilityCaseNames();
+  for (const auto& c : cases)
+    if (std::find(known.begin(), known.end(), c) == known.end()) return usage(cat("unknown stability case '", c, "'")), 2;
+  std::error_code ec;
+  std::filesystem::create_directories(out, ec);
+  if (ec) return std::fprintf(stderr, "error: cannot create %s: %s\n", out.string().c_str(), ec.message().c_str()), 1;
+  eval::References refs(out / "references", options.referenceSpp);
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  std::string csv = "scene,case,method,figure,threshold,pass,detail,broken\n";
+  std::string page =
+      "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>Retile stability</title>\n"
+      "<style>body{font:14px/1.45 sans-serif;margin:2em auto;max-width:1100px;color:#222}"
+      "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:3px 7px}"
+      "th{background:#f2f2f2}.fail{color:#b00;font-weight:bold}.pass{color:#070}</style></head><body>\n"
+      "<h1>Retile stability suite</h1>\n";
+  page += cat("<p>", options.width, "x", options.height, ", references of ", options.referenceSpp,
+              " spp. A method passes a case when its figure is at most 1.5 times the global method's (a restart "
+              "shows nothing stale) and no invariant broke (exact W x H samples every frame, finite pixels, no "
+              "error).</p>\n");
+  int broken = 0, failed = 0, total = 0;
+  for (const auto& sceneName : sceneNames) {
+    auto loaded = loadScene(sceneName);
+    if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
+    for (const auto& c : cases) {
+      const int index = static_cast<int>(&c - cases.data());
+      auto result = eval::runStabilityCase(c, loaded->scene, options, refs, [&](const std::string& what) {
+        progressBar(what, index, static_cast<int>(cases.size()),
+                    std::chrono::duration<double>(Clock::now() - start).count());
+      });
+      if (!result) {
+        std::fprintf(stderr, "\n%s: %s: cannot run: %s\n", sceneName.c_str(), c.c_str(), result.error().c_str());
+        csv += cat(sceneName, ",", c, ",,,,,,\"", result.error(), "\"\n");
+        page += cat("<h2>", html(c), "</h2><p class=\"fail\">Cannot run: ", html(result.error()), "</p>\n");
+        ++broken;
+        continue;
+      }
+      page += cat("<h2>", html(sceneName), ": ", html(c), "</h2>\n<p>", html(result->description), " Affected pixels: ",
+                  result->affected, ". Figure: ", html(result->figure), ".</p>\n<table><tr><th>method</th><th>figure</th>"
+                  "<th>threshold</th><th>result</th><th>also measured</th></tr>\n");
+      std::printf("\n%s: %s (%s)\n", sceneName.c_str(), c.c_str(), result->figure.c_str());
+      for (const auto& f : result->figures) {
+        ++total;
+        failed += !f.pass;
+        broken += !f.broken.empty();
+        const std::string verdict = !f.broken.empty() ? "BROKEN: " + f.broken : (f.pass ? "pass" : "fail");
+        std::printf("  %-26s %9s  <= %9s  %s%s%s\n", f.method.c_str(), fixed(f.value, 4).c_str(),
+                    fixed(f.threshold, 4).c_str(), verdict.c_str(), f.detail.empty() ? "" : "  ", f.detail.c_str());
+        csv += cat(sceneName, ",", c, ",", f.method, ",", std::isnan(f.value) ? std::string() : fixed(f.value, 5), ",",
+                   std::isnan(f.threshold) ? std::string() : fixed(f.threshold, 5), ",", f.pass ? 1 : 0, ",\"", f.detail,
+                   "\",\"", f.broken, "\"\n");
+        page += cat("<tr><td>", html(f.method), "</td><td>", fixed(f.value, 4), "</td><td>", fixed(f.threshold, 4),
+                    "</td><td class=\"", f.pass ? "pass" : "fail", "\">", html(verdict), "</td><td>", html(f.detail),
+                    "</td></tr>\n");
+      }
+      page += "</table>\n";
+    }
+  }
+  page += "</body></html>\n";
+  if (auto w = writeFileAtomic(out / "stability.csv", csv); !w) return std::fprintf(stderr, "error: %s\n", w.error().c_str()), 1;
+  if (auto w = writeFileAtomic(out / "stability.html", page); !w) return std::fprintf(stderr, "error: %s\n", w.error().c_str()), 1;
+  std::printf("\n%d of %d figures pass; %d broke an invariant. Wrote %s in %.0f s\n", total - failed, total, broken,
+              (out / "stability.html").string().c_str(), std::chrono::duration<double>(Clock::now() - start).count());
+  // A method failing a case is a finding, reported above; a broken invariant is a defect.
+  return broken > 0 ? 1 : 0;
+}
+
 }  // namespace
 
 int runEval(const std::vector<std::string>& argv) {
   auto args = parseArgs(argv, {"--out-dir", "--size", "--methods", "--scenarios", "--script", "--reference-spp", "--every",
-                               "--converge", "--target"},
-                        {"--quick"});
+                               "--converge", "--target", "--cases"},
+                        {"--quick", "--stability"});
   if (!args) return usage(args.error()), 2;
   if (!args->has("--out-dir")) return usage("--out-dir is required"), 2;
   eval::Options opt = args->has("--quick") ? eval::Options::quick() : eval::Options{};
@@ -133,6 +205,16 @@ int runEval(const std::vector<std::string>& argv) {
   // Only scripts were asked for: no built-in scenario unless named.
   if (!scripts.empty() && !args->has("--scenarios")) scenarioNames = {"none"};
   std::vector<std::string> sceneNames = args->positional.empty() ? std::vector<std::string>{"default"} : args->positional;
+  if (args->has("--stability")) {
+    eval::StabilityOptions so;
+    if (args->has("--quick")) so.width = 96, so.height = 54, so.referenceSpp = 512, so.small = true;
+    if (args->has("--size")) so.width = opt.width, so.height = opt.height;
+    if (args->has("--reference-spp")) so.referenceSpp = opt.referenceSpp;
+    if (args->has("--methods")) so.methods = methodLabels;
+    std::vector<std::string> cases = args->has("--cases") ? splitList(args->get("--cases")) : eval::stabilityCaseNames();
+    return runStability(sceneNames, cases, so, args->get("--out-dir"));
+  }
+  if (args->has("--cases")) return usage("--cases goes with --stability"), 2;
 
   const std::filesystem::path out = args->get("--out-dir");
   std::error_code ec;
@@ -144,9 +226,21 @@ int runEval(const std::vector<std::string>& argv) {
   // paints itself instead of asking for a Vulkan surface.
   qputenv("QT_QPA_PLATFORM", "offscreen");
   qputenv("RETILE_VIEWPORT", "widget");
+  if (qEnvironmentVariableIsEmpty("XDG_RUNTIME_DIR")) {  // Qt warns without one (CI, ssh, cron)
+    const std::filesystem::path runtime = std::filesystem::temp_directory_path() / cat("retile-runtime-", ::getuid());
+    std::filesystem::create_directories(runtime, ec);
+    std::filesystem::permissions(runtime, std::filesystem::perms::owner_all, ec);
+    qputenv("XDG_RUNTIME_DIR", QByteArray::fromStdString(runtime.string()));
+  }
   int qtArgc = 1;
   char qtName[] = "retile";
   char* qtArgv[] = {qtName, nullptr};
+  // The offscreen platform says it cannot pass size hints each time a chart's view is shown:
+  // nothing a user can act on.
+  qInstallMessageHandler([](QtMsgType type, const QMessageLogContext&, const QString& message) {
+    if (message.contains(QLatin1String("propagateSizeHints"))) return;
+    std::fprintf(stderr, "%s: %s\n", type == QtWarningMsg ? "qt warning" : "qt", message.toLocal8Bit().constData());
+  });
   QApplication app(qtArgc, qtArgv);
 
   eval::References refs(out / "references", opt.referenceSpp);
@@ -165,6 +259,7 @@ int runEval(const std::vector<std::string>& argv) {
     eval::Plan plan;
   };
   std::vector<Job> jobs;
+  std::vector<std::pair<std::string, eval::SceneModel>> models;
   for (const auto& sceneName : sceneNames) {
     auto loaded = loadScene(sceneName);
     if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
@@ -172,6 +267,7 @@ int runEval(const std::vector<std::string>& argv) {
     Scene scene = loaded->scene;
     scene.settings.width = opt.width;
     scene.settings.height = opt.height;
+    models.emplace_back(sceneName, eval::modelOf(scene));
     std::vector<std::string> skipped;
     std::vector<eval::Case> cases = eval::builtInScenarios(scene, opt, scenarioNames, &skipped);
     for (const auto& s : skipped) notes.push_back(cat(sceneName, ": scenario ", s));
@@ -316,6 +412,18 @@ int runEval(const std::vector<std::string>& argv) {
               opt.target * 100, " %.</p>\n");
   page += "<p>Data: <a href=\"metrics.csv\">metrics.csv</a> (every frame), <a href=\"summary.csv\">summary.csv</a>.</p>\n";
   for (const auto& n : notes) page += "<p class=\"note\">" + html(n) + "</p>\n";
+  page += "<h2>What each scene costs the renderer</h2>\n<table><tr><th>scene</th><th>triangles</th><th>device memory "
+          "(BVH included)</th><th>bytes per triangle</th><th>trace kernel compiled with</th></tr>\n";
+  for (const auto& [name, m] : models) {
+    std::string features;
+    for (const auto& f : m.kernelFeatures) features += (features.empty() ? "" : ", ") + f;
+    page += cat("<tr><td>", html(name), "</td><td>", m.triangles, "</td><td>", fixed(static_cast<double>(m.deviceBytes) / (1 << 20), 2),
+                " MiB</td><td>", fixed(m.bytesPerTriangle, 1), "</td><td>", html(features), "</td></tr>\n");
+    std::printf("%s: %llu triangles, %.2f MiB on the device (%.1f bytes per triangle), kernel: %s\n", name.c_str(),
+                static_cast<unsigned long long>(m.triangles), static_cast<double>(m.deviceBytes) / (1 << 20),
+                m.bytesPerTriangle, features.c_str());
+  }
+  page += "</table>\n";
   for (const auto& r : results) {
     const std::string base = cat(r.sceneSlug, "-", slug(r.scenario.name));
     page += cat("<h2>", html(r.scene), ": ", html(r.scenario.name), "</h2>\n<p>", html(r.scenario.description),

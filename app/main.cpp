@@ -21,8 +21,10 @@ void usage() {
                "                    [--denoise [--denoise-threshold PX] [--no-soft-borders]] [--no-images]\n"
                "  retile eval [SCENE ...] --out-dir DIR [--quick] [--size WxH] [--methods LIST] [--scenarios LIST]\n"
                "                    [--script FILE ...] [--reference-spp N] [--every K] [--converge SPP] [--target REL]\n"
+               "  retile eval [SCENE ...] --stability --out-dir DIR [--quick] [--size WxH] [--cases LIST] [--methods LIST]\n"
                "  retile bench throughput SCENE [--size WxH] [--frames N] [--max-bounces B]\n"
                "  retile bench bvh [--triangles N] | edit | frames SCENE [--drag] | denoise [SCENE] [--size WxH]\n"
+               "               | scale [--size WxH] [--frames N]\n"
                "  retile import FILE\n"
                "SCENE is a file (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default'.\n");
 }

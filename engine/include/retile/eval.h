@@ -27,13 +27,13 @@ namespace retile::eval {
 
 struct Options {
   int width = 320, height = 180;
-  int referenceSpp = 2048;
-  int every = 10;        // while edits arrive, frames 1, k, 2k, ... are scored; at rest every frame
-  int converge = 1024;   // spp before the first edit (the Fig. 6 protocol's)
+  int referenceSpp = 1024;
+  int every = 50;        // while edits arrive, frames 1, 10, k, 2k, ... are scored; at rest every frame
+  int converge = 1024;   // spp before the first edit (the Fig. 6 protocol's; the others take a quarter)
   int moveFrames = 100;  // Fig. 6: +0.005 in y per frame for this many frames
   int restFrames = 100;  // then this many frames without an edit (every other scenario too)
-  int dragFrames = 60;
-  int cameraFrames = 30;
+  int dragFrames = 50;
+  int cameraFrames = 20;
   double target = 0.02;  // relative RMSE of the affected region that counts as "reached"
   // 96x54, 64 spp to converge, 20 frames of move and 30 at rest, references of 512 spp, target 5 %.
   static Options quick();
@@ -71,13 +71,15 @@ struct Plan {
     std::vector<Edit> edits;             // applied before the frame is traced
     std::optional<NodeId> select;
     std::optional<std::vector<FocusPoint>> focus;
+    std::optional<std::pair<int, int>> resize;  // the viewport's new size (the stability suite)
     int state = -1;                      // index into states when the frame is scored, else -1
   };
   std::vector<Frame> frames;             // frame f (from 1) is frames[f - 1]
   std::vector<Scene> states;             // the scene as each scored frame shows it
   int lastEditFrame = 0;                 // 0: the scenario edits nothing
 };
-// Scores frame 1, every `every`-th frame and every frame from the last edit on.
+// Scores frames 1 and 10 (the summary's), every `every`-th frame and every frame from the last
+// edit on.
 Result<Plan> planScenario(const Scenario& script, const Scene& scene, int every);
 
 // Converged references on disk under `dir`, one per distinct scene state, keyed by the scene's
@@ -104,8 +106,9 @@ class References {
 // referred copy, and the affected region (pixels whose reference changed beyond noise from the
 // start in any scored state) with its complement.
 struct Targets {
-  int width = 0, height = 0;
+  int width = 0, height = 0;                        // of the start; the affected masks' size
   std::vector<std::vector<float>> linear, display;  // per plan state
+  std::vector<std::pair<int, int>> sizes;           // per plan state (a resize changes it)
   std::vector<std::uint8_t> affected, rest;
   std::size_t affectedCount = 0;
 };
@@ -164,5 +167,51 @@ std::string metricsCsvHeader();
 std::string metricsCsvRow(const Run& run, const FrameScore& f);
 std::string summaryCsvHeader();
 std::string summaryCsvRow(const Summary& s);
+
+// "Model no more than a scene needs": what the renderer holds and compiled for a scene.
+struct SceneModel {
+  std::uint64_t triangles = 0, deviceBytes = 0;  // device bytes of the scene's buffers, BVH included
+  double bytesPerTriangle = 0;
+  std::vector<std::string> kernelFeatures;
+};
+SceneModel modelOf(const Scene& scene);
+
+// ---- The stability suite: where METHOD.md says the methods fail ----
+//
+// Each case plays a short edit on a scene (the given one, or the built-in scene with an object
+// added where the case needs one) under every method, and measures one figure per method: the
+// relative RMSE (linear luminance, 4x4 blocks; of the affected region when there is one) at a
+// chosen frame against a converged reference of what that frame should show. A method passes
+// when its figure is at most 1.5 times the global method's (a restart shows no stale content, so
+// it is the yardstick), and no invariant broke: every frame traced exactly W x H samples, no
+// pixel went NaN or infinite, nothing threw.
+struct StabilityOptions {
+  int width = 160, height = 90;
+  int referenceSpp = 1024;
+  bool small = false;  // the extreme case's large image at 320x180 instead of 3840x2160 (tests)
+  std::vector<std::string> methods = defaultMethods();
+};
+
+struct StabilityFigure {
+  std::string method;    // or the variant of the extreme case ("Q=1", "T=8 3840x2160", ...)
+  double value = NAN;    // the case's figure
+  double threshold = NAN;
+  bool pass = false;
+  std::string detail;    // what else was measured (tiles never served, ...)
+  std::string broken;    // an invariant that broke; empty: none
+};
+
+struct StabilityResult {
+  std::string name, description, figure;  // figure: what the value measures
+  std::size_t affected = 0;                // pixels the case changes
+  std::vector<StabilityFigure> figures;
+};
+
+// ghosting, burst, off-screen, behind-camera, fill-screen, camera-mid-pass, resize-mid-pass,
+// light-global, mirror-only, offscreen-shadow, extreme.
+std::vector<std::string> stabilityCaseNames();
+Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& scene, const StabilityOptions& options,
+                                         References& refs,
+                                         const std::function<void(const std::string& what)>& progress = {});
 
 }  // namespace retile::eval

@@ -108,6 +108,10 @@ struct RenderRequest {
   int maxBounces = -1;             // -1: the scene's settings
   std::uint32_t seed = 0;
   bool denoise = false;            // the result's display is the whole frame denoised
+  // Samples per pixel traced in each frame. 1 keeps the editor's budget per frame; references of
+  // small images take more, since each frame's fixed cost dwarfs 1 spp of a few thousand pixels.
+  // The same sample indices either way: the image does not depend on it.
+  int samplesPerFrame = 1;
 };
 
 class Renderer {
@@ -159,8 +163,11 @@ class Renderer {
   RenderImage render(const RenderRequest& request, const std::function<bool(int, int)>& progress = {},
                      FrameStats* total = nullptr);
 
-  // Device memory held by the scene's buffers, and triangles, for the benchmarks.
+  // Device memory held by the scene's buffers (BVH included), and triangles, for the benchmarks.
   std::uint64_t sceneDeviceBytes() const;
+  // What the trace kernel was compiled with for this scene ("lambert", "rough plastic",
+  // "alpha test", "textures", "emitters", ...): a scene pays only for what it uses.
+  std::vector<std::string> kernelFeatures() const;
   std::uint64_t sceneTriangles() const;
   // Seconds the last setScene/updateScene spent building BVHs (bottom level, top level).
   double lastBlasSeconds() const;

@@ -182,7 +182,7 @@ std::vector<Case> builtInScenarios(const Scene& scene, const Options& o, const s
       edit.albedo = grey ? Vec3{0.2f, 0.35f, 0.8f} : Vec3{a.z, a.x, a.y};
       c.description = cat("A material edit: '", m->name, "' on '", subject->name, "' takes roughness ", *edit.roughness,
                           " and a new albedo, then ", o.restFrames, " frames at rest.");
-      c.script.converge = o.converge;
+      c.script.converge = std::max(o.converge / 4, 1);
       c.script.steps = {select, focus, edit, rest};
       out.push_back(std::move(c));
     }
@@ -217,7 +217,7 @@ std::vector<Case> builtInScenarios(const Scene& scene, const Options& o, const s
       c.name = "light";
       c.description = cat("A light edit: '", what, "' turns warmer and 1.5 times as strong, then ", o.restFrames,
                           " frames at rest.");
-      c.script.converge = o.converge;
+      c.script.converge = std::max(o.converge / 4, 1);
       c.script.steps = {edit, rest};
       out.push_back(std::move(c));
     }
@@ -227,7 +227,7 @@ std::vector<Case> builtInScenarios(const Scene& scene, const Options& o, const s
     c.name = "camera";
     c.description = cat("A camera move: the camera orbits its target by 0.5 degrees a frame for ", o.cameraFrames,
                         " frames, then ", o.restFrames, " frames at rest.");
-    c.script.converge = o.converge;
+    c.script.converge = std::max(o.converge / 4, 1);
     const Vec3 target = scene.camera.target, offset = scene.camera.position - target;
     for (int f = 1; f <= o.cameraFrames; ++f) {
       ScenarioStep step;
@@ -254,7 +254,7 @@ std::vector<Case> builtInScenarios(const Scene& scene, const Options& o, const s
       move.frames = o.dragFrames;
       c.description = cat("A continuous drag: '", subject->name, "' slides sideways by a fiftieth of its size a frame for ",
                           o.dragFrames, " frames, then ", o.restFrames, " frames at rest.");
-      c.script.converge = o.converge;
+      c.script.converge = std::max(o.converge / 4, 1);
       c.script.steps = {select, focus, move, rest};
       out.push_back(std::move(c));
     }
@@ -315,7 +315,7 @@ Result<Plan> planScenario(const Scenario& script, const Scene& scene, int every)
       (void)applyEdit(replay, edit);  // succeeded above
       changedSinceState = true;
     }
-    if (f == 1 || f % every == 0 || f >= plan.lastEditFrame) {
+    if (f == 1 || f == 10 || f % every == 0 || f >= plan.lastEditFrame) {
       if (changedSinceState || lastState < 0) {
         plan.states.push_back(replay);
         lastState = static_cast<int>(plan.states.size()) - 1;
@@ -412,6 +412,9 @@ Result<RenderImage> References::get(const Scene& state, const std::function<void
   req.height = state.settings.height;
   req.samplesPerPixel = spp_;
   req.seed = 0x5eed;
+  // About a quarter million samples a frame: the per-frame cost stops mattering (a 320x180
+  // reference renders 5x faster than at 1 spp a frame), and a frame stays well under a second.
+  req.samplesPerFrame = std::clamp(262144 / std::max(req.width * req.height, 1), 1, 64);
   RenderImage img = gpu_->renderer.render(req, [&](int done, int total) {
     if (progress) progress(done, total);
     return true;
@@ -447,11 +450,15 @@ Result<Targets> prepareTargets(const Plan& plan, References& refs, const std::fu
   for (std::size_t s = 0; s < plan.states.size(); ++s) {
     auto img = refs.get(plan.states[s], step(static_cast<int>(s) + 1));
     if (!img) return Result<Targets>::failure(img.error());
-    std::vector<std::uint8_t> changed = affectedPixels(start.value(), img.value());
-    for (std::size_t i = 0; i < n; ++i) t.affected[i] |= changed[i];
+    const std::size_t pixels = static_cast<std::size_t>(img->width) * static_cast<std::size_t>(img->height);
+    if (img->width == t.width && img->height == t.height) {  // after a resize nothing lines up
+      std::vector<std::uint8_t> changed = affectedPixels(start.value(), img.value());
+      for (std::size_t i = 0; i < n; ++i) t.affected[i] |= changed[i];
+    }
     std::vector<float> shown(img->color.size());
-    colors->toDisplayFloat(img->color.data(), n, DisplaySettings{}, shown.data());
+    colors->toDisplayFloat(img->color.data(), pixels, DisplaySettings{}, shown.data());
     for (float& v : shown) v = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+    t.sizes.emplace_back(img->width, img->height);
     t.linear.push_back(std::move(img->color));
     t.display.push_back(std::move(shown));
   }
@@ -462,22 +469,24 @@ Result<Targets> prepareTargets(const Plan& plan, References& refs, const std::fu
 
 void scoreFrame(const Targets& t, int state, const std::vector<float>& linear, FrameScore* s) {
   if (state < 0 || state >= static_cast<int>(t.linear.size())) return;
-  const std::size_t n = static_cast<std::size_t>(t.width) * static_cast<std::size_t>(t.height);
+  const auto [w, h] = t.sizes[static_cast<std::size_t>(state)];
+  const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   if (linear.size() != n * 3) return;
   static const auto colors = ColorConfig::get();
   std::vector<float> shown(n * 3);
   colors->toDisplayFloat(linear.data(), n, DisplaySettings{}, shown.data());
   for (float& v : shown) v = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
-  const MetricImage a{shown.data(), t.width, t.height}, r{t.display[state].data(), t.width, t.height};
+  const MetricImage a{shown.data(), w, h}, r{t.display[state].data(), w, h};
   s->rmse = rootMeanSquaredError(a, r);
   s->psnr = psnr(a, r);
   s->ssim = ssim(a, r);
   s->psnrHvsM = psnrHvsM(a, r);
-  s->relRmse = relativeRmse(linear, t.linear[state], t.width, t.height, 4);
+  s->relRmse = relativeRmse(linear, t.linear[state], w, h, 4);
+  if (w != t.width || h != t.height) return;  // the masks belong to the start's size
   if (t.affectedCount > 0) {
     s->rmseAffected = rootMeanSquaredError(a, r, t.affected.data());
     s->psnrAffected = psnr(a, r, t.affected.data());
-    s->relRmseAffected = relativeRmse(linear, t.linear[state], t.width, t.height, 4, t.affected.data());
+    s->relRmseAffected = relativeRmse(linear, t.linear[state], w, h, 4, t.affected.data());
   }
   s->rmseRest = rootMeanSquaredError(a, r, t.rest.data());
   s->psnrRest = psnr(a, r, t.rest.data());
@@ -495,8 +504,8 @@ Result<Run> runMethod(const Plan& plan, const Targets& targets, const MethodSett
   auto t0 = Clock::now();
   for (int f = 0; f < plan.converge; ++f) session.renderFrame(false);
   run.convergeMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-  const std::uint64_t budget = static_cast<std::uint64_t>(plan.start.settings.width) *
-                               static_cast<std::uint64_t>(plan.start.settings.height);
+  std::uint64_t budget = static_cast<std::uint64_t>(plan.start.settings.width) *
+                         static_cast<std::uint64_t>(plan.start.settings.height);
   double ms = 0;
   std::uint64_t samples = 0;
   for (std::size_t i = 0; i < plan.frames.size(); ++i) {
@@ -504,6 +513,10 @@ Result<Run> runMethod(const Plan& plan, const Targets& targets, const MethodSett
     auto begin = Clock::now();
     if (pf.select) session.select(*pf.select);
     if (pf.focus) session.setFocus(*pf.focus);
+    if (pf.resize) {
+      session.resize(pf.resize->first, pf.resize->second);
+      budget = static_cast<std::uint64_t>(pf.resize->first) * static_cast<std::uint64_t>(pf.resize->second);
+    }
     for (const Edit& e : pf.edits) {
       auto r = session.applyEdit(e);
       if (!r) return Result<Run>::failure(cat("frame ", i + 1, ": ", r.error()));
@@ -526,6 +539,17 @@ Result<Run> runMethod(const Plan& plan, const Targets& targets, const MethodSett
     if (onFrame && !onFrame(rec, s)) break;
   }
   return run;
+}
+
+SceneModel modelOf(const Scene& scene) {
+  Renderer r;
+  r.setScene(scene);
+  SceneModel m;
+  m.triangles = r.sceneTriangles();
+  m.deviceBytes = r.sceneDeviceBytes();
+  m.bytesPerTriangle = m.triangles ? static_cast<double>(m.deviceBytes) / static_cast<double>(m.triangles) : 0.0;
+  m.kernelFeatures = r.kernelFeatures();
+  return m;
 }
 
 Summary summarize(const Run& run, double target) {

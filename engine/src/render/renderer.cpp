@@ -618,6 +618,21 @@ SelectionCounts Renderer::takeSelectionCounts() { return impl_->takeSelectionCou
 RenderImage Renderer::readback() { return impl_->readback(); }
 std::uint64_t Renderer::sceneDeviceBytes() const { return impl_->builder.data().deviceBytes(); }
 std::uint64_t Renderer::sceneTriangles() const { return impl_->builder.data().triangleCount; }
+
+std::vector<std::string> Renderer::kernelFeatures() const {
+  const RenderSceneData& d = impl_->builder.data();
+  std::vector<std::string> out;
+  for (int t = 0; t < kMaterialTypeCount; ++t)
+    if (d.materialTypes & (1u << t)) out.push_back(materialTypeName(static_cast<MaterialType>(t)));
+  if (d.alphaTested) out.push_back("alpha test");
+  const std::uint32_t f = d.features();
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureTextures)) out.push_back("textures");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureEnvConstant)) out.push_back("constant environment");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureEnvMap)) out.push_back("environment map");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureEmitters)) out.push_back("emissive triangles");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureDeltaLights)) out.push_back("delta lights");
+  return out;
+}
 double Renderer::lastBlasSeconds() const { return impl_->builder.lastTiming().blas; }
 double Renderer::lastTlasSeconds() const { return impl_->builder.lastTiming().tlas; }
 
@@ -630,11 +645,12 @@ RenderImage Renderer::render(const RenderRequest& request, const std::function<b
   impl_->seed = request.seed;
   resize(w, h);
   FrameStats sum;
-  for (int f = 0; f < spp; ++f) {
+  const int perFrame = std::max(request.samplesPerFrame, 1);
+  for (int f = 0; f < spp; f += perFrame) {
     TileWork all;
     all.width = w;
     all.height = h;
-    all.quality = 1;
+    all.quality = std::min(perFrame, spp - f);
     all.sampleBase = static_cast<std::uint32_t>(f);
     all.restart = f == 0;
     FrameStats fs = renderFrame({all}, {});
@@ -645,7 +661,7 @@ RenderImage Renderer::render(const RenderRequest& request, const std::function<b
     sum.seconds += fs.seconds;
     sum.maxLoopIterations = std::max(sum.maxLoopIterations, fs.maxLoopIterations);
     sum.cutPaths += fs.cutPaths;
-    if (progress && !progress(f + 1, spp)) break;
+    if (progress && !progress(std::min(f + perFrame, spp), spp)) break;
   }
   if (request.denoise) {
     FrameOptions o;
