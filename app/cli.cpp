@@ -104,10 +104,16 @@ void progressBar(const std::string& label, int done, int total, double seconds) 
   // Redrawing in place needs a terminal; in a log (CI, a pipe) print one line per tenth instead.
   static const bool terminal = isatty(fileno(stderr)) != 0;
   if (!terminal) {
-    int tenths = total > 0 ? done * 10 / total : 10;
-    int before = total > 0 ? (done - 1) * 10 / total : 9;
-    if (done < total && tenths == before) return;
-    std::fprintf(stderr, "%s %d/%d  %.1f s\n", label.c_str(), done, total, seconds);
+    // Progress may jump (a run converging without a report): print whenever a new tenth is
+    // reached, and always the end.
+    static std::string lastLabel;
+    static int lastTenth = -1;
+    const int tenths = total > 0 ? done * 10 / total : 10;
+    if (label != lastLabel) lastLabel = label, lastTenth = -1;
+    if (done < total && tenths <= lastTenth) return;
+    lastTenth = tenths;
+    const double eta = done > 0 ? seconds * (total - done) / done : 0;
+    std::fprintf(stderr, "%s %d/%d  %.1f s, %.1f s left\n", label.c_str(), done, total, seconds, eta);
     return;
   }
   const int width = 30;

@@ -29,17 +29,7 @@ FrameStats traceFrames(Renderer& renderer, int w, int h, int frames, const Frame
   for (int f = 0; f < frames; ++f) {
     all.sampleBase = static_cast<std::uint32_t>(f + 1);
     all.restart = false;
-    FrameStats s = renderer.renderFrame({all}, options);
-    sum.samples += s.samples;
-    sum.primaryRays += s.primaryRays;
-    sum.bounceRays += s.bounceRays;
-    sum.shadowRays += s.shadowRays;
-    sum.seconds += s.seconds;
-    sum.maxLoopIterations = std::max(sum.maxLoopIterations, s.maxLoopIterations);
-    sum.maxSegmentIterations = std::max(sum.maxSegmentIterations, s.maxSegmentIterations);
-    sum.cutPaths += s.cutPaths;
-    sum.loopIterations += s.loopIterations;
-    sum.pathsPerInvocation = s.pathsPerInvocation;
+    sum.add(renderer.renderFrame({all}, options));
   }
   if (wallSeconds) *wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
   return sum;
@@ -66,23 +56,10 @@ int benchScale(const std::vector<std::string>& argv) {
   double first = 0;
   for (int rings : {64, 158, 354, 500, 708}) {  // 4 rings^2 triangles: ~16 k, 100 k, 500 k, 1 M, 2 M
     Scene scene = makeDefaultScene();
-    Mesh mesh;
-    mesh.id = scene.newId();
-    mesh.name = "dense sphere";
-    mesh.geometry = makeSphere(rings, 2 * rings);
-    scene.meshes.push_back(mesh);
     Material mat;
-    mat.id = scene.newId();
-    mat.name = "dense material";
     mat.type = MaterialType::RoughPlastic;
-    scene.materials.push_back(mat);
-    Object o;
-    o.id = scene.newId();
-    o.name = "dense";
-    o.mesh = mesh.id;
-    o.material = mat.id;
-    o.transform = Mat4::translate({0.2f, 0.6f, 0.6f}) * Mat4::scale(Vec3{0.6f});
-    scene.objects.push_back(o);
+    addMeshObject(scene, "dense sphere", makeSphere(rings, 2 * rings), mat,
+                  Mat4::translate({0.2f, 0.6f, 0.6f}) * Mat4::scale(Vec3{0.6f}));
     Renderer renderer;
     auto t0 = Clock::now();
     renderer.setScene(scene);
@@ -221,22 +198,14 @@ int benchEdit(const std::vector<std::string>& argv) {
     Scene scene = makeDefaultScene();
     scene.settings.width = 64;
     scene.settings.height = 36;
-    Mesh mesh;
-    mesh.id = scene.newId();
-    mesh.name = "dense sphere";
-    mesh.geometry = makeSphere(rings, 2 * rings);
-    scene.meshes.push_back(mesh);
-    Material mat;
-    mat.id = scene.newId();
-    mat.name = "dense material";
-    scene.materials.push_back(mat);
-    Object o;
-    o.id = scene.newId();
-    o.name = "dense";
-    o.mesh = mesh.id;
-    o.material = mat.id;
-    o.transform = Mat4::translate({0, 1, 0}) * Mat4::scale(Vec3{0.3f});
-    scene.objects.push_back(o);
+    const NodeId id = addMeshObject(scene, "dense sphere", makeSphere(rings, 2 * rings), Material{},
+                                    Mat4::translate({0, 1, 0}) * Mat4::scale(Vec3{0.3f}));
+    const Object* added = scene.object(id);
+    const Material* addedMaterial = added ? scene.material(added->material) : nullptr;
+    if (!addedMaterial) return 1;
+    Object o = *added;
+    Material mat = *addedMaterial;
+    const std::size_t triangles = 4u * static_cast<std::size_t>(rings) * static_cast<std::size_t>(rings);
     auto t0 = Clock::now();
     RenderSession session(scene, MethodSettings{});
     double upload = std::chrono::duration<double>(Clock::now() - t0).count();
@@ -252,7 +221,7 @@ int benchEdit(const std::vector<std::string>& argv) {
       session.applyEdit(SetMaterial{mat});
       materialMs += std::chrono::duration<double, std::milli>(Clock::now() - a).count();
     }
-    std::printf("%10zu %14.3f %14.3f %14.3f\n", mesh.geometry->triangleCount(), upload, moveMs / edits, materialMs / edits);
+    std::printf("%10zu %14.3f %14.3f %14.3f\n", triangles, upload, moveMs / edits, materialMs / edits);
   }
   return 0;
 }

@@ -151,6 +151,11 @@ Result<bool> writePointChart(const std::filesystem::path& base, const QString& t
     if (!std::isfinite(p.at.x()) || !std::isfinite(p.at.y())) continue;
     auto* s = new QScatterSeries;
     s->setColor(seriesColor(i));
+    if (p.hollow) {
+      s->setMarkerShape(QScatterSeries::MarkerShapeRectangle);
+      s->setBrush(Qt::NoBrush);
+      s->setPen(QPen(seriesColor(i), 2));
+    }
     s->setName(p.label);
     s->setMarkerSize(11);
     s->append(p.at);

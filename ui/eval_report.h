@@ -23,6 +23,7 @@ struct ChartLine {
 struct ChartPoint {
   QString label;
   QPointF at;
+  bool hollow = false;  // drawn as an empty square: a bound, not a measurement (never reached)
 };
 
 // Writes `base`.png and `base`.svg: a line per entry (error against time, one per method).

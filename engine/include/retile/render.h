@@ -96,6 +96,10 @@ struct FrameStats {
   // stop when the count passes kTraceLoopBudget, so this must stay below the ~2700 left to the limit.
   std::uint32_t maxSegmentIterations = 0;
   double pathsPerInvocation = 0;        // each invocation traces this many paths one after another
+
+  // Adds a later frame's figures: counts and seconds sum, the maxima stay maxima, the paths per
+  // invocation are the later frame's.
+  void add(const FrameStats& later);
 };
 
 struct FrameTicket {
@@ -108,10 +112,6 @@ struct RenderRequest {
   int maxBounces = -1;             // -1: the scene's settings
   std::uint32_t seed = 0;
   bool denoise = false;            // the result's display is the whole frame denoised
-  // Samples per pixel traced in each frame. 1 keeps the editor's budget per frame; references of
-  // small images take more, since each frame's fixed cost dwarfs 1 spp of a few thousand pixels.
-  // The same sample indices either way: the image does not depend on it.
-  int samplesPerFrame = 1;
 };
 
 class Renderer {

@@ -412,9 +412,6 @@ Result<RenderImage> References::get(const Scene& state, const std::function<void
   req.height = state.settings.height;
   req.samplesPerPixel = spp_;
   req.seed = 0x5eed;
-  // About a quarter million samples a frame: the per-frame cost stops mattering (a 320x180
-  // reference renders 5x faster than at 1 spp a frame), and a frame stays well under a second.
-  req.samplesPerFrame = std::clamp(262144 / std::max(req.width * req.height, 1), 1, 64);
   RenderImage img = gpu_->renderer.render(req, [&](int done, int total) {
     if (progress) progress(done, total);
     return true;

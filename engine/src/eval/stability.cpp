@@ -66,28 +66,14 @@ Edit moved(const Object& o, Vec3 by) {
   return SetObject{m};
 }
 
-// The built-in scene with one more sphere where the case needs it: behind the camera, seen only
-// in the steel panel (mirror-only), or above the frame between the light and the floor, seen
-// only by its shadow (offscreen-shadow).
+// The scene with one more sphere where a case needs it: behind the camera, seen only in a mirror
+// (mirror-only), or above the frame between the light and the floor, seen only by its shadow
+// (offscreen-shadow). Lambert green, so that a change of it shows.
 Scene withHiddenSphere(Scene s, Vec3 at, float radius, const char* name) {
-  Mesh mesh;
-  mesh.id = s.newId();
-  mesh.name = name;
-  mesh.geometry = makeSphere(24, 48);
-  s.meshes.push_back(mesh);
-  Material mat;
-  mat.id = s.newId();
-  mat.name = std::string(name) + " Paint";
-  mat.type = MaterialType::Lambert;
-  mat.albedo = {0.1f, 0.6f, 0.15f};
-  s.materials.push_back(mat);
-  Object o;
-  o.id = s.newId();
-  o.name = name;
-  o.mesh = mesh.id;
-  o.material = mat.id;
-  o.transform = Mat4::translate(at) * Mat4::scale(Vec3{radius});
-  s.objects.push_back(o);
+  Material paint;
+  paint.type = MaterialType::Lambert;
+  paint.albedo = {0.1f, 0.6f, 0.15f};
+  addMeshObject(s, name, makeSphere(24, 48), paint, Mat4::translate(at) * Mat4::scale(Vec3{radius}));
   return s;
 }
 
@@ -245,30 +231,18 @@ Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& s
     const Vec3 up = normalize(cross(right, forward));
     const float mirrorH = d * std::tan(scene.camera.verticalFov * 0.5f) * 0.4f;  // 40 % of the view's height
     Scene base = withHiddenSphere(scene, scene.camera.position - forward * (0.3f * d), 0.1f * d, "Hidden Sphere");
-    Mesh quad;
-    quad.id = base.newId();
-    quad.name = "Stability Mirror";
-    quad.geometry = makeQuad();
-    base.meshes.push_back(quad);
-    Material mirrorMat;
-    mirrorMat.id = base.newId();
-    mirrorMat.name = "Stability Mirror";
-    mirrorMat.type = MaterialType::Mirror;
-    mirrorMat.albedo = Vec3{0.9f};
-    base.materials.push_back(mirrorMat);
-    Object mirrorObj;
-    mirrorObj.id = base.newId();
-    mirrorObj.name = "Stability Mirror";
-    mirrorObj.mesh = quad.id;
-    mirrorObj.material = mirrorMat.id;
+    Material mirror;
+    mirror.type = MaterialType::Mirror;
+    mirror.albedo = Vec3{0.9f};
+    Mat4 facing;
     const Vec3 centre = scene.camera.position + forward * (0.5f * d);
     for (int i = 0; i < 3; ++i) {  // the quad's x, its normal (+y) and its z, to the view's axes
-      mirrorObj.transform.m[i][0] = right[i] * mirrorH * scene.aspect();
-      mirrorObj.transform.m[i][1] = -forward[i];
-      mirrorObj.transform.m[i][2] = up[i] * mirrorH;
-      mirrorObj.transform.m[i][3] = centre[i];
+      facing.m[i][0] = right[i] * mirrorH * scene.aspect();
+      facing.m[i][1] = -forward[i];
+      facing.m[i][2] = up[i] * mirrorH;
+      facing.m[i][3] = centre[i];
     }
-    base.objects.push_back(mirrorObj);
+    addMeshObject(base, "Stability Mirror", makeQuad(), mirror, facing);
     b = PlanBuilder(base, 64);
     const Object* hidden = objectNamed(base, "Hidden Sphere");
     if (!hidden) return R::failure(cat(name, ": the added sphere is missing"));

@@ -619,6 +619,19 @@ RenderImage Renderer::readback() { return impl_->readback(); }
 std::uint64_t Renderer::sceneDeviceBytes() const { return impl_->builder.data().deviceBytes(); }
 std::uint64_t Renderer::sceneTriangles() const { return impl_->builder.data().triangleCount; }
 
+void FrameStats::add(const FrameStats& later) {
+  samples += later.samples;
+  primaryRays += later.primaryRays;
+  bounceRays += later.bounceRays;
+  shadowRays += later.shadowRays;
+  seconds += later.seconds;
+  maxLoopIterations = std::max(maxLoopIterations, later.maxLoopIterations);
+  cutPaths += later.cutPaths;
+  loopIterations += later.loopIterations;
+  maxSegmentIterations = std::max(maxSegmentIterations, later.maxSegmentIterations);
+  pathsPerInvocation = later.pathsPerInvocation;
+}
+
 std::vector<std::string> Renderer::kernelFeatures() const {
   const RenderSceneData& d = impl_->builder.data();
   std::vector<std::string> out;
@@ -645,23 +658,15 @@ RenderImage Renderer::render(const RenderRequest& request, const std::function<b
   impl_->seed = request.seed;
   resize(w, h);
   FrameStats sum;
-  const int perFrame = std::max(request.samplesPerFrame, 1);
-  for (int f = 0; f < spp; f += perFrame) {
+  for (int f = 0; f < spp; ++f) {
     TileWork all;
     all.width = w;
     all.height = h;
-    all.quality = std::min(perFrame, spp - f);
+    all.quality = 1;
     all.sampleBase = static_cast<std::uint32_t>(f);
     all.restart = f == 0;
-    FrameStats fs = renderFrame({all}, {});
-    sum.samples += fs.samples;
-    sum.primaryRays += fs.primaryRays;
-    sum.bounceRays += fs.bounceRays;
-    sum.shadowRays += fs.shadowRays;
-    sum.seconds += fs.seconds;
-    sum.maxLoopIterations = std::max(sum.maxLoopIterations, fs.maxLoopIterations);
-    sum.cutPaths += fs.cutPaths;
-    if (progress && !progress(std::min(f + perFrame, spp), spp)) break;
+    sum.add(renderFrame({all}, {}));
+    if (progress && !progress(f + 1, spp)) break;
   }
   if (request.denoise) {
     FrameOptions o;

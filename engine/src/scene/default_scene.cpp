@@ -6,35 +6,6 @@
 #include "scene/primitives.h"
 
 namespace retile {
-namespace {
-
-NodeId addMesh(Scene& s, std::string name, std::shared_ptr<const MeshGeometry> g) {
-  Mesh m;
-  m.id = s.newId();
-  m.name = std::move(name);
-  m.geometry = std::move(g);
-  s.meshes.push_back(std::move(m));
-  return s.meshes.back().id;
-}
-
-NodeId addMaterial(Scene& s, Material m) {
-  m.id = s.newId();
-  s.materials.push_back(std::move(m));
-  return s.materials.back().id;
-}
-
-NodeId addObject(Scene& s, std::string name, NodeId mesh, NodeId material, const Mat4& xf) {
-  Object o;
-  o.id = s.newId();
-  o.name = std::move(name);
-  o.mesh = mesh;
-  o.material = material;
-  o.transform = xf;
-  s.objects.push_back(std::move(o));
-  return s.objects.back().id;
-}
-
-}  // namespace
 
 Scene makeDefaultScene() {
   Scene s;

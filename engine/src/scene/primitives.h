@@ -2,6 +2,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "retile/scene.h"
@@ -16,5 +17,14 @@ std::shared_ptr<const MeshGeometry> makeCube();
 std::shared_ptr<const MeshGeometry> makeSphere(int rings = 48, int segments = 96);
 // Surface of revolution about +y through the (radius, height) points of `profile`, in order.
 std::shared_ptr<const MeshGeometry> makeLathe(const std::vector<Vec2>& profile, int segments);
+
+// Adding nodes with fresh ids, for scenes built in code (the built-in scene, benchmarks, the
+// stability suite). Each returns the new node's id.
+NodeId addMesh(Scene& s, std::string name, std::shared_ptr<const MeshGeometry> g);
+NodeId addMaterial(Scene& s, Material m);
+NodeId addObject(Scene& s, std::string name, NodeId mesh, NodeId material, const Mat4& xf);
+// A mesh, its own material and an object using both: `name` names all three.
+NodeId addMeshObject(Scene& s, const std::string& name, std::shared_ptr<const MeshGeometry> g, Material m,
+                     const Mat4& xf);
 
 }  // namespace retile
