@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <variant>
 
 #include "retile/eval.h"
 
@@ -56,6 +57,30 @@ TEST(Eval, BuiltInScenariosFitTheSceneAndSayWhatTheyLeaveOut) {
   ASSERT_EQ(left.size(), 1u);
   EXPECT_EQ(left[0].name, "camera");
   EXPECT_EQ(skipped.size(), 4u);
+}
+
+// Scenes from other tools often leave objects unnamed, or name them alike: the scenarios then
+// name objects by id, and still edit the right one.
+TEST(Eval, ScenariosFitScenesWhoseObjectsHaveNoNames) {
+  Scene scene = makeDefaultScene();
+  scene.settings.width = 96;
+  scene.settings.height = 54;
+  for (Object& o : scene.objects) o.name.clear();
+  std::vector<std::string> skipped;
+  auto cases = builtInScenarios(scene, Options::quick(), {}, &skipped);
+  EXPECT_EQ(cases.size(), 5u) << (skipped.empty() ? "" : skipped[0]);
+  const NodeId subject = pickSubject(scene);
+  ASSERT_NE(subject, kNoNode);
+  for (const Case& c : cases) {
+    auto plan = planScenario(c.script, scene, 5);
+    ASSERT_TRUE(plan) << c.name << ": " << plan.error();
+    if (c.name == "fig6" || c.name == "drag") {
+      ASSERT_FALSE(plan->frames.empty());
+      const Edit& e = plan->frames[0].edits.at(0);
+      ASSERT_TRUE(std::holds_alternative<SetObject>(e));
+      EXPECT_EQ(std::get<SetObject>(e).object.id, subject) << c.name << " moves the picked object";
+    }
+  }
 }
 
 TEST(Eval, APlanScoresTheFirstEveryKthAndEveryRestingFrame) {

@@ -48,8 +48,9 @@ struct Case {
 std::vector<std::string> builtInScenarioNames();  // fig6, material, light, camera, drag
 // The built-in scenarios for `scene`, in that order, restricted to `names` (empty: all). The
 // edited object is the one an artist would pick: the visible, non-emissive object nearest the
-// image centre among those covering 0.2 % to 25 % of it. A scenario the scene cannot play (no
-// light, no object) is left out and `skipped` says why.
+// image centre among those covering 0.2 % to 25 % of it (when none does, the smallest covering
+// more: a scene of one object). A scenario the scene cannot play (no light, no object) is left
+// out and `skipped` says why.
 std::vector<Case> builtInScenarios(const Scene& scene, const Options& options, const std::vector<std::string>& names,
                                    std::vector<std::string>* skipped);
 // The object builtInScenarios edits, or kNoNode.

@@ -14,7 +14,8 @@
 //       { "focus": [ { "pixel": [100, 90], "follows": false },     // image pixels, or
 //                    { "uv": [0.7, 0.4], "follows": true } ] } ] }  // fractions of the image
 //
-// A `light` names a Light node or an emissive object (the default scene's area light): colour
+// Objects are named by name, or as "#ID" (the node id) when names repeat or are empty. A `light`
+// names a Light node or an emissive object (the default scene's area light): colour
 // and intensity set the emission, `move` translates it. Every step but `select` and `focus` takes
 // `frames` (default 1); an edit step applies its edit on each of them for `move`, on the first
 // for the others. Pure data and parsing: any thread.

@@ -91,8 +91,15 @@ std::optional<Projected> project(const Scene& s, const Bounds3& b) {
 }
 
 bool uniqueName(const Scene& s, const std::string& name) {
-  return !name.empty() && std::count_if(s.objects.begin(), s.objects.end(), [&](const Object& o) { return o.name == name; }) == 1;
+  return !name.empty() && name[0] != '#' &&
+         std::count_if(s.objects.begin(), s.objects.end(), [&](const Object& o) { return o.name == name; }) == 1;
 }
+
+// How a scenario step names an object: its name when unique, else "#ID" (stepEdits reads both).
+std::string reference(const Scene& s, const Object& o) { return uniqueName(s, o.name) ? o.name : cat("#", o.id); }
+
+// For descriptions: the name, or what the object is when it has none.
+std::string shown(const Object& o) { return o.name.empty() ? cat("object #", o.id) : o.name; }
 
 Bounds3 worldBounds(const Scene& s, const Object& o) {
   const Mesh* m = s.mesh(o.mesh);
@@ -103,20 +110,24 @@ Bounds3 worldBounds(const Scene& s, const Object& o) {
 }  // namespace
 
 NodeId pickSubject(const Scene& s) {
-  NodeId best = kNoNode;
-  float bestDistance = 1e30f;
+  NodeId best = kNoNode, large = kNoNode;
+  float bestDistance = 1e30f, largeFraction = 2.0f;
   const Vec2 middle{static_cast<float>(s.settings.width) * 0.5f, static_cast<float>(s.settings.height) * 0.5f};
   for (const Object& o : s.objects) {
     const Material* mat = s.material(o.material);
-    if (!o.visible || (mat && mat->emissive()) || !uniqueName(s, o.name)) continue;
+    if (!o.visible || (mat && mat->emissive())) continue;
     Bounds3 b = worldBounds(s, o);
     if (b.empty()) continue;
     auto p = project(s, b);
-    if (!p || p->fraction < 0.002f || p->fraction > 0.25f) continue;
+    if (!p || p->fraction < 0.002f) continue;
+    if (p->fraction > 0.25f) {  // a scene of one object filling the frame: the smallest such
+      if (p->fraction < largeFraction) largeFraction = p->fraction, large = o.id;
+      continue;
+    }
     float d = length(Vec3{p->centre.x - middle.x, p->centre.y - middle.y, 0.0f});
     if (d < bestDistance) bestDistance = d, best = o.id;
   }
-  return best;
+  return best != kNoNode ? best : large;
 }
 
 std::vector<Case> builtInScenarios(const Scene& scene, const Options& o, const std::vector<std::string>& names,
@@ -130,7 +141,7 @@ std::vector<Case> builtInScenarios(const Scene& scene, const Options& o, const s
   const Object* subject = scene.object(subjectId);
   ScenarioStep select;
   select.kind = ScenarioStep::Kind::Select;
-  if (subject) select.target = subject->name;
+  if (subject) select.target = reference(scene, *subject);
   // The focus methods get one following point below the object, where its contact shadow or
   // reflection on a floor usually is: a second place its edits change.
   ScenarioStep focus;
@@ -149,11 +160,11 @@ std::vector<Case> builtInScenarios(const Scene& scene, const Options& o, const s
 
   if (wanted("fig6")) {
     if (!subject) {
-      skip("fig6", "no object covers 0.2 % to 25 % of the image to move");
+      skip("fig6", "no visible object covers 0.2 % of the image or more to move");
     } else {
       Case c;
       c.name = "fig6";
-      c.description = cat("The paper's Fig. 6 protocol: converge ", o.converge, " spp, move '", subject->name,
+      c.description = cat("The paper's Fig. 6 protocol: converge ", o.converge, " spp, move '", shown(*subject),
                           "' up by 0.005 a frame for ", o.moveFrames, " frames, then ", o.restFrames, " frames at rest.");
       c.script.converge = o.converge;
       c.script.steps = {select, focus};
@@ -175,12 +186,12 @@ std::vector<Case> builtInScenarios(const Scene& scene, const Options& o, const s
       c.name = "material";
       ScenarioStep edit;
       edit.kind = ScenarioStep::Kind::Material;
-      edit.target = subject->name;  // the object's material
+      edit.target = reference(scene, *subject);  // the object's material
       edit.roughness = m->roughness < 0.3f ? 0.45f : 0.1f;
       Vec3 a = m->albedo;
       bool grey = std::abs(a.x - a.y) < 0.05f && std::abs(a.y - a.z) < 0.05f;
       edit.albedo = grey ? Vec3{0.2f, 0.35f, 0.8f} : Vec3{a.z, a.x, a.y};
-      c.description = cat("A material edit: '", m->name, "' on '", subject->name, "' takes roughness ", *edit.roughness,
+      c.description = cat("A material edit: '", m->name, "' on '", shown(*subject), "' takes roughness ", *edit.roughness,
                           " and a new albedo, then ", o.restFrames, " frames at rest.");
       c.script.converge = std::max(o.converge / 4, 1);
       c.script.steps = {select, focus, edit, rest};
@@ -202,16 +213,16 @@ std::vector<Case> builtInScenarios(const Scene& scene, const Options& o, const s
     if (edit.target.empty())
       for (const Object& ob : scene.objects) {
         const Material* m = scene.material(ob.material);
-        if (ob.visible && m && m->emissive() && uniqueName(scene, ob.name)) {
-          edit.target = ob.name;
+        if (ob.visible && m && m->emissive()) {
+          edit.target = reference(scene, ob);
           edit.color = Vec3{m->emission.x, m->emission.y * 0.8f, m->emission.z * 0.6f};
           edit.intensity = 1.5f;
-          what = ob.name;
+          what = shown(ob);
           break;
         }
       }
     if (edit.target.empty()) {
-      skip("light", "no light or uniquely named emitter to edit");
+      skip("light", "no light or emitter to edit");
     } else {
       Case c;
       c.name = "light";
@@ -241,7 +252,7 @@ std::vector<Case> builtInScenarios(const Scene& scene, const Options& o, const s
   }
   if (wanted("drag")) {
     if (!subject) {
-      skip("drag", "no object covers 0.2 % to 25 % of the image to drag");
+      skip("drag", "no visible object covers 0.2 % of the image or more to drag");
     } else {
       Case c;
       c.name = "drag";
@@ -252,7 +263,7 @@ std::vector<Case> builtInScenarios(const Scene& scene, const Options& o, const s
       move.kind = ScenarioStep::Kind::Move;
       move.vector = right * (size * 0.02f);
       move.frames = o.dragFrames;
-      c.description = cat("A continuous drag: '", subject->name, "' slides sideways by a fiftieth of its size a frame for ",
+      c.description = cat("A continuous drag: '", shown(*subject), "' slides sideways by a fiftieth of its size a frame for ",
                           o.dragFrames, " frames, then ", o.restFrames, " frames at rest.");
       c.script.converge = std::max(o.converge / 4, 1);
       c.script.steps = {select, focus, move, rest};

@@ -1,5 +1,6 @@
 #include "retile/scenario.h"
 
+#include <charconv>
 #include <cmath>
 
 #include "core/files.h"
@@ -145,9 +146,16 @@ Result<Scenario> loadScenario(const std::filesystem::path& file) {
 
 namespace {
 
+// By name, or "#ID" for objects without a unique name (what the evaluation's built-in scenarios
+// use on any scene). A name wins over an id.
 const Object* objectByName(const Scene& s, const std::string& name) {
   for (const Object& o : s.objects)
     if (o.name == name) return &o;
+  if (name.size() > 1 && name[0] == '#') {
+    NodeId id = 0;
+    auto r = std::from_chars(name.data() + 1, name.data() + name.size(), id);
+    if (r.ec == std::errc() && r.ptr == name.data() + name.size()) return s.object(id);
+  }
   return nullptr;
 }
 

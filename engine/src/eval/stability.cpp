@@ -121,7 +121,7 @@ Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& s
   const Vec3 right = normalize(cross(forward, scene.camera.up));
   const float size = subject ? length(objectBounds(scene, *subject).extent()) : 0.0f;
   auto needSubject = [&]() -> Result<bool> {
-    if (!subject) return Result<bool>::failure(cat(name, ": the scene has no object covering 0.2 % to 25 % of the image"));
+    if (!subject) return Result<bool>::failure(cat(name, ": the scene has no visible object covering 0.2 % of the image or more"));
     return true;
   };
 
@@ -211,7 +211,7 @@ Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& s
       for (const Object& ob : scene.objects) {
         const Material* m = scene.material(ob.material);
         if (ob.visible && m && m->emissive()) {
-          step.target = ob.name;
+          step.target = cat("#", ob.id);  // emitters are often unnamed
           step.intensity = 1.5f;
           break;
         }
