@@ -8,11 +8,13 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <string>
 
 #include "cli.h"
 #include "retile/color.h"
+#include "retile/eval.h"
 #include "retile/image.h"
 #include "retile/log.h"
 #include "retile/metrics.h"
@@ -34,23 +36,6 @@ void usage(const std::string& error) {
                "methods:");
   for (const auto& n : methodNames()) std::fprintf(stderr, " %s", n.c_str());
   std::fprintf(stderr, "\n");
-}
-
-// Plays the script on a copy of the scene without rendering: the state after the last edit.
-Result<Scene> finalState(const Scenario& sc, Scene scene) {
-  NodeId selection = kNoNode;
-  for (const auto& step : sc.steps)
-    for (int f = 0; f < std::max(step.frames, 1); ++f) {
-      auto e = stepEdits(step, f, scene, selection);
-      if (!e) return Result<Scene>::failure(e.error());
-      if (e->select) selection = *e->select;
-      for (const Edit& edit : e->edits) {
-        auto r = applyEdit(scene, edit);
-        if (!r) return Result<Scene>::failure(r.error());
-      }
-      if (step.kind == ScenarioStep::Kind::Select || step.kind == ScenarioStep::Kind::Focus) break;
-    }
-  return scene;
 }
 
 }  // namespace
@@ -109,8 +94,10 @@ int runEdit(const std::vector<std::string>& argv) {
   auto scenario = loadScenario(args->get("--script"));
   if (!scenario) return std::fprintf(stderr, "error: %s\n", scenario.error().c_str()), 1;
   if (converge < 0) converge = scenario->converge;
-  auto final = finalState(scenario.value(), scene);
-  if (!final) return std::fprintf(stderr, "error: %s: %s\n", args->get("--script").c_str(), final.error().c_str()), 1;
+  // The script played without rendering (eval's planner): its last frame shows the final state.
+  auto played = eval::planScenario(scenario.value(), scene, std::numeric_limits<int>::max());
+  if (!played) return std::fprintf(stderr, "error: %s: %s\n", args->get("--script").c_str(), played.error().c_str()), 1;
+  const Scene& finalScene = played->states.empty() ? played->start : played->states.back();
 
   std::filesystem::path outDir = args->get("--out-dir");
   std::error_code ec;
@@ -146,7 +133,7 @@ int runEdit(const std::vector<std::string>& argv) {
         return true;
       });
     };
-    RenderImage img = renderReference(final.value(), "reference");
+    RenderImage img = renderReference(finalScene, "reference");
     ref = img.color;
     refDisplay = displayed(ref);
     writeRenderImage(img, outDir / "reference.exr");

@@ -203,7 +203,7 @@ int runEval(const std::vector<std::string>& argv) {
       scripts.push_back(s.value());
     }
   // Only scripts were asked for: no built-in scenario unless named.
-  if (!scripts.empty() && !args->has("--scenarios")) scenarioNames = {"none"};
+  const bool builtIns = scripts.empty() || args->has("--scenarios");
   std::vector<std::string> sceneNames = args->positional.empty() ? std::vector<std::string>{"default"} : args->positional;
   if (args->has("--stability")) {
     eval::StabilityOptions so;
@@ -269,7 +269,8 @@ int runEval(const std::vector<std::string>& argv) {
     scene.settings.height = opt.height;
     models.emplace_back(sceneName, eval::modelOf(scene));
     std::vector<std::string> skipped;
-    std::vector<eval::Case> cases = eval::builtInScenarios(scene, opt, scenarioNames, &skipped);
+    std::vector<eval::Case> cases;
+    if (builtIns) cases = eval::builtInScenarios(scene, opt, scenarioNames, &skipped);
     for (const auto& s : skipped) notes.push_back(cat(sceneName, ": scenario ", s));
     for (const Scenario& s : scripts) cases.push_back({s.name, "A script: " + s.name, s});
     for (auto& c : cases) {
