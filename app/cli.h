@@ -1,4 +1,4 @@
-// The command line: `retile render`, `retile edit`, `retile eval`, `retile bench`, `retile import`. Runs on the main thread.
+// The command line: `retile render`, `retile edit`, `retile eval`, `retile compare`, `retile bench`, `retile import`. Runs on the main thread.
 #pragma once
 
 #include <string>
@@ -36,6 +36,7 @@ int runBench(const std::vector<std::string>& args);
 int runImport(const std::vector<std::string>& args);
 int runEdit(const std::vector<std::string>& args);
 int runEval(const std::vector<std::string>& args);
+int runCompare(const std::vector<std::string>& args);
 // The Qt editor on `file` ("" or "default": the built-in scene). Needs a display.
 int runEditor(int argc, char** argv, const std::string& file);
 bool isCommand(const std::string& word);

@@ -14,7 +14,7 @@
 namespace retile::cli {
 
 bool isCommand(const std::string& word) {
-  return word == "render" || word == "edit" || word == "eval" || word == "bench" || word == "import";
+  return word == "render" || word == "edit" || word == "eval" || word == "compare" || word == "bench" || word == "import";
 }
 
 int runEditor(int argc, char** argv, const std::string& file) {

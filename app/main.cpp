@@ -25,6 +25,7 @@ void usage() {
                "  retile bench throughput SCENE [--size WxH] [--frames N] [--max-bounces B]\n"
                "  retile bench bvh [--triangles N] | edit | frames SCENE [--drag] | denoise [SCENE] [--size WxH]\n"
                "               | scale [--size WxH] [--frames N]\n"
+               "  retile compare IMAGE REFERENCE [--noise IMAGE2] [--block N] [--exclude X,Y,W,H ...] [--worst K]\n"
                "  retile import FILE\n"
                "SCENE is a file (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default'.\n");
 }
@@ -48,6 +49,7 @@ int main(int argc, char** argv) {
     if (cmd == "import") return retile::cli::runImport(rest);
     if (cmd == "edit") return retile::cli::runEdit(rest);
     if (cmd == "eval") return retile::cli::runEval(rest);
+    if (cmd == "compare") return retile::cli::runCompare(rest);
     std::fprintf(stderr, "retile: unknown command '%s'\n", cmd.c_str());
     usage();
     return 2;

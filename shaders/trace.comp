@@ -314,10 +314,12 @@ bool extendPath(inout Path path) {
   BsdfSample bs = bsdfSample(m, woL, vec3(rand(path.rng), rand(path.rng), rand(path.rng)));
   if (maxComponent(bs.weight) <= 0.0 || any(isnan(bs.weight))) return false;
   vec3 wi = toWorld(bs.wi, t, b, nss);
-  float sideI = dot(wi, ngs);
+  float sideI = dot(wi, ngs), sideO = dot(wo, ngs);
   // A reflected direction must leave on the viewer's side of the true surface, a transmitted
-  // one on the other side; otherwise the shading normal lied and the path would leak.
-  if (bs.transmitted ? sideI >= 0.0 : sideI <= 0.0) return false;
+  // one on the other side; otherwise the shading normal lied and the path would leak. The
+  // viewer's side, not the normal's: inside glass it is the back (comparing with the normal
+  // alone ended every path leaving glass, and every reflection inside it: black glass).
+  if (bs.transmitted ? sideI * sideO >= 0.0 : sideI * sideO <= 0.0) return false;
   path.beta *= bs.weight;
   // Roulette must not see the 1/eta^2 radiance scaling inside glass as lost energy.
   if (bs.transmitted && !isMat(m.type, kMatThinSheet)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);

@@ -54,4 +54,27 @@ double psnrHvsM(MetricImage a, MetricImage ref, const std::uint8_t* mask = nullp
 std::vector<std::uint8_t> affectedPixels(const RenderImage& before, const RenderImage& after, double z = 4.0,
                                          double relative = 0.01);
 
+// Two linear renders of the same view compared the way Retile is checked against another renderer
+// (issue 15): both averaged over aligned block x block squares (partial ones at the right and
+// bottom edges), so that per-pixel noise averages out and what is left is bias. Pixels inside an
+// `exclude` rectangle take no part; a block keeps its place only if at least half its pixels do.
+// Noise floor: the same comparison between two renders of ours at different seeds.
+struct PixelRect {
+  int x = 0, y = 0, width = 0, height = 0;
+  bool contains(int px, int py) const { return px >= x && px < x + width && py >= y && py < y + height; }
+};
+
+struct BlockComparison {
+  double meanA = 0.0, meanRef = 0.0;  // mean of R, G and B over the compared pixels
+  // sqrt(sum over blocks and channels of (A - Ref)^2) / sqrt(sum of Ref^2): relative RMSE of the
+  // block means.
+  double relativeRmse = 0.0;
+  int cols = 0, rows = 0, blocks = 0;  // the block grid and the blocks compared
+  // Per block (row-major), its mean luminance in A and Ref and its share of the summed squared
+  // error (the shares of the compared blocks sum to 1); NaN for blocks left out.
+  std::vector<double> lumA, lumRef, errorShare;
+};
+
+BlockComparison compareBlocks(MetricImage a, MetricImage ref, int block, const std::vector<PixelRect>& exclude = {});
+
 }  // namespace retile

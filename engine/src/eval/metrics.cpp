@@ -270,4 +270,61 @@ std::vector<std::uint8_t> affectedPixels(const RenderImage& before, const Render
   return mask;
 }
 
+BlockComparison compareBlocks(MetricImage a, MetricImage ref, int block, const std::vector<PixelRect>& exclude) {
+  checkSizes(a, ref);
+  RETILE_ASSERT(block >= 1, "blocks of at least one pixel");
+  BlockComparison out;
+  out.cols = (a.width + block - 1) / block;
+  out.rows = (a.height + block - 1) / block;
+  const std::size_t nb = static_cast<std::size_t>(out.cols) * static_cast<std::size_t>(out.rows);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  out.lumA.assign(nb, nan);
+  out.lumRef.assign(nb, nan);
+  out.errorShare.assign(nb, nan);
+  std::vector<double> squared(nb, nan);
+  double sumA = 0.0, sumRef = 0.0, err = 0.0, norm = 0.0;
+  std::size_t pixels = 0;
+  for (int by = 0; by < out.rows; ++by)
+    for (int bx = 0; bx < out.cols; ++bx) {
+      double ma[3] = {0, 0, 0}, mr[3] = {0, 0, 0};
+      int in = 0, all = 0;
+      for (int y = by * block; y < std::min(a.height, (by + 1) * block); ++y)
+        for (int x = bx * block; x < std::min(a.width, (bx + 1) * block); ++x) {
+          ++all;
+          if (std::any_of(exclude.begin(), exclude.end(), [&](const PixelRect& r) { return r.contains(x, y); })) continue;
+          ++in;
+          const std::size_t i = 3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(a.width) + static_cast<std::size_t>(x));
+          for (int c = 0; c < 3; ++c) {
+            ma[c] += a.rgb[i + static_cast<std::size_t>(c)];
+            mr[c] += ref.rgb[i + static_cast<std::size_t>(c)];
+          }
+        }
+      if (in == 0 || 2 * in < all) continue;
+      const std::size_t b = static_cast<std::size_t>(by) * static_cast<std::size_t>(out.cols) + static_cast<std::size_t>(bx);
+      double e = 0.0;
+      for (int c = 0; c < 3; ++c) {
+        sumA += ma[c];
+        sumRef += mr[c];
+        ma[c] /= in;
+        mr[c] /= in;
+        e += (ma[c] - mr[c]) * (ma[c] - mr[c]);
+        norm += mr[c] * mr[c];
+      }
+      pixels += static_cast<std::size_t>(in);
+      squared[b] = e;
+      err += e;
+      out.lumA[b] = 0.2126 * ma[0] + 0.7152 * ma[1] + 0.0722 * ma[2];
+      out.lumRef[b] = 0.2126 * mr[0] + 0.7152 * mr[1] + 0.0722 * mr[2];
+      ++out.blocks;
+    }
+  if (pixels > 0) {
+    out.meanA = sumA / (3.0 * static_cast<double>(pixels));
+    out.meanRef = sumRef / (3.0 * static_cast<double>(pixels));
+  }
+  out.relativeRmse = norm > 0.0 ? std::sqrt(err / norm) : (err > 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
+  for (std::size_t b = 0; b < nb; ++b)
+    if (!std::isnan(squared[b])) out.errorShare[b] = err > 0.0 ? squared[b] / err : 0.0;
+  return out;
+}
+
 }  // namespace retile

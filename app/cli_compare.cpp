@@ -1,0 +1,116 @@
+// retile compare: how far a render is from another renderer's reference, in units of our own
+// noise (issue 15's acceptance): block-averaged relative RMSE against the reference and, with a
+// second render of ours at another seed, against that (the noise floor).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+#include "cli.h"
+#include "io/image_io.h"
+#include "retile/metrics.h"
+
+namespace retile::cli {
+
+namespace {
+
+Result<std::vector<float>> readRgb(const std::string& file) {
+  auto im = readImageRaw(file);
+  if (!im) return Result<std::vector<float>>::failure(im.error());
+  std::vector<float> rgb(static_cast<std::size_t>(im->width) * static_cast<std::size_t>(im->height) * 3);
+  for (std::size_t i = 0; i * 3 < rgb.size(); ++i)
+    for (std::size_t c = 0; c < 3; ++c) rgb[3 * i + c] = im->rgba[4 * i + c];
+  if (std::any_of(rgb.begin(), rgb.end(), [](float v) { return !std::isfinite(v); }))
+    return Result<std::vector<float>>::failure(file + ": has pixels that are not finite numbers");
+  return rgb;
+}
+
+Result<std::pair<int, int>> sizeOf(const std::string& file) {
+  auto im = readImageRaw(file);
+  if (!im) return Result<std::pair<int, int>>::failure(im.error());
+  return std::pair{im->width, im->height};
+}
+
+Result<PixelRect> parseRect(const std::string& text) {
+  PixelRect r;
+  int* dst[4] = {&r.x, &r.y, &r.width, &r.height};
+  std::size_t at = 0;
+  for (int i = 0; i < 4; ++i) {
+    std::size_t end = i < 3 ? text.find(',', at) : text.size();
+    if (end == std::string::npos) return Result<PixelRect>::failure("--exclude: '" + text + "' is not X,Y,W,H");
+    auto v = parseInt("--exclude", text.substr(at, end - at), 0, 1 << 20);
+    if (!v) return Result<PixelRect>::failure(v.error());
+    *dst[i] = v.value();
+    at = end + 1;
+  }
+  return r;
+}
+
+}  // namespace
+
+int runCompare(const std::vector<std::string>& argv) {
+  auto args = parseArgs(argv, {"--noise", "--block", "--exclude", "--worst"});
+  if (!args || args->positional.size() != 2) {
+    std::fprintf(stderr,
+                 "%s%susage: retile compare IMAGE REFERENCE [--noise IMAGE2] [--block N] [--exclude X,Y,W,H ...] [--worst K]\n"
+                 "  IMAGE2 is a second render of IMAGE's scene at another seed: its distance from IMAGE is the noise floor.\n",
+                 args ? "" : args.error().c_str(), args ? "" : "\n");
+    return 2;
+  }
+  int block = 16, worst = 8;
+  for (auto [opt, dst, hi] : {std::tuple{"--block", &block, 4096}, std::tuple{"--worst", &worst, 1000}}) {
+    if (!args->has(opt)) continue;
+    auto v = parseInt(opt, args->get(opt), opt == std::string("--block") ? 1 : 0, hi);
+    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
+    *dst = v.value();
+  }
+  std::vector<PixelRect> exclude;
+  for (const auto& [name, value] : args->options)
+    if (name == "--exclude") {
+      auto r = parseRect(value);
+      if (!r) return std::fprintf(stderr, "error: %s\n", r.error().c_str()), 2;
+      exclude.push_back(r.value());
+    }
+  std::vector<std::string> files = {args->positional[0], args->positional[1]};
+  if (args->has("--noise")) files.push_back(args->get("--noise"));
+  std::vector<std::vector<float>> images;
+  std::pair<int, int> size{0, 0};
+  for (const auto& f : files) {
+    auto s = sizeOf(f);
+    auto rgb = s ? readRgb(f) : Result<std::vector<float>>::failure(s.error());
+    if (!rgb) return std::fprintf(stderr, "error: %s\n", rgb.error().c_str()), 1;
+    if (images.empty()) size = s.value();
+    if (s.value() != size) {
+      std::fprintf(stderr, "error: %s is %dx%d, %s is %dx%d\n", f.c_str(), s->first, s->second, files[0].c_str(), size.first,
+                   size.second);
+      return 1;
+    }
+    images.push_back(std::move(rgb.value()));
+  }
+  auto view = [&](std::size_t i) { return MetricImage{images[i].data(), size.first, size.second}; };
+  BlockComparison c = compareBlocks(view(0), view(1), block, exclude);
+  std::printf("compared: %d of %d %dx%d blocks\n", c.blocks, c.cols * c.rows, block, block);
+  std::printf("mean RGB: %.6g against %.6g (%+.3f %%)\n", c.meanA, c.meanRef,
+              c.meanRef > 0 ? 100.0 * (c.meanA / c.meanRef - 1.0) : 0.0);
+  std::printf("relative RMSE of block means against the reference: %.4f\n", c.relativeRmse);
+  if (images.size() == 3) {
+    BlockComparison n = compareBlocks(view(0), view(2), block, exclude);
+    std::printf("noise floor (against %s): %.4f; ratio %.2f\n", files[2].c_str(), n.relativeRmse,
+                n.relativeRmse > 0 ? c.relativeRmse / n.relativeRmse : std::numeric_limits<double>::infinity());
+    std::printf("mean RGB of the two seeds differ by %+.3f %%\n", n.meanRef > 0 ? 100.0 * (n.meanA / n.meanRef - 1.0) : 0.0);
+  }
+  std::vector<std::size_t> order(c.errorShare.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  order.erase(std::remove_if(order.begin(), order.end(), [&](std::size_t b) { return std::isnan(c.errorShare[b]); }), order.end());
+  std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) { return c.errorShare[p] > c.errorShare[q]; });
+  if (worst > 0 && !order.empty()) std::printf("largest shares of the error (block at pixel x, y: share, luminance against reference):\n");
+  for (std::size_t k = 0; k < order.size() && k < static_cast<std::size_t>(worst); ++k) {
+    std::size_t b = order[k];
+    int x = static_cast<int>(b % static_cast<std::size_t>(c.cols)) * block, y = static_cast<int>(b / static_cast<std::size_t>(c.cols)) * block;
+    std::printf("  %4d, %4d: %5.1f %%  %.4g against %.4g (%+.0f %%)\n", x, y, 100.0 * c.errorShare[b], c.lumA[b], c.lumRef[b],
+                c.lumRef[b] > 0 ? 100.0 * (c.lumA[b] / c.lumRef[b] - 1.0) : 0.0);
+  }
+  return 0;
+}
+
+}  // namespace retile::cli
