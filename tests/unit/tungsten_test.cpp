@@ -173,6 +173,23 @@ TEST(Tungsten, TexturePathsMatchCaseInsensitivelyWithEitherSeparator) {
   for (const auto& w : r->warnings) EXPECT_EQ(w.find("not found"), std::string::npos) << w;
 }
 
+TEST(Tungsten, AConstantSkyUnderEmissionsIsLeftOutAsTungstenLeavesItOut) {
+  // The spaceship's: Tungsten's reference shows black where a sky of 0.3 would be.
+  auto outside = importTungsten(writeScene(R"({"primitives": [{"type": "quad", "emission": 1}],
+      "emissions": [{"type": "constant", "radiance": 0.3, "sample": false}]})"));
+  ASSERT_TRUE(outside.ok()) << outside.error();
+  EXPECT_EQ(outside->scene.environment.type, EnvironmentType::Constant);
+  EXPECT_EQ(outside->scene.environment.color, Vec3(0.0f));
+  bool warned = false;
+  for (const auto& w : outside->warnings) warned = warned || w.find("emissions[0]: a constant sky") != std::string::npos;
+  EXPECT_TRUE(warned) << "the user is told what was left out and how to keep it";
+  // As a primitive, the same sky lights the scene.
+  auto inside = importTungsten(writeScene(R"({"primitives": [{"type": "quad", "emission": 1},
+      {"type": "infinite_sphere", "emission": 0.3}]})"));
+  ASSERT_TRUE(inside.ok()) << inside.error();
+  EXPECT_EQ(inside->scene.environment.color, Vec3(0.3f));
+}
+
 TEST(Tungsten, PowerBecomesRadianceByArea) {
   auto file = writeScene(R"({"primitives": [{"type": "quad", "transform": {"scale": [2, 1, 0.5]}, "power": 10}]})");
   auto r = importTungsten(file);

@@ -74,9 +74,20 @@ class TungstenImporter {
       if (!p->isArray()) return fail("primitives: expected an array");
       for (std::size_t i = 0; i < p->asArray().size() && ok(); ++i) primitive(p->asArray()[i], cat("primitives[", i, "]"));
     }
-    // Not Tungsten's own key, but Bitterli's living room names its sky this way.
+    // Not Tungsten's own key, but Bitterli's living room names its sky this way (an envmap; the
+    // room has no other light). Tungsten renders these files without a `constant` entry: the
+    // spaceship's constant sky of 0.3 is black in Tungsten's render, and lit the backdrop 60 to
+    // 150 times brighter here when it was honoured. So only environment maps are taken from it.
     if (const Value* e = root.find("emissions"); e && e->isArray() && ok())
-      for (std::size_t i = 0; i < e->asArray().size(); ++i) environmentEntry(e->asArray()[i], cat("emissions[", i, "]"));
+      for (std::size_t i = 0; i < e->asArray().size(); ++i) {
+        const Value& entry = e->asArray()[i];
+        if (entry.isObject() && string(entry, "type") == "constant") {
+          warn(cat("emissions[", i, "]: a constant sky outside \"primitives\" is left out, as Tungsten leaves it out "
+                   "(add an infinite_sphere primitive to light the scene with it)"));
+          continue;
+        }
+        environmentEntry(entry, cat("emissions[", i, "]"));
+      }
     if (!ok()) return R::failure(error_);
     if (s.objects.empty() && s.environment.type == EnvironmentType::Constant && maxComponent(s.environment.color) <= 0)
       return fail("the scene has no geometry and no light");
@@ -626,7 +637,7 @@ class TungstenImporter {
   void environmentEntry(const Value& v, const std::string& where) {
     if (!v.isObject()) return;
     std::string type = string(v, "type");
-    if (type == "envmap" || type == "infinite_sphere" || type == "constant") {
+    if (type == "envmap" || type == "infinite_sphere") {
       Vec3 rot{0.0f};
       if (const Value* t = v.find("transform"); t && t->isObject()) vec3(*t, "rotation", &rot, where);
       environmentFromEmission(v, where, rot);
