@@ -51,17 +51,9 @@ int selectionBase(int px, int py) {
 
 Material fetchMaterial(int index, vec2 uv) {
   int base = index * kMaterialTexels;
-  vec4 t0 = texelFetch(uMaterials, base), t1 = texelFetch(uMaterials, base + 1), t2 = texelFetch(uMaterials, base + 2);
-  vec4 t3 = texelFetch(uMaterials, base + 3), t4 = texelFetch(uMaterials, base + 4);
-  Material m;
-  m.type = floatBitsToInt(t0.w);
-  m.albedo = t0.rgb;
-  m.roughness = t1.x;
-  m.ior = t1.y;
-  m.fdrInt = t1.w;
-  m.eta = t2.xyz;
-  m.k = t3.xyz;
-  m.emission = t4.rgb;
+  vec4 t2 = texelFetch(uMaterials, base + 2), t3 = texelFetch(uMaterials, base + 3);
+  Material m = unpackMaterial(texelFetch(uMaterials, base), texelFetch(uMaterials, base + 1), t2, t3,
+                              texelFetch(uMaterials, base + 4));
   int albedoTex = floatBitsToInt(t2.w), roughTex = floatBitsToInt(t3.w);
   if (hasFeature(kFeatureTextures) && albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
   if (hasFeature(kFeatureTextures) && roughTex >= 0) m.roughness = max(m.roughness * sampleTexture(roughTex, uv).r, 1e-3);

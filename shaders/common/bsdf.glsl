@@ -28,6 +28,20 @@ struct Material {
   vec3 emission;
 };
 
+// The material's texels as render/render_scene.cpp packMaterial writes them, textures not applied.
+Material unpackMaterial(vec4 t0, vec4 t1, vec4 t2, vec4 t3, vec4 t4) {
+  Material m;
+  m.type = floatBitsToInt(t0.w);
+  m.albedo = t0.rgb;
+  m.roughness = t1.x;
+  m.ior = t1.y;
+  m.fdrInt = t1.w;
+  m.eta = t2.xyz;
+  m.k = t3.xyz;
+  m.emission = t4.rgb;
+  return m;
+}
+
 struct BsdfSample {
   vec3 wi;
   vec3 weight;  // f * |cos| / pdf

@@ -1,6 +1,7 @@
 #include "render/render_scene.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -297,32 +298,35 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
   }
 }
 
+std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture, int roughnessTexture, int alphaTexture) {
+  Vec3 eta = m.eta, k = m.k;
+  if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
+  int type = static_cast<int>(m.type);
+  // Keep roughness away from zero, where GGX turns into a delta the rough code cannot sample.
+  float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
+  if (m.type == MaterialType::RoughPlastic || m.type == MaterialType::RoughConductor || m.type == MaterialType::RoughDielectric)
+    roughness = std::max(roughness, 1e-3f);
+  if (m.type == MaterialType::OrenNayar) roughness = std::clamp(m.roughness, 0.0f, kPi / 2);
+  float ior = std::clamp(m.ior, 1.0001f, 10.0f);
+  // Diffuse light inside a plastic coating reflects back this fraction at the boundary
+  // (Jensen et al.'s polynomial fit of the internal diffuse Fresnel reflectance).
+  float fdrInt = -1.4399f / (ior * ior) + 0.7099f / ior + 0.6681f + 0.0636f * ior;
+  return {v4(max(m.albedo, Vec3{0.0f}), bitsOf(type)),
+          vec4{roughness, ior, std::clamp(m.alpha, 0.0f, 1.0f), std::clamp(fdrInt, 0.0f, 1.0f)},
+          v4(eta, bitsOf(albedoTexture)), v4(k, bitsOf(roughnessTexture)),
+          v4(max(m.emission, Vec3{0.0f}), bitsOf(alphaTexture))};
+}
+
 void RenderSceneBuilder::packMaterials(const Scene& scene) {
   data_.materials.clear();
   data_.materialTypes = 0;
   data_.materialTextures = false;
   materialIndex_.clear();
   auto pack = [&](const Material& m) {
-    Vec3 eta = m.eta, k = m.k;
-    if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
-    int type = static_cast<int>(m.type);
-    // Keep roughness away from zero, where GGX turns into a delta the rough code cannot sample.
-    float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
-    if (m.type == MaterialType::RoughPlastic || m.type == MaterialType::RoughConductor ||
-        m.type == MaterialType::RoughDielectric)
-      roughness = std::max(roughness, 1e-3f);
-    if (m.type == MaterialType::OrenNayar) roughness = std::clamp(m.roughness, 0.0f, kPi / 2);
-    data_.materials.push_back(v4(max(m.albedo, Vec3{0.0f}), bitsOf(type)));
-    data_.materialTypes |= 1u << type;
-    float ior = std::clamp(m.ior, 1.0001f, 10.0f);
-    // Diffuse light inside a plastic coating reflects back this fraction at the boundary
-    // (Jensen et al.'s polynomial fit of the internal diffuse Fresnel reflectance).
-    float fdrInt = -1.4399f / (ior * ior) + 0.7099f / ior + 0.6681f + 0.0636f * ior;
-    data_.materials.push_back({roughness, ior, std::clamp(m.alpha, 0.0f, 1.0f), std::clamp(fdrInt, 0.0f, 1.0f)});
+    data_.materialTypes |= 1u << static_cast<int>(m.type);
     if (textureIndex(m.albedoTexture) >= 0 || textureIndex(m.roughnessTexture) >= 0) data_.materialTextures = true;
-    data_.materials.push_back(v4(eta, bitsOf(textureIndex(m.albedoTexture))));
-    data_.materials.push_back(v4(k, bitsOf(textureIndex(m.roughnessTexture))));
-    data_.materials.push_back(v4(max(m.emission, Vec3{0.0f}), bitsOf(textureIndex(m.alphaTexture))));
+    auto texels = packMaterial(m, textureIndex(m.albedoTexture), textureIndex(m.roughnessTexture), textureIndex(m.alphaTexture));
+    data_.materials.insert(data_.materials.end(), texels.begin(), texels.end());
   };
   for (const Material& m : scene.materials) {
     materialIndex_[m.id] = static_cast<int>(data_.materials.size() / gpu::kMaterialTexels);

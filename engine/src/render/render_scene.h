@@ -8,6 +8,7 @@
 // Threads: owned and used by one thread (the render thread).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -24,6 +25,12 @@
 namespace retile {
 
 using gpu::vec4;
+
+// A material as the shaders read it (kMaterialTexels texels, unpacked by unpackMaterial in
+// shaders/common/bsdf.glsl), with its textures' indices (-1: none). Roughness and IOR are
+// clamped to what the BSDF code can sample.
+std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture = -1, int roughnessTexture = -1,
+                                                    int alphaTexture = -1);
 
 // Which arrays changed in the last update, so the uploader copies only those.
 enum DirtyArrays : std::uint32_t {
