@@ -667,15 +667,15 @@ TEST(EditorDefects, ThePixelFilterIsARenderSettingWithUndo) {
   w->findChild<QTreeWidget*>()->setCurrentItem(settings, 0, QItemSelectionModel::ClearAndSelect);
   auto* filter = w->findChild<QComboBox*>("pixelFilter");
   ASSERT_TRUE(filter);
-  EXPECT_EQ(filter->currentIndex(), static_cast<int>(PixelFilter::Box)) << "the built-in scene's";
-  filter->setCurrentIndex(static_cast<int>(PixelFilter::BlackmanHarris));
-  EXPECT_EQ(w->scene().settings.pixelFilter, PixelFilter::BlackmanHarris);
-  EXPECT_EQ(w->scene().settings.filterWidth, 1.5f) << "at its usual width";
+  EXPECT_EQ(filter->currentIndex(), static_cast<int>(PixelFilter::BlackmanHarris)) << "a new scene's, as Blender's";
+  filter->setCurrentIndex(static_cast<int>(PixelFilter::Tent));
+  EXPECT_EQ(w->scene().settings.pixelFilter, PixelFilter::Tent);
+  EXPECT_EQ(w->scene().settings.filterWidth, 2.0f) << "at its usual width";
   const std::uint64_t version = w->documentVersion();
   ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; }));
   w->undoStack()->undo();
-  EXPECT_EQ(w->scene().settings.pixelFilter, PixelFilter::Box);
-  EXPECT_EQ(w->scene().settings.filterWidth, 1.0f);
+  EXPECT_EQ(w->scene().settings.pixelFilter, PixelFilter::BlackmanHarris);
+  EXPECT_EQ(w->scene().settings.filterWidth, 1.5f);
 }
 
 }  // namespace

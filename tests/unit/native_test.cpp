@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <regex>
 
 #include "core/files.h"
 #include "retile/io.h"
@@ -65,6 +66,22 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.settings.filterWidth, 1.75f);
   // Saving what was loaded gives the same bytes.
   EXPECT_EQ(nativeSceneToString(s), nativeSceneToString(back->scene));
+}
+
+TEST(Native, NewScenesUseBlackmanHarrisAndOlderFilesKeepTheBox) {
+  EXPECT_EQ(makeDefaultScene().settings.pixelFilter, PixelFilter::BlackmanHarris);
+  EXPECT_EQ(makeDefaultScene().settings.filterWidth, 1.5f);
+  // A file saved before the pixel filter existed was rendered with a box: it still is.
+  std::string text = nativeSceneToString(makeDefaultScene());
+  text = std::regex_replace(text, std::regex(R"("pixel_filter": "[a-z_]+",\s*)"), "");
+  text = std::regex_replace(text, std::regex(R"(,\s*"filter_width": [0-9.]+)"), "");
+  ASSERT_EQ(text.find("filter"), std::string::npos) << text;
+  auto dir = test::tempDir();
+  std::ofstream(dir / "old.retile") << text;
+  auto old = loadNativeScene(dir / "old.retile");
+  ASSERT_TRUE(old.ok()) << old.error() << "\n" << text;
+  EXPECT_EQ(old->scene.settings.pixelFilter, PixelFilter::Box);
+  EXPECT_EQ(old->scene.settings.filterWidth, 1.0f);
 }
 
 TEST(Native, FailedSaveKeepsTheOldFile) {

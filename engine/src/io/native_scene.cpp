@@ -331,6 +331,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
     // Files from before the pixel filter have none: a box, as they were rendered.
     std::string filter;
     r.string("pixel_filter", &filter);
+    if (filter.empty()) s.settings.pixelFilter = PixelFilter::Box;
     if (!filter.empty() && !parsePixelFilter(filter, &s.settings.pixelFilter))
       r.problem("pixel_filter", cat("unknown filter '", filter, "' (box, tent, gaussian, blackman_harris)"));
     s.settings.filterWidth = defaultFilterWidth(s.settings.pixelFilter);
