@@ -179,6 +179,8 @@ TEST_F(Bsdfs, LosslessMaterialsKeepAllEnergy) {
     EXPECT_NEAR(sampledAlbedo(material(MaterialType::ThinSheet, 1.0f), wo).first, 1.0, 1e-4);
     EXPECT_NEAR(sampledAlbedo(material(MaterialType::Dielectric, 1.0f), wo).first, F + (1 - F) / (eta * eta), 0.003);
     EXPECT_NEAR(sampledAlbedo(material(MaterialType::Plastic, 1.0f), wo).first, 1.0, 0.01) << "cos " << cosO;
+    // Over a black base the coating reflects F alone: Tungsten's dielectric without refraction.
+    EXPECT_NEAR(sampledAlbedo(material(MaterialType::Plastic, 0.0f), wo).first, F, 1e-3) << "cos " << cosO;
   }
 }
 

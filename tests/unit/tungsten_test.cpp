@@ -190,6 +190,26 @@ TEST(Tungsten, AConstantSkyUnderEmissionsIsLeftOutAsTungstenLeavesItOut) {
   EXPECT_EQ(inside->scene.environment.color, Vec3(0.3f));
 }
 
+TEST(Tungsten, ADielectricWithoutRefractionIsAFresnelReflectorOnly) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [
+      {"name": "coat", "type": "dielectric", "ior": 1.33, "albedo": 0.7, "enable_refraction": false},
+      {"name": "frosted", "type": "rough_dielectric", "ior": 1.5, "roughness": 0.3, "enable_refraction": false},
+      {"name": "glass", "type": "dielectric", "ior": 1.5}],
+      "primitives": [{"type": "quad", "bsdf": "coat"}, {"type": "quad", "bsdf": "frosted"}, {"type": "quad", "bsdf": "glass"},
+                     {"type": "quad", "emission": 1}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  const Material* coat = s.material(s.objects[0].material);
+  EXPECT_EQ(coat->type, MaterialType::Plastic) << "a coating over black reflects F and transmits nothing";
+  EXPECT_EQ(coat->albedo, Vec3(0.0f));
+  EXPECT_EQ(coat->ior, 1.33f);
+  const Material* frosted = s.material(s.objects[1].material);
+  EXPECT_EQ(frosted->type, MaterialType::RoughPlastic);
+  EXPECT_EQ(frosted->roughness, 0.3f);
+  EXPECT_EQ(s.material(s.objects[2].material)->type, MaterialType::Dielectric);
+  for (const auto& w : r->warnings) EXPECT_EQ(w.find("refraction"), std::string::npos) << w;
+}
+
 TEST(Tungsten, PowerBecomesRadianceByArea) {
   auto file = writeScene(R"({"primitives": [{"type": "quad", "transform": {"scale": [2, 1, 0.5]}, "power": 10}]})");
   auto r = importTungsten(file);

@@ -320,13 +320,17 @@ class TungstenImporter {
       roughness(0.1f);
     } else if (type == "mirror") {
       m.type = MaterialType::Mirror;
-    } else if (type == "dielectric") {
-      m.type = MaterialType::Dielectric;
-      if (const Value* e = v.find("enable_refraction"); e && e->isBool() && !e->asBool())
-        warn(cat(where, ": dielectric without refraction is rendered as glass"));
-    } else if (type == "rough_dielectric") {
-      m.type = MaterialType::RoughDielectric;
-      roughness(0.1f);
+    } else if (type == "dielectric" || type == "rough_dielectric") {
+      const bool rough = type == "rough_dielectric";
+      m.type = rough ? MaterialType::RoughDielectric : MaterialType::Dielectric;
+      if (rough) roughness(0.1f);
+      if (const Value* e = v.find("enable_refraction"); e && e->isBool() && !e->asBool()) {
+        // Tungsten's dielectric without refraction reflects F (white) and transmits nothing:
+        // exactly a coating over a black base.
+        m.type = rough ? MaterialType::RoughPlastic : MaterialType::Plastic;
+        m.albedo = Vec3{0.0f};
+        m.albedoTexture = kNoNode;
+      }
     } else if (type == "thinsheet") {
       m.type = MaterialType::ThinSheet;
     } else if (type == "null") {
