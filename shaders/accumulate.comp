@@ -18,6 +18,9 @@ layout(set = 0, binding = 3, std430) readonly buffer Aux { vec4 aux[]; };
 layout(set = 0, binding = 4, std430) buffer Accum { vec4 accum[]; };
 // Per pixel (kAuxVec4s): [0] albedo sum.rgb, depth; [1] normal sum.xyz, instance id; [2] emission sum.rgb, -.
 layout(set = 0, binding = 5, std430) buffer AccumAux { vec4 accumAux[]; };
+// Verified reuse (reuse.comp): the part of the accumulation that is history; bound only when
+// push.hasHistory is set.
+layout(set = 0, binding = 6, std430) buffer History { vec4 history[]; };
 
 layout(push_constant) uniform Push { AccumulatePush push; };
 
@@ -73,6 +76,11 @@ void main() {
   }
 
   bool restart = (item.info.w & kWorkRestart) != 0u;
+  if (restart && push.hasHistory != 0u) {
+    // A restart starts from nothing: no history either.
+    history[pixel * 2u] = vec4(0.0);
+    history[pixel * 2u + 1u] = vec4(0.0);
+  }
   vec4 acc = restart ? vec4(0.0) : accum[pixel * 2u];
   vec4 comp = restart ? vec4(0.0) : accum[pixel * 2u + 1u];
   vec4 aa = restart ? vec4(0.0, 0.0, 0.0, 1e30) : accumAux[pixel * kAuxVec4s];
@@ -82,6 +90,14 @@ void main() {
     // Smooth transition: the stale sums keep the weight of at most `cap` samples, so the old
     // image fades out in a known number of frames instead of after as many as it had samples.
     float keep = float(item.pixels.y) / acc.w;
+    if (push.hasHistory != 0u) {
+      // The history is part of the sums: it fades with them, so fresh = sums - history still holds.
+      vec4 h0 = history[pixel * 2u], h1 = history[pixel * 2u + 1u];
+      if (h0.w > 0.0) {
+        history[pixel * 2u] = h0 * keep;
+        history[pixel * 2u + 1u] = h1 * keep;
+      }
+    }
     acc = vec4(acc.rgb * keep, float(item.pixels.y));
     comp *= keep;
     aa.rgb *= keep;

@@ -132,7 +132,25 @@ struct AccumulatePush {
   uint pixelOffset;  // first (item, pixel) of this dispatch, in the items' pixel order
   uint pixelCount;
   uint itemCount;
-  uint pad;
+  uint hasHistory;   // the history buffer is bound (verified reuse): the stale cap scales it too
+};
+
+// Verified reuse (reuse.comp, schedule/reuse.h): per pixel, the history is a copy of the
+// accumulation's two vec4 as they were when an edit restarted the pixel's tile; the accumulation
+// then holds history + fresh, so fresh = accumulation - history. Each item applies one operation
+// to a rectangle before the frame's samples are accumulated.
+struct ReuseItem {
+  ivec4 rect;   // x0, y0, width, height
+  uvec4 info;   // operation, pixelStart (prefix of width * height over items), -, -
+};
+RT_CONST(uint, kReuseStart, 1u)   // no history: keep the accumulation as the history; else go back to it
+RT_CONST(uint, kReuseReject, 2u)  // drop the history from the accumulation, keep the fresh samples
+RT_CONST(uint, kReuseDrop, 3u)    // forget the history (the accumulation restarts anyway)
+
+struct ReusePush {
+  uint pixelCount;
+  uint itemCount;
+  uint pad0, pad1;
 };
 
 // The denoiser (denoise_*.comp) and the compositor (compose.comp). Per tile, a code says what the

@@ -102,6 +102,51 @@ TEST(AccumulatePass, StaleCapKeepsAtMostCapSamplesOfTheOldValue) {
   EXPECT_FLOAT_EQ(img.color[0], 14.0f / 8.0f);
 }
 
+TEST(ReusePass, KeepsTheHistoryInsideTheSumsGoesBackToItAndDropsItExactly) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const int w = 16, h = 8;
+  Scene s = wallScene(w, h, Vec3{1.0f});
+  r->setScene(s);
+  r->resize(w, h);
+  r->renderFrame({{0, 0, w, h, 4, 0, true}});  // 4 samples of 1 everywhere
+  EXPECT_TRUE(r->readback().history.empty()) << "no history until reuse asks for one";
+  s.materials[0].emission = Vec3{2.0f};
+  r->updateScene(s, kUpdateMaterials | kUpdateLights);
+  // The left half's tile restarts with reuse: its 4 samples become the history, 3 fresh ones add.
+  FrameOptions start;
+  start.reuse = {{0, 0, 8, h, FrameOptions::Reuse::Start}};
+  r->renderFrame({{0, 0, 8, h, 3, 4, false}}, start);
+  RenderImage img = r->readback();
+  ASSERT_EQ(img.history.size(), static_cast<std::size_t>(w * h * 3));
+  EXPECT_EQ(img.sampleCount[0], 7.0f);
+  EXPECT_FLOAT_EQ(img.color[0], 10.0f / 7.0f) << "the pooled mean of history and fresh";
+  EXPECT_EQ(img.history[0], 4.0f);
+  EXPECT_FLOAT_EQ(img.history[1], 1.0f) << "the history's luminance";
+  EXPECT_FLOAT_EQ(img.history[2], 1.0f) << "and its mean square";
+  EXPECT_EQ(img.history[static_cast<std::size_t>(15) * 3], 0.0f) << "the right half keeps none";
+  // A second edit in the burst: the tile goes back to the history, then adds 2 samples of 4.
+  s.materials[0].emission = Vec3{4.0f};
+  r->updateScene(s, kUpdateMaterials | kUpdateLights);
+  r->renderFrame({{0, 0, 8, h, 2, 7, false}}, start);
+  img = r->readback();
+  EXPECT_EQ(img.sampleCount[0], 6.0f);
+  EXPECT_FLOAT_EQ(img.color[0], 12.0f / 6.0f) << "4 of the history and 2 of the latest state, none of the burst's";
+  // Rejected: the history leaves the sums; the fresh samples stay, and this frame's add.
+  FrameOptions reject;
+  reject.reuse = {{0, 0, 8, h, FrameOptions::Reuse::Reject}};
+  r->renderFrame({{0, 0, 8, h, 1, 9, false}}, reject);
+  img = r->readback();
+  EXPECT_EQ(img.sampleCount[0], 3.0f);
+  EXPECT_FLOAT_EQ(img.color[0], 4.0f);
+  EXPECT_EQ(img.history[0], 0.0f);
+  EXPECT_FLOAT_EQ(img.moment2[0], 16.0f) << "the second moment loses the history's squares too";
+  // A plain restart forgets any history.
+  r->renderFrame({{0, 0, w, h, 1, 10, false}}, start);
+  r->renderFrame({{0, 0, w, h, 1, 11, true}});
+  img = r->readback();
+  for (std::size_t i = 0; i < static_cast<std::size_t>(w * h); ++i) ASSERT_EQ(img.history[i * 3], 0.0f);
+}
+
 TEST(TracePass, ProbeFramesAreTracedButNotAccumulated) {
   RETILE_RENDERER_OR_SKIP(r);
   const int w = 12, h = 6;

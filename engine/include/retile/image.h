@@ -27,6 +27,9 @@ struct RenderImage {
   // (DenoiseWork). Empty when nothing was composed: then `color` is what is shown.
   std::vector<float> display;
   const std::vector<float>& shown() const { return display.empty() ? color : display; }
+  // Verified reuse: per pixel the history kept inside the accumulation (schedule/reuse.h) as
+  // sample count, luminance mean and mean squared luminance (3 floats); empty when none is kept.
+  std::vector<float> history;
 };
 
 struct DisplaySettings {

@@ -67,6 +67,13 @@ struct FrameOptions {
   // Fixed by tests and benchmarks: which invocation traces a sample never changes its value.
   int pathsPerInvocation = 0;
   DenoiseWork denoise;  // after accumulating (a probe composes nothing)
+  // Verified reuse (schedule/reuse.h): operations on the history of these rectangles, applied
+  // before the frame's samples are accumulated; a rectangle may appear once per frame.
+  struct Reuse {
+    int x = 0, y = 0, width = 0, height = 0;
+    enum Op { Start = 1, Reject = 2, Drop = 3 } op = Start;
+  };
+  std::vector<Reuse> reuse;
 };
 
 // Per tile of the counting tile size, summed over frames until read: primary hits on the selected

@@ -70,6 +70,7 @@ struct Renderer::Impl {
   std::map<std::tuple<bool, std::uint32_t, std::uint32_t>, std::unique_ptr<vk::ComputePipeline>> traceVariants;
   vk::ComputePipeline* trace = nullptr;
   std::unique_ptr<vk::ComputePipeline> accumulate;
+  std::unique_ptr<vk::ComputePipeline> reusePass;  // created with the history, on first use
   Denoiser denoiser{ctx};
   bool displayCurrent = false;  // the denoiser's display matches the accumulation (readback takes it)
   RenderSceneBuilder builder;
@@ -77,6 +78,7 @@ struct Renderer::Impl {
   Buffer frameUbo, work, stats, selection;
   Buffer traversal, triShade, instances, materials, texInfo, texels, emitters, alias, delta, envCdf;
   Buffer samples, aux, accum, accumAux;
+  Buffer history, reuseItems;  // verified reuse: allocated on first use, dropped on resize
 
   Camera camera;
   int width = 0, height = 0;
@@ -103,6 +105,7 @@ struct Renderer::Impl {
     bool completed = false;
     bool hasImage = false;
     bool hasDisplay = false;
+    bool hasHistory = false;
     int width = 0, height = 0;
     Buffer image;                   // host-visible copies: accumulation, its auxiliary part, the display
     std::vector<NodeId> objects;    // instance -> object when submitted (edits may follow)
@@ -118,7 +121,7 @@ struct Renderer::Impl {
     accumulate = std::make_unique<vk::ComputePipeline>(
         ctx, "accumulate.comp",
         std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::Storage, Binding::Storage, Binding::Storage,
-                             Binding::Storage},
+                             Binding::Storage, Binding::Storage},
         static_cast<std::uint32_t>(sizeof(gpu::AccumulatePush)));
     frameUbo = Buffer(ctx, sizeof(gpu::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                       true, "frame constants");
@@ -236,7 +239,52 @@ struct Renderer::Impl {
     if (accum.valid()) {
       a.bind(4, accum);
       a.bind(5, accumAux);
+      // Without a history the shader never reads binding 6; it still needs a buffer.
+      a.bind(6, history.valid() ? history : accum);
     }
+    if (reusePass && history.valid()) {
+      reusePass->bind(0, frameUbo);
+      reusePass->bind(1, reuseItems);
+      reusePass->bind(2, accum);
+      reusePass->bind(3, history);
+      reusePass->bind(4, accumAux);
+    }
+  }
+
+  // The reuse pass's items for this frame (clipped to the image); allocates the history on first
+  // use. Returns the number of pixels they cover.
+  std::uint64_t prepareReuse(const std::vector<FrameOptions::Reuse>& ops, std::vector<gpu::ReuseItem>& items) {
+    std::uint64_t pixels = 0;
+    for (const auto& r : ops) {
+      int x0 = std::max(r.x, 0), y0 = std::max(r.y, 0);
+      int x1 = std::min(r.x + r.width, width), y1 = std::min(r.y + r.height, height);
+      if (x1 <= x0 || y1 <= y0) continue;
+      gpu::ReuseItem it{};
+      it.rect = {x0, y0, x1 - x0, y1 - y0};
+      it.info = {static_cast<std::uint32_t>(r.op), static_cast<std::uint32_t>(pixels), 0, 0};
+      pixels += static_cast<std::uint64_t>(x1 - x0) * static_cast<std::uint64_t>(y1 - y0);
+      items.push_back(it);
+    }
+    if (items.empty()) return 0;
+    bool rebind = false;
+    if (!history.valid()) {
+      const VkDeviceSize bytes = static_cast<VkDeviceSize>(width) * static_cast<VkDeviceSize>(height) * 2 * sizeof(gpu::vec4);
+      history = Buffer(ctx, bytes, kStorageUsage, false, "reuse history");
+      ctx.submitAndWait([&](VkCommandBuffer cb) { vkCmdFillBuffer(cb, history.handle(), 0, VK_WHOLE_SIZE, 0); });
+      if (!reusePass)
+        reusePass = std::make_unique<vk::ComputePipeline>(
+            ctx, "reuse.comp", std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::Storage, Binding::Storage, Binding::Storage},
+            static_cast<std::uint32_t>(sizeof(gpu::ReusePush)));
+      rebind = true;
+    }
+    const VkDeviceSize bytes = items.size() * sizeof(gpu::ReuseItem);
+    if (reuseItems.size() < bytes) {
+      reuseItems = Buffer(ctx, bytes * 2, kStorageUsage, true, "reuse items");
+      rebind = true;
+    }
+    if (rebind) bindAll();
+    reuseItems.upload(items.data(), bytes);
+    return pixels;
   }
 
   void ensureSampleCapacity(std::uint64_t slots) {
@@ -257,6 +305,7 @@ struct Renderer::Impl {
     // Written by the accumulate pass, read by the denoiser through texel views.
     constexpr VkBufferUsageFlags kAccumUsage = kStorageUsage | kTexelUsage;
     accum = Buffer(ctx, pixels * 2 * sizeof(gpu::vec4), kAccumUsage, false, "accumulation");
+    history = Buffer();  // a resize keeps no samples, so no history either
     accumAux = Buffer(ctx, pixels * gpu::kAuxVec4s * sizeof(gpu::vec4), kAccumUsage, false, "auxiliary accumulation");
     ctx.submitAndWait([&](VkCommandBuffer cb) {
       vkCmdFillBuffer(cb, accum.handle(), 0, VK_WHOLE_SIZE, 0);
@@ -413,6 +462,8 @@ struct Renderer::Impl {
       stats.upload(zero, sizeof zero);
       invocations = traceInvocations(slots, iterationsPerPath, options.pathsPerInvocation);
     }
+    std::vector<gpu::ReuseItem> reuse;
+    const std::uint64_t reusePixels = options.accumulate ? prepareReuse(options.reuse, reuse) : 0;
     lastItems = items;
     const bool compose = options.denoise.compose && options.accumulate;
     if (compose) denoiser.prepare(options.denoise);
@@ -425,6 +476,7 @@ struct Renderer::Impl {
     slot.completed = false;
     slot.hasImage = copyImage;
     slot.hasDisplay = copyImage && displayCurrent;
+    slot.hasHistory = copyImage && history.valid();
     slot.width = width;
     slot.height = height;
     slot.stats = FrameStats{};
@@ -434,13 +486,22 @@ struct Renderer::Impl {
     const VkDeviceSize imageBytes = pixelCount * 2 * sizeof(gpu::vec4);
     const VkDeviceSize auxBytes = pixelCount * gpu::kAuxVec4s * sizeof(gpu::vec4);
     const VkDeviceSize displayBytes = pixelCount * sizeof(gpu::vec4);
+    const VkDeviceSize historyBytes = slot.hasHistory ? imageBytes : 0;
     if (copyImage) {
-      if (!slot.image.valid() || slot.image.size() != imageBytes + auxBytes + displayBytes)
-        slot.image = Buffer(ctx, imageBytes + auxBytes + displayBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, "image read-back");
+      const VkDeviceSize total = imageBytes + auxBytes + displayBytes + historyBytes;
+      if (!slot.image.valid() || slot.image.size() != total)
+        slot.image = Buffer(ctx, total, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, "image read-back");
       slot.objects = builder.data().instanceObject;
     }
     slot.submitted = std::chrono::steady_clock::now();
     ctx.submit([&](VkCommandBuffer cb) {
+      if (reusePixels > 0) {
+        gpu::ReusePush rp{static_cast<std::uint32_t>(reusePixels), static_cast<std::uint32_t>(reuse.size()), 0, 0};
+        std::uint32_t gy;
+        std::uint32_t gx = groupsFor(reusePixels, gpu::kAccumulateWorkgroup, &gy);
+        reusePass->dispatch(cb, gx, gy, &rp, sizeof rp);
+        vk::computeBarrier(cb);
+      }
       if (!items.empty()) {
         // A slot the trace pass does not reach (its invocation ran out of loop budget) must read
         // as weight 0, not as the last frame's sample.
@@ -451,7 +512,8 @@ struct Renderer::Impl {
         std::uint32_t gx = groupsFor(invocations, gpu::kTraceWorkgroup, &gy);
         trace->dispatch(cb, gx, gy, &tp, sizeof tp);
         vk::computeBarrier(cb);
-        gpu::AccumulatePush ap{0, static_cast<std::uint32_t>(pixels), static_cast<std::uint32_t>(items.size()), 0};
+        gpu::AccumulatePush ap{0, static_cast<std::uint32_t>(pixels), static_cast<std::uint32_t>(items.size()),
+                               history.valid() ? 1u : 0u};
         gx = groupsFor(pixels, gpu::kAccumulateWorkgroup, &gy);
         if (options.accumulate) accumulate->dispatch(cb, gx, gy, &ap, sizeof ap);
       }
@@ -467,6 +529,10 @@ struct Renderer::Impl {
         if (slot.hasDisplay) {
           VkBufferCopy d{0, imageBytes + auxBytes, displayBytes};
           vkCmdCopyBuffer(cb, denoiser.display().handle(), slot.image.handle(), 1, &d);
+        }
+        if (slot.hasHistory) {
+          VkBufferCopy h{0, imageBytes + auxBytes + displayBytes, historyBytes};
+          vkCmdCopyBuffer(cb, history.handle(), slot.image.handle(), 1, &h);
         }
       }
     });
@@ -510,8 +576,10 @@ struct Renderer::Impl {
     auto n = static_cast<std::size_t>(slot.width) * static_cast<std::size_t>(slot.height);
     // Read through the mapping: the slot is not touched by the frame now in flight.
     const auto* acc = static_cast<const gpu::vec4*>(slot.image.mapped());
-    return convert(acc, acc + n * 2, slot.hasDisplay ? acc + n * (2 + gpu::kAuxVec4s) : nullptr, slot.width, slot.height,
-                   slot.objects);
+    RenderImage img = convert(acc, acc + n * 2, slot.hasDisplay ? acc + n * (2 + gpu::kAuxVec4s) : nullptr, slot.width,
+                              slot.height, slot.objects);
+    if (slot.hasHistory) img.history = convertHistory(acc + n * (3 + gpu::kAuxVec4s), n);
+    return img;
   }
 
   RenderImage readback() {
@@ -525,8 +593,28 @@ struct Renderer::Impl {
       shown.resize(n);
       denoiser.display().download(shown.data(), n * sizeof(gpu::vec4));
     }
-    return convert(acc.data(), ax.data(), displayCurrent ? shown.data() : nullptr, width, height,
-                   builder.data().instanceObject);
+    RenderImage img = convert(acc.data(), ax.data(), displayCurrent ? shown.data() : nullptr, width, height,
+                              builder.data().instanceObject);
+    if (history.valid()) {
+      std::vector<gpu::vec4> h(n * 2);
+      history.download(h.data(), h.size() * sizeof(gpu::vec4));
+      img.history = convertHistory(h.data(), n);
+    }
+    return img;
+  }
+
+  // Per pixel [sum.rgb count, compensation.rgb squares] to count, luminance mean, mean square.
+  static std::vector<float> convertHistory(const gpu::vec4* h, std::size_t n) {
+    std::vector<float> out(n * 3);
+    for (std::size_t i = 0; i < n; ++i) {
+      const gpu::vec4& s = h[i * 2];
+      const gpu::vec4& c = h[i * 2 + 1];
+      const double inv = s.w > 0 ? 1.0 / s.w : 0.0;
+      out[i * 3] = s.w;
+      out[i * 3 + 1] = static_cast<float>((0.2126 * (double(s.x) - c.x) + 0.7152 * (double(s.y) - c.y) + 0.0722 * (double(s.z) - c.z)) * inv);
+      out[i * 3 + 2] = static_cast<float>(c.w * inv);
+    }
+    return out;
   }
 
   // Per pixel: accumulation [sum.rgb count, compensation.rgb squares] and auxiliary [albedo.rgb

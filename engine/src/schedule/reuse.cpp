@@ -1,0 +1,58 @@
+#include "schedule/reuse.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace retile {
+
+double normalQuantileTwoSided(double p) {
+  p = std::clamp(p, 1e-300, 1.0);
+  // Solve erfc(z / sqrt 2) = p by bisection: monotone, and exact to the double's precision.
+  double lo = 0.0, hi = 40.0;
+  for (int i = 0; i < 200; ++i) {
+    double mid = 0.5 * (lo + hi);
+    if (std::erfc(mid / std::sqrt(2.0)) > p) lo = mid; else hi = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+ReuseTest testReuse(const std::vector<LuminanceSums>& fresh, const std::vector<LuminanceSums>& history, int width,
+                    int height, double falseRejectRate) {
+  ReuseTest out;
+  const int bx = (width + 3) / 4, by = (height + 3) / 4;
+  // Per block and for the whole tile: the summed difference and its variance.
+  std::vector<double> diff(static_cast<std::size_t>(bx * by) + 1, 0.0), var(diff.size(), 0.0);
+  const std::size_t whole = diff.size() - 1;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+      const LuminanceSums& f = fresh[i];
+      const LuminanceSums& h = history[i];
+      if (f.count < 1 || h.count < 2) continue;
+      const double hm = h.sum / h.count;
+      const double s2 = std::max(h.squares / h.count - hm * hm, 0.0) * h.count / (h.count - 1);
+      const double d = f.sum / f.count - hm;
+      const double v = s2 * (1.0 / f.count + 1.0 / h.count);
+      const std::size_t b = static_cast<std::size_t>((y / 4) * bx + x / 4);
+      for (std::size_t k : {b, whole}) {
+        diff[k] += d;
+        var[k] += v;
+      }
+      ++out.pixels;
+    }
+  int tests = 0;
+  for (std::size_t k = 0; k < diff.size(); ++k) {
+    if (var[k] <= 0.0) {
+      // No noise in the history (a flat colour): any difference beyond rounding is a change.
+      if (std::abs(diff[k]) > 1e-6) out.statistic = std::numeric_limits<double>::infinity();
+      continue;
+    }
+    ++tests;
+    out.statistic = std::max(out.statistic, std::abs(diff[k]) / std::sqrt(var[k]));
+  }
+  out.threshold = normalQuantileTwoSided(falseRejectRate / std::max(tests, 1));
+  return out;
+}
+
+}  // namespace retile
