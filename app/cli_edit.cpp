@@ -32,7 +32,7 @@ void usage(const std::string& error) {
                "usage: retile edit SCENE --script EDITS.json --method NAME --out-dir DIR [--size WxH] [--tile T]\n"
                "                   [--quality Q|auto] [--smooth] [--stale-cap N] [--converge SPP] [--max-bounces B]\n"
                "                   [--reference SPP] [--block B] [--threshold REL] [--no-images]\n"
-               "                   [--denoise [--denoise-threshold PX] [--no-soft-borders]]\n"
+               "                   [--denoise [--denoise-threshold PX] [--no-soft-borders]] [--reuse [--reuse-rate A]]\n"
                "methods:");
   for (const auto& n : methodNames()) std::fprintf(stderr, " %s", n.c_str());
   std::fprintf(stderr, "\n");
@@ -43,8 +43,8 @@ void usage(const std::string& error) {
 int runEdit(const std::vector<std::string>& argv) {
   auto args = parseArgs(argv,
                         {"--script", "--method", "--out-dir", "--size", "--tile", "--quality", "--stale-cap", "--converge",
-                         "--max-bounces", "--reference", "--block", "--threshold", "--denoise-threshold"},
-                        {"--smooth", "--no-images", "--denoise", "--no-soft-borders"});
+                         "--max-bounces", "--reference", "--block", "--threshold", "--denoise-threshold", "--reuse-rate"},
+                        {"--smooth", "--no-images", "--denoise", "--no-soft-borders", "--reuse"});
   if (!args) return usage(args.error()), 2;
   if (args->positional.size() != 1 || !args->has("--script") || !args->has("--method") || !args->has("--out-dir"))
     return usage("SCENE, --script, --method and --out-dir are required"), 2;
@@ -77,6 +77,13 @@ int runEdit(const std::vector<std::string>& argv) {
   }
   method.smooth = args->has("--smooth");
   method.denoise = args->has("--denoise");
+  method.reuse = args->has("--reuse");
+  if (args->has("--reuse-rate")) {
+    if (!method.reuse) return usage("--reuse-rate goes with --reuse"), 2;
+    auto v = parseNumber("--reuse-rate", args->get("--reuse-rate"), 1e-12, 0.49);
+    if (!v) return usage(v.error()), 2;
+    method.reuseFalseReject = v.value();
+  }
   method.softBorders = !args->has("--no-soft-borders");
   if (!method.denoise && (args->has("--denoise-threshold") || args->has("--no-soft-borders")))
     return usage("--denoise-threshold and --no-soft-borders go with --denoise"), 2;
@@ -170,7 +177,7 @@ int runEdit(const std::vector<std::string>& argv) {
   std::ofstream csv(outDir / "frames.csv");
   csv << "frame,step,method,mode,samples,tiles_served,queue_left,quality,ms,schedule_ms,trace_ms,rel_rmse,"
          "denoise_regions,denoise_width,denoise_height,psnr,ssim,psnr_hvs_m,rmse_affected,rmse_rest,psnr_affected,"
-         "psnr_rest\n";
+         "psnr_rest,reused_tiles,rejected_tiles\n";
   const int total = scenario->totalFrames();
   int frame = 0, lastEditFrame = 0, settledFrame = -1;
   double sumScheduleMs = 0;
@@ -213,11 +220,11 @@ int runEdit(const std::vector<std::string>& argv) {
                       rootMeanSquaredError(a, r), psnr(a, r));
       scores = q;
     }
-    std::snprintf(line, sizeof line, "%d,%zu,%s,%s,%llu,%zu,%zu,%d,%.3f,%.4f,%.3f,%s,%zu,%d,%d,%s\n", frame, sub.step,
+    std::snprintf(line, sizeof line, "%d,%zu,%s,%s,%llu,%zu,%zu,%d,%.3f,%.4f,%.3f,%s,%zu,%d,%d,%s,%d,%d\n", frame, sub.step,
                   rec.method.c_str(), rec.mode.c_str(), static_cast<unsigned long long>(rec.samples), rec.servedTiles.size(),
                   rec.queueLength - rec.queueServed, rec.quality, rec.frameMs, rec.scheduleMs, rec.traceMs,
                   std::isnan(err) ? "" : std::to_string(err).c_str(), rec.denoised.size(), outer.width, outer.height,
-                  scores.c_str());
+                  scores.c_str(), rec.reusedTiles, rec.rejectedTiles);
     csv << line;
     if (images && rec.image) {
       char name[64];

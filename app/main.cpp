@@ -18,7 +18,7 @@ void usage() {
                "                      [--view Standard|Filmic] [--exposure STOPS] [--denoise]\n"
                "  retile edit SCENE --script EDITS.json --method NAME --out-dir DIR [--size WxH] [--tile T]\n"
                "                    [--quality Q|auto] [--smooth] [--stale-cap N] [--converge SPP] [--reference SPP]\n"
-               "                    [--denoise [--denoise-threshold PX] [--no-soft-borders]] [--no-images]\n"
+               "                    [--denoise [--denoise-threshold PX] [--no-soft-borders]] [--reuse [--reuse-rate A]] [--no-images]\n"
                "  retile eval [SCENE ...] --out-dir DIR [--quick] [--size WxH] [--methods LIST] [--scenarios LIST]\n"
                "                    [--script FILE ...] [--reference-spp N] [--every K] [--converge SPP] [--target REL]\n"
                "  retile eval [SCENE ...] --stability --out-dir DIR [--quick] [--size WxH] [--cases LIST] [--methods LIST]\n"

@@ -117,13 +117,14 @@ TEST(ReusePass, KeepsTheHistoryInsideTheSumsGoesBackToItAndDropsItExactly) {
   start.reuse = {{0, 0, 8, h, FrameOptions::Reuse::Start}};
   r->renderFrame({{0, 0, 8, h, 3, 4, false}}, start);
   RenderImage img = r->readback();
-  ASSERT_EQ(img.history.size(), static_cast<std::size_t>(w * h * 3));
+  constexpr std::size_t k = RenderImage::kHistoryFloats;
+  ASSERT_EQ(img.history.size(), static_cast<std::size_t>(w * h) * k);
   EXPECT_EQ(img.sampleCount[0], 7.0f);
   EXPECT_FLOAT_EQ(img.color[0], 10.0f / 7.0f) << "the pooled mean of history and fresh";
   EXPECT_EQ(img.history[0], 4.0f);
-  EXPECT_FLOAT_EQ(img.history[1], 1.0f) << "the history's luminance";
-  EXPECT_FLOAT_EQ(img.history[2], 1.0f) << "and its mean square";
-  EXPECT_EQ(img.history[static_cast<std::size_t>(15) * 3], 0.0f) << "the right half keeps none";
+  EXPECT_FLOAT_EQ(img.history[1], 1.0f) << "the history's red";
+  EXPECT_FLOAT_EQ(img.history[4], 1.0f) << "and its mean square";
+  EXPECT_EQ(img.history[15 * k], 0.0f) << "the right half keeps none";
   // A second edit in the burst: the tile goes back to the history, then adds 2 samples of 4.
   s.materials[0].emission = Vec3{4.0f};
   r->updateScene(s, kUpdateMaterials | kUpdateLights);
@@ -144,7 +145,7 @@ TEST(ReusePass, KeepsTheHistoryInsideTheSumsGoesBackToItAndDropsItExactly) {
   r->renderFrame({{0, 0, w, h, 1, 10, false}}, start);
   r->renderFrame({{0, 0, w, h, 1, 11, true}});
   img = r->readback();
-  for (std::size_t i = 0; i < static_cast<std::size_t>(w * h); ++i) ASSERT_EQ(img.history[i * 3], 0.0f);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(w * h); ++i) ASSERT_EQ(img.history[i * k], 0.0f);
 }
 
 TEST(TracePass, ProbeFramesAreTracedButNotAccumulated) {

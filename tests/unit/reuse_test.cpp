@@ -20,6 +20,7 @@ std::vector<LuminanceSums> sums(std::mt19937& rng, int w, int h, double mean, do
       p.count += 1;
       p.sum += x;
       p.squares += x * x;
+      for (double& c : p.rgb) c += x;  // grey
     }
   return out;
 }
@@ -73,8 +74,25 @@ TEST(Reuse, AChangeInOneBlockIsFoundWhereTheTileAverageWouldHideIt) {
       auto& p = f[static_cast<std::size_t>(y * 16 + x)];
       p.squares = p.squares * 1.69;
       p.sum *= 1.3;
+      for (double& c : p.rgb) c *= 1.3;
     }
   EXPECT_TRUE(testReuse(f, h, 16, 16, 1e-4).reject());
+}
+
+TEST(Reuse, AChangeOfHueAtEqualLuminanceIsFound) {
+  // Red becomes a green-blue of the same luminance: the luminance test alone would keep it.
+  std::mt19937 rng(13);
+  auto h = sums(rng, 16, 16, 0.25, 0.1, 256);
+  auto f = sums(rng, 16, 16, 0.25, 0.1, 32);
+  const double red[3] = {0.25 / 0.2126, 0, 0}, teal[3] = {0, 0.25 / (0.7152 + 0.0722) * 1.0, 0.25 / (0.7152 + 0.0722)};
+  for (auto* v : {&h, &f})
+    for (auto& p : *v)
+      for (int c = 0; c < 3; ++c) p.rgb[c] = p.sum * (v == &h ? red[c] : teal[c]);
+  EXPECT_TRUE(testReuse(f, h, 16, 16, 1e-4).reject());
+  // The same colour on both sides is kept.
+  for (auto& p : f)
+    for (int c = 0; c < 3; ++c) p.rgb[c] = p.sum * red[c];
+  EXPECT_FALSE(testReuse(f, h, 16, 16, 1e-4).reject());
 }
 
 TEST(Reuse, PixelsWithoutSamplesTakeNoPart) {

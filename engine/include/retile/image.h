@@ -28,7 +28,9 @@ struct RenderImage {
   std::vector<float> display;
   const std::vector<float>& shown() const { return display.empty() ? color : display; }
   // Verified reuse: per pixel the history kept inside the accumulation (schedule/reuse.h) as
-  // sample count, luminance mean and mean squared luminance (3 floats); empty when none is kept.
+  // sample count, mean R, G, B and mean squared luminance (kHistoryFloats floats); empty when none
+  // is kept.
+  static constexpr std::size_t kHistoryFloats = 5;
   std::vector<float> history;
 };
 

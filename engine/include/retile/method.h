@@ -44,6 +44,11 @@ struct MethodSettings {
   int denoiseThreshold = 200;
   bool softBorders = true;  // with denoise: seams between tiles showing different things blend
   static constexpr int kFeatherPixels = 4;  // over this many pixels each side
+  // Verified reuse (schedule/reuse.h): a restarted tile keeps its samples beside the fresh ones
+  // while a test finds them in agreement. The false-reject rate is the chance that one test of
+  // an unchanged tile drops its history.
+  bool reuse = false;
+  double reuseFalseReject = 1e-4;
 };
 
 // "spiral", "spiral+smooth", "global+denoise", "indirection+focus+smooth+denoise": the method and

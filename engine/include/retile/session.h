@@ -57,6 +57,11 @@ struct FrameRecord {
   std::vector<int> servedTiles;       // tiles traced this frame, in order
   RegionRect region;                  // the render region (empty: the whole image is rendered)
   std::vector<DenoisedRegion> denoised;  // stacked denoised regions, oldest (innermost) first; empty: none
+  // Verified reuse, per tile (empty without reuse): 0 no history, 1 reusing its history, 2 history
+  // rejected; and for rejected tiles the frame that rejected it (else 0).
+  std::vector<std::uint8_t> tileReuse;
+  std::vector<std::uint64_t> tileRejectedAt;
+  int reusedTiles = 0, rejectedTiles = 0;
   std::size_t queueLength = 0;        // tiles in the current pass
   std::size_t queueServed = 0;        // tiles of the pass finished
   std::uint64_t samples = 0;          // samples traced this frame: always width x height

@@ -603,16 +603,18 @@ struct Renderer::Impl {
     return img;
   }
 
-  // Per pixel [sum.rgb count, compensation.rgb squares] to count, luminance mean, mean square.
+  // Per pixel [sum.rgb count, compensation.rgb squares] to count, mean RGB, mean square.
   static std::vector<float> convertHistory(const gpu::vec4* h, std::size_t n) {
-    std::vector<float> out(n * 3);
+    constexpr std::size_t k = RenderImage::kHistoryFloats;
+    std::vector<float> out(n * k);
     for (std::size_t i = 0; i < n; ++i) {
       const gpu::vec4& s = h[i * 2];
       const gpu::vec4& c = h[i * 2 + 1];
       const double inv = s.w > 0 ? 1.0 / s.w : 0.0;
-      out[i * 3] = s.w;
-      out[i * 3 + 1] = static_cast<float>((0.2126 * (double(s.x) - c.x) + 0.7152 * (double(s.y) - c.y) + 0.0722 * (double(s.z) - c.z)) * inv);
-      out[i * 3 + 2] = static_cast<float>(c.w * inv);
+      out[i * k] = s.w;
+      for (int ch = 0; ch < 3; ++ch)
+        out[i * k + 1 + static_cast<std::size_t>(ch)] = static_cast<float>((double((&s.x)[ch]) - (&c.x)[ch]) * inv);
+      out[i * k + 4] = static_cast<float>(c.w * inv);
     }
     return out;
   }

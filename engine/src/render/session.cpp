@@ -10,6 +10,7 @@
 #include "schedule/denoise_regions.h"
 #include "schedule/planner.h"
 #include "schedule/policies.h"
+#include "schedule/reuse.h"
 #include "schedule/scheduler.h"
 
 namespace retile {
@@ -78,6 +79,88 @@ struct RenderSession::Impl {
   std::shared_ptr<const RenderImage> lastImage;
   std::uint64_t lastImageFrame = 0;  // the frame lastImage shows the accumulation after
   RegionRect region;  // the render region in pixels (empty: the whole image)
+  // Verified reuse, per tile: its state, the frame of its last restart with reuse (a test of
+  // samples read back before it is about the previous edit and is ignored) and of its rejection;
+  // tiles the last read-back rejected, applied with the next frame.
+  std::vector<TileReuse> reuse;
+  std::vector<std::uint64_t> reuseStarted, reuseRejectedAt;
+  std::vector<int> pendingRejects;
+
+  void resetReuse() {
+    const auto n = static_cast<std::size_t>(scheduler.grid().count());
+    reuse.assign(n, TileReuse::None);
+    reuseStarted.assign(n, 0);
+    reuseRejectedAt.assign(n, 0);
+    pendingRejects.clear();
+  }
+
+  // Restarts of a pass keep their tiles' samples as history; a global update drops every history
+  // (its restarts do, in the accumulate pass); rejections found in the last read-back apply.
+  void planReuse(FramePlan& plan, std::vector<TileWork>& work, FrameOptions& options, std::uint64_t frameNumber) {
+    if (reuse.size() != static_cast<std::size_t>(scheduler.grid().count())) resetReuse();
+    if (plan.mode == AccumMode::GlobalUpdate) {
+      resetReuse();
+      return;
+    }
+    const TileGrid& grid = scheduler.grid();
+    std::vector<char> started(reuse.size(), 0);
+    for (std::size_t i = 0; i < plan.chunks.size(); ++i) {
+      const TileChunk& c = plan.chunks[i];
+      if (!c.restart) continue;
+      work[i].restart = false;
+      options.reuse.push_back({c.rect.x, c.rect.y, c.rect.width, c.rect.height, FrameOptions::Reuse::Start});
+      auto t = static_cast<std::size_t>(c.tile);
+      started[t] = 1;
+      reuse[t] = TileReuse::Reusing;
+      reuseStarted[t] = frameNumber;
+      reuseRejectedAt[t] = 0;
+    }
+    for (int tile : pendingRejects) {
+      auto t = static_cast<std::size_t>(tile);
+      if (started[t] || reuse[t] != TileReuse::Reusing) continue;  // a new edit's history replaces the verdict
+      TileRect r = grid.rect(tile);
+      options.reuse.push_back({r.x, r.y, r.width, r.height, FrameOptions::Reuse::Reject});
+      reuse[t] = TileReuse::Rejected;
+      reuseRejectedAt[t] = frameNumber;
+    }
+    pendingRejects.clear();
+  }
+
+  // Tests every tile that reuses its history against the fresh samples the image holds.
+  void testReuse(const RenderImage& img, std::uint64_t imageFrame, double falseRejectRate) {
+    if (img.history.empty() || img.width != width || img.height != height) return;
+    const TileGrid& grid = scheduler.grid();
+    std::vector<LuminanceSums> fresh, hist;
+    for (int t = 0; t < grid.count(); ++t) {
+      auto ti = static_cast<std::size_t>(t);
+      if (ti >= reuse.size() || reuse[ti] != TileReuse::Reusing || reuseStarted[ti] >= imageFrame + 1) continue;
+      TileRect r = grid.rect(t);
+      fresh.assign(static_cast<std::size_t>(r.pixels()), {});
+      hist.assign(fresh.size(), {});
+      for (int y = 0; y < r.height; ++y)
+        for (int x = 0; x < r.width; ++x) {
+          const std::size_t p = static_cast<std::size_t>(r.y + y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(r.x + x);
+          const std::size_t k = static_cast<std::size_t>(y * r.width + x);
+          constexpr std::size_t kh = RenderImage::kHistoryFloats;
+          const float* hp = &img.history[p * kh];
+          const float* c = &img.color[p * 3];
+          const double n = img.sampleCount[p], m = hp[0];
+          LuminanceSums& H = hist[k];
+          LuminanceSums& F = fresh[k];
+          H.count = m;
+          H.sum = (0.2126 * hp[1] + 0.7152 * hp[2] + 0.0722 * hp[3]) * m;
+          H.squares = hp[4] * m;
+          F.count = n - m;
+          F.sum = (0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]) * n - H.sum;
+          F.squares = img.moment2[p] * n - H.squares;
+          for (int ch = 0; ch < 3; ++ch) {
+            H.rgb[ch] = hp[1 + ch] * m;
+            F.rgb[ch] = c[ch] * n - H.rgb[ch];
+          }
+        }
+      if (retile::testReuse(fresh, hist, r.width, r.height, falseRejectRate).reject()) pendingRejects.push_back(t);
+    }
+  }
 
   explicit Impl(const RendererOptions& o) : renderer(o) {}
 
@@ -101,6 +184,7 @@ struct RenderSession::Impl {
     planner.setGrid(grid);
     denoise.reset(grid);
     batch.clear();  // measured on the old grid; the reset restarts everything anyway
+    resetReuse();
   }
 
   void execute(const Plan& p) {
@@ -415,11 +499,13 @@ void RenderSession::submitFrame(bool readImage) {
   FrameOptions options;
   options.accumulate = plan.mode != AccumMode::Probe;
   if (method().denoise) options.denoise = d.denoiseWork(plan.mode, d.frame + 1, method());
+  if (method().reuse && options.accumulate) d.planReuse(plan, work, options, d.frame + 1);
   Impl::Pending p;
   p.mode = plan.mode;
   p.counting = d.planner.countThisFrame(plan.mode);
   if (p.counting) options.selectionTileSize = grid.tileSize();
-  p.readImage = readImage;
+  // Verified reuse tests the samples of every frame while a tile reuses its history.
+  p.readImage = readImage || (method().reuse && std::find(d.reuse.begin(), d.reuse.end(), TileReuse::Reusing) != d.reuse.end());
   p.start = start;
 
   FrameRecord& rec = p.rec;
@@ -447,6 +533,15 @@ void RenderSession::submitFrame(bool readImage) {
   if (method().denoise)
     for (const DenoiseRegion& r : d.lastRegions)
       rec.denoised.push_back({RegionRect{r.rect.x, r.rect.y, r.rect.width, r.rect.height}, rec.frame - r.frame});
+  if (method().reuse) {
+    rec.tileReuse.reserve(d.reuse.size());
+    for (TileReuse r : d.reuse) {
+      rec.tileReuse.push_back(static_cast<std::uint8_t>(r));
+      rec.reusedTiles += r == TileReuse::Reusing;
+      rec.rejectedTiles += r == TileReuse::Rejected;
+    }
+    rec.tileRejectedAt = d.reuseRejectedAt;
+  }
   rec.queueLength = d.scheduler.queueLength();
   rec.queueServed = d.scheduler.queueServed();
   rec.scheduleMs = msSince(start);
@@ -469,6 +564,7 @@ FrameRecord RenderSession::finishFrame() {
     d.lastImage = std::make_shared<RenderImage>(d.renderer.frameImage(p.ticket));
     d.lastImageFrame = rec.frame;
     rec.image = d.lastImage;
+    if (method().reuse) d.testReuse(*d.lastImage, rec.frame, method().reuseFalseReject);
   }
   rec.readbackMs = msSince(readStart);
   rec.frameMs = msSince(p.start);

@@ -27,6 +27,7 @@ std::vector<std::string> methodNames() { return {std::begin(kNames), std::end(kN
 std::string methodLabel(const MethodSettings& s) {
   std::string label = methodName(s.kind);
   if (s.smooth && s.kind != MethodKind::Global) label += "+smooth";
+  if (s.reuse) label += "+reuse";
   if (s.denoise) label += "+denoise";
   return label;
 }
@@ -41,6 +42,9 @@ std::string validateMethodSettings(const MethodSettings& s) {
   for (const auto& f : s.focus)
     if (!(f.pixel.x == f.pixel.x) || !(f.pixel.y == f.pixel.y)) return "a focus point is NaN";
   if (s.indirectionFrames < 1 || s.indirectionFrames > 64) return "indirection frames must be 1..64";
+  if (s.reuse && s.kind == MethodKind::Global) return "reuse keeps what an edit did not change: it needs an incremental method, not global";
+  if (!(s.reuseFalseReject > 0.0 && s.reuseFalseReject < 0.5))
+    return cat("the reuse false-reject rate must be in (0, 0.5), not ", s.reuseFalseReject);
   if (s.denoiseThreshold < 0 || s.denoiseThreshold > 16384) return cat("denoise threshold must be 0..16384 pixels, not ", s.denoiseThreshold);
   return {};
 }

@@ -21,9 +21,10 @@ ReuseTest testReuse(const std::vector<LuminanceSums>& fresh, const std::vector<L
                     int height, double falseRejectRate) {
   ReuseTest out;
   const int bx = (width + 3) / 4, by = (height + 3) / 4;
-  // Per block and for the whole tile: the summed difference and its variance.
-  std::vector<double> diff(static_cast<std::size_t>(bx * by) + 1, 0.0), var(diff.size(), 0.0);
-  const std::size_t whole = diff.size() - 1;
+  // Per block and for the whole tile, per quantity (luminance, R, G, B): the summed difference
+  // and its variance.
+  const std::size_t groups = static_cast<std::size_t>(bx * by) + 1, whole = groups - 1;
+  std::vector<double> diff(groups * 4, 0.0), var(groups * 4, 0.0);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
@@ -32,20 +33,26 @@ ReuseTest testReuse(const std::vector<LuminanceSums>& fresh, const std::vector<L
       if (f.count < 1 || h.count < 2) continue;
       const double hm = h.sum / h.count;
       const double s2 = std::max(h.squares / h.count - hm * hm, 0.0) * h.count / (h.count - 1);
-      const double d = f.sum / f.count - hm;
-      const double v = s2 * (1.0 / f.count + 1.0 / h.count);
-      const std::size_t b = static_cast<std::size_t>((y / 4) * bx + x / 4);
-      for (std::size_t k : {b, whole}) {
-        diff[k] += d;
-        var[k] += v;
+      const double w = 1.0 / f.count + 1.0 / h.count;
+      double d[4] = {f.sum / f.count - hm, 0, 0, 0}, v[4] = {s2 * w, 0, 0, 0};
+      for (int c = 0; c < 3; ++c) {
+        const double hc = h.rgb[c] / h.count;
+        d[c + 1] = f.rgb[c] / f.count - hc;
+        v[c + 1] = hm > 0.0 ? s2 * w * (hc / hm) * (hc / hm) : 0.0;
       }
+      const std::size_t b = static_cast<std::size_t>((y / 4) * bx + x / 4);
+      for (std::size_t g : {b, whole})
+        for (std::size_t q = 0; q < 4; ++q) {
+          diff[g * 4 + q] += d[q];
+          var[g * 4 + q] += v[q];
+        }
       ++out.pixels;
     }
   int tests = 0;
   for (std::size_t k = 0; k < diff.size(); ++k) {
     if (var[k] <= 0.0) {
       // No noise in the history (a flat colour): any difference beyond rounding is a change.
-      if (std::abs(diff[k]) > 1e-6) out.statistic = std::numeric_limits<double>::infinity();
+      if (std::abs(diff[k]) > 1e-6 * (1.0 + std::abs(diff[k]))) out.statistic = std::numeric_limits<double>::infinity();
       continue;
     }
     ++tests;

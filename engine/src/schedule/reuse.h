@@ -9,14 +9,16 @@
 // history (its second moment less its mean squared: under "nothing changed" the fresh samples
 // have the same variance, and the history's estimate of it rests on many samples),
 //     z = sum_p (f_p - h_p) / sqrt(sum_p s_p^2 (1/n_p + 1/m_p))
-// over the block's pixels with fresh samples. The history is rejected when |z| of the tile or of
-// any block exceeds the two-sided normal quantile of alpha / (2 * tests) (Bonferroni over the
-// tile's tests), alpha being the false-reject rate: the chance that one test of an unchanged tile
-// drops its history. A kept history that is off by d (in luminance) is found once
-// sqrt(n) d / s passes the threshold: the test's power grows with the fresh count n, so any real
-// change is found eventually. While kept, the shown mean is (m h + n f) / (m + n); its error from a
-// kept history is at most m / (m + n) times the largest difference the test lets pass,
-// z * s * sqrt(1/n + 1/m) (docs/ARCHITECTURE.md states the bound).
+// over the block's pixels with fresh samples; and the same for each of R, G and B, whose variance
+// is taken as the luminance's scaled by (channel mean / luminance mean)^2 (only luminance has a
+// second moment; a change of hue at equal luminance would pass a luminance test). The history is
+// rejected when |z| of the tile or of any block exceeds the two-sided normal quantile of
+// alpha / tests (Bonferroni over the tile's tests), alpha being the false-reject rate: the chance
+// that one test of an unchanged tile drops its history. A kept history that is off by d (in
+// luminance) is found once sqrt(n) d / s passes the threshold: the test's power grows with the
+// fresh count n, so any real change is found eventually. While kept, the shown mean is
+// (m h + n f) / (m + n); its error from a kept history is at most m / (m + n) times the largest
+// difference the test lets pass, z * s * sqrt(1/n + 1/m) (docs/ARCHITECTURE.md states the bound).
 #pragma once
 
 #include <cstdint>
@@ -26,9 +28,10 @@
 
 namespace retile {
 
-// A pixel's luminance sums: samples, their sum and the sum of their squares.
+// A pixel's sums: samples, the sum of their luminance and of its square, the sums of R, G, B.
 struct LuminanceSums {
   double count = 0, sum = 0, squares = 0;
+  double rgb[3] = {0, 0, 0};
 };
 
 struct ReuseTest {
