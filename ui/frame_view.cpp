@@ -352,6 +352,29 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
       p.drawText(rr.adjusted(4, 3 + 11 * (i % 2), -4, -3), Qt::AlignTop | Qt::AlignLeft, tr("%1").arg(d.age));
     }
   }
+  if (overlays_.reuse && static_cast<int>(f.tileReuse.size()) == tiles) {
+    // Reusing: a green corner mark, so the picture stays readable; rejected: red hatching with
+    // the frames since the rejection.
+    const QColor keep(90, 230, 120), drop(255, 70, 70);
+    for (int t = 0; t < tiles; ++t) {
+      const QRectF box = tileRect(t);
+      const auto state = f.tileReuse[static_cast<std::size_t>(t)];
+      if (state == 1) {
+        const double k = std::min(box.width(), box.height()) * 0.3;
+        QPolygonF corner({box.topRight(), box.topRight() + QPointF(-k, 0), box.topRight() + QPointF(0, k)});
+        p.setPen(Qt::NoPen);
+        p.setBrush(keep);
+        p.drawPolygon(corner);
+      } else if (state == 2) {
+        p.fillRect(box, QBrush(drop, Qt::FDiagPattern));
+        p.setPen(QPen(drop, 1.0));
+        p.setBrush(Qt::NoBrush);
+        p.drawRect(box.adjusted(1, 1, -1, -1));
+        const std::uint64_t at = t < static_cast<int>(f.tileRejectedAt.size()) ? f.tileRejectedAt[static_cast<std::size_t>(t)] : 0;
+        if (at > 0 && f.frame >= at) label(box.adjusted(2, 1, -2, -1), Qt::AlignLeft | Qt::AlignBottom, QString::number(f.frame - at));
+      }
+    }
+  }
   if (overlays_.markers) {
     QPointF poc(r.x() + f.pointOfChange.x * sx, r.y() + f.pointOfChange.y * sy);
     p.setPen(QPen(QColor(255, 60, 60), 2.5));
@@ -392,6 +415,10 @@ std::vector<FrameView::LegendRow> FrameView::legendRows() const {
   if (overlays_.denoised && !f.denoised.empty())
     rows.push_back({QColor::fromHsvF(0.08, 1.0, 1.0),
                     tr("dashed: %n denoised region(s), labelled frames since", nullptr, static_cast<int>(f.denoised.size()))});
+  if (overlays_.reuse && !f.tileReuse.empty()) {
+    rows.push_back({QColor(90, 230, 120), tr("corner: %n tile(s) reusing their history", nullptr, f.reusedTiles)});
+    rows.push_back({QColor(255, 70, 70), tr("hatched: %n history(ies) rejected, frames since", nullptr, f.rejectedTiles)});
+  }
   rows.push_back({Qt::lightGray, tr("%1, %2: %3/%4 tiles").arg(QString::fromStdString(f.method), QString::fromStdString(f.mode))
                                      .arg(f.queueServed).arg(f.queueLength)});
   return rows;

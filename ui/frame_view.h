@@ -28,6 +28,7 @@ struct OverlaySettings {
   bool legend = true;
   bool classes = false;   // indirection classes: high, middle, low (indirection methods only)
   bool denoised = true;   // the denoised regions' boundaries, labelled with their age
+  bool reuse = true;      // verified reuse: tiles reusing their history, tiles whose history was rejected
 };
 
 class FrameView : public QWidget {

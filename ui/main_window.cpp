@@ -260,6 +260,7 @@ void MainWindow::buildMenus() {
   toggle(tr("Tiles served this &frame"), &OverlaySettings::served);
   toggle(tr("Point of change and &focus points"), &OverlaySettings::markers);
   toggle(tr("&Denoised regions"), &OverlaySettings::denoised);
+  toggle(tr("&Reused and rejected histories"), &OverlaySettings::reuse);
   toggle(tr("&Legend"), &OverlaySettings::legend);
 
   QMenu* tools = menuBar()->addMenu(tr("&Tools"));
@@ -455,6 +456,12 @@ void MainWindow::buildDocks() {
   focusModeBox_->setToolTip(tr("Focus points (up to 3) for the focus methods. Shift+click adds one; 'follows the cursor' "
                                "stands in for an eye tracker."));
   auto* clearFocus = new QPushButton(tr("Clear focus points"), methodBox);
+  reuseBox_ = new QCheckBox(tr("reuse verified samples"), methodBox);
+  reuseBox_->setObjectName("reuse");
+  reuseBox_->setChecked(method_.reuse);
+  reuseBox_->setToolTip(tr("After an edit, a re-rendered tile keeps its converged samples while a test finds the fresh ones "
+                           "in agreement with them, and drops them for good the moment they disagree. Not with the "
+                           "global method."));
   denoiseBox_ = new QCheckBox(tr("denoise"), methodBox);
   denoiseBox_->setObjectName("denoise");
   denoiseBox_->setChecked(method_.denoise);
@@ -479,6 +486,7 @@ void MainWindow::buildDocks() {
   mf->addRow(tr("Stale cap C"), staleBox_);
   mf->addRow(tr("Focus"), focusModeBox_);
   mf->addRow(QString(), clearFocus);
+  mf->addRow(QString(), reuseBox_);
   mf->addRow(QString(), denoiseBox_);
   mf->addRow(tr("Denoise threshold"), denoiseThresholdBox_);
   mf->addRow(QString(), softBordersBox_);
@@ -489,6 +497,7 @@ void MainWindow::buildDocks() {
   connect(smoothBox_, &QCheckBox::toggled, this, [this] { sendMethod(); });
   connect(staleBox_, &QSpinBox::valueChanged, this, [this] { sendMethod(); });
   connect(denoiseBox_, &QCheckBox::toggled, this, [this] { sendMethod(); });
+  connect(reuseBox_, &QCheckBox::toggled, this, [this] { sendMethod(); });
   connect(denoiseThresholdBox_, &QSpinBox::valueChanged, this, [this] { sendMethod(); });
   connect(softBordersBox_, &QCheckBox::toggled, this, [this] { sendMethod(); });
   connect(clearFocus, &QPushButton::clicked, this, [this] {
@@ -620,6 +629,8 @@ void MainWindow::sendMethod() {
   m.smooth = smoothBox_->isChecked();
   m.staleCap = staleBox_->value();
   m.denoise = denoiseBox_->isChecked();
+  m.reuse = reuseBox_->isChecked() && m.kind != MethodKind::Global;
+  reuseBox_->setEnabled(m.kind != MethodKind::Global);
   m.denoiseThreshold = denoiseThresholdBox_->value();
   m.softBorders = softBordersBox_->isChecked();
   staleBox_->setEnabled(m.smooth);

@@ -150,6 +150,7 @@ class MainWindow : public QMainWindow {
   bool panelEdit_ = false;  // the edit being applied comes from the properties panel itself
   QSet<QString> loggedWarnings_;  // of the current document: each is logged once
   QCheckBox* denoiseBox_ = nullptr;
+  QCheckBox* reuseBox_ = nullptr;
   QSpinBox* denoiseThresholdBox_ = nullptr;
   QCheckBox* softBordersBox_ = nullptr;
   QLabel* status_ = nullptr;

@@ -203,6 +203,47 @@ TEST(Editor, OverlaysDrawOverTheImage) {
   EXPECT_GT(changed, drawn.width() * drawn.height() / 10) << "the heat map covers the queued tiles";
 }
 
+TEST(Editor, ReuseReachesTheEngineAndTheOverlayShowsReusedAndRejectedTiles) {
+  auto w = makeWindow();  // 96 x 54
+  auto* reuse = w->findChild<QCheckBox*>("reuse");
+  ASSERT_TRUE(reuse);
+  reuse->setChecked(true);
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.method == "spiral+reuse" && f.mode == "refinement"; }));
+  // Let the picture converge a little, then recolour the cup: its tiles disagree with their
+  // history, most of the rest agree.
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 40; }));
+  NodeId cup = objectNamed(w->scene(), "Cup");
+  const NodeId mat = w->scene().object(cup)->material;
+  Material before = *w->scene().material(mat), after = before;
+  after.albedo = Vec3{0.05f, 0.9f, 0.1f};
+  w->edit(SetMaterial{before}, SetMaterial{after}, "recolour");
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.reusedTiles > 0 && f.rejectedTiles > 0; }))
+      << "tiles away from the cup keep their history, the cup's lose it";
+  const FrameRecord f = *w->viewport()->frame();
+  ASSERT_EQ(f.tileReuse.size(), static_cast<std::size_t>(f.cols * f.rows));
+
+  OverlaySettings off{false, false, false, false, false, false};
+  off.denoised = false;
+  off.reuse = false;
+  OverlaySettings shown = off;
+  shown.reuse = true;
+  w->viewport()->showFrame(w->viewport()->frame());
+  w->viewport()->setOverlays(off);
+  QImage plain = w->viewport()->composed();
+  w->viewport()->setOverlays(shown);
+  QImage drawn = w->viewport()->composed();
+  int green = 0, red = 0;
+  for (int y = 0; y < drawn.height(); ++y)
+    for (int x = 0; x < drawn.width(); ++x) {
+      QColor a = plain.pixelColor(x, y), b = drawn.pixelColor(x, y);
+      if (a == b) continue;
+      green += b.green() > 200 && b.red() < 120;
+      red += b.red() > 200 && b.green() < 100;
+    }
+  EXPECT_GT(green, 20) << "reusing tiles are marked";
+  EXPECT_GT(red, 20) << "rejected tiles are hatched";
+}
+
 TEST(Editor, TheDenoiseSettingsReachTheEngineAndTheRegionBoundariesDraw) {
   auto w = makeWindow();  // 96 x 54
   auto* denoise = w->findChild<QCheckBox*>("denoise");
