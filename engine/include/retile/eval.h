@@ -59,7 +59,7 @@ NodeId pickSubject(const Scene& scene);
 // "spiral", "global+denoise", "indirection+focus+smooth" (methodLabel's names) to settings:
 // indirection methods take automatic Q, as the editor offers them.
 Result<MethodSettings> parseMethodLabel(const std::string& label);
-// global, spiral, focus, indirection, change, spiral+smooth, global+denoise, spiral+denoise.
+// global, spiral, focus, indirection, change, spiral+smooth, global+denoise, spiral+denoise, spiral+reuse.
 std::vector<std::string> defaultMethods();
 
 // A scenario played on a copy of the scene, frame by frame, without rendering.

@@ -38,7 +38,8 @@ Options Options::quick() {
 std::vector<std::string> builtInScenarioNames() { return {"fig6", "material", "light", "camera", "drag"}; }
 
 std::vector<std::string> defaultMethods() {
-  return {"global", "spiral", "focus", "indirection", "change", "spiral+smooth", "global+denoise", "spiral+denoise"};
+  return {"global",         "spiral",         "focus",         "indirection", "change", "spiral+smooth",
+          "global+denoise", "spiral+denoise", "spiral+reuse"};
 }
 
 Result<MethodSettings> parseMethodLabel(const std::string& label) {
@@ -55,8 +56,9 @@ Result<MethodSettings> parseMethodLabel(const std::string& label) {
   for (std::size_t i = 1; i < parts.size(); ++i) {
     if (parts[i] == "smooth") m.smooth = true;
     else if (parts[i] == "denoise") m.denoise = true;
+    else if (parts[i] == "reuse") m.reuse = true;
     else if (parts[i] == "focus" && m.kind == MethodKind::Indirection) m.kind = MethodKind::IndirectionFocus;
-    else return R::failure(cat("unknown option '", parts[i], "' in method '", label, "' (smooth, denoise)"));
+    else return R::failure(cat("unknown option '", parts[i], "' in method '", label, "' (smooth, denoise, reuse)"));
   }
   if (m.kind == MethodKind::Indirection || m.kind == MethodKind::IndirectionFocus) m.quality = 0;
   if (std::string bad = validateMethodSettings(m); !bad.empty()) return R::failure(cat(label, ": ", bad));

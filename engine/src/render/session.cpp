@@ -85,12 +85,15 @@ struct RenderSession::Impl {
   std::vector<TileReuse> reuse;
   std::vector<std::uint64_t> reuseStarted, reuseRejectedAt;
   std::vector<int> pendingRejects;
+  std::uint64_t pass = 0;               // counts the passes started (execute)
+  std::vector<std::uint64_t> reusePass; // per tile: the pass that last started its history
 
   void resetReuse() {
     const auto n = static_cast<std::size_t>(scheduler.grid().count());
     reuse.assign(n, TileReuse::None);
     reuseStarted.assign(n, 0);
     reuseRejectedAt.assign(n, 0);
+    reusePass.assign(n, 0);
     pendingRejects.clear();
   }
 
@@ -106,10 +109,18 @@ struct RenderSession::Impl {
     std::vector<char> started(reuse.size(), 0);
     for (std::size_t i = 0; i < plan.chunks.size(); ++i) {
       const TileChunk& c = plan.chunks[i];
-      if (!c.restart) continue;
-      work[i].restart = false;
-      options.reuse.push_back({c.rect.x, c.rect.y, c.rect.width, c.rect.height, FrameOptions::Reuse::Start});
       auto t = static_cast<std::size_t>(c.tile);
+      // With reuse, the smooth transition's stale tiles keep their verified history instead of
+      // a capped one: their first serve in the pass starts the history like a restart.
+      if (c.capStale > 0 && !c.restart) {
+        work[i].capStale = 0;
+        if (reusePass[t] == pass) continue;
+      } else if (!c.restart) {
+        continue;
+      }
+      work[i].restart = false;
+      reusePass[t] = pass;
+      options.reuse.push_back({c.rect.x, c.rect.y, c.rect.width, c.rect.height, FrameOptions::Reuse::Start});
       started[t] = 1;
       reuse[t] = TileReuse::Reusing;
       reuseStarted[t] = frameNumber;
@@ -131,6 +142,8 @@ struct RenderSession::Impl {
     if (img.history.empty() || img.width != width || img.height != height) return;
     const TileGrid& grid = scheduler.grid();
     std::vector<LuminanceSums> fresh, hist;
+    std::vector<ReuseTest> tested(static_cast<std::size_t>(grid.count()));
+    std::vector<int> kept;
     for (int t = 0; t < grid.count(); ++t) {
       auto ti = static_cast<std::size_t>(t);
       if (ti >= reuse.size() || reuse[ti] != TileReuse::Reusing || reuseStarted[ti] >= imageFrame + 1) continue;
@@ -158,8 +171,28 @@ struct RenderSession::Impl {
             F.rgb[ch] = c[ch] * n - H.rgb[ch];
           }
         }
-      if (retile::testReuse(fresh, hist, r.width, r.height, falseRejectRate).reject()) pendingRejects.push_back(t);
+      tested[ti] = retile::testReuse(fresh, hist, r.width, r.height, falseRejectRate);
+      if (tested[ti].reject()) pendingRejects.push_back(t);
+      else kept.push_back(t);
     }
+    // Changes too small for one tile: each kept tile pooled with its kept neighbours, then all
+    // the kept tiles together (a light a few per cent brighter changes every lit tile a little).
+    std::vector<int> more;
+    for (int t : kept) {
+      std::vector<const ReuseTest*> pool;
+      const int cx = t % grid.cols(), cy = t / grid.cols();
+      for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, grid.rows() - 1); ++y)
+        for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, grid.cols() - 1); ++x) {
+          const auto n = static_cast<std::size_t>(y * grid.cols() + x);
+          if (tested[n].pixels > 0 && !tested[n].reject()) pool.push_back(&tested[n]);
+        }
+      if (pool.size() > 1 && testPooled(pool, falseRejectRate).reject()) more.push_back(t);
+    }
+    std::vector<const ReuseTest*> all;
+    for (int t : kept)
+      if (std::find(more.begin(), more.end(), t) == more.end()) all.push_back(&tested[static_cast<std::size_t>(t)]);
+    if (all.size() > 1 && testPooled(all, falseRejectRate).reject()) more = kept;
+    pendingRejects.insert(pendingRejects.end(), more.begin(), more.end());
   }
 
   explicit Impl(const RendererOptions& o) : renderer(o) {}
@@ -194,6 +227,7 @@ struct RenderSession::Impl {
       case PlanKind::Probe: scheduler.probe(); break;
       case PlanKind::Pass:
         scheduler.startPass(p.order, p.quality, p.prioritized, p.smooth, p.staleCap);
+        ++pass;
         leading.assign(static_cast<std::size_t>(scheduler.grid().count()), 0);
         for (int i = 0; i < p.leading && i < static_cast<int>(p.order.size()); ++i)
           leading[static_cast<std::size_t>(p.order[static_cast<std::size_t>(i)])] = 1;
@@ -546,7 +580,7 @@ void RenderSession::submitFrame(bool readImage) {
   rec.queueServed = d.scheduler.queueServed();
   rec.scheduleMs = msSince(start);
 
-  p.ticket = d.renderer.submitFrame(work, options, readImage);
+  p.ticket = d.renderer.submitFrame(work, options, p.readImage);
   d.pending.push_back(std::move(p));
 }
 

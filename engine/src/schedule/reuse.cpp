@@ -48,6 +48,10 @@ ReuseTest testReuse(const std::vector<LuminanceSums>& fresh, const std::vector<L
         }
       ++out.pixels;
     }
+  for (std::size_t q = 0; q < 4; ++q) {
+    out.diff[q] = diff[whole * 4 + q];
+    out.var[q] = var[whole * 4 + q];
+  }
   int tests = 0;
   for (std::size_t k = 0; k < diff.size(); ++k) {
     if (var[k] <= 0.0) {
@@ -57,6 +61,24 @@ ReuseTest testReuse(const std::vector<LuminanceSums>& fresh, const std::vector<L
     }
     ++tests;
     out.statistic = std::max(out.statistic, std::abs(diff[k]) / std::sqrt(var[k]));
+  }
+  out.threshold = normalQuantileTwoSided(falseRejectRate / std::max(tests, 1));
+  return out;
+}
+
+ReuseTest testPooled(const std::vector<const ReuseTest*>& tiles, double falseRejectRate) {
+  ReuseTest out;
+  for (const ReuseTest* t : tiles)
+    for (int q = 0; q < 4; ++q) {
+      out.diff[q] += t->diff[q];
+      out.var[q] += t->var[q];
+      out.pixels += q == 0 ? t->pixels : 0;
+    }
+  int tests = 0;
+  for (int q = 0; q < 4; ++q) {
+    if (out.var[q] <= 0.0) continue;
+    ++tests;
+    out.statistic = std::max(out.statistic, std::abs(out.diff[q]) / std::sqrt(out.var[q]));
   }
   out.threshold = normalQuantileTwoSided(falseRejectRate / std::max(tests, 1));
   return out;

@@ -38,6 +38,9 @@ struct ReuseTest {
   double statistic = 0;  // the largest |z| of the tile and its blocks
   double threshold = 0;  // the rejection threshold for this tile's number of tests
   int pixels = 0;        // pixels with both fresh samples and a history
+  // The whole tile's summed differences and their variances (luminance, R, G, B), for pooling
+  // with other tiles.
+  double diff[4] = {0, 0, 0, 0}, var[4] = {0, 0, 0, 0};
   bool reject() const { return statistic > threshold; }
 };
 
@@ -48,6 +51,11 @@ double normalQuantileTwoSided(double p);
 // without fresh samples or without a history take no part.
 ReuseTest testReuse(const std::vector<LuminanceSums>& fresh, const std::vector<LuminanceSums>& history, int width,
                     int height, double falseRejectRate);
+
+// Pools tiles' whole-tile sums into one test (luminance, R, G, B; Bonferroni over the four): a
+// change too small for any one tile's test, spread over many tiles (a light a few per cent
+// brighter), is found by the pool of a tile's neighbourhood or of the whole image.
+ReuseTest testPooled(const std::vector<const ReuseTest*>& tiles, double falseRejectRate);
 
 enum class TileReuse : std::uint8_t {
   None,      // no history kept (no edit since the last global restart, or nothing to keep)
