@@ -183,3 +183,32 @@ TEST(Metrics, TheAffectedRegionPoolsBlocksToFindSmallWidespreadChanges) {
 
 }  // namespace
 }  // namespace retile
+
+namespace retile {
+namespace {
+
+TEST(Metrics, BlockComparisonAveragesBlocksAndLeavesOutExcludedPixels) {
+  // 32x16, two 16x16 blocks: A is the reference plus 10 % on the right block, and a wild pixel in
+  // an excluded corner of the left one.
+  const int w = 32, h = 16;
+  std::vector<float> ref(w * h * 3, 0.5f), a = ref;
+  for (int y = 0; y < h; ++y)
+    for (int x = 16; x < w; ++x)
+      for (int c = 0; c < 3; ++c) a[(y * w + x) * 3 + c] = 0.55f;
+  a[0] = 1000.0f;
+  BlockComparison b = compareBlocks({a.data(), w, h}, {ref.data(), w, h}, 16, {{0, 0, 2, 2}});
+  EXPECT_EQ(b.blocks, 2);
+  EXPECT_NEAR(b.meanRef, 0.5, 1e-9);
+  EXPECT_NEAR(b.meanA / b.meanRef, 1.05, 1e-3) << "the excluded pixel takes no part";
+  // Block means 0.5/0.5 and 0.55/0.5 per channel: sqrt(3 * 0.05^2) / sqrt(6 * 0.25).
+  EXPECT_NEAR(b.relativeRmse, std::sqrt(3 * 0.0025) / std::sqrt(6 * 0.25), 1e-6);
+  EXPECT_NEAR(b.errorShare[1], 1.0, 1e-9) << "all of the error is in the right block";
+  EXPECT_NEAR(b.lumA[1] / b.lumRef[1], 1.1, 1e-5);
+  // A block mostly excluded is left out.
+  BlockComparison c = compareBlocks({a.data(), w, h}, {ref.data(), w, h}, 16, {{0, 0, 16, 12}});
+  EXPECT_EQ(c.blocks, 1);
+  EXPECT_TRUE(std::isnan(c.errorShare[0]));
+}
+
+}  // namespace
+}  // namespace retile
