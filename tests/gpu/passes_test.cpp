@@ -282,7 +282,8 @@ std::uint32_t pcgHash(std::uint32_t v) {
   return (word >> 22u) ^ word;
 }
 CameraRay cameraRay(const Camera& c, int w, int h, int px, int py, std::uint32_t sampleIndex, std::uint32_t seed) {
-  // rng.glsl pixelJitter: R2 over the sample index, rotated by a per-pixel offset.
+  // rng.glsl pixelJitter: R2 over the sample index, rotated by a per-pixel offset; a box filter
+  // (the scene's pixel filter must be PixelFilter::Box with width 1).
   std::uint32_t hash = pcgHash(static_cast<std::uint32_t>(py * w + px) ^ pcgHash(seed + 0x85ebca6bu));
   std::uint32_t ox = hash + 3242174889u * sampleIndex, oy = pcgHash(hash) + 2447445413u * sampleIndex;
   float jx = static_cast<float>(ox >> 8) * (1.0f / 16777216.0f);
@@ -307,6 +308,8 @@ TEST(TracePass, FirstHitsMatchABruteForceReference) {
   s.camera.position = {0, 0, 4.5f};
   s.camera.target = {0, 0, 0};
   s.settings.maxBounces = 0;
+  s.settings.pixelFilter = PixelFilter::Box;  // as cameraRay places the samples
+  s.settings.filterWidth = 1.0f;
   s.environment.color = Vec3{1.0f};
   auto soup = std::make_shared<MeshGeometry>();
   std::mt19937 rng(5);
