@@ -33,8 +33,10 @@ layout(set = 0, binding = 15, std430) buffer Selection { uint selectionCounts[];
 layout(push_constant) uniform Push { TracePush push; };
 
 // A sample's offset from the pixel centre along one axis for u in [0, 1): the filter's inverse
-// CDF, linear between its 33 tabulated points (layouts.h).
+// CDF, linear between its 33 tabulated points (layouts.h), or exact for a tent.
 float filterOffset(float u) {
+  float tent = frame.filterWarp[8].w;
+  if (tent > 0.0) return tent * (u < 0.5 ? sqrt(2.0 * u) - 1.0 : 1.0 - sqrt(2.0 - 2.0 * u));
   float t = u * float(kFilterWarpSegments);
   int i = min(int(t), kFilterWarpSegments - 1);
   float a = frame.filterWarp[i >> 2][i & 3], b = frame.filterWarp[(i + 1) >> 2][(i + 1) & 3];

@@ -105,7 +105,8 @@ struct FrameUniforms {
   uvec4 work;           // work item count, total sample slots, selected instance + 1 (0: none),
                         // tile size of the selection counters (0: not counting)
   // A sample's offset from the pixel centre along each axis, in pixels, for u = i / 32: the
-  // inverse CDF of the scene's pixel filter (filter importance sampling), 33 values, packed.
+  // inverse CDF of the scene's pixel filter (filter importance sampling), 33 values, packed; the
+  // last slot (filterWarp[8].w): a tent's radius, inverted exactly instead (0: use the table).
   vec4 filterWarp[9];
 };
 

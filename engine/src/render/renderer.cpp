@@ -421,6 +421,9 @@ struct Renderer::Impl {
       gpu::vec4& v = u.filterWarp[i / 4];
       (i % 4 == 0 ? v.x : i % 4 == 1 ? v.y : i % 4 == 2 ? v.z : v.w) = warp[i];
     }
+    // The tent's inverse CDF has an infinite slope at its ends, where the table's straight pieces
+    // put too many samples: the shader inverts it exactly when this (its radius) is set.
+    u.filterWarp[8].w = warpFilter == PixelFilter::Tent ? 0.5f * std::clamp(warpWidth, 0.01f, 16.0f) : 0.0f;
     frameUbo.upload(&u, sizeof u);
   }
 
