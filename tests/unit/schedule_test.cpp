@@ -261,3 +261,37 @@ TEST(Method, NamesRoundTripAndSettingsAreChecked) {
 
 }  // namespace
 }  // namespace retile
+
+namespace retile {
+namespace {
+
+TEST(Refinement, CreditsSendTheBudgetToTheTilesWithTheFewestSamples) {
+  // 4x2 tiles of 16x16; after the global update every tile has 1 spp. Six keep a history of 100
+  // spp (credit), two lost theirs: refinement raises those two first, and spends the whole
+  // budget exactly.
+  TileGrid g(64, 32, 16);
+  TileScheduler s(g);
+  s.nextFrame();  // the global update
+  std::vector<double> credit(8, 100.0);
+  credit[2] = credit[5] = 0.0;
+  s.setCredit(credit);
+  FramePlan p = s.nextFrame();
+  EXPECT_EQ(p.mode, AccumMode::Refinement);
+  std::int64_t samples = 0;
+  int servedOthers = 0;
+  for (const TileChunk& c : p.chunks) {
+    samples += c.rect.pixels() * c.quality;
+    if (c.tile != 2 && c.tile != 5) ++servedOthers;
+  }
+  EXPECT_EQ(samples, 64 * 32) << "exactly W x H samples";
+  EXPECT_EQ(servedOthers, 0) << "the budget goes to the tiles that lost their history";
+  EXPECT_NEAR(s.tileSamples()[2], 5.0, 1e-9) << "1 + 4 spp each: 8 tiles' worth of samples over 2";
+  EXPECT_NEAR(s.tileSamples()[5], 5.0, 1e-9);
+  // Without credits, every tile gets one sample a frame as before.
+  s.setCredit({});
+  FramePlan q = s.nextFrame();
+  EXPECT_EQ(q.chunks.size(), 8u);
+}
+
+}  // namespace
+}  // namespace retile

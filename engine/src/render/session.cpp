@@ -87,6 +87,7 @@ struct RenderSession::Impl {
   std::vector<int> pendingRejects;
   std::uint64_t pass = 0;               // counts the passes started (execute)
   std::vector<std::uint64_t> reusePass; // per tile: the pass that last started its history
+  std::vector<double> reuseCredit;      // per tile: spp of history it keeps (the scheduler's credit)
 
   void resetReuse() {
     const auto n = static_cast<std::size_t>(scheduler.grid().count());
@@ -94,15 +95,19 @@ struct RenderSession::Impl {
     reuseStarted.assign(n, 0);
     reuseRejectedAt.assign(n, 0);
     reusePass.assign(n, 0);
+    reuseCredit.assign(n, 0.0);
     pendingRejects.clear();
   }
 
   // Restarts of a pass keep their tiles' samples as history; a global update drops every history
   // (its restarts do, in the accumulate pass); rejections found in the last read-back apply.
-  void planReuse(FramePlan& plan, std::vector<TileWork>& work, FrameOptions& options, std::uint64_t frameNumber) {
+  // `before`: the scheduler's samples per tile before this frame's plan (a restart resets them).
+  void planReuse(FramePlan& plan, std::vector<TileWork>& work, FrameOptions& options, std::uint64_t frameNumber,
+                 const std::vector<double>& before) {
     if (reuse.size() != static_cast<std::size_t>(scheduler.grid().count())) resetReuse();
     if (plan.mode == AccumMode::GlobalUpdate) {
       resetReuse();
+      scheduler.setCredit(reuseCredit);
       return;
     }
     const TileGrid& grid = scheduler.grid();
@@ -112,12 +117,17 @@ struct RenderSession::Impl {
       auto t = static_cast<std::size_t>(c.tile);
       // With reuse, the smooth transition's stale tiles keep their verified history instead of
       // a capped one: their first serve in the pass starts the history like a restart.
+      const double had = t < before.size() ? before[t] : 0.0;
+      double kept = had;  // spp the tile's history will hold
       if (c.capStale > 0 && !c.restart) {
         work[i].capStale = 0;
         if (reusePass[t] == pass) continue;
+        kept = had - std::min(had, static_cast<double>(c.capStale));  // the scheduler counts the cap as fresh
       } else if (!c.restart) {
         continue;
       }
+      // A tile that keeps a history goes back to it: its credit stays.
+      if (reuse[t] != TileReuse::Reusing) reuseCredit[t] = kept + reuseCredit[t];
       work[i].restart = false;
       reusePass[t] = pass;
       options.reuse.push_back({c.rect.x, c.rect.y, c.rect.width, c.rect.height, FrameOptions::Reuse::Start});
@@ -133,8 +143,10 @@ struct RenderSession::Impl {
       options.reuse.push_back({r.x, r.y, r.width, r.height, FrameOptions::Reuse::Reject});
       reuse[t] = TileReuse::Rejected;
       reuseRejectedAt[t] = frameNumber;
+      reuseCredit[t] = 0.0;
     }
     pendingRejects.clear();
+    scheduler.setCredit(reuseCredit);
   }
 
   // Tests every tile that reuses its history against the fresh samples the image holds.
@@ -525,6 +537,9 @@ void RenderSession::submitFrame(bool readImage) {
   d.execute(d.batch.empty() ? d.planner.planQuiet(d.scheduler.passActive()) : d.planner.planBatch(d.batch));
   d.batch.clear();
   d.syncCounting();
+  std::vector<double> samplesBefore;
+  if (method().reuse) samplesBefore = d.scheduler.tileSamples();
+  else d.scheduler.setCredit({});
   FramePlan plan = d.scheduler.nextFrame();
   std::vector<TileWork> work;
   work.reserve(plan.chunks.size());
@@ -533,7 +548,7 @@ void RenderSession::submitFrame(bool readImage) {
   FrameOptions options;
   options.accumulate = plan.mode != AccumMode::Probe;
   if (method().denoise) options.denoise = d.denoiseWork(plan.mode, d.frame + 1, method());
-  if (method().reuse && options.accumulate) d.planReuse(plan, work, options, d.frame + 1);
+  if (method().reuse && options.accumulate) d.planReuse(plan, work, options, d.frame + 1, samplesBefore);
   Impl::Pending p;
   p.mode = plan.mode;
   p.counting = d.planner.countThisFrame(plan.mode);

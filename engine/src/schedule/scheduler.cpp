@@ -1,6 +1,7 @@
 #include "schedule/scheduler.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace retile {
 
@@ -217,6 +218,40 @@ FramePlan TileScheduler::nextFrame() {
       std::int64_t pixels = grid_.rect(t).pixels();
       int k = static_cast<int>(std::min<std::int64_t>(regionQuality, remaining / pixels));
       if (k <= 0) break;
+      emit(plan, t, grid_.rect(t), k, false, 0, true);
+      served[static_cast<std::size_t>(t)] = 1;
+      remaining -= pixels * k;
+    }
+  } else if (!passActive() && credit_.size() == static_cast<std::size_t>(n)) {
+    // Refinement with credits: raise the tiles with the fewest samples in all to a common level
+    // L, each by whole samples per pixel, as far as the budget goes; the remainder as usual.
+    std::vector<double> have(static_cast<std::size_t>(n));
+    std::vector<int> order;
+    for (int t = 0; t < n; ++t) {
+      if (served[static_cast<std::size_t>(t)]) continue;
+      have[static_cast<std::size_t>(t)] = samples_[static_cast<std::size_t>(t)] + credit_[static_cast<std::size_t>(t)];
+      order.push_back(t);
+    }
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return have[static_cast<std::size_t>(a)] < have[static_cast<std::size_t>(b)]; });
+    // The level: the largest L whose whole-sample raises fit the budget (L at least the lowest
+    // tile + 1, so something is always served).
+    auto cost = [&](double level) {
+      std::int64_t c = 0;
+      for (int t : order) {
+        const double need = std::ceil(level - have[static_cast<std::size_t>(t)]);
+        if (need > 0) c += static_cast<std::int64_t>(need) * grid_.rect(t).pixels();
+      }
+      return c;
+    };
+    double lo = order.empty() ? 0.0 : have[static_cast<std::size_t>(order.front())], hi = lo + 1e6;
+    for (int i = 0; i < 60; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      if (cost(mid) <= remaining) lo = mid; else hi = mid;
+    }
+    for (int t : order) {
+      const int k = static_cast<int>(std::min<double>(std::ceil(lo - have[static_cast<std::size_t>(t)]), 1e6));
+      const std::int64_t pixels = grid_.rect(t).pixels();
+      if (k <= 0 || pixels * k > remaining) continue;
       emit(plan, t, grid_.rect(t), k, false, 0, true);
       served[static_cast<std::size_t>(t)] = 1;
       remaining -= pixels * k;

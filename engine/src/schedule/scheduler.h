@@ -57,6 +57,11 @@ class TileScheduler {
   // budget on the region (about W x H / region pixels spp per tile, each tile once per frame,
   // so a frame traces at most W x H samples); passes skip tiles outside it.
   void setRegion(std::vector<char> tiles);
+  // Samples per pixel a tile holds beyond those counted since its restart (verified reuse: the
+  // history it keeps). With credits, continuous refinement serves the tiles with the fewest
+  // samples in all first, up to a common level (water-filling), instead of one sample to each:
+  // tiles whose history was rejected catch up with the ones that kept theirs. Empty: none.
+  void setCredit(std::vector<double> credit) { credit_ = std::move(credit); }
   bool inRegion(int tile) const { return region_.empty() || region_[static_cast<std::size_t>(tile)]; }
 
   const TileGrid& grid() const { return grid_; }
@@ -93,6 +98,7 @@ class TileScheduler {
   int staleCap_ = 0;
   std::size_t refineCursor_ = 0;
   std::vector<double> samples_;
+  std::vector<double> credit_;
   std::vector<std::uint32_t> nextIndex_;
   std::vector<int> finished_;  // tiles of the pass already at quality, most recent last
 };
