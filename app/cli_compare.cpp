@@ -14,21 +14,21 @@ namespace retile::cli {
 
 namespace {
 
-Result<std::vector<float>> readRgb(const std::string& file) {
-  auto im = readImageRaw(file);
-  if (!im) return Result<std::vector<float>>::failure(im.error());
-  std::vector<float> rgb(static_cast<std::size_t>(im->width) * static_cast<std::size_t>(im->height) * 3);
-  for (std::size_t i = 0; i * 3 < rgb.size(); ++i)
-    for (std::size_t c = 0; c < 3; ++c) rgb[3 * i + c] = im->rgba[4 * i + c];
-  if (std::any_of(rgb.begin(), rgb.end(), [](float v) { return !std::isfinite(v); }))
-    return Result<std::vector<float>>::failure(file + ": has pixels that are not finite numbers");
-  return rgb;
-}
+struct RgbImage {
+  int width = 0, height = 0;
+  std::vector<float> rgb;
+};
 
-Result<std::pair<int, int>> sizeOf(const std::string& file) {
+Result<RgbImage> readRgb(const std::string& file) {
   auto im = readImageRaw(file);
-  if (!im) return Result<std::pair<int, int>>::failure(im.error());
-  return std::pair{im->width, im->height};
+  if (!im) return Result<RgbImage>::failure(im.error());
+  RgbImage out{im->width, im->height, {}};
+  out.rgb.resize(static_cast<std::size_t>(im->width) * static_cast<std::size_t>(im->height) * 3);
+  for (std::size_t i = 0; i * 3 < out.rgb.size(); ++i)
+    for (std::size_t c = 0; c < 3; ++c) out.rgb[3 * i + c] = im->rgba[4 * i + c];
+  if (std::any_of(out.rgb.begin(), out.rgb.end(), [](float v) { return !std::isfinite(v); }))
+    return Result<RgbImage>::failure(file + ": has pixels that are not finite numbers");
+  return out;
 }
 
 Result<PixelRect> parseRect(const std::string& text) {
@@ -58,9 +58,9 @@ int runCompare(const std::vector<std::string>& argv) {
     return 2;
   }
   int block = 16, worst = 8;
-  for (auto [opt, dst, hi] : {std::tuple{"--block", &block, 4096}, std::tuple{"--worst", &worst, 1000}}) {
+  for (auto [opt, dst, lo, hi] : {std::tuple{"--block", &block, 1, 4096}, std::tuple{"--worst", &worst, 0, 1000}}) {
     if (!args->has(opt)) continue;
-    auto v = parseInt(opt, args->get(opt), opt == std::string("--block") ? 1 : 0, hi);
+    auto v = parseInt(opt, args->get(opt), lo, hi);
     if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
     *dst = v.value();
   }
@@ -73,21 +73,18 @@ int runCompare(const std::vector<std::string>& argv) {
     }
   std::vector<std::string> files = {args->positional[0], args->positional[1]};
   if (args->has("--noise")) files.push_back(args->get("--noise"));
-  std::vector<std::vector<float>> images;
-  std::pair<int, int> size{0, 0};
+  std::vector<RgbImage> images;
   for (const auto& f : files) {
-    auto s = sizeOf(f);
-    auto rgb = s ? readRgb(f) : Result<std::vector<float>>::failure(s.error());
-    if (!rgb) return std::fprintf(stderr, "error: %s\n", rgb.error().c_str()), 1;
-    if (images.empty()) size = s.value();
-    if (s.value() != size) {
-      std::fprintf(stderr, "error: %s is %dx%d, %s is %dx%d\n", f.c_str(), s->first, s->second, files[0].c_str(), size.first,
-                   size.second);
+    auto im = readRgb(f);
+    if (!im) return std::fprintf(stderr, "error: %s\n", im.error().c_str()), 1;
+    if (!images.empty() && (im->width != images[0].width || im->height != images[0].height)) {
+      std::fprintf(stderr, "error: %s is %dx%d, %s is %dx%d\n", f.c_str(), im->width, im->height, files[0].c_str(),
+                   images[0].width, images[0].height);
       return 1;
     }
-    images.push_back(std::move(rgb.value()));
+    images.push_back(std::move(im.value()));
   }
-  auto view = [&](std::size_t i) { return MetricImage{images[i].data(), size.first, size.second}; };
+  auto view = [&](std::size_t i) { return MetricImage{images[i].rgb.data(), images[i].width, images[i].height}; };
   BlockComparison c = compareBlocks(view(0), view(1), block, exclude);
   std::printf("compared: %d of %d %dx%d blocks\n", c.blocks, c.cols * c.rows, block, block);
   std::printf("mean RGB: %.6g against %.6g (%+.3f %%)\n", c.meanA, c.meanRef,

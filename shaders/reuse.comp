@@ -3,7 +3,7 @@
 // each item, keep the accumulation as the history when an edit restarts the tile, go back to the
 // history when another edit restarts it while the history is still kept (edits in a burst compare
 // against the last converged samples, not against half-fresh ones), or drop the history from the
-// accumulation when the test rejected it. Sums stay exact: a pixel's accumulation is its history
+// accumulation when the test rejected it. (A plain restart forgets the history in accumulate.comp.) Sums stay exact: a pixel's accumulation is its history
 // plus its fresh samples at every moment, compensations included.
 #extension GL_GOOGLE_include_directive : require
 
@@ -47,7 +47,7 @@ void main() {
       history[pixel * 2u] = a0;
       history[pixel * 2u + 1u] = a1;
     }
-  } else if (op == kReuseReject) {
+  } else {  // kReuseReject
     if (h0.w > 0.0) {
       // Both sums carry a Kahan compensation: subtract the compensated values.
       accum[pixel * 2u] = vec4((a0.rgb - a1.rgb) - (h0.rgb - h1.rgb), max(a0.w - h0.w, 0.0));
@@ -59,9 +59,6 @@ void main() {
         accumAux[pixel * uint(kAuxVec4s) + j] = j == 0u ? vec4(x.rgb * keep, x.w) : (j == 1u ? vec4(x.xyz * keep, x.w) : x * keep);
       }
     }
-    history[pixel * 2u] = vec4(0.0);
-    history[pixel * 2u + 1u] = vec4(0.0);
-  } else {
     history[pixel * 2u] = vec4(0.0);
     history[pixel * 2u + 1u] = vec4(0.0);
   }

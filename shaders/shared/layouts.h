@@ -146,7 +146,6 @@ struct ReuseItem {
 };
 RT_CONST(uint, kReuseStart, 1u)   // no history: keep the accumulation as the history; else go back to it
 RT_CONST(uint, kReuseReject, 2u)  // drop the history from the accumulation, keep the fresh samples
-RT_CONST(uint, kReuseDrop, 3u)    // forget the history (the accumulation restarts anyway)
 
 struct ReusePush {
   uint pixelCount;

@@ -71,7 +71,7 @@ struct FrameOptions {
   // before the frame's samples are accumulated; a rectangle may appear once per frame.
   struct Reuse {
     int x = 0, y = 0, width = 0, height = 0;
-    enum Op { Start = 1, Reject = 2, Drop = 3 } op = Start;
+    enum Op { Start = 1, Reject = 2 } op = Start;
   };
   std::vector<Reuse> reuse;
 };

@@ -200,9 +200,11 @@ struct RenderSession::Impl {
         }
       if (pool.size() > 1 && testPooled(pool, falseRejectRate).reject()) more.push_back(t);
     }
+    std::vector<char> found(tested.size(), 0);
+    for (int t : more) found[static_cast<std::size_t>(t)] = 1;
     std::vector<const ReuseTest*> all;
     for (int t : kept)
-      if (std::find(more.begin(), more.end(), t) == more.end()) all.push_back(&tested[static_cast<std::size_t>(t)]);
+      if (!found[static_cast<std::size_t>(t)]) all.push_back(&tested[static_cast<std::size_t>(t)]);
     if (all.size() > 1 && testPooled(all, falseRejectRate).reject()) more = kept;
     pendingRejects.insert(pendingRejects.end(), more.begin(), more.end());
   }
