@@ -55,6 +55,7 @@ struct DenoiseWork {
   int tileSize = 16;
   std::vector<std::uint32_t> tileCodes;  // per tile of tileSize: TileShows
   int featherPixels = 0;  // soft borders: seams between tiles showing different things blend over this
+  bool timePasses = false;  // measure each pass on the device (FrameStats::denoisePasses); benchmarks
 };
 
 // The whole image denoised (global + denoise, continuous refinement, `retile render --denoise`).
@@ -103,6 +104,12 @@ struct FrameStats {
   // stop when the count passes kTraceLoopBudget, so this must stay below the ~2700 left to the limit.
   std::uint32_t maxSegmentIterations = 0;
   double pathsPerInvocation = 0;        // each invocation traces this many paths one after another
+  // With DenoiseWork::timePasses: the device's time for each denoiser pass, in record order.
+  struct PassTime {
+    const char* name;
+    double ms;
+  };
+  std::vector<PassTime> denoisePasses;
 
   // Adds a later frame's figures: counts and seconds sum, the maxima stay maxima, the paths per
   // invocation are the later frame's.

@@ -4,6 +4,7 @@
 #include <tuple>
 
 #include "retile/log.h"
+#include "vk/check.h"
 #include "shared/layouts.h"
 
 namespace retile {
@@ -27,10 +28,16 @@ std::uint32_t groups(int width, int height, std::uint32_t* groupsY) {
   return static_cast<std::uint32_t>((width + gpu::kDenoiseTile - 1) / gpu::kDenoiseTile);
 }
 
+constexpr std::uint32_t kMaxStamps = 5 + gpu::kDenoiseIterations;  // start, prepare, variance, the iterations, finish, compose
+constexpr const char* kAtrousNames[] = {"a-trous 1", "a-trous 2", "a-trous 4", "a-trous 8", "a-trous 16", "a-trous 32"};
+static_assert(gpu::kDenoiseIterations <= 6);
+
 }  // namespace
 
 Denoiser::Denoiser(vk::Context& ctx) : ctx_(ctx) {}
-Denoiser::~Denoiser() = default;
+Denoiser::~Denoiser() {
+  if (timestamps_ != VK_NULL_HANDLE) vkDestroyQueryPool(ctx_.device(), timestamps_, nullptr);
+}
 
 void Denoiser::resize(int width, int height, vk::Buffer& accum, vk::Buffer& accumAux) {
   width_ = width;
@@ -117,7 +124,21 @@ void Denoiser::prepare(const DenoiseWork& work) {
 }
 
 void Denoiser::record(VkCommandBuffer cb, const DenoiseWork& work) {
+  timedPasses_.clear();
   if (!work.compose) return;
+  // Timestamps after each pass (the pass before them has finished: one queue, barriers between).
+  if (work.timePasses && timestamps_ == VK_NULL_HANDLE) {
+    VkQueryPoolCreateInfo info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    info.queryCount = kMaxStamps;
+    vk::checkVk(vkCreateQueryPool(ctx_.device(), &info, nullptr, &timestamps_), "creating the denoiser's timestamps");
+  }
+  if (work.timePasses) vkCmdResetQueryPool(cb, timestamps_, 0, kMaxStamps);
+  auto stamp = [&](const char* name) {
+    if (!work.timePasses) return;
+    vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, timestamps_, static_cast<std::uint32_t>(timedPasses_.size()));
+    timedPasses_.push_back(name);
+  };
   gpu::DenoisePush push{};
   push.image = {static_cast<std::uint32_t>(width_), static_cast<std::uint32_t>(height_), 1,
                 static_cast<std::uint32_t>(std::max(work.featherPixels, 0))};
@@ -131,23 +152,45 @@ void Denoiser::record(VkCommandBuffer cb, const DenoiseWork& work) {
       push.domain = {x0, y0, x1 - x0, y1 - y0};
       std::uint32_t gx = groups(x1 - x0, y1 - y0, &gy);
       vk::computeBarrier(cb);
+      stamp("start");
       prepare_->dispatch(cb, gx, gy, &push, sizeof push);
+      stamp("prepare");
       vk::computeBarrier(cb);
       variance_->dispatch(cb, gx, gy, &push, sizeof push);
+      stamp("variance");
       for (int i = 0; i < gpu::kDenoiseIterations; ++i) {
         vk::computeBarrier(cb);
         push.image.z = 1u << i;
         (i % 2 == 0 ? atrousBA_ : atrousAB_)->dispatch(cb, gx, gy, &push, sizeof push);
+        stamp(kAtrousNames[i]);
       }
       vk::computeBarrier(cb);
       finish_->dispatch(cb, gx, gy, &push, sizeof push);
+      stamp("finish");
     }
   }
   push.domain = {0, 0, width_, height_};
   push.image.z = 1;
   vk::computeBarrier(cb);
   std::uint32_t gx = groups(width_, height_, &gy);
+  if (timedPasses_.empty()) stamp("start");
   compose_->dispatch(cb, gx, gy, &push, sizeof push);
+  stamp("compose");
+}
+
+std::vector<FrameStats::PassTime> Denoiser::passTimes() {
+  std::vector<FrameStats::PassTime> out;
+  if (timedPasses_.size() < 2) return out;
+  std::vector<std::uint64_t> ticks(timedPasses_.size());
+  vk::checkVk(vkGetQueryPoolResults(ctx_.device(), timestamps_, 0, static_cast<std::uint32_t>(ticks.size()),
+                                    ticks.size() * sizeof(std::uint64_t), ticks.data(), sizeof(std::uint64_t),
+                                    VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+              "reading the denoiser's timestamps");
+  const double msPerTick = static_cast<double>(ctx_.properties().limits.timestampPeriod) * 1e-6;
+  for (std::size_t i = 1; i < ticks.size(); ++i)
+    out.push_back({timedPasses_[i], static_cast<double>(ticks[i] - ticks[i - 1]) * msPerTick});
+  timedPasses_.clear();
+  return out;
 }
 
 }  // namespace retile

@@ -29,6 +29,9 @@ class Denoiser {
   void record(VkCommandBuffer cb, const DenoiseWork& work);
   // The composed image (RGBA32F per pixel), valid once a frame has composed.
   vk::Buffer& display() { return display_; }
+  // After a frame recorded with work.timePasses has completed (and before the next is recorded):
+  // each pass's device time.
+  std::vector<FrameStats::PassTime> passTimes();
 
  private:
   void allocate();
@@ -39,6 +42,8 @@ class Denoiser {
   vk::Buffer* accumAux_ = nullptr;
   bool allocated_ = false;
   std::unique_ptr<vk::ComputePipeline> prepare_, variance_, atrousAB_, atrousBA_, finish_, compose_;
+  VkQueryPool timestamps_ = VK_NULL_HANDLE;
+  std::vector<const char*> timedPasses_;  // the passes the last timed frame recorded
   vk::Buffer a_, b_, surface_, guide_, moments_, layer_, display_, tiles_;
 };
 

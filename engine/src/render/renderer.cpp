@@ -552,6 +552,7 @@ struct Renderer::Impl {
     FrameStats& fs = slot.stats;
     fs.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - slot.submitted).count();
     slot.completed = true;
+    fs.denoisePasses = denoiser.passTimes();
     if (fs.samples == 0) return;
     std::uint32_t counts[gpu::kStatsCount];
     stats.download(counts, sizeof counts);
