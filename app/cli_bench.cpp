@@ -293,7 +293,7 @@ int benchDenoise(const std::vector<std::string>& argv) {
   double traceMs = median(trace), denoiseMs = median(denoised), composeMs = median(composed);
   std::printf("image          %dx%d, %s\n", w, h, args->positional.empty() ? "default" : args->positional[0].c_str());
   std::printf("frame          %.1f ms (1 spp traced and accumulated; medians of %d interleaved rounds)\n", traceMs, frames);
-  std::printf("denoise        %.1f ms (the passes below, then compose)\n", denoiseMs);
+  std::printf("denoise        %.1f ms (the passes below; a frame denoised whole needs no compositor)\n", denoiseMs);
   for (std::size_t k = 0; k < passMs.size(); ++k)
     std::printf("  %-12s %.1f ms on the device\n", passNames[k], median(passMs[k]));
   std::printf("compose        %.1f ms (the compositor alone)\n", composeMs);

@@ -24,12 +24,39 @@ ivec2 clampToDomain(ivec2 q) { return clamp(q, push.domain.xy, push.domain.xy + 
 bool inDomain(ivec2 q) { return all(greaterThanEqual(q, push.domain.xy)) && all(lessThan(q, push.domain.xy + push.domain.zw)); }
 uint pixelIndex(ivec2 q) { return uint(q.y) * push.image.x + uint(q.x); }
 
+// What the preparation and the finish read of a pixel's accumulation: its mean, the mean of the
+// squares of its luminance, and the guides (the first non-specular hit's albedo, normal, depth
+// and the emission seen up to it), each a mean over the pixel's samples. For shaders that bind
+// uAccum and uAccumAux before including this.
+#ifdef DENOISE_READS_ACCUMULATION
+struct Guides {
+  vec3 mean, albedo, emission, normal;
+  float meanSquare, depth, samples;
+};
+Guides readGuides(int i) {
+  vec4 s = texelFetch(uAccum, i * 2), c = texelFetch(uAccum, i * 2 + 1);
+  vec4 a = texelFetch(uAccumAux, i * int(kAuxVec4s)), b = texelFetch(uAccumAux, i * int(kAuxVec4s) + 1);
+  vec4 e = texelFetch(uAccumAux, i * int(kAuxVec4s) + 2);
+  float inv = s.w > 0.0 ? 1.0 / s.w : 0.0;
+  Guides g;
+  g.samples = s.w;
+  g.mean = (s.rgb - c.rgb) * inv;
+  g.meanSquare = c.w * inv;
+  g.albedo = a.rgb * inv;
+  g.emission = e.rgb * inv;
+  float len = length(b.xyz);
+  g.normal = len > 0.0 ? b.xyz / len : vec3(0.0, 0.0, 1.0);
+  g.depth = a.w >= 1e29 ? kBackgroundDepth : a.w;
+  return g;
+}
+#endif
+
 vec3 demodulate(vec3 c, vec3 albedo) { return c / max(albedo, vec3(kAlbedoFloor)); }
 vec3 remodulate(vec3 c, vec3 albedo) { return c * max(albedo, vec3(kAlbedoFloor)); }
 
 // The a-trous iterations read the demodulated colour and the standard deviation of the pixel's
 // mean as four halves (one RGBA16F texel, converted by the fetch) and the pixel's normal and depth
-// from the guide texel, which never changes between iterations; they write the halves only.
+// from the surface texel, which never changes between iterations; they write the halves only.
 uvec2 packColor(vec3 color, float variance) {
   return uvec2(packHalf2x16(color.rg), packHalf2x16(vec2(color.b, sqrt(max(variance, 0.0)))));
 }

@@ -158,7 +158,7 @@ struct ReusePush {
 // fresh: it has), or the denoised layer (a region's frozen result). kTileWrite marks the tiles
 // that take this frame's denoised result into the layer.
 RT_CONST(int, kDenoiseTile, 8)        // workgroups of 8x8 pixels
-RT_CONST(int, kDenoiseIterations, 5)   // a-trous steps 1, 2, 4, 8, 16: a 125-pixel footprint
+RT_CONST(int, kDenoiseIterations, 4)   // a-trous steps 1, 2, 4, 8 of the 3x3 kernel: a 31-pixel footprint
 RT_CONST(uint, kTileStale, 0u)
 RT_CONST(uint, kTileFresh, 1u)
 RT_CONST(uint, kTileLayer, 2u)

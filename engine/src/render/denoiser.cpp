@@ -32,6 +32,14 @@ constexpr std::uint32_t kMaxStamps = 5 + gpu::kDenoiseIterations;  // start, pre
 constexpr const char* kAtrousNames[] = {"a-trous 1", "a-trous 2", "a-trous 4", "a-trous 8", "a-trous 16", "a-trous 32"};
 static_assert(gpu::kDenoiseIterations <= 6);
 
+// Every tile shows the layer as this frame writes it, all alike (so no seam between them).
+bool showsLayerWhole(const DenoiseWork& work) {
+  if (work.tileCodes.empty()) return false;
+  const std::uint32_t first = work.tileCodes.front();
+  return (first & gpu::kTileWrite) != 0 && (first & gpu::kTileKindMask) >= gpu::kTileLayer &&
+         std::all_of(work.tileCodes.begin(), work.tileCodes.end(), [&](std::uint32_t c) { return c == first; });
+}
+
 }  // namespace
 
 Denoiser::Denoiser(vk::Context& ctx) : ctx_(ctx) {}
@@ -45,7 +53,7 @@ void Denoiser::resize(int width, int height, vk::Buffer& accum, vk::Buffer& accu
   accum_ = &accum;
   accumAux_ = &accumAux;
   allocated_ = false;
-  for (vk::Buffer* b : {&a_, &b_, &surface_, &guide_, &moments_, &layer_, &display_}) *b = vk::Buffer();
+  for (vk::Buffer* b : {&a_, &b_, &surface_, &gradient_, &moments_, &layer_, &display_}) *b = vk::Buffer();
 }
 
 void Denoiser::allocate() {
@@ -54,7 +62,7 @@ void Denoiser::allocate() {
     using B = Binding;
     prepare_ = std::make_unique<vk::ComputePipeline>(
         ctx_, "denoise_prepare.comp",
-        std::vector<B>{B::UniformTexel, B::UniformTexel, B::Storage, B::Storage, B::Storage, B::Storage, B::Storage}, push);
+        std::vector<B>{B::UniformTexel, B::UniformTexel, B::Storage, B::Storage, B::Storage, B::Storage}, push);
     variance_ = std::make_unique<vk::ComputePipeline>(
         ctx_, "denoise_variance.comp",
         std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
@@ -63,7 +71,12 @@ void Denoiser::allocate() {
       *p = std::make_unique<vk::ComputePipeline>(
           ctx_, "denoise_atrous.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage}, push);
     finish_ = std::make_unique<vk::ComputePipeline>(
-        ctx_, "denoise_finish.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
+        ctx_, "denoise_finish.comp",
+        std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
+    finishShown_ = std::make_unique<vk::ComputePipeline>(
+        ctx_, "denoise_finish.comp",
+        std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage, B::Storage, B::Storage}, push,
+        std::vector<vk::ShaderDefine>{{"DENOISE_FINISH_SHOWS", "1"}});
     compose_ = std::make_unique<vk::ComputePipeline>(
         ctx_, "compose.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
   }
@@ -72,7 +85,7 @@ void Denoiser::allocate() {
   a_ = vk::Buffer(ctx_, pixels * 8, kReadWrite, false, "denoiser ping");
   b_ = vk::Buffer(ctx_, pixels * 8, kReadWrite, false, "denoiser pong");
   surface_ = vk::Buffer(ctx_, px, kReadWrite, false, "denoiser surfaces");
-  guide_ = vk::Buffer(ctx_, 2 * px, kReadWrite, false, "denoiser guides");
+  gradient_ = vk::Buffer(ctx_, pixels * sizeof(float), kReadWrite, false, "denoiser depth gradients");
   moments_ = vk::Buffer(ctx_, px, kReadWrite, false, "denoiser moments");
   layer_ = vk::Buffer(ctx_, px, kReadWrite, false, "denoised layer");
   display_ = vk::Buffer(ctx_, px, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, "displayed image");
@@ -82,24 +95,26 @@ void Denoiser::allocate() {
   prepare_->bind(1, *accumAux_, kRgba32);
   prepare_->bind(2, a_);
   prepare_->bind(3, surface_);
-  prepare_->bind(4, guide_);
-  prepare_->bind(5, moments_);
+  prepare_->bind(4, moments_);
   variance_->bind(0, a_, kHalf4);
   variance_->bind(1, surface_, kRgba32);
   variance_->bind(2, moments_, kRgba32);
   variance_->bind(3, b_);
-  variance_->bind(4, guide_);
+  variance_->bind(4, gradient_);
   for (auto [pipe, from, to] : {std::tuple{atrousBA_.get(), &b_, &a_}, std::tuple{atrousAB_.get(), &a_, &b_}}) {
     pipe->bind(0, *from, kHalf4);
     pipe->bind(1, surface_, kRgba32);
-    pipe->bind(2, guide_, kRgba32);
+    pipe->bind(2, gradient_, VK_FORMAT_R32_SFLOAT);
     pipe->bind(3, *to);
   }
-  // kDenoiseIterations is odd: the variance pass writes b, the iterations go b->a, a->b, ..., b->a.
-  static_assert(gpu::kDenoiseIterations % 2 == 1);
-  finish_->bind(0, a_, kHalf4);
-  finish_->bind(1, guide_, kRgba32);
-  finish_->bind(3, layer_);
+  // The variance pass writes b; the iterations go b->a, a->b, ...; the last one's output is finished.
+  for (vk::ComputePipeline* finish : {finish_.get(), finishShown_.get()}) {
+    finish->bind(0, gpu::kDenoiseIterations % 2 == 1 ? a_ : b_, kHalf4);
+    finish->bind(1, *accum_, kRgba32);
+    finish->bind(2, *accumAux_, kRgba32);
+    finish->bind(4, layer_);
+  }
+  finishShown_->bind(5, display_);
   compose_->bind(0, *accum_, kRgba32);
   compose_->bind(1, layer_, kRgba32);
   compose_->bind(3, display_);
@@ -116,8 +131,9 @@ void Denoiser::prepare(const DenoiseWork& work) {
   VkDeviceSize bytes = std::max<VkDeviceSize>(count * sizeof(std::uint32_t), 16);
   if (!tiles_.valid() || tiles_.size() < bytes) {
     tiles_ = vk::Buffer(ctx_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "tile codes");
-    prepare_->bind(6, tiles_);
-    finish_->bind(2, tiles_);
+    prepare_->bind(5, tiles_);
+    finish_->bind(3, tiles_);
+    finishShown_->bind(3, tiles_);
     compose_->bind(2, tiles_);
   }
   tiles_.upload(work.tileCodes.data(), count * sizeof(std::uint32_t));
@@ -165,8 +181,12 @@ void Denoiser::record(VkCommandBuffer cb, const DenoiseWork& work) {
         stamp(kAtrousNames[i]);
       }
       vk::computeBarrier(cb);
-      finish_->dispatch(cb, gx, gy, &push, sizeof push);
+      // A frame denoised whole shows the layer everywhere, without seams: the finish writes the
+      // displayed image too and there is nothing left to compose.
+      const bool shown = x0 == 0 && y0 == 0 && x1 == width_ && y1 == height_ && showsLayerWhole(work);
+      (shown ? finishShown_ : finish_)->dispatch(cb, gx, gy, &push, sizeof push);
       stamp("finish");
+      if (shown) return;
     }
   }
   push.domain = {0, 0, width_, height_};

@@ -41,10 +41,10 @@ class Denoiser {
   vk::Buffer* accum_ = nullptr;
   vk::Buffer* accumAux_ = nullptr;
   bool allocated_ = false;
-  std::unique_ptr<vk::ComputePipeline> prepare_, variance_, atrousAB_, atrousBA_, finish_, compose_;
+  std::unique_ptr<vk::ComputePipeline> prepare_, variance_, atrousAB_, atrousBA_, finish_, finishShown_, compose_;
   VkQueryPool timestamps_ = VK_NULL_HANDLE;
   std::vector<const char*> timedPasses_;  // the passes the last timed frame recorded
-  vk::Buffer a_, b_, surface_, guide_, moments_, layer_, display_, tiles_;
+  vk::Buffer a_, b_, surface_, gradient_, moments_, layer_, display_, tiles_;
 };
 
 }  // namespace retile
