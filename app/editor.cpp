@@ -35,7 +35,10 @@ int runEditor(int argc, char** argv, const std::string& file) {
     }
   }
   QStringList recovery = ui::MainWindow::recoveryCandidates();
-  ui::MainWindow window(std::move(scene), path);
+  ui::EditorOptions options;
+  // The window and its docks as the user left them (a screenshot shows the default layout).
+  options.keepLayout = !qEnvironmentVariableIsSet("RETILE_SCREENSHOT");
+  ui::MainWindow window(std::move(scene), path, options);
   window.show();
   // The last session did not close cleanly: offer its newest autosave.
   if (!recovery.isEmpty() && !qEnvironmentVariableIsSet("RETILE_NO_PROMPTS") &&

@@ -27,6 +27,7 @@ void usage() {
                "               | scale [--size WxH] [--frames N]\n"
                "  retile compare IMAGE REFERENCE [--noise IMAGE2] [--block N] [--exclude X,Y,W,H ...] [--worst K]\n"
                "  retile import FILE\n"
+               "  retile --version | --help\n"
                "SCENE is a file (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default'.\n");
 }
 
@@ -38,8 +39,12 @@ int main(int argc, char** argv) {
   try {
     if (args.empty() || (args.size() == 1 && args[0].rfind("-", 0) != 0 && !retile::cli::isCommand(args[0])))
       return retile::cli::runEditor(argc, argv, args.empty() ? std::string() : args[0]);
-    if (args[0] == "--help" || args[0] == "-h") {
+    if (args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
       usage();
+      return 0;
+    }
+    if (args[0] == "--version" || args[0] == "-V") {
+      std::printf("retile %s\n", RETILE_VERSION);
       return 0;
     }
     std::string cmd = args[0];

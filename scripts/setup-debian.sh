@@ -5,10 +5,12 @@ set -euo pipefail
 
 # zlib1g-dev: Debian's Assimp CMake package names libz.so in its link interface, but libassimp-dev
 # does not depend on zlib1g-dev, so a fresh machine fails at the link step without it.
+# file, dpkg-dev: CPack's Debian generator finds the executables with file and their library
+# dependencies with dpkg-shlibdeps (the `package` target).
 # locales: the locale sources that localedef compiles, for the tests that run under a comma-decimal
 # locale (de_DE) as an artist in much of Europe does.
 packages=(
-  build-essential cmake ninja-build pkg-config git
+  build-essential cmake ninja-build pkg-config git file dpkg-dev
   qt6-base-dev qt6-base-dev-tools qt6-charts-dev qt6-svg-dev libqt6opengl6-dev libgl-dev
   libvulkan-dev vulkan-tools mesa-vulkan-drivers vulkan-validationlayers
   glslang-dev glslang-tools spirv-tools

@@ -199,6 +199,11 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
   connect(&undo_, &QUndoStack::cleanChanged, this, [this] { updateTitle(); });
   updateTitle();
   resize(1280, 800);
+  if (options_.keepLayout) {
+    QSettings settings;
+    restoreGeometry(settings.value("window/geometry").toByteArray());
+    restoreState(settings.value("window/docks").toByteArray());
+  }
   startEngine(doc_.scene());
   rebuildOutliner();
   rebuildProperties();
@@ -1060,6 +1065,11 @@ void MainWindow::closeEvent(QCloseEvent* e) {
     return;
   }
   if (engine_) engine_->stop();
+  if (options_.keepLayout) {
+    QSettings settings;
+    settings.setValue("window/geometry", saveGeometry());
+    settings.setValue("window/docks", saveState());
+  }
   // A clean close: no recovery is offered next time.
   QDir dir(recoveryDirectory());
   for (const QString& f : dir.entryList({"autosave-*.retile", "session.lock"}, QDir::Files)) dir.remove(f);

@@ -37,6 +37,9 @@ namespace retile::ui {
 struct EditorOptions {
   int renderScale = 4;        // render at 1/scale of the viewport (lavapipe traces well under 1 M samples/s)
   QSize initialRenderSize{};  // fixed render size (tests); empty: follow the viewport
+  // Restore the window's geometry and dock layout from QSettings and save them on close (the app;
+  // tests leave it off so that one test's layout never reaches the next).
+  bool keepLayout = false;
 };
 
 class MainWindow : public QMainWindow {

@@ -2,6 +2,8 @@
 // edit from the properties reaches the render thread and re-renders around the object, undo
 // restores, save and open round-trip, overlays draw, a broken file leaves the scene alone.
 #include <QApplication>
+#include <QDockWidget>
+#include <QSettings>
 #include <QStandardPaths>
 #include <QDoubleSpinBox>
 #include <QTemporaryDir>
@@ -810,6 +812,41 @@ TEST(Editor, TheIndirectionClassesOverlayShowsTheClassesOfTheSelectedObject) {
       if (a != b && a.red() > 200 && a.green() < 90 && a.blue() < 90) ++red;
     }
   EXPECT_GT(red, 20) << "high tiles outlined in red where the sphere is";
+}
+
+// The window's size and which docks show come back in the next session (QSettings), and only for
+// windows that keep their layout (the app; tests do not).
+TEST(Editor, KeepsTheWindowAndDockLayoutBetweenSessions) {
+  QSettings().remove("window");
+  EditorOptions keep;
+  keep.initialRenderSize = QSize(96, 54);
+  keep.keepLayout = true;
+  {
+    MainWindow w(makeDefaultScene(), std::filesystem::path(), keep);
+    w.show();
+    w.resize(1111, 733);
+    auto* log = w.findChild<QDockWidget*>("log");
+    ASSERT_NE(log, nullptr);
+    ASSERT_TRUE(log->isVisible());
+    log->hide();
+    ASSERT_TRUE(w.close());
+  }
+  {
+    MainWindow w(makeDefaultScene(), std::filesystem::path(), keep);
+    w.show();
+    EXPECT_EQ(w.size(), QSize(1111, 733));
+    EXPECT_FALSE(w.findChild<QDockWidget*>("log")->isVisible());
+    EXPECT_TRUE(w.findChild<QDockWidget*>("outliner")->isVisible());
+  }
+  {
+    EditorOptions fresh = keep;
+    fresh.keepLayout = false;
+    MainWindow w(makeDefaultScene(), std::filesystem::path(), fresh);
+    w.show();
+    EXPECT_EQ(w.size(), QSize(1280, 800));
+    EXPECT_TRUE(w.findChild<QDockWidget*>("log")->isVisible());
+  }
+  QSettings().remove("window");
 }
 
 }  // namespace

@@ -37,8 +37,8 @@ class ColorConfig {
   virtual void srgbToLinear(float* rgba, std::size_t pixels) const = 0;
 };
 
-// Where shipped resources live: $RETILE_RESOURCES, else the source tree's resources/ for
-// builds run in place, else <executable>/../share/retile.
+// Where shipped resources live: $RETILE_RESOURCES, else <executable>/../share/retile when it
+// holds them (installed), else the source tree's resources/ (builds run in place).
 std::string resourceDirectory();
 
 }  // namespace retile

@@ -19,11 +19,14 @@ namespace retile {
 
 std::string resourceDirectory() {
   if (const char* env = std::getenv("RETILE_RESOURCES"); env && *env) return env;
+  // Installed first (the package's share/retile beside its bin/), so that an installed retile on
+  // the machine that built it does not read the source tree.
   std::error_code ec;
+  fs::path installed = (executableDirectory() / ".." / "share" / "retile").lexically_normal();
+  if (fs::exists(installed / "ocio" / "config.ocio", ec)) return installed.string();
   fs::path built = RETILE_RESOURCE_DIR;
   if (fs::exists(built / "ocio" / "config.ocio", ec)) return built.string();
-  fs::path installed = executableDirectory() / ".." / "share" / "retile";
-  return installed.lexically_normal().string();
+  return installed.string();
 }
 
 namespace {

@@ -16,6 +16,9 @@ fs::path importWorkerPath() {
   fs::path beside = executableDirectory() / "retile-import-worker";
   std::error_code ec;
   if (fs::exists(beside, ec)) return beside;
+  // Installed (packaging/CMakeLists.txt): a helper, not a command, so not in bin/.
+  fs::path installed = (executableDirectory() / ".." / "libexec" / "retile" / "retile-import-worker").lexically_normal();
+  if (fs::exists(installed, ec)) return installed;
 #ifdef RETILE_IMPORT_WORKER_BUILD_PATH
   return RETILE_IMPORT_WORKER_BUILD_PATH;
 #else
