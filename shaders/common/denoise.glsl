@@ -21,7 +21,6 @@ bool domainPixel(out uint index, out ivec2 xy) {
 }
 
 ivec2 clampToDomain(ivec2 q) { return clamp(q, push.domain.xy, push.domain.xy + push.domain.zw - 1); }
-bool inDomain(ivec2 q) { return all(greaterThanEqual(q, push.domain.xy)) && all(lessThan(q, push.domain.xy + push.domain.zw)); }
 uint pixelIndex(ivec2 q) { return uint(q.y) * push.image.x + uint(q.x); }
 
 // What the preparation and the finish read of a pixel's accumulation: its mean, the mean of the

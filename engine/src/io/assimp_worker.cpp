@@ -19,6 +19,7 @@
 #include "core/files.h"
 #include "retile/io.h"
 #include "retile/log.h"
+#include "scene/validate.h"
 
 namespace fs = std::filesystem;
 
@@ -446,6 +447,14 @@ int assimpWorkerMain(int argc, char** argv) {
     if (assimpErrors.size() > kShown)
       std::fprintf(stderr, "warning: %s: Assimp reported %zu more problems\n", file.filename().string().c_str(),
                    assimpErrors.size() - kShown);
+    // The conversion is written as JSON, which has no infinities: values a hostile file leaves
+    // out of range are repaired or refused here, and the parent checks the scene it reads again.
+    std::vector<std::string> repairs;
+    if (auto valid = validateScene(conv.scene, repairs); !valid) {
+      std::fprintf(stderr, "error: %s\n", valid.error().c_str());
+      return 2;
+    }
+    for (const std::string& r : repairs) std::fprintf(stderr, "warning: %s: %s\n", file.filename().string().c_str(), r.c_str());
     std::string out = nativeSceneToString(conv.scene);
     std::fwrite(out.data(), 1, out.size(), stdout);
     std::fflush(stdout);

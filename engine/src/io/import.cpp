@@ -5,6 +5,7 @@
 #include "core/process.h"
 #include "retile/io.h"
 #include "retile/log.h"
+#include "scene/validate.h"
 
 namespace fs = std::filesystem;
 
@@ -88,7 +89,9 @@ Result<ImportedScene> importAssimp(const fs::path& file, const ImportOptions& op
   return result;
 }
 
-Result<ImportedScene> importScene(const fs::path& file, const ImportOptions& options) {
+namespace {
+
+Result<ImportedScene> importByFormat(const fs::path& file, const ImportOptions& options) {
   using R = Result<ImportedScene>;
   std::error_code ec;
   if (!fs::exists(file, ec)) return R::failure(cat(file.string(), ": file not found"));
@@ -108,6 +111,19 @@ Result<ImportedScene> importScene(const fs::path& file, const ImportOptions& opt
     return importTungsten(file, options);
   }
   return importAssimp(file, options);
+}
+
+}  // namespace
+
+Result<ImportedScene> importScene(const fs::path& file, const ImportOptions& options) {
+  auto imported = importByFormat(file, options);
+  if (!imported) return imported;
+  // Whatever read it, nothing past this point sees a value the renderer cannot take.
+  std::vector<std::string> repairs;
+  auto valid = validateScene(imported->scene, repairs);
+  if (!valid) return Result<ImportedScene>::failure(cat(file.string(), ": ", valid.error()));
+  for (const std::string& r : repairs) imported->warnings.push_back(cat(file.filename().string(), ": ", r));
+  return imported;
 }
 
 }  // namespace retile
