@@ -16,14 +16,7 @@ layout(set = 0, binding = 1) uniform samplerBuffer uAccum;
 layout(set = 0, binding = 2) uniform samplerBuffer uAccumAux;
 layout(set = 0, binding = 3, std430) readonly buffer Tiles { uint tileCodes[]; };
 layout(set = 0, binding = 4, std430) buffer Layer { vec4 layer[]; };
-#ifdef DENOISE_FINISH_SHOWS
-// Compiled as a second pipeline for frames denoised whole, where every tile shows the layer just
-// written and there is no seam to soften: the finish writes the displayed image too, and the
-// compositor does not run (a pass fewer: an eighth of the denoiser's time on lavapipe).
-layout(set = 0, binding = 5, std430) writeonly buffer Display { vec4 display[]; };
-#endif
 
-#define DENOISE_READS_ACCUMULATION
 #include "common/denoise.glsl"
 
 void main() {
@@ -31,10 +24,13 @@ void main() {
   ivec2 xy;
   bool live = domainPixel(p, xy);
   uint tile = uint(xy.y / int(push.tiles.x)) * push.tiles.y + uint(xy.x / int(push.tiles.x));
-  Guides g = readGuides(int(p));
-  vec3 c = remodulate(texelFetch(uColors, int(p)).rgb, g.albedo) + g.emission;
+  // Only what remodulation needs: the sample count, the albedo and the emission sums.
+  int i = int(p);
+  float n = texelFetch(uAccum, i * 2).w;
+  float inv = n > 0.0 ? 1.0 / n : 0.0;
+  vec3 albedo = texelFetch(uAccumAux, i * int(kAuxVec4s)).rgb * inv;
+  vec3 emission = texelFetch(uAccumAux, i * int(kAuxVec4s) + 2).rgb * inv;
+  vec3 c = remodulate(texelFetch(uColors, i).rgb, albedo) + emission;
   if (live && (tileCodes[tile] & kTileWrite) != 0u) layer[p] = vec4(c, 1.0);
-#ifdef DENOISE_FINISH_SHOWS
-  if (live) display[p] = vec4(c, 1.0);
-#endif
+
 }

@@ -23,10 +23,11 @@ bool domainPixel(out uint index, out ivec2 xy) {
 ivec2 clampToDomain(ivec2 q) { return clamp(q, push.domain.xy, push.domain.xy + push.domain.zw - 1); }
 uint pixelIndex(ivec2 q) { return uint(q.y) * push.image.x + uint(q.x); }
 
-// What the preparation and the finish read of a pixel's accumulation: its mean, the mean of the
-// squares of its luminance, and the guides (the first non-specular hit's albedo, normal, depth
-// and the emission seen up to it), each a mean over the pixel's samples. For shaders that bind
-// uAccum and uAccumAux before including this.
+// What the preparation reads of a pixel's accumulation: its mean, the mean of the squares of its
+// luminance, and the guides (the first non-specular hit's albedo, normal, depth and the emission
+// seen up to it), each a mean over the pixel's samples. For shaders that bind uAccum and uAccumAux
+// before including this. (lavapipe fetches every texel named, used or not: a shader that needs
+// less reads less.)
 #ifdef DENOISE_READS_ACCUMULATION
 struct Guides {
   vec3 mean, albedo, emission, normal;

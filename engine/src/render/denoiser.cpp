@@ -73,10 +73,6 @@ void Denoiser::allocate() {
     finish_ = std::make_unique<vk::ComputePipeline>(
         ctx_, "denoise_finish.comp",
         std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
-    finishShown_ = std::make_unique<vk::ComputePipeline>(
-        ctx_, "denoise_finish.comp",
-        std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage, B::Storage, B::Storage}, push,
-        std::vector<vk::ShaderDefine>{{"DENOISE_FINISH_SHOWS", "1"}});
     compose_ = std::make_unique<vk::ComputePipeline>(
         ctx_, "compose.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
   }
@@ -108,13 +104,10 @@ void Denoiser::allocate() {
     pipe->bind(3, *to);
   }
   // The variance pass writes b; the iterations go b->a, a->b, ...; the last one's output is finished.
-  for (vk::ComputePipeline* finish : {finish_.get(), finishShown_.get()}) {
-    finish->bind(0, gpu::kDenoiseIterations % 2 == 1 ? a_ : b_, kHalf4);
-    finish->bind(1, *accum_, kRgba32);
-    finish->bind(2, *accumAux_, kRgba32);
-    finish->bind(4, layer_);
-  }
-  finishShown_->bind(5, display_);
+  finish_->bind(0, gpu::kDenoiseIterations % 2 == 1 ? a_ : b_, kHalf4);
+  finish_->bind(1, *accum_, kRgba32);
+  finish_->bind(2, *accumAux_, kRgba32);
+  finish_->bind(4, layer_);
   compose_->bind(0, *accum_, kRgba32);
   compose_->bind(1, layer_, kRgba32);
   compose_->bind(3, display_);
@@ -133,7 +126,6 @@ void Denoiser::prepare(const DenoiseWork& work) {
     tiles_ = vk::Buffer(ctx_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "tile codes");
     prepare_->bind(5, tiles_);
     finish_->bind(3, tiles_);
-    finishShown_->bind(3, tiles_);
     compose_->bind(2, tiles_);
   }
   tiles_.upload(work.tileCodes.data(), count * sizeof(std::uint32_t));
@@ -141,6 +133,7 @@ void Denoiser::prepare(const DenoiseWork& work) {
 
 void Denoiser::record(VkCommandBuffer cb, const DenoiseWork& work) {
   timedPasses_.clear();
+  layerShown_ = false;
   if (!work.compose) return;
   // Timestamps after each pass (the pass before them has finished: one queue, barriers between).
   if (work.timePasses && timestamps_ == VK_NULL_HANDLE) {
@@ -181,12 +174,12 @@ void Denoiser::record(VkCommandBuffer cb, const DenoiseWork& work) {
         stamp(kAtrousNames[i]);
       }
       vk::computeBarrier(cb);
-      // A frame denoised whole shows the layer everywhere, without seams: the finish writes the
-      // displayed image too and there is nothing left to compose.
-      const bool shown = x0 == 0 && y0 == 0 && x1 == width_ && y1 == height_ && showsLayerWhole(work);
-      (shown ? finishShown_ : finish_)->dispatch(cb, gx, gy, &push, sizeof push);
+      finish_->dispatch(cb, gx, gy, &push, sizeof push);
       stamp("finish");
-      if (shown) return;
+      // A frame denoised whole shows the layer everywhere, without seams: the layer is the
+      // displayed image and there is nothing to compose.
+      layerShown_ = x0 == 0 && y0 == 0 && x1 == width_ && y1 == height_ && showsLayerWhole(work);
+      if (layerShown_) return;
     }
   }
   push.domain = {0, 0, width_, height_};

@@ -27,8 +27,9 @@ class Denoiser {
   void prepare(const DenoiseWork& work);
   // Records the passes, after the accumulate pass.
   void record(VkCommandBuffer cb, const DenoiseWork& work);
-  // The composed image (RGBA32F per pixel), valid once a frame has composed.
-  vk::Buffer& display() { return display_; }
+  // The composed image (RGBA32F per pixel), valid once a frame has composed: the layer itself
+  // when the last frame was denoised whole (every tile shows it, so nothing is composed).
+  vk::Buffer& display() { return layerShown_ ? layer_ : display_; }
   // After a frame recorded with work.timePasses has completed (and before the next is recorded):
   // each pass's device time.
   std::vector<FrameStats::PassTime> passTimes();
@@ -41,9 +42,10 @@ class Denoiser {
   vk::Buffer* accum_ = nullptr;
   vk::Buffer* accumAux_ = nullptr;
   bool allocated_ = false;
-  std::unique_ptr<vk::ComputePipeline> prepare_, variance_, atrousAB_, atrousBA_, finish_, finishShown_, compose_;
+  std::unique_ptr<vk::ComputePipeline> prepare_, variance_, atrousAB_, atrousBA_, finish_, compose_;
   VkQueryPool timestamps_ = VK_NULL_HANDLE;
   std::vector<const char*> timedPasses_;  // the passes the last timed frame recorded
+  bool layerShown_ = false;               // the last frame recorded shows the layer whole
   vk::Buffer a_, b_, surface_, gradient_, moments_, layer_, display_, tiles_;
 };
 
