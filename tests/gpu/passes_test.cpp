@@ -102,6 +102,53 @@ TEST(AccumulatePass, StaleCapKeepsAtMostCapSamplesOfTheOldValue) {
   EXPECT_FLOAT_EQ(img.color[0], 14.0f / 8.0f);
 }
 
+// Soft borders (compose.comp): a pixel of a fresh tile near a seam with a tile showing the layer
+// cross-fades to the layer's value at the same pixel, never to another place's: the layer holds 4
+// in the middle tile and 2 around it, the fresh samples 8, so near the seams the middle tile
+// fades from 8 towards 4 (its own old value), where a mirror image would fade towards 2.
+TEST(ComposePass, SoftBordersFadeToTheSamePixelsOtherValue) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const int w = 48, h = 16, T = 16, feather = 4;
+  Scene s = wallScene(w, h, Vec3{2.0f});
+  r->setScene(s);
+  r->resize(w, h);
+  FrameOptions whole;
+  whole.denoise = wholeFrameDenoise(w, h, T);
+  r->renderFrame({{0, 0, w, h, 2, 0, true}}, whole);  // layer: 2 everywhere
+  auto set = [&](float e) {
+    s.materials[0].emission = Vec3{e};
+    r->updateScene(s, kUpdateMaterials | kUpdateLights);
+  };
+  set(4.0f);
+  FrameOptions middle;
+  middle.denoise.compose = middle.denoise.filter = true;
+  middle.denoise.x = T;
+  middle.denoise.width = T;
+  middle.denoise.height = h;
+  middle.denoise.tileSize = T;
+  middle.denoise.tileCodes = {kShowPreviousLayer, kShowLayer | kShowWriteLayer | kShowFiltered, kShowPreviousLayer};
+  r->renderFrame({{T, 0, T, h, 2, 0, true}}, middle);  // layer: 4 in the middle tile
+  set(8.0f);
+  FrameOptions fresh;
+  fresh.denoise.compose = true;
+  fresh.denoise.tileSize = T;
+  fresh.denoise.featherPixels = feather;
+  fresh.denoise.tileCodes = {kShowPreviousLayer, kShowFresh, kShowPreviousLayer};
+  r->renderFrame({{T, 0, T, h, 2, 0, true}}, fresh);
+  RenderImage img = r->readback();
+  ASSERT_EQ(img.display.size(), static_cast<std::size_t>(w * h * 3));
+  auto weight = [&](int d) { return 0.5f * std::max(0.0f, 1.0f - (static_cast<float>(d) + 0.5f) / feather); };
+  for (int x = 0; x < w; ++x) {
+    float expected = 2.0f;  // outside: the layer, fading towards its own raw samples (2 as well)
+    if (x >= T && x < 2 * T) {
+      float faded = weight(x - T) + weight(2 * T - 1 - x);
+      expected = 8.0f * (1.0f - faded) + 4.0f * faded;
+    }
+    for (int y = 0; y < h; ++y)
+      ASSERT_NEAR(img.display[static_cast<std::size_t>(y * w + x) * 3], expected, 1e-4f) << "pixel " << x << "," << y;
+  }
+}
+
 TEST(ReusePass, KeepsTheHistoryInsideTheSumsGoesBackToItAndDropsItExactly) {
   RETILE_RENDERER_OR_SKIP(r);
   const int w = 16, h = 8;
