@@ -146,6 +146,26 @@ Result<bool> writePointChart(const std::filesystem::path& base, const QString& t
   chart->addAxis(y, Qt::AlignLeft);
   const double inf = std::numeric_limits<double>::infinity();
   double xlo = inf, xhi = -inf, ylo = inf, yhi = -inf;
+  for (const ChartPoint& p : points)
+    if (std::isfinite(p.at.x()) && std::isfinite(p.at.y()))
+      xlo = std::min(xlo, p.at.x()), xhi = std::max(xhi, p.at.x()), ylo = std::min(ylo, p.at.y()), yhi = std::max(yhi, p.at.y());
+  // A point whose label would fall on an earlier one's (within 4 % of the y span, 20 % of the x
+  // span: labels are a line high but wide) shares that label ("spiral, change"): labels drawn on
+  // top of each other could not be read. The legend lists every point anyway.
+  const double spanX = std::max(xhi - std::min(xlo, 0.0), 1e-9), spanY = std::max(yhi - ylo, 1e-9);
+  std::vector<QString> labels(points.size());
+  std::vector<int> labelOwner(points.size(), -1);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    labelOwner[i] = static_cast<int>(i);
+    for (std::size_t j = 0; j < i; ++j)
+      if (labelOwner[j] == static_cast<int>(j) && std::abs(points[i].at.x() - points[j].at.x()) < 0.2 * spanX &&
+          std::abs(points[i].at.y() - points[j].at.y()) < 0.04 * spanY) {
+        labelOwner[i] = static_cast<int>(j);
+        break;
+      }
+    auto owner = static_cast<std::size_t>(labelOwner[i]);
+    labels[owner] = labels[owner].isEmpty() ? points[i].label : labels[owner] + ", " + points[i].label;
+  }
   for (std::size_t i = 0; i < points.size(); ++i) {
     const ChartPoint& p = points[i];
     if (!std::isfinite(p.at.x()) || !std::isfinite(p.at.y())) continue;
@@ -156,17 +176,15 @@ Result<bool> writePointChart(const std::filesystem::path& base, const QString& t
       s->setBrush(Qt::NoBrush);
       s->setPen(QPen(seriesColor(i), 2));
     }
-    s->setName(p.label);
+    s->setName(p.legend.isEmpty() ? p.label : p.legend);
     s->setMarkerSize(11);
     s->append(p.at);
-    s->setPointLabelsVisible(true);
-    s->setPointLabelsFormat(p.label);
+    s->setPointLabelsVisible(labelOwner[i] == static_cast<int>(i));
+    s->setPointLabelsFormat(labels[i]);
     s->setPointLabelsClipping(false);
     chart->addSeries(s);
     s->attachAxis(x);
     s->attachAxis(y);
-    xlo = std::min(xlo, p.at.x()), xhi = std::max(xhi, p.at.x());
-    ylo = std::min(ylo, p.at.y()), yhi = std::max(yhi, p.at.y());
   }
   fitAxis(x, std::min(xlo, 0.0), xhi, false);
   static_cast<QValueAxis*>(x)->setMin(0);  // times are never negative

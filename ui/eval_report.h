@@ -21,7 +21,8 @@ struct ChartLine {
 };
 
 struct ChartPoint {
-  QString label;
+  QString label;        // on the plot (points that would overlap share one label)
+  QString legend;       // in the legend; empty: the label
   QPointF at;
   bool hollow = false;  // drawn as an empty square: a bound, not a measurement (never reached)
 };
