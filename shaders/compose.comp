@@ -1,13 +1,14 @@
 #version 460
 // The displayed image: per tile the raw accumulation or the denoised layer (tileCodes), with soft
 // borders. Where two tiles show different things (fresh and stale samples, or two regions'
-// denoised results), each pixel within `feather` pixels of the seam blends in what the other tile
-// would show at that same pixel, half at the seam falling to none at the feather's width, so the
-// seam is a cross-fade and is not mistaken for a shadow or an edge. Between two tiles that both
-// show raw samples the same pixel has only one value, so the pixel's mirror image across the seam
-// stands in. (The mirror image everywhere put other places' content beside the seam: with the
-// change method's scattered tiles it doubled the error, docs/MEASUREMENTS.md.) One invocation per
-// pixel of the image.
+// denoised results), each pixel within `feather` pixels of the seam blends in something of the
+// other side, half at the seam falling to none at the feather's width, so the seam is not mistaken
+// for a shadow or an edge. Across a seam between raw samples and the layer, that is what the other
+// tile shows at the same pixel (a cross-fade between the pixel's two values); across a seam
+// between two tiles of one kind (raw and raw, or two regions' results in the one layer), a pixel
+// has one value of that kind, so its mirror image across the seam stands in. (The mirror image at
+// raw-to-layer seams too put other places' content beside them: with the change method's scattered
+// fresh tiles it doubled the error, docs/MEASUREMENTS.md.) One invocation per pixel of the image.
 #extension GL_GOOGLE_include_directive : require
 
 #include "shared/layouts.h"
@@ -62,8 +63,8 @@ void main() {
     mirror = clamp(mirror, ivec2(0), ivec2(push.image.xy) - 1);
     uint otherCode = codeAt(o);
     float w = exists && otherCode != code ? 0.5 * max(0.0, 1.0 - (float(d) + 0.5) / max(feather, 1e-6)) : 0.0;
-    bool bothRaw = code < kTileLayer && otherCode < kTileLayer;
-    blend += w * shown(bothRaw ? mirror : xy, otherCode);
+    bool sameKind = (code < kTileLayer) == (otherCode < kTileLayer);
+    blend += w * shown(sameKind ? mirror : xy, otherCode);
     total += w;
   }
   v = v * (1.0 - total) + blend;
