@@ -71,9 +71,9 @@ Result<double> parseNumber(const std::string& option, const std::string& text, d
 Result<bool> parseSize(const std::string& text, int* width, int* height) {
   auto x = text.find('x');
   if (x == std::string::npos) return Result<bool>::failure(cat("--size: '", text, "' is not WIDTHxHEIGHT"));
-  auto w = parseInt("--size width", text.substr(0, x), 1, 16384);
+  auto w = parseInt("--size width", text.substr(0, x), 1, kMaxImageSide);
   if (!w) return Result<bool>::failure(w.error());
-  auto h = parseInt("--size height", text.substr(x + 1), 1, 16384);
+  auto h = parseInt("--size height", text.substr(x + 1), 1, kMaxImageSide);
   if (!h) return Result<bool>::failure(h.error());
   *width = w.value();
   *height = h.value();

@@ -151,6 +151,9 @@ float defaultFilterWidth(PixelFilter f);  // box 1, tent 2 (Tungsten's), Gaussia
 // from the pixel centre in pixels. Separable filters: x and y are drawn independently.
 std::vector<float> pixelFilterWarp(PixelFilter f, float width, int segments);
 
+// The largest image side anything accepts (files, edits, the command line, the renderer).
+constexpr int kMaxImageSide = 16384;
+
 struct RenderSettings {
   int width = 640;
   int height = 360;

@@ -494,8 +494,9 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
     out.warnings.push_back(cat(file.string(), ": environment names missing texture ", s.environment.map));
     s.environment.map = kNoNode;
   }
-  if (s.settings.width < 1 || s.settings.height < 1 || s.settings.width > 16384 || s.settings.height > 16384)
-    return R::failure(cat(file.string(), ": settings: size ", s.settings.width, "x", s.settings.height, " is outside 1..16384"));
+  if (s.settings.width < 1 || s.settings.height < 1 || s.settings.width > kMaxImageSide || s.settings.height > kMaxImageSide)
+    return R::failure(cat(file.string(), ": settings: size ", s.settings.width, "x", s.settings.height, " is outside 1..",
+                          kMaxImageSide));
   s.reserveIds(std::max(nextId, maxId + 1));
   return out;
 }

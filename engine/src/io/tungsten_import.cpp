@@ -439,8 +439,8 @@ class TungstenImporter {
     if (type != "pinhole") warn(cat("camera type '", type, "' is rendered as a pinhole camera"));
     if (const Value* r = c.find("resolution")) {
       Vec2 res;
-      if (!json::toVec2(*r, &res) || res.x < 1 || res.y < 1 || res.x > 16384 || res.y > 16384)
-        return problem(where, "resolution: expected one or two whole numbers within 1..16384");
+      if (!json::toVec2(*r, &res) || res.x < 1 || res.y < 1 || res.x > kMaxImageSide || res.y > kMaxImageSide)
+        return problem(where, cat("resolution: expected one or two whole numbers within 1..", kMaxImageSide));
       s.settings.width = static_cast<int>(res.x);
       s.settings.height = static_cast<int>(res.y);
     } else {

@@ -297,7 +297,7 @@ struct Renderer::Impl {
 
   void resize(int w, int h) {
     completeInFlight();  // the frame in flight uses what this touches
-    RETILE_ASSERT(w > 0 && h > 0 && w <= 16384 && h <= 16384, cat("size ", w, "x", h));
+    RETILE_ASSERT(w > 0 && h > 0 && w <= kMaxImageSide && h <= kMaxImageSide, cat("size ", w, "x", h));
     width = w;
     height = h;
     countTileSize = 0;  // the counters' layout follows the image

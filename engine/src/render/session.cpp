@@ -327,8 +327,8 @@ const MethodSettings& RenderSession::method() const { return impl_->planner.meth
 
 void RenderSession::resize(int width, int height) {
   completeGpu();  // the frame in flight's counters and probe belong to the state it was planned in
-  width = std::clamp(width, 1, 16384);
-  height = std::clamp(height, 1, 16384);
+  width = std::clamp(width, 1, kMaxImageSide);
+  height = std::clamp(height, 1, kMaxImageSide);
   impl_->width = width;
   impl_->height = height;
   scene_.settings.width = width;

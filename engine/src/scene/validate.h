@@ -15,7 +15,6 @@ namespace retile {
 // values near the float limit): float keeps about 7 digits, so geometry that far out cannot sit
 // beside anything of a visible size. Real scenes stay many orders of magnitude inside it.
 constexpr float kMaxCoordinate = 1e12f;
-constexpr int kMaxImageSide = 16384;
 
 // Repairs what can be repaired and says what it did, one warning per kind of fault and item
 // (triangles with non-finite or absurd vertices or indices past the vertex list are dropped,
