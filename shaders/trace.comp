@@ -32,11 +32,32 @@ layout(set = 0, binding = 15, std430) buffer Selection { uint selectionCounts[];
 
 layout(push_constant) uniform Push { TracePush push; };
 
+float warpSlot(int i) { return frame.filterWarp[i >> 2][i & 3]; }
+
+// Tungsten's table (FilterSampling::Tungsten) at step i = 0..30: slot i - 1 holds it, step 0's is 0.
+float tungstenCdf(int i) { return i <= 0 ? 0.0 : warpSlot(i - 1); }
+
 // A sample's offset from the pixel centre along one axis for u in [0, 1): the filter's inverse
-// CDF, linear between its 33 tabulated points (layouts.h), or exact for a tent.
+// CDF, linear between its 33 tabulated points (layouts.h), or exact for a tent, or as Tungsten
+// draws it (ReconstructionFilter::sample: the first step whose CDF exceeds the draw, searched from
+// step 1, so the draw lands one step further out than the weight it was drawn with).
 float filterOffset(float u) {
   float tent = frame.filterWarp[8].w;
   if (tent > 0.0) return tent * (u < 0.5 ? sqrt(2.0 * u) - 1.0 : 1.0 - sqrt(2.0 - 2.0 * u));
+  if (tent < 0.0) {
+    bool negative = u < 0.5;
+    float xi = negative ? 2.0 * u : 2.0 * u - 1.0;
+    int lo = 1, hi = 30;  // the first step in 1..29 with CDF > xi, else 30
+    for (int k = 0; k < 5; ++k) {
+      int mid = (lo + hi) >> 1;
+      bool below = mid >= 30 || xi < tungstenCdf(mid);
+      hi = below ? mid : hi;
+      lo = below ? lo : mid + 1;
+    }
+    float c0 = tungstenCdf(lo - 1), c1 = tungstenCdf(lo);
+    float offset = -tent * (float(lo) + (xi - c0) / max(c1 - c0, 1e-9)) / 31.0;
+    return negative ? -offset : offset;
+  }
   float t = u * float(kFilterWarpSegments);
   int i = min(int(t), kFilterWarpSegments - 1);
   float a = frame.filterWarp[i >> 2][i & 3], b = frame.filterWarp[(i + 1) >> 2][(i + 1) & 3];

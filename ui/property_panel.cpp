@@ -522,6 +522,13 @@ void PropertyPanel::buildRender(Builder& b) {
            [edit](double v, int drag) {
              edit(tr("Filter width"), drag, [v](RenderSettings& x) { x.filterWidth = static_cast<float>(v); });
            });
+  // Tungsten scene files come with Tungsten's way of drawing its tent and Gaussian, so they converge
+  // to the picture their author saw; any scene may switch.
+  b.choice(tr("Filter sampling"), "filterSampling", {tr("Exact"), tr("As Tungsten draws it")}, static_cast<int>(r.filterSampling),
+           [edit](int i) {
+             if (i < 0 || i > 1) return;
+             edit(tr("Filter sampling"), 0, [i](RenderSettings& x) { x.filterSampling = static_cast<FilterSampling>(i); });
+           });
   b.label(tr("Resolution"), tr("%1 x %2 (the viewport's size times the render scale)").arg(renderSize_.width()).arg(renderSize_.height()));
 }
 

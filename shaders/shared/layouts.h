@@ -106,7 +106,9 @@ struct FrameUniforms {
                         // tile size of the selection counters (0: not counting)
   // A sample's offset from the pixel centre along each axis, in pixels, for u = i / 32: the
   // inverse CDF of the scene's pixel filter (filter importance sampling), 33 values, packed; the
-  // last slot (filterWarp[8].w): a tent's radius, inverted exactly instead (0: use the table).
+  // last slot (filterWarp[8].w): a tent's radius, inverted exactly instead (0: use the table);
+  // negative: minus the radius of a filter drawn as Tungsten draws it, whose table's CDF at steps
+  // 1..30 then fills the first 30 slots (retile/scene.h, FilterSampling).
   vec4 filterWarp[9];
 };
 

@@ -676,6 +676,14 @@ TEST(EditorDefects, ThePixelFilterIsARenderSettingWithUndo) {
   w->undoStack()->undo();
   EXPECT_EQ(w->scene().settings.pixelFilter, PixelFilter::BlackmanHarris);
   EXPECT_EQ(w->scene().settings.filterWidth, 1.5f);
+  // Drawn as Tungsten draws it (what Tungsten files bring): a setting like the others.
+  auto* sampling = w->findChild<QComboBox*>("filterSampling");
+  ASSERT_TRUE(sampling);
+  EXPECT_EQ(sampling->currentIndex(), static_cast<int>(FilterSampling::Exact));
+  sampling->setCurrentIndex(static_cast<int>(FilterSampling::Tungsten));
+  EXPECT_EQ(w->scene().settings.filterSampling, FilterSampling::Tungsten);
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().settings.filterSampling, FilterSampling::Exact);
 }
 
 }  // namespace

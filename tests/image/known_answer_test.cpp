@@ -127,7 +127,9 @@ TEST(KnownAnswer, DiffusePlaneUnderUniformSky) {
 
 // The pixel filter (filter importance sampling): a light's straight edge on a pixel boundary.
 // With a box each pixel sees only its own square; with Tungsten's tent (one pixel each way) the
-// pixel on either side of the edge takes 1/8 from across it (the tent's mass beyond half a pixel).
+// pixel on either side of the edge takes 1/8 from across it (the tent's mass beyond half a pixel);
+// drawn as Tungsten draws it (31 steps, each landing one step further out) 0.1457 (0.2913 of one
+// side's mass lies beyond half a pixel, from a direct evaluation of Tungsten's sampling routine).
 TEST(KnownAnswer, PixelFiltersSpreadAnEdgeAsTheyShould) {
   RETILE_RENDERER_OR_SKIP(r);
   Scene s = test::emptyScene(32, 8);
@@ -146,14 +148,19 @@ TEST(KnownAnswer, PixelFiltersSpreadAnEdgeAsTheyShould) {
     for (int y = 0; y < img.height; ++y) sum += img.color[(static_cast<std::size_t>(y) * img.width + x) * 3 + 1];
     return sum / img.height;
   };
-  for (auto [filter, inner, across] : {std::tuple{PixelFilter::Box, 1.0, 0.0}, std::tuple{PixelFilter::Tent, 0.875, 0.125}}) {
-    SCOPED_TRACE(pixelFilterName(filter));
+  for (auto [filter, sampling, inner, across] :
+       {std::tuple{PixelFilter::Box, FilterSampling::Exact, 1.0, 0.0}, std::tuple{PixelFilter::Tent, FilterSampling::Exact, 0.875, 0.125},
+        std::tuple{PixelFilter::Tent, FilterSampling::Tungsten, 0.8543, 0.1457},
+        std::tuple{PixelFilter::Box, FilterSampling::Tungsten, 1.0, 0.0}}) {
+    SCOPED_TRACE(std::string(pixelFilterName(filter)) + (sampling == FilterSampling::Tungsten ? " as Tungsten draws it" : ""));
     s.settings.pixelFilter = filter;
     s.settings.filterWidth = defaultFilterWidth(filter);
+    s.settings.filterSampling = sampling;
     const RenderImage img = renderScene(*r, s, 256);
     const double a = column(img, 15), b = column(img, 16);
-    EXPECT_NEAR(std::max(a, b), inner, 0.02);
-    EXPECT_NEAR(std::min(a, b), across, 0.02);
+    // 0.008: the two tents' spreads differ by 0.021
+    EXPECT_NEAR(std::max(a, b), inner, 0.008);
+    EXPECT_NEAR(std::min(a, b), across, 0.008);
     EXPECT_NEAR(std::max(column(img, 13), column(img, 18)), 1.0, 0.02) << "two pixels away: untouched";
     EXPECT_NEAR(std::min(column(img, 13), column(img, 18)), 0.0, 0.02);
   }

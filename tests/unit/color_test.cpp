@@ -1,6 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <fstream>
+
+#include "io/image_io.h"
 #include "retile/color.h"
+#include "retile/scene.h"
+#include "test_support.h"
 
 namespace retile {
 namespace {
@@ -20,6 +25,33 @@ TEST(Color, SrgbTextureDecodesToLinear) {
   EXPECT_NEAR(px[2], 1.0f, 1e-6f);
   EXPECT_EQ(px[3], 0.25f) << "alpha is untouched";
   EXPECT_NEAR(px[5], 0.5f, 1e-4f);
+}
+
+// Tungsten's "gamma_correct" (TungstenGamma): floor(255 (v/255)^2.2) / 255, its decoding table,
+// against entries of that table; sRGB gives other values (64 -> 13, not 12; 21 -> 1.9, not 1).
+TEST(Color, TungstenGammaTexturesDecodeWithTungstensTable) {
+  const auto file = test::tempDir() / "ramp.ppm";
+  {
+    std::ofstream out(file, std::ios::binary);
+    out << "P6\n6 1\n255\n";
+    for (unsigned char v : {0, 20, 21, 64, 128, 255}) out << v << v << v;
+  }
+  Texture t;
+  t.kind = TextureKind::File;
+  t.path = file;
+  t.colorSpace = TextureColorSpace::TungstenGamma;
+  auto img = loadTextureImage(t, file.parent_path());
+  ASSERT_TRUE(img.ok()) << img.error();
+  ASSERT_EQ(img->width, 6);
+  const float expected[] = {0, 0, 1, 12, 55, 255};
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_FLOAT_EQ(img->rgba[static_cast<std::size_t>(i) * 4] * 255.0f, expected[i]) << i;
+    EXPECT_EQ(img->rgba[static_cast<std::size_t>(i) * 4 + 3], 1.0f) << "alpha as stored";
+  }
+  t.colorSpace = TextureColorSpace::SRGB;
+  auto srgb = loadTextureImage(t, file.parent_path());
+  ASSERT_TRUE(srgb.ok());
+  EXPECT_NEAR(srgb->rgba[3 * 4] * 255.0f, 13.08f, 0.01f);
 }
 
 TEST(Color, DisplayViews) {

@@ -48,10 +48,26 @@ void expectSameScene(const Scene& a, const Scene& b) {
   EXPECT_EQ(a.peekNextId(), b.peekNextId());
 }
 
+// What a Tungsten file brought (its texture decoding) survives a save as a native scene.
+TEST(Native, TungstenTextureDecodingRoundTrips) {
+  Scene s = makeDefaultScene();
+  Texture t;
+  t.id = s.newId();
+  t.path = "wood.jpg";
+  t.colorSpace = TextureColorSpace::TungstenGamma;
+  s.textures.push_back(t);
+  auto file = test::tempDir() / "scene.retile";
+  ASSERT_TRUE(saveNativeScene(s, file).ok());
+  auto back = loadNativeScene(file);
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_EQ(back->scene.textures.back().colorSpace, TextureColorSpace::TungstenGamma);
+}
+
 TEST(Native, DefaultSceneRoundTripsLosslessly) {
   Scene s = makeDefaultScene();
   s.settings.pixelFilter = PixelFilter::BlackmanHarris;
   s.settings.filterWidth = 1.75f;
+  s.settings.filterSampling = FilterSampling::Tungsten;
   s.lights.push_back(Light{s.newId(), "Key", LightType::Spot, {1, 0.9f, 0.8f}, 3.5f, {1, 2, 3}, {0, -1, 0}, 0.4f, 0.2f, true});
   auto dir = test::tempDir();
   auto file = dir / "scene.retile";
@@ -64,6 +80,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.lights[0].intensity, 3.5f);
   EXPECT_EQ(back->scene.settings.pixelFilter, PixelFilter::BlackmanHarris);
   EXPECT_EQ(back->scene.settings.filterWidth, 1.75f);
+  EXPECT_EQ(back->scene.settings.filterSampling, FilterSampling::Tungsten);
   // Saving what was loaded gives the same bytes.
   EXPECT_EQ(nativeSceneToString(s), nativeSceneToString(back->scene));
 }

@@ -31,6 +31,7 @@ TEST(Tungsten, CornellBoxMatchesTheObjVersion) {
   EXPECT_NEAR(degrees(s.camera.verticalFov), 19.5f, 1e-3f);  // square image: horizontal == vertical
   EXPECT_EQ(s.settings.pixelFilter, PixelFilter::Tent) << "the scene's reconstruction_filter";
   EXPECT_EQ(s.settings.filterWidth, 2.0f) << "Tungsten's tent reaches one pixel each way";
+  EXPECT_EQ(s.settings.filterSampling, FilterSampling::Tungsten) << "drawn as the scene's author saw it";
 
   // The light: a downward-facing quad 2 cm below the ceiling, corners as in cornell-box.obj.
   const Object* light = objectWithMaterial(s, "Light");
@@ -84,6 +85,9 @@ TEST(Tungsten, LivingRoomOpensWithSubstitutesForMissingFiles) {
     if (m.name == "TableWood") {
       EXPECT_EQ(m.type, MaterialType::RoughPlastic);
       EXPECT_FLOAT_EQ(m.roughness, 0.05f);
+      const Texture* wood = s.texture(m.albedoTexture);
+      ASSERT_TRUE(wood);
+      EXPECT_EQ(wood->colorSpace, TextureColorSpace::TungstenGamma) << "decoded as Tungsten decodes it";
     }
   }
   EXPECT_GE(textured, 3);

@@ -40,7 +40,12 @@ struct Mesh {
 enum class TextureKind { File, Embedded, Checker };
 // How texel values are turned into linear scene values. Auto: 8-bit formats are sRGB-encoded,
 // floating-point formats (EXR, HDR) are linear. Raw: no conversion (roughness, alpha masks).
-enum class TextureColorSpace { Auto, SRGB, Linear, Raw };
+// TungstenGamma: Tungsten's "gamma_correct" (its files' default), so their textures keep the
+// values their author saw: 8-bit values v become floor(255 (v/255)^2.2) / 255, its decoding
+// table (darker than sRGB in the shadows: 5 % less blue in the living room's wood floor);
+// floating-point formats stay linear.
+enum class TextureColorSpace { Auto, SRGB, Linear, Raw, TungstenGamma };
+constexpr int kTextureColorSpaceCount = 5;
 
 struct Texture {
   NodeId id = kNoNode;
@@ -151,6 +156,18 @@ float defaultFilterWidth(PixelFilter f);  // box 1, tent 2 (Tungsten's), Gaussia
 // from the pixel centre in pixels. Separable filters: x and y are drawn independently.
 std::vector<float> pixelFilterWarp(PixelFilter f, float width, int segments);
 
+// How the filter's offsets are drawn. Exact: from the filter itself (pixelFilterWarp). Tungsten:
+// as Tungsten draws them, so its scene files converge to the picture their author saw: the
+// filter's weight at k/31 of its radius, k = 0..30, makes a 31-step table, and a draw that falls
+// in step k lands one step further out, in (k+1)/31..(k+2)/31 of the radius. The tent comes out
+// about 1/31 px wider than the true tent, and the edges of bright lights differ by up to 10 %
+// without it. Tungsten's Gaussian is exp(-2 x^2) - exp(-8) over a radius of 2 px; its box is
+// drawn exactly; other filters are drawn exactly either way.
+enum class FilterSampling { Exact, Tungsten };
+constexpr int kTungstenFilterSteps = 31;
+// The Tungsten table's CDF at steps 1..30 (step 0's is 0, step 31's is 1), for tent and Gaussian.
+std::vector<float> tungstenFilterCdf(PixelFilter f);
+
 // The largest image side anything accepts (files, edits, the command line, the renderer).
 constexpr int kMaxImageSide = 16384;
 
@@ -163,6 +180,7 @@ struct RenderSettings {
   // New scenes (the built-in one, glTF/OBJ/FBX imports): Blackman-Harris 1.5 px, as Blender.
   PixelFilter pixelFilter = PixelFilter::BlackmanHarris;
   float filterWidth = 1.5f;
+  FilterSampling filterSampling = FilterSampling::Exact;  // Tungsten scene files: Tungsten
 };
 
 class Scene {

@@ -3,6 +3,8 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -21,6 +23,21 @@ struct Decoded {
   bool isFloat = false;
   std::string colorSpaceTag;
 };
+
+// Tungsten's LDR decoding (ImageIO::loadLdr with gamma correction): a 256-entry table of
+// floor(255 (v/255)^2.2), kept in 8 bits; colour only, alpha stays as stored.
+void tungstenGamma(LinearImage& image) {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int v = 0; v < 256; ++v) t[static_cast<std::size_t>(v)] = static_cast<float>(std::floor(255.0 * std::pow(v / 255.0, 2.2) + 1e-9) / 255.0);
+    return t;
+  }();
+  for (std::size_t i = 0; i < image.rgba.size(); ++i) {
+    if (i % 4 == 3) continue;
+    const long v = std::lround(std::clamp(image.rgba[i], 0.0f, 1.0f) * 255.0f);
+    image.rgba[i] = table[static_cast<std::size_t>(v)];
+  }
+}
 
 Result<Decoded> decode(const std::string& name, OIIO::Filesystem::IOProxy* proxy, const ImageLimits& limits) {
   using R = Result<Decoded>;
@@ -101,6 +118,9 @@ Result<LinearImage> loadTextureImage(const Texture& tex, const fs::path& base, c
   Decoded& dec = d.value();
   bool srgb = false;
   switch (tex.colorSpace) {
+    case TextureColorSpace::TungstenGamma:
+      if (!dec.isFloat) tungstenGamma(dec.image);
+      break;
     case TextureColorSpace::SRGB: srgb = true; break;
     case TextureColorSpace::Linear:
     case TextureColorSpace::Raw: srgb = false; break;

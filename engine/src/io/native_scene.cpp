@@ -34,6 +34,7 @@ const char* colorSpaceName(TextureColorSpace c) {
     case TextureColorSpace::SRGB: return "srgb";
     case TextureColorSpace::Linear: return "linear";
     case TextureColorSpace::Raw: return "raw";
+    case TextureColorSpace::TungstenGamma: return "tungsten_gamma";
   }
   return "auto";
 }
@@ -176,6 +177,8 @@ std::string nativeSceneToString(const Scene& s) {
   settings.set("seed", s.settings.seed);
   settings.set("pixel_filter", pixelFilterName(s.settings.pixelFilter));
   settings.set("filter_width", s.settings.filterWidth);
+  // Only scenes that came from Tungsten files say it; everything else draws the filter exactly.
+  if (s.settings.filterSampling == FilterSampling::Tungsten) settings.set("filter_sampling", "tungsten");
   root.set("settings", settings);
 
   Value cam(json::Object{});
@@ -338,6 +341,11 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
     r.number("filter_width", &s.settings.filterWidth);
     if (!(s.settings.filterWidth > 0.0f && s.settings.filterWidth <= 16.0f))
       r.problem("filter_width", "expected a width in pixels within (0, 16]");
+    std::string sampling;
+    r.string("filter_sampling", &sampling);
+    if (sampling == "tungsten") s.settings.filterSampling = FilterSampling::Tungsten;
+    else if (!sampling.empty() && sampling != "exact")
+      r.problem("filter_sampling", cat("unknown filter sampling '", sampling, "' (exact, tungsten)"));
   }
   if (const Value* v = root.find("camera")) {
     Reader r(&error, "camera", v);
@@ -390,7 +398,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.id("id", &t.id, true);
       r.string("name", &t.name);
       r.enumeration("kind", &t.kind, textureKindName, 3);
-      r.enumeration("color_space", &t.colorSpace, colorSpaceName, 4);
+      r.enumeration("color_space", &t.colorSpace, colorSpaceName, kTextureColorSpaceCount);
       std::string path, absolute;
       r.string("path", &path);
       r.string("absolute_path", &absolute);

@@ -153,7 +153,7 @@ class TungstenImporter {
     if (v.isString()) {
       r.isTexture = true;
       r.constant = Vec3{1.0f};
-      r.texture = fileTexture(v.asString(), data ? TextureColorSpace::Raw : TextureColorSpace::Auto);
+      r.texture = fileTexture(v.asString(), data ? TextureColorSpace::Raw : TextureColorSpace::TungstenGamma);
       return r;
     }
     if (!v.isObject()) {
@@ -177,7 +177,7 @@ class TungstenImporter {
       number(v, "scale", &scale, where);
       r.isTexture = true;
       r.constant = Vec3{scale};
-      r.texture = fileTexture(f, data ? TextureColorSpace::Raw : gamma ? TextureColorSpace::Auto : TextureColorSpace::Linear);
+      r.texture = fileTexture(f, data ? TextureColorSpace::Raw : gamma ? TextureColorSpace::TungstenGamma : TextureColorSpace::Linear);
       return r;
     }
     if (type == "checker") {
@@ -458,6 +458,7 @@ class TungstenImporter {
       }
     }
     s.settings.filterWidth = defaultFilterWidth(s.settings.pixelFilter);  // Tungsten's widths
+    s.settings.filterSampling = FilterSampling::Tungsten;
     float fov = 60;
     number(c, "fov", &fov, where);
     if (!(fov > 0 && fov < 180)) return problem(where, "fov must be between 0 and 180 degrees");

@@ -93,6 +93,7 @@ struct Renderer::Impl {
   std::vector<float> warp;
   PixelFilter warpFilter = PixelFilter::Box;
   float warpWidth = 0.0f;
+  bool warpTungsten = false;
   bool hasScene = false;
   NodeId selectedObject = kNoNode;
   int countTileSize = 0;            // tile size the selection buffer is laid out for
@@ -412,10 +413,15 @@ struct Renderer::Impl {
     u.sceneSphere = {c.x, c.y, c.z, d.bounds.empty() ? 1.0f : 0.5f * length(d.bounds.extent())};
     std::uint32_t sel = countTile > 0 ? selectedInstance() : 0u;
     u.work = {itemCount, static_cast<std::uint32_t>(slots), sel, sel ? static_cast<std::uint32_t>(countTile) : 0u};
-    if (warpFilter != sceneSettings.pixelFilter || warpWidth != sceneSettings.filterWidth || warp.empty()) {
+    // Tungsten draws its box exactly, and has no other filter the table could stand for.
+    const bool tungsten = sceneSettings.filterSampling == FilterSampling::Tungsten &&
+                          (sceneSettings.pixelFilter == PixelFilter::Tent || sceneSettings.pixelFilter == PixelFilter::Gaussian);
+    if (warpFilter != sceneSettings.pixelFilter || warpWidth != sceneSettings.filterWidth || warpTungsten != tungsten ||
+        warp.empty()) {
       warpFilter = sceneSettings.pixelFilter;
       warpWidth = sceneSettings.filterWidth;
-      warp = pixelFilterWarp(warpFilter, warpWidth, gpu::kFilterWarpSegments);
+      warpTungsten = tungsten;
+      warp = tungsten ? tungstenFilterCdf(warpFilter) : pixelFilterWarp(warpFilter, warpWidth, gpu::kFilterWarpSegments);
     }
     for (std::size_t i = 0; i < warp.size(); ++i) {
       gpu::vec4& v = u.filterWarp[i / 4];
@@ -423,7 +429,8 @@ struct Renderer::Impl {
     }
     // The tent's inverse CDF has an infinite slope at its ends, where the table's straight pieces
     // put too many samples: the shader inverts it exactly when this (its radius) is set.
-    u.filterWarp[8].w = warpFilter == PixelFilter::Tent ? 0.5f * std::clamp(warpWidth, 0.01f, 16.0f) : 0.0f;
+    const float radius = 0.5f * std::clamp(warpWidth, 0.01f, 16.0f);
+    u.filterWarp[8].w = tungsten ? -radius : warpFilter == PixelFilter::Tent ? radius : 0.0f;
     frameUbo.upload(&u, sizeof u);
   }
 
