@@ -48,19 +48,21 @@ void expectSameScene(const Scene& a, const Scene& b) {
   EXPECT_EQ(a.peekNextId(), b.peekNextId());
 }
 
-// What a Tungsten file brought (its texture decoding) survives a save as a native scene.
-TEST(Native, TungstenTextureDecodingRoundTrips) {
+// What a Tungsten file brought (its texture decoding and stand-in) survives a save as a native scene.
+TEST(Native, TungstenTextureHandlingRoundTrips) {
   Scene s = makeDefaultScene();
   Texture t;
   t.id = s.newId();
   t.path = "wood.jpg";
   t.colorSpace = TextureColorSpace::TungstenGamma;
+  t.whenMissing = MissingTexture::Tungsten;
   s.textures.push_back(t);
   auto file = test::tempDir() / "scene.retile";
   ASSERT_TRUE(saveNativeScene(s, file).ok());
   auto back = loadNativeScene(file);
   ASSERT_TRUE(back.ok()) << back.error();
   EXPECT_EQ(back->scene.textures.back().colorSpace, TextureColorSpace::TungstenGamma);
+  EXPECT_EQ(back->scene.textures.back().whenMissing, MissingTexture::Tungsten);
 }
 
 TEST(Native, DefaultSceneRoundTripsLosslessly) {

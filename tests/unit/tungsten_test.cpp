@@ -79,6 +79,15 @@ TEST(Tungsten, LivingRoomOpensWithSubstitutesForMissingFiles) {
     textured += m.albedoTexture != kNoNode;
     mirrors += m.type == MaterialType::Mirror;
     aluminium += m.type == MaterialType::RoughConductor && m.metal == "Al";
+    if (m.name == "Leaves") {
+      // leaf.png is missing: Tungsten's stand-in checker, as colour and as alpha (half the squares
+      // transparent), not an opaque surface.
+      const Texture* alpha = s.texture(m.alphaTexture);
+      ASSERT_TRUE(alpha);
+      EXPECT_EQ(alpha->whenMissing, MissingTexture::Tungsten);
+      ASSERT_TRUE(s.texture(m.albedoTexture));
+      EXPECT_EQ(s.texture(m.albedoTexture)->whenMissing, MissingTexture::Tungsten);
+    }
     if (m.name == "PlantPot") {
       EXPECT_NEAR(m.roughness, 1.0f / std::sqrt(2.0f), 1e-6f);
     }

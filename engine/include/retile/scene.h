@@ -47,6 +47,12 @@ enum class TextureKind { File, Embedded, Checker };
 enum class TextureColorSpace { Auto, SRGB, Linear, Raw, TungstenGamma };
 constexpr int kTextureColorSpaceCount = 5;
 
+// What stands in for a file that cannot be read. Checker: magenta and black squares nobody takes
+// for the real texture. Tungsten: what Tungsten draws instead (a 2x2 checker of 1 and 0 over the
+// uv square, as colour and as alpha), so its scene files converge to its pictures with a file
+// missing too; the warning still names the file.
+enum class MissingTexture { Checker, Tungsten };
+
 struct Texture {
   NodeId id = kNoNode;
   std::string name;
@@ -55,6 +61,7 @@ struct Texture {
   std::vector<std::uint8_t> encoded;    // Embedded: the file's bytes (PNG, JPEG, ...)
   std::string encodedFormat;            // Embedded: a file extension hint such as "png"
   TextureColorSpace colorSpace = TextureColorSpace::Auto;
+  MissingTexture whenMissing = MissingTexture::Checker;
   Vec3 checkerOn{0.8f}, checkerOff{0.2f};  // Checker: colours and squares per unit of uv
   int checkerResU = 8, checkerResV = 8;
 };

@@ -222,6 +222,7 @@ std::string nativeSceneToString(const Scene& s) {
     v.set("name", t.name);
     v.set("kind", textureKindName(t.kind));
     v.set("color_space", colorSpaceName(t.colorSpace));
+    if (t.whenMissing == MissingTexture::Tungsten) v.set("when_missing", "tungsten");
     if (t.kind == TextureKind::File) {
       // Stored as written, plus the absolute location so a copy saved elsewhere still finds it.
       v.set("path", t.path.generic_string());
@@ -399,6 +400,11 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.string("name", &t.name);
       r.enumeration("kind", &t.kind, textureKindName, 3);
       r.enumeration("color_space", &t.colorSpace, colorSpaceName, kTextureColorSpaceCount);
+      std::string whenMissing;
+      r.string("when_missing", &whenMissing);
+      if (whenMissing == "tungsten") t.whenMissing = MissingTexture::Tungsten;
+      else if (!whenMissing.empty() && whenMissing != "checker")
+        r.problem("when_missing", cat("unknown stand-in '", whenMissing, "' (checker, tungsten)"));
       std::string path, absolute;
       r.string("path", &path);
       r.string("absolute_path", &absolute);

@@ -138,9 +138,10 @@ class TungstenImporter {
     t.path = ref;
     t.name = fs::path(ref).filename().string();
     t.colorSpace = cs;
+    t.whenMissing = MissingTexture::Tungsten;
     // One warning per missing file, however many materials use it; the environment says its own.
     if (!resolveScenePath(base_, ref) && !quietMissingTexture_ && missingWarned_.insert(ref).second)
-      warn(cat("texture '", ref, "' not found; it renders as a magenta checker until the file is there"));
+      warn(cat("texture '", ref, "' not found; until the file is there it renders as Tungsten renders a missing texture, a black and white checker (as colour and as alpha)"));
     out_.scene.textures.push_back(t);
     textures_[key] = t.id;
     return t.id;
@@ -254,14 +255,8 @@ class TungstenImporter {
       if (const Value* a = v.find("alpha")) {
         TextureRef t = texture(*a, where + ".alpha", true);
         m.alpha = std::clamp(luminance(t.constant), 0.0f, 1.0f);
-        if (t.isTexture) {
-          const Texture* tex = out_.scene.texture(t.texture);
-          if (tex && tex->kind == TextureKind::File && !resolveScenePath(base_, tex->path.string())) {
-            warn(cat(where, ": alpha map '", tex->path.string(), "' is missing; the surface is drawn opaque"));
-          } else {
-            m.alphaTexture = t.texture;
-          }
-        }
+        // A missing alpha map is Tungsten's stand-in checker too: half the squares transparent.
+        if (t.isTexture) m.alphaTexture = t.texture;
       }
       return m;
     }

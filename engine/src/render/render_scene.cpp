@@ -495,11 +495,15 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
         d.image = std::move(img.value());
       } else {
         d.image = {};
-        if (warnings) warnings->push_back(cat(img.error(), "; shown as a magenta checker"));
+        if (warnings)
+          warnings->push_back(cat(img.error(), t.whenMissing == MissingTexture::Tungsten ? "; shown as Tungsten shows it (a black and white checker)"
+                                                                                      : "; shown as a magenta checker"));
       }
     }
     if (d.ok) {
       appendBitmap(d.image, d.image.hasAlpha);
+    } else if (t.whenMissing == MissingTexture::Tungsten) {
+      appendChecker({1, 1, 1}, {0, 0, 0}, 2, 2);  // Tungsten's 2x2 stand-in, its texel (0, 0) white, at the top left
     } else {
       // A visible substitute: nobody mistakes magenta and black squares for the real texture.
       appendChecker({1, 0, 1}, {0.05f, 0.05f, 0.05f}, 8, 8);
