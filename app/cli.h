@@ -1,27 +1,67 @@
-// The command line: `retile render`, `retile edit`, `retile eval`, `retile compare`, `retile bench`, `retile import`. Runs on the main thread.
+// The command line: `retile render`, `retile edit`, `retile eval`, `retile compare`, `retile bench`, `retile import`,
+// one CLI11 tree that main() builds and parses. Everything here runs on the main thread.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "retile/error.h"
 #include "retile/io.h"
 
+namespace CLI {
+class App;
+class Option;
+class Validator;
+}  // namespace CLI
+
 namespace retile::cli {
 
-// Parsed "--name value" options and positional arguments; unknown options are errors.
-struct Args {
-  std::vector<std::string> positional;
-  std::vector<std::pair<std::string, std::string>> options;
-  bool has(const std::string& name) const;
-  std::string get(const std::string& name, const std::string& fallback = "") const;
+// Each adds its command to `app`, the options declared beside the code that reads them. When the
+// command is chosen, its callback runs it (inside App::parse, after every option was read and
+// checked) and leaves the exit status in *status. A problem with the command line found in the
+// callback (options that go together) is thrown as a CLI::ParseError, so it is reported like one.
+void addRender(CLI::App& app, int* status);
+void addEdit(CLI::App& app, int* status);
+void addEval(CLI::App& app, int* status);
+void addCompare(CLI::App& app, int* status);
+void addImport(CLI::App& app, int* status);
+void addBench(CLI::App& app, int* status);  // bench throughput, bvh, edit, frames, denoise, scale
+
+// The Qt editor on `file` ("" or "default": the built-in scene). Needs a display.
+int runEditor(int argc, char** argv, const std::string& file);
+
+// ---- Options, for the add* functions ----
+//
+// Numbers are read as files read them (std::from_chars, core/numbers.h), never by CLI11's own
+// conversion: that uses strtold, which follows the process locale (under de_DE, once Qt has set
+// it, "0.5" stops at the '.'), and strtoll in base 0, which reads "010" as 8. A bad value is
+// refused with the option's name, e.g. "--spp: 'abc' is not a whole number" or
+// "--spp: 0 is outside 1..1048576". The help line gets the range and, where `out` holds one,
+// the default appended.
+
+struct ImageSize {
+  int width = 0, height = 0;
 };
 
-Result<Args> parseArgs(const std::vector<std::string>& argv, const std::vector<std::string>& known,
-                       const std::vector<std::string>& flags = {});
-Result<int> parseInt(const std::string& option, const std::string& text, int lo, int hi);
-Result<double> parseNumber(const std::string& option, const std::string& text, double lo, double hi);
-Result<bool> parseSize(const std::string& text, int* width, int* height);
+CLI::Option* addInt(CLI::App& app, const std::string& name, int* out, int lo, int hi, const std::string& help);
+CLI::Option* addNumber(CLI::App& app, const std::string& name, double* out, double lo, double hi,
+                       const std::string& help);
+// --size WxH, each side 1..kMaxImageSide.
+CLI::Option* addSize(CLI::App& app, ImageSize* out, const std::string& help);
+// Without the option `out` stays empty; `otherwise` says what is used then ("the scene's").
+CLI::Option* addInt(CLI::App& app, const std::string& name, std::optional<int>* out, int lo, int hi,
+                    const std::string& help, const std::string& otherwise);
+CLI::Option* addNumber(CLI::App& app, const std::string& name, std::optional<double>* out, double lo, double hi,
+                       const std::string& help, const std::string& otherwise);
+CLI::Option* addSize(CLI::App& app, std::optional<ImageSize>* out, const std::string& help,
+                     const std::string& otherwise);
+// A positional SCENE: a file any importer reads, or "default".
+CLI::Option* addScene(CLI::App& app, std::string* out);
+// Refuses a value that is not one of `names`; `what` names their kind in the message ("method").
+CLI::Validator oneOf(const std::string& what, const std::vector<std::string>& names);
+// A whole number lo..hi, or the message saying why `text` is not one (without the option's name).
+Result<int> readInt(const std::string& text, int lo, int hi);
 
 // "default" is the built-in scene; anything else a file any importer reads.
 Result<ImportedScene> loadScene(const std::string& name);
@@ -30,15 +70,5 @@ Result<ImportedScene> loadScene(const std::string& name);
 void printRenderWarnings(const std::vector<std::string>& renderWarnings, const std::vector<std::string>& importWarnings);
 // A one-line progress bar on stderr, redrawn in place (a line per tenth when not a terminal).
 void progressBar(const std::string& label, int done, int total, double seconds);
-
-int runRender(const std::vector<std::string>& args);
-int runBench(const std::vector<std::string>& args);
-int runImport(const std::vector<std::string>& args);
-int runEdit(const std::vector<std::string>& args);
-int runEval(const std::vector<std::string>& args);
-int runCompare(const std::vector<std::string>& args);
-// The Qt editor on `file` ("" or "default": the built-in scene). Needs a display.
-int runEditor(int argc, char** argv, const std::string& file);
-bool isCommand(const std::string& word);
 
 }  // namespace retile::cli

@@ -2,10 +2,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <memory>
+#include <optional>
 #include <random>
 #include <thread>
 
 #include "cli.h"
+#include "cli11.h"
 #include "render/bvh.h"
 #include "retile/engine.h"
 #include "retile/log.h"
@@ -38,19 +41,13 @@ FrameStats traceFrames(Renderer& renderer, int w, int h, int frames, const Frame
 // Throughput against triangle count: the built-in scene plus one sphere tessellated to N
 // triangles filling a good part of the view, N from 16 k to 2 M. Samples/s should fall slowly
 // (a BVH is logarithmic) and bytes per triangle stay flat.
-int benchScale(const std::vector<std::string>& argv) {
-  auto args = parseArgs(argv, {"--size", "--frames"});
-  if (!args) return std::fprintf(stderr, "usage: retile bench scale [--size WxH] [--frames N]\n"), 2;
-  int w = 320, h = 180, frames = 16;
-  if (args->has("--size")) {
-    auto r = parseSize(args->get("--size"), &w, &h);
-    if (!r) return std::fprintf(stderr, "error: %s\n", r.error().c_str()), 2;
-  }
-  if (args->has("--frames")) {
-    auto v = parseInt("--frames", args->get("--frames"), 1, 100000);
-    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
-    frames = v.value();
-  }
+struct ScaleOptions {
+  ImageSize size{320, 180};
+  int frames = 16;
+};
+
+int benchScale(const ScaleOptions& o) {
+  const int w = o.size.width, h = o.size.height, frames = o.frames;
   std::printf("%10s %12s %10s %12s %14s %12s\n", "triangles", "samples/s", "vs first", "upload s", "device MiB",
               "bytes/tri");
   double first = 0;
@@ -78,36 +75,18 @@ int benchScale(const std::vector<std::string>& argv) {
   return 0;
 }
 
-int benchThroughput(const std::vector<std::string>& argv) {
-  auto args = parseArgs(argv, {"--size", "--frames", "--max-bounces", "--paths"});
-  if (!args || args->positional.size() != 1) {
-    std::fprintf(stderr,
-                 "usage: retile bench throughput SCENE [--size WxH] [--frames N] [--max-bounces B] [--paths P]\n"
-                 "  --paths P  paths per trace invocation (default: chosen from the last frame's cost)\n");
-    return 2;
-  }
-  int w = 256, h = 256, frames = 16, bounces = -1;
-  if (args->has("--size")) {
-    auto r = parseSize(args->get("--size"), &w, &h);
-    if (!r) return std::fprintf(stderr, "error: %s\n", r.error().c_str()), 2;
-  }
-  if (args->has("--frames")) {
-    auto v = parseInt("--frames", args->get("--frames"), 1, 100000);
-    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
-    frames = v.value();
-  }
-  if (args->has("--max-bounces")) {
-    auto v = parseInt("--max-bounces", args->get("--max-bounces"), 0, 1024);
-    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
-    bounces = v.value();
-  }
+struct ThroughputOptions {
+  std::string scene;
+  ImageSize size{256, 256};
+  int frames = 16;
+  std::optional<int> maxBounces, paths;
+};
+
+int benchThroughput(const ThroughputOptions& o) {
+  const int w = o.size.width, h = o.size.height, frames = o.frames, bounces = o.maxBounces.value_or(-1);
   FrameOptions options;
-  if (args->has("--paths")) {
-    auto v = parseInt("--paths", args->get("--paths"), 1, 1 << 20);
-    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
-    options.pathsPerInvocation = v.value();
-  }
-  auto loaded = loadScene(args->positional[0]);
+  if (o.paths) options.pathsPerInvocation = *o.paths;
+  auto loaded = loadScene(o.scene);
   if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
 
   Renderer renderer;
@@ -120,7 +99,7 @@ int benchThroughput(const std::vector<std::string>& argv) {
   FrameStats sum = traceFrames(renderer, w, h, frames, options, &wall);
   double sec = sum.seconds;
   auto tris = renderer.sceneTriangles();
-  std::printf("scene          %s (%llu triangles)\n", args->positional[0].c_str(), static_cast<unsigned long long>(tris));
+  std::printf("scene          %s (%llu triangles)\n", o.scene.c_str(), static_cast<unsigned long long>(tris));
   std::printf("device         %s\n", renderer.deviceName().c_str());
   std::printf("image          %dx%d, max bounces %d, %d frames of 1 spp\n", w, h,
               bounces >= 0 ? bounces : loaded->scene.settings.maxBounces, frames);
@@ -147,15 +126,7 @@ int benchThroughput(const std::vector<std::string>& argv) {
   return 0;
 }
 
-int benchBvh(const std::vector<std::string>& argv) {
-  auto args = parseArgs(argv, {"--triangles"});
-  if (!args) return std::fprintf(stderr, "error: %s\n", args.error().c_str()), 2;
-  int n = 1'000'000;
-  if (args->has("--triangles")) {
-    auto v = parseInt("--triangles", args->get("--triangles"), 1, 50'000'000);
-    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
-    n = v.value();
-  }
+int benchBvh(int n) {
   // A tessellated wavy surface: triangles of even size, like a scanned mesh.
   int side = static_cast<int>(std::sqrt(n / 2.0)) + 1;
   std::vector<Bounds3> boxes;
@@ -184,15 +155,7 @@ int benchBvh(const std::vector<std::string>& argv) {
 // Edit cost against mesh size: the default scene plus one mesh of N triangles; times moving that
 // object and changing its material through a RenderSession (what the render thread does between
 // frames), N from 10 k to 1 M. Both must stay flat: neither touches mesh data.
-int benchEdit(const std::vector<std::string>& argv) {
-  auto args = parseArgs(argv, {"--edits"});
-  if (!args) return std::fprintf(stderr, "usage: retile bench edit [--edits N]\n"), 2;
-  int edits = 20;
-  if (args->has("--edits")) {
-    auto v = parseInt("--edits", args->get("--edits"), 1, 10000);
-    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
-    edits = v.value();
-  }
+int benchEdit(int edits) {
   std::printf("%10s %14s %14s %14s\n", "triangles", "upload s", "move ms/edit", "material ms/edit");
   for (int rings : {64, 224, 708}) {  // 2 * rings * 2 * rings triangles: ~16 k, ~200 k, ~2 M
     Scene scene = makeDefaultScene();
@@ -229,23 +192,15 @@ int benchEdit(const std::vector<std::string>& argv) {
 // The denoiser's cost: the whole frame denoised and composed, against a frame of 1 spp traced and
 // accumulated at the same size (what the denoise variants add to each frame of the global method
 // and of continuous refinement; incremental passes denoise only a growing region, now and then).
-int benchDenoise(const std::vector<std::string>& argv) {
-  auto args = parseArgs(argv, {"--size", "--frames"});
-  if (!args || args->positional.size() > 1) {
-    std::fprintf(stderr, "usage: retile bench denoise [SCENE] [--size WxH] [--frames N]\n");
-    return 2;
-  }
-  int w = 640, h = 360, frames = 15;
-  if (args->has("--size")) {
-    auto r = parseSize(args->get("--size"), &w, &h);
-    if (!r) return std::fprintf(stderr, "error: %s\n", r.error().c_str()), 2;
-  }
-  if (args->has("--frames")) {
-    auto v = parseInt("--frames", args->get("--frames"), 1, 10000);
-    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
-    frames = v.value();
-  }
-  auto loaded = loadScene(args->positional.empty() ? "default" : args->positional[0]);
+struct DenoiseOptions {
+  std::string scene = "default";
+  ImageSize size{640, 360};
+  int frames = 15;
+};
+
+int benchDenoise(const DenoiseOptions& o) {
+  const int w = o.size.width, h = o.size.height, frames = o.frames;
+  auto loaded = loadScene(o.scene);
   if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
   Renderer renderer;
   printRenderWarnings(renderer.setScene(loaded->scene), loaded->warnings);
@@ -291,7 +246,7 @@ int benchDenoise(const std::vector<std::string>& argv) {
     return v[v.size() / 2];
   };
   double traceMs = median(trace), denoiseMs = median(denoised), composeMs = median(composed);
-  std::printf("image          %dx%d, %s\n", w, h, args->positional.empty() ? "default" : args->positional[0].c_str());
+  std::printf("image          %dx%d, %s\n", w, h, o.scene.c_str());
   std::printf("frame          %.1f ms (1 spp traced and accumulated; medians of %d interleaved rounds)\n", traceMs, frames);
   std::printf("denoise        %.1f ms (the passes below; a frame denoised whole needs no compositor)\n", denoiseMs);
   for (std::size_t k = 0; k < passMs.size(); ++k)
@@ -305,35 +260,28 @@ int benchDenoise(const std::vector<std::string>& argv) {
 // Frames per second of the render thread as the editor drives it (Engine, newest frame to the
 // mailbox), at rest or while an object is dragged (one move submitted per published frame), for
 // `--seconds` after one second of warm-up.
-int benchFrames(const std::vector<std::string>& argv) {
-  auto args = parseArgs(argv, {"--size", "--seconds", "--method", "--object"}, {"--drag"});
-  if (!args || args->positional.size() != 1) {
-    std::fprintf(stderr,
-                 "usage: retile bench frames SCENE [--size WxH] [--seconds S] [--method NAME] [--drag [--object NAME]]\n");
-    return 2;
-  }
-  auto loaded = loadScene(args->positional[0]);
+struct FramesOptions {
+  std::string scene;
+  ImageSize size{240, 135};
+  int seconds = 5;
+  std::string method = methodName(MethodSettings{}.kind);
+  bool drag = false;
+  std::optional<std::string> object;
+};
+
+int benchFrames(const FramesOptions& opt) {
+  auto loaded = loadScene(opt.scene);
   if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
   Scene scene = loaded->scene;
-  scene.settings.width = 240;
-  scene.settings.height = 135;
-  if (args->has("--size")) {
-    auto r = parseSize(args->get("--size"), &scene.settings.width, &scene.settings.height);
-    if (!r) return std::fprintf(stderr, "error: %s\n", r.error().c_str()), 2;
-  }
-  int seconds = 5;
-  if (args->has("--seconds")) {
-    auto v = parseInt("--seconds", args->get("--seconds"), 1, 3600);
-    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
-    seconds = v.value();
-  }
+  scene.settings.width = opt.size.width;
+  scene.settings.height = opt.size.height;
+  const int seconds = opt.seconds;
   MethodSettings method;
-  if (args->has("--method") && !methodFromName(args->get("--method"), &method.kind))
-    return std::fprintf(stderr, "error: unknown method '%s'\n", args->get("--method").c_str()), 2;
-  const bool drag = args->has("--drag");
+  methodFromName(opt.method, &method.kind);  // checked by the option
+  const bool drag = opt.drag;
   NodeId dragged = kNoNode;
   for (const Object& o : scene.objects)
-    if (dragged == kNoNode && (!args->has("--object") || o.name == args->get("--object"))) dragged = o.id;
+    if (dragged == kNoNode && (!opt.object || o.name == *opt.object)) dragged = o.id;
   if (drag && dragged == kNoNode) return std::fprintf(stderr, "error: no object to drag\n"), 1;
   Object moving = dragged != kNoNode ? *scene.object(dragged) : Object{};
 
@@ -364,7 +312,7 @@ int benchFrames(const std::vector<std::string>& argv) {
   engine.stop();
   for (const auto& e : engine.takeErrors())
     if (e.rfind("warning: ", 0) != 0) return std::fprintf(stderr, "error: %s\n", e.c_str()), 1;
-  std::printf("scene          %s at %dx%d, %s%s\n", args->positional[0].c_str(), scene.settings.width,
+  std::printf("scene          %s at %dx%d, %s%s\n", opt.scene.c_str(), scene.settings.width,
               scene.settings.height, methodName(method.kind), drag ? ", dragging an object every frame" : ", at rest");
   std::printf("frames/s       %.2f (%llu frames in %.1f s)\n", static_cast<double>(frames) / s,
               static_cast<unsigned long long>(frames), s);
@@ -373,23 +321,62 @@ int benchFrames(const std::vector<std::string>& argv) {
 
 }  // namespace
 
-int runBench(const std::vector<std::string>& argv) {
-  if (argv.empty()) {
-    std::fprintf(stderr,
-                 "usage: retile bench throughput SCENE ... | retile bench bvh [--triangles N] | retile bench edit\n"
-                 "       | retile bench frames SCENE ... | retile bench denoise [SCENE] [--size WxH]\n"
-                 "       | retile bench scale [--size WxH] [--frames N]\n");
-    return 2;
-  }
-  std::vector<std::string> rest(argv.begin() + 1, argv.end());
-  if (argv[0] == "throughput") return benchThroughput(rest);
-  if (argv[0] == "bvh") return benchBvh(rest);
-  if (argv[0] == "edit") return benchEdit(rest);
-  if (argv[0] == "frames") return benchFrames(rest);
-  if (argv[0] == "denoise") return benchDenoise(rest);
-  if (argv[0] == "scale") return benchScale(rest);
-  std::fprintf(stderr, "retile bench: unknown benchmark '%s' (throughput, bvh, edit, frames, denoise, scale)\n", argv[0].c_str());
-  return 2;
+void addBench(CLI::App& app, int* status) {
+  CLI::App* bench = app.add_subcommand("bench", "Benchmarks: they print figures and never pass or fail");
+  bench->require_subcommand(1);
+
+  CLI::App* cmd = bench->add_subcommand("throughput", "Samples/s, rays/s and device memory of 1-spp frames of a scene");
+  auto throughput = std::make_shared<ThroughputOptions>();
+  addScene(*cmd, &throughput->scene);
+  addSize(*cmd, &throughput->size, "image size");
+  addInt(*cmd, "--frames", &throughput->frames, 1, 100000, "frames timed, after one warm-up frame");
+  addInt(*cmd, "--max-bounces", &throughput->maxBounces, 0, 1024, "longest path", "the scene's");
+  addInt(*cmd, "--paths", &throughput->paths, 1, 1 << 20, "paths per trace invocation",
+         "chosen from the last frame's cost")
+      ->type_name("P");
+  cmd->callback([throughput, status] { *status = benchThroughput(*throughput); });
+
+  cmd = bench->add_subcommand("bvh", "BVH build time for a tessellated surface of N triangles");
+  auto triangles = std::make_shared<int>(1'000'000);
+  addInt(*cmd, "--triangles", triangles.get(), 1, 50'000'000, "triangles");
+  cmd->callback([triangles, status] { *status = benchBvh(*triangles); });
+
+  cmd = bench->add_subcommand(
+      "edit", "Cost of moving an object and changing its material against mesh size (16 k to 2 M triangles)");
+  auto edits = std::make_shared<int>(20);
+  addInt(*cmd, "--edits", edits.get(), 1, 10000, "edits of each kind timed per mesh size");
+  cmd->callback([edits, status] { *status = benchEdit(*edits); });
+
+  cmd = bench->add_subcommand(
+      "frames", "The editor's frames/s (render thread and mailbox), at rest or while an object is dragged");
+  auto frames = std::make_shared<FramesOptions>();
+  addScene(*cmd, &frames->scene);
+  addSize(*cmd, &frames->size, "image size");
+  addInt(*cmd, "--seconds", &frames->seconds, 1, 3600, "time measured, after one second of warm-up");
+  std::string methods;
+  for (const auto& n : methodNames()) methods += (methods.empty() ? "" : ", ") + n;
+  cmd->add_option("--method", frames->method,
+                  "the re-rendering method: " + methods + " (default: " + frames->method + ")")
+      ->type_name("NAME")
+      ->check(oneOf("method", methodNames()));
+  cmd->add_flag("--drag", frames->drag, "move an object a little on every frame shown");
+  cmd->add_option("--object", frames->object, "with --drag: the object moved (default: the first)")->type_name("NAME");
+  cmd->callback([frames, status] { *status = benchFrames(*frames); });
+
+  cmd = bench->add_subcommand("denoise", "The denoiser's cost against a frame of 1 spp, pass by pass");
+  auto denoise = std::make_shared<DenoiseOptions>();
+  cmd->add_option("SCENE", denoise->scene,
+                  "a scene file (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default' (default: default)")
+      ->type_name("");
+  addSize(*cmd, &denoise->size, "image size");
+  addInt(*cmd, "--frames", &denoise->frames, 1, 10000, "interleaved rounds timed");
+  cmd->callback([denoise, status] { *status = benchDenoise(*denoise); });
+
+  cmd = bench->add_subcommand("scale", "Samples/s and memory against triangle count (16 k to 2 M)");
+  auto scale = std::make_shared<ScaleOptions>();
+  addSize(*cmd, &scale->size, "image size");
+  addInt(*cmd, "--frames", &scale->frames, 1, 100000, "frames timed per triangle count");
+  cmd->callback([scale, status] { *status = benchScale(*scale); });
 }
 
 }  // namespace retile::cli

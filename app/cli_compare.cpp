@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <numeric>
 
 #include "cli.h"
+#include "cli11.h"
 #include "io/image_io.h"
 #include "retile/metrics.h"
 
@@ -37,8 +39,8 @@ Result<PixelRect> parseRect(const std::string& text) {
   std::size_t at = 0;
   for (int i = 0; i < 4; ++i) {
     std::size_t end = i < 3 ? text.find(',', at) : text.size();
-    if (end == std::string::npos) return Result<PixelRect>::failure("--exclude: '" + text + "' is not X,Y,W,H");
-    auto v = parseInt("--exclude", text.substr(at, end - at), 0, 1 << 20);
+    if (end == std::string::npos) return Result<PixelRect>::failure("'" + text + "' is not X,Y,W,H");
+    auto v = readInt(text.substr(at, end - at), 0, 1 << 20);
     if (!v) return Result<PixelRect>::failure(v.error());
     *dst[i] = v.value();
     at = end + 1;
@@ -46,33 +48,18 @@ Result<PixelRect> parseRect(const std::string& text) {
   return r;
 }
 
-}  // namespace
-
-int runCompare(const std::vector<std::string>& argv) {
-  auto args = parseArgs(argv, {"--noise", "--block", "--exclude", "--worst"});
-  if (!args || args->positional.size() != 2) {
-    std::fprintf(stderr,
-                 "%s%susage: retile compare IMAGE REFERENCE [--noise IMAGE2] [--block N] [--exclude X,Y,W,H ...] [--worst K]\n"
-                 "  IMAGE2 is a second render of IMAGE's scene at another seed: its distance from IMAGE is the noise floor.\n",
-                 args ? "" : args.error().c_str(), args ? "" : "\n");
-    return 2;
-  }
+struct CompareOptions {
+  std::string image, reference, noise;
   int block = 16, worst = 8;
-  for (auto [opt, dst, lo, hi] : {std::tuple{"--block", &block, 1, 4096}, std::tuple{"--worst", &worst, 0, 1000}}) {
-    if (!args->has(opt)) continue;
-    auto v = parseInt(opt, args->get(opt), lo, hi);
-    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
-    *dst = v.value();
-  }
+  std::vector<std::string> exclude;
+};
+
+int runCompare(const CompareOptions& o) {
+  const int block = o.block, worst = o.worst;
   std::vector<PixelRect> exclude;
-  for (const auto& [name, value] : args->options)
-    if (name == "--exclude") {
-      auto r = parseRect(value);
-      if (!r) return std::fprintf(stderr, "error: %s\n", r.error().c_str()), 2;
-      exclude.push_back(r.value());
-    }
-  std::vector<std::string> files = {args->positional[0], args->positional[1]};
-  if (args->has("--noise")) files.push_back(args->get("--noise"));
+  for (const auto& text : o.exclude) exclude.push_back(parseRect(text).value());  // checked by the option
+  std::vector<std::string> files = {o.image, o.reference};
+  if (!o.noise.empty()) files.push_back(o.noise);
   std::vector<RgbImage> images;
   for (const auto& f : files) {
     auto im = readRgb(f);
@@ -108,6 +95,33 @@ int runCompare(const std::vector<std::string>& argv) {
                 c.lumRef[b] > 0 ? 100.0 * (c.lumA[b] / c.lumRef[b] - 1.0) : 0.0);
   }
   return 0;
+}
+
+}  // namespace
+
+void addCompare(CLI::App& app, int* status) {
+  CLI::App* cmd = app.add_subcommand(
+      "compare", "How far IMAGE is from REFERENCE (another renderer's), in units of our own noise: relative RMSE of "
+                 "block means");
+  auto o = std::make_shared<CompareOptions>();
+  cmd->add_option("IMAGE", o->image, "our render (EXR, PNG, any image OpenImageIO reads)")->required()->type_name("");
+  cmd->add_option("REFERENCE", o->reference, "the image to compare against")->required()->type_name("");
+  cmd->add_option("--noise", o->noise,
+                  "a second render of IMAGE's scene at another seed: its distance from IMAGE is the noise floor")
+      ->type_name("IMAGE2");
+  addInt(*cmd, "--block", &o->block, 1, 4096, "side of the blocks averaged");
+  cmd->add_option("--exclude", o->exclude,
+                  "leave out the pixels of this rectangle (repeat for more); a block counts if half its pixels remain")
+      ->type_name("X,Y,W,H")
+      ->allow_extra_args(false)
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            auto r = parseRect(text);
+            return r ? std::string() : r.error();
+          },
+          ""));
+  addInt(*cmd, "--worst", &o->worst, 0, 1000, "list the blocks with the largest shares of the error")->type_name("K");
+  cmd->callback([o, status] { *status = runCompare(*o); });
 }
 
 }  // namespace retile::cli

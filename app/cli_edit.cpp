@@ -10,9 +10,11 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "cli.h"
+#include "cli11.h"
 #include "retile/color.h"
 #include "retile/eval.h"
 #include "retile/image.h"
@@ -26,91 +28,44 @@ namespace retile::cli {
 
 namespace {
 
-void usage(const std::string& error) {
-  if (!error.empty()) std::fprintf(stderr, "error: %s\n", error.c_str());
-  std::fprintf(stderr,
-               "usage: retile edit SCENE --script EDITS.json --method NAME --out-dir DIR [--size WxH] [--tile T]\n"
-               "                   [--quality Q|auto] [--smooth] [--stale-cap N] [--converge SPP] [--max-bounces B]\n"
-               "                   [--reference SPP] [--block B] [--threshold REL] [--no-images]\n"
-               "                   [--denoise [--denoise-threshold PX] [--no-soft-borders]] [--reuse [--reuse-rate A]]\n"
-               "methods:");
-  for (const auto& n : methodNames()) std::fprintf(stderr, " %s", n.c_str());
-  std::fprintf(stderr, "\n");
-}
-
-}  // namespace
-
-int runEdit(const std::vector<std::string>& argv) {
-  auto args = parseArgs(argv,
-                        {"--script", "--method", "--out-dir", "--size", "--tile", "--quality", "--stale-cap", "--converge",
-                         "--max-bounces", "--reference", "--block", "--threshold", "--denoise-threshold", "--reuse-rate"},
-                        {"--smooth", "--no-images", "--denoise", "--no-soft-borders", "--reuse"});
-  if (!args) return usage(args.error()), 2;
-  if (args->positional.size() != 1 || !args->has("--script") || !args->has("--method") || !args->has("--out-dir"))
-    return usage("SCENE, --script, --method and --out-dir are required"), 2;
-
-  MethodSettings method;
-  if (!methodFromName(args->get("--method"), &method.kind)) return usage(cat("unknown method '", args->get("--method"), "'")), 2;
-  auto intOpt = [&](const char* name, int lo, int hi, int* out) -> bool {
-    if (!args->has(name)) return true;
-    auto v = parseInt(name, args->get(name), lo, hi);
-    if (!v) {
-      usage(v.error());
-      return false;
-    }
-    *out = v.value();
-    return true;
-  };
-  if (args->get("--quality") == "auto") method.quality = 0;
-  else if (!intOpt("--quality", 1, 4096, &method.quality)) return 2;
-  int converge = -1, maxBounces = -1, reference = 0, block = 4;
-  if (!intOpt("--tile", 8, 32, &method.tileSize) || !intOpt("--stale-cap", 1, 1 << 20, &method.staleCap) ||
-      !intOpt("--converge", 0, 1 << 20, &converge) || !intOpt("--max-bounces", 0, 1024, &maxBounces) ||
-      !intOpt("--reference", 1, 1 << 20, &reference) || !intOpt("--block", 1, 64, &block) ||
-      !intOpt("--denoise-threshold", 0, 16384, &method.denoiseThreshold))
-    return 2;
+struct EditOptions {
+  std::string scene, script, outDir;
+  MethodSettings method;  // the kind is set from methodName when the command runs
+  std::string methodName;
+  std::optional<ImageSize> size;
+  std::optional<int> converge, maxBounces, reference;
+  int block = 4;
   double threshold = 0.01;
-  if (args->has("--threshold")) {
-    auto v = parseNumber("--threshold", args->get("--threshold"), 0, 1e30);
-    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
-    threshold = v.value();
-  }
-  method.smooth = args->has("--smooth");
-  method.denoise = args->has("--denoise");
-  method.reuse = args->has("--reuse");
-  if (args->has("--reuse-rate")) {
-    if (!method.reuse) return usage("--reuse-rate goes with --reuse"), 2;
-    auto v = parseNumber("--reuse-rate", args->get("--reuse-rate"), 1e-12, 0.49);
-    if (!v) return usage(v.error()), 2;
-    method.reuseFalseReject = v.value();
-  }
-  method.softBorders = !args->has("--no-soft-borders");
-  if (!method.denoise && (args->has("--denoise-threshold") || args->has("--no-soft-borders")))
-    return usage("--denoise-threshold and --no-soft-borders go with --denoise"), 2;
-  if (std::string bad = validateMethodSettings(method); !bad.empty()) return usage(bad), 2;
+  bool noSoftBorders = false, noImages = false;
+};
 
-  auto loaded = loadScene(args->positional[0]);
+int runEdit(EditOptions o) {
+  MethodSettings& method = o.method;
+  methodFromName(o.methodName, &method.kind);  // checked by the option
+  method.softBorders = !o.noSoftBorders;
+  if (std::string bad = validateMethodSettings(method); !bad.empty()) throw CLI::ValidationError(bad);
+  const int reference = o.reference.value_or(0), block = o.block;
+  const double threshold = o.threshold;
+
+  auto loaded = loadScene(o.scene);
   if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
   for (const auto& w : loaded->warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   Scene scene = loaded->scene;
-  if (args->has("--size")) {
-    auto r = parseSize(args->get("--size"), &scene.settings.width, &scene.settings.height);
-    if (!r) return usage(r.error()), 2;
-  }
-  if (maxBounces >= 0) scene.settings.maxBounces = maxBounces;
-  auto scenario = loadScenario(args->get("--script"));
+  if (o.size) scene.settings.width = o.size->width, scene.settings.height = o.size->height;
+  if (o.maxBounces) scene.settings.maxBounces = *o.maxBounces;
+  auto scenario = loadScenario(o.script);
   if (!scenario) return std::fprintf(stderr, "error: %s\n", scenario.error().c_str()), 1;
-  if (converge < 0) converge = scenario->converge;
+  const int converge = o.converge.value_or(scenario->converge);
   // The script played without rendering (eval's planner): its last frame shows the final state.
   auto played = eval::planScenario(scenario.value(), scene, std::numeric_limits<int>::max());
-  if (!played) return std::fprintf(stderr, "error: %s: %s\n", args->get("--script").c_str(), played.error().c_str()), 1;
+  if (!played) return std::fprintf(stderr, "error: %s: %s\n", o.script.c_str(), played.error().c_str()), 1;
   const Scene& finalScene = played->states.empty() ? played->start : played->states.back();
 
-  std::filesystem::path outDir = args->get("--out-dir");
+  std::filesystem::path outDir = o.outDir;
   std::error_code ec;
   std::filesystem::create_directories(outDir, ec);
   if (ec) return std::fprintf(stderr, "error: cannot create %s: %s\n", outDir.string().c_str(), ec.message().c_str()), 1;
-  const bool images = !args->has("--no-images");
+  const bool images = !o.noImages;
   const int w = scene.settings.width, h = scene.settings.height;
 
   // The fresh render of the final state, from its own renderer and seed. The display-referred
@@ -163,7 +118,7 @@ int runEdit(const std::vector<std::string>& argv) {
     const ScenarioStep& step = scenario->steps[firstStep];
     if (step.kind != ScenarioStep::Kind::Select && step.kind != ScenarioStep::Kind::Focus) break;
     auto e = stepEdits(step, 0, session.scene(), session.selection());
-    if (!e) return std::fprintf(stderr, "error: %s: steps[%zu]: %s\n", args->get("--script").c_str(), firstStep, e.error().c_str()), 1;
+    if (!e) return std::fprintf(stderr, "error: %s: steps[%zu]: %s\n", o.script.c_str(), firstStep, e.error().c_str()), 1;
     if (e->select) session.select(*e->select);
     if (e->focus) session.setFocus(*e->focus);
   }
@@ -244,7 +199,7 @@ int runEdit(const std::vector<std::string>& argv) {
     bool instant = step.kind == ScenarioStep::Kind::Select || step.kind == ScenarioStep::Kind::Focus;
     for (int f = 0; f < (instant ? 1 : step.frames); ++f) {
       auto e = stepEdits(step, f, session.scene(), session.selection());
-      if (!e) return std::fprintf(stderr, "\nerror: %s: steps[%zu]: %s\n", args->get("--script").c_str(), si, e.error().c_str()), 1;
+      if (!e) return std::fprintf(stderr, "\nerror: %s: steps[%zu]: %s\n", o.script.c_str(), si, e.error().c_str()), 1;
       if (e->select) session.select(*e->select);
       if (e->focus) session.setFocus(*e->focus);
       for (const Edit& edit : e->edits) {
@@ -279,6 +234,74 @@ int runEdit(const std::vector<std::string>& argv) {
   }
   std::printf("wrote          %s\n", (outDir / "frames.csv").string().c_str());
   return exact ? 0 : 1;
+}
+
+}  // namespace
+
+void addEdit(CLI::App& app, int* status) {
+  CLI::App* cmd = app.add_subcommand(
+      "edit",
+      "Converge a scene, play a script of timed edits under one method, and write every frame (EXR) and frames.csv");
+  auto o = std::make_shared<EditOptions>();
+  std::string methods;
+  for (const auto& n : methodNames()) methods += (methods.empty() ? "" : ", ") + n;
+  addScene(*cmd, &o->scene);
+  cmd->add_option("--script", o->script, "the edits, a scenario script (resources/scripts/*.json)")
+      ->required()
+      ->type_name("EDITS.json");
+  cmd->add_option("--method", o->methodName, "the re-rendering method: " + methods)
+      ->required()
+      ->type_name("NAME")
+      ->check(oneOf("method", methodNames()));
+  cmd->add_option("--out-dir", o->outDir, "where frames.csv and the frames go (made if missing)")
+      ->required()
+      ->type_name("DIR");
+  addSize(*cmd, &o->size, "image size", "the scene's");
+  addInt(*cmd, "--tile", &o->method.tileSize, 8, 32, "tile side T: 8, 16 or 32 pixels")->type_name("T");
+  const int quality = o->method.quality;
+  auto readQuality = [](const std::string& text) -> Result<int> {
+    if (text == "auto") return 0;
+    auto q = readInt(text, 1, 4096);
+    return q ? q : Result<int>::failure(q.error() + " nor 'auto'");
+  };
+  cmd->add_option_function<std::string>(
+         "--quality", [o, readQuality](const std::string& text) { o->method.quality = readQuality(text).value(); },
+         cat("samples per pixel of a served tile, or 'auto', the indirection methods' choice (1..4096; default: ",
+             quality, ")"))
+      ->type_name("Q|auto")
+      ->check(CLI::Validator(
+          [readQuality](std::string& text) {
+            auto q = readQuality(text);
+            return q ? std::string() : q.error();
+          },
+          ""));
+  cmd->add_flag("--smooth", o->method.smooth, "smooth transition: tiles not yet served keep capped stale samples");
+  addInt(*cmd, "--stale-cap", &o->method.staleCap, 1, 1 << 20, "with --smooth: stale samples kept per pixel");
+  addInt(*cmd, "--converge", &o->converge, 0, 1 << 20, "samples per pixel before the first edit", "the script's")
+      ->type_name("SPP");
+  addInt(*cmd, "--max-bounces", &o->maxBounces, 0, 1024, "longest path", "the scene's");
+  addInt(*cmd, "--reference", &o->reference, 1, 1 << 20,
+         "render the final state fresh at SPP (reference.exr) and score every frame against it", "none")
+      ->type_name("SPP");
+  addInt(*cmd, "--block", &o->block, 1, 64, "with --reference: side of the blocks the relative RMSE averages");
+  addNumber(*cmd, "--threshold", &o->threshold, 0, 1e30,
+            "with --reference: relative RMSE below which a frame counts as settled")
+      ->type_name("REL");
+  CLI::Option* denoise = cmd->add_flag("--denoise", o->method.denoise, "denoise what the method shows");
+  addInt(*cmd, "--denoise-threshold", &o->method.denoiseThreshold, 0, 16384,
+         "pixels a pass's region grows before it is denoised again at its new size")
+      ->type_name("PX")
+      ->needs(denoise);
+  cmd->add_flag("--no-soft-borders", o->noSoftBorders, "no blending at seams between tiles showing different things")
+      ->needs(denoise);
+  CLI::Option* reuse = cmd->add_flag("--reuse", o->method.reuse,
+                                     "verified reuse: restarted tiles keep samples a test finds in agreement");
+  addNumber(*cmd, "--reuse-rate", &o->method.reuseFalseReject, 1e-12, 0.49,
+            "chance that one test of an unchanged tile drops its history")
+      ->type_name("A")
+      ->needs(reuse);
+  cmd->add_flag("--no-images", o->noImages, "write frames.csv only, no EXR per frame");
+  cmd->callback([o, status] { *status = runEdit(*o); });
 }
 
 }  // namespace retile::cli

@@ -12,9 +12,11 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <sstream>
+#include <memory>
+#include <optional>
 
 #include "cli.h"
+#include "cli11.h"
 #include "core/files.h"
 #include "eval_report.h"
 #include "retile/eval.h"
@@ -23,29 +25,6 @@
 namespace retile::cli {
 
 namespace {
-
-void usage(const std::string& error) {
-  if (!error.empty()) std::fprintf(stderr, "error: %s\n", error.c_str());
-  std::fprintf(stderr,
-               "usage: retile eval [SCENE ...] --out-dir DIR [--quick] [--size WxH] [--methods LIST] [--scenarios LIST]\n"
-               "                   [--script FILE ...] [--reference-spp N] [--every K] [--converge SPP] [--target REL]\n"
-               "       retile eval [SCENE ...] --stability --out-dir DIR [--quick] [--size WxH] [--cases LIST] [--methods LIST]\n"
-               "SCENE defaults to 'default'. LIST is comma-separated.\n"
-               "scenarios: fig6, material, light, camera, drag (default: all), plus each --script\n"
-               "methods (default):");
-  for (const auto& m : eval::defaultMethods()) std::fprintf(stderr, " %s", m.c_str());
-  std::fprintf(stderr, "\n         any of");
-  for (const auto& n : methodNames()) std::fprintf(stderr, " %s", n.c_str());
-  std::fprintf(stderr, " with +smooth and/or +denoise\n");
-}
-
-std::vector<std::string> splitList(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  for (std::string item; std::getline(in, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 std::string html(const std::string& s) {
   std::string o;
@@ -87,9 +66,6 @@ struct ScenarioResult {
 
 int runStability(const std::vector<std::string>& sceneNames, const std::vector<std::string>& cases,
                  const eval::StabilityOptions& options, const std::filesystem::path& out) {
-  const auto known = eval::stabilityCaseNames();
-  for (const auto& c : cases)
-    if (std::find(known.begin(), known.end(), c) == known.end()) return usage(cat("unknown stability case '", c, "'")), 2;
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
   if (ec) return std::fprintf(stderr, "error: cannot create %s: %s\n", out.string().c_str(), ec.message().c_str()), 1;
@@ -154,69 +130,47 @@ int runStability(const std::vector<std::string>& sceneNames, const std::vector<s
   return broken > 0 ? 1 : 0;
 }
 
-}  // namespace
+struct EvalOptions {
+  std::vector<std::string> scenes{"default"};
+  std::string outDir;
+  bool quick = false, stability = false;
+  std::optional<ImageSize> size;
+  std::vector<std::string> methods, scenarios, scripts, cases;
+  std::optional<int> referenceSpp, every, converge;
+  std::optional<double> target;
+};
 
-int runEval(const std::vector<std::string>& argv) {
-  auto args = parseArgs(argv, {"--out-dir", "--size", "--methods", "--scenarios", "--script", "--reference-spp", "--every",
-                               "--converge", "--target", "--cases"},
-                        {"--quick", "--stability"});
-  if (!args) return usage(args.error()), 2;
-  if (!args->has("--out-dir")) return usage("--out-dir is required"), 2;
-  eval::Options opt = args->has("--quick") ? eval::Options::quick() : eval::Options{};
-  if (args->has("--size")) {
-    auto r = parseSize(args->get("--size"), &opt.width, &opt.height);
-    if (!r) return usage(r.error()), 2;
-  }
-  for (auto [name, lo, hi, out] : {std::tuple{"--reference-spp", 1, 1 << 20, &opt.referenceSpp},
-                                   std::tuple{"--every", 1, 100000, &opt.every},
-                                   std::tuple{"--converge", 0, 1 << 20, &opt.converge}}) {
-    if (!args->has(name)) continue;
-    auto v = parseInt(name, args->get(name), lo, hi);
-    if (!v) return usage(v.error()), 2;
-    *out = v.value();
-  }
-  if (args->has("--target")) {
-    auto v = parseNumber("--target", args->get("--target"), 1e-6, 10);
-    if (!v) return usage(v.error()), 2;
-    opt.target = v.value();
-  }
-  std::vector<std::string> methodLabels = args->has("--methods") ? splitList(args->get("--methods")) : eval::defaultMethods();
+int runEval(const EvalOptions& o) {
+  eval::Options opt = o.quick ? eval::Options::quick() : eval::Options{};
+  if (o.size) opt.width = o.size->width, opt.height = o.size->height;
+  if (o.referenceSpp) opt.referenceSpp = *o.referenceSpp;
+  if (o.every) opt.every = *o.every;
+  if (o.converge) opt.converge = *o.converge;
+  if (o.target) opt.target = *o.target;
+  const std::vector<std::string> methodLabels = o.methods.empty() ? eval::defaultMethods() : o.methods;
   std::vector<MethodSettings> methods;
-  for (const auto& label : methodLabels) {
-    auto m = eval::parseMethodLabel(label);
-    if (!m) return usage(m.error()), 2;
-    methods.push_back(m.value());
-  }
-  std::vector<std::string> scenarioNames;
-  if (args->has("--scenarios")) {
-    scenarioNames = splitList(args->get("--scenarios"));
-    const auto known = eval::builtInScenarioNames();
-    for (const auto& n : scenarioNames)
-      if (std::find(known.begin(), known.end(), n) == known.end())
-        return usage(cat("unknown scenario '", n, "' (fig6, material, light, camera, drag; scripts go with --script)")), 2;
-  }
+  for (const auto& label : methodLabels)
+    methods.push_back(eval::parseMethodLabel(label).value());  // checked by the option
+  const std::vector<std::string>& scenarioNames = o.scenarios;
   std::vector<Scenario> scripts;
-  for (const auto& [k, v] : args->options)
-    if (k == "--script") {
-      auto s = loadScenario(v);
-      if (!s) return std::fprintf(stderr, "error: %s\n", s.error().c_str()), 1;
-      scripts.push_back(s.value());
-    }
-  // Only scripts were asked for: no built-in scenario unless named.
-  const bool builtIns = scripts.empty() || args->has("--scenarios");
-  std::vector<std::string> sceneNames = args->positional.empty() ? std::vector<std::string>{"default"} : args->positional;
-  if (args->has("--stability")) {
-    eval::StabilityOptions so;
-    if (args->has("--quick")) so.width = 96, so.height = 54, so.referenceSpp = 512, so.small = true;
-    if (args->has("--size")) so.width = opt.width, so.height = opt.height;
-    if (args->has("--reference-spp")) so.referenceSpp = opt.referenceSpp;
-    if (args->has("--methods")) so.methods = methodLabels;
-    std::vector<std::string> cases = args->has("--cases") ? splitList(args->get("--cases")) : eval::stabilityCaseNames();
-    return runStability(sceneNames, cases, so, args->get("--out-dir"));
+  for (const auto& file : o.scripts) {
+    auto s = loadScenario(file);
+    if (!s) return std::fprintf(stderr, "error: %s\n", s.error().c_str()), 1;
+    scripts.push_back(s.value());
   }
-  if (args->has("--cases")) return usage("--cases goes with --stability"), 2;
+  // Only scripts were asked for: no built-in scenario unless named.
+  const bool builtIns = scripts.empty() || !scenarioNames.empty();
+  const std::vector<std::string>& sceneNames = o.scenes;
+  if (o.stability) {
+    eval::StabilityOptions so;
+    if (o.quick) so.width = 96, so.height = 54, so.referenceSpp = 512, so.small = true;
+    if (o.size) so.width = opt.width, so.height = opt.height;
+    if (o.referenceSpp) so.referenceSpp = opt.referenceSpp;
+    if (!o.methods.empty()) so.methods = methodLabels;
+    return runStability(sceneNames, o.cases.empty() ? eval::stabilityCaseNames() : o.cases, so, o.outDir);
+  }
 
-  const std::filesystem::path out = args->get("--out-dir");
+  const std::filesystem::path out = o.outDir;
   std::error_code ec;
   std::filesystem::create_directories(out / "charts", ec);
   std::filesystem::create_directories(out / "strips", ec);
@@ -468,6 +422,84 @@ int runEval(const std::vector<std::string>& argv) {
   std::printf("wrote %s (%d charts, %zu strips) in %.0f s\n", (out / "index.html").string().c_str(), chartsWritten,
               results.size(), seconds());
   return 0;
+}
+
+}  // namespace
+
+void addEval(CLI::App& app, int* status) {
+  CLI::App* cmd = app.add_subcommand(
+      "eval", "Every method through the same scenarios, scored against cached references: a report in --out-dir "
+              "(index.html, CSV, charts); with --stability, the stability suite");
+  auto o = std::make_shared<EvalOptions>();
+  const eval::Options full, quick = eval::Options::quick();
+  const eval::StabilityOptions stable;
+  auto join = [](const std::vector<std::string>& names) {
+    std::string s;
+    for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+    return s;
+  };
+  cmd->add_option("SCENE", o->scenes, "scene files (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default' "
+                                      "(default: default)")
+      ->type_name("");
+  cmd->add_option("--out-dir", o->outDir, "where the report and the references go (made if missing; references "
+                                          "already there are reused)")
+      ->required()
+      ->type_name("DIR");
+  cmd->add_flag("--quick", o->quick, "small images, short scenarios, lower references (what the tests run)");
+  cmd->add_flag("--stability", o->stability,
+                "run the stability suite (stability.csv, stability.html) instead of the scenarios");
+  addSize(*cmd, &o->size, "image size",
+          cat(full.width, "x", full.height, ", ", quick.width, "x", quick.height, " with --quick; --stability: ",
+              stable.width, "x", stable.height));
+  // Every list is checked item by item when it is read, so a typo fails before any rendering.
+  auto checkEach = [](auto read) {
+    return CLI::Validator(
+        [read](std::string& item) {
+          auto r = read(item);
+          return r ? std::string() : r.error();
+        },
+        "");
+  };
+  std::string labels;
+  for (const auto& n : methodNames()) labels += (labels.empty() ? "" : ", ") + n;
+  cmd->add_option("--methods", o->methods,
+                  "comma-separated methods, each of " + labels + " with +smooth, +denoise, +reuse (default: " +
+                      join(eval::defaultMethods()) + ")")
+      ->type_name("LIST")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(checkEach([](const std::string& label) { return eval::parseMethodLabel(label); }));
+  cmd->add_option("--scenarios", o->scenarios,
+                  "comma-separated built-in scenarios: " + join(eval::builtInScenarioNames()) +
+                      " (default: all of them, none when --script is given)")
+      ->type_name("LIST")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(oneOf("scenario", eval::builtInScenarioNames()));
+  cmd->add_option("--script", o->scripts, "a scenario script to play as well (repeat for more)")
+      ->type_name("FILE")
+      ->allow_extra_args(false);
+  addInt(*cmd, "--reference-spp", &o->referenceSpp, 1, 1 << 20, "samples per pixel of the references",
+         cat(full.referenceSpp, ", ", quick.referenceSpp, " with --quick"));
+  addInt(*cmd, "--every", &o->every, 1, 100000, "while edits arrive, score frames 1, 10, K, 2K, ...",
+         cat(full.every, ", ", quick.every, " with --quick"))
+      ->type_name("K");
+  addInt(*cmd, "--converge", &o->converge, 0, 1 << 20, "samples per pixel before the first edit",
+         cat(full.converge, ", ", quick.converge, " with --quick"))
+      ->type_name("SPP");
+  addNumber(*cmd, "--target", &o->target, 1e-6, 10,
+            "relative RMSE of the affected region that counts as reached",
+            cat(full.target, ", ", quick.target, " with --quick"))
+      ->type_name("REL");
+  CLI::Option* stability = cmd->get_option("--stability");
+  cmd->add_option("--cases", o->cases, "with --stability: comma-separated cases (default: all): " +
+                                           join(eval::stabilityCaseNames()))
+      ->type_name("LIST")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(oneOf("stability case", eval::stabilityCaseNames()))
+      ->needs(stability);
+  cmd->callback([o, status] { *status = runEval(*o); });
 }
 
 }  // namespace retile::cli

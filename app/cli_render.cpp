@@ -1,55 +1,44 @@
+// `retile render`: a scene to one image, the way a user checks a scene or makes a reference.
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
+#include <optional>
 
 #include "cli.h"
+#include "cli11.h"
 #include "retile/image.h"
 #include "retile/log.h"
 #include "retile/render.h"
 
 namespace retile::cli {
 
-int runRender(const std::vector<std::string>& argv) {
-  auto args = parseArgs(argv, {"--size", "--spp", "--seed", "--max-bounces", "--out", "--view", "--exposure"}, {"--denoise"});
-  if (!args || args->positional.size() != 1) {
-    std::fprintf(stderr,
-                 "%s%susage: retile render SCENE [--size WxH] [--spp N] [--seed S] [--max-bounces B] [--denoise] [--out FILE]\n",
-                 args ? "" : args.error().c_str(), args ? "" : "\n");
-    return 2;
-  }
-  RenderRequest req;
-  req.denoise = args->has("--denoise");
-  if (args->has("--size")) {
-    auto r = parseSize(args->get("--size"), &req.width, &req.height);
-    if (!r) return std::fprintf(stderr, "error: %s\n", r.error().c_str()), 2;
-  }
-  for (auto [opt, dst, lo, hi] : {std::tuple{"--spp", &req.samplesPerPixel, 1, 1 << 20},
-                                  std::tuple{"--max-bounces", &req.maxBounces, 0, 1024}}) {
-    if (!args->has(opt)) continue;
-    auto v = parseInt(opt, args->get(opt), lo, hi);
-    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
-    *dst = v.value();
-  }
-  if (args->has("--seed")) {
-    auto v = parseInt("--seed", args->get("--seed"), 0, 2147483647);
-    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
-    req.seed = static_cast<std::uint32_t>(v.value());
-  }
-  DisplaySettings display;
-  display.view = args->get("--view", "Standard");
-  if (args->has("--exposure")) {
-    auto v = parseNumber("--exposure", args->get("--exposure"), -64, 64);
-    if (!v) return std::fprintf(stderr, "error: %s\n", v.error().c_str()), 2;
-    display.exposure = static_cast<float>(v.value());
-  }
-  std::filesystem::path out = args->get("--out", "retile-render.png");
-  std::string ext = out.extension().string();
-  if (ext != ".png" && ext != ".exr") {
-    std::fprintf(stderr, "error: --out: '%s' must end in .png or .exr\n", out.string().c_str());
-    return 2;
-  }
+namespace {
 
-  auto loaded = loadScene(args->positional[0]);
+struct RenderOptions {
+  std::string scene;
+  std::optional<ImageSize> size;
+  std::optional<int> spp, maxBounces;
+  int seed = 0;
+  std::string out = "retile-render.png";
+  std::string view = "Standard";
+  double exposure = 0;
+  bool denoise = false;
+};
+
+int runRender(const RenderOptions& o) {
+  RenderRequest req;
+  req.denoise = o.denoise;
+  if (o.size) req.width = o.size->width, req.height = o.size->height;
+  if (o.spp) req.samplesPerPixel = *o.spp;
+  if (o.maxBounces) req.maxBounces = *o.maxBounces;
+  req.seed = static_cast<std::uint32_t>(o.seed);
+  DisplaySettings display;
+  display.view = o.view;
+  display.exposure = static_cast<float>(o.exposure);
+  const std::filesystem::path out = o.out;
+
+  auto loaded = loadScene(o.scene);
   if (!loaded) {
     std::fprintf(stderr, "error: %s\n", loaded.error().c_str());
     return 1;
@@ -76,6 +65,33 @@ int runRender(const std::vector<std::string>& argv) {
               image.width, image.height, image.sampleCount.empty() ? 0.0 : static_cast<double>(image.sampleCount[0]),
               req.denoise ? ", denoised" : "", seconds, stats.seconds > 0 ? static_cast<double>(stats.samples) / stats.seconds * 1e-6 : 0.0);
   return 0;
+}
+
+}  // namespace
+
+void addRender(CLI::App& app, int* status) {
+  CLI::App* cmd = app.add_subcommand("render", "Render a scene to an image (PNG through the view transform, or EXR)");
+  auto o = std::make_shared<RenderOptions>();
+  addScene(*cmd, &o->scene);
+  addSize(*cmd, &o->size, "image size", "the scene's");
+  addInt(*cmd, "--spp", &o->spp, 1, 1 << 20, "samples per pixel", "the scene's");
+  addInt(*cmd, "--seed", &o->seed, 0, 2147483647, "random seed");
+  addInt(*cmd, "--max-bounces", &o->maxBounces, 0, 1024, "longest path", "the scene's");
+  cmd->add_option("--out", o->out, "the image written: FILE.png or FILE.exr (default: " + o->out + ")")
+      ->type_name("FILE")
+      ->check(CLI::Validator(
+          [](std::string& file) {
+            const std::string ext = std::filesystem::path(file).extension().string();
+            return ext == ".png" || ext == ".exr" ? std::string() : "'" + file + "' must end in .png or .exr";
+          },
+          ""));
+  cmd->add_option("--view", o->view,
+                  "the PNG's OCIO view of the sRGB display: Standard, Filmic or Raw (default: " + o->view + ")")
+      ->type_name("NAME");
+  addNumber(*cmd, "--exposure", &o->exposure, -64, 64, "stops, applied before the PNG's view transform")
+      ->type_name("STOPS");
+  cmd->add_flag("--denoise", o->denoise, "denoise the whole image (the EXR keeps the raw samples too)");
+  cmd->callback([o, status] { *status = runRender(*o); });
 }
 
 }  // namespace retile::cli

@@ -13,10 +13,6 @@
 
 namespace retile::cli {
 
-bool isCommand(const std::string& word) {
-  return word == "render" || word == "edit" || word == "eval" || word == "compare" || word == "bench" || word == "import";
-}
-
 int runEditor(int argc, char** argv, const std::string& file) {
   QApplication app(argc, argv);
   QApplication::setApplicationName("Retile");

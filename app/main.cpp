@@ -1,34 +1,52 @@
-// retile: the editor (issue 4 brings it) and the command line.
+// retile: the editor, or with a command the command line (cli.h).
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <string>
 #include <vector>
 
 #include "cli.h"
+#include "cli11.h"
 #include "retile/log.h"
 
 namespace {
 
-void usage() {
-  std::fprintf(stderr,
-               "usage:\n"
-               "  retile [SCENE]                      opens the editor (the built-in scene without SCENE)\n"
-               "  retile render SCENE [--size WxH] [--spp N] [--seed S] [--max-bounces B] [--out FILE.exr|png]\n"
-               "                      [--view Standard|Filmic] [--exposure STOPS] [--denoise]\n"
-               "  retile edit SCENE --script EDITS.json --method NAME --out-dir DIR [--size WxH] [--tile T]\n"
-               "                    [--quality Q|auto] [--smooth] [--stale-cap N] [--converge SPP] [--reference SPP]\n"
-               "                    [--denoise [--denoise-threshold PX] [--no-soft-borders]] [--reuse [--reuse-rate A]] [--no-images]\n"
-               "  retile eval [SCENE ...] --out-dir DIR [--quick] [--size WxH] [--methods LIST] [--scenarios LIST]\n"
-               "                    [--script FILE ...] [--reference-spp N] [--every K] [--converge SPP] [--target REL]\n"
-               "  retile eval [SCENE ...] --stability --out-dir DIR [--quick] [--size WxH] [--cases LIST] [--methods LIST]\n"
-               "  retile bench throughput SCENE [--size WxH] [--frames N] [--max-bounces B]\n"
-               "  retile bench bvh [--triangles N] | edit | frames SCENE [--drag] | denoise [SCENE] [--size WxH]\n"
-               "               | scale [--size WxH] [--frames N]\n"
-               "  retile compare IMAGE REFERENCE [--noise IMAGE2] [--block N] [--exclude X,Y,W,H ...] [--worst K]\n"
-               "  retile import FILE\n"
-               "  retile --version | --help\n"
-               "SCENE is a file (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default'.\n");
+const CLI::App* findCommand(const CLI::App& app, const std::string& word) {
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    if (sub->check_name(word)) return sub;
+  return nullptr;
+}
+
+// CLI11 reports a mistyped command, or an unknown option where a command is due, as "A subcommand
+// is required". Walks the words that choose a command and names the one it does not know.
+bool unknownCommand(const CLI::App& app, const std::vector<std::string>& args) {
+  const CLI::App* at = &app;
+  std::string path = app.get_name();
+  for (const std::string& word : args) {
+    if (at->get_subcommands([](const CLI::App*) { return true; }).empty()) return false;
+    const bool option = word.rfind("-", 0) == 0;
+    if (option && at->get_option_no_throw(word.substr(0, word.find('='))) != nullptr) return false;
+    const CLI::App* next = option ? nullptr : findCommand(*at, word);
+    if (!next) {
+      std::fprintf(stderr, "%s: unknown %s '%s'\nRun '%s --help' for the commands.\n", path.c_str(),
+                   option ? "option" : "command", word.c_str(), path.c_str());
+      return true;
+    }
+    at = next;
+    path += " " + word;
+  }
+  return false;
+}
+
+// "retile bench throughput": the command whose options were being read, for the hint to its help.
+std::string commandPath(const CLI::App& app) {
+  std::string path = app.get_name();
+  for (const CLI::App* at = &app; !at->get_subcommands().empty();) {
+    at = at->get_subcommands().front();
+    path += " " + at->get_name();
+  }
+  return path;
 }
 
 }  // namespace
@@ -36,27 +54,39 @@ void usage() {
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (const char* v = std::getenv("RETILE_LOG"); v && std::strcmp(v, "debug") == 0) retile::setLogLevel(retile::LogLevel::Debug);
+
+  CLI::App app(
+      "Retile: an interactive path-traced scene editor that re-renders an edit tile by tile, nearest the edit first.\n"
+      "Without a command, `retile [SCENE]` opens the editor on SCENE (the built-in scene without one).",
+      "retile");
+  app.set_version_flag("-V,--version", "retile " RETILE_VERSION, "print the version and exit");
+  app.set_help_flag("-h,--help", "print this help and exit");
+  app.require_subcommand(1);
+  int status = 0;
+  retile::cli::addRender(app, &status);
+  retile::cli::addEdit(app, &status);
+  retile::cli::addEval(app, &status);
+  retile::cli::addCompare(app, &status);
+  retile::cli::addBench(app, &status);
+  retile::cli::addImport(app, &status);
+  // After the commands, which would otherwise inherit it.
+  app.footer("SCENE is a file (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default'.\n"
+             "`retile COMMAND --help` lists a command's options.");
+
   try {
-    if (args.empty() || (args.size() == 1 && args[0].rfind("-", 0) != 0 && !retile::cli::isCommand(args[0])))
+    // The editor takes the command line as it is (Qt reads its own options from it): nothing
+    // but a scene file, or nothing at all.
+    if (args.empty() || (args.size() == 1 && args[0].rfind("-", 0) != 0 && !findCommand(app, args[0])))
       return retile::cli::runEditor(argc, argv, args.empty() ? std::string() : args[0]);
-    if (args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
-      usage();
-      return 0;
-    }
-    if (args[0] == "--version" || args[0] == "-V") {
-      std::printf("retile %s\n", RETILE_VERSION);
-      return 0;
-    }
-    std::string cmd = args[0];
-    std::vector<std::string> rest(args.begin() + 1, args.end());
-    if (cmd == "render") return retile::cli::runRender(rest);
-    if (cmd == "bench") return retile::cli::runBench(rest);
-    if (cmd == "import") return retile::cli::runImport(rest);
-    if (cmd == "edit") return retile::cli::runEdit(rest);
-    if (cmd == "eval") return retile::cli::runEval(rest);
-    if (cmd == "compare") return retile::cli::runCompare(rest);
-    std::fprintf(stderr, "retile: unknown command '%s'\n", cmd.c_str());
-    usage();
+    if (unknownCommand(app, args)) return 2;
+    app.parse(argc, argv);
+    return status;
+  } catch (const CLI::ParseError& e) {
+    // --help and --version end the parse this way too, with exit code 0.
+    if (e.get_exit_code() == 0) return app.exit(e);
+    const std::string command = commandPath(app);
+    std::fprintf(stderr, "%s: error: %s\nRun '%s --help' for its options.\n", command.c_str(), e.what(),
+                 command.c_str());
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

@@ -9,6 +9,7 @@ set -euo pipefail
 # dependencies with dpkg-shlibdeps (the `package` target).
 # locales: the locale sources that localedef compiles, for the tests that run under a comma-decimal
 # locale (de_DE) as an artist in much of Europe does.
+# libcli11-dev: the command line's parser (header-only): options, ranges and --help of every command.
 packages=(
   build-essential cmake ninja-build pkg-config git file dpkg-dev
   qt6-base-dev qt6-base-dev-tools qt6-charts-dev qt6-svg-dev libqt6opengl6-dev libgl-dev
@@ -18,6 +19,7 @@ packages=(
   libopenimageio-dev openimageio-tools
   libopencolorio-dev
   libgtest-dev libgmock-dev
+  libcli11-dev
   locales
   xvfb xauth libxkbcommon-x11-0 libxcb-cursor0 libxcb-icccm4 libxcb-image0 libxcb-keysyms1
   libxcb-randr0 libxcb-render-util0 libxcb-shape0 libxcb-xinerama0 libxcb-xkb1 fonts-dejavu-core

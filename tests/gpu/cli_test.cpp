@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <string>
+#include <vector>
 
 #include "core/files.h"
 #include "core/process.h"
@@ -55,6 +57,87 @@ TEST(Cli, ImportAndRenderUnderACommaDecimalLocale) {
   ChildResult comma = runChild(RETILE_CLI_PATH, {"render", scene.string(), "--exposure", "0,5"}, limits);
   EXPECT_EQ(comma.exitCode, 2);
   EXPECT_NE(comma.err.find("'0,5' is not a number"), std::string::npos) << comma.err;
+}
+
+// Each command explains itself: `--help` at every level exits 0 and lists the command's options
+// (one CLI11 tree, so nothing the command reads is missing from its help).
+TEST(Cli, HelpAtEveryLevelListsTheOptions) {
+  struct Case {
+    std::vector<std::string> args;
+    std::vector<std::string> mentions;
+  };
+  const std::vector<Case> cases = {
+      {{"--help"}, {"render", "edit", "eval", "compare", "bench", "import", "--version", "retile [SCENE]"}},
+      {{"render", "--help"}, {"Usage: retile render", "--spp", "--size", "--seed", "--max-bounces", "--out", "--view",
+                              "--exposure", "--denoise", "1..1048576"}},
+      {{"edit", "-h"}, {"--script", "--method", "--out-dir", "--stale-cap", "--no-images", "--quality", "--reference",
+                        "--threshold", "--denoise-threshold", "--no-soft-borders", "--reuse-rate", "spiral"}},
+      {{"eval", "--help"}, {"--quick", "--stability", "--methods", "--scenarios", "--script", "--reference-spp",
+                            "--every", "--target", "--cases", "ghosting"}},
+      {{"compare", "--help"}, {"IMAGE", "REFERENCE", "--noise", "--block", "--exclude", "--worst"}},
+      {{"import", "--help"}, {"FILE"}},
+      {{"bench", "--help"}, {"throughput", "bvh", "edit", "frames", "denoise", "scale"}},
+      {{"bench", "throughput", "--help"}, {"Usage: retile bench throughput", "--paths", "--frames", "--max-bounces",
+                                           "--size"}},
+      {{"bench", "frames", "--help"}, {"--seconds", "--method", "--drag", "--object"}},
+      {{"bench", "edit", "--help"}, {"--edits"}},
+      {{"bench", "bvh", "--help"}, {"--triangles"}},
+  };
+  for (const Case& c : cases) {
+    std::string line;
+    for (const auto& a : c.args) line += " " + a;
+    SCOPED_TRACE("retile" + line);
+    ChildResult r = runChild(RETILE_CLI_PATH, c.args, ChildLimits{});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    for (const auto& m : c.mentions) EXPECT_NE(r.out.find(m), std::string::npos) << m << " in\n" << r.out;
+  }
+  ChildResult version = runChild(RETILE_CLI_PATH, {"-V"}, ChildLimits{});
+  EXPECT_EQ(version.exitCode, 0);
+  EXPECT_EQ(version.out.rfind("retile 0.", 0), 0u) << version.out;
+}
+
+// A mistyped value is refused before anything is loaded or rendered: exit 2 and a message naming
+// the option, never a silent 0.
+TEST(Cli, RefusesBadValuesNamingTheOption) {
+  const std::filesystem::path out = test::tempDir() / "never.png";
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{"render", "default", "--spp", "abc"}, "--spp: 'abc' is not a whole number"},
+      {{"render", "default", "--spp", "0"}, "--spp: 0 is outside 1..1048576"},
+      {{"render", "default", "--max-bounces", "2000"}, "--max-bounces: 2000 is outside 0..1024"},
+      {{"render", "default", "--exposure", "x"}, "--exposure: 'x' is not a number"},
+      {{"render", "default", "--size", "64x0"}, "--size: height 0 is outside 1..16384"},
+      {{"render", "default", "--out", "a.jpg"}, "--out: 'a.jpg' must end in .png or .exr"},
+      {{"render", "default", "--frobnicate", "2"}, "--frobnicate"},
+      {{"render"}, "SCENE is required"},
+      {{"edit", "default", "--script", "s.json", "--method", "spiral", "--out-dir", "d", "--threshold", "abc"},
+       "--threshold: 'abc' is not a number"},
+      {{"edit", "default", "--script", "s.json", "--method", "spirl", "--out-dir", "d"}, "unknown method 'spirl'"},
+      {{"edit", "default", "--method", "spiral", "--out-dir", "d"}, "--script is required"},
+      {{"edit", "default", "--script", "s.json", "--method", "spiral", "--out-dir", "d", "--reuse-rate", "0.1"},
+       "--reuse-rate requires --reuse"},
+      {{"eval", "--out-dir", "d", "--scenarios", "fig6,fig7"}, "unknown scenario 'fig7'"},
+      {{"eval", "--out-dir", "d", "--cases", "burst"}, "--cases requires --stability"},
+      {{"compare", "a.exr", "b.exr", "--exclude", "1,2,3"}, "--exclude: '1,2,3' is not X,Y,W,H"},
+      {{"bench", "throughput", "default", "--paths", "-1"}, "--paths: -1 is outside 1..1048576"},
+      {{"bench", "throughput", "default", "--frames", "1e3"}, "--frames: '1e3' is not a whole number"},
+      {{"bench", "fast"}, "unknown command 'fast'"},
+  };
+  for (Case c : cases) {
+    std::string line;
+    for (const auto& a : c.args) line += " " + a;
+    SCOPED_TRACE("retile" + line);
+    if (c.args[0] == "render" && std::find(c.args.begin(), c.args.end(), "--out") == c.args.end())
+      c.args.insert(c.args.end(), {"--out", out.string()});
+    ChildResult r = runChild(RETILE_CLI_PATH, c.args, ChildLimits{});
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("device:"), std::string::npos) << "refused before a renderer was made:\n" << r.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 // `retile eval --quick` as a reviewer runs it: every default method through three scenarios, a
