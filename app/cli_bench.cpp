@@ -1,5 +1,6 @@
 // Benchmarks print figures; they never pass or fail (speed goals are not tests).
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -15,6 +16,7 @@
 #include "retile/render.h"
 #include "retile/session.h"
 #include "scene/primitives.h"
+#include "scene/synthetic.h"
 
 namespace retile::cli {
 namespace {
@@ -70,6 +72,66 @@ int benchScale(const ScaleOptions& o) {
     std::printf("%10llu %10.3f M %9.2fx %12.2f %14.1f %12.1f\n", static_cast<unsigned long long>(tris), rate * 1e-6,
                 rate / first, upload, static_cast<double>(renderer.sceneDeviceBytes()) / (1 << 20),
                 static_cast<double>(renderer.sceneDeviceBytes()) / static_cast<double>(tris));
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
+// Throughput and memory on a furnished room (scene/synthetic.h) of 100 k, 1 M and 4 M triangles
+// by default: what a big interior costs, per triangle, with the device memory split by what it
+// holds.
+struct RoomOptions {
+  std::string triangles = "100k,1M,4M";
+  ImageSize size{320, 180};
+  int frames = 8;
+  int maxBounces = 16;
+  std::string writeScene;  // also save the first room as a native scene, to look at
+};
+
+// "100k,1M,4M" -> counts; k and M multiply by a thousand and a million.
+std::vector<std::uint64_t> parseCounts(const std::string& text) {
+  std::vector<std::uint64_t> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    std::size_t end = text.find(',', start);
+    if (end == std::string::npos) end = text.size();
+    std::string item = text.substr(start, end - start);
+    std::uint64_t scale = 1;
+    if (!item.empty() && (item.back() == 'k' || item.back() == 'K')) scale = 1000, item.pop_back();
+    else if (!item.empty() && (item.back() == 'M' || item.back() == 'm')) scale = 1000000, item.pop_back();
+    std::uint64_t v = 0;
+    auto r = std::from_chars(item.data(), item.data() + item.size(), v);
+    if (r.ec != std::errc() || r.ptr != item.data() + item.size() || v == 0) return {};
+    out.push_back(v * scale);
+    start = end + 1;
+  }
+  return out;
+}
+
+int benchRoom(const RoomOptions& o) {
+  const std::vector<std::uint64_t> counts = parseCounts(o.triangles);
+  std::printf("%10s %11s %9s %9s %10s | bytes per triangle: %6s %6s %6s %6s %6s\n", "triangles", "samples/s", "build s",
+              "objects", "device MiB", "total", "tris", "BVH", "shade", "other");
+  for (std::uint64_t n : counts) {
+    const Scene scene = makeFurnishedRoom(n);
+    if (!o.writeScene.empty() && n == counts.front()) {
+      if (auto saved = saveNativeScene(scene, o.writeScene); !saved) return std::fprintf(stderr, "error: %s\n", saved.error().c_str()), 1;
+    }
+    Renderer renderer;
+    auto t0 = Clock::now();
+    renderer.setScene(scene);
+    const double build = std::chrono::duration<double>(Clock::now() - t0).count();
+    renderer.setMaxBounces(o.maxBounces);
+    renderer.resize(o.size.width, o.size.height);
+    FrameStats sum = traceFrames(renderer, o.size.width, o.size.height, o.frames, FrameOptions{});
+    const double rate = static_cast<double>(sum.samples) / sum.seconds;
+    const double tris = static_cast<double>(renderer.sceneTriangles());
+    const Renderer::SceneMemory m = renderer.sceneMemory();
+    const double total = static_cast<double>(renderer.sceneDeviceBytes());
+    std::printf("%10.0f %9.3f M %9.2f %9zu %10.1f | %26.1f %6.1f %6.1f %6.1f %6.1f\n", tris, rate * 1e-6, build,
+                scene.objects.size(), total / (1 << 20), total / tris, static_cast<double>(m.triangles) / tris,
+                static_cast<double>(m.bvh) / tris, static_cast<double>(m.shading) / tris,
+                static_cast<double>(m.textures + m.other) / tris);
     std::fflush(stdout);
   }
   return 0;
@@ -371,6 +433,18 @@ void addBench(CLI::App& app, int* status) {
   addSize(*cmd, &denoise->size, "image size");
   addInt(*cmd, "--frames", &denoise->frames, 1, 10000, "interleaved rounds timed");
   cmd->callback([denoise, status] { *status = benchDenoise(*denoise); });
+
+  cmd = bench->add_subcommand("room", "Samples/s and memory per triangle on a synthetic furnished room (100 k, 1 M, 4 M triangles)");
+  auto room = std::make_shared<RoomOptions>();
+  cmd->add_option("--triangles", room->triangles, "triangle counts, k and M allowed (default: 100k,1M,4M)")
+      ->type_name("LIST")
+      ->check(CLI::Validator([](std::string& v) { return parseCounts(v).empty() ? "--triangles: expected counts such as 100k,1M,4M" : std::string(); },
+                             ""));
+  addSize(*cmd, &room->size, "image size");
+  addInt(*cmd, "--frames", &room->frames, 1, 100000, "frames timed per size");
+  addInt(*cmd, "--max-bounces", &room->maxBounces, 0, 1024, "bounce limit");
+  cmd->add_option("--write-scene", room->writeScene, "also save the first room as a native scene (.retile)")->type_name("FILE");
+  cmd->callback([room, status] { *status = benchRoom(*room); });
 
   cmd = bench->add_subcommand("scale", "Samples/s and memory against triangle count (16 k to 2 M)");
   auto scale = std::make_shared<ScaleOptions>();

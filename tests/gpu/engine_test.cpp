@@ -11,6 +11,7 @@
 #include "gpu_support.h"
 #include "retile/engine.h"
 #include "retile/session.h"
+#include "scene/synthetic.h"
 #include "test_support.h"
 
 namespace retile {
@@ -143,6 +144,18 @@ TEST(Session, PipelinedFramesEqualFramesWaitedFor) {
       EXPECT_FALSE(waited.back().tileClass.empty()) << "counters were gathered";
     }
   }
+}
+
+// The device memory split (bench room's columns) adds up, and each part is what it says: 48 bytes
+// of positions per unique triangle, 64 of shading data.
+TEST(Engine, SceneMemoryPartsAddUp) {
+  RETILE_RENDERER_OR_SKIP(r);
+  r->setScene(makeFurnishedRoom(20000));
+  const Renderer::SceneMemory m = r->sceneMemory();
+  EXPECT_EQ(m.triangles + m.bvh + m.shading + m.textures + m.other, r->sceneDeviceBytes());
+  EXPECT_EQ(m.triangles, r->sceneTriangles() * 48);
+  EXPECT_EQ(m.shading, r->sceneTriangles() * 64);
+  EXPECT_GT(m.bvh, r->sceneTriangles() * 8) << "a node per few triangles";
 }
 
 TEST(Engine, FramesFlowAndEditsArriveWithTheirVersion) {

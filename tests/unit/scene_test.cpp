@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "retile/edit.h"
+#include "scene/synthetic.h"
 #include "test_support.h"
 
 namespace retile {
@@ -139,6 +140,23 @@ TEST(Document, CoalesceKeysSeparateTargetsAndKinds) {
   EXPECT_EQ(editCoalesceKey(a), editCoalesceKey(b));
   EXPECT_NE(editCoalesceKey(a), editCoalesceKey(c));
   EXPECT_NE(editCoalesceKey(a), editCoalesceKey(d));
+}
+
+// The benchmark room: close to the asked triangle count at every size, many separate objects
+// (not one blob), every position finite, the same room every time.
+TEST(Synthetic, FurnishedRoomHasTheTrianglesAskedForInManyObjects) {
+  for (std::uint64_t n : {20000ull, 200000ull}) {
+    const Scene s = makeFurnishedRoom(n);
+    EXPECT_NEAR(static_cast<double>(s.triangleCount()), static_cast<double>(n), 0.15 * static_cast<double>(n));
+    EXPECT_GT(s.objects.size(), 100u);
+    std::size_t biggest = 0;
+    for (const Mesh& m : s.meshes) {
+      biggest = std::max(biggest, m.geometry->triangleCount());
+      for (const Vec3& p : m.geometry->positions) ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+    }
+    EXPECT_LT(static_cast<double>(biggest), 0.3 * static_cast<double>(s.triangleCount())) << "no mesh holds most of it";
+  }
+  EXPECT_EQ(makeFurnishedRoom(20000).meshes.back().geometry->positions, makeFurnishedRoom(20000).meshes.back().geometry->positions);
 }
 
 }  // namespace

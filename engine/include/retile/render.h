@@ -179,6 +179,13 @@ class Renderer {
 
   // Device memory held by the scene's buffers (BVH included), and triangles, for the benchmarks.
   std::uint64_t sceneDeviceBytes() const;
+  // The same bytes by what they hold: triangle positions, BVH nodes (every mesh's and the top
+  // level's), per-triangle shading data (normals, uvs), textures, and the rest (instances,
+  // materials, lights, the environment's distribution).
+  struct SceneMemory {
+    std::uint64_t triangles = 0, bvh = 0, shading = 0, textures = 0, other = 0;
+  };
+  SceneMemory sceneMemory() const;
   // What the trace kernel was compiled with for this scene ("lambert", "rough plastic",
   // "alpha test", "textures", "emitters", ...): a scene pays only for what it uses.
   std::vector<std::string> kernelFeatures() const;

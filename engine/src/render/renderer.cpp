@@ -718,6 +718,19 @@ void Renderer::setSelection(NodeId object) { impl_->selectedObject = object; }
 SelectionCounts Renderer::takeSelectionCounts() { return impl_->takeSelectionCounts(); }
 RenderImage Renderer::readback() { return impl_->readback(); }
 std::uint64_t Renderer::sceneDeviceBytes() const { return impl_->builder.data().deviceBytes(); }
+Renderer::SceneMemory Renderer::sceneMemory() const {
+  const RenderSceneData& d = impl_->builder.data();
+  auto bytes = [](const auto& x) { return static_cast<std::uint64_t>(x.size() * sizeof(x[0])); };
+  SceneMemory m;
+  // The traversal buffer holds every unique triangle first, then the meshes' BVH nodes.
+  m.triangles = std::min(bytes(d.meshTraversal), d.triangleCount * gpu::kTriTexels * sizeof(gpu::vec4));
+  m.bvh = bytes(d.meshTraversal) - m.triangles + bytes(d.topTraversal);
+  m.shading = bytes(d.triangleShading);
+  m.textures = bytes(d.textureInfo) + bytes(d.texels);
+  m.other = d.deviceBytes() - m.triangles - m.bvh - m.shading - m.textures;
+  return m;
+}
+
 std::uint64_t Renderer::sceneTriangles() const { return impl_->builder.data().triangleCount; }
 
 void FrameStats::add(const FrameStats& later) {
