@@ -58,7 +58,9 @@ struct Case {
 
 // The living room's bound is what the filter reaches, not the 1/3 aimed at: most of its 4-spp
 // error is light arriving through the windows along rare paths, sparse sparkles no spatial filter
-// of a few iterations spreads far enough (see docs/MEASUREMENTS.md). The Cornell box asks for a
+// of a few iterations spreads far enough (see docs/MEASUREMENTS.md); 0.71 with opaque stand-in
+// leaves, 0.74 since the missing leaf texture is Tungsten's checker, half of each leaf cut out by
+// its alpha (more edges, more sparse light through the plants). The Cornell box asks for a
 // tent filter: the pixels around the bright light then see it in a few of their samples (a ring of
 // sparse, very bright samples), and the denoiser adds the emission it collected back unfiltered,
 // so the ring stays: 0.74 measured, against 0.24 with a box. The 1/3 bound holds for the box; the
@@ -66,7 +68,7 @@ struct Case {
 const Case kCases[] = {{"default", "", 160, 90, 1024, 1.0 / 3.0},
                        {"cornell (box)", "scenes/cornell-box/scene.json", 128, 128, 1024, 1.0 / 3.0, true},
                        {"cornell (its tent)", "scenes/cornell-box/scene.json", 128, 128, 1024, 0.8},
-                       {"living room", "scenes/living-room/scene.json", 160, 90, 512, 0.72}};
+                       {"living room", "scenes/living-room/scene.json", 160, 90, 512, 0.77}};
 
 TEST(Denoise, RemovesMostNoiseAtFourSamplesAndNothingOnceConverged) {
   RETILE_RENDERER_OR_SKIP(probe);
