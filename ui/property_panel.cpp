@@ -296,6 +296,10 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       edit(tr("Roughness"), drag, [v](Material& x) { x.roughness = std::max(0.001f, static_cast<float>(v)); });
     });
     form_->addRow(tr("Roughness"), row);
+    if (m.type != MaterialType::OrenNayar)
+      b.choice(tr("Distribution"), "distribution", {tr("GGX"), tr("Beckmann")}, m.beckmann ? 1 : 0, [edit](int i) {
+        edit(tr("Distribution"), 0, [i](Material& x) { x.beckmann = i == 1; });
+      });
   }
   if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic || m.type == MaterialType::Dielectric ||
       m.type == MaterialType::RoughDielectric || m.type == MaterialType::ThinSheet) {

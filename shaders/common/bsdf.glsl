@@ -12,15 +12,19 @@
 // alone: lavapipe runs every branch some lane of eight takes, and code for absent types still
 // costs registers and spills (removing the nine unused types speeds the Cornell box up by 9 %).
 #ifndef RETILE_MATERIALS
-#define RETILE_MATERIALS 0x7ff
+#define RETILE_MATERIALS 0xfff
 #endif
 const int kMaterialMask = RETILE_MATERIALS;
 bool isMat(int t, int k) { return (kMaterialMask & (1 << k)) != 0 && t == k; }
+// Some rough material of the scene asks for Beckmann's distribution (bit kMaskBeckmann of the
+// mask): without it the Beckmann code is not compiled in.
+const bool kBeckmannUsed = (kMaterialMask & (1 << kMaskBeckmann)) != 0;
 
 struct Material {
   int type;
   vec3 albedo;
-  float roughness;   // GGX alpha, or Oren-Nayar sigma
+  float roughness;   // microfacet alpha, or Oren-Nayar sigma
+  bool beckmann;     // rough types: Beckmann's distribution instead of GGX
   float ior;
   float fdrInt;      // plastic: internal diffuse Fresnel reflectance of the coating
   vec3 eta;
@@ -31,7 +35,9 @@ struct Material {
 // The material's texels as render/render_scene.cpp packMaterial writes them, textures not applied.
 Material unpackMaterial(vec4 t0, vec4 t1, vec4 t2, vec4 t3, vec4 t4) {
   Material m;
-  m.type = floatBitsToInt(t0.w);
+  int type = floatBitsToInt(t0.w);
+  m.type = type & (kMatBeckmann - 1);
+  m.beckmann = kBeckmannUsed && (type & kMatBeckmann) != 0;
   m.albedo = t0.rgb;
   m.roughness = t1.x;
   m.ior = t1.y;
@@ -129,8 +135,46 @@ vec3 sampleGgxVisibleNormal(vec3 wo, float a, vec2 u) {
   return normalize(vec3(a * nh.x, a * nh.y, max(1e-6, nh.z)));
 }
 
-// pdf of wi = reflect(wo, h) under visible-normal sampling.
-float ggxReflectionPdf(vec3 wo, vec3 h, float a) { return ggxD(h, a) * ggxG1(wo, a) / (4.0 * wo.z); }
+// Beckmann's distribution, with the rational fit of Smith's Lambda (Walter et al. 2007), as
+// Tungsten has it.
+float beckmannD(vec3 h, float a) {
+  if (h.z <= 0.0) return 0.0;
+  float c2 = h.z * h.z;
+  return exp(-(1.0 - c2) / (c2 * a * a)) / (PI * a * a * c2 * c2);
+}
+
+float beckmannLambda(vec3 w, float a) {
+  float c2 = w.z * w.z;
+  if (c2 >= 1.0) return 0.0;
+  float x = sqrt(c2 / max(1.0 - c2, 1e-12)) / a;  // 1 / (alpha tan(theta))
+  return x < 1.6 ? (1.0 - 1.259 * x + 0.396 * x * x) / (3.535 * x + 2.181 * x * x) : 0.0;
+}
+
+// The material's microfacet distribution: GGX, or Beckmann where asked for.
+float mfD(Material m, vec3 h, float a) { return kBeckmannUsed && m.beckmann ? beckmannD(h, a) : ggxD(h, a); }
+float mfLambda(Material m, vec3 w, float a) { return kBeckmannUsed && m.beckmann ? beckmannLambda(w, a) : ggxLambda(w, a); }
+float mfG1(Material m, vec3 w, float a) { return 1.0 / (1.0 + mfLambda(m, w, a)); }
+float mfG2(Material m, vec3 wo, vec3 wi, float a) { return 1.0 / (1.0 + mfLambda(m, wo, a) + mfLambda(m, wi, a)); }
+
+// A microfacet normal for wo: GGX's visible normals; Beckmann's D cos(theta) (as Tungsten draws it).
+vec3 mfSample(Material m, vec3 wo, float a, vec2 u) {
+  if (kBeckmannUsed && m.beckmann) {
+    float t2 = -a * a * log(max(1.0 - u.x, 1e-12));
+    float c = 1.0 / sqrt(1.0 + t2), sn = sqrt(max(0.0, 1.0 - c * c));
+    float phi = 2.0 * PI * u.y;
+    return vec3(sn * cos(phi), sn * sin(phi), c);
+  }
+  return sampleGgxVisibleNormal(wo, a, u);
+}
+
+// The solid-angle density mfSample gives h.
+float mfNormalPdf(Material m, vec3 wo, vec3 h, float a) {
+  if (kBeckmannUsed && m.beckmann) return beckmannD(h, a) * max(h.z, 0.0);
+  return ggxD(h, a) * ggxG1(wo, a) * max(dot(wo, h), 0.0) / wo.z;
+}
+
+// pdf of wi = reflect(wo, h) when h comes from mfSample.
+float mfReflectionPdf(Material m, vec3 wo, vec3 h, float a) { return mfNormalPdf(m, wo, h, a) / (4.0 * max(dot(wo, h), 1e-12)); }
 
 float plasticSpecularProbability(Material m, float cosO) {
   float fo = fresnelDielectric(cosO, m.ior);
@@ -173,9 +217,9 @@ vec3 bsdfEval(Material m, vec3 wo, vec3 wi, out float pdf) {
     if (i.z > 0.0) {
       vec3 h = normalize(o + i);
       float F = fresnelDielectric(dot(o, h), eta);
-      float D = ggxD(h, a);
-      pdf = F * D * ggxG1(o, a) / (4.0 * o.z);
-      return vec3(F * D * ggxG2(o, i, a) / (4.0 * o.z));
+      float D = mfD(m, h, a);
+      pdf = F * mfReflectionPdf(m, o, h, a);
+      return vec3(F * D * mfG2(m, o, i, a) / (4.0 * o.z));
     }
     vec3 h = -(o + eta * i);
     float hl = length(h);
@@ -185,11 +229,11 @@ vec3 bsdfEval(Material m, vec3 wo, vec3 wi, out float pdf) {
     float oh = dot(o, h), ih = dot(i, h);
     if (oh <= 0.0 || ih >= 0.0) return vec3(0.0);
     float F = fresnelDielectric(oh, eta);
-    float D = ggxD(h, a);
+    float D = mfD(m, h, a);
     float denom = oh + eta * ih;
     float jac = eta * eta * abs(ih) / (denom * denom);
-    pdf = (1.0 - F) * D * ggxG1(o, a) * oh / o.z * jac;
-    float f = abs(ih) * oh / (o.z * abs(i.z)) * (1.0 - F) * D * ggxG2(o, i, a) / (denom * denom);
+    pdf = (1.0 - F) * mfNormalPdf(m, o, h, a) * jac;
+    float f = abs(ih) * oh / (o.z * abs(i.z)) * (1.0 - F) * D * mfG2(m, o, i, a) / (denom * denom);
     return m.albedo * (f * abs(i.z));
   }
   if (wo.z <= 0.0 || wi.z <= 0.0 || isDeltaMaterial(m)) return vec3(0.0);
@@ -210,19 +254,19 @@ vec3 bsdfEval(Material m, vec3 wo, vec3 wi, out float pdf) {
     float a = m.roughness;
     vec3 h = normalize(wo + wi);
     float F = fresnelDielectric(dot(wo, h), m.ior);
-    float D = ggxD(h, a);
-    float spec = F * D * ggxG2(wo, wi, a) / (4.0 * wo.z * wi.z);
+    float D = mfD(m, h, a);
+    float spec = F * D * mfG2(m, wo, wi, a) / (4.0 * wo.z * wi.z);
     float ps = plasticSpecularProbability(m, wo.z);
-    pdf = ps * ggxReflectionPdf(wo, h, a) + (1.0 - ps) * wi.z * INV_PI;
+    pdf = ps * mfReflectionPdf(m, wo, h, a) + (1.0 - ps) * wi.z * INV_PI;
     return (vec3(spec) + plasticDiffuse(m, wo, wi)) * wi.z;
   }
   if (isMat(t, kMatRoughConductor)) {
     float a = m.roughness;
     vec3 h = normalize(wo + wi);
-    float D = ggxD(h, a);
+    float D = mfD(m, h, a);
     vec3 F = fresnelConductor(dot(wo, h), m.eta, m.k);
-    pdf = ggxReflectionPdf(wo, h, a);
-    return m.albedo * F * (D * ggxG2(wo, wi, a) / (4.0 * wo.z));
+    pdf = mfReflectionPdf(m, wo, h, a);
+    return m.albedo * F * (D * mfG2(m, wo, wi, a) / (4.0 * wo.z));
   }
   return vec3(0.0);
 }
@@ -278,7 +322,7 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
     float eta = entering ? m.ior : 1.0 / m.ior;
     vec3 o = entering ? wo : -wo;
     if (o.z <= 0.0) return s;
-    vec3 h = sampleGgxVisibleNormal(o, a, u.xy);
+    vec3 h = mfSample(m, o, a, u.xy);
     float oh = dot(o, h);
     if (oh <= 0.0) return s;
     float F = fresnelDielectric(oh, eta);
@@ -286,18 +330,18 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
     if (u.z < F) {
       i = reflect(-o, h);
       if (i.z <= 0.0) return s;
-      s.weight = vec3(ggxG2(o, i, a) / ggxG1(o, a));
     } else {
       i = refract(-o, h, 1.0 / eta);
       if (i.z >= 0.0 || dot(i, i) == 0.0) return s;
-      s.weight = m.albedo * (ggxG2(o, i, a) / ggxG1(o, a) / (eta * eta));
       s.transmitted = true;
     }
     s.wi = entering ? i : -i;
     float p;
-    bsdfEval(m, wo, s.wi, p);
+    vec3 f = bsdfEval(m, wo, s.wi, p);
     s.pdf = p;
-    if (!(p > 0.0)) s.weight = vec3(0.0);
+    // For GGX this is G2 / G1 (/ eta^2 through the boundary), for Beckmann's D cos sampling
+    // G2 (o.h) / (o.z h.z): both are f / pdf.
+    s.weight = p > 0.0 ? f / p : vec3(0.0);
     return s;
   }
   if (wo.z <= 0.0) return s;
@@ -317,12 +361,15 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
   }
   if (isMat(t, kMatRoughConductor)) {
     float a = m.roughness;
-    vec3 h = sampleGgxVisibleNormal(wo, a, u.xy);
+    vec3 h = mfSample(m, wo, a, u.xy);
+    if (dot(wo, h) <= 0.0) return s;
     vec3 i = reflect(-wo, h);
     if (i.z <= 0.0) return s;
     s.wi = i;
-    s.pdf = ggxReflectionPdf(wo, h, a);
-    s.weight = m.albedo * fresnelConductor(dot(wo, h), m.eta, m.k) * (ggxG2(wo, i, a) / ggxG1(wo, a));
+    s.pdf = mfReflectionPdf(m, wo, h, a);
+    vec3 F = m.albedo * fresnelConductor(dot(wo, h), m.eta, m.k);
+    if (kBeckmannUsed && m.beckmann) s.weight = F * (mfD(m, h, a) * mfG2(m, wo, i, a) / (4.0 * wo.z * max(s.pdf, 1e-12)));
+    else s.weight = F * (ggxG2(wo, i, a) / ggxG1(wo, a));
     return s;
   }
   if (isMat(t, kMatPlastic)) {
@@ -344,7 +391,7 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
   if (isMat(t, kMatRoughPlastic)) {
     float ps = plasticSpecularProbability(m, wo.z);
     if (u.z < ps) {
-      vec3 h = sampleGgxVisibleNormal(wo, m.roughness, u.xy);
+      vec3 h = mfSample(m, wo, m.roughness, u.xy);
       s.wi = reflect(-wo, h);
     } else {
       s.wi = sampleCosineHemisphere(u.xy);

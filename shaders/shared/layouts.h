@@ -60,6 +60,10 @@ RT_CONST(int, kMatDielectric, 7)
 RT_CONST(int, kMatRoughDielectric, 8)
 RT_CONST(int, kMatThinSheet, 9)
 RT_CONST(int, kMatNull, 10)
+// Packed with a rough type (type | kMatBeckmann): Beckmann's distribution instead of GGX; and the
+// bit of the kernel's material mask that says some material has it.
+RT_CONST(int, kMatBeckmann, 256)
+RT_CONST(int, kMaskBeckmann, 11)
 
 RT_CONST(int, kTexBitmap, 0)
 RT_CONST(int, kTexChecker, 1)

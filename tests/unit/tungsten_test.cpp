@@ -223,6 +223,30 @@ TEST(Tungsten, ADielectricWithoutRefractionIsAFresnelReflectorOnly) {
   for (const auto& w : r->warnings) EXPECT_EQ(w.find("refraction"), std::string::npos) << w;
 }
 
+// The spaceship's leathers ask for Beckmann: rendered with it (no warning); a Phong distribution
+// still becomes GGX with a warning naming it. Saved natively, the distribution stays.
+TEST(Tungsten, BeckmannIsKeptAndPhongWarns) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [
+      {"name": "leather", "type": "rough_plastic", "distribution": "beckmann", "roughness": 0.4},
+      {"name": "old", "type": "rough_conductor", "distribution": "phong", "roughness": 0.2}],
+      "primitives": [{"type": "quad", "bsdf": "leather"}, {"type": "quad", "bsdf": "old"}, {"type": "quad", "emission": 1}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  EXPECT_TRUE(s.material(s.objects[0].material)->beckmann);
+  EXPECT_FALSE(s.material(s.objects[1].material)->beckmann);
+  int phong = 0;
+  for (const auto& w : r->warnings) {
+    EXPECT_EQ(w.find("beckmann"), std::string::npos) << w;
+    phong += w.find("'phong' is rendered as GGX") != std::string::npos;
+  }
+  EXPECT_EQ(phong, 1);
+  auto file = test::tempDir() / "scene.retile";
+  ASSERT_TRUE(saveNativeScene(s, file).ok());
+  auto back = loadNativeScene(file);
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_TRUE(back->scene.material(back->scene.objects[0].material)->beckmann);
+}
+
 TEST(Tungsten, PowerBecomesRadianceByArea) {
   auto file = writeScene(R"({"primitives": [{"type": "quad", "transform": {"scale": [2, 1, 0.5]}, "power": 10}]})");
   auto r = importTungsten(file);

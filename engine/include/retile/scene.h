@@ -90,7 +90,10 @@ struct Material {
   MaterialType type = MaterialType::Lambert;
   Vec3 albedo{0.8f};
   NodeId albedoTexture = kNoNode;
-  float roughness = 0.1f;          // GGX alpha for rough types; sigma for Oren-Nayar
+  float roughness = 0.1f;          // microfacet alpha for rough types; sigma for Oren-Nayar
+  // Rough types: the microfacet distribution. GGX's long tails are the default; Beckmann for
+  // files that ask for it (Tungsten's "distribution": "beckmann"), drawn as Tungsten draws it.
+  bool beckmann = false;
   NodeId roughnessTexture = kNoNode;
   float ior = 1.5f;                // dielectric index (plastic coating, glass, thin sheet)
   std::string metal = "Cu";        // conductors: a named metal (see conductorNames) or "custom"

@@ -250,6 +250,7 @@ std::string nativeSceneToString(const Scene& s) {
     v.set("albedo", json::fromVec3(m.albedo));
     v.set("albedo_texture", m.albedoTexture);
     v.set("roughness", m.roughness);
+    if (m.beckmann) v.set("distribution", "beckmann");
     v.set("roughness_texture", m.roughnessTexture);
     v.set("ior", m.ior);
     v.set("metal", m.metal);
@@ -436,6 +437,11 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.vec3("albedo", &m.albedo);
       r.id("albedo_texture", &m.albedoTexture);
       r.number("roughness", &m.roughness);
+      std::string distribution;
+      r.string("distribution", &distribution);
+      if (distribution == "beckmann") m.beckmann = true;
+      else if (!distribution.empty() && distribution != "ggx")
+        r.problem("distribution", cat("unknown distribution '", distribution, "' (ggx, beckmann)"));
       r.id("roughness_texture", &m.roughnessTexture);
       r.number("ior", &m.ior);
       r.string("metal", &m.metal);

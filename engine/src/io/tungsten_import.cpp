@@ -266,7 +266,8 @@ class TungstenImporter {
       m.albedoTexture = t.texture;
     }
     std::string dist = string(v, "distribution", "ggx");
-    if (dist != "ggx") warn(cat(where, ": distribution '", dist, "' is rendered as GGX"));
+    m.beckmann = dist == "beckmann";
+    if (dist != "ggx" && dist != "beckmann") warn(cat(where, ": distribution '", dist, "' is rendered as GGX"));
     auto roughness = [&](float fallback) {
       m.roughness = fallback;
       if (const Value* r = v.find("roughness")) {

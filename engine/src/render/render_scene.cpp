@@ -301,11 +301,12 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture, int roughnessTexture, int alphaTexture) {
   Vec3 eta = m.eta, k = m.k;
   if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
-  int type = static_cast<int>(m.type);
+  const bool rough = m.type == MaterialType::RoughPlastic || m.type == MaterialType::RoughConductor ||
+                     m.type == MaterialType::RoughDielectric;
+  int type = static_cast<int>(m.type) | (rough && m.beckmann ? gpu::kMatBeckmann : 0);
   // Keep roughness away from zero, where GGX turns into a delta the rough code cannot sample.
   float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
-  if (m.type == MaterialType::RoughPlastic || m.type == MaterialType::RoughConductor || m.type == MaterialType::RoughDielectric)
-    roughness = std::max(roughness, 1e-3f);
+  if (rough) roughness = std::max(roughness, 1e-3f);
   if (m.type == MaterialType::OrenNayar) roughness = std::clamp(m.roughness, 0.0f, kPi / 2);
   float ior = std::clamp(m.ior, 1.0001f, 10.0f);
   // Diffuse light inside a plastic coating reflects back this fraction at the boundary
@@ -324,6 +325,10 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
   materialIndex_.clear();
   auto pack = [&](const Material& m) {
     data_.materialTypes |= 1u << static_cast<int>(m.type);
+    // The kernel compiles Beckmann's distribution in only for scenes that use it.
+    if (m.beckmann && (m.type == MaterialType::RoughPlastic || m.type == MaterialType::RoughConductor ||
+                       m.type == MaterialType::RoughDielectric))
+      data_.materialTypes |= 1u << gpu::kMaskBeckmann;
     if (textureIndex(m.albedoTexture) >= 0 || textureIndex(m.roughnessTexture) >= 0) data_.materialTextures = true;
     auto texels = packMaterial(m, textureIndex(m.albedoTexture), textureIndex(m.roughnessTexture), textureIndex(m.alphaTexture));
     data_.materials.insert(data_.materials.end(), texels.begin(), texels.end());

@@ -751,6 +751,7 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   std::vector<std::string> out;
   for (int t = 0; t < kMaterialTypeCount; ++t)
     if (d.materialTypes & (1u << t)) out.push_back(materialTypeName(static_cast<MaterialType>(t)));
+  if (d.materialTypes & (1u << gpu::kMaskBeckmann)) out.push_back("beckmann");
   if (d.alphaTested) out.push_back("alpha test");
   const std::uint32_t f = d.features();
   if (f & static_cast<std::uint32_t>(gpu::kFeatureTextures)) out.push_back("textures");
