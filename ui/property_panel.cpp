@@ -267,8 +267,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   b.color(tr("Albedo"), "albedo", m.albedo, defaults.albedo, [edit](Vec3 c, int drag) {
     edit(tr("Albedo"), drag, [c](Material& x) { x.albedo = c; });
   });
-  const bool rough = m.type == MaterialType::RoughPlastic || m.type == MaterialType::RoughConductor ||
-                     m.type == MaterialType::RoughDielectric || m.type == MaterialType::OrenNayar;
+  const bool rough = isMicrofacet(m.type) || m.type == MaterialType::OrenNayar;
   if (rough) {  // smooth types ignore roughness: no field that does nothing
     // A slider as well as the field: the gesture look-dev artists use most.
     auto* row = new QWidget(body_);
@@ -296,7 +295,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       edit(tr("Roughness"), drag, [v](Material& x) { x.roughness = std::max(0.001f, static_cast<float>(v)); });
     });
     form_->addRow(tr("Roughness"), row);
-    if (m.type != MaterialType::OrenNayar)
+    if (isMicrofacet(m.type))
       b.choice(tr("Distribution"), "distribution", {tr("GGX"), tr("Beckmann")}, m.beckmann ? 1 : 0, [edit](int i) {
         edit(tr("Distribution"), 0, [i](Material& x) { x.beckmann = i == 1; });
       });

@@ -83,6 +83,10 @@ enum class MaterialType {
 constexpr int kMaterialTypeCount = 11;
 const char* materialTypeName(MaterialType t);
 bool materialTypeFromName(const std::string& name, MaterialType* out);
+// The types whose roughness is a microfacet alpha and which may use Beckmann's distribution.
+constexpr bool isMicrofacet(MaterialType t) {
+  return t == MaterialType::RoughPlastic || t == MaterialType::RoughConductor || t == MaterialType::RoughDielectric;
+}
 
 struct Material {
   NodeId id = kNoNode;

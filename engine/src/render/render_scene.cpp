@@ -301,8 +301,7 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture, int roughnessTexture, int alphaTexture) {
   Vec3 eta = m.eta, k = m.k;
   if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
-  const bool rough = m.type == MaterialType::RoughPlastic || m.type == MaterialType::RoughConductor ||
-                     m.type == MaterialType::RoughDielectric;
+  const bool rough = isMicrofacet(m.type);
   int type = static_cast<int>(m.type) | (rough && m.beckmann ? gpu::kMatBeckmann : 0);
   // Keep roughness away from zero, where GGX turns into a delta the rough code cannot sample.
   float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
@@ -326,8 +325,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
   auto pack = [&](const Material& m) {
     data_.materialTypes |= 1u << static_cast<int>(m.type);
     // The kernel compiles Beckmann's distribution in only for scenes that use it.
-    if (m.beckmann && (m.type == MaterialType::RoughPlastic || m.type == MaterialType::RoughConductor ||
-                       m.type == MaterialType::RoughDielectric))
+    if (m.beckmann && isMicrofacet(m.type))
       data_.materialTypes |= 1u << gpu::kMaskBeckmann;
     if (textureIndex(m.albedoTexture) >= 0 || textureIndex(m.roughnessTexture) >= 0) data_.materialTextures = true;
     auto texels = packMaterial(m, textureIndex(m.albedoTexture), textureIndex(m.roughnessTexture), textureIndex(m.alphaTexture));
