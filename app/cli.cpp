@@ -61,7 +61,7 @@ void progressBar(const std::string& label, int done, int total, double seconds) 
 
 namespace {
 
-int runImport(const std::string& file) {
+int runImport(const std::string& file, const std::string& saveAs) {
   auto scene = loadScene(file);
   if (!scene) {
     std::fprintf(stderr, "error: %s\n", scene.error().c_str());
@@ -72,6 +72,14 @@ int runImport(const std::string& file) {
   std::printf("%s: %s scene: %zu objects, %zu meshes, %zu triangles, %zu materials, %zu textures, %zu lights\n",
               file.c_str(), scene->format.c_str(), s.objects.size(), s.meshes.size(), s.triangleCount(),
               s.materials.size(), s.textures.size(), s.lights.size());
+  if (!saveAs.empty()) {
+    auto saved = saveNativeScene(s, saveAs);
+    if (!saved) {
+      std::fprintf(stderr, "error: %s\n", saved.error().c_str());
+      return 1;
+    }
+    std::printf("saved as %s\n", saveAs.c_str());
+  }
   return 0;
 }
 
@@ -84,7 +92,10 @@ void addImport(CLI::App& app, int* status) {
   cmd->add_option("FILE", *file, "a scene file (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default'")
       ->required()
       ->type_name("");
-  cmd->callback([file, status] { *status = runImport(*file); });
+  auto saveAs = std::make_shared<std::string>();
+  cmd->add_option("--save", *saveAs, "also save the imported scene in Retile's own format (.retile), atomically")
+      ->type_name("OUT.retile");
+  cmd->callback([file, saveAs, status] { *status = runImport(*file, *saveAs); });
 }
 
 }  // namespace retile::cli

@@ -37,9 +37,16 @@ TEST(Cli, ImportAndRenderUnderACommaDecimalLocale) {
   ChildLimits limits;
   limits.timeout = std::chrono::minutes(5);
 
-  ChildResult imported = runChild(RETILE_CLI_PATH, {"import", scene.string()}, limits);
+  std::filesystem::path saved = test::tempDir() / "box.retile";
+  ChildResult imported = runChild(RETILE_CLI_PATH, {"import", scene.string(), "--save", saved.string()}, limits);
   ASSERT_EQ(imported.exitCode, 0) << imported.err;
   EXPECT_NE(imported.out.find("8 objects"), std::string::npos) << imported.out;
+  // Saved under the comma locale, read here under the C locale: the same scene, to the bit.
+  auto original = importScene(scene);
+  auto reread = loadNativeScene(saved);
+  ASSERT_TRUE(original.ok()) << original.error();
+  ASSERT_TRUE(reread.ok()) << reread.error();
+  EXPECT_EQ(nativeSceneToString(reread->scene), nativeSceneToString(original->scene));
 
   std::filesystem::path out = test::tempDir() / "box.exr";
   ChildResult rendered = runChild(RETILE_CLI_PATH,
@@ -75,7 +82,7 @@ TEST(Cli, HelpAtEveryLevelListsTheOptions) {
       {{"eval", "--help"}, {"--quick", "--stability", "--methods", "--scenarios", "--script", "--reference-spp",
                             "--every", "--target", "--cases", "ghosting"}},
       {{"compare", "--help"}, {"IMAGE", "REFERENCE", "--noise", "--block", "--exclude", "--worst"}},
-      {{"import", "--help"}, {"FILE"}},
+      {{"import", "--help"}, {"FILE", "--save"}},
       {{"bench", "--help"}, {"throughput", "bvh", "edit", "frames", "denoise", "scale"}},
       {{"bench", "throughput", "--help"}, {"Usage: retile bench throughput", "--paths", "--frames", "--max-bounces",
                                            "--size"}},

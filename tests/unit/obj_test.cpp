@@ -42,6 +42,20 @@ TEST(Obj, DropsNanVerticesWithAWarning) {
   EXPECT_NE(w[0].find("NaN"), std::string::npos) << w[0];
 }
 
+// Found by fuzz_obj: a face skipped for an out-of-range index had already added its other
+// vertices, an infinite one among them, which no triangle used and nothing removed, so the mesh's
+// bounds (camera framing, the BVH's root) were infinite.
+TEST(Obj, VerticesOfSkippedFacesDoNotReachTheBounds) {
+  auto p = writeText("skipped.obj", "v inf -inf 8\nv 0 1 0\nv 1 0 0\nv 0 0 1\nf 1 2 99\nf 2 3 4\n");
+  std::vector<std::string> w;
+  auto g = readObjGeometry(p, &w);
+  ASSERT_TRUE(g.ok()) << g.error();
+  EXPECT_EQ(g->triangleCount(), 1u);
+  EXPECT_EQ(g->positions.size(), 3u);
+  Bounds3 b = g->bounds();
+  EXPECT_TRUE(isFinite(b.lo) && isFinite(b.hi));
+}
+
 TEST(Obj, BadInputsFailWithTheFileName) {
   for (const char* text : {"v 1 2\nf 1 2 3\n", "v 0 0 0\nf 1 x 3\n", "", "f 1 2 3\n"}) {
     auto p = writeText("bad.obj", text);

@@ -7,7 +7,6 @@
 #pragma once
 
 #include <optional>
-#include <source_location>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -33,12 +32,14 @@ class AssertionError : public Error {
   using Error::Error;
 };
 
-[[noreturn]] void assertionFailed(const char* expr, const std::string& values,
-                                  std::source_location where = std::source_location::current());
+// The location comes from the macro, not std::source_location: clang 14 (the fuzz build's
+// compiler) cannot compile libstdc++ 12's source_location.
+[[noreturn]] void assertionFailed(const char* expr, const std::string& values, const char* file, int line,
+                                  const char* function);
 
-#define RETILE_ASSERT(cond, values)                                \
-  do {                                                             \
-    if (!(cond)) ::retile::assertionFailed(#cond, (values));       \
+#define RETILE_ASSERT(cond, values)                                                       \
+  do {                                                                                    \
+    if (!(cond)) ::retile::assertionFailed(#cond, (values), __FILE__, __LINE__, __func__); \
   } while (false)
 
 // A value or a user-facing message. Move-only types are fine.

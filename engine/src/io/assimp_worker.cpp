@@ -399,66 +399,66 @@ class CollectingAssimpLog : public Assimp::LogStream {
 
 }  // namespace
 
+Result<std::string> convertWithAssimp(const fs::path& file) {
+  using R = Result<std::string>;
+  Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);  // no default streams
+  std::vector<std::string> assimpErrors;
+  struct KillLogger {  // after the importer is gone, before the errors its log stream fills
+    ~KillLogger() { Assimp::DefaultLogger::kill(); }
+  } killLogger;
+  Assimp::DefaultLogger::get()->attachStream(new CollectingAssimpLog(&assimpErrors), Assimp::Logger::Err);
+  auto checked = precheckAssimpInput(file);
+  if (!checked) return R::failure(checked.error());
+  for (const auto& w : checked.value()) std::fprintf(stderr, "warning: %s: %s\n", file.filename().string().c_str(), w.c_str());
+  Assimp::Importer importer;
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  importer.SetPropertyBool(AI_CONFIG_PP_FD_REMOVE, true);
+  // Assimp's area test uses an absolute 1e-6 and deletes every triangle of a model authored in
+  // small units (Khronos' MetalRoughSpheres). Zero-area triangles are never hit, so keeping them is harmless.
+  importer.SetPropertyBool(AI_CONFIG_PP_FD_CHECKAREA, false);
+  // Files without normals get smooth ones, but not across hard edges: Assimp's default of 175
+  // degrees rounds a box's corners into its faces (the Cornell box's blocks shade wrongly).
+  importer.SetPropertyFloat(AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, 60.0f);
+  unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_SortByPType |
+                   aiProcess_JoinIdenticalVertices | aiProcess_GenSmoothNormals | aiProcess_FindInvalidData |
+                   aiProcess_FindDegenerates;
+  const aiScene* ai = importer.ReadFile(file.string(), flags);
+  if (!ai) {
+    std::string why = importer.GetErrorString();
+    return R::failure(why.empty() ? "Assimp could not read the file" : why);
+  }
+  if (ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE) return R::failure("the file holds no complete scene (animation or skeleton data only)");
+  Converter conv{ai, file, {}, {}, {}, {}, {}, {}, 0, false};
+  std::string ext = lowercase(file.extension().string());
+  conv.gltf = ext == ".gltf" || ext == ".glb";
+  conv.run();
+  const std::size_t kShown = 6;
+  for (std::size_t i = 0; i < assimpErrors.size() && i < kShown; ++i)
+    std::fprintf(stderr, "warning: %s: Assimp: %s\n", file.filename().string().c_str(), assimpErrors[i].c_str());
+  if (assimpErrors.size() > kShown)
+    std::fprintf(stderr, "warning: %s: Assimp reported %zu more problems\n", file.filename().string().c_str(),
+                 assimpErrors.size() - kShown);
+  // The conversion is written as JSON, which has no infinities: values a hostile file leaves
+  // out of range are repaired or refused here, and the parent checks the scene it reads again.
+  std::vector<std::string> repairs;
+  if (auto valid = validateScene(conv.scene, repairs); !valid) return R::failure(valid.error());
+  for (const std::string& r : repairs) std::fprintf(stderr, "warning: %s: %s\n", file.filename().string().c_str(), r.c_str());
+  return nativeSceneToString(conv.scene);
+}
+
 int assimpWorkerMain(int argc, char** argv) {
   if (argc != 2) {
     std::fprintf(stderr, "error: usage: retile-import-worker FILE\n");
     return 2;
   }
-  fs::path file = argv[1];
   try {
-    Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);  // no default streams
-    std::vector<std::string> assimpErrors;
-    Assimp::DefaultLogger::get()->attachStream(new CollectingAssimpLog(&assimpErrors), Assimp::Logger::Err);
-    auto checked = precheckAssimpInput(file);
-    if (!checked) {
-      std::fprintf(stderr, "error: %s\n", checked.error().c_str());
+    auto out = convertWithAssimp(argv[1]);
+    if (!out) {
+      std::fprintf(stderr, "error: %s\n", out.error().c_str());
       return 2;
     }
-    for (const auto& w : checked.value()) std::fprintf(stderr, "warning: %s: %s\n", file.filename().string().c_str(), w.c_str());
-    Assimp::Importer importer;
-    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-    importer.SetPropertyBool(AI_CONFIG_PP_FD_REMOVE, true);
-    // Assimp's area test uses an absolute 1e-6 and deletes every triangle of a model authored in
-    // small units (Khronos' MetalRoughSpheres). Zero-area triangles are never hit, so keeping them is harmless.
-    importer.SetPropertyBool(AI_CONFIG_PP_FD_CHECKAREA, false);
-    // Files without normals get smooth ones, but not across hard edges: Assimp's default of 175
-    // degrees rounds a box's corners into its faces (the Cornell box's blocks shade wrongly).
-    importer.SetPropertyFloat(AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, 60.0f);
-    unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_SortByPType |
-                     aiProcess_JoinIdenticalVertices | aiProcess_GenSmoothNormals | aiProcess_FindInvalidData |
-                     aiProcess_FindDegenerates;
-    const aiScene* ai = importer.ReadFile(file.string(), flags);
-    if (!ai) {
-      std::string why = importer.GetErrorString();
-      std::fprintf(stderr, "error: %s\n", why.empty() ? "Assimp could not read the file" : why.c_str());
-      return 2;
-    }
-    if (ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE) {
-      std::fprintf(stderr, "error: the file holds no complete scene (animation or skeleton data only)\n");
-      return 2;
-    }
-    Converter conv{ai, file, {}, {}, {}, {}, {}, {}, 0, false};
-    std::string ext = lowercase(file.extension().string());
-    conv.gltf = ext == ".gltf" || ext == ".glb";
-    conv.run();
-    const std::size_t kShown = 6;
-    for (std::size_t i = 0; i < assimpErrors.size() && i < kShown; ++i)
-      std::fprintf(stderr, "warning: %s: Assimp: %s\n", file.filename().string().c_str(), assimpErrors[i].c_str());
-    if (assimpErrors.size() > kShown)
-      std::fprintf(stderr, "warning: %s: Assimp reported %zu more problems\n", file.filename().string().c_str(),
-                   assimpErrors.size() - kShown);
-    // The conversion is written as JSON, which has no infinities: values a hostile file leaves
-    // out of range are repaired or refused here, and the parent checks the scene it reads again.
-    std::vector<std::string> repairs;
-    if (auto valid = validateScene(conv.scene, repairs); !valid) {
-      std::fprintf(stderr, "error: %s\n", valid.error().c_str());
-      return 2;
-    }
-    for (const std::string& r : repairs) std::fprintf(stderr, "warning: %s: %s\n", file.filename().string().c_str(), r.c_str());
-    std::string out = nativeSceneToString(conv.scene);
-    std::fwrite(out.data(), 1, out.size(), stdout);
+    std::fwrite(out->data(), 1, out->size(), stdout);
     std::fflush(stdout);
-    Assimp::DefaultLogger::kill();
     return 0;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "error: ran out of memory (the importer's memory limit was reached)\n");

@@ -1,6 +1,7 @@
 // Our own OBJ reader for the meshes that Tungsten scenes reference. Assimp reads OBJ files that
 // the user opens directly (with their .mtl); Tungsten meshes carry no materials and can number in
 // the hundreds, where one child process per file would cost seconds.
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <unordered_map>
@@ -179,8 +180,10 @@ std::size_t sanitizeGeometry(MeshGeometry& g) {
   }
   dropped += (g.indices.size() % 3) ? 1 : 0;
   g.indices = std::move(kept);
-  if (dropped) {
-    // Compact so that vertices of dropped triangles (NaN among them) cannot reach bounds.
+  // Every position a kept triangle uses is finite now; one that is not belongs to no triangle (a
+  // dropped one, or a face a reader skipped) but would still reach the bounds.
+  if (dropped || std::any_of(g.positions.begin(), g.positions.end(), [](const Vec3& p) { return !isFinite(p); })) {
+    // Compact: vertices no triangle uses go.
     std::vector<std::uint32_t> remap(n, UINT32_MAX);
     MeshGeometry out;
     for (std::uint32_t& idx : g.indices) {

@@ -292,8 +292,9 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
   for (auto& [key, e] : meshes_) {
     auto base = static_cast<std::int64_t>(data_.meshTraversal.size());
     e.rootItem = traversalItem(base, gpu::kItemNode, 1);
+    const std::int64_t triOffset = e.triOffset;  // a structured binding cannot be captured before C++20's P1091 in clang 14
     appendNodes(data_.meshTraversal, e.bvh.nodes, 0, [&](std::int32_t index, std::int32_t count) {
-      return traversalItem((static_cast<std::int64_t>(e.triOffset) + index) * gpu::kTriTexels, gpu::kItemTriangles, count);
+      return traversalItem((triOffset + index) * gpu::kTriTexels, gpu::kItemTriangles, count);
     });
   }
 }
