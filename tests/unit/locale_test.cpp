@@ -10,6 +10,7 @@
 #include <fstream>
 #include <random>
 #include <regex>
+#include <string>
 
 #include "core/files.h"
 #include "core/json.h"
@@ -33,6 +34,10 @@ TEST(Numbers, UnderflowReadsAsZeroAndOverflowAsInfinity) {
   EXPECT_EQ(numbers::toFloat("-123456789e40"), -INFINITY);
   EXPECT_EQ(numbers::toDouble("1e400"), INFINITY);
   EXPECT_EQ(numbers::toDouble("1e-99999999999999999999"), 0.0) << "an exponent too long for a long";
+  // Found by fuzz_json: digits before an exponent at the limit of a long overflowed their sum.
+  const std::string digits(800, '5');
+  EXPECT_EQ(numbers::toDouble(digits + "e9223372036854775807"), INFINITY);
+  EXPECT_EQ(numbers::toDouble("0." + std::string(800, '0') + "1e-9223372036854775808"), 0.0);
   EXPECT_EQ(numbers::toFloat("1e-40"), 1e-40f) << "a float denormal is representable";
   EXPECT_FALSE(numbers::toDouble("0,5"));
   EXPECT_FALSE(numbers::toDouble("1.5 "));

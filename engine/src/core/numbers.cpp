@@ -35,6 +35,9 @@ bool isUnderflow(const char* first, const char* last) {
     long exponent = 0;
     auto r = std::from_chars(p + 1 + (p + 1 < last && p[1] == '+'), last, exponent);
     if (r.ec == std::errc::result_out_of_range) return p + 1 < last && p[1] == '-';
+    // Saturate: hundreds of digits before an exponent near the limit must not overflow the sum.
+    if (exponent > 0 && order > std::numeric_limits<long>::max() - exponent) return false;
+    if (exponent < 0 && order < std::numeric_limits<long>::min() - exponent) return true;
     order += exponent;
   }
   return order < 0;
