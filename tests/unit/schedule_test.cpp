@@ -293,5 +293,46 @@ TEST(Refinement, CreditsSendTheBudgetToTheTilesWithTheFewestSamples) {
   EXPECT_EQ(q.chunks.size(), 8u);
 }
 
+TEST(Refinement, DuringAPassTilesThatLostTheirHistoryCatchUpWithHalfTheBudget) {
+  // 8x2 tiles of 16x16, every one holding 100 spp of history. A pass at Q = 4 over all of them:
+  // each frame's budget (16 tiles' worth at 1 spp) finishes four tiles. Once the first finished
+  // tile's history is rejected (credit 0), later frames give it up to half the budget while the
+  // pass goes on with the rest; every frame still traces exactly W x H samples, no pixel twice.
+  TileGrid g(128, 32, 16);
+  TileScheduler s(g);
+  s.nextFrame();  // the global update
+  std::vector<int> order(16);
+  for (int i = 0; i < 16; ++i) order[static_cast<std::size_t>(i)] = i;
+  s.startPass(order, 4, 16, false, 64);
+  std::vector<double> credit(16, 100.0);
+  s.setCredit(credit);
+  s.nextFrame();
+  EXPECT_EQ(s.queueServed(), 4u) << "no tile is behind yet: the whole budget goes to the pass";
+  credit[0] = 0.0;  // tile 0's history was rejected: it holds its 4 fresh spp only
+  s.setCredit(credit);
+  std::size_t servedBefore = s.queueServed();
+  FramePlan second = s.nextFrame();
+  std::int64_t samples = 0, toTile0 = 0;
+  std::vector<int> covered(static_cast<std::size_t>(g.pixels()), 0);
+  for (const TileChunk& c : second.chunks) {
+    samples += c.rect.pixels() * c.quality;
+    if (c.tile == 0) toTile0 += c.rect.pixels() * c.quality;
+    for (int y = c.rect.y; y < c.rect.y + c.rect.height; ++y)
+      for (int x = c.rect.x; x < c.rect.x + c.rect.width; ++x) ++covered[static_cast<std::size_t>(y * 128 + x)];
+  }
+  EXPECT_EQ(samples, 128 * 32) << "exactly W x H samples";
+  EXPECT_LE(*std::max_element(covered.begin(), covered.end()), 1) << "no pixel twice in a frame";
+  EXPECT_EQ(toTile0, 128 * 32 / 2) << "half the budget raises the tile that lost its history";
+  EXPECT_EQ(s.queueServed(), servedBefore + 2) << "the pass goes on with the other half";
+  EXPECT_TRUE(s.passActive());
+  // Without credits (no reuse) the pass has the whole budget, as the paper's method.
+  TileScheduler plain(g);
+  plain.nextFrame();
+  plain.startPass(order, 4, 16, false, 64);
+  plain.nextFrame();
+  plain.nextFrame();
+  EXPECT_EQ(plain.queueServed(), 8u);
+}
+
 }  // namespace
 }  // namespace retile

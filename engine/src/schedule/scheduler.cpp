@@ -154,6 +154,40 @@ void TileScheduler::fillRemainder(FramePlan& plan, std::int64_t remainder, const
   }
 }
 
+// Raises the candidates with the fewest samples in all (history credit counted) to a common level
+// L, each by whole samples per pixel, as far as `budget` goes (L at least the lowest + 1, so
+// something is served when one sample of the lowest fits). Returns the samples spent.
+std::int64_t TileScheduler::waterFill(FramePlan& plan, std::vector<int> order, std::int64_t budget,
+                                      std::vector<char>& served) {
+  if (order.empty() || budget <= 0) return 0;
+  std::vector<double> have(static_cast<std::size_t>(grid_.count()));
+  for (int t : order) have[static_cast<std::size_t>(t)] = samples_[static_cast<std::size_t>(t)] + credit_[static_cast<std::size_t>(t)];
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return have[static_cast<std::size_t>(a)] < have[static_cast<std::size_t>(b)]; });
+  auto cost = [&](double level) {
+    std::int64_t c = 0;
+    for (int t : order) {
+      const double need = std::ceil(level - have[static_cast<std::size_t>(t)]);
+      if (need > 0) c += static_cast<std::int64_t>(need) * grid_.rect(t).pixels();
+    }
+    return c;
+  };
+  double lo = have[static_cast<std::size_t>(order.front())], hi = lo + 1e6;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    if (cost(mid) <= budget) lo = mid; else hi = mid;
+  }
+  std::int64_t spent = 0;
+  for (int t : order) {
+    const int k = static_cast<int>(std::min<double>(std::ceil(lo - have[static_cast<std::size_t>(t)]), 1e6));
+    const std::int64_t pixels = grid_.rect(t).pixels();
+    if (k <= 0 || spent + pixels * k > budget) continue;
+    emit(plan, t, grid_.rect(t), k, false, 0, true);
+    served[static_cast<std::size_t>(t)] = 1;
+    spent += pixels * k;
+  }
+  return spent;
+}
+
 FramePlan TileScheduler::nextFrame() {
   FramePlan plan;
   const std::int64_t budget = grid_.pixels();
@@ -195,6 +229,24 @@ FramePlan TileScheduler::nextFrame() {
 
   std::int64_t remaining = budget;
   plan.mode = passActive() ? AccumMode::Incremental : AccumMode::Refinement;
+  if (passActive() && credit_.size() == static_cast<std::size_t>(n) && !finished_.empty()) {
+    // Catch-up (verified reuse): tiles this pass finished that hold far fewer samples than the
+    // others it finished (their history was rejected: the edit changed them, the others kept
+    // theirs) get up to half the budget, raised together from the lowest, so the changed part of
+    // the picture converges while the pass goes on testing the other histories instead of
+    // waiting for the pass to end. When the edit changed everything (a light), every finished
+    // tile is equally fresh and the pass keeps the whole budget to restart the stale rest.
+    std::vector<double> have;
+    for (int t : finished_) have.push_back(samples_[static_cast<std::size_t>(t)] + credit_[static_cast<std::size_t>(t)]);
+    std::nth_element(have.begin(), have.begin() + static_cast<std::ptrdiff_t>(have.size() / 2), have.end());
+    const double median = have[have.size() / 2];
+    std::vector<int> behind;
+    for (int t : finished_) {
+      const auto i = static_cast<std::size_t>(t);
+      if (samples_[i] + credit_[i] < kCatchUpFraction * median) behind.push_back(t);
+    }
+    remaining -= waterFill(plan, behind, remaining / 2, served);
+  }
   while (pos_ < queue_.size()) {
     int t = queue_[pos_];
     PassTile& pt = pass_[pos_];
@@ -223,39 +275,11 @@ FramePlan TileScheduler::nextFrame() {
       remaining -= pixels * k;
     }
   } else if (!passActive() && credit_.size() == static_cast<std::size_t>(n)) {
-    // Refinement with credits: raise the tiles with the fewest samples in all to a common level
-    // L, each by whole samples per pixel, as far as the budget goes; the remainder as usual.
-    std::vector<double> have(static_cast<std::size_t>(n));
-    std::vector<int> order;
-    for (int t = 0; t < n; ++t) {
-      if (served[static_cast<std::size_t>(t)]) continue;
-      have[static_cast<std::size_t>(t)] = samples_[static_cast<std::size_t>(t)] + credit_[static_cast<std::size_t>(t)];
-      order.push_back(t);
-    }
-    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return have[static_cast<std::size_t>(a)] < have[static_cast<std::size_t>(b)]; });
-    // The level: the largest L whose whole-sample raises fit the budget (L at least the lowest
-    // tile + 1, so something is always served).
-    auto cost = [&](double level) {
-      std::int64_t c = 0;
-      for (int t : order) {
-        const double need = std::ceil(level - have[static_cast<std::size_t>(t)]);
-        if (need > 0) c += static_cast<std::int64_t>(need) * grid_.rect(t).pixels();
-      }
-      return c;
-    };
-    double lo = order.empty() ? 0.0 : have[static_cast<std::size_t>(order.front())], hi = lo + 1e6;
-    for (int i = 0; i < 60; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      if (cost(mid) <= remaining) lo = mid; else hi = mid;
-    }
-    for (int t : order) {
-      const int k = static_cast<int>(std::min<double>(std::ceil(lo - have[static_cast<std::size_t>(t)]), 1e6));
-      const std::int64_t pixels = grid_.rect(t).pixels();
-      if (k <= 0 || pixels * k > remaining) continue;
-      emit(plan, t, grid_.rect(t), k, false, 0, true);
-      served[static_cast<std::size_t>(t)] = 1;
-      remaining -= pixels * k;
-    }
+    // Refinement with credits: the whole budget raises the tiles with the fewest samples in all.
+    std::vector<int> candidates;
+    for (int t = 0; t < n; ++t)
+      if (!served[static_cast<std::size_t>(t)]) candidates.push_back(t);
+    remaining -= waterFill(plan, candidates, remaining, served);
   } else if (!passActive()) {
     // Continuous refinement: every tile at 1 spp, round robin, so that a full frame is exactly
     // one pass over the image.

@@ -37,6 +37,8 @@ struct FramePlan {
 
 class TileScheduler {
  public:
+  static constexpr double kCatchUpFraction = 0.5;
+
   TileScheduler() = default;
   explicit TileScheduler(const TileGrid& grid) { reset(grid); }
 
@@ -60,7 +62,9 @@ class TileScheduler {
   // Samples per pixel a tile holds beyond those counted since its restart (verified reuse: the
   // history it keeps). With credits, continuous refinement serves the tiles with the fewest
   // samples in all first, up to a common level (water-filling), instead of one sample to each:
-  // tiles whose history was rejected catch up with the ones that kept theirs. Empty: none.
+  // tiles whose history was rejected catch up with the ones that kept theirs. During a pass,
+  // tiles it finished with fewer than kCatchUpFraction of the median samples in all of the tiles
+  // it finished get up to half of each frame's budget the same way (catch-up). Empty: none.
   void setCredit(std::vector<double> credit) { credit_ = std::move(credit); }
   bool inRegion(int tile) const { return region_.empty() || region_[static_cast<std::size_t>(tile)]; }
 
@@ -83,6 +87,7 @@ class TileScheduler {
     bool started = false;
   };
   void emit(FramePlan& plan, int tile, TileRect rect, int quality, bool restart, int cap, bool wholeTile);
+  std::int64_t waterFill(FramePlan& plan, std::vector<int> order, std::int64_t budget, std::vector<char>& served);
   std::vector<char> region_;
   void fillRemainder(FramePlan& plan, std::int64_t remainder, const std::vector<char>& served);
 
