@@ -222,5 +222,53 @@ TEST(Engine, StopsWhileRendering) {
   engine.stop();  // twice is harmless
 }
 
+// Fault: the device fails mid-render (injected: lavapipe never loses its device). The failure is
+// reported, rendering starts again on a new device, and the new session renders the scene with
+// every edit and resize that arrived before the failure: here the lights off and a new size, so a
+// session that came back with the initial scene would show a lit picture of the wrong size.
+TEST(Engine, AFailedDeviceIsReplacedAndTheEditsSurvive) {
+  RETILE_RENDERER_OR_SKIP(probe);
+  probe.reset();
+  EngineOptions options;
+  options.failFrame = 4;
+  Scene doc = smallDefault();
+  Engine engine(doc, MethodSettings{}, options);
+  std::uint64_t v = 1;
+  for (Material m : doc.materials) {
+    m.emission = Vec3{0.0f};
+    engine.submit(Edit{SetMaterial{m}}, v++);
+  }
+  for (Light l : doc.lights) {
+    l.intensity = 0.0f;
+    engine.submit(Edit{SetLight{l}}, v++);
+  }
+  Environment dark = doc.environment;
+  dark.intensity = 0.0f;
+  engine.submit(Edit{SetEnvironment{dark}}, v++);
+  engine.submit(ResizeCommand{48, 24}, v);
+  engine.start();
+
+  std::vector<std::string> errors;
+  for (int i = 0; i < 2000 && errors.empty(); ++i) {
+    std::this_thread::sleep_for(10ms);
+    errors = engine.takeErrors();
+  }
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("starts again on a new device"), std::string::npos) << errors[0];
+  const std::uint64_t atFailure = engine.framesRendered();
+  ASSERT_TRUE(waitFor(engine, [&](const FrameRecord&) { return engine.framesRendered() > atFailure + 3; }))
+      << "frames flow again";
+  EXPECT_TRUE(engine.running());
+  auto f = engine.latestFrame();
+  ASSERT_TRUE(f && f->image);
+  EXPECT_EQ(f->documentVersion, v);
+  EXPECT_EQ(f->image->width, 48);
+  EXPECT_EQ(f->image->height, 24);
+  double sum = 0;
+  for (float c : f->image->color) sum += c;
+  EXPECT_EQ(sum, 0.0) << "the lights stay off on the new device";
+  EXPECT_TRUE(engine.takeErrors().empty()) << "one failure, one report";
+}
+
 }  // namespace
 }  // namespace retile

@@ -92,6 +92,9 @@ struct EngineOptions {
   int maxSamplesPerPixel = 4096;
   // The document version the initial scene corresponds to: frames carry it until the first edit.
   std::uint64_t documentVersion = 0;
+  // Fault injection for tests: the Nth frame (from 1) fails as a frame on a lost device does, so
+  // that the recovery can be tested on a device that never fails. 0: never.
+  int failFrame = 0;
 };
 
 class Engine {

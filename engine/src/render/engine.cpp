@@ -149,10 +149,17 @@ void Engine::run() {
   }
   bool paused = false;
   std::shared_ptr<const FrameRecord> last;
+  // What a new session needs beyond the old one's scene when a device fails.
+  std::uint64_t version = options_.documentVersion;
+  RegionRect region;
+  int restarts = 0;  // devices started since the last frame that made it
+  std::uint64_t submitted = 0;
   while (!stop_) {
     bool changed = false;
     for (auto& entry : queue_.drain()) {
       changed = true;
+      version = std::max(version, entry.version);
+      if (const auto* r = std::get_if<RegionCommand>(&entry.command)) region = r->region;
       try {
         std::visit(
             [&](auto& c) {
@@ -185,6 +192,7 @@ void Engine::run() {
       last = rec;
       mailbox_.publish(rec);
       ++frames_;
+      restarts = 0;
       std::function<void()> cb;
       {
         std::lock_guard lock(mutex_);
@@ -202,12 +210,36 @@ void Engine::run() {
         continue;
       }
       // Pipelined: frame n+1 traces while frame n is read back and published.
+      if (++submitted == static_cast<std::uint64_t>(options_.failFrame))
+        throw Error("the device was lost (injected by EngineOptions::failFrame)");
       session->submitFrame(true);
       if (session->framesInFlight() > 1) publish(session->finishFrame());
     } catch (const std::exception& e) {
-      // A failed frame (device lost, out of memory) ends rendering; the document is untouched.
-      report(cat("rendering stopped: ", e.what()));
-      break;
+      // A failed frame (device lost, out of memory) takes the session's GPU state with it, not its
+      // scene, which holds every edit applied so far: rendering starts again on a new device with
+      // it (the accumulation restarts). The document, on the GUI thread, is never touched.
+      constexpr int kMaxRestarts = 3;
+      if (++restarts > kMaxRestarts) {
+        report(cat("rendering stopped: ", e.what(), " (", kMaxRestarts, " new devices failed in a row)"));
+        break;
+      }
+      report(cat("the device failed: ", e.what(), "; rendering starts again on a new device"));
+      try {
+        Scene scene = session->scene();
+        MethodSettings method = session->method();
+        NodeId selection = session->selection();
+        session.reset();  // destroys the old device first: lavapipe and small GPUs hold one well
+        session = std::make_unique<RenderSession>(std::move(scene), std::move(method), options_.renderer);
+        session->setDocumentVersion(version);
+        session->select(selection);
+        if (!region.empty()) session->setRegion(region);
+        last.reset();
+        std::lock_guard lock(mutex_);
+        device_ = session->deviceName();
+      } catch (const std::exception& again) {
+        report(cat("rendering stopped: no new device: ", again.what()));
+        break;
+      }
     }
   }
   running_ = false;
