@@ -35,9 +35,22 @@ FrameView::FrameView(QWidget* parent) : QWidget(parent) {
     container_->setGeometry(rect());
     container_->setFocusPolicy(Qt::NoFocus);
     presentation_ = tr("Vulkan window");
+    vulkan_->setFailureHandler([this](const QString& reason) { fallBackToWidget(reason); });
   } else {
     presentation_ = tr("widget (%1)").arg(why);
   }
+}
+
+void FrameView::fallBackToWidget(const QString& why) {
+  if (!vulkan_) return;
+  // The container owns the window: deleting it destroys the swapchain and Qt's device with it.
+  container_->hide();
+  container_->deleteLater();
+  container_ = nullptr;
+  vulkan_ = nullptr;
+  presentation_ = tr("widget (%1)").arg(why);
+  emit presentationChanged(presentation_);
+  update();
 }
 
 void FrameView::setOverlays(const OverlaySettings& o) {

@@ -84,6 +84,8 @@ class FrameView : public QWidget {
 
   // The presenting Vulkan window, or nullptr when this widget paints (and why, for the log).
   VulkanViewport* vulkanWindow() const { return vulkan_; }
+  // The Vulkan window failed for good: from now on this widget paints the picture itself.
+  void fallBackToWidget(const QString& why);
   QString presentation() const { return presentation_; }
   // The picture exactly as presented: image, overlays and banners at the widget's size.
   QImage composed() const;
@@ -108,6 +110,7 @@ class FrameView : public QWidget {
   TileLabels tileLabels(const QRectF& tile) const;
 
  signals:
+  void presentationChanged(const QString& presentation);  // the viewport fell back to the widget
   void objectPicked(quint64 object);  // 0: nothing under the cursor
   void objectToggled(quint64 object);  // Ctrl+click on an object: into or out of the selection
   void focusPlaced(QPointF imagePixel);

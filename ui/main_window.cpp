@@ -208,6 +208,8 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
   rebuildOutliner();
   rebuildProperties();
   log(tr("viewport: %1").arg(view_->presentation()));
+  connect(view_, &FrameView::presentationChanged, this,
+          [this](const QString& p) { log(tr("viewport: presentation failed; now drawn as a %1").arg(p)); });
 }
 
 MainWindow::~MainWindow() {

@@ -29,24 +29,30 @@ class PresentRenderer : public QVulkanWindowRenderer {
   explicit PresentRenderer(VulkanViewport* w) : w_(w) {}
 
   void initResources() override {
+    ok_ = true;
     dev_ = w_->device();
     f_ = w_->vulkanInstance()->deviceFunctions(dev_);
     VkDescriptorSetLayoutBinding b{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
     VkDescriptorSetLayoutCreateInfo dl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, nullptr, 0, 1, &b};
-    check(f_->vkCreateDescriptorSetLayout(dev_, &dl, nullptr, &setLayout_), "vkCreateDescriptorSetLayout");
+    if (!check(f_->vkCreateDescriptorSetLayout(dev_, &dl, nullptr, &setLayout_), "vkCreateDescriptorSetLayout")) return;
     VkPushConstantRange pr{VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(Push)};
     VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO, nullptr, 0, 1, &setLayout_, 1, &pr};
-    check(f_->vkCreatePipelineLayout(dev_, &pl, nullptr, &layout_), "vkCreatePipelineLayout");
+    if (!check(f_->vkCreatePipelineLayout(dev_, &pl, nullptr, &layout_), "vkCreatePipelineLayout")) return;
     VkDescriptorPoolSize ps{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, QVulkanWindow::MAX_CONCURRENT_FRAME_COUNT};
     VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, nullptr, 0,
                                   QVulkanWindow::MAX_CONCURRENT_FRAME_COUNT, 1, &ps};
-    check(f_->vkCreateDescriptorPool(dev_, &dp, nullptr, &pool_), "vkCreateDescriptorPool");
+    if (!check(f_->vkCreateDescriptorPool(dev_, &dp, nullptr, &pool_), "vkCreateDescriptorPool")) return;
     for (int i = 0; i < w_->concurrentFrameCount(); ++i) {
       VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO, nullptr, pool_, 1, &setLayout_};
-      check(f_->vkAllocateDescriptorSets(dev_, &ai, &frames_[static_cast<std::size_t>(i)].set), "vkAllocateDescriptorSets");
+      if (!check(f_->vkAllocateDescriptorSets(dev_, &ai, &frames_[static_cast<std::size_t>(i)].set), "vkAllocateDescriptorSets"))
+        return;
     }
     createPipeline();
   }
+
+  // Qt releases everything and tries a new device by itself; the editor draws as a widget instead,
+  // which cannot fail this way.
+  void logicalDeviceLost() override { w_->fail(QStringLiteral("the Vulkan device was lost")); }
 
   void releaseResources() override {
     for (auto& fr : frames_) releaseBuffer(fr);
@@ -65,7 +71,8 @@ class PresentRenderer : public QVulkanWindowRenderer {
     Frame& fr = frames_[static_cast<std::size_t>(w_->currentFrame())];
     // The window waited on this slot's fence before calling us: its buffer is free to rewrite.
     const QImage& pic = w_->picture();
-    const bool have = !pic.isNull() && pic.format() == QImage::Format_RGB32 && upload(fr, pic);
+    // After a failed call of ours, frames only clear (the window is about to be replaced).
+    const bool have = ok_ && !pic.isNull() && pic.format() == QImage::Format_RGB32 && upload(fr, pic);
     const QSize target = w_->swapChainImageSize();
     VkClearValue clear[3]{};
     clear[0].color = {{0.125f, 0.125f, 0.14f, 1.0f}};
@@ -92,6 +99,7 @@ class PresentRenderer : public QVulkanWindowRenderer {
       f_->vkCmdDraw(cb, 3, 1, 0, 0);
     }
     f_->vkCmdEndRenderPass(cb);
+    if (have) w_->framePresented();
     w_->frameReady();
   }
 
@@ -104,8 +112,13 @@ class PresentRenderer : public QVulkanWindowRenderer {
     VkDescriptorSet set = VK_NULL_HANDLE;
   };
 
-  static void check(VkResult r, const char* what) {
-    if (r != VK_SUCCESS) qFatal("viewport: %s failed (VkResult %d)", what, static_cast<int>(r));
+  // A failed call (out of device memory, a lost device) stops drawing and hands the viewport
+  // back to the widget; it never ends the program.
+  bool check(VkResult r, const char* what) {
+    if (r == VK_SUCCESS) return true;
+    ok_ = false;
+    w_->fail(QStringLiteral("%1 failed (VkResult %2)").arg(QLatin1String(what)).arg(static_cast<int>(r)));
+    return false;
   }
   static bool isSrgb(VkFormat f) {
     return f == VK_FORMAT_B8G8R8A8_SRGB || f == VK_FORMAT_R8G8B8A8_SRGB || f == VK_FORMAT_A8B8G8R8_SRGB_PACK32;
@@ -115,11 +128,16 @@ class PresentRenderer : public QVulkanWindowRenderer {
     VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO, nullptr, 0, bytes, code};
     VkShaderModule m = VK_NULL_HANDLE;
     check(f_->vkCreateShaderModule(dev_, &ci, nullptr, &m), "vkCreateShaderModule");
-    return m;
+    return m;  // VK_NULL_HANDLE after a failure, which createPipeline checks
   }
 
   void createPipeline() {
     VkShaderModule vs = module(kPresentVert, sizeof kPresentVert), fs = module(kPresentFrag, sizeof kPresentFrag);
+    if (!vs || !fs) {
+      f_->vkDestroyShaderModule(dev_, vs, nullptr);
+      f_->vkDestroyShaderModule(dev_, fs, nullptr);
+      return;
+    }
     std::array<VkPipelineShaderStageCreateInfo, 2> stages{};
     stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT, vs, "main", nullptr};
     stages[1] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_FRAGMENT_BIT, fs, "main", nullptr};
@@ -208,6 +226,7 @@ class PresentRenderer : public QVulkanWindowRenderer {
   }
 
   VulkanViewport* w_;
+  bool ok_ = false;
   VkDevice dev_ = VK_NULL_HANDLE;
   QVulkanDeviceFunctions* f_ = nullptr;
   VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
@@ -221,6 +240,39 @@ class PresentRenderer : public QVulkanWindowRenderer {
 
 VulkanViewport::VulkanViewport(QWidget* eventTarget) : target_(eventTarget) {
   setVulkanInstance(sharedInstance());
+  // Qt reports a failed swapchain acquire or present only as a warning and keeps trying: a
+  // picture that waits seconds for a frame, or a window exposed for seconds without valid
+  // presentation, is taken as a failure.
+  watchdog_.setInterval(1000);
+  QObject::connect(&watchdog_, &QTimer::timeout, this, [this] { watch(); });
+  watchdog_.start();
+}
+
+void VulkanViewport::fail(const QString& why) {
+  if (failed_) return;
+  failed_ = true;
+  watchdog_.stop();
+  if (auto handler = onFailure_)
+    QMetaObject::invokeMethod(target_, [handler, why] { handler(why); }, Qt::QueuedConnection);
+}
+
+void VulkanViewport::framePresented() { waiting_.invalidate(); }
+
+void VulkanViewport::watch() {
+  constexpr qint64 kLimitMs = 5000;
+  const bool visible = isExposed() && !size().isEmpty();
+  if (!visible) {
+    waiting_.invalidate();
+    notStarted_.invalidate();
+    return;
+  }
+  if (!isValid()) {
+    if (!notStarted_.isValid()) notStarted_.start();
+    if (notStarted_.elapsed() > kLimitMs) fail(QStringLiteral("Vulkan presentation did not start"));
+    return;
+  }
+  notStarted_.invalidate();
+  if (waiting_.isValid() && waiting_.elapsed() > kLimitMs) fail(QStringLiteral("the swapchain stopped presenting frames"));
 }
 
 QVulkanInstance* VulkanViewport::sharedInstance(QString* why) {
@@ -247,6 +299,7 @@ QVulkanInstance* VulkanViewport::sharedInstance(QString* why) {
 
 void VulkanViewport::setPicture(QImage picture) {
   picture_ = std::move(picture);
+  if (!waiting_.isValid()) waiting_.start();
   requestUpdate();
 }
 

@@ -8,8 +8,12 @@
 // needs no lock. Input events are forwarded to FrameView, which owns all viewport interaction.
 #pragma once
 
+#include <QElapsedTimer>
 #include <QImage>
+#include <QTimer>
 #include <QVulkanWindow>
+
+#include <functional>
 
 class QWidget;
 
@@ -31,12 +35,26 @@ class VulkanViewport : public QVulkanWindow {
   const QImage& picture() const { return picture_; }
   QVulkanWindowRenderer* createRenderer() override;
 
+  // Presentation failed for good (device lost, a Vulkan call of ours failed, Vulkan never started,
+  // or the swapchain stopped presenting while pictures waited): `handler` is called once, queued,
+  // so the owner may delete this window. The renderer and the watchdog call fail(); so do tests.
+  void setFailureHandler(std::function<void(const QString&)> handler) { onFailure_ = std::move(handler); }
+  void fail(const QString& why);
+  bool failed() const { return failed_; }
+  void framePresented();  // the renderer recorded a frame
+
  protected:
   bool event(QEvent* e) override;
 
  private:
+  void watch();
   QWidget* target_;
   QImage picture_;
+  std::function<void(const QString&)> onFailure_;
+  bool failed_ = false;
+  QTimer watchdog_;
+  QElapsedTimer waiting_;    // since the oldest picture not yet presented (invalid: none waits)
+  QElapsedTimer notStarted_; // since the window was exposed without valid presentation
 };
 
 }  // namespace retile::ui

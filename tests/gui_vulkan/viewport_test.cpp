@@ -3,6 +3,7 @@
 // compared), and input on the Vulkan window reaches the viewport (a click picks an object).
 #include <QApplication>
 #include <QPixmap>
+#include <QPointer>
 #include <QScreen>
 #include <QStandardPaths>
 #include <QTemporaryDir>
@@ -88,6 +89,41 @@ TEST(VulkanViewport, AClickOnTheVulkanWindowPicksAnObject) {
             static_cast<int>(r.y() + (sy / count + 0.5) * r.height() / frame->height));
   QTest::mouseClick(vw, Qt::LeftButton, Qt::NoModifier, at);
   EXPECT_TRUE(QTest::qWaitFor([&] { return w->selection() == sphere; }, 5000)) << "the click reached the viewport";
+}
+
+// Fault: presentation fails after start (here as the renderer reports Qt's lost device, with
+// the same call; lavapipe never loses one). The viewport falls back to drawing the picture as a
+// widget: the Vulkan window goes, frames keep arriving, and the screen shows the composed picture.
+TEST(VulkanViewport, AFailedPresentationFallsBackToTheWidget) {
+  auto w = makeWindow();
+  QPointer<VulkanViewport> vw = w->viewport()->vulkanWindow();
+  ASSERT_TRUE(vw);
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(vw, 20000));
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  vw->fail(QStringLiteral("the Vulkan device was lost"));
+  ASSERT_TRUE(QTest::qWaitFor([&] { return vw.isNull(); }, 5000)) << "the Vulkan window is destroyed";
+  EXPECT_EQ(w->viewport()->vulkanWindow(), nullptr);
+  EXPECT_TRUE(w->viewport()->presentation().startsWith("widget (the Vulkan device was lost"))
+      << w->viewport()->presentation().toStdString();
+  const std::uint64_t before = w->engine()->framesRendered();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord&) { return w->engine()->framesRendered() > before + 2; }))
+      << "rendering goes on";
+  w->engine()->submit(PauseCommand{true});
+  QTest::qWait(500);
+  QApplication::processEvents();
+  FrameView* view = w->viewport();
+  const QPoint at = view->mapTo(w.get(), QPoint(0, 0));
+  const QImage shown = w->screen()->grabWindow(w->winId(), at.x(), at.y(), view->width(), view->height())
+                           .toImage().convertToFormat(QImage::Format_RGB32);
+  const QImage expected = view->composed().convertToFormat(QImage::Format_RGB32);
+  ASSERT_EQ(shown.size(), expected.size());
+  double diff = 0;
+  for (int y = 0; y < shown.height(); ++y)
+    for (int x = 0; x < shown.width(); ++x) {
+      QRgb a = shown.pixel(x, y), b = expected.pixel(x, y);
+      diff += std::abs(qRed(a) - qRed(b)) + std::abs(qGreen(a) - qGreen(b)) + std::abs(qBlue(a) - qBlue(b));
+    }
+  EXPECT_LT(diff / (3.0 * shown.width() * shown.height()), 1.5) << "the screen shows the widget's picture";
 }
 
 }  // namespace
