@@ -431,7 +431,11 @@ Result<std::string> convertWithAssimp(const fs::path& file) {
   Converter conv{ai, file, {}, {}, {}, {}, {}, {}, 0, false};
   std::string ext = lowercase(file.extension().string());
   conv.gltf = ext == ".gltf" || ext == ".glb";
-  conv.run();
+  try {
+    conv.run();  // refuses a file it cannot use (no triangle meshes, ...) by throwing Error
+  } catch (const Error& e) {
+    return R::failure(e.what());
+  }
   const std::size_t kShown = 6;
   for (std::size_t i = 0; i < assimpErrors.size() && i < kShown; ++i)
     std::fprintf(stderr, "warning: %s: Assimp: %s\n", file.filename().string().c_str(), assimpErrors[i].c_str());
