@@ -160,6 +160,25 @@ TEST(Native, KillDuringASaveLeavesAWholeFile) {
   EXPECT_GT(leftovers, 0);
 }
 
+// The temporaries a killed save leaves behind go with the next save of the same file once they
+// are older than any save can take; a recent one (a save running now) and other files stay.
+TEST(Native, ASaveRemovesTheTemporariesOfKilledSaves) {
+  auto dir = test::tempDir() / "stale";
+  std::filesystem::create_directories(dir);
+  auto file = dir / "scene.retile";
+  auto stale = dir / ".scene.tmp1a2b3c.retile", recent = dir / ".scene.tmp4d5e6f.retile";
+  auto otherScene = dir / ".other.tmp123456.retile", notOurs = dir / ".scene.tmp.keep";
+  for (const auto& p : {stale, recent, otherScene, notOurs}) std::ofstream(p) << "partial";
+  const auto old = std::filesystem::file_time_type::clock::now() - std::chrono::hours(1);
+  for (const auto& p : {stale, otherScene, notOurs}) std::filesystem::last_write_time(p, old);
+  ASSERT_TRUE(writeFileAtomic(file, "whole").ok());
+  EXPECT_FALSE(std::filesystem::exists(stale));
+  EXPECT_TRUE(std::filesystem::exists(recent));
+  EXPECT_TRUE(std::filesystem::exists(otherScene)) << "another file's temporaries are its own saves' business";
+  EXPECT_TRUE(std::filesystem::exists(notOurs));
+  EXPECT_TRUE(std::filesystem::exists(file));
+}
+
 TEST(Native, SaveOverADirectoryFailsCleanly) {
   auto dir = test::tempDir();
   auto target = dir / "scene.retile";

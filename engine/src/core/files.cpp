@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -67,7 +68,27 @@ Result<bool> writeFileAtomic(const fs::path& path, std::string_view bytes) {
     ::unlink(tmp.c_str());
     return Result<bool>::failure(cat(path.string(), ": rename failed (", why, "); the existing file is unchanged"));
   }
+  removeStaleTemporaries(path);
   return true;
+}
+
+// A save killed between creating its temporary and the rename (kill -9, power loss) leaves the
+// hidden temporary behind. The next save of the same file removes those older than ten minutes:
+// no save takes that long, so none of them can belong to a save still running.
+void removeStaleTemporaries(const fs::path& path) {
+  std::error_code ec;
+  const std::string prefix = cat(".", path.stem().string(), ".tmp");
+  const std::string suffix = path.extension().string();
+  const auto cutoff = fs::file_time_type::clock::now() - std::chrono::minutes(10);
+  fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() < prefix.size() + suffix.size() || name.compare(0, prefix.size(), prefix) != 0 ||
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+      continue;
+    std::error_code fileEc;
+    if (it->is_regular_file(fileEc) && it->last_write_time(fileEc) < cutoff && !fileEc) fs::remove(it->path(), fileEc);
+  }
 }
 
 std::string lowercase(std::string_view s) {

@@ -20,6 +20,9 @@ Result<std::string> readFile(const std::filesystem::path& path,
 // Writes `bytes` to a temporary file beside `path`, flushes it to disk and renames it over
 // `path`, so a crash or a full disk never leaves a half-written file in its place.
 Result<bool> writeFileAtomic(const std::filesystem::path& path, std::string_view bytes);
+// Removes the hidden temporaries of `path`'s saves that were killed before their rename, those
+// older than ten minutes (writeFileAtomic calls it after each successful save).
+void removeStaleTemporaries(const std::filesystem::path& path);
 
 // Temporary name beside `path` that keeps its extension (image writers choose the format by it).
 std::filesystem::path temporarySibling(const std::filesystem::path& path);
