@@ -3,7 +3,9 @@
 //
 // Threads: every public member of Engine, EditQueue and Mailbox may be called from any thread.
 // Nothing here waits on rendering: submit() queues, latestFrame() swaps a pointer. The render
-// thread drains the queue only between frames; exceptions on it become errors (takeErrors()).
+// thread drains the queue only between frames; exceptions on it become errors (takeErrors()). A
+// frame that fails (device lost, out of device memory) is reported and rendering starts again on
+// a new session and device, from the old session's scene with every command applied.
 #pragma once
 
 #include <atomic>
