@@ -23,24 +23,21 @@ rm -rf "$seeds"
 mkdir -p "$seeds"/{fuzz_json,fuzz_obj,fuzz_scenario,fuzz_native,fuzz_tungsten,fuzz_assimp}
 small() { find "$@" -type f -size -64k 2>/dev/null; }
 n=0
-for f in $(small "$shared/scenes" "$shared/corpus" -name '*.json') resources/scripts/*.json; do
-  cp "$f" "$seeds/fuzz_json/$((n++)).json"
-done
-for f in $(small "$shared/scenes" "$shared/corpus" -name '*.gltf'); do cp "$f" "$seeds/fuzz_json/$((n++)).json"; done
-for f in "$shared"/scenes/*/scene.json $(small "$shared/corpus" -name '*.json'); do
-  cp "$f" "$seeds/fuzz_tungsten/$((n++)).json"
-done
-for f in $(small "$shared/scenes" "$shared/corpus" -iname '*.obj'); do cp "$f" "$seeds/fuzz_obj/$((n++)).obj"; done
-cp resources/scripts/*.json "$seeds/fuzz_scenario/"
-for f in default "$shared"/scenes/cornell-box/scene.json $(small "$shared/corpus/valid" -name '*.gltf' | head -8); do
+# Copies the files listed on stdin (one a line: names may hold spaces) into TARGET's seeds.
+seed() { while IFS= read -r f; do cp "$f" "$seeds/$1/$((n++))$2"; done; }
+seed fuzz_json .json < <(small "$shared/scenes" "$shared/corpus" \( -name '*.json' -o -name '*.gltf' \); printf '%s\n' resources/scripts/*.json)
+seed fuzz_tungsten .json < <(printf '%s\n' "$shared"/scenes/*/scene.json; small "$shared/corpus" -name '*.json')
+seed fuzz_obj .obj < <(small "$shared/scenes" "$shared/corpus" -iname '*.obj')
+seed fuzz_scenario .json < <(printf '%s\n' resources/scripts/*.json)
+while IFS= read -r f; do
   build-ci/bin/retile import "$f" --save "$seeds/fuzz_native/$((n++)).retile" >/dev/null 2>&1 || true
-done
+done < <(printf '%s\n' default "$shared"/scenes/cornell-box/scene.json; small "$shared/corpus/valid" -name '*.gltf' | head -8)
 # The conversion's first byte picks the format (the order of kExtensions in fuzz_assimp.cpp).
 exts=(obj gltf glb ply stl dae fbx off)
 for i in "${!exts[@]}"; do
-  for f in $(small "$shared/corpus" -iname "*.${exts[$i]}"); do
+  while IFS= read -r f; do
     { printf "\\x$(printf %02x "$i")"; cat "$f"; } >"$seeds/fuzz_assimp/$((n++))"
-  done
+  done < <(small "$shared/corpus" -iname "*.${exts[$i]}")
 done
 
 # Leaks inside libraries (listed with their reasons) are not findings.
