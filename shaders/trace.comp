@@ -242,8 +242,9 @@ bool extendPath(inout Path path) {
     vec3 n = r0.xyz * nObj.x + r1.xyz * nObj.y + r2.xyz * nObj.z;
     if (dot(n, n) > 0.0) {
       ns = normalize(n);
-      // Shading normals from files may disagree with the winding; the winding decides the front.
-      if (dot(ns, ng) < 0.0) ns = -ns;
+      // Shading normals from files may disagree with the winding; the winding decides the front
+      // (in Tungsten's convention the shading normal is taken as it is).
+      if (!hasFeature(kFeatureTungstenShading) && dot(ns, ng) < 0.0) ns = -ns;
     }
   }
 
@@ -279,17 +280,17 @@ bool extendPath(inout Path path) {
 
   if (path.depth >= maxBounces) return false;
 
-  // Shading frame. Opaque materials are two-sided: flip to the viewer's side.
+  // Shading frame. Opaque materials are two-sided: flip to the viewer's side, of the true surface
+  // (consistent) or of the shading normal (Tungsten's convention).
+  const bool tungstenShading = hasFeature(kFeatureTungstenShading);
   bool transmissive = isTransmissive(m);
   vec3 ngs = ng, nss = ns;
-  if (!transmissive && !frontFace) {
-    ngs = -ng;
-    nss = -ns;
-  }
+  if (!transmissive && !frontFace) ngs = -ng;
+  if (!transmissive && (tungstenShading ? dot(ns, wo) < 0.0 : !frontFace)) nss = -ns;
   vec3 t, b;
   makeFrame(nss, t, b);
   vec3 woL = toLocal(wo, t, b, nss);
-  if (!transmissive && woL.z <= 0.0) {
+  if (!tungstenShading && !transmissive && woL.z <= 0.0) {
     // The interpolated normal faces away from the viewer: shade with the geometric one.
     nss = ngs;
     makeFrame(nss, t, b);
@@ -307,7 +308,7 @@ bool extendPath(inout Path path) {
     if (ls.pdf > 0.0 && maxComponent(ls.radiance) > 0.0) {
       float sideL = dot(ls.dir, ngs);
       bool sameSide = sideL > 0.0;
-      if (sameSide || transmissive) {
+      if (sameSide || transmissive || tungstenShading) {
         float bsdfPdf;
         vec3 f = bsdfEval(m, woL, toLocal(ls.dir, t, b, nss), bsdfPdf);
         if (maxComponent(f) > 0.0) {
@@ -334,7 +335,8 @@ bool extendPath(inout Path path) {
   // one on the other side; otherwise the shading normal lied and the path would leak. The
   // viewer's side, not the normal's: inside glass it is the back (comparing with the normal
   // alone ended every path leaving glass, and every reflection inside it: black glass).
-  if (bs.transmitted ? sideI * sideO >= 0.0 : sideI * sideO <= 0.0) return false;
+  // Tungsten's convention has no such check (its enable_consistency_checks is off by default).
+  if (!tungstenShading && (bs.transmitted ? sideI * sideO >= 0.0 : sideI * sideO <= 0.0)) return false;
   path.beta *= bs.weight;
   // Roulette must not see the 1/eta^2 radiance scaling inside glass as lost energy.
   if (bs.transmitted && !isMat(m.type, kMatThinSheet)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);

@@ -299,6 +299,9 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       b.choice(tr("Distribution"), "distribution", {tr("GGX"), tr("Beckmann")}, m.beckmann ? 1 : 0, [edit](int i) {
         edit(tr("Distribution"), 0, [i](Material& x) { x.beckmann = i == 1; });
       });
+    if (isMicrofacet(m.type))
+      b.choice(tr("Shadowing"), "shadowing", {tr("Height-correlated"), tr("Separable (Tungsten)")}, m.separableShadowing ? 1 : 0,
+               [edit](int i) { edit(tr("Shadowing"), 0, [i](Material& x) { x.separableShadowing = i == 1; }); });
   }
   if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic || m.type == MaterialType::Dielectric ||
       m.type == MaterialType::RoughDielectric || m.type == MaterialType::ThinSheet) {
@@ -531,6 +534,12 @@ void PropertyPanel::buildRender(Builder& b) {
            [edit](int i) {
              if (i < 0 || i > 1) return;
              edit(tr("Filter sampling"), 0, [i](RenderSettings& x) { x.filterSampling = static_cast<FilterSampling>(i); });
+           });
+  // Tungsten scene files come with its shading-normal convention too (see ShadingConvention).
+  b.choice(tr("Shading normals"), "shading", {tr("Consistent"), tr("As Tungsten shades them")}, static_cast<int>(r.shading),
+           [edit](int i) {
+             if (i < 0 || i > 1) return;
+             edit(tr("Shading normals"), 0, [i](RenderSettings& x) { x.shading = static_cast<ShadingConvention>(i); });
            });
   b.label(tr("Resolution"), tr("%1 x %2 (the viewport's size times the render scale)").arg(renderSize_.width()).arg(renderSize_.height()));
 }

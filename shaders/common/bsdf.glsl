@@ -25,6 +25,7 @@ struct Material {
   vec3 albedo;
   float roughness;   // microfacet alpha, or Oren-Nayar sigma
   bool beckmann;     // rough types: Beckmann's distribution instead of GGX
+  bool separable;    // rough types: G = G1(wo) G1(wi) instead of height-correlated
   float ior;
   float fdrInt;      // plastic: internal diffuse Fresnel reflectance of the coating
   vec3 eta;
@@ -36,8 +37,9 @@ struct Material {
 Material unpackMaterial(vec4 t0, vec4 t1, vec4 t2, vec4 t3, vec4 t4) {
   Material m;
   int type = floatBitsToInt(t0.w);
-  m.type = type & (kMatBeckmann - 1);
+  m.type = type & kMatTypeBits;
   m.beckmann = kBeckmannUsed && (type & kMatBeckmann) != 0;
+  m.separable = (type & kMatSeparable) != 0;
   m.albedo = t0.rgb;
   m.roughness = t1.x;
   m.ior = t1.y;
@@ -154,7 +156,10 @@ float beckmannLambda(vec3 w, float a) {
 float mfD(Material m, vec3 h, float a) { return kBeckmannUsed && m.beckmann ? beckmannD(h, a) : ggxD(h, a); }
 float mfLambda(Material m, vec3 w, float a) { return kBeckmannUsed && m.beckmann ? beckmannLambda(w, a) : ggxLambda(w, a); }
 float mfG1(Material m, vec3 w, float a) { return 1.0 / (1.0 + mfLambda(m, w, a)); }
-float mfG2(Material m, vec3 wo, vec3 wi, float a) { return 1.0 / (1.0 + mfLambda(m, wo, a) + mfLambda(m, wi, a)); }
+float mfG2(Material m, vec3 wo, vec3 wi, float a) {
+  float lo = mfLambda(m, wo, a), li = mfLambda(m, wi, a);
+  return m.separable ? 1.0 / ((1.0 + lo) * (1.0 + li)) : 1.0 / (1.0 + lo + li);
+}
 
 // A microfacet normal for wo: GGX's visible normals; Beckmann's D cos(theta) (as Tungsten draws it).
 vec3 mfSample(Material m, vec3 wo, float a, vec2 u) {
@@ -369,7 +374,7 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
     s.pdf = mfReflectionPdf(m, wo, h, a);
     vec3 F = m.albedo * fresnelConductor(dot(wo, h), m.eta, m.k);
     if (kBeckmannUsed && m.beckmann) s.weight = F * (mfD(m, h, a) * mfG2(m, wo, i, a) / (4.0 * wo.z * max(s.pdf, 1e-12)));
-    else s.weight = F * (ggxG2(wo, i, a) / ggxG1(wo, a));
+    else s.weight = F * (mfG2(m, wo, i, a) / ggxG1(wo, a));
     return s;
   }
   if (isMat(t, kMatPlastic)) {

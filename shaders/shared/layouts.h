@@ -44,7 +44,8 @@ RT_CONST(int, kFeatureEnvConstant, 2)
 RT_CONST(int, kFeatureEnvMap, 4)
 RT_CONST(int, kFeatureEmitters, 8)       // emissive triangles
 RT_CONST(int, kFeatureDeltaLights, 16)   // point, spot and directional lights
-RT_CONST(int, kFeatureAll, 31)
+RT_CONST(int, kFeatureTungstenShading, 32)  // ShadingConvention::Tungsten (scene.h)
+RT_CONST(int, kFeatureAll, 63)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceEmissive, 4)
@@ -64,6 +65,10 @@ RT_CONST(int, kMatNull, 10)
 // bit of the kernel's material mask that says some material has it.
 RT_CONST(int, kMatBeckmann, 256)
 RT_CONST(int, kMaskBeckmann, 11)
+// Packed with a rough type: Smith's G as the product G1(wo) G1(wi) (Material::separableShadowing).
+// A multiply more per evaluation, so no kernel variant.
+RT_CONST(int, kMatSeparable, 512)
+RT_CONST(int, kMatTypeBits, 255)
 
 RT_CONST(int, kTexBitmap, 0)
 RT_CONST(int, kTexChecker, 1)

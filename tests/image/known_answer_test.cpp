@@ -23,6 +23,14 @@ RenderImage renderScene(Renderer& r, const Scene& s, int spp, std::uint32_t seed
   return r.render(req);
 }
 
+// The camera at `height` above the origin, looking down -y with image x along world x.
+void lookStraightDown(Scene& s, float height, float fovDegrees) {
+  s.camera.position = {0, height, 0};
+  s.camera.target = {0, 0, 0};
+  s.camera.up = {0, 0, -1};
+  s.camera.verticalFov = radians(fovDegrees);
+}
+
 // Mean over the pixels whose first hit is `object`.
 double meanOver(const RenderImage& img, NodeId object, int* count = nullptr) {
   double sum = 0;
@@ -112,10 +120,7 @@ TEST(KnownAnswer, DiffusePlaneUnderUniformSky) {
   RETILE_RENDERER_OR_SKIP(r);
   Scene s = test::emptyScene(32, 32);
   // Looking straight down at a large plane: it sees only sky above it.
-  s.camera.position = {0, 3, 0};
-  s.camera.target = {0, 0, 0};
-  s.camera.up = {0, 0, -1};
-  s.camera.verticalFov = radians(20);
+  lookStraightDown(s, 3, 20);
   s.settings.maxBounces = 3;
   s.environment.color = Vec3{2.0f};
   Material m;
@@ -133,10 +138,7 @@ TEST(KnownAnswer, DiffusePlaneUnderUniformSky) {
 TEST(KnownAnswer, PixelFiltersSpreadAnEdgeAsTheyShould) {
   RETILE_RENDERER_OR_SKIP(r);
   Scene s = test::emptyScene(32, 8);
-  s.camera.position = {0, 3, 0};
-  s.camera.target = {0, 0, 0};
-  s.camera.up = {0, 0, -1};  // image x is world x: the edge x = 0 is the boundary of columns 15 and 16
-  s.camera.verticalFov = radians(20);
+  lookStraightDown(s, 3, 20);  // image x is world x: the edge x = 0 is the boundary of columns 15 and 16
   s.settings.maxBounces = 0;
   Material light;
   light.albedo = Vec3{0.0f};
@@ -168,10 +170,7 @@ TEST(KnownAnswer, PixelFiltersSpreadAnEdgeAsTheyShould) {
 
 double smallLightOnPlane(Renderer& r, float height, NodeId* planeOut) {
   Scene s = test::emptyScene(16, 16);
-  s.camera.position = {0, 0.5f, 0};
-  s.camera.target = {0, 0, 0};
-  s.camera.up = {0, 0, -1};
-  s.camera.verticalFov = radians(2);  // just the spot below the light
+  lookStraightDown(s, 0.5f, 2);  // just the spot below the light
   s.settings.maxBounces = 1;         // direct light only
   Material plane;
   plane.albedo = Vec3{1.0f};
@@ -183,6 +182,41 @@ double smallLightOnPlane(Renderer& r, float height, NodeId* planeOut) {
                       Mat4::translate({0, height, 0}) * Mat4::rotateX(kPi) * Mat4::scale({0.05f, 1, 0.05f}));
   RenderImage img = renderScene(r, s, 64);
   return meanOver(img, *planeOut);
+}
+
+// Shading normals that lie (ShadingConvention): a plane whose normals lean 80 degrees towards +x,
+// lit only by a point light below it on that side. Consistent: the light is behind the true
+// surface, so the plane stays black. Tungsten's convention (two-sided shading, no consistency
+// checks) lights it as if the shading normal were the surface: albedo / pi * I * cos / d^2 with the
+// cosine taken against the shading normal.
+TEST(KnownAnswer, ShadingConventionsDisagreeWhereTheShadingNormalLies) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(16, 16);
+  lookStraightDown(s, 3, 2);
+  s.settings.maxBounces = 1;
+  auto g = std::make_shared<MeshGeometry>(*makeQuad());
+  const float lean = radians(80);
+  const Vec3 ns{std::sin(lean), std::cos(lean), 0};
+  g->normals.assign(4, ns);
+  Material m;
+  m.albedo = Vec3{1.0f};
+  NodeId plane = test::addMeshObject(s, "plane", g, test::addMaterial(s, m), Mat4{});
+  Light light;
+  light.id = s.newId();
+  light.type = LightType::Point;
+  light.intensity = 10.0f;
+  light.position = {3, -0.5f, 0};
+  s.lights.push_back(light);
+  const Vec3 toLight = light.position;  // from the plane's centre
+  const double d2 = dot(toLight, toLight);
+  const double expected = 10.0 / kPi * dot(ns, toLight) / std::sqrt(d2) / d2;
+
+  double consistent = meanOver(renderScene(*r, s, 64), plane);
+  s.settings.shading = ShadingConvention::Tungsten;
+  double tungsten = meanOver(renderScene(*r, s, 64), plane);
+  EXPECT_LT(consistent, 1e-6) << "light from behind the true surface";
+  EXPECT_NEAR(tungsten, expected, 0.03 * expected);
+  EXPECT_GT(expected, 0.3);
 }
 
 TEST(KnownAnswer, InverseSquareFalloffOfASmallLight) {
@@ -201,10 +235,7 @@ TEST(KnownAnswer, InverseSquareFalloffOfASmallLight) {
 TEST(KnownAnswer, LightsAndSkyAddUpAsEditsBringThemInAndTakeThemOut) {
   RETILE_RENDERER_OR_SKIP(r);
   Scene s = test::emptyScene(16, 16);
-  s.camera.position = {0, 0.5f, 0};
-  s.camera.target = {0, 0, 0};
-  s.camera.up = {0, 0, -1};
-  s.camera.verticalFov = radians(2);
+  lookStraightDown(s, 0.5f, 2);
   s.settings.maxBounces = 1;
   Material m;
   m.albedo = Vec3{0.5f};

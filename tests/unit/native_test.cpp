@@ -74,6 +74,8 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   s.settings.pixelFilter = PixelFilter::BlackmanHarris;
   s.settings.filterWidth = 1.75f;
   s.settings.filterSampling = FilterSampling::Tungsten;
+  s.settings.shading = ShadingConvention::Tungsten;
+  s.materials[0].separableShadowing = true;
   s.lights.push_back(Light{s.newId(), "Key", LightType::Spot, {1, 0.9f, 0.8f}, 3.5f, {1, 2, 3}, {0, -1, 0}, 0.4f, 0.2f, true});
   auto dir = test::tempDir();
   auto file = dir / "scene.retile";
@@ -87,6 +89,8 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.settings.pixelFilter, PixelFilter::BlackmanHarris);
   EXPECT_EQ(back->scene.settings.filterWidth, 1.75f);
   EXPECT_EQ(back->scene.settings.filterSampling, FilterSampling::Tungsten);
+  EXPECT_EQ(back->scene.settings.shading, ShadingConvention::Tungsten);
+  EXPECT_TRUE(back->scene.materials[0].separableShadowing);
   // Saving what was loaded gives the same bytes.
   EXPECT_EQ(nativeSceneToString(s), nativeSceneToString(back->scene));
 }

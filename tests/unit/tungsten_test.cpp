@@ -32,6 +32,7 @@ TEST(Tungsten, CornellBoxMatchesTheObjVersion) {
   EXPECT_EQ(s.settings.pixelFilter, PixelFilter::Tent) << "the scene's reconstruction_filter";
   EXPECT_EQ(s.settings.filterWidth, 2.0f) << "Tungsten's tent reaches one pixel each way";
   EXPECT_EQ(s.settings.filterSampling, FilterSampling::Tungsten) << "drawn as the scene's author saw it";
+  EXPECT_EQ(s.settings.shading, ShadingConvention::Tungsten) << "Tungsten's defaults: two-sided, no consistency checks";
 
   // The light: a downward-facing quad 2 cm below the ceiling, corners as in cornell-box.obj.
   const Object* light = objectWithMaterial(s, "Light");
@@ -224,7 +225,8 @@ TEST(Tungsten, ADielectricWithoutRefractionIsAFresnelReflectorOnly) {
 }
 
 // The spaceship's leathers ask for Beckmann: rendered with it (no warning); a Phong distribution
-// still becomes GGX with a warning naming it. Saved natively, the distribution stays.
+// still becomes GGX with a warning naming it. Every rough material takes Tungsten's separable
+// Smith shadowing. Saved natively, distribution and shadowing stay.
 TEST(Tungsten, BeckmannIsKeptAndPhongWarns) {
   auto r = importTungsten(writeScene(R"({"bsdfs": [
       {"name": "leather", "type": "rough_plastic", "distribution": "beckmann", "roughness": 0.4},
@@ -234,6 +236,8 @@ TEST(Tungsten, BeckmannIsKeptAndPhongWarns) {
   const Scene& s = r->scene;
   EXPECT_TRUE(s.material(s.objects[0].material)->beckmann);
   EXPECT_FALSE(s.material(s.objects[1].material)->beckmann);
+  EXPECT_TRUE(s.material(s.objects[0].material)->separableShadowing);
+  EXPECT_TRUE(s.material(s.objects[1].material)->separableShadowing);
   int phong = 0;
   for (const auto& w : r->warnings) {
     EXPECT_EQ(w.find("beckmann"), std::string::npos) << w;
@@ -245,6 +249,7 @@ TEST(Tungsten, BeckmannIsKeptAndPhongWarns) {
   auto back = loadNativeScene(file);
   ASSERT_TRUE(back.ok()) << back.error();
   EXPECT_TRUE(back->scene.material(back->scene.objects[0].material)->beckmann);
+  EXPECT_TRUE(back->scene.material(back->scene.objects[1].material)->separableShadowing);
 }
 
 TEST(Tungsten, PowerBecomesRadianceByArea) {

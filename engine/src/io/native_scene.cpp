@@ -179,6 +179,7 @@ std::string nativeSceneToString(const Scene& s) {
   settings.set("filter_width", s.settings.filterWidth);
   // Only scenes that came from Tungsten files say it; everything else draws the filter exactly.
   if (s.settings.filterSampling == FilterSampling::Tungsten) settings.set("filter_sampling", "tungsten");
+  if (s.settings.shading == ShadingConvention::Tungsten) settings.set("shading", "tungsten");
   root.set("settings", settings);
 
   Value cam(json::Object{});
@@ -251,6 +252,7 @@ std::string nativeSceneToString(const Scene& s) {
     v.set("albedo_texture", m.albedoTexture);
     v.set("roughness", m.roughness);
     if (m.beckmann) v.set("distribution", "beckmann");
+    if (m.separableShadowing) v.set("shadowing", "separable");
     v.set("roughness_texture", m.roughnessTexture);
     v.set("ior", m.ior);
     v.set("metal", m.metal);
@@ -348,6 +350,11 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
     if (sampling == "tungsten") s.settings.filterSampling = FilterSampling::Tungsten;
     else if (!sampling.empty() && sampling != "exact")
       r.problem("filter_sampling", cat("unknown filter sampling '", sampling, "' (exact, tungsten)"));
+    std::string shading;
+    r.string("shading", &shading);
+    if (shading == "tungsten") s.settings.shading = ShadingConvention::Tungsten;
+    else if (!shading.empty() && shading != "consistent")
+      r.problem("shading", cat("unknown shading '", shading, "' (consistent, tungsten)"));
   }
   if (const Value* v = root.find("camera")) {
     Reader r(&error, "camera", v);
@@ -442,6 +449,11 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       if (distribution == "beckmann") m.beckmann = true;
       else if (!distribution.empty() && distribution != "ggx")
         r.problem("distribution", cat("unknown distribution '", distribution, "' (ggx, beckmann)"));
+      std::string shadowing;
+      r.string("shadowing", &shadowing);
+      if (shadowing == "separable") m.separableShadowing = true;
+      else if (!shadowing.empty() && shadowing != "correlated")
+        r.problem("shadowing", cat("unknown shadowing '", shadowing, "' (correlated, separable)"));
       r.id("roughness_texture", &m.roughnessTexture);
       r.number("ior", &m.ior);
       r.string("metal", &m.metal);

@@ -65,6 +65,15 @@ class TungstenImporter {
       if (const Value* v = in->find("max_bounces"); v && json::toFloat(*v, &mb) && mb >= 0)
         s.settings.maxBounces = std::clamp(static_cast<int>(mb) - 1, 0, 1024);  // Tungsten counts segments
     }
+    // Tungsten's defaults: two-sided shading on, consistency checks off. With the checks on, its
+    // paths end where ours do; one-sided shading has no counterpart here and is shaded two-sided.
+    bool consistency = false, twoSided = true;
+    if (const Value* in = root.find("integrator"); in && in->isObject()) {
+      if (const Value* v = in->find("enable_consistency_checks"); v && v->isBool()) consistency = v->asBool();
+      if (const Value* v = in->find("enable_two_sided_shading"); v && v->isBool()) twoSided = v->asBool();
+    }
+    s.settings.shading = !consistency && twoSided ? ShadingConvention::Tungsten : ShadingConvention::Consistent;
+    if (!twoSided) warn("integrator: one-sided shading (enable_two_sided_shading: false) is rendered two-sided");
     if (const Value* r = root.find("renderer"); r && r->isObject()) {
       float spp;
       if (const Value* v = r->find("spp"); v && json::toFloat(*v, &spp) && spp >= 1)
@@ -267,6 +276,7 @@ class TungstenImporter {
     }
     std::string dist = string(v, "distribution", "ggx");
     m.beckmann = dist == "beckmann";
+    m.separableShadowing = true;  // Tungsten's Microfacet::G is G1(wi) G1(wo)
     if (dist != "ggx" && dist != "beckmann") warn(cat(where, ": distribution '", dist, "' is rendered as GGX"));
     auto roughness = [&](float fallback) {
       m.roughness = fallback;

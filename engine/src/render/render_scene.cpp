@@ -181,6 +181,7 @@ std::uint32_t RenderSceneData::features() const {
   if (environmentType == gpu::kEnvMap) f |= gpu::kFeatureEnvMap;
   if (!emitters.empty()) f |= gpu::kFeatureEmitters;
   if (!deltaLights.empty()) f |= gpu::kFeatureDeltaLights;
+  if (tungstenShading) f |= gpu::kFeatureTungstenShading;
   return f;
 }
 
@@ -197,6 +198,7 @@ int RenderSceneBuilder::materialIndex(NodeId id) const {
 std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags, std::vector<std::string>* warnings) {
   if (first_) flags = kUpdateAll;
   first_ = false;
+  data_.tungstenShading = scene.settings.shading == ShadingConvention::Tungsten;  // a kernel variant, no array
   timing_ = {};
   std::uint32_t dirty = 0;
   if (flags & kUpdateTextures || flags & kUpdateEnvironment) {
@@ -303,7 +305,8 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   Vec3 eta = m.eta, k = m.k;
   if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
   const bool rough = isMicrofacet(m.type);
-  int type = static_cast<int>(m.type) | (rough && m.beckmann ? gpu::kMatBeckmann : 0);
+  int type = static_cast<int>(m.type) | (rough && m.beckmann ? gpu::kMatBeckmann : 0) |
+             (rough && m.separableShadowing ? gpu::kMatSeparable : 0);
   // Keep roughness away from zero, where GGX turns into a delta the rough code cannot sample.
   float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
   if (rough) roughness = std::max(roughness, 1e-3f);

@@ -74,6 +74,7 @@ struct RenderSceneData {
   std::uint32_t materialTypes = 0;     // bit kMat... of each material type present
   bool materialTextures = false;       // some material reads an albedo or roughness texture
 
+  bool tungstenShading = false;        // RenderSettings::shading is Tungsten's
   std::uint32_t features() const;      // kFeature... (layouts.h) of what the arrays hold
 
   std::uint64_t deviceBytes() const;

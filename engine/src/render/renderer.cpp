@@ -759,6 +759,7 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   if (f & static_cast<std::uint32_t>(gpu::kFeatureEnvMap)) out.push_back("environment map");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureEmitters)) out.push_back("emissive triangles");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureDeltaLights)) out.push_back("delta lights");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureTungstenShading)) out.push_back("Tungsten's shading normals");
   return out;
 }
 double Renderer::lastBlasSeconds() const { return impl_->builder.lastTiming().blas; }
