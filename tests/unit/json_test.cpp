@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "core/json.h"
 
 namespace retile::json {
@@ -43,6 +45,28 @@ TEST(Json, WriteRoundTripsFloatsExactly) {
   EXPECT_EQ(static_cast<float>(back->find("f")->asNumber()), 0.1f);
   EXPECT_EQ(back->find("d")->asNumber(), 1.0 / 3.0);
   EXPECT_EQ(back->find("s")->asString(), "quote \" backslash \\ tab \t");
+}
+
+// JSON has no NaN or infinity: the writer's output must still parse, and a caller can find where
+// such a number sits before writing.
+TEST(Json, NonFiniteNumbersWriteAsNullAndCanBeFound) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  Value material(Object{});
+  material.set("albedo", fromVec3(Vec3{2.0f, static_cast<float>(nan), 0.0f}));
+  Value first(Object{});
+  Array materials;
+  materials.push_back(std::move(first));
+  materials.push_back(std::move(material));
+  Value v(Object{});
+  v.set("fine", 1.5);
+  v.set("materials", std::move(materials));
+  EXPECT_EQ(firstNonFinite(v), "materials[1].albedo[1]");
+  auto back = parse(write(v));
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_TRUE(back->find("materials")->asArray()[1].find("albedo")->asArray()[1].isNull());
+  EXPECT_EQ(write(Value(-inf), false), "null");
+  EXPECT_EQ(firstNonFinite(Value(inf)), "the value");
+  EXPECT_EQ(firstNonFinite(back.value()), "");
 }
 
 TEST(Json, LenientVectorReaders) {

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <limits>
 #include <thread>
 #include <regex>
 
@@ -125,6 +126,22 @@ TEST(Native, FailedSaveKeepsTheOldFile) {
   std::filesystem::permissions(dir, std::filesystem::perms::owner_all);
   if (::geteuid() == 0) GTEST_SKIP() << "running as root: directory permissions do not stop writes";
   EXPECT_FALSE(r.ok());
+  EXPECT_EQ(readFile(file).value(), before.value());
+}
+
+// A NaN that reached the document (no importer or panel lets one in, but an edit could) is not
+// written: JSON cannot hold it, and the file would not read back. The save names the value and
+// leaves the file as it was.
+TEST(Native, ASceneWithANonFiniteValueIsNotSaved) {
+  auto file = test::tempDir() / "scene.retile";
+  ASSERT_TRUE(saveNativeScene(makeDefaultScene(), file).ok());
+  auto before = readFile(file);
+  Scene s = makeDefaultScene();
+  s.materials[1].roughness = std::numeric_limits<float>::quiet_NaN();
+  auto r = saveNativeScene(s, file);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("scene.retile"), std::string::npos) << r.error();
+  EXPECT_NE(r.error().find("materials[1].roughness is not a finite number"), std::string::npos) << r.error();
   EXPECT_EQ(readFile(file).value(), before.value());
 }
 

@@ -335,7 +335,10 @@ void writeValue(std::string& out, const Value& v, bool pretty, int indent) {
   switch (v.type()) {
     case Value::Type::kNull: out += "null"; break;
     case Value::Type::kBool: out += v.asBool() ? "true" : "false"; break;
-    case Value::Type::kNumber: numbers::append(out, v.asNumber()); break;
+    case Value::Type::kNumber:
+      if (std::isfinite(v.asNumber())) numbers::append(out, v.asNumber());
+      else out += "null";
+      break;
     case Value::Type::kString: writeString(out, v.asString()); break;
     case Value::Type::kArray: {
       const Array& a = v.asArray();
@@ -371,6 +374,34 @@ void writeValue(std::string& out, const Value& v, bool pretty, int indent) {
 
 Result<Value> parse(std::string_view text, const ParseLimits& limits) {
   return Parser(text, limits).run();
+}
+
+namespace {
+
+bool findNonFinite(const Value& v, std::string& path) {
+  const std::size_t at = path.size();
+  if (v.isNumber()) return !std::isfinite(v.asNumber());
+  if (v.isArray())
+    for (std::size_t i = 0; i < v.asArray().size(); ++i) {
+      path += cat("[", i, "]");
+      if (findNonFinite(v.asArray()[i], path)) return true;
+      path.resize(at);
+    }
+  if (v.isObject())
+    for (const auto& [key, e] : v.asObject()) {
+      path += path.empty() ? key : "." + key;
+      if (findNonFinite(e, path)) return true;
+      path.resize(at);
+    }
+  return false;
+}
+
+}  // namespace
+
+std::string firstNonFinite(const Value& value) {
+  std::string path;
+  if (!findNonFinite(value, path)) return {};
+  return path.empty() ? "the value" : path;
 }
 
 std::string write(const Value& value, bool pretty) {

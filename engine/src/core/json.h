@@ -78,8 +78,14 @@ struct ParseLimits {
 // Parses a whole document; trailing content other than whitespace is an error.
 Result<Value> parse(std::string_view text, const ParseLimits& limits = {});
 
-// Writes with two-space indentation; numbers round-trip floats exactly.
+// Writes with two-space indentation; numbers round-trip floats exactly. JSON has no NaN or
+// infinity: they are written as null (an infinite PSNR in a report), and a caller that must read
+// its output back checks firstNonFinite before writing.
 std::string write(const Value& value, bool pretty = true);
+
+// Where the first NaN or infinite number in `value` sits ("materials[2].albedo[0]"), or an empty
+// string when every number is finite.
+std::string firstNonFinite(const Value& value);
 
 }  // namespace retile::json
 

@@ -163,7 +163,9 @@ const char* materialName(MaterialType t) { return materialTypeName(t); }
 
 }  // namespace
 
-std::string nativeSceneToString(const Scene& s) {
+namespace {
+
+Value nativeSceneToJson(const Scene& s) {
   Value root(json::Object{});
   root.set("format", kFormatTag);
   root.set("version", kNativeFormatVersion);
@@ -294,11 +296,20 @@ std::string nativeSceneToString(const Scene& s) {
     lights.push_back(std::move(v));
   }
   root.set("lights", std::move(lights));
-  return json::write(root);
+  return root;
 }
 
+}  // namespace
+
+std::string nativeSceneToString(const Scene& s) { return json::write(nativeSceneToJson(s)); }
+
 Result<bool> saveNativeScene(const Scene& scene, const fs::path& file) {
-  return writeFileAtomic(file, nativeSceneToString(scene));
+  // A NaN or infinity would be written as null and the file would not read back: refuse, so the
+  // file on disk stays as it was and the caller can say which value is at fault.
+  const Value root = nativeSceneToJson(scene);
+  if (std::string at = json::firstNonFinite(root); !at.empty())
+    return Result<bool>::failure(cat(file.string(), ": not saved: ", at, " is not a finite number"));
+  return writeFileAtomic(file, json::write(root));
 }
 
 Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::path& file, const fs::path& baseDir) {
