@@ -34,11 +34,18 @@ Result<std::string> readFile(const fs::path& path, std::uint64_t maxBytes) {
   return data;
 }
 
+namespace {
+
+// A save's temporary is ".STEM.tmpXXXXXX.EXT" beside the file: hidden, and found again by the
+// prefix when a killed save left it behind.
+std::string temporaryPrefix(const fs::path& path) { return cat(".", path.stem().string(), ".tmp"); }
+
+}  // namespace
+
 fs::path temporarySibling(const fs::path& path) {
   static thread_local std::mt19937_64 rng{std::random_device{}()};
   fs::path p = path;
-  std::string stem = path.stem().string();
-  p.replace_filename(cat(".", stem, ".tmp", std::hex, rng() & 0xffffff, path.extension().string()));
+  p.replace_filename(cat(temporaryPrefix(path), std::hex, rng() & 0xffffff, path.extension().string()));
   return p;
 }
 
@@ -77,7 +84,7 @@ Result<bool> writeFileAtomic(const fs::path& path, std::string_view bytes) {
 // no save takes that long, so none of them can belong to a save still running.
 void removeStaleTemporaries(const fs::path& path) {
   std::error_code ec;
-  const std::string prefix = cat(".", path.stem().string(), ".tmp");
+  const std::string prefix = temporaryPrefix(path);
   const std::string suffix = path.extension().string();
   const auto cutoff = fs::file_time_type::clock::now() - std::chrono::minutes(10);
   fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();

@@ -161,7 +161,7 @@ std::int64_t TileScheduler::waterFill(FramePlan& plan, std::vector<int> order, s
                                       std::vector<char>& served) {
   if (order.empty() || budget <= 0) return 0;
   std::vector<double> have(static_cast<std::size_t>(grid_.count()));
-  for (int t : order) have[static_cast<std::size_t>(t)] = samples_[static_cast<std::size_t>(t)] + credit_[static_cast<std::size_t>(t)];
+  for (int t : order) have[static_cast<std::size_t>(t)] = held(t);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return have[static_cast<std::size_t>(a)] < have[static_cast<std::size_t>(b)]; });
   auto cost = [&](double level) {
     std::int64_t c = 0;
@@ -237,14 +237,12 @@ FramePlan TileScheduler::nextFrame() {
     // waiting for the pass to end. When the edit changed everything (a light), every finished
     // tile is equally fresh and the pass keeps the whole budget to restart the stale rest.
     std::vector<double> have;
-    for (int t : finished_) have.push_back(samples_[static_cast<std::size_t>(t)] + credit_[static_cast<std::size_t>(t)]);
+    for (int t : finished_) have.push_back(held(t));
     std::nth_element(have.begin(), have.begin() + static_cast<std::ptrdiff_t>(have.size() / 2), have.end());
     const double median = have[have.size() / 2];
     std::vector<int> behind;
-    for (int t : finished_) {
-      const auto i = static_cast<std::size_t>(t);
-      if (samples_[i] + credit_[i] < kCatchUpFraction * median) behind.push_back(t);
-    }
+    for (int t : finished_)
+      if (held(t) < kCatchUpFraction * median) behind.push_back(t);
     remaining -= waterFill(plan, behind, remaining / 2, served);
   }
   while (pos_ < queue_.size()) {

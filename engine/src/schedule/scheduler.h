@@ -88,6 +88,11 @@ class TileScheduler {
   };
   void emit(FramePlan& plan, int tile, TileRect rect, int quality, bool restart, int cap, bool wholeTile);
   std::int64_t waterFill(FramePlan& plan, std::vector<int> order, std::int64_t budget, std::vector<char>& served);
+  // Samples per pixel tile t holds, its kept history's credit counted.
+  double held(int t) const {
+    const auto i = static_cast<std::size_t>(t);
+    return samples_[i] + (i < credit_.size() ? credit_[i] : 0.0);
+  }
   std::vector<char> region_;
   void fillRemainder(FramePlan& plan, std::int64_t remainder, const std::vector<char>& served);
 
