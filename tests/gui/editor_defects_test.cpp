@@ -657,8 +657,8 @@ TEST(EditorDefects, CtrlClickSelectsSeveralObjectsAndADragMovesThemTogether) {
   EXPECT_EQ(w->selectedObjects(), std::vector<NodeId>{sphere});
 }
 
-// The pixel filter is a render setting: chosen in Properties, it reaches the engine as one undo
-// step and restarts the accumulation (samples are placed differently).
+// The pixel filter, how it is drawn and the shading-normal convention are render settings:
+// chosen in Properties, each reaches the engine as one undo step and restarts the accumulation.
 TEST(EditorDefects, ThePixelFilterIsARenderSettingWithUndo) {
   auto w = makeWindow();
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
@@ -684,6 +684,17 @@ TEST(EditorDefects, ThePixelFilterIsARenderSettingWithUndo) {
   EXPECT_EQ(w->scene().settings.filterSampling, FilterSampling::Tungsten);
   w->undoStack()->undo();
   EXPECT_EQ(w->scene().settings.filterSampling, FilterSampling::Exact);
+  // So is Tungsten's shading-normal convention; switching it must reach the renderer (another
+  // trace kernel) and be rendered.
+  auto* shading = w->findChild<QComboBox*>("shading");
+  ASSERT_TRUE(shading);
+  EXPECT_EQ(shading->currentIndex(), static_cast<int>(ShadingConvention::Consistent));
+  shading->setCurrentIndex(static_cast<int>(ShadingConvention::Tungsten));
+  EXPECT_EQ(w->scene().settings.shading, ShadingConvention::Tungsten);
+  const std::uint64_t shaded = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == shaded; }));
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().settings.shading, ShadingConvention::Consistent);
 }
 
 }  // namespace
