@@ -119,7 +119,6 @@ float ggxLambda(vec3 w, float a) {
 }
 
 float ggxG1(vec3 w, float a) { return 1.0 / (1.0 + ggxLambda(w, a)); }
-float ggxG2(vec3 wo, vec3 wi, float a) { return 1.0 / (1.0 + ggxLambda(wo, a) + ggxLambda(wi, a)); }
 
 // Heitz 2018: sample a microfacet normal from the distribution of normals visible from wo.
 vec3 sampleGgxVisibleNormal(vec3 wo, float a, vec2 u) {

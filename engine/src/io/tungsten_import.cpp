@@ -66,7 +66,8 @@ class TungstenImporter {
         s.settings.maxBounces = std::clamp(static_cast<int>(mb) - 1, 0, 1024);  // Tungsten counts segments
     }
     // Tungsten's defaults: two-sided shading on, consistency checks off. With the checks on, its
-    // paths end where ours do; one-sided shading has no counterpart here and is shaded two-sided.
+    // paths end about where ours do (ours also shade with the geometric normal where the viewer
+    // is behind the shading normal); one-sided shading has no counterpart here.
     bool consistency = false, twoSided = true;
     if (const Value* in = root.find("integrator"); in && in->isObject()) {
       if (const Value* v = in->find("enable_consistency_checks"); v && v->isBool()) consistency = v->asBool();
