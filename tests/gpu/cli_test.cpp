@@ -12,7 +12,9 @@
 #include "core/files.h"
 #include "core/process.h"
 #include "io/image_io.h"
+#include "retile/image.h"
 #include "retile/io.h"
+#include "retile/log.h"
 #include "test_support.h"
 
 namespace retile {
@@ -64,6 +66,50 @@ TEST(Cli, ImportAndRenderUnderACommaDecimalLocale) {
   ChildResult comma = runChild(RETILE_CLI_PATH, {"render", scene.string(), "--exposure", "0,5"}, limits);
   EXPECT_EQ(comma.exitCode, 2);
   EXPECT_NE(comma.err.find("'0,5' is not a number"), std::string::npos) << comma.err;
+}
+
+// `retile compare` with a noise image lists the ratio by block size: noise averages away as blocks
+// grow, a bias does not. Three synthetic images: the reference flat; ours at two seeds, each with
+// its own noise and both 3 % brighter on the left half (the bias our renderer would have).
+TEST(Cli, CompareTellsABiasFromNoiseByBlockSize) {
+  const int w = 128, h = 64;
+  auto image = [&](unsigned seed, float noise, float bias) {
+    RenderImage im;
+    im.width = w;
+    im.height = h;
+    im.color.resize(static_cast<std::size_t>(w * h * 3));
+    std::uint32_t state = seed;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        state = state * 1664525u + 1013904223u;
+        const float u = static_cast<float>(state >> 8) / static_cast<float>(1u << 24) - 0.5f;
+        const float v = 0.5f * (1.0f + (x < w / 2 ? bias : 0.0f)) + noise * u;
+        for (int c = 0; c < 3; ++c) im.color[static_cast<std::size_t>((y * w + x) * 3 + c)] = v;
+      }
+    return im;
+  };
+  const auto dir = test::tempDir();
+  ASSERT_TRUE(writeRenderImage(image(1, 0.0f, 0.0f), dir / "ref.exr").ok());
+  ASSERT_TRUE(writeRenderImage(image(2, 0.2f, 0.03f), dir / "a.exr").ok());
+  ASSERT_TRUE(writeRenderImage(image(3, 0.2f, 0.03f), dir / "b.exr").ok());
+  ChildLimits limits;
+  limits.timeout = std::chrono::minutes(2);
+  ChildResult r = runChild(RETILE_CLI_PATH,
+                           {"compare", (dir / "a.exr").string(), (dir / "ref.exr").string(), "--noise", (dir / "b.exr").string()},
+                           limits);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  auto ratioAt = [&](int size) {
+    const std::string key = cat("block ", size < 10 ? " " : "", size, ": ");
+    const std::size_t at = r.out.find(key);
+    if (at == std::string::npos) return -1.0;
+    const std::size_t ratio = r.out.find("ratio ", at);
+    return std::atof(r.out.c_str() + ratio + 6);
+  };
+  const double one = ratioAt(1), big = ratioAt(32);
+  ASSERT_GT(one, 0) << r.out;
+  ASSERT_GT(big, 0) << r.out;
+  EXPECT_LT(one, 1.2) << "per pixel the noise hides the bias\n" << r.out;
+  EXPECT_GT(big, 3.0) << "over 32x32 blocks the bias stands out\n" << r.out;
 }
 
 // Each command explains itself: `--help` at every level exits 0 and lists the command's options
