@@ -188,8 +188,8 @@ enum class FilterSampling { Exact, Tungsten };
 // whose next direction would cross the true surface ends, so light cannot leak through a mesh.
 // Tungsten: as Tungsten's path tracer with the defaults its scene files are made with (two-sided
 // shading, consistency checks off): the shading normal, turned toward the viewer, alone decides,
-// and paths may cross the true surface. Smooth meshes then shade differently at their rims (the
-// spaceship's hull: 2 to 4 % in 8x8 blocks).
+// and paths may cross the true surface. Smooth meshes then shade differently where the shading
+// normal and the true surface disagree, mostly at their rims.
 enum class ShadingConvention { Consistent, Tungsten };
 constexpr int kTungstenFilterSteps = 31;
 // The Tungsten table's CDF at steps 1..30 (step 0's is 0, step 31's is 1), for tent and Gaussian.
