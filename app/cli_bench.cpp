@@ -110,8 +110,9 @@ std::vector<std::uint64_t> parseCounts(const std::string& text) {
 
 int benchRoom(const RoomOptions& o) {
   const std::vector<std::uint64_t> counts = parseCounts(o.triangles);
-  std::printf("%10s %11s %9s %9s %10s | bytes per triangle: %6s %6s %6s %6s %6s\n", "triangles", "samples/s", "build s",
-              "objects", "device MiB", "total", "tris", "BVH", "shade", "other");
+  // Loop iterations per path do not drift with the machine's speed, as samples/s does.
+  std::printf("%10s %11s %9s %9s %9s %10s | bytes per triangle: %6s %6s %6s %6s %6s\n", "triangles", "samples/s",
+              "iter/path", "build s", "objects", "device MiB", "total", "tris", "BVH", "shade", "other");
   for (std::uint64_t n : counts) {
     const Scene scene = makeFurnishedRoom(n);
     if (!o.writeScene.empty() && n == counts.front()) {
@@ -128,7 +129,8 @@ int benchRoom(const RoomOptions& o) {
     const double tris = static_cast<double>(renderer.sceneTriangles());
     const Renderer::SceneMemory m = renderer.sceneMemory();
     const double total = static_cast<double>(renderer.sceneDeviceBytes());
-    std::printf("%10.0f %9.3f M %9.2f %9zu %10.1f | %26.1f %6.1f %6.1f %6.1f %6.1f\n", tris, rate * 1e-6, build,
+    const double iterations = static_cast<double>(sum.loopIterations) / static_cast<double>(std::max<std::uint64_t>(sum.samples, 1));
+    std::printf("%10.0f %9.3f M %9.1f %9.2f %9zu %10.1f | %26.1f %6.1f %6.1f %6.1f %6.1f\n", tris, rate * 1e-6, iterations, build,
                 scene.objects.size(), total / (1 << 20), total / tris, static_cast<double>(m.triangles) / tris,
                 static_cast<double>(m.bvh) / tris, static_cast<double>(m.shading) / tris,
                 static_cast<double>(m.textures + m.other) / tris);
@@ -175,6 +177,9 @@ int benchThroughput(const ThroughputOptions& o) {
   std::printf("frame time     %.1f ms (device), %.1f ms (wall)\n", sec / frames * 1e3, wall / frames * 1e3);
   std::printf("scene upload   %.3f s (BVH bottom level %.3f s, top level %.4f s)\n", setup, renderer.lastBlasSeconds(),
               renderer.lastTlasSeconds());
+  std::printf("top level      %llu references to %llu instances\n",
+              static_cast<unsigned long long>(renderer.sceneInstanceReferences()),
+              static_cast<unsigned long long>(renderer.sceneInstances()));
   std::printf("loop iterations %u at most in one invocation (paths stop at %u; lavapipe's limit is near 32767); "
               "%llu paths cut short; %u at most in one path segment\n",
               sum.maxLoopIterations, kTraceLoopBudget, static_cast<unsigned long long>(sum.cutPaths),

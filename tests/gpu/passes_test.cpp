@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <random>
+#include <span>
 
 #include "gpu_support.h"
 #include "render/bvh.h"
@@ -344,13 +345,46 @@ CameraRay cameraRay(const Camera& c, int w, int h, int px, int py, std::uint32_t
   return {c.position, normalize(forward + right * (nx * tanHalf * aspect) - up * (ny * tanHalf))};
 }
 
-// Traversal against brute force. A soup of overlapping triangles makes a mesh BVH that is deep
-// and wide open (rays enter both children of many nodes, so the stack grows past the eight
-// entries kept in variables), and three instances of it, one rotated and scaled, make the ray
-// go in and out of instances.
-TEST(TracePass, FirstHitsMatchABruteForceReference) {
-  RETILE_RENDERER_OR_SKIP(r);
-  const int w = 48, h = 36;
+// Renders one sample per pixel of `s` (whose objects `ids` are instances of `mesh` placed by
+// `placements`) and counts the pixels whose first hit (object and depth) differs from brute force.
+struct FirstHitCheck {
+  int checked = 0, hits = 0, disagree = 0;
+};
+FirstHitCheck compareFirstHits(Renderer& r, const Scene& s, const MeshGeometry& mesh, std::span<const Mat4> placements,
+                               std::span<const NodeId> ids) {
+  const int w = s.settings.width, h = s.settings.height;
+  FrameOptions options;
+  r.renderFrame({{0, 0, w, h, 1, 0, true}}, options);
+  RenderImage img = r.readback();
+  FirstHitCheck c;
+  if (img.width != w || img.height != h) return c;
+  for (int py = 0; py < h; ++py)
+    for (int px = 0; px < w; ++px) {
+      CameraRay ray = cameraRay(s.camera, w, h, px, py, 0, 3);
+      float best = 1e30f;
+      NodeId bestId = kNoNode;
+      for (std::size_t k = 0; k < ids.size(); ++k)
+        for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
+          Vec3 v[3];
+          for (int j = 0; j < 3; ++j) v[j] = placements[k].transformPoint(mesh.positions[mesh.indices[t * 3 + static_cast<std::size_t>(j)]]);
+          float th, u, vv;
+          if (intersectTriangle(ray.origin, ray.dir, v[0], v[1], v[2], best, &th, &u, &vv)) {
+            best = th;
+            bestId = ids[k];
+          }
+        }
+      std::size_t i = static_cast<std::size_t>(py * w + px);
+      ++c.checked;
+      if (bestId != kNoNode) ++c.hits;
+      // Rays that graze an edge may go either way in float arithmetic; a traversal that loses
+      // stack entries or subtrees disagrees on many pixels.
+      bool same = img.objectId[i] == bestId && (bestId == kNoNode || std::abs(img.depth[i] - best) <= 1e-3f * best);
+      if (!same) ++c.disagree;
+    }
+  return c;
+}
+
+Scene firstHitScene(int w, int h) {
   Scene s = test::emptyScene(w, h);
   s.camera.position = {0, 0, 4.5f};
   s.camera.target = {0, 0, 0};
@@ -358,6 +392,16 @@ TEST(TracePass, FirstHitsMatchABruteForceReference) {
   s.settings.pixelFilter = PixelFilter::Box;  // as cameraRay places the samples
   s.settings.filterWidth = 1.0f;
   s.environment.color = Vec3{1.0f};
+  return s;
+}
+
+// Traversal against brute force. A soup of overlapping triangles makes a mesh BVH that is deep
+// and wide open (rays enter both children of many nodes, so the stack grows past the eight
+// entries kept in variables), and three instances of it, one rotated and scaled, make the ray
+// go in and out of instances.
+TEST(TracePass, FirstHitsMatchABruteForceReference) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = firstHitScene(48, 36);
   auto soup = std::make_shared<MeshGeometry>();
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f), size(0.05f, 0.5f);
@@ -373,39 +417,48 @@ TEST(TracePass, FirstHitsMatchABruteForceReference) {
   std::vector<NodeId> ids;
   for (const Mat4& m : placements) ids.push_back(test::addMeshObject(s, "soup", soup, mat, m));
   r->setScene(s);
-  r->resize(w, h);
+  r->resize(s.settings.width, s.settings.height);
   r->setSeed(3);
-  FrameOptions options;
-  r->renderFrame({{0, 0, w, h, 1, 0, true}}, options);
-  RenderImage img = r->readback();
-  ASSERT_EQ(img.width, w);
+  const FirstHitCheck c = compareFirstHits(*r, s, *soup, placements, ids);
+  EXPECT_GT(c.hits, c.checked / 2) << "the soup should fill most of the view";
+  EXPECT_LE(c.disagree, c.checked / 500) << c.disagree << " of " << c.checked << " pixels see another first hit than brute force";
+}
 
-  int checked = 0, disagree = 0, hits = 0;
-  for (int py = 0; py < h; ++py)
-    for (int px = 0; px < w; ++px) {
-      CameraRay ray = cameraRay(s.camera, w, h, px, py, 0, 3);
-      float best = 1e30f;
-      NodeId bestId = kNoNode;
-      for (std::size_t k = 0; k < ids.size(); ++k)
-        for (std::size_t t = 0; t < soup->triangleCount(); ++t) {
-          Vec3 v[3];
-          for (int j = 0; j < 3; ++j) v[j] = placements[k].transformPoint(soup->positions[soup->indices[t * 3 + static_cast<std::size_t>(j)]]);
-          float th, u, vv;
-          if (intersectTriangle(ray.origin, ray.dir, v[0], v[1], v[2], best, &th, &u, &vv)) {
-            best = th;
-            bestId = ids[k];
-          }
-        }
-      std::size_t i = static_cast<std::size_t>(py * w + px);
-      ++checked;
-      if (bestId != kNoNode) ++hits;
-      // Rays that graze an edge may go either way in float arithmetic; a traversal that loses
-      // stack entries misses whole subtrees and disagrees on many pixels.
-      bool same = img.objectId[i] == bestId && (bestId == kNoNode || std::abs(img.depth[i] - best) <= 1e-3f * best);
-      if (!same) ++disagree;
-    }
-  EXPECT_GT(hits, checked / 2) << "the soup should fill most of the view";
-  EXPECT_LE(disagree, checked / 500) << disagree << " of " << checked << " pixels see another first hit than brute force";
+// Instances whose boxes hold each other's geometry are entered at subtrees of their BVHs
+// (re-braiding, render_scene.cpp): three thin rods of small triangles along diagonals of the
+// same cube. Moving one repacks the instance BVH alone; the hits agree before and after.
+TEST(TracePass, InstancesEnteredAtSubtreesHitWhatBruteForceHits) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = firstHitScene(48, 36);
+  auto rod = std::make_shared<MeshGeometry>();
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  for (std::uint32_t i = 0; i < 3000; ++i) {
+    const Vec3 c = Vec3{1.2f} * unit(rng);
+    for (int v = 0; v < 3; ++v) rod->positions.push_back(c + Vec3{unit(rng), unit(rng), unit(rng)} * 0.08f);
+    for (std::uint32_t v = 0; v < 3; ++v) rod->indices.push_back(i * 3 + v);
+  }
+  NodeId mat = test::addMaterial(s, Material{});
+  Mat4 placements[] = {Mat4::identity(), Mat4::rotateY(1.5708f), Mat4::rotateX(1.5708f) * Mat4::scale({1.0f, 0.7f, 1.0f})};
+  std::vector<NodeId> ids;
+  for (const Mat4& m : placements) ids.push_back(test::addMeshObject(s, "rod", rod, mat, m));
+  r->setScene(s);
+  EXPECT_GT(r->sceneInstanceReferences(), r->sceneInstances()) << "rods crossing each other's boxes are entered at subtrees";
+  r->resize(s.settings.width, s.settings.height);
+  r->setSeed(3);
+  FirstHitCheck c = compareFirstHits(*r, s, *rod, placements, ids);
+  EXPECT_GT(c.hits, c.checked / 20) << "the rods should cross the view";
+  EXPECT_LE(c.disagree, c.checked / 500) << c.disagree << " of " << c.checked << " pixels see another first hit than brute force";
+
+  placements[2] = Mat4::translate({0.3f, 0.2f, 0.1f}) * placements[2];
+  Object* moved = s.object(ids[2]);
+  ASSERT_NE(moved, nullptr);
+  moved->transform = placements[2];
+  r->updateScene(s, kUpdateInstances);
+  c = compareFirstHits(*r, s, *rod, placements, ids);
+  EXPECT_GT(c.hits, c.checked / 20);
+  EXPECT_LE(c.disagree, c.checked / 500) << "after a move: " << c.disagree << " of " << c.checked
+                                         << " pixels see another first hit than brute force";
 }
 
 // One frame of the default scene traced with `paths` paths per invocation.

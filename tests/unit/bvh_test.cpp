@@ -6,6 +6,8 @@
 #include <utility>
 
 #include "render/bvh.h"
+#include "render/render_scene.h"
+#include "scene/primitives.h"
 #include "retile/io.h"
 #include "test_support.h"
 
@@ -149,6 +151,73 @@ TEST(Bvh, BunnyAgreesWithBruteForce) {
   Soup s;
   for (std::uint32_t i : g->indices) s.verts.push_back(g->positions[i]);
   checkAgainstBruteForce(s, 400, 5);
+}
+
+// Two unit cubes far apart: the root is visited, then each leaf's one primitive costs one step
+// for the share of rays through the root's box that also pass through the leaf's.
+TEST(Bvh, ExpectedStepsFollowTheSurfaceAreaHeuristic) {
+  Bounds3 a, b;
+  a.grow({0, 0, 0});
+  a.grow({1, 1, 1});
+  b.grow({9, 0, 0});
+  b.grow({10, 1, 1});
+  const std::vector<Bounds3> boxes{a, b};
+  BvhBuildOptions one;
+  one.maxLeafSize = 1;
+  const Bvh bvh = buildBvh(boxes, one);
+  ASSERT_EQ(bvh.nodes.size(), 1u);
+  const float root = bvh.bounds.area();  // 10 x 1 x 1: 42
+  EXPECT_FLOAT_EQ(expectedSteps(bvh, [](std::uint32_t) { return 1.0f; })[0], 1.0f + 2 * 6.0f / root);
+  // A primitive's own cost scales its term.
+  const std::vector<float> steps = expectedSteps(bvh, [&](std::uint32_t p) { return bvh.primOrder[p] == 0 ? 5.0f : 1.0f; });
+  EXPECT_FLOAT_EQ(steps[0], 1.0f + (6.0f * 5.0f + 6.0f) / root);
+}
+
+// Instances that overlap are entered at subtrees of their BVHs, so that the instance BVH can
+// separate what their boxes share; instances apart keep one reference each. A move keeps the
+// choice and repacks the same number of references.
+// Small triangles along the diagonal from -corner to corner: a thin rod whose box is mostly empty.
+std::shared_ptr<const MeshGeometry> diagonalRod(Vec3 corner, std::uint32_t triangles, std::uint32_t seed) {
+  auto soup = std::make_shared<MeshGeometry>();
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  for (std::uint32_t i = 0; i < triangles; ++i) {
+    const Vec3 c = corner * unit(rng);
+    for (int v = 0; v < 3; ++v) soup->positions.push_back(c + Vec3{unit(rng), unit(rng), unit(rng)} * 0.05f);
+    for (std::uint32_t v = 0; v < 3; ++v) soup->indices.push_back(i * 3 + v);
+  }
+  return soup;
+}
+
+TEST(RenderScene, OverlappingInstancesAreEnteredAtSubtrees) {
+  Scene s = test::emptyScene(8, 8);
+  const NodeId mat = test::addMaterial(s, Material{});
+  // Two rods crossing the same cube along different diagonals: each box holds the other rod.
+  test::addMeshObject(s, "a", diagonalRod({1, 1, 1}, 2000, 1), mat, Mat4::identity());
+  const NodeId b = test::addMeshObject(s, "b", diagonalRod({1, -1, 1}, 2000, 2), mat, Mat4::identity());
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  const std::size_t references = builder.data().instanceReferences;
+  EXPECT_EQ(builder.data().instanceObject.size(), 2u);
+  EXPECT_GT(references, 2u);
+  // A move repacks the instance BVH with the same choice.
+  Object* moved = s.object(b);
+  ASSERT_NE(moved, nullptr);
+  moved->transform = Mat4::translate({0.1f, 0, 0}) * moved->transform;
+  EXPECT_NE(builder.update(s, kUpdateInstances, nullptr) & kDirtyInstances, 0u);
+  EXPECT_EQ(builder.data().instanceReferences, references);
+}
+
+TEST(RenderScene, InstancesApartKeepOneReferenceEach) {
+  Scene s = test::emptyScene(8, 8);
+  const NodeId mat = test::addMaterial(s, Material{});
+  const auto sphere = makeSphere(16, 32);
+  for (int i = 0; i < 6; ++i)
+    test::addMeshObject(s, "ball", sphere, mat, Mat4::translate({4.0f * static_cast<float>(i), 0, 0}));
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  EXPECT_EQ(builder.data().instanceObject.size(), 6u);
+  EXPECT_EQ(builder.data().instanceReferences, 6u);
 }
 
 }  // namespace

@@ -190,6 +190,10 @@ class Renderer {
   // "alpha test", "textures", "emitters", ...): a scene pays only for what it uses.
   std::vector<std::string> kernelFeatures() const;
   std::uint64_t sceneTriangles() const;
+  // The instance BVH's leaves: one per visible object, more where objects overlap and their own
+  // BVHs are entered at subtrees (render/render_scene.cpp, re-braiding).
+  std::uint64_t sceneInstances() const;
+  std::uint64_t sceneInstanceReferences() const;
   // Seconds the last setScene/updateScene spent building BVHs (bottom level, top level).
   double lastBlasSeconds() const;
   double lastTlasSeconds() const;

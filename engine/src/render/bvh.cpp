@@ -259,6 +259,37 @@ Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options
   return out;
 }
 
+std::vector<float> expectedSteps(const Bvh& bvh, const std::function<float(std::uint32_t)>& primCost) {
+  std::vector<float> steps(bvh.nodes.size(), 0.0f);
+  for (std::size_t k = bvh.nodes.size(); k-- > 0;) {
+    const GpuBvhNode& n = bvh.nodes[k];
+    Bounds3 box;
+    float weighted = 0;  // sum over slots of area * expected steps inside
+    float unweighted = 0;
+    auto slot = [&](const float* mn, const float* mx, std::int32_t index, std::int32_t count) {
+      if (count < 0) return;
+      Bounds3 b;
+      b.grow({mn[0], mn[1], mn[2]});
+      b.grow({mx[0], mx[1], mx[2]});
+      box.grow(b);
+      float inside = 0;
+      if (count == 0) {
+        inside = steps[static_cast<std::size_t>(index)];
+      } else {
+        for (std::int32_t i = 0; i < count; ++i) inside += primCost(static_cast<std::uint32_t>(index + i));
+      }
+      weighted += b.area() * inside;
+      unweighted += inside;
+    };
+    slot(n.lmin, n.lmax, n.left, n.leftCount);
+    slot(n.rmin, n.rmax, n.right, n.rightCount);
+    const float area = box.area();
+    // A box without area (a line or a point): every ray that reaches it enters both slots.
+    steps[k] = 1.0f + (area > 0 ? weighted / area : unweighted);
+  }
+  return steps;
+}
+
 bool intersectTriangle(Vec3 o, Vec3 d, Vec3 v0, Vec3 v1, Vec3 v2, float tMax, float* t, float* u, float* v) {
   Vec3 e1 = v1 - v0, e2 = v2 - v0;
   Vec3 p = cross(d, e2);

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -47,6 +48,12 @@ struct Bvh {
 // Builds with binned SAH over the given primitive boxes. An empty input yields a single root
 // with two empty slots, so traversal code needs no special case.
 Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options = {});
+
+// Expected traversal steps of a ray that enters each node's box (index as in bvh.nodes), by the
+// surface area heuristic: a node visit costs one step and a leaf's primitives primCost(packed
+// index) each, as in the shader, where every loop iteration does one step of any kind.
+// Children's indices exceed their parent's (the builder packs breadth-first).
+std::vector<float> expectedSteps(const Bvh& bvh, const std::function<float(std::uint32_t)>& primCost);
 
 // Reference traversal of a packed triangle BVH, mirroring the shader, for tests.
 struct RayHit {

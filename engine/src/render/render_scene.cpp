@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <numeric>
+#include <optional>
 
 #include "core/files.h"
 #include "io/image_io.h"
@@ -223,7 +224,7 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
   }
   if (flags & (kUpdateInstances | kUpdateLights)) {
     auto t = Clock::now();
-    packInstances(scene);
+    packInstances(scene, (flags & kUpdateGeometry) != 0);
     timing_.tlas = secondsSince(t);
     t = Clock::now();
     packEmitters(scene);
@@ -253,6 +254,7 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
     // A leaf's item carries its triangle count in two bits (layouts.h).
     static_assert(BvhBuildOptions{}.maxLeafSize <= gpu::kMaxLeafTriangles);
     e.bvh = buildBvh(boxes);
+    e.steps = expectedSteps(e.bvh, [](std::uint32_t) { return 1.0f; });
     e.triangles.resize(n * gpu::kTriTexels);
     e.shading.resize(n * gpu::kTriShadeTexels);
     bool hasN = !g.normals.empty(), hasUv = !g.uvs.empty();
@@ -345,7 +347,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
   pack(fallback);
 }
 
-void RenderSceneBuilder::packInstances(const Scene& scene) {
+void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   struct Candidate {
     const Object* object;
     const MeshEntry* mesh;
@@ -360,20 +362,112 @@ void RenderSceneBuilder::packInstances(const Scene& scene) {
     if (b.empty()) continue;
     cands.push_back({&o, it->second, b});
   }
-  std::vector<Bounds3> boxes;
-  boxes.reserve(cands.size());
-  for (const auto& c : cands) boxes.push_back(c.bounds);
+
+  // Where instances overlap, a ray inside their union is inside every one of their boxes and
+  // must enter each. So the instance BVH is built over references to subtrees of the instances'
+  // BVHs (partial re-braiding, after Benthin et al. 2017): starting from each instance's root,
+  // the reference with the largest box is replaced by its two children until there are `factor`
+  // references per instance. A reference is entered like an instance, at its subtree. Where
+  // instances do not overlap, opening them only adds steps, so the factor is the one whose
+  // instance BVH the surface area heuristic expects to cost the fewest steps. It is chosen when
+  // the objects or meshes change, and kept while objects move, so that a move builds one
+  // instance BVH, whose size stays proportional to the number of objects.
+  struct Ref {
+    std::uint32_t cand;
+    std::int32_t item;  // where traversal enters the instance's BVH
+    std::int32_t node;  // that BVH's node index when item is an inner node, else -1
+    Bounds3 bounds;     // world space
+  };
+  auto braid = [&](std::size_t budget) {
+    std::vector<Ref> refs;
+    refs.reserve(budget);
+    for (std::uint32_t c = 0; c < cands.size(); ++c) refs.push_back({c, cands[c].mesh->rootItem, 0, cands[c].bounds});
+    auto smaller = [&](std::size_t a, std::size_t b) { return refs[a].bounds.area() < refs[b].bounds.area(); };
+    std::vector<std::size_t> open(refs.size());  // a max-heap by area of the references that can still be opened
+    std::iota(open.begin(), open.end(), std::size_t{0});
+    std::make_heap(open.begin(), open.end(), smaller);
+    while (!open.empty() && refs.size() < budget) {
+      std::pop_heap(open.begin(), open.end(), smaller);
+      const std::size_t r = open.back();
+      open.pop_back();
+      const Candidate& c = cands[refs[r].cand];
+      const GpuBvhNode& n = c.mesh->bvh.nodes[static_cast<std::size_t>(refs[r].node)];
+      const std::int64_t nodes = c.mesh->rootItem >> gpu::kItemOffsetShift;
+      auto child = [&](std::int32_t index, std::int32_t count, const float* lo, const float* hi) -> std::optional<Ref> {
+        if (count < 0) return std::nullopt;
+        Bounds3 box;
+        box.grow({lo[0], lo[1], lo[2]});
+        box.grow({hi[0], hi[1], hi[2]});
+        const Bounds3 world = transformBounds(c.object->transform, box);
+        if (count == 0)
+          return Ref{refs[r].cand, traversalItem(nodes + std::int64_t{index} * gpu::kNodeTexels, gpu::kItemNode, 1), index, world};
+        return Ref{refs[r].cand, traversalItem((std::int64_t{c.mesh->triOffset} + index) * gpu::kTriTexels, gpu::kItemTriangles, count),
+                   -1, world};
+      };
+      const std::optional<Ref> left = child(n.left, n.leftCount, n.lmin, n.lmax);
+      const std::optional<Ref> right = child(n.right, n.rightCount, n.rmin, n.rmax);
+      if (!left || !right) continue;  // a leaf root with an empty slot: nothing to open
+      refs[r] = *left;
+      refs.push_back(*right);
+      for (std::size_t i : {r, refs.size() - 1}) {
+        if (refs[i].node < 0) continue;
+        open.push_back(i);
+        std::push_heap(open.begin(), open.end(), smaller);
+      }
+    }
+    return refs;
+  };
   BvhBuildOptions opt;
-  opt.maxLeafSize = 1;  // a TLAS leaf is one instance: traversal enters its BVH directly
-  Bvh tlas = buildBvh(boxes, opt);
-  // The top part of the traversal buffer: the instance BVH, then one record per instance (in
-  // the BVH's packed order, which is also the instance index).
+  opt.maxLeafSize = 1;  // a TLAS leaf is one reference: traversal enters its subtree directly
+  auto build = [&](std::size_t factor, std::vector<Ref>* refs, float* cost) {
+    *refs = braid(std::max(cands.size(), std::min(cands.size() * factor, kMaxBraidReferences)));
+    std::vector<Bounds3> boxes;
+    boxes.reserve(refs->size());
+    for (const Ref& r : *refs) boxes.push_back(r.bounds);
+    Bvh bvh = buildBvh(boxes, opt);
+    if (cost) {
+      // Entering a reference is one step, then its subtree's.
+      *cost = expectedSteps(bvh, [&](std::uint32_t p) {
+        const Ref& r = (*refs)[bvh.primOrder[p]];
+        if (r.node >= 0) return 1.0f + cands[r.cand].mesh->steps[static_cast<std::size_t>(r.node)];
+        return 1.0f + static_cast<float>(((r.item >> 2) & 3) + 1);  // a leaf: its triangles
+      })[0];
+    }
+    return bvh;
+  };
+  std::vector<Ref> refs;
+  Bvh tlas;
+  if (chooseBraid || cands.size() != braidInstances_) {
+    braidFactor_ = 1;
+    braidInstances_ = cands.size();
+    tlas = build(1, &refs, &braidCost_);
+    std::size_t previous = refs.size();
+    for (std::size_t factor = 2; factor <= kMaxBraidFactor; factor *= 2) {
+      std::vector<Ref> tried;
+      float cost = 0;
+      Bvh bvh = build(factor, &tried, &cost);
+      const bool opened = tried.size() > previous;
+      previous = tried.size();
+      if (cost < braidCost_) {
+        braidCost_ = cost;
+        braidFactor_ = factor;
+        refs = std::move(tried);
+        tlas = std::move(bvh);
+      }
+      if (!opened) break;  // nothing left to open, or the cap reached
+    }
+  } else {
+    tlas = build(braidFactor_, &refs, nullptr);
+  }
+
+  // The top part of the traversal buffer: the instance BVH, then one record per reference (in
+  // the BVH's packed order).
   auto base = static_cast<std::int64_t>(data_.meshTraversal.size());
   auto records = base + static_cast<std::int64_t>(tlas.nodes.size()) * gpu::kNodeTexels;
   data_.topTraversal.clear();
   data_.tlasRoot = traversalItem(base, gpu::kItemNode, 1);
   appendNodes(data_.topTraversal, tlas.nodes, base, [&](std::int32_t index, std::int32_t count) {
-    RETILE_ASSERT(count == 1, cat("a top-level leaf of ", count, " instances"));
+    RETILE_ASSERT(count == 1, cat("a top-level leaf of ", count, " references"));
     return traversalItem(records + static_cast<std::int64_t>(index) * gpu::kInstanceRecordTexels, gpu::kItemInstance, 1);
   });
   data_.instances.clear();
@@ -381,27 +475,32 @@ void RenderSceneBuilder::packInstances(const Scene& scene) {
   data_.bounds = tlas.bounds;
   data_.instancedTriangles = 0;
   data_.alphaTested = false;
-  for (std::uint32_t p : tlas.primOrder) {
-    const Candidate& c = cands[p];
+  std::vector<int> flagsOf(cands.size(), 0);
+  std::vector<Mat4> inverseOf(cands.size());
+  for (std::size_t i = 0; i < cands.size(); ++i) {
+    const Candidate& c = cands[i];
     const Material* mat = scene.material(c.object->material);
     int flags = 0;
     if (mat && (mat->alpha < 1.0f || textureIndex(mat->alphaTexture) >= 0)) flags |= gpu::kInstanceAlphaTested;
     if (mat && mat->emissive()) flags |= gpu::kInstanceEmissive;
     if (flags & gpu::kInstanceAlphaTested) data_.alphaTested = true;
-    Mat4 inv = c.object->transform.inverse();
-    auto instance = static_cast<std::int32_t>(data_.instanceObject.size());
-    for (int r = 0; r < 3; ++r) {
-      data_.instances.push_back({inv.m[r][0], inv.m[r][1], inv.m[r][2], inv.m[r][3]});
-      data_.topTraversal.push_back(data_.instances.back());
-    }
-    data_.topTraversal.push_back(ints(c.mesh->rootItem, instance, flags, 0));
-    data_.instances.push_back(ints(0, static_cast<std::int32_t>(c.mesh->triOffset),
-                                   materialIndex(c.object->material), -1));
-    data_.instances.push_back(ints(instance + 1, flags, 0, 0));
+    flagsOf[i] = flags;
+    inverseOf[i] = c.object->transform.inverse();
+    const Mat4& inv = inverseOf[i];
+    for (int r = 0; r < 3; ++r) data_.instances.push_back({inv.m[r][0], inv.m[r][1], inv.m[r][2], inv.m[r][3]});
+    data_.instances.push_back(ints(0, static_cast<std::int32_t>(c.mesh->triOffset), materialIndex(c.object->material), -1));
+    data_.instances.push_back(ints(static_cast<std::int32_t>(i) + 1, flags, 0, 0));
     data_.instanceObject.push_back(c.object->id);
     data_.instancedTriangles += c.mesh->bvh.primOrder.size();
   }
-  RETILE_ASSERT(records + static_cast<std::int64_t>(cands.size()) * gpu::kInstanceRecordTexels ==
+  for (std::uint32_t p : tlas.primOrder) {
+    const Ref& r = refs[p];
+    const Mat4& inv = inverseOf[r.cand];
+    for (int row = 0; row < 3; ++row) data_.topTraversal.push_back({inv.m[row][0], inv.m[row][1], inv.m[row][2], inv.m[row][3]});
+    data_.topTraversal.push_back(ints(r.item, static_cast<std::int32_t>(r.cand), flagsOf[r.cand], 0));
+  }
+  data_.instanceReferences = refs.size();
+  RETILE_ASSERT(records + static_cast<std::int64_t>(refs.size()) * gpu::kInstanceRecordTexels ==
                     base + static_cast<std::int64_t>(data_.topTraversal.size()),
                 "instance records out of place");
 }

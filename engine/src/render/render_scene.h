@@ -61,6 +61,7 @@ struct RenderSceneData {
   std::vector<float> environmentCdf;   // marginal (h+1) then conditional rows (w+1 each)
 
   std::vector<NodeId> instanceObject;  // instance index -> object id
+  std::size_t instanceReferences = 0;  // leaves of the instance BVH: instances or their subtrees
   Bounds3 bounds;
   float lightPick[3] = {0, 0, 0};      // emitters, environment, delta lights
   int environmentType = 0;             // kEnvNone / kEnvConstant / kEnvMap
@@ -99,6 +100,7 @@ class RenderSceneBuilder {
     Bvh bvh;
     std::vector<vec4> triangles;   // kTriTexels per triangle, packed order (w of the first unset)
     std::vector<vec4> shading;
+    std::vector<float> steps;      // expectedSteps of each BVH node
     std::int32_t rootItem = -1;    // in data_.meshTraversal
     std::uint32_t triOffset = 0;   // global index of its first packed triangle
     bool used = false;
@@ -111,7 +113,8 @@ class RenderSceneBuilder {
   };
 
   void packGeometry(const Scene& scene);
-  void packInstances(const Scene& scene);
+  // chooseBraid: choose how far instances are opened (packInstances), as when meshes change.
+  void packInstances(const Scene& scene, bool chooseBraid);
   void packMaterials(const Scene& scene);
   void packTextures(const Scene& scene, std::vector<std::string>* warnings);
   void packEmitters(const Scene& scene);
@@ -131,6 +134,11 @@ class RenderSceneBuilder {
   float environmentPower_ = 0;
   float deltaPower_ = 0;
   bool first_ = true;
+  // Re-braiding (packInstances): references per instance tried up to kMaxBraidFactor, and at most
+  // kMaxBraidReferences in all; the factor chosen, for how many instances, at what expected cost.
+  static constexpr std::size_t kMaxBraidFactor = 64, kMaxBraidReferences = 16384;
+  std::size_t braidFactor_ = 1, braidInstances_ = 0;
+  float braidCost_ = 0;
   Timing timing_;
 };
 

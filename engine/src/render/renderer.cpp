@@ -732,6 +732,8 @@ Renderer::SceneMemory Renderer::sceneMemory() const {
 }
 
 std::uint64_t Renderer::sceneTriangles() const { return impl_->builder.data().triangleCount; }
+std::uint64_t Renderer::sceneInstances() const { return impl_->builder.data().instanceObject.size(); }
+std::uint64_t Renderer::sceneInstanceReferences() const { return impl_->builder.data().instanceReferences; }
 
 void FrameStats::add(const FrameStats& later) {
   samples += later.samples;
