@@ -1,10 +1,10 @@
 // Benchmarks print figures; they never pass or fail (speed goals are not tests).
 #include <algorithm>
 #include <charconv>
-#include <cstdlib>
-#include <fstream>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <random>

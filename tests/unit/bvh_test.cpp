@@ -174,9 +174,6 @@ TEST(Bvh, ExpectedStepsFollowTheSurfaceAreaHeuristic) {
   EXPECT_FLOAT_EQ(steps[0], 1.0f + (6.0f * 5.0f + 6.0f) / root);
 }
 
-// Instances that overlap are entered at subtrees of their BVHs, so that the instance BVH can
-// separate what their boxes share; instances apart keep one reference each. A move keeps the
-// choice and repacks the same number of references.
 // Small triangles along the diagonal from -corner to corner: a thin rod whose box is mostly empty.
 std::shared_ptr<const MeshGeometry> diagonalRod(Vec3 corner, std::uint32_t triangles, std::uint32_t seed) {
   auto soup = std::make_shared<MeshGeometry>();
@@ -190,6 +187,9 @@ std::shared_ptr<const MeshGeometry> diagonalRod(Vec3 corner, std::uint32_t trian
   return soup;
 }
 
+// Instances that overlap are entered at subtrees of their BVHs, so that the instance BVH can
+// separate what their boxes share; instances apart keep one reference each. A move keeps the
+// choice and repacks the same number of references.
 TEST(RenderScene, OverlappingInstancesAreEnteredAtSubtrees) {
   Scene s = test::emptyScene(8, 8);
   const NodeId mat = test::addMaterial(s, Material{});

@@ -259,6 +259,15 @@ Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options
   return out;
 }
 
+Bounds3 slotBounds(const float* mn, const float* mx) {
+  Bounds3 b;
+  for (int k = 0; k < 3; ++k) {
+    b.lo[k] = mn[k];
+    b.hi[k] = mx[k];
+  }
+  return b;
+}
+
 std::vector<float> expectedSteps(const Bvh& bvh, const std::function<float(std::uint32_t)>& primCost) {
   std::vector<float> steps(bvh.nodes.size(), 0.0f);
   for (std::size_t k = bvh.nodes.size(); k-- > 0;) {
@@ -268,9 +277,7 @@ std::vector<float> expectedSteps(const Bvh& bvh, const std::function<float(std::
     float unweighted = 0;
     auto slot = [&](const float* mn, const float* mx, std::int32_t index, std::int32_t count) {
       if (count < 0) return;
-      Bounds3 b;
-      b.grow({mn[0], mn[1], mn[2]});
-      b.grow({mx[0], mx[1], mx[2]});
+      const Bounds3 b = slotBounds(mn, mx);
       box.grow(b);
       float inside = 0;
       if (count == 0) {

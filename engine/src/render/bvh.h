@@ -49,6 +49,9 @@ struct Bvh {
 // with two empty slots, so traversal code needs no special case.
 Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options = {});
 
+// The box of a node's slot (lmin/lmax or rmin/rmax), the inverse of how the builder fills it.
+Bounds3 slotBounds(const float* mn, const float* mx);
+
 // Expected traversal steps of a ray that enters each node's box (index as in bvh.nodes), by the
 // surface area heuristic: a node visit costs one step and a leaf's primitives primCost(packed
 // index) each, as in the shader, where every loop iteration does one step of any kind.

@@ -408,10 +408,7 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
       const std::int64_t nodes = c.mesh->rootItem >> gpu::kItemOffsetShift;
       auto child = [&](std::int32_t index, std::int32_t count, const float* lo, const float* hi) -> std::optional<Ref> {
         if (count < 0) return std::nullopt;
-        Bounds3 box;
-        box.grow({lo[0], lo[1], lo[2]});
-        box.grow({hi[0], hi[1], hi[2]});
-        const Bounds3 world = transformBounds(c.object->transform, box);
+        const Bounds3 world = transformBounds(c.object->transform, slotBounds(lo, hi));
         if (count == 0)
           return Ref{refs[r].cand, traversalItem(nodes + std::int64_t{index} * gpu::kNodeTexels, gpu::kItemNode, 1), index, world};
         return Ref{refs[r].cand, traversalItem((std::int64_t{c.mesh->triOffset} + index) * gpu::kTriTexels, gpu::kItemTriangles, count),
