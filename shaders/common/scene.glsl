@@ -37,6 +37,9 @@ const int kStackSize = 128;
 #define RETILE_ALPHA_TEST 1
 #endif
 const float kInfinity = 1e30;
+// A box's exit distance is taken this much further, so that rounding never loses a hit on a
+// box's face (render/bvh.cpp kSlabSlack).
+const float kSlabSlack = 1.0000004;
 
 // The scene's features (kFeature... in layouts.h). lavapipe runs every branch, taken or not (see
 // traceRay), so code for what the scene lacks would cost every path segment: the renderer
@@ -139,8 +142,9 @@ bool slabTest(vec3 bmin, vec3 bmax, vec3 o, vec3 invD, float tMax, out float tNe
   vec3 lo = mix(t0, t1, swap), hi = mix(t1, t0, swap);
   float a = lo.x > lo.y ? lo.x : lo.y, b = lo.z > 0.0 ? lo.z : 0.0;
   tNear = a > b ? a : b;
-  float c = hi.x < hi.y ? hi.x : hi.y, e = hi.z < tMax ? hi.z : tMax;
-  float tFar = c < e ? c : e;
+  float c = hi.x < hi.y ? hi.x : hi.y;
+  c = (c < hi.z ? c : hi.z) * kSlabSlack;
+  float tFar = c < tMax ? c : tMax;
   return tNear <= tFar;
 }
 

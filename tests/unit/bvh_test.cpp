@@ -154,6 +154,45 @@ TEST(Bvh, BunnyAgreesWithBruteForce) {
   checkAgainstBruteForce(s, 400, 5);
 }
 
+// Rays aimed at the edges of axis-aligned squares on an integer grid (a tiled floor), from near
+// and far: they hit triangles on the planes where child boxes meet, where a box test that
+// rounds inwards loses hits. Each ray finds the hit brute force finds. (A four-wide BVH with
+// quantised boxes failed this without room around its planes; docs/MEASUREMENTS.md.)
+TEST(Bvh, RaysAtBoxFacesStillHit) {
+  Soup s;
+  for (int i = 0; i < 16; ++i)
+    for (int j = 0; j < 16; ++j) {
+      const float x = static_cast<float>(i), z = static_cast<float>(j);
+      s.verts.insert(s.verts.end(), {{x, 0, z}, {x + 1, 0, z}, {x + 1, 0, z + 1}, {x, 0, z}, {x + 1, 0, z + 1}, {x, 0, z + 1}});
+    }
+  std::vector<Bounds3> boxes(s.verts.size() / 3);
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    for (std::size_t k = 0; k < 3; ++k) boxes[i].grow(s.verts[i * 3 + k]);
+  const Bvh bvh = buildBvh(boxes);
+  std::vector<Vec3> packed;
+  for (std::uint32_t p : bvh.primOrder)
+    for (std::size_t k = 0; k < 3; ++k) packed.push_back(s.verts[p * 3 + k]);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> u(0, 1);
+  std::uniform_int_distribution<int> line(0, 16);
+  int hits = 0;
+  for (int i = 0; i < 20000; ++i) {
+    // A point on a grid line (x or z an integer), seen from near or far above.
+    Vec3 target{static_cast<float>(line(rng)), 0, u(rng) * 16};
+    if (i % 2) std::swap(target.x, target.z);
+    const float distance = i % 3 == 0 ? 1e-3f : (i % 3 == 1 ? 1.0f : 1e3f);
+    const Vec3 o = target + normalize(Vec3{u(rng) - 0.5f, 0.2f + u(rng), u(rng) - 0.5f}) * distance;
+    const Vec3 d = normalize(target - o);
+    const RayHit ref = bruteForce(s, o, d);
+    const RayHit got = traverseClosest(bvh, packed, o, d, 1e30f);
+    if (ref.prim < 0) continue;  // between two triangles' edges, brute force finds neither
+    ++hits;
+    ASSERT_GE(got.prim, 0) << "ray " << i << " from " << distance << " missed; brute force hit at t=" << ref.t;
+    EXPECT_NEAR(got.t, ref.t, 1e-5f * std::max(1.0f, ref.t)) << "ray " << i;
+  }
+  EXPECT_GT(hits, 15000);
+}
+
 // Two unit cubes far apart: the root is visited, then each leaf's one primitive costs one step
 // for the share of rays through the root's box that also pass through the leaf's.
 TEST(Bvh, ExpectedStepsFollowTheSurfaceAreaHeuristic) {

@@ -318,8 +318,14 @@ bool intersectTriangle(Vec3 o, Vec3 d, Vec3 v0, Vec3 v1, Vec3 v2, float tMax, fl
 }
 
 namespace {
+// The box's exit distance is taken this much further (the shader's kSlabSlack): each distance
+// is rounded, and for a flat box (a floor) seen from afar, the rounded entry through one pair of
+// planes can pass the rounded exit through another by an ulp and lose the hit (Ize, "Robust
+// BVH ray traversal", 2013: 1 + 2 gamma(3)).
+constexpr float kSlabSlack = 1.0000004f;
+
 bool slab(const float* mn, const float* mx, Vec3 o, Vec3 inv, float tMax, float* tNear) {
-  float t0 = 0.0f, t1 = tMax;
+  float t0 = 0.0f, t1 = std::numeric_limits<float>::infinity();
   for (int k = 0; k < 3; ++k) {
     float a = (mn[k] - o[k]) * inv[k];
     float b = (mx[k] - o[k]) * inv[k];
@@ -328,7 +334,7 @@ bool slab(const float* mn, const float* mx, Vec3 o, Vec3 inv, float tMax, float*
     t1 = std::min(t1, b);
   }
   *tNear = t0;
-  return t0 <= t1;
+  return t0 <= std::min(t1 * kSlabSlack, tMax);
 }
 }  // namespace
 
