@@ -8,6 +8,7 @@
 
 #include "cli.h"
 #include "cli11.h"
+#include "core/process.h"
 #include "retile/log.h"
 
 namespace {
@@ -52,6 +53,8 @@ std::string commandPath(const CLI::App& app) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Before any thread starts: Qt's Vulkan window creates its own lavapipe device in this thread.
+  retile::flushDenormals();
   std::vector<std::string> args(argv + 1, argv + argc);
   if (const char* v = std::getenv("RETILE_LOG"); v && std::strcmp(v, "debug") == 0) retile::setLogLevel(retile::LogLevel::Debug);
 

@@ -37,8 +37,7 @@ const int kStackSize = 128;
 #define RETILE_ALPHA_TEST 1
 #endif
 const float kInfinity = 1e30;
-// A box's exit distance is taken this much further, so that rounding never loses a hit on a
-// box's face (render/bvh.cpp kSlabSlack).
+// A quantised box's exit distance is taken this much further (render/bvh.cpp kSlabSlack).
 const float kSlabSlack = 1.0000004;
 
 // The scene's features (kFeature... in layouts.h). lavapipe runs every branch, taken or not (see
@@ -133,21 +132,6 @@ bool alphaPasses(int instance, int prim, float u, float v, float rayRandom) {
   return r < alpha;
 }
 
-bool slabTest(vec3 bmin, vec3 bmax, vec3 o, vec3 invD, float tMax, out float tNear) {
-  vec3 t0 = (bmin - o) * invD;
-  vec3 t1 = (bmax - o) * invD;
-  // Selects rather than min and max: lavapipe gives those NaN semantics at three instructions
-  // each, and no NaN reaches here (safeInverse keeps invD finite).
-  bvec3 swap = lessThan(t1, t0);
-  vec3 lo = mix(t0, t1, swap), hi = mix(t1, t0, swap);
-  float a = lo.x > lo.y ? lo.x : lo.y, b = lo.z > 0.0 ? lo.z : 0.0;
-  tNear = a > b ? a : b;
-  float c = hi.x < hi.y ? hi.x : hi.y;
-  c = (c < hi.z ? c : hi.z) * kSlabSlack;
-  float tFar = c < tMax ? c : tMax;
-  return tNear <= tFar;
-}
-
 vec3 safeInverse(vec3 d) {
   const float eps = 1e-12;
   return vec3(abs(d.x) > eps ? 1.0 / d.x : (d.x >= 0.0 ? 1e30 : -1e30),
@@ -159,8 +143,8 @@ vec3 safeInverse(vec3 d) {
 //
 // lavapipe (Mesa 22.3) runs both sides of every branch with lanes masked off: an if skips no
 // code, even when no lane takes it. A loop iteration therefore costs all the code in its body,
-// whichever step each lane is at. So one iteration does one step of any kind (visit a node's two
-// children, test one triangle, or enter an instance), and all three read their record through
+// whichever step each lane is at. So one iteration does one step of any kind (visit a node to
+// take one of its four children, test one triangle, or enter an instance), and all three read their record through
 // the same four texel fetches of the one traversal buffer. Testing up to two leaves of four
 // triangles in the visiting iteration, as before, made every iteration pay for 24 fetches.
 Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
@@ -202,19 +186,57 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
     vec4 r2 = texelFetch(uTraversal, at + 2), r3 = texelFetch(uTraversal, at + 3);
     int next = -1;
     if (kind == kItemNode) {
-      int left = floatBitsToInt(r0.w), right = floatBitsToInt(r2.w);
-      float tl, tr;
-      bool hl = left >= 0 && slabTest(r0.xyz, r1.xyz, o, invD, hit.t, tl);
-      bool hr = right >= 0 && slabTest(r2.xyz, r3.xyz, o, invD, hit.t, tr);
-      if (hl && hr) {
-        bool leftFirst = tl <= tr;
-        if (stackSize < kStackSize) {
-          top = leftFirst ? right : left;
-          stackSize++;
-        }
-        next = leftFirst ? left : right;
-      } else {
-        next = hl ? left : (hr ? right : -1);
+      // Four child boxes, quantised (render/bvh.h QuantizedNode): a plane's distance is
+      // (origin - o) / d + q * scale / d, each axis for the four children at once. The children
+      // are taken in the node's order for the ray's octant, one per visit, and one entry is
+      // pushed (see above): the one child left, or, with more left, the node itself, with the
+      // position to go on from in its item's count bits. Its next visit tests the boxes again,
+      // against the hit found meanwhile.
+      uvec3 e = (uvec3(floatBitsToUint(r0.w)) >> uvec3(0u, 8u, 16u)) & 255u;
+      vec3 base = (r0.xyz - o) * invD;
+      vec3 scaled = uintBitsToFloat(e << 23u) * invD;
+      uvec4 qa = floatBitsToUint(r2), qb = floatBitsToUint(r3);
+      // The planes a ray enters and leaves by: lo and hi swap where the direction is negative.
+      bool bx = invD.x < 0.0, by = invD.y < 0.0, bz = invD.z < 0.0;
+      uint inX = bx ? qa.w : qa.x, outX = bx ? qa.x : qa.w;
+      uint inY = by ? qb.x : qa.y, outY = by ? qa.y : qb.x;
+      uint inZ = bz ? qb.y : qa.z, outZ = bz ? qa.z : qb.y;
+      const uvec4 bytes = uvec4(0u, 8u, 16u, 24u);
+      // Axis by axis, so that few values are live at once. Selects rather than min and max:
+      // lavapipe gives those NaN semantics at three instructions each, and no NaN reaches here
+      // (safeInverse keeps invD finite).
+      vec4 tNear = base.x + vec4((uvec4(inX) >> bytes) & 255u) * scaled.x;
+      tNear = mix(vec4(0.0), tNear, greaterThan(tNear, vec4(0.0)));
+      vec4 tFar = base.x + vec4((uvec4(outX) >> bytes) & 255u) * scaled.x;
+      vec4 t = base.y + vec4((uvec4(inY) >> bytes) & 255u) * scaled.y;
+      tNear = mix(tNear, t, greaterThan(t, tNear));
+      t = base.y + vec4((uvec4(outY) >> bytes) & 255u) * scaled.y;
+      tFar = mix(tFar, t, lessThan(t, tFar));
+      t = base.z + vec4((uvec4(inZ) >> bytes) & 255u) * scaled.z;
+      tNear = mix(tNear, t, greaterThan(t, tNear));
+      t = base.z + vec4((uvec4(outZ) >> bytes) & 255u) * scaled.z;
+      tFar = mix(tFar, t, lessThan(t, tFar)) * kSlabSlack;
+      tFar = mix(vec4(hit.t), tFar, lessThan(tFar, vec4(hit.t)));
+      ivec4 children = floatBitsToInt(r1);
+      // An empty slot's box is inside out (render/bvh.cpp quantize), but in a node of no extent
+      // far from the origin its planes can round to one point: its item says it is empty.
+      ivec4 entered = ivec4(lessThanEqual(tNear, tFar)) * ivec4(greaterThanEqual(children, ivec4(0)));
+      int octant = int(bx) | (int(by) << 1) | (int(bz) << 2);
+      uint order = ((octant < 4 ? qb.z : qb.w) >> (8u * uint(octant & 3))) & 255u;
+      uvec4 slots = (uvec4(order) >> uvec4(0u, 2u, 4u, 6u)) & 3u;
+      uint inSlots = uint(entered.x | (entered.y << 1) | (entered.z << 2) | (entered.w << 3));
+      uvec4 inOrder = (uvec4(inSlots) >> slots) & 1u;
+      uint left = (inOrder.x | (inOrder.y << 1) | (inOrder.z << 2) | (inOrder.w << 3)) & (15u << uint((item >> 2) & 3));
+      int pos = findLSB(left);
+      uint slot = (order >> uint(2 * pos)) & 3u;
+      if (left != 0u) next = slot == 0u ? children.x : (slot == 1u ? children.y : (slot == 2u ? children.z : children.w));
+      // What is pushed: the one child left, as it is, or the node, to go on from pos + 1.
+      uint rest = left & (left - 1u);
+      uint other = (order >> uint(2 * findLSB(rest))) & 3u;
+      int otherChild = other == 0u ? children.x : (other == 1u ? children.y : (other == 2u ? children.z : children.w));
+      if (rest != 0u && stackSize < kStackSize) {
+        top = (rest & (rest - 1u)) == 0u ? otherChild : (item & ~12) | ((pos + 1) << 2);
+        stackSize++;
       }
     } else if (kind == kItemTriangles) {
       // Moeller-Trumbore against v0 = r0.xyz, e1 = r1.xyz, e2 = r2.xyz.

@@ -16,7 +16,7 @@ struct alignas(16) ivec4 { std::int32_t x, y, z, w; };
 #endif
 
 // Texels (RGBA32F) per record in the read-only scene buffers.
-RT_CONST(int, kNodeTexels, 4)       // left.min.xyz left item | left.max.xyz - | right.min.xyz right item | right.max.xyz -
+RT_CONST(int, kNodeTexels, 4)       // origin.xyz exponents | 4 child items | lo.xyz hi.x | hi.yz order (render/bvh.h QuantizedNode)
 RT_CONST(int, kTriTexels, 3)        // v0.xyz triangle index | e1 = v1 - v0 | e2 = v2 - v0 (object space)
 RT_CONST(int, kInstanceRecordTexels, 4)  // world-to-object rows 0..2 | root item, instance, flags, -
 RT_CONST(int, kTriShadeTexels, 4)   // n0.xyz uv0.x | n1.xyz uv0.y | n2.xyz uv1.x | uv1.y uv2.xy hasNormals
@@ -28,8 +28,9 @@ RT_CONST(int, kDeltaLightTexels, 4) // position.xyz type | direction.xyz cosOute
 
 // The traversal buffer holds every triangle (packed triangle p at texel p * kTriTexels), then the
 // mesh BVHs, the instance BVH and one record per instance. An item names one record of it:
-// texel offset << kItemOffsetShift | (triangles - 1) << 2 | kind, or -1 for none. A run of up to
-// kMaxLeafTriangles consecutive triangles is one item (a BVH leaf).
+// texel offset << kItemOffsetShift | n << 2 | kind, or -1 for none. A run of up to
+// kMaxLeafTriangles consecutive triangles is one item (a BVH leaf), n its triangles - 1; for a
+// node, n is the rank of the child to take next (scene.glsl traceRay), 0 in the buffer.
 RT_CONST(int, kItemNode, 0)
 RT_CONST(int, kItemTriangles, 1)
 RT_CONST(int, kItemInstance, 2)

@@ -11,6 +11,10 @@
 #include <cerrno>
 #include <cstring>
 
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
+
 #include "retile/log.h"
 
 // An AddressSanitizer build (the asan preset) reserves terabytes of address space for its shadow
@@ -23,6 +27,13 @@ constexpr bool kAddressSanitizer = false;
 #endif
 
 namespace retile {
+
+void flushDenormals() {
+#if defined(__SSE__)
+  constexpr unsigned kFlushToZero = 0x8000, kDenormalsAreZero = 0x0040;
+  _mm_setcsr(_mm_getcsr() | kFlushToZero | kDenormalsAreZero);
+#endif
+}
 
 std::string signalDescription(int sig) {
   const char* name = "";

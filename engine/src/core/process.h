@@ -39,6 +39,16 @@ std::string signalDescription(int sig);
 // where the C library cannot do it.
 void releaseFreedMemory();
 
+// Makes the calling thread, and every thread it creates afterwards (they inherit the setting),
+// treat denormal floats as zero (x86 MXCSR DAZ and FTZ; a no-op elsewhere). lavapipe runs every
+// branch of a shader for every invocation, so the traversal loop does float arithmetic on
+// records of other kinds (node items and packed bytes read as floats, many of them denormal),
+// and each denormal operand costs a microcode assist: on the spaceship, the four-wide BVH
+// traced 15 % more samples per second with them flushed (docs/MEASUREMENTS.md). Vulkan 1.2's
+// float controls would say it per shader, but lavapipe offers no flush-to-zero. Call before the
+// Vulkan device is created (its worker threads inherit); nothing Retile computes needs denormals.
+void flushDenormals();
+
 // Directory of the running executable (from /proc/self/exe); empty if unknown.
 std::filesystem::path executableDirectory();
 

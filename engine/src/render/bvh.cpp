@@ -49,7 +49,6 @@ struct Builder {
   std::vector<std::uint32_t>& order;
   const BvhBuildOptions& opt;
   std::vector<BuildNode> nodes;
-  int maxDepth = 0;
 
   Builder(std::span<const Bounds3> b, std::vector<std::uint32_t>& o, const BvhBuildOptions& op)
       : order(o), opt(op) {
@@ -155,7 +154,6 @@ struct Builder {
     while (!stack.empty()) {
       Item it = stack.back();
       stack.pop_back();
-      maxDepth = std::max(maxDepth, it.depth);
       BuildNode n = nodes[it.node];
       if (n.count <= 1) continue;
       if (it.depth >= kSahDepthLimit && n.count <= static_cast<std::uint32_t>(opt.maxLeafSize)) continue;
@@ -181,25 +179,17 @@ struct Builder {
   }
 };
 
-void setSlot(float mn[3], float mx[3], std::int32_t& index, std::int32_t& count, const Bounds3& b, std::int32_t i,
-             std::int32_t c) {
-  for (int k = 0; k < 3; ++k) {
-    mn[k] = b.lo[k];
-    mx[k] = b.hi[k];
-  }
-  index = i;
-  count = c;
-}
+// Room every quantised plane keeps from the plane it bounds, as a fraction of the node's extent:
+// the shader computes a plane's distance as (origin - o) / d + q * scale / d, whose rounding
+// differs from that of the exact box's slab test by a few ulps of the node's size.
+constexpr float kQuantisedPad = 1.0f / (1 << 20);
+// And the exit distance is taken a few ulps further, for rays from afar, where the rounding of
+// the distances themselves exceeds the pad (the shader's kSlabSlack).
+constexpr float kSlabSlack = 1.0000004f;
 
-void setEmpty(float mn[3], float mx[3], std::int32_t& index, std::int32_t& count) {
-  // min > max: the slab test never reports a hit.
-  for (int k = 0; k < 3; ++k) {
-    mn[k] = 1e30f;
-    mx[k] = -1e30f;
-  }
-  index = 0;
-  count = -1;
-}
+// A plane of the grid, in the float arithmetic of dequantize (q * scale is exact: q < 2^8 and
+// scale a power of two).
+float gridPlane(float origin, std::uint32_t q, float scale) { return origin + static_cast<float>(q) * scale; }
 
 }  // namespace
 
@@ -209,61 +199,118 @@ Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options
   out.primOrder.resize(primBounds.size());
   for (std::size_t i = 0; i < primBounds.size(); ++i) out.primOrder[i] = static_cast<std::uint32_t>(i);
   if (primBounds.empty()) {
-    GpuBvhNode root{};
-    setEmpty(root.lmin, root.lmax, root.left, root.leftCount);
-    setEmpty(root.rmin, root.rmax, root.right, root.rightCount);
-    out.nodes.push_back(root);
+    out.nodes.emplace_back();
     return out;
   }
   Builder b(primBounds, out.primOrder, options);
   b.build();
   out.bounds = b.nodes[0].bounds;
-  out.depth = b.maxDepth;
 
-  // Pack: every inner build node becomes a GPU node; leaves live in their parent's slots. A
-  // root that is a leaf gets a GPU node with one empty slot.
+  // Collapse to four-wide nodes: a node takes its binary node's children and opens the inner
+  // child of largest surface area until it has kBvhWidth (opening the largest takes out the
+  // steps most rays would spend on it). Breadth first, so children follow their parents.
   const auto& bn = b.nodes;
-  std::vector<std::int32_t> gpuIndex(bn.size(), -1);
-  std::vector<std::uint32_t> inner;
-  inner.push_back(0);
-  gpuIndex[0] = 0;
-  for (std::size_t k = 0; k < inner.size(); ++k) {
-    const BuildNode& n = bn[inner[k]];
-    for (std::int32_t c : {n.left, n.right}) {
-      if (c >= 0 && bn[static_cast<std::size_t>(c)].left >= 0) {
-        gpuIndex[static_cast<std::size_t>(c)] = static_cast<std::int32_t>(inner.size());
-        inner.push_back(static_cast<std::uint32_t>(c));
+  std::vector<std::uint32_t> behind{0};  // the binary node each four-wide node stands for
+  std::vector<int> level{1};
+  for (std::size_t k = 0; k < behind.size(); ++k) {
+    const BuildNode& n = bn[behind[k]];
+    std::vector<std::uint32_t> kids;
+    if (n.left < 0) {
+      kids.push_back(behind[k]);  // the root is a leaf
+    } else {
+      kids = {static_cast<std::uint32_t>(n.left), static_cast<std::uint32_t>(n.right)};
+    }
+    while (kids.size() < static_cast<std::size_t>(kBvhWidth)) {
+      int open = -1;
+      for (std::size_t c = 0; c < kids.size(); ++c)
+        if (bn[kids[c]].left >= 0 && (open < 0 || bn[kids[c]].bounds.area() > bn[kids[static_cast<std::size_t>(open)]].bounds.area()))
+          open = static_cast<int>(c);
+      if (open < 0) break;
+      const BuildNode& o = bn[kids[static_cast<std::size_t>(open)]];
+      kids[static_cast<std::size_t>(open)] = static_cast<std::uint32_t>(o.left);
+      kids.push_back(static_cast<std::uint32_t>(o.right));
+    }
+    BvhNode w;
+    for (std::size_t c = 0; c < kids.size(); ++c) {
+      const BuildNode& ch = bn[kids[c]];
+      w.box[c] = ch.bounds;
+      if (ch.left < 0 || kids[c] == behind[k]) {
+        w.index[c] = static_cast<std::int32_t>(ch.start);
+        w.count[c] = static_cast<std::int32_t>(ch.count);
+      } else {
+        w.index[c] = static_cast<std::int32_t>(behind.size());
+        w.count[c] = 0;
+        behind.push_back(kids[c]);
+        level.push_back(level[k] + 1);
+        out.depth = std::max(out.depth, level[k] + 1);
       }
     }
+    out.nodes.push_back(w);
   }
-  out.nodes.resize(inner.size());
-  for (std::size_t k = 0; k < inner.size(); ++k) {
-    const BuildNode& n = bn[inner[k]];
-    GpuBvhNode& g = out.nodes[k];
-    if (n.left < 0) {  // the root is a leaf
-      setSlot(g.lmin, g.lmax, g.left, g.leftCount, n.bounds, static_cast<std::int32_t>(n.start),
-              static_cast<std::int32_t>(n.count));
-      setEmpty(g.rmin, g.rmax, g.right, g.rightCount);
-      continue;
-    }
-    auto fill = [&](std::int32_t c, float* mn, float* mx, std::int32_t& idx, std::int32_t& cnt) {
-      const BuildNode& ch = bn[static_cast<std::size_t>(c)];
-      if (ch.left < 0)
-        setSlot(mn, mx, idx, cnt, ch.bounds, static_cast<std::int32_t>(ch.start), static_cast<std::int32_t>(ch.count));
-      else
-        setSlot(mn, mx, idx, cnt, ch.bounds, gpuIndex[static_cast<std::size_t>(c)], 0);
-    };
-    fill(n.left, g.lmin, g.lmax, g.left, g.leftCount);
-    fill(n.right, g.rmin, g.rmax, g.right, g.rightCount);
-  }
+  out.depth = std::max(out.depth, 1);
   return out;
 }
 
-Bounds3 slotBounds(const float* mn, const float* mx) {
+QuantizedNode quantize(const BvhNode& node) {
+  QuantizedNode q{};
+  Bounds3 all;
+  for (int c = 0; c < kBvhWidth; ++c)
+    if (node.count[static_cast<std::size_t>(c)] >= 0) all.grow(node.box[static_cast<std::size_t>(c)]);
+  if (all.empty()) all = Bounds3{Vec3{0.0f}, Vec3{0.0f}};
+  for (int a = 0; a < 3; ++a) {
+    const double extent = static_cast<double>(all.hi[a]) - all.lo[a];
+    const auto pad = static_cast<float>(extent * kQuantisedPad);
+    // The grid starts a pad below the lowest plane; the smallest power of two whose 255 steps
+    // reach a pad above the highest is the scale.
+    const float origin = all.lo[a] - pad;
+    const float top = all.hi[a] + pad;
+    int e = -126;
+    const double need = (static_cast<double>(top) - origin) / 255.0;
+    if (need > 0) e = std::clamp(static_cast<int>(std::ceil(std::log2(need))), -126, 127);
+    while (e < 127 && gridPlane(origin, 255, std::ldexp(1.0f, e)) < top) ++e;
+    const float scale = std::ldexp(1.0f, e);
+    q.origin[a] = origin;
+    q.exponents |= static_cast<std::uint32_t>(e + 127) << (8 * a);
+    for (int c = 0; c < kBvhWidth; ++c) {
+      const auto k = static_cast<std::size_t>(c);
+      std::uint32_t lo = 255, hi = 0;  // an empty slot: inside out, so no ray enters it
+      if (node.count[k] >= 0) {
+        const float want = node.box[k].lo[a] - pad, wantHi = node.box[k].hi[a] + pad;
+        lo = static_cast<std::uint32_t>(std::clamp(std::floor((static_cast<double>(want) - origin) / scale), 0.0, 255.0));
+        while (lo > 0 && gridPlane(origin, lo, scale) > want) --lo;
+        hi = static_cast<std::uint32_t>(std::clamp(std::ceil((static_cast<double>(wantHi) - origin) / scale), 0.0, 255.0));
+        while (hi < 255 && gridPlane(origin, hi, scale) < wantHi) ++hi;
+      }
+      q.lo[a] |= lo << (8 * c);
+      q.hi[a] |= hi << (8 * c);
+    }
+  }
+  for (std::uint32_t octant = 0; octant < 8; ++octant) {
+    // Along the octant's diagonal, the smaller a centre's projection, the nearer; empty slots last.
+    const Vec3 dir{octant & 1 ? -1.0f : 1.0f, octant & 2 ? -1.0f : 1.0f, octant & 4 ? -1.0f : 1.0f};
+    std::array<int, kBvhWidth> slots{0, 1, 2, 3};
+    auto key = [&](int c) {
+      const auto k = static_cast<std::size_t>(c);
+      return node.count[k] < 0 ? std::numeric_limits<float>::infinity() : dot(node.box[k].lo * 0.5f + node.box[k].hi * 0.5f, dir);
+    };
+    std::stable_sort(slots.begin(), slots.end(), [&](int x, int y) { return key(x) < key(y); });
+    std::uint32_t bits = 0;
+    for (int i = 0; i < kBvhWidth; ++i) bits |= static_cast<std::uint32_t>(slots[static_cast<std::size_t>(i)]) << (2 * i);
+    q.order[octant / 4] |= bits << (8 * (octant % 4));
+  }
+  return q;
+}
+
+float quantizedScale(const QuantizedNode& q, int axis) {
+  return std::ldexp(1.0f, static_cast<int>((q.exponents >> (8 * axis)) & 255u) - 127);
+}
+
+Bounds3 dequantize(const QuantizedNode& q, int child) {
   Bounds3 b;
-  for (int k = 0; k < 3; ++k) {
-    b.lo[k] = mn[k];
-    b.hi[k] = mx[k];
+  for (int a = 0; a < 3; ++a) {
+    const float s = quantizedScale(q, a);
+    b.lo[a] = gridPlane(q.origin[a], (q.lo[a] >> (8 * child)) & 255u, s);
+    b.hi[a] = gridPlane(q.origin[a], (q.hi[a] >> (8 * child)) & 255u, s);
   }
   return b;
 }
@@ -271,28 +318,27 @@ Bounds3 slotBounds(const float* mn, const float* mx) {
 std::vector<float> expectedSteps(const Bvh& bvh, const std::function<float(std::uint32_t)>& primCost) {
   std::vector<float> steps(bvh.nodes.size(), 0.0f);
   for (std::size_t k = bvh.nodes.size(); k-- > 0;) {
-    const GpuBvhNode& n = bvh.nodes[k];
+    const BvhNode& n = bvh.nodes[k];
     Bounds3 box;
-    float weighted = 0;  // sum over slots of area * expected steps inside
-    float unweighted = 0;
-    auto slot = [&](const float* mn, const float* mx, std::int32_t index, std::int32_t count) {
-      if (count < 0) return;
-      const Bounds3 b = slotBounds(mn, mx);
-      box.grow(b);
-      float inside = 0;
-      if (count == 0) {
-        inside = steps[static_cast<std::size_t>(index)];
-      } else {
-        for (std::int32_t i = 0; i < count; ++i) inside += primCost(static_cast<std::uint32_t>(index + i));
-      }
-      weighted += b.area() * inside;
-      unweighted += inside;
-    };
-    slot(n.lmin, n.lmax, n.left, n.leftCount);
-    slot(n.rmin, n.rmax, n.right, n.rightCount);
+    for (std::size_t c = 0; c < kBvhWidth; ++c)
+      if (n.count[c] >= 0) box.grow(n.box[c]);
     const float area = box.area();
-    // A box without area (a line or a point): every ray that reaches it enters both slots.
-    steps[k] = 1.0f + (area > 0 ? weighted / area : unweighted);
+    float entered = 0;  // expected children entered
+    float inside = 0;   // expected steps inside them
+    for (std::size_t c = 0; c < kBvhWidth; ++c) {
+      if (n.count[c] < 0) continue;
+      float cost = 0;
+      if (n.count[c] == 0) {
+        cost = steps[static_cast<std::size_t>(n.index[c])];
+      } else {
+        for (std::int32_t i = 0; i < n.count[c]; ++i) cost += primCost(static_cast<std::uint32_t>(n.index[c] + i));
+      }
+      // A box without area (a line or a point): every ray that reaches it enters every child.
+      const float p = area > 0 ? n.box[c].area() / area : 1.0f;
+      entered += p;
+      inside += p * cost;
+    }
+    steps[k] = std::max(1.0f, entered) + inside;
   }
   return steps;
 }
@@ -318,23 +364,31 @@ bool intersectTriangle(Vec3 o, Vec3 d, Vec3 v0, Vec3 v1, Vec3 v2, float tMax, fl
 }
 
 namespace {
-// The box's exit distance is taken this much further (the shader's kSlabSlack): each distance
-// is rounded, and for a flat box (a floor) seen from afar, the rounded entry through one pair of
-// planes can pass the rounded exit through another by an ulp and lose the hit (Ize, "Robust
-// BVH ray traversal", 2013: 1 + 2 gamma(3)).
-constexpr float kSlabSlack = 1.0000004f;
-
-bool slab(const float* mn, const float* mx, Vec3 o, Vec3 inv, float tMax, float* tNear) {
-  float t0 = 0.0f, t1 = std::numeric_limits<float>::infinity();
-  for (int k = 0; k < 3; ++k) {
-    float a = (mn[k] - o[k]) * inv[k];
-    float b = (mx[k] - o[k]) * inv[k];
-    if (a > b) std::swap(a, b);
-    t0 = std::max(t0, a);
-    t1 = std::min(t1, b);
+// The shader's test of a node's four child boxes (shaders/common/scene.glsl), operation for
+// operation: which children the ray enters before tMax (bit c for slot c).
+int enteredChildren(const BvhNode& n, const QuantizedNode& q, Vec3 o, Vec3 inv, float tMax) {
+  float lo[kBvhWidth], hi[kBvhWidth];
+  for (int c = 0; c < kBvhWidth; ++c) {
+    lo[c] = 0.0f;
+    hi[c] = std::numeric_limits<float>::infinity();
   }
-  *tNear = t0;
-  return t0 <= std::min(t1 * kSlabSlack, tMax);
+  for (int a = 0; a < 3; ++a) {
+    const float base = (q.origin[a] - o[a]) * inv[a];
+    const float step = quantizedScale(q, a) * inv[a];
+    for (int c = 0; c < kBvhWidth; ++c) {
+      float t0 = base + static_cast<float>((q.lo[a] >> (8 * c)) & 255u) * step;
+      float t1 = base + static_cast<float>((q.hi[a] >> (8 * c)) & 255u) * step;
+      if (inv[a] < 0.0f) std::swap(t0, t1);
+      lo[c] = t0 > lo[c] ? t0 : lo[c];
+      hi[c] = t1 < hi[c] ? t1 : hi[c];
+    }
+  }
+  int mask = 0;
+  for (int c = 0; c < kBvhWidth; ++c) {
+    const float far = hi[c] * kSlabSlack;
+    if (lo[c] <= (far < tMax ? far : tMax) && n.count[static_cast<std::size_t>(c)] >= 0) mask |= 1 << c;
+  }
+  return mask;
 }
 }  // namespace
 
@@ -342,47 +396,56 @@ RayHit traverseClosest(const Bvh& bvh, std::span<const Vec3> tris, Vec3 o, Vec3 
   RayHit hit;
   hit.t = tMax;
   Vec3 inv{1.0f / d.x, 1.0f / d.y, 1.0f / d.z};
-  std::int32_t stack[128];
+  // What the shader's items name: a node to visit from a position of its order on (count 0), or
+  // a leaf of `count` primitives.
+  struct Entry {
+    std::int32_t index;
+    std::int32_t count;
+    int from;
+  };
+  Entry stack[128];
   int sp = 0;
-  std::int32_t node = 0;
+  Entry at{0, 0, 0};
   for (;;) {
-    const GpuBvhNode& n = bvh.nodes[static_cast<std::size_t>(node)];
-    float tl, tr;
-    bool hl = n.leftCount >= 0 && slab(n.lmin, n.lmax, o, inv, hit.t, &tl);
-    bool hr = n.rightCount >= 0 && slab(n.rmin, n.rmax, o, inv, hit.t, &tr);
-    auto leaf = [&](std::int32_t start, std::int32_t count) {
-      for (std::int32_t i = start; i < start + count; ++i) {
+    if (at.count > 0) {
+      for (std::int32_t i = at.index; i < at.index + at.count; ++i) {
         float t, u, v;
-        auto k = static_cast<std::size_t>(i) * 3;
-        if (intersectTriangle(o, d, tris[k], tris[k + 1], tris[k + 2], hit.t, &t, &u, &v)) {
+        auto p = static_cast<std::size_t>(i) * 3;
+        if (intersectTriangle(o, d, tris[p], tris[p + 1], tris[p + 2], hit.t, &t, &u, &v)) {
           hit.t = t;
           hit.u = u;
           hit.v = v;
           hit.prim = i;
         }
       }
-    };
-    if (hl && n.leftCount > 0) {
-      leaf(n.left, n.leftCount);
-      hl = false;
-    }
-    if (hr && n.rightCount > 0) {
-      leaf(n.right, n.rightCount);
-      hr = false;
-    }
-    if (hl && hr) {
-      std::int32_t nearN = tl <= tr ? n.left : n.right;
-      std::int32_t farN = tl <= tr ? n.right : n.left;
-      stack[sp++] = farN;
-      node = nearN;
-    } else if (hl) {
-      node = n.left;
-    } else if (hr) {
-      node = n.right;
     } else {
-      if (sp == 0) break;
-      node = stack[--sp];
+      const BvhNode& n = bvh.nodes[static_cast<std::size_t>(at.index)];
+      const QuantizedNode q = quantize(n);
+      const int mask = enteredChildren(n, q, o, inv, hit.t);
+      // The node's order for the ray's octant, from position at.from on.
+      const int octant = (inv.x < 0.0f ? 1 : 0) | (inv.y < 0.0f ? 2 : 0) | (inv.z < 0.0f ? 4 : 0);
+      const std::uint32_t order = (q.order[octant / 4] >> (8 * (octant % 4))) & 255u;
+      int open[kBvhWidth], opened = 0, first = -1;
+      for (int i = at.from; i < kBvhWidth; ++i) {
+        const int slot = static_cast<int>((order >> (2 * i)) & 3u);
+        if (!(mask >> slot & 1)) continue;
+        if (first < 0) first = i;
+        open[opened++] = slot;
+      }
+      auto child = [&](int slot) {
+        const auto k = static_cast<std::size_t>(slot);
+        return Entry{n.index[k], n.count[k], 0};
+      };
+      if (opened > 0) {
+        // Pushed: the one child left as it is, or this node, to go on after the first.
+        if (opened == 2) stack[sp++] = child(open[1]);
+        if (opened > 2) stack[sp++] = {at.index, 0, first + 1};
+        at = child(open[0]);
+        continue;
+      }
     }
+    if (sp == 0) break;
+    at = stack[--sp];
   }
   return hit;
 }

@@ -1,15 +1,15 @@
 // Bounding volume hierarchies on the CPU, packed for the GPU. Pure computation: no Vulkan, any
 // thread, testable without a device.
 //
-// Node layout of the builder's output (64 bytes): each node stores the boxes of both children,
-// so one visit decides which children a ray enters and in which order.
-//   lmin left | lmax leftCount | rmin right | rmax rightCount
-// count > 0: a leaf of `count` primitives starting at `index` (in the packed primitive order);
-// count == 0: an inner node at `index`; count < 0: an empty slot (its box never hits).
-// render/render_scene.cpp packs these nodes into the traversal buffer the shader reads, with the
-// children as items (shaders/shared/layouts.h).
+// The hierarchy is four-wide: a binary SAH build collapsed so that each node holds up to four
+// children. On lavapipe every loop iteration of the traversal pays for the whole loop body
+// (shaders/common/scene.glsl), so what counts is the number of steps a ray takes; a four-wide node
+// decides among four children in one step, and its child boxes, quantised to 8 bits per plane
+// relative to the node's box, keep a node in the 64 bytes a binary node took
+// (docs/MEASUREMENTS.md has the figures).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -19,17 +19,33 @@
 
 namespace retile {
 
-struct GpuBvhNode {
-  float lmin[3];
-  std::int32_t left;
-  float lmax[3];
-  std::int32_t leftCount;
-  float rmin[3];
-  std::int32_t right;
-  float rmax[3];
-  std::int32_t rightCount;
+constexpr int kBvhWidth = 4;
+
+// A node as built. Slot c: count[c] > 0 is a leaf of count[c] primitives starting at index[c] (in
+// the packed primitive order); count[c] == 0 an inner node at index[c]; count[c] < 0 an empty
+// slot. Used slots come first.
+struct BvhNode {
+  std::array<Bounds3, kBvhWidth> box;
+  std::array<std::int32_t, kBvhWidth> index{};
+  std::array<std::int32_t, kBvhWidth> count{-1, -1, -1, -1};
 };
-static_assert(sizeof(GpuBvhNode) == 64);
+
+// A node's child boxes as the GPU reads them: per axis, a float origin and a power-of-two
+// scale, and for each child an 8-bit lower and upper plane (child c in bits 8c..8c+7 of lo[axis]
+// and hi[axis]). Every child's box contains the box it was made from (origin + q * scale, in
+// float arithmetic, rounds outwards).
+// order[o / 4] holds, in bits 8 (o % 4).., the slots in the order a ray of octant o (bit k set: a
+// negative direction along axis k) takes them: nearest centre first, two bits per position.
+struct QuantizedNode {
+  float origin[3];
+  std::uint32_t exponents;  // biased exponent of axis k's scale in bits 8k..8k+7
+  std::uint32_t lo[3];
+  std::uint32_t hi[3];
+  std::uint32_t order[2];
+};
+QuantizedNode quantize(const BvhNode& node);
+float quantizedScale(const QuantizedNode& q, int axis);
+Bounds3 dequantize(const QuantizedNode& q, int child);
 
 struct BvhBuildOptions {
   int maxLeafSize = 4;     // leaves never hold more (forced splits beyond it)
@@ -39,26 +55,25 @@ struct BvhBuildOptions {
 };
 
 struct Bvh {
-  std::vector<GpuBvhNode> nodes;        // nodes[0] is the root
+  std::vector<BvhNode> nodes;           // nodes[0] is the root; children after their parent
   std::vector<std::uint32_t> primOrder; // packed primitive i is input primitive primOrder[i]
   Bounds3 bounds;
   int depth = 0;
 };
 
-// Builds with binned SAH over the given primitive boxes. An empty input yields a single root
-// with two empty slots, so traversal code needs no special case.
+// Builds with binned SAH over the given primitive boxes, then collapses to four-wide nodes. An
+// empty input yields a single root with empty slots, so traversal code needs no special case.
+// depth counts the levels of four-wide nodes.
 Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options = {});
 
-// The box of a node's slot (lmin/lmax or rmin/rmax), the inverse of how the builder fills it.
-Bounds3 slotBounds(const float* mn, const float* mx);
-
 // Expected traversal steps of a ray that enters each node's box (index as in bvh.nodes), by the
-// surface area heuristic: a node visit costs one step and a leaf's primitives primCost(packed
-// index) each, as in the shader, where every loop iteration does one step of any kind.
-// Children's indices exceed their parent's (the builder packs breadth-first).
+// surface area heuristic, as the shader traverses: a node takes one step for each child the ray
+// enters (and at least one), a leaf's primitives primCost(packed index) each; every loop
+// iteration does one step of any kind.
 std::vector<float> expectedSteps(const Bvh& bvh, const std::function<float(std::uint32_t)>& primCost);
 
-// Reference traversal of a packed triangle BVH, mirroring the shader, for tests.
+// Reference traversal of a packed triangle BVH, mirroring the shader (quantised boxes, children
+// in the node's order for the ray's octant, one stack entry pushed per visit), for tests.
 struct RayHit {
   float t = 0;
   float u = 0, v = 0;

@@ -65,18 +65,21 @@ std::int32_t traversalItem(std::int64_t offset, int kind, std::int32_t count) {
 // buffer that starts at its texel `outBase`: inner children become node items, leaves whatever
 // `leafItem(index, count)` names.
 template <class LeafItem>
-void appendNodes(std::vector<vec4>& out, const std::vector<GpuBvhNode>& nodes, std::int64_t outBase, LeafItem leafItem) {
+void appendNodes(std::vector<vec4>& out, const std::vector<BvhNode>& nodes, std::int64_t outBase, LeafItem leafItem) {
   std::int64_t base = outBase + static_cast<std::int64_t>(out.size());
   auto child = [&](std::int32_t index, std::int32_t count) {
     if (count < 0) return std::int32_t{-1};
     if (count == 0) return traversalItem(base + static_cast<std::int64_t>(index) * gpu::kNodeTexels, gpu::kItemNode, 1);
     return leafItem(index, count);
   };
-  for (const GpuBvhNode& n : nodes) {
-    out.push_back({n.lmin[0], n.lmin[1], n.lmin[2], bitsOf(child(n.left, n.leftCount))});
-    out.push_back({n.lmax[0], n.lmax[1], n.lmax[2], 0});
-    out.push_back({n.rmin[0], n.rmin[1], n.rmin[2], bitsOf(child(n.right, n.rightCount))});
-    out.push_back({n.rmax[0], n.rmax[1], n.rmax[2], 0});
+  auto word = [](std::uint32_t u) { return std::bit_cast<float>(u); };
+  for (const BvhNode& n : nodes) {
+    const QuantizedNode q = quantize(n);
+    out.push_back({q.origin[0], q.origin[1], q.origin[2], word(q.exponents)});
+    out.push_back(ints(child(n.index[0], n.count[0]), child(n.index[1], n.count[1]), child(n.index[2], n.count[2]),
+                       child(n.index[3], n.count[3])));
+    out.push_back({word(q.lo[0]), word(q.lo[1]), word(q.lo[2]), word(q.hi[0])});
+    out.push_back({word(q.hi[1]), word(q.hi[2]), word(q.order[0]), word(q.order[1])});
   }
 }
 
@@ -379,8 +382,8 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   // Where instances overlap, a ray inside their union is inside every one of their boxes and
   // must enter each. So the instance BVH is built over references to subtrees of the instances'
   // BVHs (partial re-braiding, after Benthin et al. 2017): starting from each instance's root,
-  // the reference with the largest box is replaced by its two children until there are `factor`
-  // references per instance. A reference is entered like an instance, at its subtree. Where
+  // the reference with the largest box is replaced by its children (up to four) until there are
+  // `factor` references per instance. A reference is entered like an instance, at its subtree. Where
   // instances do not overlap, opening them only adds steps, so the factor is the one whose
   // instance BVH the surface area heuristic expects to cost the fewest steps. It is chosen when
   // the objects or meshes change, and kept while objects move, so that a move builds one
@@ -404,26 +407,30 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
       const std::size_t r = open.back();
       open.pop_back();
       const Candidate& c = cands[refs[r].cand];
-      const GpuBvhNode& n = c.mesh->bvh.nodes[static_cast<std::size_t>(refs[r].node)];
+      const BvhNode& n = c.mesh->bvh.nodes[static_cast<std::size_t>(refs[r].node)];
       const std::int64_t nodes = c.mesh->rootItem >> gpu::kItemOffsetShift;
-      auto child = [&](std::int32_t index, std::int32_t count, const float* lo, const float* hi) -> std::optional<Ref> {
-        if (count < 0) return std::nullopt;
-        const Bounds3 world = transformBounds(c.object->transform, slotBounds(lo, hi));
+      std::vector<Ref> children;
+      for (std::size_t k = 0; k < kBvhWidth; ++k) {
+        const std::int32_t index = n.index[k], count = n.count[k];
+        if (count < 0) continue;
+        const Bounds3 world = transformBounds(c.object->transform, n.box[k]);
         if (count == 0)
-          return Ref{refs[r].cand, traversalItem(nodes + std::int64_t{index} * gpu::kNodeTexels, gpu::kItemNode, 1), index, world};
-        return Ref{refs[r].cand, traversalItem((std::int64_t{c.mesh->triOffset} + index) * gpu::kTriTexels, gpu::kItemTriangles, count),
-                   -1, world};
-      };
-      const std::optional<Ref> left = child(n.left, n.leftCount, n.lmin, n.lmax);
-      const std::optional<Ref> right = child(n.right, n.rightCount, n.rmin, n.rmax);
-      if (!left || !right) continue;  // a leaf root with an empty slot: nothing to open
-      refs[r] = *left;
-      refs.push_back(*right);
-      for (std::size_t i : {r, refs.size() - 1}) {
-        if (refs[i].node < 0) continue;
+          children.push_back({refs[r].cand, traversalItem(nodes + std::int64_t{index} * gpu::kNodeTexels, gpu::kItemNode, 1), index, world});
+        else
+          children.push_back({refs[r].cand, traversalItem((std::int64_t{c.mesh->triOffset} + index) * gpu::kTriTexels, gpu::kItemTriangles, count),
+                              -1, world});
+      }
+      if (children.size() < 2) continue;  // a leaf root: nothing to open
+      const std::size_t first = refs.size();
+      refs[r] = children[0];
+      refs.insert(refs.end(), children.begin() + 1, children.end());
+      auto reopen = [&](std::size_t i) {
+        if (refs[i].node < 0) return;
         open.push_back(i);
         std::push_heap(open.begin(), open.end(), smaller);
-      }
+      };
+      reopen(r);
+      for (std::size_t i = first; i < refs.size(); ++i) reopen(i);
     }
     return refs;
   };

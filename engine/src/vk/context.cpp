@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/process.h"
 #include "retile/log.h"
 #include "vk/check.h"
 
@@ -79,6 +80,7 @@ bool hasLayer(const char* name) {
 }  // namespace
 
 Context::Context(const DeviceChoice& choiceIn) {
+  flushDenormals();  // lavapipe's threads, created with the device, inherit it (core/process.h)
   DeviceChoice choice = choiceIn;
   if (const char* env = std::getenv("RETILE_DEVICE"); env && *env) choice.preferred = env;
   if (const char* env = std::getenv("RETILE_VALIDATION"); env && *env) choice.validation = std::strcmp(env, "0") != 0;
