@@ -144,8 +144,8 @@ vec3 safeInverse(vec3 d) {
 // lavapipe (Mesa 22.3) runs both sides of every branch with lanes masked off: an if skips no
 // code, even when no lane takes it. A loop iteration therefore costs all the code in its body,
 // whichever step each lane is at. So one iteration does one step of any kind (visit a node to
-// take one of its four children, test one triangle, or enter an instance), and all three read their record through
-// the same four texel fetches of the one traversal buffer. Testing up to two leaves of four
+// take one of its four children, test one triangle, or enter an instance), and all three read
+// their record through the same four texel fetches of the one traversal buffer. Testing up to two leaves of four
 // triangles in the visiting iteration, as before, made every iteration pay for 24 fetches.
 Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
   Hit hit;

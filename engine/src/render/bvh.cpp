@@ -338,7 +338,9 @@ std::vector<float> expectedSteps(const Bvh& bvh, const std::function<float(std::
       entered += p;
       inside += p * cost;
     }
-    steps[k] = std::max(1.0f, entered) + inside;
+    // A visit takes one child and pushes the rest: the one left as it is, more than one by
+    // pushing the node again; so n children entered cost max(1, n - 1) visits.
+    steps[k] = std::max(1.0f, entered - 1.0f) + inside;
   }
   return steps;
 }

@@ -67,9 +67,9 @@ struct Bvh {
 Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options = {});
 
 // Expected traversal steps of a ray that enters each node's box (index as in bvh.nodes), by the
-// surface area heuristic, as the shader traverses: a node takes one step for each child the ray
-// enters (and at least one), a leaf's primitives primCost(packed index) each; every loop
-// iteration does one step of any kind.
+// surface area heuristic, as the shader traverses: a node takes a step for each child the ray
+// enters after the second (and at least one), a leaf's primitives primCost(packed index) each;
+// every loop iteration does one step of any kind.
 std::vector<float> expectedSteps(const Bvh& bvh, const std::function<float(std::uint32_t)>& primCost);
 
 // Reference traversal of a packed triangle BVH, mirroring the shader (quantised boxes, children

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstring>
 #include <numeric>
-#include <optional>
 
 #include "core/files.h"
 #include "io/image_io.h"
@@ -383,8 +382,8 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   // must enter each. So the instance BVH is built over references to subtrees of the instances'
   // BVHs (partial re-braiding, after Benthin et al. 2017): starting from each instance's root,
   // the reference with the largest box is replaced by its children (up to four) until there are
-  // `factor` references per instance. A reference is entered like an instance, at its subtree. Where
-  // instances do not overlap, opening them only adds steps, so the factor is the one whose
+  // `factor` references per instance. A reference is entered like an instance, at its subtree.
+  // Where instances do not overlap, opening them only adds steps, so the factor is the one whose
   // instance BVH the surface area heuristic expects to cost the fewest steps. It is chosen when
   // the objects or meshes change, and kept while objects move, so that a move builds one
   // instance BVH, whose size stays proportional to the number of objects.
