@@ -86,8 +86,8 @@ int runCompare(const CompareOptions& o) {
     // not, so a ratio that climbs with the block size points at a bias rather than at noise.
     std::printf("by block size (a ratio that grows with the size is a systematic difference, not noise):\n");
     for (int size = 1; size <= 32; size *= 2) {
-      BlockComparison cs = compareBlocks(view(0), view(1), size, exclude);
-      BlockComparison ns = compareBlocks(view(0), view(2), size, exclude);
+      const BlockComparison cs = size == block ? c : compareBlocks(view(0), view(1), size, exclude);
+      const BlockComparison ns = size == block ? n : compareBlocks(view(0), view(2), size, exclude);
       std::printf("  block %2d: %.4f against a floor of %.4f, ratio %.2f\n", size, cs.relativeRmse, ns.relativeRmse,
                   ns.relativeRmse > 0 ? cs.relativeRmse / ns.relativeRmse : std::numeric_limits<double>::infinity());
     }
