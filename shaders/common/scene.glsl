@@ -132,6 +132,11 @@ bool alphaPasses(int instance, int prim, float u, float v, float rayRandom) {
   return r < alpha;
 }
 
+// children[slot], by selects: a varying index into a vector would become a loop over the lanes.
+int childAt(ivec4 children, uint slot) {
+  return slot == 0u ? children.x : (slot == 1u ? children.y : (slot == 2u ? children.z : children.w));
+}
+
 vec3 safeInverse(vec3 d) {
   const float eps = 1e-12;
   return vec3(abs(d.x) > eps ? 1.0 / d.x : (d.x >= 0.0 ? 1e30 : -1e30),
@@ -229,11 +234,10 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
       uint left = (inOrder.x | (inOrder.y << 1) | (inOrder.z << 2) | (inOrder.w << 3)) & (15u << uint((item >> 2) & 3));
       int pos = findLSB(left);
       uint slot = (order >> uint(2 * pos)) & 3u;
-      if (left != 0u) next = slot == 0u ? children.x : (slot == 1u ? children.y : (slot == 2u ? children.z : children.w));
+      if (left != 0u) next = childAt(children, slot);
       // What is pushed: the one child left, as it is, or the node, to go on from pos + 1.
       uint rest = left & (left - 1u);
-      uint other = (order >> uint(2 * findLSB(rest))) & 3u;
-      int otherChild = other == 0u ? children.x : (other == 1u ? children.y : (other == 2u ? children.z : children.w));
+      int otherChild = childAt(children, (order >> uint(2 * findLSB(rest))) & 3u);
       if (rest != 0u && stackSize < kStackSize) {
         top = (rest & (rest - 1u)) == 0u ? otherChild : (item & ~12) | ((pos + 1) << 2);
         stackSize++;

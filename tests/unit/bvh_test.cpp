@@ -32,20 +32,25 @@ RayHit bruteForce(const Soup& s, Vec3 o, Vec3 d) {
   return best;
 }
 
+// Builds the soup's BVH and its triangles in packed order, as traverseClosest takes them.
+Bvh buildSoup(const Soup& soup, std::vector<Vec3>* packed) {
+  std::vector<Bounds3> boxes(soup.verts.size() / 3);
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    for (std::size_t k = 0; k < 3; ++k) boxes[i].grow(soup.verts[i * 3 + k]);
+  Bvh bvh = buildBvh(boxes);
+  packed->clear();
+  for (std::uint32_t p : bvh.primOrder)
+    for (std::size_t k = 0; k < 3; ++k) packed->push_back(soup.verts[p * 3 + k]);
+  return bvh;
+}
+
 void checkAgainstBruteForce(const Soup& soup, int rays, std::uint32_t seed) {
   std::size_t n = soup.verts.size() / 3;
-  std::vector<Bounds3> boxes(n);
   Bounds3 all;
-  for (std::size_t i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k) {
-      boxes[i].grow(soup.verts[i * 3 + static_cast<std::size_t>(k)]);
-      all.grow(soup.verts[i * 3 + static_cast<std::size_t>(k)]);
-    }
-  Bvh bvh = buildBvh(boxes);
+  for (const Vec3& v : soup.verts) all.grow(v);
+  std::vector<Vec3> packed;
+  Bvh bvh = buildSoup(soup, &packed);
   ASSERT_EQ(bvh.primOrder.size(), n);
-  std::vector<Vec3> packed(n * 3);
-  for (std::size_t p = 0; p < n; ++p)
-    for (int k = 0; k < 3; ++k) packed[p * 3 + static_cast<std::size_t>(k)] = soup.verts[bvh.primOrder[p] * 3 + static_cast<std::size_t>(k)];
 
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(0, 1);
@@ -206,13 +211,8 @@ TEST(Bvh, RaysAtBoxFacesStillHit) {
       const float x = static_cast<float>(i), z = static_cast<float>(j);
       s.verts.insert(s.verts.end(), {{x, 0, z}, {x + 1, 0, z}, {x + 1, 0, z + 1}, {x, 0, z}, {x + 1, 0, z + 1}, {x, 0, z + 1}});
     }
-  std::vector<Bounds3> boxes(s.verts.size() / 3);
-  for (std::size_t i = 0; i < boxes.size(); ++i)
-    for (std::size_t k = 0; k < 3; ++k) boxes[i].grow(s.verts[i * 3 + k]);
-  const Bvh bvh = buildBvh(boxes);
   std::vector<Vec3> packed;
-  for (std::uint32_t p : bvh.primOrder)
-    for (std::size_t k = 0; k < 3; ++k) packed.push_back(s.verts[p * 3 + k]);
+  const Bvh bvh = buildSoup(s, &packed);
   std::mt19937 rng(17);
   std::uniform_real_distribution<float> u(0, 1);
   std::uniform_int_distribution<int> line(0, 16);

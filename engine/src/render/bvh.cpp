@@ -214,24 +214,26 @@ Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options
   std::vector<int> level{1};
   for (std::size_t k = 0; k < behind.size(); ++k) {
     const BuildNode& n = bn[behind[k]];
-    std::vector<std::uint32_t> kids;
+    // A fixed array, not a vector: this runs once per node of every mesh built.
+    std::array<std::uint32_t, kBvhWidth> kids{};
+    std::size_t count = 0;
     if (n.left < 0) {
-      kids.push_back(behind[k]);  // the root is a leaf
+      kids[count++] = behind[k];  // the root is a leaf
     } else {
-      kids = {static_cast<std::uint32_t>(n.left), static_cast<std::uint32_t>(n.right)};
+      kids[count++] = static_cast<std::uint32_t>(n.left);
+      kids[count++] = static_cast<std::uint32_t>(n.right);
     }
-    while (kids.size() < static_cast<std::size_t>(kBvhWidth)) {
-      int open = -1;
-      for (std::size_t c = 0; c < kids.size(); ++c)
-        if (bn[kids[c]].left >= 0 && (open < 0 || bn[kids[c]].bounds.area() > bn[kids[static_cast<std::size_t>(open)]].bounds.area()))
-          open = static_cast<int>(c);
-      if (open < 0) break;
-      const BuildNode& o = bn[kids[static_cast<std::size_t>(open)]];
-      kids[static_cast<std::size_t>(open)] = static_cast<std::uint32_t>(o.left);
-      kids.push_back(static_cast<std::uint32_t>(o.right));
+    while (count < kids.size()) {
+      std::size_t open = count;
+      for (std::size_t c = 0; c < count; ++c)
+        if (bn[kids[c]].left >= 0 && (open == count || bn[kids[c]].bounds.area() > bn[kids[open]].bounds.area())) open = c;
+      if (open == count) break;
+      const BuildNode& o = bn[kids[open]];
+      kids[open] = static_cast<std::uint32_t>(o.left);
+      kids[count++] = static_cast<std::uint32_t>(o.right);
     }
     BvhNode w;
-    for (std::size_t c = 0; c < kids.size(); ++c) {
+    for (std::size_t c = 0; c < count; ++c) {
       const BuildNode& ch = bn[kids[c]];
       w.box[c] = ch.bounds;
       if (ch.left < 0 || kids[c] == behind[k]) {
