@@ -23,6 +23,5 @@ test -s "$stage/triangle.png"
 
 # The render thread's channels and the engine facade again under ThreadSanitizer.
 cmake --preset tsan
-cmake --build --preset tsan --target unit_tests gpu_tests
-TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build-tsan/bin/unit_tests --gtest_filter='EditQueue*:Mailbox*'
-TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build-tsan/bin/gpu_tests --gtest_filter='Engine*'
+cmake --build --preset tsan --target thread_tests
+TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build-tsan/bin/thread_tests --gtest_filter='EditQueue*:Mailbox*:Engine*'
