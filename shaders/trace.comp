@@ -134,6 +134,21 @@ struct Path {
   int auxInstance;
 };
 
+// The shadow ray of a path vertex's next-event estimation. It is traced with the next segment's
+// extension ray, in one loop (traceRays): the path's own next segment, or, when the path ended at
+// that vertex, the first segment of the path the invocation starts next, so that no segment is
+// spent on it alone (a segment costs the shading code for all eight lanes).
+struct Shadow {
+  bool pending;
+  vec3 origin, dir;
+  float tMax, random;
+  vec3 L;      // what it adds when nothing blocks it
+  bool ended;  // its path has ended: its sample is then rewritten as full when nothing blocks it
+  uint slot;
+  vec3 full;
+  int selBase;
+};
+
 uint primaryRays = 0u, bounceRays = 0u, shadowRays = 0u;
 
 Path startPath(uint slot) {
@@ -194,13 +209,40 @@ void writeSample(Path path, bool ended) {
   aux[path.slot * kAuxVec4s + 2u] = vec4(path.auxEmission, 0.0);
 }
 
-// Traces one segment of the path and shades its hit: emission, next-event estimation and the
-// next direction. Returns false when the path has ended.
-bool extendPath(inout Path path) {
+// The path has no next direction: a pending shadow ray goes on with the next path.
+bool endPath(Path path, inout Shadow shadow) {
+  shadow.ended = true;
+  shadow.slot = path.slot;
+  shadow.full = path.L + shadow.L;
+  return false;
+}
+
+// A shadow ray traced: its path's light, or its ended path's sample rewritten.
+void resolveShadow(inout Path path, inout Shadow shadow, Hit sh) {
+  if (!shadow.pending) return;
+  shadowRays++;
+  int selected = int(frame.work.z) - 1;
+  if (shadow.selBase >= 0 && sh.prim >= 0 && sh.instance == selected) atomicAdd(selectionCounts[shadow.selBase + 2], 1u);
+  bool visible = sh.prim < 0;
+  // The path is still this invocation's (it goes on, or no path has started since it ended).
+  bool own = !shadow.ended || path.slot == shadow.slot;
+  if (visible && own) path.L += shadow.L;
+  bool valid = !(any(isnan(shadow.full)) || any(isinf(shadow.full)));
+  if (visible && !own) samples[shadow.slot] = valid ? vec4(shadow.full, 1.0) : vec4(0.0);
+  shadow.pending = false;
+}
+
+// Traces one segment of the path and shades its hit: emission, next-event estimation (its shadow
+// ray is traced with the next segment) and the next direction. Returns false when the path has
+// ended.
+bool extendPath(inout Path path, bool alive, inout Shadow shadow) {
   int selected = int(frame.work.z) - 1;
   int maxBounces = int(frame.image.w);
   vec3 ro = path.ro, rd = path.rd;
-  Hit hit = traceRay(ro, rd, kInfinity, false, rand(path.rng));
+  Hit hit, sh;
+  traceRays(alive, ro, rd, rand(path.rng), shadow.pending, shadow.origin, shadow.dir, shadow.tMax, shadow.random, hit, sh);
+  resolveShadow(path, shadow, sh);
+  if (!alive) return false;
   if (path.depth == 0) primaryRays++; else bounceRays++;
   if (path.selBase >= 0 && hit.prim >= 0 && hit.instance == selected) {
     // Direct hits, then reflections weighted (maxBounces + 1) / depth: 4, 2, 1 at 3 bounces.
@@ -301,9 +343,8 @@ bool extendPath(inout Path path) {
   if (!isDeltaMaterial(m) && (frame.lightPick.x + frame.lightPick.y + frame.lightPick.z) > 0.0) {
     vec3 lu = vec3(rand(path.rng), rand(path.rng), rand(path.rng));
     LightSample ls = sampleLight(pos, lu);
-    // Only some of these lanes ran the sky map's search loops, and only some trace a shadow ray:
-    // all of them take the count here, or a lane that searched but traces no shadow ray would
-    // carry iterations the shadow ray's lanes never see.
+    // Only some of these lanes ran the sky map's search loops: all of them take the count here,
+    // or a lane that did not search would miss iterations the others ran.
     syncLoopIterations();
     if (ls.pdf > 0.0 && maxComponent(ls.radiance) > 0.0) {
       float sideL = dot(ls.dir, ngs);
@@ -312,15 +353,15 @@ bool extendPath(inout Path path) {
         float bsdfPdf;
         vec3 f = bsdfEval(m, woL, toLocal(ls.dir, t, b, nss), bsdfPdf);
         if (maxComponent(f) > 0.0) {
-          vec3 origin = offsetRay(pos, sideL > 0.0 ? ngs : -ngs);
-          float tMax = ls.dist >= kInfinity ? kInfinity : ls.dist * (1.0 - 1e-4);
-          shadowRays++;
-          Hit sh = traceRay(origin, ls.dir, tMax, true, rand(path.rng));
-          if (path.selBase >= 0 && sh.prim >= 0 && sh.instance == selected) atomicAdd(selectionCounts[path.selBase + 2], 1u);
-          if (sh.prim < 0) {
-            float w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, bsdfPdf);
-            path.L += path.beta * f * ls.radiance * (w / ls.pdf);
-          }
+          float w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, bsdfPdf);
+          shadow.origin = offsetRay(pos, sideL > 0.0 ? ngs : -ngs);
+          shadow.dir = ls.dir;
+          shadow.tMax = ls.dist >= kInfinity ? kInfinity : ls.dist * (1.0 - 1e-4);
+          shadow.random = rand(path.rng);
+          shadow.L = path.beta * f * ls.radiance * (w / ls.pdf);
+          shadow.ended = false;
+          shadow.selBase = path.selBase;
+          shadow.pending = true;
         }
       }
     }
@@ -328,7 +369,7 @@ bool extendPath(inout Path path) {
 
   // Continue the path by sampling the BSDF.
   BsdfSample bs = bsdfSample(m, woL, vec3(rand(path.rng), rand(path.rng), rand(path.rng)));
-  if (maxComponent(bs.weight) <= 0.0 || any(isnan(bs.weight))) return false;
+  if (maxComponent(bs.weight) <= 0.0 || any(isnan(bs.weight))) return endPath(path, shadow);
   vec3 wi = toWorld(bs.wi, t, b, nss);
   float sideI = dot(wi, ngs), sideO = dot(wo, ngs);
   // A reflected direction must leave on the viewer's side of the true surface, a transmitted
@@ -336,7 +377,7 @@ bool extendPath(inout Path path) {
   // viewer's side, not the normal's: inside glass it is the back (comparing with the normal
   // alone ended every path leaving glass, and every reflection inside it: black glass).
   // Tungsten's convention has no such check (its enable_consistency_checks is off by default).
-  if (!tungstenShading && (bs.transmitted ? sideI * sideO >= 0.0 : sideI * sideO <= 0.0)) return false;
+  if (!tungstenShading && (bs.transmitted ? sideI * sideO >= 0.0 : sideI * sideO <= 0.0)) return endPath(path, shadow);
   path.beta *= bs.weight;
   // Roulette must not see the 1/eta^2 radiance scaling inside glass as lost energy.
   if (bs.transmitted && !isMat(m.type, kMatThinSheet)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
@@ -350,7 +391,7 @@ bool extendPath(inout Path path) {
   // Russian roulette after a few bounces, keeping the expected value.
   if (path.depth > 3) {
     float q = max(0.05, 1.0 - maxComponent(path.beta * path.etaScale));
-    if (rand(path.rng) < q) return false;
+    if (rand(path.rng) < q) return endPath(path, shadow);
     path.beta /= 1.0 - q;
   }
   return true;
@@ -373,6 +414,8 @@ void main() {
   path.travelled = 0.0;
   path.auxInstance = 0;
   bool alive = false;
+  Shadow shadow;
+  shadow.pending = false;
   uint cutPaths = 0u;
   uint maxSegment = 0u;
   // Every lane's count is the eight's here: the last synchronisation of an iteration (after the
@@ -380,8 +423,9 @@ void main() {
   for (;;) {
     loopIterations++;
     if (loopIterations > kLoopBudget || loopIterations + 2u * maxSegment > kLoopLimit) {
-      // Out of loop budget (the same decision in every lane): paths end as they stand, and slots
-      // not yet started keep the weight 0 the renderer cleared them to.
+      // Out of loop budget (the same decision in every lane): paths end as they stand (a shadow
+      // ray still to trace is dropped, from an ended path too), and slots not yet started keep
+      // the weight 0 the renderer cleared them to.
       if (alive) {
         cutPaths++;
         writeSample(path, true);
@@ -397,9 +441,9 @@ void main() {
     // Only the lanes that started a path ran findItem's loop; every lane takes its count here,
     // before the extension ray's loop, which the others may run longest.
     syncLoopIterations();
-    if (subgroupAll(!alive)) break;
+    if (subgroupAll(!alive && !shadow.pending)) break;
     uint segmentStart = loopIterations;
-    if (alive && !extendPath(path)) alive = false;
+    if ((alive || shadow.pending) && !extendPath(path, alive, shadow)) alive = false;
     syncLoopIterations();
     maxSegment = max(maxSegment, loopIterations - segmentStart);
     // Every lane writes its path's state every iteration, the ended ones included (again): a

@@ -4,6 +4,7 @@
 #define RETILE_SCENE_GLSL
 
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_vote : require
 
 #include "shared/layouts.h"
 #include "common/sampling.glsl"
@@ -144,7 +145,12 @@ vec3 safeInverse(vec3 d) {
               abs(d.z) > eps ? 1.0 / d.z : (d.z >= 0.0 ? 1e30 : -1e30));
 }
 
-// Closest hit (anyHit == false) or any opaque hit (anyHit == true, for shadow rays).
+// Two rays, one after the other in one loop: the closest hit of an extension ray (when first)
+// and any opaque hit of a shadow ray up to tMax2 (when second; prim -1 when nothing blocks it). A
+// ray not traced comes back as a miss. One loop for both: lavapipe runs eight lanes in lock-step
+// and a loop as long as its slowest lane, so the eight extension rays and then the eight shadow
+// rays in two loops ran the longest of each (157 loop iterations per spaceship path against 131
+// in one loop), and the loop's code is compiled once.
 //
 // lavapipe (Mesa 22.3) runs both sides of every branch with lanes masked off: an if skips no
 // code, even when no lane takes it. A loop iteration therefore costs all the code in its body,
@@ -152,14 +158,24 @@ vec3 safeInverse(vec3 d) {
 // take one of its four children, test one triangle, or enter an instance), and all three read
 // their record through the same four texel fetches of the one traversal buffer. Testing up to two leaves of four
 // triangles in the visiting iteration, as before, made every iteration pay for 24 fetches.
-Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
+void traceRays(bool first, vec3 origin1, vec3 dir1, float random1, bool second, vec3 origin2, vec3 dir2, float tMax2,
+               float random2, out Hit closest, out Hit shadow) {
   Hit hit;
-  hit.t = tMax;
+  hit.t = kInfinity;
   hit.prim = -1;
   hit.instance = -1;
   hit.u = 0.0;
   hit.v = 0.0;
-  if (frame.scene.y == 0) return hit;
+  closest = hit;
+  shadow = hit;
+  shadow.t = tMax2;
+  if (frame.scene.y == 0 || !(first || second)) return;
+  bool onShadow = !first;  // the lane traces the shadow ray now
+  bool done = false;
+  hit.t = onShadow ? tMax2 : kInfinity;
+  vec3 invDir2 = safeInverse(dir2);
+  vec3 origin = onShadow ? origin2 : origin1, dir = onShadow ? dir2 : dir1;
+  float rayRandom = onShadow ? random2 : random1;
 
   // The traversal stack: its top entry in a variable, the ones below it in an array. lavapipe
   // turns an access to a per-invocation array at a varying index into a loop over the eight
@@ -175,7 +191,7 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
   int stackSize = 0;
   int stackBelow[kStackSize];  // entries under the top; the last slot takes the spill of a full stack
   int item = frame.scene.x;  // the instance BVH's root
-  vec3 invDir = safeInverse(dir);
+  vec3 invDir = onShadow ? invDir2 : safeInverse(dir1);
   vec3 o = origin, d = dir, invD = invDir;
   int instance = -1;
   int instFlags = 0;
@@ -190,6 +206,7 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
     vec4 r0 = texelFetch(uTraversal, at), r1 = texelFetch(uTraversal, at + 1);
     vec4 r2 = texelFetch(uTraversal, at + 2), r3 = texelFetch(uTraversal, at + 3);
     int next = -1;
+    bool finished = false;
     if (kind == kItemNode) {
       // Four child boxes, quantised (render/bvh.h QuantizedNode): a plane's distance is
       // (origin - o) / d + q * scale / d, each axis for the four children at once. The children
@@ -263,7 +280,7 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
         hit.v = vv;
         hit.prim = p;
         hit.instance = instance;
-        if (anyHit) break;
+        finished = onShadow;
       }
       // The rest of the leaf: one triangle further on, one fewer to go.
       if ((item & 12) != 0) next = item + ((kTriTexels << kItemOffsetShift) - 4);
@@ -277,24 +294,50 @@ Hit traceRay(vec3 origin, vec3 dir, float tMax, bool anyHit, float rayRandom) {
       instanceSp = stackSize;
       next = floatBitsToInt(r3.x);
     }
-    if (next < 0) {
-      if (stackSize == instanceSp) {
-        // Back from the instance to world space.
-        o = origin;
-        d = dir;
-        invD = invDir;
-        instance = -1;
-        instanceSp = -1;
+    if (next < 0 && !finished) {
+      finished = stackSize == 0;
+      if (!finished) {
+        next = top;
+        top = below;
+        stackSize--;
       }
-      if (stackSize == 0) break;
-      next = top;
-      top = below;
-      stackSize--;
+    }
+    if (finished && (onShadow || !second)) {
+      // Both rays done. The lane stays in the loop until the eight are done, visiting the root
+      // with a ray that enters nothing: a lane that left the loop made every iteration's stack
+      // write, masked for it, reload its slot and mispredict.
+      if (!done) {
+        if (onShadow) shadow = hit; else closest = hit;
+      }
+      done = true;
+      hit.t = -1.0;
+      stackSize = 0;
+      next = frame.scene.x;
+    } else if (finished) {
+      // The extension ray is done: the shadow ray starts at the instance BVH's root.
+      closest = hit;
+      onShadow = true;
+      hit.t = tMax2;
+      hit.prim = -1;
+      origin = origin2;
+      dir = dir2;
+      invDir = invDir2;
+      rayRandom = random2;
+      stackSize = 0;
+      next = frame.scene.x;
+    }
+    if (stackSize < instanceSp || finished) {
+      // Back from the instance to world space (or to the shadow ray's).
+      o = origin;
+      d = dir;
+      invD = invDir;
+      instance = -1;
+      instanceSp = -1;
     }
     item = next;
+    if (subgroupAll(done)) break;
   }
   syncLoopIterations();
-  return hit;
 }
 
 #endif
