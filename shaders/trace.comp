@@ -174,6 +174,16 @@ Path startPath(uint slot) {
   path.rd = normalize(frame.cameraForward.xyz + ndc.x * tanHalf * frame.cameraRight.w * frame.cameraRight.xyz -
                       ndc.y * tanHalf * frame.cameraUp.xyz);
   path.ro = frame.cameraPosition.xyz;
+  float aperture = frame.cameraUp.w;
+  if (aperture > 0.0) {
+    // A thin lens: the ray leaves a point of the lens disc (uniform over its area) for the point
+    // where the pinhole ray meets the plane in focus. A pinhole draws no numbers for it, so its
+    // samples stay what they were.
+    vec3 focus = path.ro + path.rd * (frame.cameraForward.w / dot(path.rd, frame.cameraForward.xyz));
+    float r = aperture * sqrt(rand(path.rng)), phi = 6.2831853 * rand(path.rng);
+    path.ro += r * (cos(phi) * frame.cameraRight.xyz + sin(phi) * frame.cameraUp.xyz);
+    path.rd = normalize(focus - path.ro);
+  }
   path.L = vec3(0.0);
   path.beta = vec3(1.0);
   path.etaScale = 1.0;

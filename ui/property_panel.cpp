@@ -451,6 +451,13 @@ void PropertyPanel::buildCamera(Builder& b) {
   b.number(tr("Vertical field of view"), "fov", degrees(c.verticalFov), 1.0, 170.0, 40.0, 1, [edit](double v, int drag) {
     edit(tr("Field of view"), drag, [v](Camera& x) { x.verticalFov = radians(static_cast<float>(v)); });
   });
+  // Depth of field: a lens of this radius, sharp at the focus distance (0: a pinhole).
+  b.number(tr("Aperture radius"), "apertureRadius", c.apertureRadius, 0.0, 10.0, 0.0, 4, [edit](double v, int drag) {
+    edit(tr("Aperture radius"), drag, [v](Camera& x) { x.apertureRadius = static_cast<float>(v); });
+  });
+  b.number(tr("Focus distance"), "focusDistance", c.focusDistance, 0.001, 1e5, 1.0, 3, [edit](double v, int drag) {
+    edit(tr("Focus distance"), drag, [v](Camera& x) { x.focusDistance = static_cast<float>(v); });
+  });
 }
 
 void PropertyPanel::buildEnvironment(Builder& b) {

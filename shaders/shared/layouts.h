@@ -104,8 +104,8 @@ RT_CONST(int, kFilterWarpSegments, 32)  // the pixel filter's inverse CDF: 33 po
 struct FrameUniforms {
   vec4 cameraPosition;  // xyz, tan(verticalFov / 2)
   vec4 cameraRight;     // xyz (unit), aspect = width / height
-  vec4 cameraUp;        // xyz (unit)
-  vec4 cameraForward;   // xyz (unit)
+  vec4 cameraUp;        // xyz (unit), the thin lens's aperture radius (0: a pinhole)
+  vec4 cameraForward;   // xyz (unit), the distance of the plane in focus along it
   uvec4 image;          // width, height, seed, maxBounces
   ivec4 scene;          // tlasRoot, instanceCount, emitterCount, deltaLightCount
   vec4 lightPick;       // probability of picking: emitters, environment, delta lights; -

@@ -439,6 +439,14 @@ TEST(Editor, CameraEnvironmentAndRenderSettingsHavePanels) {
   ASSERT_TRUE(fov);
   fov->setValue(55.0);
   EXPECT_NEAR(degrees(w->scene().camera.verticalFov), 55.0f, 1e-3f);
+  // Depth of field from the same panel.
+  auto* aperture = w->properties()->findChild<ScrubField*>("apertureRadius");
+  auto* focus = w->properties()->findChild<ScrubField*>("focusDistance");
+  ASSERT_TRUE(aperture && focus);
+  aperture->setValue(0.05);
+  focus->setValue(4.0);
+  EXPECT_FLOAT_EQ(w->scene().camera.apertureRadius, 0.05f);
+  EXPECT_FLOAT_EQ(w->scene().camera.focusDistance, 4.0f);
   ASSERT_TRUE(pick("Environment"));
   auto* intensity = w->properties()->findChild<ScrubField*>("environmentIntensity");
   ASSERT_TRUE(intensity);

@@ -140,6 +140,11 @@ TEST(KnownAnswer, PixelFiltersSpreadAnEdgeAsTheyShould) {
   Scene s = test::emptyScene(32, 8);
   lookStraightDown(s, 3, 20);  // image x is world x: the edge x = 0 is the boundary of columns 15 and 16
   s.settings.maxBounces = 0;
+  // A box filter sums to one over the pixel grid wherever an edge falls, so the total is the
+  // light's area in pixels (a narrower Blackman-Harris sums to more or less than one by where the
+  // edges fall: 11 % less here).
+  s.settings.pixelFilter = PixelFilter::Box;
+  s.settings.filterWidth = 1.0f;
   Material light;
   light.albedo = Vec3{0.0f};
   light.emission = Vec3{1.0f};
@@ -228,6 +233,63 @@ TEST(KnownAnswer, InverseSquareFalloffOfASmallLight) {
   double expectedNear = 100.0 * 0.0025 / (kPi * 1.0);
   EXPECT_NEAR(near, expectedNear, expectedNear * 0.02);
   EXPECT_NEAR(near / far, 4.0, 0.08);
+}
+
+// The image of a small square light seen straight down from 4 units: its total and, about its
+// centroid, its spread (the mean of the squared distance along x and y, in pixels squared).
+struct Spot {
+  double total = 0, spread = 0;
+};
+Spot lightSeenThroughLens(Renderer& r, float apertureRadius, float focusDistance) {
+  Scene s = test::emptyScene(64, 64);
+  lookStraightDown(s, 4.0f, 10.0f);
+  s.camera.apertureRadius = apertureRadius;
+  s.camera.focusDistance = focusDistance;
+  s.settings.maxBounces = 0;
+  // A box filter sums to one over the pixel grid wherever an edge falls, so the total is the
+  // light's area in pixels (a narrower Blackman-Harris sums to more or less than one by where the
+  // edges fall: 11 % less here).
+  s.settings.pixelFilter = PixelFilter::Box;
+  s.settings.filterWidth = 1.0f;
+  Material light;
+  light.albedo = Vec3{0.0f};
+  light.emission = Vec3{1.0f};
+  test::addMeshObject(s, "light", makeQuad(), test::addMaterial(s, light), Mat4::scale({0.05f, 1, 0.05f}));
+  RenderImage img = renderScene(r, s, 1024);
+  double sum = 0, sx = 0, sy = 0, sxx = 0, syy = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      double v = img.color[(static_cast<std::size_t>(y) * img.width + x) * 3 + 1];
+      sum += v, sx += v * (x + 0.5), sy += v * (y + 0.5), sxx += v * (x + 0.5) * (x + 0.5), syy += v * (y + 0.5) * (y + 0.5);
+    }
+  Spot spot;
+  spot.total = sum;
+  double mx = sx / sum, my = sy / sum;
+  spot.spread = 0.5 * ((sxx / sum - mx * mx) + (syy / sum - my * my));
+  return spot;
+}
+
+// A thin lens (Camera::apertureRadius, focusDistance) spreads a point at distance D over a disc of
+// radius R |D - F| / D on the plane in focus; a disc of radius rho has a spread of rho^2 / 4 per
+// axis, which adds to the light's own and the pixel filter's. Focused on the light, the lens
+// changes nothing; and the light's total stays its area in pixels (it is small against its
+// distance).
+TEST(KnownAnswer, AThinLensBlursByItsCircleOfConfusion) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const float R = 0.05f, D = 4.0f, F = 2.0f;
+  Spot pinhole = lightSeenThroughLens(*r, 0.0f, 1.0f);
+  Spot focused = lightSeenThroughLens(*r, R, D);
+  Spot blurred = lightSeenThroughLens(*r, R, F);
+  // Pixels per unit on the plane in focus: 64 pixels over 2 F tan(5 degrees).
+  const double rho = R * std::abs(D - F) / D * 64.0 / (2.0 * F * std::tan(radians(5.0f)));
+  EXPECT_NEAR(focused.spread, pinhole.spread, pinhole.spread * 0.05);
+  EXPECT_NEAR(blurred.spread - pinhole.spread, rho * rho / 4.0, rho * rho / 4.0 * 0.08)
+      << "spread " << blurred.spread << " against " << pinhole.spread << " without the lens";
+  const double area = std::pow(0.05 * 64.0 / (2.0 * D * std::tan(radians(5.0f))), 2.0);
+  // Within 2.5 %: five seeds of the blurred light ranged over -0.7 to +0.7 %.
+  EXPECT_NEAR(pinhole.total, area, area * 0.025);
+  EXPECT_NEAR(focused.total, area, area * 0.025);
+  EXPECT_NEAR(blurred.total, area, area * 0.025);
 }
 
 // The renderer compiles the trace kernel for the lights a scene has (kFeature... in layouts.h).

@@ -116,6 +116,12 @@ TEST(Document, BadEditsAreRefusedAndChangeNothing) {
   Camera c = doc.scene().camera;
   c.verticalFov = 0;
   EXPECT_FALSE(doc.apply(SetCamera{c}).ok());
+  c = doc.scene().camera;
+  c.apertureRadius = -0.1f;
+  EXPECT_FALSE(doc.apply(SetCamera{c}).ok());
+  c.apertureRadius = 0.1f;
+  c.focusDistance = 0;
+  EXPECT_FALSE(doc.apply(SetCamera{c}).ok());
   RenderSettings rs;
   rs.width = 0;
   EXPECT_FALSE(doc.apply(SetRenderSettings{rs}).ok());

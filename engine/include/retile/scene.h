@@ -148,6 +148,10 @@ struct Camera {
   Vec3 target{0.0f, 1.0f, 0.0f};
   Vec3 up{0.0f, 1.0f, 0.0f};
   float verticalFov = radians(40.0f);
+  // A thin lens: rays leave a disc of this radius (scene units) about the position, across the
+  // view direction, and meet again on the plane focusDistance along it. 0 is a pinhole.
+  float apertureRadius = 0.0f;
+  float focusDistance = 1.0f;
 };
 
 enum class EnvironmentType { Constant, Map, Sky };

@@ -189,6 +189,10 @@ Value nativeSceneToJson(const Scene& s) {
   cam.set("target", json::fromVec3(s.camera.target));
   cam.set("up", json::fromVec3(s.camera.up));
   cam.set("vertical_fov", s.camera.verticalFov);
+  if (s.camera.apertureRadius > 0) {
+    cam.set("aperture_radius", s.camera.apertureRadius);
+    cam.set("focus_distance", s.camera.focusDistance);
+  }
   root.set("camera", cam);
 
   const Environment& e = s.environment;
@@ -373,6 +377,8 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
     r.vec3("target", &s.camera.target);
     r.vec3("up", &s.camera.up);
     r.number("vertical_fov", &s.camera.verticalFov);
+    r.number("aperture_radius", &s.camera.apertureRadius);
+    r.number("focus_distance", &s.camera.focusDistance);
   }
   if (const Value* v = root.find("environment")) {
     Reader r(&error, "environment", v);

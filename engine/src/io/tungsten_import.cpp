@@ -83,6 +83,7 @@ class TungstenImporter {
     if (const Value* p = root.find("primitives"); p && ok()) {
       if (!p->isArray()) return fail("primitives: expected an array");
       for (std::size_t i = 0; i < p->asArray().size() && ok(); ++i) primitive(p->asArray()[i], cat("primitives[", i, "]"));
+      if (!focusPivot_.empty() && ok()) focusOn(*p);
     }
     // Not Tungsten's own key, but Bitterli's living room names its sky this way (an envmap; the
     // room has no other light). Tungsten renders these files without a `constant` entry: the
@@ -105,6 +106,21 @@ class TungstenImporter {
   }
 
  private:
+  // The thin lens focuses as far as the origin of the primitive focus_pivot names (Tungsten's
+  // ThinlensCamera::prepareForRender), else where focus_distance says.
+  void focusOn(const Value& primitives) {
+    for (std::size_t i = 0; i < primitives.asArray().size(); ++i) {
+      const Value& p = primitives.asArray()[i];
+      if (!p.isObject() || string(p, "name") != focusPivot_) continue;
+      Vec3 origin{0.0f};
+      if (const Value* t = p.find("transform")) origin = transform(t, cat("primitives[", i, "].transform")).transformPoint({0, 0, 0});
+      float d = length(origin - out_.scene.camera.position);
+      if (std::isfinite(d) && d > 0) out_.scene.camera.focusDistance = d;
+      return;
+    }
+    warn(cat("camera: focus_pivot '", focusPivot_, "' names no primitive; focused at focus_distance"));
+  }
+
   bool ok() const { return error_.empty(); }
   Result<ImportedScene> fail(const std::string& what) {
     if (error_.empty()) error_ = cat(file_.string(), ": ", what);
@@ -443,7 +459,23 @@ class TungstenImporter {
     if (!c.isObject()) return problem(where, "expected an object");
     Scene& s = out_.scene;
     std::string type = string(c, "type", "pinhole");
-    if (type != "pinhole") warn(cat("camera type '", type, "' is rendered as a pinhole camera"));
+    if (type == "thinlens") {
+      // Tungsten's ThinlensCamera: a disc of radius aperture_size, sharp on the plane focus_distance
+      // along the view direction (its defaults 0.001 and 1), or as far as focus_pivot's origin.
+      s.camera.apertureRadius = 0.001f;
+      s.camera.focusDistance = 1.0f;
+      number(c, "aperture_size", &s.camera.apertureRadius, where);
+      number(c, "focus_distance", &s.camera.focusDistance, where);
+      if (!(s.camera.apertureRadius >= 0) || !(s.camera.focusDistance > 0))
+        return problem(where, "aperture_size must not be negative and focus_distance must be positive");
+      focusPivot_ = string(c, "focus_pivot");
+      float catEye = 0;
+      number(c, "cateye", &catEye, where);
+      if (catEye > 0) warn("camera: the cat's-eye vignetting of a thin lens (cateye) is left out");
+      if (c.find("aperture")) warn("camera: an aperture texture is rendered as a round aperture");
+    } else if (type != "pinhole") {
+      warn(cat("camera type '", type, "' is rendered as a pinhole camera"));
+    }
     if (const Value* r = c.find("resolution")) {
       Vec2 res;
       if (!json::toVec2(*r, &res) || res.x < 1 || res.y < 1 || res.x > kMaxImageSide || res.y > kMaxImageSide)
@@ -782,6 +814,7 @@ class TungstenImporter {
   ImportedScene out_;
   std::string error_;
   std::map<std::string, Material> named_;
+  std::string focusPivot_;  // the thin lens camera's focus_pivot
   std::map<std::string, NodeId> textures_;
   std::set<std::string> missingWarned_;
   bool quietMissingTexture_ = false;

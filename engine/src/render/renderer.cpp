@@ -402,8 +402,8 @@ struct Renderer::Impl {
     float tanHalf = std::tan(0.5f * camera.verticalFov);
     u.cameraPosition = {camera.position.x, camera.position.y, camera.position.z, tanHalf};
     u.cameraRight = {right.x, right.y, right.z, static_cast<float>(width) / static_cast<float>(height)};
-    u.cameraUp = {up.x, up.y, up.z, 0};
-    u.cameraForward = {forward.x, forward.y, forward.z, 0};
+    u.cameraUp = {up.x, up.y, up.z, camera.apertureRadius};
+    u.cameraForward = {forward.x, forward.y, forward.z, camera.focusDistance};
     u.image = {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height), seed,
                static_cast<std::uint32_t>(std::max(maxBounces, 0))};
     u.scene = {d.tlasRoot, static_cast<std::int32_t>(d.instanceObject.size()),

@@ -45,9 +45,12 @@ std::string checkLight(const Light& l) {
 }
 
 std::string checkCamera(const Camera& c) {
-  if (!isFinite(c.position) || !isFinite(c.target) || !isFinite(c.up) || !finite(c.verticalFov))
+  if (!isFinite(c.position) || !isFinite(c.target) || !isFinite(c.up) || !finite(c.verticalFov) ||
+      !finite(c.apertureRadius) || !finite(c.focusDistance))
     return "camera: a parameter is not a finite number";
   if (c.verticalFov <= 0 || c.verticalFov >= kPi) return "camera: field of view must be between 0 and 180 degrees";
+  if (c.apertureRadius < 0) return "camera: the aperture radius must not be negative";
+  if (!(c.focusDistance > 0)) return "camera: the focus distance must be positive";
   if (length(c.target - c.position) == 0) return "camera: position and target coincide";
   return {};
 }

@@ -179,6 +179,14 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
                            scene.camera.position.z, ") is not finite, too far out or looks nowhere; framing the scene instead"));
     scene.camera = framingCamera(scene);
   }
+  Camera& cam = scene.camera;
+  if (!(std::isfinite(cam.apertureRadius) && cam.apertureRadius >= 0 && std::isfinite(cam.focusDistance) &&
+        cam.focusDistance > 0)) {
+    warnings.push_back(cat("the camera's lens (aperture radius ", cam.apertureRadius, ", focus distance ",
+                           cam.focusDistance, ") is not usable; rendering through a pinhole"));
+    cam.apertureRadius = 0.0f;
+    cam.focusDistance = 1.0f;
+  }
 
   if ((trianglesBefore > 0 || lightsBefore > 0) && trianglesAfter == 0 && scene.lights.empty())
     return Result<bool>::failure(cat("nothing to render is left: all ", trianglesBefore, " triangles and ", lightsBefore,
