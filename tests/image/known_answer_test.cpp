@@ -140,11 +140,6 @@ TEST(KnownAnswer, PixelFiltersSpreadAnEdgeAsTheyShould) {
   Scene s = test::emptyScene(32, 8);
   lookStraightDown(s, 3, 20);  // image x is world x: the edge x = 0 is the boundary of columns 15 and 16
   s.settings.maxBounces = 0;
-  // A box filter sums to one over the pixel grid wherever an edge falls, so the total is the
-  // light's area in pixels (a narrower Blackman-Harris sums to more or less than one by where the
-  // edges fall: 11 % less here).
-  s.settings.pixelFilter = PixelFilter::Box;
-  s.settings.filterWidth = 1.0f;
   Material light;
   light.albedo = Vec3{0.0f};
   light.emission = Vec3{1.0f};
