@@ -269,10 +269,10 @@ class Parser {
         case 'r': out += '\r'; break;
         case 't': out += '\t'; break;
         case 'u': {
-          std::uint32_t cp;
+          std::uint32_t cp = 0;  // set by parseHex4 (a TSan build of GCC 12 cannot tell)
           if (!parseHex4(cp)) return false;
           if (cp >= 0xD800 && cp < 0xDC00) {
-            std::uint32_t lo;
+            std::uint32_t lo = 0;
             if (s_.compare(pos_, 2, "\\u") != 0) return setError("unpaired surrogate in \\u escape");
             pos_ += 2;
             if (!parseHex4(lo)) return false;
