@@ -523,8 +523,12 @@ void NodeGraphView::rebuild() {
   }
   {
     const Camera& c = scene_.camera;
+    const double fov = static_cast<double>(c.verticalFov) * 180.0 / kPi;
+    // With a lens, the distance in focus (the subtitle has room for little more).
     add(kCameraNode, NodeKind::Camera, tr("Camera").toStdString(),
-        tr("Field of view %1\u00b0").arg(static_cast<double>(c.verticalFov) * 180.0 / kPi, 0, 'f', 1));
+        c.apertureRadius > 0
+            ? tr("%1\u00b0, in focus at %2").arg(fov, 0, 'f', 1).arg(static_cast<double>(c.focusDistance), 0, 'g', 3)
+            : tr("Field of view %1\u00b0").arg(fov, 0, 'f', 1));
     const RenderSettings& r = scene_.settings;
     add(kSettingsNode, NodeKind::Settings, tr("Render Settings").toStdString(),
         tr("%1x%2, %3 spp, %4 bounces").arg(r.width).arg(r.height).arg(r.samplesPerPixel).arg(r.maxBounces));
