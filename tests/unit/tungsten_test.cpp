@@ -166,6 +166,29 @@ TEST(Tungsten, UndefinedBsdfsBecomeStandInsWithAWarning) {
   EXPECT_EQ(null, 1);
 }
 
+TEST(Tungsten, WhatIsNotRenderedIsNamedInAWarning) {
+  // The volumetric caustic's medium, a bump map, a bsdf per material index: the file opens, and
+  // the user learns what the image leaves out. A constant bump has no slope: nothing to say.
+  auto r = importTungsten(writeScene(R"({"media": [{"name": "gas", "type": "homogeneous", "sigma_s": 1}],
+      "bsdfs": [{"name": "a", "type": "lambert"}, {"name": "b", "type": "mirror"}],
+      "primitives": [
+        {"type": "quad", "name": "wall", "bsdf": "a", "int_medium": "gas", "bump": "bumps.png"},
+        {"type": "quad", "name": "flat", "bsdf": "a", "bump": 0.5},
+        {"type": "cube", "name": "both", "bsdf": ["a", "b"], "emission": 1}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  EXPECT_EQ(r->scene.objects.size(), 3u);
+  int media = 0, bump = 0, bsdfs = 0;
+  for (const auto& w : r->warnings) {
+    media += w.find("participating media are not rendered ('gas')") != std::string::npos;
+    bump += w.find("bump map is not rendered") != std::string::npos;
+    bsdfs += w.find("primitives[2]: 2 bsdfs by material index") != std::string::npos;
+  }
+  EXPECT_EQ(media, 1);
+  EXPECT_EQ(bump, 1) << "only the textured bump";
+  EXPECT_EQ(bsdfs, 1);
+  for (const auto& w : r->warnings) EXPECT_EQ(w.find("bumps.png' not found"), std::string::npos) << "a bump is not loaded: " << w;
+}
+
 TEST(Tungsten, MissingMeshIsSkippedWithAWarning) {
   auto file = writeScene(R"({"primitives": [
       {"type": "mesh", "file": "nowhere.obj"},

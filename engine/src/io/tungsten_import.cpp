@@ -80,6 +80,12 @@ class TungstenImporter {
       if (const Value* v = r->find("spp"); v && json::toFloat(*v, &spp) && spp >= 1)
         s.settings.samplesPerPixel = std::clamp(static_cast<int>(spp), 1, 1 << 20);
     }
+    if (const Value* m = root.find("media"); m && m->isArray() && !m->asArray().empty()) {
+      std::string names;
+      for (const Value& medium : m->asArray())
+        if (medium.isObject()) names += cat(names.empty() ? "" : ", ", "'", string(medium, "name", "?"), "'");
+      warn(cat("media: participating media are not rendered (", names, "); light travels through them as through a vacuum"));
+    }
     if (const Value* p = root.find("primitives"); p && ok()) {
       if (!p->isArray()) return fail("primitives: expected an array");
       for (std::size_t i = 0; i < p->asArray().size() && ok(); ++i) primitive(p->asArray()[i], cat("primitives[", i, "]"));
@@ -751,11 +757,20 @@ class TungstenImporter {
     }
     if (!ok() || mesh == kNoNode) return;
 
+    if (const Value* bump = p.find("bump")) {
+      // Tungsten tilts the shading frame by the texture's slope (Primitive::setupTangentFrame);
+      // a constant has no slope.
+      Vec3 constant;
+      bool sloped = !json::toVec3(*bump, &constant) && !(bump->isObject() && string(*bump, "type") == "constant");
+      if (sloped) warn(cat(where, ": the bump map is not rendered; the surface shades with its own normals"));
+    }
     Material mat;
     mat.albedo = Vec3{1.0f};
     if (const Value* b = p.find("bsdf")) {
       // An array names one bsdf per material index; OBJ meshes carry index 0.
       const Value& first = b->isArray() && !b->asArray().empty() ? b->asArray()[0] : *b;
+      if (b->isArray() && b->asArray().size() > 1)
+        warn(cat(where, ": ", b->asArray().size(), " bsdfs by material index; every triangle takes the first"));
       mat = bsdf(first, where + ".bsdf", 0, p.find("emission") || p.find("power"));
       if (!ok()) return;
     }
