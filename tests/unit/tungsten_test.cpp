@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "retile/io.h"
@@ -187,6 +188,23 @@ TEST(Tungsten, WhatIsNotRenderedIsNamedInAWarning) {
   EXPECT_EQ(bump, 1) << "only the textured bump";
   EXPECT_EQ(bsdfs, 1);
   for (const auto& w : r->warnings) EXPECT_EQ(w.find("bumps.png' not found"), std::string::npos) << "a bump is not loaded: " << w;
+}
+
+TEST(Tungsten, PalikMetalNamesAreTheirMetals) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [
+        {"name": "a", "type": "conductor", "material": "Ni_palik"},
+        {"name": "b", "type": "rough_conductor", "material": "Au"},
+        {"name": "c", "type": "conductor", "material": "Unobtainium_palik"}],
+      "primitives": [{"type": "quad", "bsdf": "a"}, {"type": "quad", "bsdf": "b"}, {"type": "quad", "bsdf": "c"}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  std::map<std::string, std::string> metals;
+  for (const auto& m : r->scene.materials) metals[m.name] = m.metal;
+  EXPECT_EQ(metals["a"], "Ni");
+  EXPECT_EQ(metals["b"], "Au");
+  EXPECT_EQ(metals["c"], "Cu") << "an unknown metal falls back to copper";
+  int unknown = 0;
+  for (const auto& w : r->warnings) unknown += w.find("unknown metal 'Unobtainium_palik'") != std::string::npos;
+  EXPECT_EQ(unknown, 1) << "named as the file names it";
 }
 
 TEST(Tungsten, MissingMeshIsSkippedWithAWarning) {
