@@ -207,6 +207,45 @@ TEST(Tungsten, PalikMetalNamesAreTheirMetals) {
   EXPECT_EQ(unknown, 1) << "named as the file names it";
 }
 
+TEST(Tungsten, PointLightsAndCylindersAreImported) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [{"name": "a", "type": "lambert"}],
+      "primitives": [
+        {"type": "point", "name": "bulb", "transform": {"position": [1, 2, 3]}, "power": [12.566371, 0, 6.2831855]},
+        {"type": "point", "transform": {"position": [0, 1, 0]}, "emission": 2},
+        {"type": "cylinder", "bsdf": "a", "transform": {"position": [0, 1, 0], "scale": [2, 4, 1]}},
+        {"type": "cylinder", "bsdf": "a", "capped": false}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  ASSERT_EQ(s.lights.size(), 2u);
+  EXPECT_EQ(s.lights[0].name, "bulb");
+  EXPECT_EQ(s.lights[0].type, LightType::Point);
+  EXPECT_NEAR(s.lights[0].position.z, 3.0f, 1e-6f);
+  // Power spreads over the sphere of directions: 4 pi W in red is 1 W/sr, 2 pi W in blue half that.
+  EXPECT_NEAR(s.lights[0].intensity * s.lights[0].color.x, 1.0f, 1e-5f);
+  EXPECT_NEAR(s.lights[0].intensity * s.lights[0].color.z, 0.5f, 1e-5f);
+  EXPECT_NEAR(s.lights[1].intensity, 2.0f, 1e-6f) << "emission is the intensity";
+  ASSERT_EQ(s.objects.size(), 2u);
+  // Round: radius half the larger of the x and z scales (1), height the y scale (4).
+  Bounds3 b = worldBounds(s, s.objects[0]);
+  EXPECT_NEAR(b.hi.x - b.lo.x, 2.0f, 1e-3f);
+  EXPECT_NEAR(b.hi.z - b.lo.z, 2.0f, 1e-3f);
+  EXPECT_NEAR(b.lo.y, -1.0f, 1e-4f);
+  EXPECT_NEAR(b.hi.y, 3.0f, 1e-4f);
+  const auto& capped = *s.mesh(s.objects[0].mesh)->geometry;
+  const auto& open = *s.mesh(s.objects[1].mesh)->geometry;
+  EXPECT_GT(capped.indices.size(), open.indices.size()) << "the caps close it";
+  // Every face points away from the axis or out of its cap.
+  for (const auto* g : {&capped, &open})
+    for (std::size_t t = 0; t + 2 < g->indices.size(); t += 3) {
+      Vec3 p0 = g->positions[g->indices[t]], p1 = g->positions[g->indices[t + 1]], p2 = g->positions[g->indices[t + 2]];
+      Vec3 n = cross(p1 - p0, p2 - p0);
+      if (length(n) < 1e-9f) continue;
+      Vec3 c = (p0 + p1 + p2) / 3.0f;
+      Vec3 out = std::abs(c.y) > 0.4999f && std::abs(std::abs(n.y) - length(n)) < 1e-6f ? Vec3{0, c.y, 0} : Vec3{c.x, 0, c.z};
+      EXPECT_GT(dot(n, out), 0.0f) << "triangle " << t / 3;
+    }
+}
+
 TEST(Tungsten, MissingMeshIsSkippedWithAWarning) {
   auto file = writeScene(R"({"primitives": [
       {"type": "mesh", "file": "nowhere.obj"},

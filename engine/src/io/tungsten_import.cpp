@@ -543,6 +543,8 @@ class TungstenImporter {
     else if (kind == "cube") g = makeCube();
     else if (kind == "sphere") g = makeSphere();
     else if (kind == "disk") g = makeLathe({{1.0f, 0.0f}, {0.0f, 0.0f}}, 64);
+    else if (kind == "cylinder") g = makeCylinder(true);
+    else if (kind == "open cylinder") g = makeCylinder(false);
     shapes_[kind] = g;
     return g;
   }
@@ -746,6 +748,28 @@ class TungstenImporter {
       return;
     }
 
+    if (type == "point") {
+      // A point light: Tungsten's emission is its intensity (W/sr), its power spreads over 4 pi.
+      Mat4 m = transform(tv, where);
+      Vec3 intensity{0.0f};
+      if (const Value* e = p.find("emission")) intensity = texture(*e, where + ".emission", false).constant;
+      if (const Value* pw = p.find("power")) intensity = texture(*pw, where + ".power", false).constant / (4 * kPi);
+      if (!ok()) return;
+      Light l;
+      l.id = s.newId();
+      l.name = string(p, "name", cat("point ", s.lights.size() + 1));
+      l.type = LightType::Point;
+      l.position = m.transformPoint({0, 0, 0});
+      l.intensity = maxComponent(intensity);
+      l.color = l.intensity > 0 ? intensity / l.intensity : Vec3{1.0f};
+      if (!std::isfinite(l.intensity) || !isFinite(l.position)) {
+        warn(cat(where, ": the point light's position or intensity is not finite; skipped"));
+        return;
+      }
+      s.lights.push_back(l);
+      return;
+    }
+
     NodeId mesh = kNoNode;
     Mat4 xf = transform(tv, where, &scale, type == "quad" || type == "disk");
     if (!ok()) return;
@@ -759,6 +783,14 @@ class TungstenImporter {
       Vec3 safe{scale.x != 0 ? r / scale.x : 0, scale.y != 0 ? r / scale.y : 0, scale.z != 0 ? r / scale.z : 0};
       xf = xf * Mat4::scale(safe);
       mesh = meshNode(type, type, shape(type));
+    } else if (type == "cylinder") {
+      // Round too: the radius is half the larger of the x and z scales, the height the y scale.
+      float r = std::max(std::abs(scale.x), std::abs(scale.z));
+      xf = xf * Mat4::scale({scale.x != 0 ? r / scale.x : 0, 1, scale.z != 0 ? r / scale.z : 0});
+      bool capped = true;
+      if (const Value* c = p.find("capped"); c && c->isBool()) capped = c->asBool();
+      std::string kind = capped ? "cylinder" : "open cylinder";
+      mesh = meshNode(kind, "cylinder", shape(kind));
     } else {
       warn(cat(where, ": primitive type '", type, "' is not supported; skipped"));
       return;

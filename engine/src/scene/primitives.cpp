@@ -87,6 +87,19 @@ std::shared_ptr<const MeshGeometry> makeLathe(const std::vector<Vec2>& profile, 
   return g;
 }
 
+std::shared_ptr<const MeshGeometry> makeCylinder(bool capped, int segments) {
+  auto g = std::make_shared<MeshGeometry>(*makeLathe({{0.5f, -0.5f}, {0.5f, 0.5f}}, segments));
+  if (!capped) return g;
+  for (const auto& cap : {makeLathe({{0.0f, -0.5f}, {0.5f, -0.5f}}, segments), makeLathe({{0.5f, 0.5f}, {0.0f, 0.5f}}, segments)}) {
+    auto base = static_cast<std::uint32_t>(g->positions.size());
+    g->positions.insert(g->positions.end(), cap->positions.begin(), cap->positions.end());
+    g->normals.insert(g->normals.end(), cap->normals.begin(), cap->normals.end());
+    g->uvs.insert(g->uvs.end(), cap->uvs.begin(), cap->uvs.end());
+    for (std::uint32_t i : cap->indices) g->indices.push_back(base + i);
+  }
+  return g;
+}
+
 NodeId addMesh(Scene& s, std::string name, std::shared_ptr<const MeshGeometry> g) {
   Mesh m;
   m.id = s.newId();

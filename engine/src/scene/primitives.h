@@ -18,6 +18,10 @@ std::shared_ptr<const MeshGeometry> makeSphere(int rings = 48, int segments = 96
 // Surface of revolution about +y through the (radius, height) points of `profile`, in order.
 std::shared_ptr<const MeshGeometry> makeLathe(const std::vector<Vec2>& profile, int segments);
 
+// Cylinder about +y of radius 0.5 and height 1 centred on the origin; `capped` closes its ends
+// with flat discs (their own vertices, so the rims shade sharp).
+std::shared_ptr<const MeshGeometry> makeCylinder(bool capped, int segments = 64);
+
 // Adding nodes with fresh ids, for scenes built in code (the built-in scene, benchmarks, the
 // stability suite). Each returns the new node's id.
 NodeId addMesh(Scene& s, std::string name, std::shared_ptr<const MeshGeometry> g);
