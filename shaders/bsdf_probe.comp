@@ -23,7 +23,8 @@ void main() {
   if (q >= push.count) return;
   uint base = q * kQueryVec4s;
   Material m = unpackMaterial(queries[base], queries[base + 1u], queries[base + 2u], queries[base + 3u], queries[base + 4u]);
-  vec3 wo = queries[base + 5u].xyz, wi = queries[base + 6u].xyz, u = queries[base + 7u].xyz;
+  uint at = base + uint(kMaterialTexels);
+  vec3 wo = queries[at].xyz, wi = queries[at + 1u].xyz, u = queries[at + 2u].xyz;
   float pdf;
   vec3 f = bsdfEval(m, wo, wi, pdf);
   BsdfSample s = bsdfSample(m, wo, u);

@@ -201,6 +201,23 @@ Path startPath(uint slot) {
   return path;
 }
 
+// The shading normal ns tilted by a bump map's slope (textureSlope, times the strength), as
+// Tungsten tilts it (Primitive::setupTangentFrame): the triangle's unit tangents along u and v
+// (q1, q2 its edges, duv1, duv2 theirs in uv) take the slope as their component along ns, and
+// their cross product is the new normal, on ns's side. Unchanged where the uvs are degenerate.
+vec3 bumpNormal(vec3 ns, vec3 q1, vec3 q2, vec2 duv1, vec2 duv2, vec2 slope) {
+  if (abs(duv1.x * duv2.y - duv2.x * duv1.y) < 1e-6) return ns;
+  vec3 t = q1 * duv2.y - duv1.y * q2, b = q2 * duv1.x - duv2.x * q1;
+  if (dot(t, t) <= 0.0 || dot(b, b) <= 0.0) return ns;
+  t = normalize(t);
+  b = normalize(b);
+  t += ns * (slope.x - dot(ns, t));
+  b += ns * (slope.y - dot(ns, b));
+  vec3 n = cross(t, b);
+  if (!(dot(n, n) > 0.0)) return ns;
+  return dot(n, ns) < 0.0 ? -normalize(n) : normalize(n);
+}
+
 // Surfaces whose reflection or refraction shows other objects' edges: mirrors, smooth glass and
 // metal, and their nearly smooth rough kinds. The denoiser's guides look through them.
 bool guideLooksThrough(Material m) {
@@ -297,6 +314,18 @@ bool extendPath(inout Path path, bool alive, inout Shadow shadow) {
       // Shading normals from files may disagree with the winding; the winding decides the front
       // (in Tungsten's convention the shading normal is taken as it is).
       if (!hasFeature(kFeatureTungstenShading) && dot(ns, ng) < 0.0) ns = -ns;
+    }
+  }
+  if (hasFeature(kFeatureBump)) {
+    vec4 bump = texelFetch(uMaterials, floatBitsToInt(info.z) * kMaterialTexels + 5);
+    int bumpTex = floatBitsToInt(bump.x);
+    if (bumpTex >= 0) {
+      // The triangle's edges in world space: the world-to-object rows' inverse, by cofactors.
+      vec3 c0 = cross(r1.xyz, r2.xyz), c1 = cross(r2.xyz, r0.xyz), c2 = cross(r0.xyz, r1.xyz);
+      float det = dot(r0.xyz, c0);
+      vec3 q1 = (c0 * e1.x + c1 * e1.y + c2 * e1.z) / det, q2 = (c0 * e2.x + c1 * e2.y + c2 * e2.z) / det;
+      vec2 duv1 = vec2(s2.w, s3.x) - vec2(s0.w, s1.w), duv2 = s3.yz - vec2(s0.w, s1.w);
+      ns = bumpNormal(ns, q1, q2, duv1, duv2, bump.y * textureSlope(bumpTex, uv));
     }
   }
 

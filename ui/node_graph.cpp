@@ -64,14 +64,20 @@ QColor socketColor(const QString& socket) {
   return socket == QLatin1String("material") ? QColor(96, 210, 128) : QColor(236, 196, 72);
 }
 
-bool isTextureInput(const QString& s) {
-  return s == QLatin1String("albedo") || s == QLatin1String("roughness") || s == QLatin1String("alpha");
+// A material node's texture inputs, top to bottom.
+const QStringList& textureInputs() {
+  static const QStringList inputs{QStringLiteral("albedo"), QStringLiteral("roughness"), QStringLiteral("alpha"),
+                                  QStringLiteral("bump")};
+  return inputs;
 }
+
+bool isTextureInput(const QString& s) { return textureInputs().contains(s); }
 
 NodeId Material::*textureSlot(const QString& input) {
   if (input == QLatin1String("albedo")) return &Material::albedoTexture;
   if (input == QLatin1String("roughness")) return &Material::roughnessTexture;
   if (input == QLatin1String("alpha")) return &Material::alphaTexture;
+  if (input == QLatin1String("bump")) return &Material::bumpTexture;
   return nullptr;
 }
 
@@ -188,7 +194,7 @@ class EditBuilder {
       Texture copy = *t;
       std::vector<std::pair<NodeId, QString>> users;
       for (const Material& m : scene_.materials)
-        for (const QString& slot : {QStringLiteral("albedo"), QStringLiteral("roughness"), QStringLiteral("alpha")})
+        for (const QString& slot : textureInputs())
           if (m.*textureSlot(slot) == id) users.emplace_back(m.id, slot);
       for (const auto& [m, slot] : users)
         if (!assign(m, slot, kNoNode)) return false;
@@ -465,7 +471,8 @@ void NodeGraphView::resetLayout() {
   if (QLineEdit* open = rename_) static_cast<RenameEdit&>(*open).cancelled();
   pendingSelection_.clear();
   setSelection({});
-  for (Material& m : copiedMaterials_) m.albedoTexture = m.roughnessTexture = m.alphaTexture = kNoNode;
+  for (Material& m : copiedMaterials_)
+    for (NodeId* t : m.textureSlots()) *t = kNoNode;
   pasteCount_ = 0;
   positions_.clear();
   rebuild();
@@ -509,7 +516,7 @@ void NodeGraphView::rebuild() {
     QString sub = QString::fromLatin1(materialTypeName(m.type));
     if (m.emissive()) sub += tr(", emissive");
     GraphNodeItem* n = add(m.id, NodeKind::Material, m.name, sub);
-    n->inputs = {QStringLiteral("albedo"), QStringLiteral("roughness"), QStringLiteral("alpha")};
+    n->inputs = textureInputs();
     n->output = QStringLiteral("material");
     // An emitter shows its light's hue; its albedo is usually black.
     const float peak = std::max({m.emission.x, m.emission.y, m.emission.z});
@@ -574,7 +581,7 @@ void NodeGraphView::rebuild() {
   for (const Object& o : scene_.objects)
     if (o.material != kNoNode) addLink(o.material, o.id, QStringLiteral("material"));
   for (const Material& m : scene_.materials)
-    for (const QString& slot : {QStringLiteral("albedo"), QStringLiteral("roughness"), QStringLiteral("alpha")})
+    for (const QString& slot : textureInputs())
       if (m.*textureSlot(slot) != kNoNode) addLink(m.*textureSlot(slot), m.id, slot);
 
   setSelection(selection);
@@ -591,7 +598,7 @@ void NodeGraphView::layOut(const std::vector<GraphNodeItem*>& nodes) {
   for (std::size_t i = 0; i < scene_.materials.size(); ++i) {
     const Material& m = scene_.materials[i];
     materialRank[m.id] = i;
-    for (NodeId t : {m.albedoTexture, m.roughnessTexture, m.alphaTexture})
+    for (NodeId t : m.textures())
       if (t != kNoNode && !textureRank.count(t)) textureRank[t] = i;
   }
   auto rank = [&](const GraphNodeItem* n) -> std::size_t {
@@ -936,7 +943,7 @@ bool NodeGraphView::paste() {
     m.id = b.newId();
     m.name = uniqueName(b.scene().materials, m.name);
     // The copy may come from before its textures were deleted: keep only what still exists.
-    for (NodeId* t : {&m.albedoTexture, &m.roughnessTexture, &m.alphaTexture})
+    for (NodeId* t : m.textureSlots())
       if (*t != kNoNode && !scene_.texture(*t)) *t = kNoNode;
     if (!b.step(RemoveNode{m.id}, AddMaterial{m})) return false;
     positions_[m.id] = copiedPositions_[k++] + offset;

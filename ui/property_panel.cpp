@@ -329,7 +329,8 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   };
   for (const Slot& slot : {Slot{"Albedo texture", "albedoTexture", &Material::albedoTexture},
                            Slot{"Roughness texture", "roughnessTexture", &Material::roughnessTexture},
-                           Slot{"Alpha texture", "alphaTexture", &Material::alphaTexture}}) {
+                           Slot{"Alpha texture", "alphaTexture", &Material::alphaTexture},
+                           Slot{"Bump texture", "bumpTexture", &Material::bumpTexture}}) {
     if (slot.field == &Material::roughnessTexture && !rough) continue;
     QStringList names{tr("(none)")};
     std::vector<NodeId> ids{kNoNode};
@@ -348,6 +349,9 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     });
     const Texture* tex = scene_().texture(m.*slot.field);
     if (tex && tex->kind == TextureKind::File) texturePath(b, *tex, QString("%1Path").arg(slot.name));
+    if (slot.field == &Material::bumpTexture && tex)
+      b.number(tr("Bump strength"), "bumpStrength", m.bumpStrength, -1e4, 1e4, defaults.bumpStrength, 3,
+               [edit](double v, int drag) { edit(tr("Bump strength"), drag, [v](Material& x) { x.bumpStrength = static_cast<float>(v); }); });
   }
 
   const float strength = peak(m.emission);

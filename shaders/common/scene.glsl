@@ -103,6 +103,37 @@ vec4 sampleTexture(int index, vec2 uv) {
   return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
 }
 
+// The slope of a texture's value (the mean of its colour channels) at uv, as Tungsten's bump
+// maps take it (BitmapTexture::derivatives): differences across two texels, along u and down the
+// image's rows, interpolated between the four texels about uv. Not divided by the texel size:
+// the slope of a bump map depends on its resolution, as in Tungsten. Checkers are flat.
+vec2 textureSlope(int index, vec2 uv) {
+  vec4 info = texelFetch(uTexInfo, index * kTextureTexels);
+  if ((floatBitsToInt(info.w) & 15) == kTexChecker) return vec2(0.0);
+  int offset = floatBitsToInt(info.x);
+  int w = floatBitsToInt(info.y), h = floatBitsToInt(info.z);
+  vec2 wrapped = vec2(uv.x, 1.0 - uv.y);
+  wrapped = any(isnan(wrapped)) || any(isinf(wrapped)) ? vec2(0.0) : wrapped - floor(wrapped);
+  vec2 p = wrapped * vec2(w, h) - 0.5;
+  vec2 f = p - floor(p);
+  ivec2 i = ivec2(floor(p));
+  // Columns i - 1 .. i + 2 and rows likewise, wrapped.
+  ivec4 xs = (ivec4(i.x) + ivec4(-1, 0, 1, 2) + 2 * w) % w;
+  ivec4 ys = ((ivec4(i.y) + ivec4(-1, 0, 1, 2) + 2 * h) % h) * w + offset;
+  const vec3 mean = vec3(1.0 / 3.0);
+#define RETILE_TEXEL(x, y) dot(texelFetch(uTexels, ys[y] + xs[x]).rgb, mean)
+  float a01 = RETILE_TEXEL(1, 0), a02 = RETILE_TEXEL(2, 0);
+  float a10 = RETILE_TEXEL(0, 1), a11 = RETILE_TEXEL(1, 1), a12 = RETILE_TEXEL(2, 1), a13 = RETILE_TEXEL(3, 1);
+  float a20 = RETILE_TEXEL(0, 2), a21 = RETILE_TEXEL(1, 2), a22 = RETILE_TEXEL(2, 2), a23 = RETILE_TEXEL(3, 2);
+  float a31 = RETILE_TEXEL(1, 3), a32 = RETILE_TEXEL(2, 3);
+#undef RETILE_TEXEL
+  // Differences about the texels (1, 1), (2, 1), (1, 2) and (2, 2), in that order.
+  vec4 du = vec4(a12 - a10, a13 - a11, a22 - a20, a23 - a21);
+  vec4 dv = vec4(a21 - a01, a22 - a02, a31 - a11, a32 - a12);
+  vec4 weight = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+  return vec2(dot(du, weight), dot(dv, weight));
+}
+
 float sampleAlphaTexture(int index, vec2 uv) {
   vec4 info = texelFetch(uTexInfo, index * kTextureTexels);
   vec4 t = sampleTexture(index, uv);

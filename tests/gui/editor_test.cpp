@@ -380,6 +380,30 @@ TEST(Editor, AutosaveRotatesAndACleanCloseLeavesNothingToRecover) {
 }
 
 
+TEST(Editor, AMaterialTakesABumpMapAndItsStrengthFromItsPanel) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  const NodeId material = w->scene().object(sphere)->material;
+  auto* bump = w->findChild<QComboBox*>("bumpTexture");
+  ASSERT_TRUE(bump);
+  EXPECT_EQ(bump->currentIndex(), 0) << "(none)";
+  EXPECT_FALSE(w->findChild<ScrubField*>("bumpStrength")) << "a strength only once there is a map";
+  const int checker = bump->findText("Checker");
+  ASSERT_GT(checker, 0);
+  bump->setCurrentIndex(checker);
+  EXPECT_EQ(w->scene().material(material)->bumpTexture, w->scene().textures[static_cast<std::size_t>(checker - 1)].id);
+  QTest::qWait(50);  // the panel rebuilds on the next turn of the event loop
+  auto* strength = w->findChild<ScrubField*>("bumpStrength");
+  ASSERT_TRUE(strength);
+  strength->setValue(2.5);
+  EXPECT_FLOAT_EQ(w->scene().material(material)->bumpStrength, 2.5f);
+  w->undoStack()->undo();
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().material(material)->bumpTexture, kNoNode);
+  EXPECT_FLOAT_EQ(w->scene().material(material)->bumpStrength, 1.0f);
+}
+
 TEST(Editor, ScrubbingAFieldIsOneUndoStepAndEscCancelsTyping) {
   auto w = makeWindow();
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");

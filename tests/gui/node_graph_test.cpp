@@ -31,7 +31,7 @@ std::string describe(const Scene& s) {
   };
   for (const Material& m : sorted(s.materials))
     out << "M" << m.id << " " << m.name << " " << static_cast<int>(m.type) << " " << m.albedo.x << " " << m.roughness
-        << " " << m.albedoTexture << " " << m.roughnessTexture << " " << m.alphaTexture << "\n";
+        << " " << m.albedoTexture << " " << m.roughnessTexture << " " << m.alphaTexture << " " << m.bumpTexture << "\n";
   for (const Object& o : sorted(s.objects))
     out << "O" << o.id << " " << o.name << " " << o.mesh << " " << o.material << "\n";
   for (const Texture& t : sorted(s.textures)) out << "T" << t.id << " " << t.name << "\n";
@@ -194,6 +194,14 @@ TEST_F(NodeGraph, DraggingSocketsLinksAndDraggingTheLinkOffUnlinks) {
   undo(edits.back());
   EXPECT_EQ(scene().material(ground)->roughnessTexture, checker);
   EXPECT_EQ(scene().material(ground)->alphaTexture, kNoNode);
+
+  // And to the bump input, below alpha.
+  drag(at(view.socketScenePos(ground, "roughness", false)), at(view.socketScenePos(ground, "bump", false)));
+  EXPECT_EQ(scene().material(ground)->roughnessTexture, kNoNode);
+  EXPECT_EQ(scene().material(ground)->bumpTexture, checker);
+  EXPECT_EQ(view.linkSource(ground, "bump"), checker);
+  undo(edits.back());
+  EXPECT_EQ(scene().material(ground)->bumpTexture, kNoNode);
 
   // Dropping a material on a texture input is refused: no edit.
   const std::size_t count = edits.size();

@@ -9,6 +9,7 @@
 
 #include "gpu_support.h"
 #include "retile/edit.h"
+#include "retile/image.h"
 #include "scene/primitives.h"
 #include "test_support.h"
 
@@ -217,6 +218,54 @@ TEST(KnownAnswer, ShadingConventionsDisagreeWhereTheShadingNormalLies) {
   EXPECT_LT(consistent, 1e-6) << "light from behind the true surface";
   EXPECT_NEAR(tungsten, expected, 0.03 * expected);
   EXPECT_GT(expected, 0.3);
+}
+
+TEST(KnownAnswer, ABumpMapTiltsTheNormalByItsSlope) {
+  // A height that climbs 1/64 a texel along u: Tungsten's slope (the difference across two
+  // texels) is 1/32, times a strength of 16 it is 0.5. On the default quad (u along +x, v along
+  // +z, its uv winding opposite to its faces') Tungsten's tangents make the normal (0.5, 1, 0)
+  // normalised. A sun from (+-1, 1, 0) then lights a white plane by E/pi n.l: 0.949 E/pi from the
+  // side the normal leans to, 0.316 E/pi from the other, 0.707 E/pi without the bump.
+  RETILE_RENDERER_OR_SKIP(r);
+  auto dir = test::tempDir();
+  RenderImage ramp;
+  ramp.width = 64;
+  ramp.height = 8;
+  for (int y = 0; y < ramp.height; ++y)
+    for (int x = 0; x < ramp.width; ++x)
+      for (int c = 0; c < 3; ++c) ramp.color.push_back(static_cast<float>(x) / 64.0f);
+  ASSERT_TRUE(writeRenderImage(ramp, dir / "ramp.exr").ok());
+
+  Scene s = test::emptyScene(16, 16);
+  lookStraightDown(s, 3, 2);  // the middle tenth of the plane, far from the ramp's wrap
+  s.settings.maxBounces = 1;
+  Texture t;
+  t.id = s.newId();
+  t.name = "ramp";
+  t.path = dir / "ramp.exr";
+  t.colorSpace = TextureColorSpace::Linear;
+  s.textures.push_back(t);
+  Material m;
+  m.albedo = Vec3{1.0f};
+  m.bumpTexture = t.id;
+  m.bumpStrength = 16.0f;
+  NodeId material = test::addMaterial(s, m);
+  NodeId plane = test::addMeshObject(s, "plane", makeQuad(), material, Mat4::scale({4, 1, 4}));
+  Light sun;
+  sun.id = s.newId();
+  sun.type = LightType::Directional;
+  sun.intensity = 1.0f;
+  s.lights.push_back(sun);
+
+  const double n = std::sqrt(1.25), l = std::sqrt(2.0);
+  for (float side : {1.0f, -1.0f}) {
+    s.lights[0].direction = normalize(Vec3{-side, -1, 0});  // where the light travels
+    double expected = (side * 0.5 + 1.0) / (n * l) / kPi;
+    EXPECT_NEAR(meanOver(renderScene(*r, s, 16), plane), expected, 0.01 * expected) << "sun on the side " << side;
+  }
+  s.materials[0].bumpStrength = 0.0f;
+  double flat = 1.0 / l / kPi;
+  EXPECT_NEAR(meanOver(renderScene(*r, s, 16), plane), flat, 0.01 * flat) << "no slope, no tilt";
 }
 
 TEST(KnownAnswer, InverseSquareFalloffOfASmallLight) {

@@ -77,6 +77,9 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   s.settings.filterSampling = FilterSampling::Tungsten;
   s.settings.shading = ShadingConvention::Tungsten;
   s.materials[0].separableShadowing = true;
+  ASSERT_FALSE(s.textures.empty());
+  s.materials[0].bumpTexture = s.textures[0].id;
+  s.materials[0].bumpStrength = -2.5f;
   s.lights.push_back(Light{s.newId(), "Key", LightType::Spot, {1, 0.9f, 0.8f}, 3.5f, {1, 2, 3}, {0, -1, 0}, 0.4f, 0.2f, true});
   auto dir = test::tempDir();
   auto file = dir / "scene.retile";
@@ -92,6 +95,8 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.settings.filterSampling, FilterSampling::Tungsten);
   EXPECT_EQ(back->scene.settings.shading, ShadingConvention::Tungsten);
   EXPECT_TRUE(back->scene.materials[0].separableShadowing);
+  EXPECT_EQ(back->scene.materials[0].bumpTexture, s.textures[0].id);
+  EXPECT_EQ(back->scene.materials[0].bumpStrength, -2.5f);
   // Saving what was loaded gives the same bytes.
   EXPECT_EQ(nativeSceneToString(s), nativeSceneToString(back->scene));
 }

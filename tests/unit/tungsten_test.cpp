@@ -168,26 +168,47 @@ TEST(Tungsten, UndefinedBsdfsBecomeStandInsWithAWarning) {
 }
 
 TEST(Tungsten, WhatIsNotRenderedIsNamedInAWarning) {
-  // The volumetric caustic's medium, a bump map, a bsdf per material index: the file opens, and
-  // the user learns what the image leaves out. A constant bump has no slope: nothing to say.
+  // The volumetric caustic's medium and a bsdf per material index: the file opens, and the user
+  // learns what the image leaves out.
   auto r = importTungsten(writeScene(R"({"media": [{"name": "gas", "type": "homogeneous", "sigma_s": 1}],
       "bsdfs": [{"name": "a", "type": "lambert"}, {"name": "b", "type": "mirror"}],
       "primitives": [
-        {"type": "quad", "name": "wall", "bsdf": "a", "int_medium": "gas", "bump": "bumps.png"},
-        {"type": "quad", "name": "flat", "bsdf": "a", "bump": 0.5},
+        {"type": "quad", "name": "wall", "bsdf": "a", "int_medium": "gas"},
         {"type": "cube", "name": "both", "bsdf": ["a", "b"], "emission": 1}]})"));
   ASSERT_TRUE(r.ok()) << r.error();
-  EXPECT_EQ(r->scene.objects.size(), 3u);
-  int media = 0, bump = 0, bsdfs = 0;
+  EXPECT_EQ(r->scene.objects.size(), 2u);
+  int media = 0, bsdfs = 0;
   for (const auto& w : r->warnings) {
     media += w.find("participating media are not rendered ('gas')") != std::string::npos;
-    bump += w.find("bump map is not rendered") != std::string::npos;
-    bsdfs += w.find("primitives[2]: 2 bsdfs by material index") != std::string::npos;
+    bsdfs += w.find("primitives[1]: 2 bsdfs by material index") != std::string::npos;
   }
   EXPECT_EQ(media, 1);
-  EXPECT_EQ(bump, 1) << "only the textured bump";
   EXPECT_EQ(bsdfs, 1);
-  for (const auto& w : r->warnings) EXPECT_EQ(w.find("bumps.png' not found"), std::string::npos) << "a bump is not loaded: " << w;
+}
+
+TEST(Tungsten, BumpMapsGoToACopyOfTheBsdf) {
+  auto dir = test::tempDir();
+  {
+    std::ofstream(dir / "scene.json") << R"({"bsdfs": [{"name": "a", "type": "lambert"}],
+      "primitives": [
+        {"type": "quad", "name": "plain", "bsdf": "a"},
+        {"type": "quad", "name": "bumped", "bsdf": "a", "bump": {"type": "bitmap", "file": "h.png", "scale": 2}, "bump_strength": 3},
+        {"type": "quad", "name": "same", "bsdf": "a", "bump": {"type": "bitmap", "file": "h.png", "scale": 2}, "bump_strength": 3},
+        {"type": "quad", "name": "flat", "bsdf": "a", "bump": 0.5}]})";
+  }
+  auto r = importTungsten(dir / "scene.json");
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  ASSERT_EQ(s.objects.size(), 4u);
+  const Material* plain = s.material(s.objects[0].material);
+  const Material* bumped = s.material(s.objects[1].material);
+  ASSERT_TRUE(plain && bumped);
+  EXPECT_EQ(plain->bumpTexture, kNoNode) << "the shared bsdf stays as it was";
+  EXPECT_NE(bumped->bumpTexture, kNoNode);
+  EXPECT_EQ(bumped->name, "a (bump)");
+  EXPECT_FLOAT_EQ(bumped->bumpStrength, 6.0f) << "bump_strength times the bitmap's scale";
+  EXPECT_EQ(s.objects[2].material, s.objects[1].material) << "one copy per bsdf and bump";
+  EXPECT_EQ(s.material(s.objects[3].material)->bumpTexture, kNoNode) << "a constant has no slope";
 }
 
 TEST(Tungsten, PalikMetalNamesAreTheirMetals) {

@@ -6,6 +6,7 @@
 // an object edit never copies vertex data.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -110,6 +111,15 @@ struct Material {
   Vec3 emission{0.0f};             // radiance emitted from the front side
   float alpha = 1.0f;              // coverage; < 1 or an alpha texture makes a cut-out
   NodeId alphaTexture = kNoNode;
+  // Tilts the shading normal by the slope of this texture's value (the mean of its channels), as
+  // Tungsten's bump maps do (BitmapTexture::derivatives: the difference across two texels); the
+  // slope is scaled by bumpStrength.
+  NodeId bumpTexture = kNoNode;
+  float bumpStrength = 1.0f;
+
+  // Every texture reference, for code that visits them all (deletion, validation, copies).
+  std::array<NodeId, 4> textures() const { return {albedoTexture, roughnessTexture, alphaTexture, bumpTexture}; }
+  std::array<NodeId*, 4> textureSlots() { return {&albedoTexture, &roughnessTexture, &alphaTexture, &bumpTexture}; }
 
   bool emissive() const { return emission.x > 0 || emission.y > 0 || emission.z > 0; }
 };

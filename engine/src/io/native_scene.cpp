@@ -267,6 +267,8 @@ Value nativeSceneToJson(const Scene& s) {
     v.set("emission", json::fromVec3(m.emission));
     v.set("alpha", m.alpha);
     v.set("alpha_texture", m.alphaTexture);
+    v.set("bump_texture", m.bumpTexture);
+    v.set("bump_strength", m.bumpStrength);
     materials.push_back(std::move(v));
   }
   root.set("materials", std::move(materials));
@@ -479,6 +481,8 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.vec3("emission", &m.emission);
       r.number("alpha", &m.alpha);
       r.id("alpha_texture", &m.alphaTexture);
+      r.id("bump_texture", &m.bumpTexture);
+      r.number("bump_strength", &m.bumpStrength);
       s.materials.push_back(std::move(m));
     }
   if (auto* a = list("objects"))
@@ -527,7 +531,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
   if (std::adjacent_find(ids.begin(), ids.end()) != ids.end() || (!ids.empty() && ids.front() == kNoNode))
     return R::failure(cat(file.string(), ": node ids are not unique and non-zero"));
   for (Material& m : s.materials)
-    for (NodeId* t : {&m.albedoTexture, &m.roughnessTexture, &m.alphaTexture})
+    for (NodeId* t : m.textureSlots())
       if (*t != kNoNode && !s.texture(*t)) {
         out.warnings.push_back(cat(file.string(), ": material '", m.name, "' names missing texture ", *t));
         *t = kNoNode;

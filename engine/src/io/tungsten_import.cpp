@@ -5,6 +5,7 @@
 #include <cstring>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include "core/files.h"
 #include "core/json.h"
@@ -797,12 +798,16 @@ class TungstenImporter {
     }
     if (!ok() || mesh == kNoNode) return;
 
+    // A bump map belongs to the primitive in Tungsten and to the material here (as emission
+    // does): the primitive gets its own copy of its bsdf. A constant has no slope.
+    NodeId bumpTexture = kNoNode;
+    float bumpStrength = 1;
     if (const Value* bump = p.find("bump")) {
-      // Tungsten tilts the shading frame by the texture's slope (Primitive::setupTangentFrame);
-      // a constant has no slope.
-      Vec3 constant;
-      bool sloped = !json::toVec3(*bump, &constant) && !(bump->isObject() && string(*bump, "type") == "constant");
-      if (sloped) warn(cat(where, ": the bump map is not rendered; the surface shades with its own normals"));
+      TextureRef t = texture(*bump, where + ".bump", false);
+      if (!ok()) return;
+      number(p, "bump_strength", &bumpStrength, where);
+      bumpTexture = t.texture;
+      bumpStrength *= t.constant.x;  // a bitmap's scale
     }
     Material mat;
     mat.albedo = Vec3{1.0f};
@@ -830,7 +835,22 @@ class TungstenImporter {
       emissive = true;
     }
     NodeId materialId = kNoNode;
-    if (emissive) {
+    mat.bumpTexture = bumpTexture;
+    mat.bumpStrength = bumpTexture != kNoNode ? bumpStrength : 1.0f;
+    const bool bumped = bumpTexture != kNoNode;
+    if (bumped && !emissive) {
+      // Primitives with the same bsdf and bump share one copy.
+      auto key = std::make_tuple(mat.name, bumpTexture, bumpStrength);
+      if (auto it = bumped_.find(key); it != bumped_.end()) {
+        materialId = it->second;
+      } else {
+        Material m = mat;
+        m.id = s.newId();
+        m.name = cat(mat.name.empty() ? where : mat.name, " (bump)");
+        s.materials.push_back(m);
+        materialId = bumped_[key] = m.id;
+      }
+    } else if (emissive) {
       // Emission belongs to the primitive in Tungsten and to the material here: give each
       // emitter its own copy of its bsdf.
       Material m = mat;
@@ -876,6 +896,7 @@ class TungstenImporter {
   std::map<std::string, NodeId> meshIds_;
   std::map<std::string, std::shared_ptr<const MeshGeometry>> shapes_;
   int emitters_ = 0;
+  std::map<std::tuple<std::string, NodeId, float>, NodeId> bumped_;  // (bsdf, texture, strength) -> its copy
 };
 
 }  // namespace

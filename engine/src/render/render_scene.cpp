@@ -185,6 +185,7 @@ std::uint32_t RenderSceneData::features() const {
   if (!emitters.empty()) f |= gpu::kFeatureEmitters;
   if (!deltaLights.empty()) f |= gpu::kFeatureDeltaLights;
   if (tungstenShading) f |= gpu::kFeatureTungstenShading;
+  if (materialBump) f |= gpu::kFeatureBump;
   return f;
 }
 
@@ -318,7 +319,8 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
   }
 }
 
-std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture, int roughnessTexture, int alphaTexture) {
+std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture, int roughnessTexture, int alphaTexture,
+                                                    int bumpTexture) {
   Vec3 eta = m.eta, k = m.k;
   if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
   const bool rough = isMicrofacet(m.type);
@@ -335,13 +337,15 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   return {v4(max(m.albedo, Vec3{0.0f}), bitsOf(type)),
           vec4{roughness, ior, std::clamp(m.alpha, 0.0f, 1.0f), std::clamp(fdrInt, 0.0f, 1.0f)},
           v4(eta, bitsOf(albedoTexture)), v4(k, bitsOf(roughnessTexture)),
-          v4(max(m.emission, Vec3{0.0f}), bitsOf(alphaTexture))};
+          v4(max(m.emission, Vec3{0.0f}), bitsOf(alphaTexture)),
+          vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, 0, 0}};
 }
 
 void RenderSceneBuilder::packMaterials(const Scene& scene) {
   data_.materials.clear();
   data_.materialTypes = 0;
   data_.materialTextures = false;
+  data_.materialBump = false;
   materialIndex_.clear();
   auto pack = [&](const Material& m) {
     data_.materialTypes |= 1u << static_cast<int>(m.type);
@@ -349,7 +353,9 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     if (m.beckmann && isMicrofacet(m.type))
       data_.materialTypes |= 1u << gpu::kMaskBeckmann;
     if (textureIndex(m.albedoTexture) >= 0 || textureIndex(m.roughnessTexture) >= 0) data_.materialTextures = true;
-    auto texels = packMaterial(m, textureIndex(m.albedoTexture), textureIndex(m.roughnessTexture), textureIndex(m.alphaTexture));
+    if (textureIndex(m.bumpTexture) >= 0 && m.bumpStrength != 0) data_.materialBump = true;
+    auto texels = packMaterial(m, textureIndex(m.albedoTexture), textureIndex(m.roughnessTexture), textureIndex(m.alphaTexture),
+                               textureIndex(m.bumpTexture));
     data_.materials.insert(data_.materials.end(), texels.begin(), texels.end());
   };
   for (const Material& m : scene.materials) {

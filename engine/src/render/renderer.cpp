@@ -770,6 +770,7 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   if (f & static_cast<std::uint32_t>(gpu::kFeatureEmitters)) out.push_back("emissive triangles");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureDeltaLights)) out.push_back("delta lights");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureTungstenShading)) out.push_back("Tungsten's shading normals");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureBump)) out.push_back("bump maps");
   return out;
 }
 double Renderer::lastBlasSeconds() const { return impl_->builder.lastTiming().blas; }

@@ -22,9 +22,9 @@ bool finite(float v) { return std::isfinite(v); }
 
 std::string checkMaterial(const Scene& s, const Material& m) {
   if (!isFinite(m.albedo) || !isFinite(m.emission) || !isFinite(m.eta) || !isFinite(m.k) ||
-      !finite(m.roughness) || !finite(m.ior) || !finite(m.alpha))
+      !finite(m.roughness) || !finite(m.ior) || !finite(m.alpha) || !finite(m.bumpStrength))
     return cat("material '", m.name, "': a parameter is not a finite number");
-  for (NodeId t : {m.albedoTexture, m.roughnessTexture, m.alphaTexture})
+  for (NodeId t : m.textures())
     if (t != kNoNode && !s.texture(t)) return cat("material '", m.name, "': texture ", t, " does not exist");
   return {};
 }
@@ -201,7 +201,7 @@ Result<std::uint32_t> applyEdit(Scene& s, const Edit& edit) {
               if (o.material == id) o.material = kNoNode;
             }
             for (Material& m : s.materials)
-              for (NodeId* t : {&m.albedoTexture, &m.roughnessTexture, &m.alphaTexture})
+              for (NodeId* t : m.textureSlots())
                 if (*t == id) *t = kNoNode;
             if (s.environment.map == id) {
               s.environment.map = kNoNode;
