@@ -80,6 +80,10 @@ Material fetchMaterial(int index, vec2 uv) {
   int albedoTex = floatBitsToInt(t2.w), roughTex = floatBitsToInt(t3.w);
   if (hasFeature(kFeatureTextures) && albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
   if (hasFeature(kFeatureTextures) && roughTex >= 0) m.roughness = max(m.roughness * sampleTexture(roughTex, uv).r, 1e-3);
+  if (hasFeature(kFeatureEmissionTextures)) {
+    int emissionTex = floatBitsToInt(texelFetch(uMaterials, base + 5).z);
+    if (emissionTex >= 0) m.emission *= sampleTexture(emissionTex, uv).rgb;
+  }
   return m;
 }
 

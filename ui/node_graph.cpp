@@ -67,7 +67,7 @@ QColor socketColor(const QString& socket) {
 // A material node's texture inputs, top to bottom.
 const QStringList& textureInputs() {
   static const QStringList inputs{QStringLiteral("albedo"), QStringLiteral("roughness"), QStringLiteral("alpha"),
-                                  QStringLiteral("bump")};
+                                  QStringLiteral("bump"), QStringLiteral("emission")};
   return inputs;
 }
 
@@ -78,6 +78,7 @@ NodeId Material::*textureSlot(const QString& input) {
   if (input == QLatin1String("roughness")) return &Material::roughnessTexture;
   if (input == QLatin1String("alpha")) return &Material::alphaTexture;
   if (input == QLatin1String("bump")) return &Material::bumpTexture;
+  if (input == QLatin1String("emission")) return &Material::emissionTexture;
   return nullptr;
 }
 

@@ -330,7 +330,8 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   for (const Slot& slot : {Slot{"Albedo texture", "albedoTexture", &Material::albedoTexture},
                            Slot{"Roughness texture", "roughnessTexture", &Material::roughnessTexture},
                            Slot{"Alpha texture", "alphaTexture", &Material::alphaTexture},
-                           Slot{"Bump texture", "bumpTexture", &Material::bumpTexture}}) {
+                           Slot{"Bump texture", "bumpTexture", &Material::bumpTexture},
+                           Slot{"Emission texture", "emissionTexture", &Material::emissionTexture}}) {
     if (slot.field == &Material::roughnessTexture && !rough) continue;
     QStringList names{tr("(none)")};
     std::vector<NodeId> ids{kNoNode};

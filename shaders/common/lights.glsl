@@ -132,6 +132,8 @@ LightSample sampleLight(vec3 p, vec3 u) {
     if (cosL <= 0.0 || t0.w <= 0.0) return ls;  // emitters shine from their front only
     ls.dist = d;
     ls.radiance = t3.rgb;
+    if (hasFeature(kFeatureEmissionTextures) && floatBitsToInt(t4.w) >= 0)
+      ls.radiance *= sampleTexture(floatBitsToInt(t4.w), triangleUv(floatBitsToInt(t2.w), b.x, b.y)).rgb;
     ls.pdf = pe * t3.w * d2 / (cosL * t0.w);
     return ls;
   }

@@ -268,6 +268,51 @@ TEST(KnownAnswer, ABumpMapTiltsTheNormalByItsSlope) {
   EXPECT_NEAR(meanOver(renderScene(*r, s, 16), plane), flat, 0.01 * flat) << "no slope, no tilt";
 }
 
+TEST(KnownAnswer, ATexturedEmitterLightsAsItsLitPartAlone) {
+  // A 1x1 emitter whose texture is 1 over its half u < 0.5 and 0 over the rest lights the floor
+  // below as a 0.5x1 emitter over that half does: light samples (which pick points over the
+  // whole quad and must read the texture there) and BSDF rays that hit it agree.
+  RETILE_RENDERER_OR_SKIP(r);
+  auto dir = test::tempDir();
+  RenderImage half;
+  half.width = 64;
+  half.height = 1;
+  for (int x = 0; x < half.width; ++x)
+    for (int c = 0; c < 3; ++c) half.color.push_back(x < 32 ? 1.0f : 0.0f);
+  ASSERT_TRUE(writeRenderImage(half, dir / "half.exr").ok());
+
+  auto floorLitBy = [&](bool textured) {
+    Scene s = test::emptyScene(16, 16);
+    lookStraightDown(s, 3, 2);
+    s.settings.maxBounces = 1;
+    Material white;
+    white.albedo = Vec3{1.0f};
+    NodeId floor = test::addMeshObject(s, "floor", makeQuad(), test::addMaterial(s, white), Mat4::scale({8, 1, 8}));
+    Material light;
+    light.albedo = Vec3{0.0f};
+    light.emission = Vec3{5.0f};
+    // Facing down (the quad's u still runs along +x), 1 above the floor, off to the side.
+    const Mat4 down = Mat4::rotateX(kPi);
+    if (textured) {
+      Texture t;
+      t.id = s.newId();
+      t.name = "half";
+      t.path = dir / "half.exr";
+      t.colorSpace = TextureColorSpace::Linear;
+      s.textures.push_back(t);
+      light.emissionTexture = t.id;
+      test::addMeshObject(s, "light", makeQuad(), test::addMaterial(s, light), Mat4::translate({1.5f, 1, 0}) * down);
+    } else {
+      test::addMeshObject(s, "light", makeQuad(), test::addMaterial(s, light),
+                          Mat4::translate({1.25f, 1, 0}) * Mat4::scale({0.5f, 1, 1}) * down);
+    }
+    return meanOver(renderScene(*r, s, 256), floor);
+  };
+  const double reference = floorLitBy(false), textured = floorLitBy(true);
+  EXPECT_GT(reference, 0.05);
+  EXPECT_NEAR(textured, reference, 0.03 * reference);
+}
+
 TEST(KnownAnswer, InverseSquareFalloffOfASmallLight) {
   RETILE_RENDERER_OR_SKIP(r);
   NodeId plane;

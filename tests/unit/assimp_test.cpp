@@ -30,6 +30,25 @@ TEST(Assimp, CornellObjWithMtlEmissionAsLight) {
   EXPECT_EQ(s.settings.width, s.settings.height);
 }
 
+TEST(Assimp, AnEmissionMapIsTheEmissionTexture) {
+  // OBJ's map_Ke (glTF's emissiveTexture arrives the same way, as Assimp's emissive texture).
+  auto dir = test::tempDir();
+  std::ofstream(dir / "sign.mtl") << "newmtl neon\nKd 0 0 0\nKe 2 2 2\nmap_Ke glow.png\n";
+  std::ofstream(dir / "sign.obj") << "mtllib sign.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl neon\nf 1/1 2/2 3/3\n";
+  auto r = importScene(dir / "sign.obj");
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Material* neon = nullptr;
+  for (const auto& m : r->scene.materials)
+    if (m.name == "neon") neon = &m;
+  ASSERT_TRUE(neon);
+  const Material& m = *neon;
+  EXPECT_EQ(m.emission, Vec3(2.0f));
+  ASSERT_NE(m.emissionTexture, kNoNode);
+  const Texture* t = r->scene.texture(m.emissionTexture);
+  ASSERT_TRUE(t);
+  EXPECT_EQ(t->path.filename(), "glow.png");
+}
+
 TEST(Assimp, CrashingFileIsReportedNotFatal) {
   RETILE_SHARED_OR_SKIP(file, "corpus/malformed/other/assimp-malformed_zero_numvertices/malformed_zero_numvertices.md2");
   auto r = importScene(file);

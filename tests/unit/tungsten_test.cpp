@@ -267,6 +267,21 @@ TEST(Tungsten, PointLightsAndCylindersAreImported) {
     }
 }
 
+TEST(Tungsten, TexturedEmissionKeepsItsTexture) {
+  auto r = importTungsten(writeScene(R"({"primitives": [
+      {"type": "quad", "name": "screen", "emission": {"type": "bitmap", "file": "tv.png", "scale": 4}},
+      {"type": "quad", "name": "lamp", "emission": 2}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  const Material* screen = s.material(s.objects[0].material);
+  const Material* lamp = s.material(s.objects[1].material);
+  ASSERT_TRUE(screen && lamp);
+  EXPECT_NE(screen->emissionTexture, kNoNode);
+  EXPECT_EQ(screen->emission, Vec3(4.0f)) << "the bitmap's scale is the factor";
+  EXPECT_EQ(lamp->emissionTexture, kNoNode);
+  for (const auto& w : r->warnings) EXPECT_EQ(w.find("textured emission"), std::string::npos) << w;
+}
+
 TEST(Tungsten, MissingMeshIsSkippedWithAWarning) {
   auto file = writeScene(R"({"primitives": [
       {"type": "mesh", "file": "nowhere.obj"},

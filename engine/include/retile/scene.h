@@ -109,6 +109,7 @@ struct Material {
   Vec3 eta{0.2f, 0.92f, 1.1f};     // conductors with metal == "custom"
   Vec3 k{3.9f, 2.45f, 2.14f};
   Vec3 emission{0.0f};             // radiance emitted from the front side
+  NodeId emissionTexture = kNoNode;  // multiplies emission (glTF's emissiveTexture, Tungsten's textured emission)
   float alpha = 1.0f;              // coverage; < 1 or an alpha texture makes a cut-out
   NodeId alphaTexture = kNoNode;
   // Tilts the shading normal by the slope of this texture's value (the mean of its channels), as
@@ -118,8 +119,10 @@ struct Material {
   float bumpStrength = 1.0f;
 
   // Every texture reference, for code that visits them all (deletion, validation, copies).
-  std::array<NodeId, 4> textures() const { return {albedoTexture, roughnessTexture, alphaTexture, bumpTexture}; }
-  std::array<NodeId*, 4> textureSlots() { return {&albedoTexture, &roughnessTexture, &alphaTexture, &bumpTexture}; }
+  std::array<NodeId, 5> textures() const { return {albedoTexture, roughnessTexture, alphaTexture, bumpTexture, emissionTexture}; }
+  std::array<NodeId*, 5> textureSlots() {
+    return {&albedoTexture, &roughnessTexture, &alphaTexture, &bumpTexture, &emissionTexture};
+  }
 
   bool emissive() const { return emission.x > 0 || emission.y > 0 || emission.z > 0; }
 };

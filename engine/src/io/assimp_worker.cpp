@@ -172,6 +172,11 @@ struct Converter {
       }
     }
 
+    // Emission is the factor times the texture (glTF's emissiveTexture, OBJ's map_Ke): with a
+    // factor of 0 the texture is linked but gives nothing until the factor is raised.
+    if (NodeId emissionTex = texture(mat, aiTextureType_EMISSIVE, TextureColorSpace::Auto); emissionTex != kNoNode)
+      m.emissionTexture = emissionTex;
+
     float opacity = 1;
     aiString alphaMode;
     // glTF copies baseColorFactor.a into opacity even for OPAQUE materials, where it means nothing.

@@ -268,6 +268,7 @@ Value nativeSceneToJson(const Scene& s) {
     v.set("alpha", m.alpha);
     v.set("alpha_texture", m.alphaTexture);
     v.set("bump_texture", m.bumpTexture);
+    v.set("emission_texture", m.emissionTexture);
     v.set("bump_strength", m.bumpStrength);
     materials.push_back(std::move(v));
   }
@@ -482,6 +483,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.number("alpha", &m.alpha);
       r.id("alpha_texture", &m.alphaTexture);
       r.id("bump_texture", &m.bumpTexture);
+      r.id("emission_texture", &m.emissionTexture);
       r.number("bump_strength", &m.bumpStrength);
       s.materials.push_back(std::move(m));
     }

@@ -820,11 +820,12 @@ class TungstenImporter {
       if (!ok()) return;
     }
     Vec3 emission{0.0f};
+    NodeId emissionTexture = kNoNode;
     bool emissive = false;
     if (const Value* e = p.find("emission")) {
       TextureRef t = texture(*e, where + ".emission", false);
-      if (t.isTexture) warn(cat(where, ": textured emission is rendered as its constant factor"));
       emission = t.constant;
+      emissionTexture = t.texture;
       emissive = true;
     }
     if (const Value* pw = p.find("power")) {
@@ -832,6 +833,7 @@ class TungstenImporter {
       const Mesh* mm = s.mesh(mesh);
       float area = mm && mm->geometry ? worldArea(*mm->geometry, xf) : 0.0f;
       emission = area > 0 ? t.constant / (kPi * area) : Vec3{0.0f};
+      emissionTexture = t.texture;
       emissive = true;
     }
     NodeId materialId = kNoNode;
@@ -857,6 +859,7 @@ class TungstenImporter {
       m.id = s.newId();
       m.name = cat(mat.name.empty() ? std::string("emitter") : mat.name, " (", string(p, "name", cat("light ", ++emitters_)), ")");
       m.emission = max(emission, Vec3{0.0f});
+      m.emissionTexture = emissionTexture;
       s.materials.push_back(m);
       materialId = m.id;
     } else if (!mat.name.empty() && named_.count(mat.name) && p.find("bsdf")->isString()) {

@@ -186,6 +186,7 @@ std::uint32_t RenderSceneData::features() const {
   if (!deltaLights.empty()) f |= gpu::kFeatureDeltaLights;
   if (tungstenShading) f |= gpu::kFeatureTungstenShading;
   if (materialBump) f |= gpu::kFeatureBump;
+  if (emissionTextures) f |= gpu::kFeatureEmissionTextures;
   return f;
 }
 
@@ -320,7 +321,7 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
 }
 
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture, int roughnessTexture, int alphaTexture,
-                                                    int bumpTexture) {
+                                                    int bumpTexture, int emissionTexture) {
   Vec3 eta = m.eta, k = m.k;
   if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
   const bool rough = isMicrofacet(m.type);
@@ -338,7 +339,7 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
           vec4{roughness, ior, std::clamp(m.alpha, 0.0f, 1.0f), std::clamp(fdrInt, 0.0f, 1.0f)},
           v4(eta, bitsOf(albedoTexture)), v4(k, bitsOf(roughnessTexture)),
           v4(max(m.emission, Vec3{0.0f}), bitsOf(alphaTexture)),
-          vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, 0, 0}};
+          vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, bitsOf(emissionTexture), 0}};
 }
 
 void RenderSceneBuilder::packMaterials(const Scene& scene) {
@@ -346,6 +347,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
   data_.materialTypes = 0;
   data_.materialTextures = false;
   data_.materialBump = false;
+  data_.emissionTextures = false;
   materialIndex_.clear();
   auto pack = [&](const Material& m) {
     data_.materialTypes |= 1u << static_cast<int>(m.type);
@@ -354,8 +356,9 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
       data_.materialTypes |= 1u << gpu::kMaskBeckmann;
     if (textureIndex(m.albedoTexture) >= 0 || textureIndex(m.roughnessTexture) >= 0) data_.materialTextures = true;
     if (textureIndex(m.bumpTexture) >= 0 && m.bumpStrength != 0) data_.materialBump = true;
+    if (textureIndex(m.emissionTexture) >= 0 && m.emissive()) data_.emissionTextures = true;
     auto texels = packMaterial(m, textureIndex(m.albedoTexture), textureIndex(m.roughnessTexture), textureIndex(m.alphaTexture),
-                               textureIndex(m.bumpTexture));
+                               textureIndex(m.bumpTexture), textureIndex(m.emissionTexture));
     data_.materials.insert(data_.materials.end(), texels.begin(), texels.end());
   };
   for (const Material& m : scene.materials) {
@@ -556,9 +559,10 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
       Vec3 nrm = normalize(normalMatrix.transformVector(cross(e1, e2)));
       data_.emitters.push_back(v4(w0, area));
       data_.emitters.push_back(v4(w1 - w0, bitsOf(static_cast<std::int32_t>(i))));
-      data_.emitters.push_back(v4(w2 - w0, 0));
+      // The triangle's packed index and the emission texture's, for its uvs at a light sample.
+      data_.emitters.push_back(v4(w2 - w0, bitsOf(static_cast<std::int32_t>(mesh->triOffset + p))));
       data_.emitters.push_back(v4(mat->emission, 0));
-      data_.emitters.push_back(v4(nrm, 0));
+      data_.emitters.push_back(v4(nrm, bitsOf(textureIndex(mat->emissionTexture))));
       power.push_back(area > 0 && std::isfinite(area) ? area * kPi * radianceLum : 0.0f);
     }
   }

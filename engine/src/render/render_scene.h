@@ -30,7 +30,7 @@ using gpu::vec4;
 // shaders/common/bsdf.glsl), with its textures' indices (-1: none). Roughness and IOR are
 // clamped to what the BSDF code can sample.
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture = -1, int roughnessTexture = -1,
-                                                    int alphaTexture = -1, int bumpTexture = -1);
+                                                    int alphaTexture = -1, int bumpTexture = -1, int emissionTexture = -1);
 
 // Which arrays changed in the last update, so the uploader copies only those.
 enum DirtyArrays : std::uint32_t {
@@ -75,6 +75,7 @@ struct RenderSceneData {
   std::uint32_t materialTypes = 0;     // bit kMat... of each material type present
   bool materialTextures = false;       // some material reads an albedo or roughness texture
   bool materialBump = false;           // some material has a bump map
+  bool emissionTextures = false;       // some emissive material has an emission texture
 
   bool tungstenShading = false;        // RenderSettings::shading is Tungsten's
   std::uint32_t features() const;      // kFeature... (layouts.h) of what the arrays hold

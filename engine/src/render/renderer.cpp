@@ -771,6 +771,7 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   if (f & static_cast<std::uint32_t>(gpu::kFeatureDeltaLights)) out.push_back("delta lights");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureTungstenShading)) out.push_back("Tungsten's shading normals");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureBump)) out.push_back("bump maps");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureEmissionTextures)) out.push_back("emission textures");
   return out;
 }
 double Renderer::lastBlasSeconds() const { return impl_->builder.lastTiming().blas; }
