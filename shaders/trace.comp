@@ -212,7 +212,7 @@ Path startPath(uint slot) {
 vec3 bumpNormal(vec3 ns, vec3 q1, vec3 q2, vec2 duv1, vec2 duv2, vec2 slope) {
   if (abs(duv1.x * duv2.y - duv2.x * duv1.y) < 1e-6) return ns;
   vec3 t = q1 * duv2.y - duv1.y * q2, b = q2 * duv1.x - duv2.x * q1;
-  if (dot(t, t) <= 0.0 || dot(b, b) <= 0.0) return ns;
+  if (!(dot(t, t) > 0.0) || !(dot(b, b) > 0.0)) return ns;  // NaN too
   t = normalize(t);
   b = normalize(b);
   t += ns * (slope.x - dot(ns, t));

@@ -111,7 +111,7 @@ vec2 textureSlope(int index, vec2 uv) {
   vec4 info = texelFetch(uTexInfo, index * kTextureTexels);
   if ((floatBitsToInt(info.w) & 15) == kTexChecker) return vec2(0.0);
   int offset = floatBitsToInt(info.x);
-  int w = floatBitsToInt(info.y), h = floatBitsToInt(info.z);
+  int w = max(floatBitsToInt(info.y), 1), h = max(floatBitsToInt(info.z), 1);
   vec2 wrapped = vec2(uv.x, 1.0 - uv.y);
   wrapped = any(isnan(wrapped)) || any(isinf(wrapped)) ? vec2(0.0) : wrapped - floor(wrapped);
   vec2 p = wrapped * vec2(w, h) - 0.5;

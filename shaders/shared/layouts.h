@@ -23,7 +23,7 @@ RT_CONST(int, kTriShadeTexels, 4)   // n0.xyz uv0.x | n1.xyz uv0.y | n2.xyz uv1.
 RT_CONST(int, kInstanceTexels, 5)   // shading: world-to-object rows 0..2 | - triOffset material emitterOffset | objectIndex+1 flags
 RT_CONST(int, kMaterialTexels, 6)   // see render/render_scene.cpp packMaterial
 RT_CONST(int, kTextureTexels, 3)    // offset w h kind | on.rgb resU | off.rgb resV
-RT_CONST(int, kEmitterTexels, 5)    // v0.xyz area | e1.xyz instance | e2.xyz - | radiance.rgb pick pdf | normal.xyz -
+RT_CONST(int, kEmitterTexels, 5)    // v0.xyz area | e1.xyz instance | e2.xyz triangle | radiance.rgb pick pdf | normal.xyz emission texture
 RT_CONST(int, kDeltaLightTexels, 4) // position.xyz type | direction.xyz cosOuter | intensity.rgb cosInner | -
 
 // The traversal buffer holds every triangle (packed triangle p at texel p * kTriTexels), then the
