@@ -301,6 +301,40 @@ TEST(RenderScene, InstancesApartKeepOneReferenceEach) {
   EXPECT_EQ(builder.data().instanceReferences, 6u);
 }
 
+// Light samples pick emitter triangles by power: a textured emitter's is scaled by its texture's
+// mean, and its records name its triangle and texture for the uv lookup at a sample.
+TEST(RenderScene, ATexturedEmitterIsPickedByItsTexturesMean) {
+  Scene s = test::emptyScene(8, 8);
+  Texture dim;
+  dim.id = s.newId();
+  dim.kind = TextureKind::Checker;
+  dim.checkerOn = Vec3{0.2f};
+  dim.checkerOff = Vec3{0.0f};  // mean 0.1
+  s.textures.push_back(dim);
+  Material plain;
+  plain.emission = Vec3{3.0f};
+  Material textured = plain;
+  textured.emissionTexture = dim.id;
+  test::addMeshObject(s, "plain", makeQuad(), test::addMaterial(s, plain), Mat4::identity());
+  test::addMeshObject(s, "textured", makeQuad(), test::addMaterial(s, textured), Mat4::translate({3, 0, 0}));
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  const RenderSceneData& d = builder.data();
+  ASSERT_EQ(d.emitters.size(), 4u * gpu::kEmitterTexels);
+  EXPECT_NE(d.features() & static_cast<std::uint32_t>(gpu::kFeatureEmissionTextures), 0u);
+  double pick[2] = {0, 0};
+  for (std::size_t e = 0; e < 4; ++e) {
+    const vec4* r = d.emitters.data() + e * gpu::kEmitterTexels;
+    const int texture = std::bit_cast<std::int32_t>(r[4].w);
+    pick[texture >= 0 ? 1 : 0] += r[3].w;
+    const int triangle = std::bit_cast<std::int32_t>(r[2].w);
+    ASSERT_GE(triangle, 0);
+    ASSERT_LT(static_cast<std::size_t>(triangle), d.triangleCount);
+  }
+  EXPECT_NEAR(pick[0] + pick[1], 1.0, 1e-5);
+  EXPECT_NEAR(pick[1], 0.1 / 1.1, 1e-4) << "the textured emitter has a tenth of the power";
+}
+
 // A mesh's packed triangles are kept in one place (the arrays of the last update) and copied
 // from there when meshes come and go: after adding a mesh and removing the first, every packed
 // triangle still holds its mesh's vertices and names its own global index.

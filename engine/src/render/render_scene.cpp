@@ -542,7 +542,11 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
     Mat4 normalMatrix = o->transform.inverse().transposed();
     auto first = static_cast<std::int32_t>(data_.emitters.size() / gpu::kEmitterTexels);
     data_.instances[i * gpu::kInstanceTexels + 3].w = bitsOf(first);
-    float radianceLum = std::max(luminance(mat->emission), 1e-6f);
+    // Light samples pick triangles by power: a textured emitter's is its texture's mean times its
+    // emission (light samples read the texture where they land, so any choice stays unbiased).
+    Vec3 radiance = mat->emission;
+    if (auto it = textureMean_.find(mat->emissionTexture); it != textureMean_.end()) radiance = radiance * it->second;
+    float radianceLum = std::max(luminance(radiance), 1e-6f);
     std::size_t n = mesh->bvh.primOrder.size();
     for (std::size_t p = 0; p < n; ++p) {
       const vec4* t = data_.meshTraversal.data() + (std::size_t{mesh->triOffset} + p) * gpu::kTriTexels;
@@ -598,7 +602,14 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
   data_.textureInfo.clear();
   data_.texels.clear();
   textureIndex_.clear();
+  textureMean_.clear();
+  Vec3 mean{0.0f};  // of the texture appended last
   auto appendBitmap = [&](const LinearImage& img, bool hasAlpha) {
+    double sum[3] = {0, 0, 0};
+    for (std::size_t i = 0; i + 3 < img.rgba.size(); i += 4)
+      for (std::size_t c = 0; c < 3; ++c) sum[c] += std::isfinite(img.rgba[i + c]) ? img.rgba[i + c] : 0.0f;
+    const double n = std::max<double>(static_cast<double>(img.rgba.size() / 4), 1.0);
+    mean = Vec3{static_cast<float>(sum[0] / n), static_cast<float>(sum[1] / n), static_cast<float>(sum[2] / n)};
     auto offset = static_cast<std::int32_t>(data_.texels.size() / 4);
     data_.textureInfo.push_back(ints(offset, img.width, img.height, gpu::kTexBitmap | (hasAlpha ? 16 : 0)));
     data_.textureInfo.push_back({0, 0, 0, 0});
@@ -607,6 +618,7 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
     for (float f : img.rgba) data_.texels.push_back(floatToHalf(std::isfinite(f) ? f : 0.0f));
   };
   auto appendChecker = [&](Vec3 on, Vec3 off, int ru, int rv) {
+    mean = (on + off) * 0.5f;
     data_.textureInfo.push_back(ints(0, 0, 0, gpu::kTexChecker));
     data_.textureInfo.push_back(v4(on, static_cast<float>(std::max(ru, 1))));
     data_.textureInfo.push_back(v4(off, static_cast<float>(std::max(rv, 1))));
@@ -616,6 +628,7 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
     if (t.kind == TextureKind::Checker) {
       appendChecker(t.checkerOn, t.checkerOff, t.checkerResU, t.checkerResV);
       textureIndex_[t.id] = index;
+      textureMean_[t.id] = mean;
       continue;
     }
     std::string sig = textureSignature(t, scene.baseDirectory);
@@ -642,6 +655,7 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
       appendChecker({1, 0, 1}, {0.05f, 0.05f, 0.05f}, 8, 8);
     }
     textureIndex_[t.id] = index;
+    textureMean_[t.id] = mean;
   }
   // Forget textures that left the scene.
   std::erase_if(cache, [&](const auto& kv) { return !scene.texture(kv.first); });

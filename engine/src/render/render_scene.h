@@ -132,6 +132,8 @@ class RenderSceneBuilder {
   std::map<const MeshGeometry*, MeshEntry> meshes_;
   std::unordered_map<NodeId, Decoded> decoded_;
   std::unordered_map<NodeId, int> textureIndex_;
+  // Each texture's mean RGB as packed: a textured emitter's share of the light samples.
+  std::unordered_map<NodeId, Vec3> textureMean_;
   std::unordered_map<NodeId, int> materialIndex_;
   std::unordered_map<NodeId, const MeshEntry*> meshOf_;  // mesh node id -> entry
   int defaultMaterial_ = 0;
