@@ -22,7 +22,8 @@ void main() {
   uint q = gl_GlobalInvocationID.x;
   if (q >= push.count) return;
   uint base = q * kQueryVec4s;
-  Material m = unpackMaterial(queries[base], queries[base + 1u], queries[base + 2u], queries[base + 3u], queries[base + 4u]);
+  Material m = unpackMaterial(queries[base], queries[base + 1u], queries[base + 2u], queries[base + 3u], queries[base + 4u],
+                              queries[base + 6u]);
   uint at = base + uint(kMaterialTexels);
   vec3 wo = queries[at].xyz, wi = queries[at + 1u].xyz, u = queries[at + 2u].xyz;
   float pdf;

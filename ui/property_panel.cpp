@@ -55,11 +55,13 @@ class PropertyPanel::Builder {
     return f;
   }
 
-  void vec3(const QString& name, const QString& objectName, Vec3 value, double step, std::function<void(int, double, int)> apply) {
+  // Three fields labelled X, Y, Z, or R, G, B for a quantity per colour channel.
+  void vec3(const QString& name, const QString& objectName, Vec3 value, double step, std::function<void(int, double, int)> apply,
+            bool perChannel = false) {
     auto* row = new QWidget(p_->body_);
     auto* l = new QHBoxLayout(row);
     l->setContentsMargins(0, 0, 0, 0);
-    static const char* const kAxisName[3] = {"X", "Y", "Z"};
+    const char* const kAxisName[3] = {perChannel ? "R" : "X", perChannel ? "G" : "Y", perChannel ? "B" : "Z"};
     static const QColor kAxisColor[3] = {QColor(220, 70, 70), QColor(70, 170, 70), QColor(80, 120, 230)};
     for (int axis = 0; axis < 3; ++axis) {
       // Labelled in the gizmo's axis colours, so a field reads without counting.
@@ -309,6 +311,13 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       edit(tr("IOR"), drag, [v](Material& x) { x.ior = static_cast<float>(v); });
     });
   }
+  if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic)
+    b.vec3(tr("Coating absorption"), "coatingAbsorption", m.coatingAbsorption, 0.01, [edit](int channel, double v, int drag) {
+      edit(tr("Coating absorption"), drag, [channel, v](Material& x) {
+        float a = std::max(0.0f, static_cast<float>(v));
+        (channel == 0 ? x.coatingAbsorption.x : channel == 1 ? x.coatingAbsorption.y : x.coatingAbsorption.z) = a;
+      });
+    }, true);
   if (m.type == MaterialType::Conductor || m.type == MaterialType::RoughConductor) {
     QStringList metals;
     for (const auto& n : conductorNames()) metals << QString::fromStdString(n);

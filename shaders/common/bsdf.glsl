@@ -28,13 +28,14 @@ struct Material {
   bool separable;    // rough types: G = G1(wo) G1(wi) instead of height-correlated
   float ior;
   float fdrInt;      // plastic: internal diffuse Fresnel reflectance of the coating
+  vec3 coating;      // plastic: the coating's absorption (sigma_a times thickness)
   vec3 eta;
   vec3 k;
   vec3 emission;
 };
 
 // The material's texels as render/render_scene.cpp packMaterial writes them, textures not applied.
-Material unpackMaterial(vec4 t0, vec4 t1, vec4 t2, vec4 t3, vec4 t4) {
+Material unpackMaterial(vec4 t0, vec4 t1, vec4 t2, vec4 t3, vec4 t4, vec4 t6) {
   Material m;
   int type = floatBitsToInt(t0.w);
   m.type = type & kMatTypeBits;
@@ -47,6 +48,7 @@ Material unpackMaterial(vec4 t0, vec4 t1, vec4 t2, vec4 t3, vec4 t4) {
   m.eta = t2.xyz;
   m.k = t3.xyz;
   m.emission = t4.rgb;
+  m.coating = t6.rgb;
   return m;
 }
 
@@ -182,7 +184,8 @@ float mfReflectionPdf(Material m, vec3 wo, vec3 h, float a) { return mfNormalPdf
 
 float plasticSpecularProbability(Material m, float cosO) {
   float fo = fresnelDielectric(cosO, m.ior);
-  float diffuse = (1.0 - fo) * luminance(m.albedo);
+  // The base as seen through the coating at normal incidence both ways.
+  float diffuse = (1.0 - fo) * luminance(m.albedo * exp(-2.0 * m.coating));
   return clamp(fo / max(fo + diffuse, 1e-6), 0.05, 0.95);
 }
 
@@ -192,7 +195,9 @@ vec3 plasticDiffuse(Material m, vec3 wo, vec3 wi) {
   float fo = fresnelDielectric(wo.z, m.ior);
   float fi = fresnelDielectric(wi.z, m.ior);
   vec3 base = m.albedo / (1.0 - m.albedo * m.fdrInt);
-  return base * (INV_PI * (1.0 - fo) * (1.0 - fi) / (m.ior * m.ior));
+  // An absorbing coating dims the light on its two slanted paths through it (Tungsten's plastic).
+  vec3 through = exp(-m.coating * (1.0 / max(wo.z, 1e-6) + 1.0 / max(wi.z, 1e-6)));
+  return base * through * (INV_PI * (1.0 - fo) * (1.0 - fi) / (m.ior * m.ior));
 }
 
 float orenNayarFactor(Material m, vec3 wo, vec3 wi) {

@@ -40,6 +40,11 @@ Material separable(Material m) {
   return m;
 }
 
+Material coated(Material m, float absorption) {
+  m.coatingAbsorption = Vec3{absorption};
+  return m;
+}
+
 struct Case {
   const char* name;
   Material m;
@@ -59,7 +64,9 @@ std::vector<Case> smoothLobed() {
           {"rough_dielectric_beckmann", beckmann(material(MaterialType::RoughDielectric, 1.0f, 0.3f))},
           {"rough_conductor_separable", separable(material(MaterialType::RoughConductor, 1.0f, 0.3f))},
           {"rough_dielectric_separable", separable(material(MaterialType::RoughDielectric, 1.0f, 0.3f))},
-          {"rough_plastic_beckmann_separable", separable(beckmann(material(MaterialType::RoughPlastic, 0.8f, 0.4f)))}};
+          {"rough_plastic_beckmann_separable", separable(beckmann(material(MaterialType::RoughPlastic, 0.8f, 0.4f)))},
+          {"plastic_absorbing", coated(material(MaterialType::Plastic, 0.8f), 0.3f)},
+          {"rough_plastic_absorbing", coated(material(MaterialType::RoughPlastic, 0.8f, 0.3f), 0.3f)}};
 }
 
 class Bsdfs : public ::testing::Test {
@@ -236,6 +243,32 @@ TEST_F(Bsdfs, ReflectionIsReciprocal) {
     for (std::size_t i = 0; i < q.size(); i += 2) {
       float ab = luminance(r[i].f) / q[i].wi.z, ba = luminance(r[i + 1].f) / q[i + 1].wi.z;
       ASSERT_NEAR(ab, ba, 1e-3f * std::max(ab, ba) + 1e-6f) << c.name;
+    }
+  }
+}
+
+TEST_F(Bsdfs, AnAbsorbingCoatingDimsTheBaseAlongBothPaths) {
+  // Tungsten's plastic: the diffuse base seen through a coating of absorption a (sigma_a times
+  // thickness) is dimmed by exp(-a (1 / cos wo + 1 / cos wi)); the coating's own reflection is
+  // not. The base alone is the material less the same material over a black base.
+  for (MaterialType type : {MaterialType::Plastic, MaterialType::RoughPlastic}) {
+    const Material clear = material(type, 0.8f), black = material(type, 0.0f);
+    std::vector<BsdfQuery> q;
+    const std::pair<float, float> angles[] = {{0.9f, 0.8f}, {0.5f, 0.3f}, {0.2f, 0.7f}};
+    for (auto [co, ci] : angles) {
+      Vec3 wo = direction(co, 0.4f), wi = direction(ci, 2.5f);
+      q.push_back({clear, wo, wi});
+      q.push_back({coated(clear, 0.25f), wo, wi});
+      q.push_back({black, wo, wi});
+      q.push_back({coated(black, 0.25f), wo, wi});
+    }
+    auto a = run(q);
+    for (std::size_t k = 0; k < std::size(angles); ++k) {
+      const auto [co, ci] = angles[k];
+      const double base = a[4 * k].f.y - a[4 * k + 2].f.y, dimmed = a[4 * k + 1].f.y - a[4 * k + 3].f.y;
+      EXPECT_NEAR(a[4 * k + 3].f.y, a[4 * k + 2].f.y, 1e-6) << "the coating's reflection is not absorbed";
+      ASSERT_GT(base, 0.01);
+      EXPECT_NEAR(dimmed / base, std::exp(-0.25 * (1.0 / co + 1.0 / ci)), 1e-4) << "cos " << co << ", " << ci;
     }
   }
 }

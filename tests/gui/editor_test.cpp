@@ -404,6 +404,21 @@ TEST(Editor, AMaterialTakesABumpMapAndItsStrengthFromItsPanel) {
   EXPECT_FLOAT_EQ(w->scene().material(material)->bumpStrength, 1.0f);
 }
 
+TEST(Editor, APlasticsCoatingAbsorptionIsEditedPerChannel) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  const NodeId material = w->scene().object(sphere)->material;
+  ASSERT_EQ(w->scene().material(material)->type, MaterialType::RoughPlastic);
+  auto* green = w->findChild<ScrubField*>("coatingAbsorption1");
+  ASSERT_TRUE(green) << "R, G, B fields for a plastic";
+  green->setValue(0.5);
+  EXPECT_EQ(w->scene().material(material)->coatingAbsorption, Vec3(0.0f, 0.5f, 0.0f));
+  green = w->findChild<ScrubField*>("coatingAbsorption1");
+  green->setValue(-1.0);
+  EXPECT_EQ(w->scene().material(material)->coatingAbsorption.y, 0.0f) << "absorption is not negative";
+}
+
 TEST(Editor, ScrubbingAFieldIsOneUndoStepAndEscCancelsTyping) {
   auto w = makeWindow();
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");

@@ -282,6 +282,22 @@ TEST(Tungsten, TexturedEmissionKeepsItsTexture) {
   for (const auto& w : r->warnings) EXPECT_EQ(w.find("textured emission"), std::string::npos) << w;
 }
 
+TEST(Tungsten, APlasticCoatingAbsorbsSigmaATimesItsThickness) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [
+        {"name": "a", "type": "rough_plastic", "sigma_a": [0.5, 1, 2], "thickness": 0.2},
+        {"name": "b", "type": "plastic", "sigma_a": 0.3},
+        {"name": "c", "type": "plastic"}],
+      "primitives": [{"type": "quad", "bsdf": "a"}, {"type": "quad", "bsdf": "b"}, {"type": "quad", "bsdf": "c"}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  std::map<std::string, Vec3> coating;
+  for (const auto& m : r->scene.materials) coating[m.name] = m.coatingAbsorption;
+  EXPECT_NEAR(coating["a"].x, 0.1f, 1e-6f);
+  EXPECT_NEAR(coating["a"].z, 0.4f, 1e-6f);
+  EXPECT_NEAR(coating["b"].y, 0.3f, 1e-6f) << "thickness 1 by default";
+  EXPECT_EQ(coating["c"], Vec3(0.0f));
+  for (const auto& w : r->warnings) EXPECT_EQ(w.find("sigma_a"), std::string::npos) << w;
+}
+
 TEST(Tungsten, MissingMeshIsSkippedWithAWarning) {
   auto file = writeScene(R"({"primitives": [
       {"type": "mesh", "file": "nowhere.obj"},

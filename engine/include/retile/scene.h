@@ -105,6 +105,9 @@ struct Material {
   bool separableShadowing = false;
   NodeId roughnessTexture = kNoNode;
   float ior = 1.5f;                // dielectric index (plastic coating, glass, thin sheet)
+  // Plastics: the coating's absorption, its sigma_a times its thickness (Tungsten's plastic):
+  // the diffuse base shows through dimmed by exp(-a (1 / cos wi + 1 / cos wo)).
+  Vec3 coatingAbsorption{0.0f};
   std::string metal = "Cu";        // conductors: a named metal (see conductorNames) or "custom"
   Vec3 eta{0.2f, 0.92f, 1.1f};     // conductors with metal == "custom"
   Vec3 k{3.9f, 2.45f, 2.14f};

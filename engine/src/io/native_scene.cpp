@@ -261,6 +261,7 @@ Value nativeSceneToJson(const Scene& s) {
     if (m.separableShadowing) v.set("shadowing", "separable");
     v.set("roughness_texture", m.roughnessTexture);
     v.set("ior", m.ior);
+    v.set("coating_absorption", json::fromVec3(m.coatingAbsorption));
     v.set("metal", m.metal);
     v.set("eta", json::fromVec3(m.eta));
     v.set("k", json::fromVec3(m.k));
@@ -476,6 +477,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
         r.problem("shadowing", cat("unknown shadowing '", shadowing, "' (correlated, separable)"));
       r.id("roughness_texture", &m.roughnessTexture);
       r.number("ior", &m.ior);
+      r.vec3("coating_absorption", &m.coatingAbsorption);
       r.string("metal", &m.metal);
       r.vec3("eta", &m.eta);
       r.vec3("k", &m.k);

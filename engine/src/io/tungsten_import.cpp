@@ -380,9 +380,13 @@ class TungstenImporter {
       warn(cat(where, ": bsdf type '", type, "' is not supported; rendered as lambert with its albedo"));
       m.type = MaterialType::Lambert;
     }
-    if (const Value* s = v.find("sigma_a")) {
-      Vec3 sa;
-      if (json::toVec3(*s, &sa) && maxComponent(sa) > 0) warn(cat(where, ": absorbing coatings (sigma_a) are not rendered"));
+    if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic) {
+      // The coating absorbs sigma_a per unit of its thickness (Tungsten's defaults: 0 and 1).
+      Vec3 sigmaA{0.0f};
+      float thickness = 1;
+      vec3(v, "sigma_a", &sigmaA, where);
+      number(v, "thickness", &thickness, where);
+      m.coatingAbsorption = max(sigmaA * thickness, Vec3{0.0f});
     }
     return m;
   }

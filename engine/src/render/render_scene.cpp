@@ -339,7 +339,8 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
           vec4{roughness, ior, std::clamp(m.alpha, 0.0f, 1.0f), std::clamp(fdrInt, 0.0f, 1.0f)},
           v4(eta, bitsOf(albedoTexture)), v4(k, bitsOf(roughnessTexture)),
           v4(max(m.emission, Vec3{0.0f}), bitsOf(alphaTexture)),
-          vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, bitsOf(emissionTexture), 0}};
+          vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, bitsOf(emissionTexture), 0},
+          v4(max(m.coatingAbsorption, Vec3{0.0f}), 0)};
 }
 
 void RenderSceneBuilder::packMaterials(const Scene& scene) {

@@ -26,9 +26,9 @@ namespace retile {
 
 using gpu::vec4;
 
-// A material as the shaders read it (kMaterialTexels texels: the first five unpacked by
-// unpackMaterial in shaders/common/bsdf.glsl, the sixth, bump map and emission texture, read by
-// trace.comp), with its textures' indices (-1: none). Roughness and IOR are clamped to what the
+// A material as the shaders read it (kMaterialTexels texels: the first five and the seventh
+// unpacked by unpackMaterial in shaders/common/bsdf.glsl, the sixth, bump map and emission
+// texture, read by trace.comp), with its textures' indices (-1: none). Roughness and IOR are clamped to what the
 // BSDF code can sample.
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture = -1, int roughnessTexture = -1,
                                                     int alphaTexture = -1, int bumpTexture = -1, int emissionTexture = -1);

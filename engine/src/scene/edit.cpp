@@ -21,7 +21,7 @@ Applied fail(const std::string& message) { return Applied::failure(message); }
 bool finite(float v) { return std::isfinite(v); }
 
 std::string checkMaterial(const Scene& s, const Material& m) {
-  if (!isFinite(m.albedo) || !isFinite(m.emission) || !isFinite(m.eta) || !isFinite(m.k) ||
+  if (!isFinite(m.albedo) || !isFinite(m.emission) || !isFinite(m.eta) || !isFinite(m.k) || !isFinite(m.coatingAbsorption) ||
       !finite(m.roughness) || !finite(m.ior) || !finite(m.alpha) || !finite(m.bumpStrength))
     return cat("material '", m.name, "': a parameter is not a finite number");
   for (NodeId t : m.textures())
