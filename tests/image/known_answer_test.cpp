@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <memory>
+#include <string>
 #include <tuple>
 #include <utility>
 
@@ -43,6 +45,27 @@ double meanOver(const RenderImage& img, NodeId object, int* count = nullptr) {
     }
   if (count) *count = n;
   return n ? sum / n : 0.0;
+}
+
+// A linear grey texture of `width` x `height` texels whose column x holds value(x), written to
+// `dir` as EXR and added to the scene.
+template <class Value>
+NodeId addColumnTexture(Scene& s, const std::filesystem::path& dir, const std::string& name, int width, int height, Value value) {
+  RenderImage img;
+  img.width = width;
+  img.height = height;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      for (int c = 0; c < 3; ++c) img.color.push_back(value(x));
+  const auto file = dir / (name + ".exr");
+  EXPECT_TRUE(writeRenderImage(img, file).ok()) << file;
+  Texture t;
+  t.id = s.newId();
+  t.name = name;
+  t.path = file;
+  t.colorSpace = TextureColorSpace::Linear;
+  s.textures.push_back(t);
+  return t.id;
 }
 
 TEST(KnownAnswer, WhiteFurnaceConvexObject) {
@@ -227,27 +250,12 @@ TEST(KnownAnswer, ABumpMapTiltsTheNormalByItsSlope) {
   // normalised. A sun from (+-1, 1, 0) then lights a white plane by E/pi n.l: 0.949 E/pi from the
   // side the normal leans to, 0.316 E/pi from the other, 0.707 E/pi without the bump.
   RETILE_RENDERER_OR_SKIP(r);
-  auto dir = test::tempDir();
-  RenderImage ramp;
-  ramp.width = 64;
-  ramp.height = 8;
-  for (int y = 0; y < ramp.height; ++y)
-    for (int x = 0; x < ramp.width; ++x)
-      for (int c = 0; c < 3; ++c) ramp.color.push_back(static_cast<float>(x) / 64.0f);
-  ASSERT_TRUE(writeRenderImage(ramp, dir / "ramp.exr").ok());
-
   Scene s = test::emptyScene(16, 16);
   lookStraightDown(s, 3, 2);  // the middle tenth of the plane, far from the ramp's wrap
   s.settings.maxBounces = 1;
-  Texture t;
-  t.id = s.newId();
-  t.name = "ramp";
-  t.path = dir / "ramp.exr";
-  t.colorSpace = TextureColorSpace::Linear;
-  s.textures.push_back(t);
   Material m;
   m.albedo = Vec3{1.0f};
-  m.bumpTexture = t.id;
+  m.bumpTexture = addColumnTexture(s, test::tempDir(), "ramp", 64, 8, [](int x) { return static_cast<float>(x) / 64.0f; });
   m.bumpStrength = 16.0f;
   NodeId material = test::addMaterial(s, m);
   NodeId plane = test::addMeshObject(s, "plane", makeQuad(), material, Mat4::scale({4, 1, 4}));
@@ -274,12 +282,6 @@ TEST(KnownAnswer, ATexturedEmitterLightsAsItsLitPartAlone) {
   // whole quad and must read the texture there) and BSDF rays that hit it agree.
   RETILE_RENDERER_OR_SKIP(r);
   auto dir = test::tempDir();
-  RenderImage half;
-  half.width = 64;
-  half.height = 1;
-  for (int x = 0; x < half.width; ++x)
-    for (int c = 0; c < 3; ++c) half.color.push_back(x < 32 ? 1.0f : 0.0f);
-  ASSERT_TRUE(writeRenderImage(half, dir / "half.exr").ok());
 
   auto floorLitBy = [&](bool textured) {
     Scene s = test::emptyScene(16, 16);
@@ -294,13 +296,7 @@ TEST(KnownAnswer, ATexturedEmitterLightsAsItsLitPartAlone) {
     // Facing down (the quad's u still runs along +x), 1 above the floor, off to the side.
     const Mat4 down = Mat4::rotateX(kPi);
     if (textured) {
-      Texture t;
-      t.id = s.newId();
-      t.name = "half";
-      t.path = dir / "half.exr";
-      t.colorSpace = TextureColorSpace::Linear;
-      s.textures.push_back(t);
-      light.emissionTexture = t.id;
+      light.emissionTexture = addColumnTexture(s, dir, "half", 64, 1, [](int x) { return x < 32 ? 1.0f : 0.0f; });
       test::addMeshObject(s, "light", makeQuad(), test::addMaterial(s, light), Mat4::translate({1.5f, 1, 0}) * down);
     } else {
       test::addMeshObject(s, "light", makeQuad(), test::addMaterial(s, light),
