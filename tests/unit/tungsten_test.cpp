@@ -298,6 +298,26 @@ TEST(Tungsten, APlasticCoatingAbsorbsSigmaATimesItsThickness) {
   for (const auto& w : r->warnings) EXPECT_EQ(w.find("sigma_a"), std::string::npos) << w;
 }
 
+TEST(Tungsten, AMixedBsdfIsItsWeightierPart) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [
+        {"name": "gold", "type": "conductor", "material": "Au"},
+        {"name": "mix", "type": "mixed", "bsdf0": "gold", "bsdf1": {"type": "lambert", "albedo": 0.2}, "ratio": 0.3, "albedo": 0.5},
+        {"name": "even", "type": "mixed", "bsdf0": "gold", "bsdf1": {"type": "lambert"}}],
+      "primitives": [{"type": "quad", "bsdf": "mix"}, {"type": "quad", "bsdf": "even"}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Material* mix = r->scene.material(r->scene.objects[0].material);
+  const Material* even = r->scene.material(r->scene.objects[1].material);
+  ASSERT_TRUE(mix && even);
+  EXPECT_EQ(mix->name, "mix");
+  EXPECT_EQ(mix->type, MaterialType::Lambert) << "ratio 0.3: bsdf1 weighs more";
+  EXPECT_NEAR(mix->albedo.y, 0.1f, 1e-6f) << "under the blend's albedo";
+  EXPECT_EQ(even->type, MaterialType::Conductor) << "Tungsten's default ratio 0.5: bsdf0";
+  EXPECT_EQ(even->metal, "Au");
+  int warned = 0;
+  for (const auto& w : r->warnings) warned += w.find("a blend of two bsdfs is rendered as its") != std::string::npos;
+  EXPECT_EQ(warned, 2);
+}
+
 TEST(Tungsten, MissingMeshIsSkippedWithAWarning) {
   auto file = writeScene(R"({"primitives": [
       {"type": "mesh", "file": "nowhere.obj"},

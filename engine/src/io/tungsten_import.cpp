@@ -293,6 +293,33 @@ class TungstenImporter {
       }
       return m;
     }
+    if (type == "mixed") {
+      // Tungsten's blend, albedo * (ratio * bsdf0 + (1 - ratio) * bsdf1), has no counterpart:
+      // the part that weighs more stands for it, under the blend's albedo.
+      float ratio = 0.5f;
+      if (const Value* r = v.find("ratio")) {
+        TextureRef t = texture(*r, where + ".ratio", true);
+        ratio = std::clamp(luminance(t.constant), 0.0f, 1.0f);
+        if (t.isTexture) warn(cat(where, ": a textured blend ratio is taken as its constant factor"));
+      }
+      const char* part = ratio >= 0.5f ? "bsdf0" : "bsdf1";
+      const Value* chosen = v.find(part);
+      if (!chosen) {
+        problem(where, cat("mixed bsdf without \"", part, "\""));
+        return m;
+      }
+      Material base = bsdf(*chosen, cat(where, ".", part), depth + 1);
+      std::string name = m.name;
+      m = base;
+      m.name = name;
+      if (const Value* a = v.find("albedo")) {
+        TextureRef t = texture(*a, where + ".albedo", false);
+        m.albedo = m.albedo * t.constant;
+        if (t.isTexture && m.albedoTexture == kNoNode) m.albedoTexture = t.texture;
+      }
+      warn(cat(where, ": a blend of two bsdfs is rendered as its ", part, " (ratio ", ratio, ")"));
+      return m;
+    }
     if (const Value* a = v.find("albedo")) {
       TextureRef t = texture(*a, where + ".albedo", false);
       m.albedo = t.constant;
