@@ -64,21 +64,31 @@ QColor socketColor(const QString& socket) {
   return socket == QLatin1String("material") ? QColor(96, 210, 128) : QColor(236, 196, 72);
 }
 
-// A material node's texture inputs, top to bottom.
+// A material node's texture inputs, top to bottom, and the fields they set.
+struct TextureInput {
+  const char* name;
+  NodeId Material::*field;
+};
+constexpr TextureInput kTextureInputs[] = {{"albedo", &Material::albedoTexture},
+                                           {"roughness", &Material::roughnessTexture},
+                                           {"alpha", &Material::alphaTexture},
+                                           {"bump", &Material::bumpTexture},
+                                           {"emission", &Material::emissionTexture}};
+
 const QStringList& textureInputs() {
-  static const QStringList inputs{QStringLiteral("albedo"), QStringLiteral("roughness"), QStringLiteral("alpha"),
-                                  QStringLiteral("bump"), QStringLiteral("emission")};
+  static const QStringList inputs = [] {
+    QStringList l;
+    for (const TextureInput& t : kTextureInputs) l << QLatin1String(t.name);
+    return l;
+  }();
   return inputs;
 }
 
 bool isTextureInput(const QString& s) { return textureInputs().contains(s); }
 
 NodeId Material::*textureSlot(const QString& input) {
-  if (input == QLatin1String("albedo")) return &Material::albedoTexture;
-  if (input == QLatin1String("roughness")) return &Material::roughnessTexture;
-  if (input == QLatin1String("alpha")) return &Material::alphaTexture;
-  if (input == QLatin1String("bump")) return &Material::bumpTexture;
-  if (input == QLatin1String("emission")) return &Material::emissionTexture;
+  for (const TextureInput& t : kTextureInputs)
+    if (input == QLatin1String(t.name)) return t.field;
   return nullptr;
 }
 

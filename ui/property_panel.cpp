@@ -313,10 +313,8 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   }
   if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic)
     b.vec3(tr("Coating absorption"), "coatingAbsorption", m.coatingAbsorption, 0.01, [edit](int channel, double v, int drag) {
-      edit(tr("Coating absorption"), drag, [channel, v](Material& x) {
-        float a = std::max(0.0f, static_cast<float>(v));
-        (channel == 0 ? x.coatingAbsorption.x : channel == 1 ? x.coatingAbsorption.y : x.coatingAbsorption.z) = a;
-      });
+      edit(tr("Coating absorption"), drag,
+           [channel, v](Material& x) { axisOf(x.coatingAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
     }, true);
   if (m.type == MaterialType::Conductor || m.type == MaterialType::RoughConductor) {
     QStringList metals;

@@ -271,7 +271,7 @@ TEST(KnownAnswer, ABumpMapTiltsTheNormalByItsSlope) {
     double expected = (side * 0.5 + 1.0) / (n * l) / kPi;
     EXPECT_NEAR(meanOver(renderScene(*r, s, 16), plane), expected, 0.01 * expected) << "sun on the side " << side;
   }
-  s.materials[0].bumpStrength = 0.0f;
+  s.material(material)->bumpStrength = 0.0f;
   double flat = 1.0 / l / kPi;
   EXPECT_NEAR(meanOver(renderScene(*r, s, 16), plane), flat, 0.01 * flat) << "no slope, no tilt";
 }

@@ -346,16 +346,14 @@ class TungstenImporter {
         m.k = k;
       }
       std::string named = string(v, "material");
-      // Tungsten also names each metal's table from Palik's handbook "<metal>_palik". Its RGB
-      // values are the plain name's, except copper's, whose eta and k differ by under 7 %.
-      const std::string palik = "_palik";
-      if (named.size() > palik.size() && named.compare(named.size() - palik.size(), palik.size(), palik) == 0) {
-        Vec3 e2, k2;
-        std::string plain = named.substr(0, named.size() - palik.size());
-        if (conductorIor(plain, &e2, &k2)) named = plain;
-      }
       if (!named.empty()) {
         Vec3 e2, k2;
+        // Tungsten also names each metal's table from Palik's handbook "<metal>_palik". Its RGB
+        // values are the plain name's, except copper's, whose eta and k differ by under 7 %.
+        const std::string palik = "_palik";
+        if (named.size() > palik.size() && named.ends_with(palik) &&
+            conductorIor(named.substr(0, named.size() - palik.size()), &e2, &k2))
+          named.resize(named.size() - palik.size());
         if (conductorIor(named, &e2, &k2)) {
           m.metal = named;
         } else {
@@ -868,10 +866,11 @@ class TungstenImporter {
       emissive = true;
     }
     NodeId materialId = kNoNode;
-    mat.bumpTexture = bumpTexture;
-    mat.bumpStrength = bumpTexture != kNoNode ? bumpStrength : 1.0f;
-    const bool bumped = bumpTexture != kNoNode;
-    if (bumped && !emissive) {
+    if (bumpTexture != kNoNode) {
+      mat.bumpTexture = bumpTexture;
+      mat.bumpStrength = bumpStrength;
+    }
+    if (bumpTexture != kNoNode && !emissive) {
       // Primitives with the same bsdf and bump share one copy.
       auto key = std::make_tuple(mat.name, bumpTexture, bumpStrength);
       if (auto it = bumped_.find(key); it != bumped_.end()) {

@@ -606,17 +606,19 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
   textureMean_.clear();
   Vec3 mean{0.0f};  // of the texture appended last
   auto appendBitmap = [&](const LinearImage& img, bool hasAlpha) {
-    double sum[3] = {0, 0, 0};
-    for (std::size_t i = 0; i + 3 < img.rgba.size(); i += 4)
-      for (std::size_t c = 0; c < 3; ++c) sum[c] += std::isfinite(img.rgba[i + c]) ? img.rgba[i + c] : 0.0f;
-    const double n = std::max<double>(static_cast<double>(img.rgba.size() / 4), 1.0);
-    mean = Vec3{static_cast<float>(sum[0] / n), static_cast<float>(sum[1] / n), static_cast<float>(sum[2] / n)};
     auto offset = static_cast<std::int32_t>(data_.texels.size() / 4);
     data_.textureInfo.push_back(ints(offset, img.width, img.height, gpu::kTexBitmap | (hasAlpha ? 16 : 0)));
     data_.textureInfo.push_back({0, 0, 0, 0});
     data_.textureInfo.push_back({0, 0, 0, 0});
     data_.texels.reserve(data_.texels.size() + img.rgba.size());
-    for (float f : img.rgba) data_.texels.push_back(floatToHalf(std::isfinite(f) ? f : 0.0f));
+    double sum[4] = {0, 0, 0, 0};  // the mean's channels, in the one pass over the texels
+    for (std::size_t i = 0; i < img.rgba.size(); ++i) {
+      const float f = std::isfinite(img.rgba[i]) ? img.rgba[i] : 0.0f;
+      sum[i & 3] += f;
+      data_.texels.push_back(floatToHalf(f));
+    }
+    const double n = std::max<double>(static_cast<double>(img.rgba.size() / 4), 1.0);
+    mean = Vec3{static_cast<float>(sum[0] / n), static_cast<float>(sum[1] / n), static_cast<float>(sum[2] / n)};
   };
   auto appendChecker = [&](Vec3 on, Vec3 off, int ru, int rv) {
     mean = (on + off) * 0.5f;
