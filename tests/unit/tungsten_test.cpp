@@ -194,12 +194,14 @@ TEST(Tungsten, BumpMapsGoToACopyOfTheBsdf) {
         {"type": "quad", "name": "plain", "bsdf": "a"},
         {"type": "quad", "name": "bumped", "bsdf": "a", "bump": {"type": "bitmap", "file": "h.png", "scale": 2}, "bump_strength": 3},
         {"type": "quad", "name": "same", "bsdf": "a", "bump": {"type": "bitmap", "file": "h.png", "scale": 2}, "bump_strength": 3},
-        {"type": "quad", "name": "flat", "bsdf": "a", "bump": 0.5}]})";
+        {"type": "quad", "name": "flat", "bsdf": "a", "bump": 0.5},
+        {"type": "quad", "name": "red", "bsdf": {"type": "lambert", "albedo": [1, 0, 0]}, "bump": "h.png"},
+        {"type": "quad", "name": "blue", "bsdf": {"type": "lambert", "albedo": [0, 0, 1]}, "bump": "h.png"}]})";
   }
   auto r = importTungsten(dir / "scene.json");
   ASSERT_TRUE(r.ok()) << r.error();
   const Scene& s = r->scene;
-  ASSERT_EQ(s.objects.size(), 4u);
+  ASSERT_EQ(s.objects.size(), 6u);
   const Material* plain = s.material(s.objects[0].material);
   const Material* bumped = s.material(s.objects[1].material);
   ASSERT_TRUE(plain && bumped);
@@ -209,6 +211,8 @@ TEST(Tungsten, BumpMapsGoToACopyOfTheBsdf) {
   EXPECT_FLOAT_EQ(bumped->bumpStrength, 6.0f) << "bump_strength times the bitmap's scale";
   EXPECT_EQ(s.objects[2].material, s.objects[1].material) << "one copy per bsdf and bump";
   EXPECT_EQ(s.material(s.objects[3].material)->bumpTexture, kNoNode) << "a constant has no slope";
+  EXPECT_NE(s.objects[4].material, s.objects[5].material) << "two unnamed inline bsdfs keep their own copies";
+  EXPECT_EQ(s.material(s.objects[5].material)->albedo, Vec3(0, 0, 1));
 }
 
 TEST(Tungsten, PalikMetalNamesAreTheirMetals) {

@@ -871,16 +871,19 @@ class TungstenImporter {
       mat.bumpStrength = bumpStrength;
     }
     if (bumpTexture != kNoNode && !emissive) {
-      // Primitives with the same bsdf and bump share one copy.
+      // Primitives naming the same bsdf with the same bump share one copy; an inline bsdf is
+      // the primitive's own (two unnamed ones must not meet under the empty name).
+      const bool named = p.find("bsdf") && p.find("bsdf")->isString();
       auto key = std::make_tuple(mat.name, bumpTexture, bumpStrength);
-      if (auto it = bumped_.find(key); it != bumped_.end()) {
+      if (auto it = bumped_.find(key); named && it != bumped_.end()) {
         materialId = it->second;
       } else {
         Material m = mat;
         m.id = s.newId();
         m.name = cat(mat.name.empty() ? where : mat.name, " (bump)");
         s.materials.push_back(m);
-        materialId = bumped_[key] = m.id;
+        materialId = m.id;
+        if (named) bumped_[key] = m.id;
       }
     } else if (emissive) {
       // Emission belongs to the primitive in Tungsten and to the material here: give each
