@@ -280,6 +280,12 @@ vec3 bsdfEval(Material m, vec3 wo, vec3 wi, out float pdf) {
   return vec3(0.0);
 }
 
+// Delta lobes are weighed where they are drawn; every other direction is weighed by the one
+// bsdfEval call at the end, whatever the type. lavapipe runs the code of every material type the
+// kernel has for every lane (its branches skip nothing), and each call of bsdfEval is inlined with
+// all of them: a call per type that needs one made bsdfSample hold up to four copies (one call:
+// the spaceship 5 % faster). Evaluating this direction and the light sample's in one loop instead
+// of two calls (a loop not unrolled) was slower again.
 BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
   BsdfSample s;
   s.wi = vec3(0.0, 0.0, 1.0);
@@ -287,6 +293,7 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
   s.pdf = 0.0;
   s.delta = false;
   s.transmitted = false;
+  bool evaluate = false;  // s.wi is a non-delta lobe's, to weigh by f / pdf
   int t = m.type;
   if (isMat(t, kMatDielectric) || isMat(t, kMatThinSheet)) {
     bool entering = wo.z > 0.0;
@@ -309,9 +316,7 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
         s.pdf = 1.0 - R;
         s.transmitted = true;
       }
-      return s;
-    }
-    if (u.x < F) {
+    } else if (u.x < F) {
       s.wi = vec3(-wo.x, -wo.y, wo.z);
       s.weight = vec3(1.0);
       s.pdf = F;
@@ -323,102 +328,54 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
       s.pdf = 1.0 - F;
       s.transmitted = true;
     }
-    return s;
-  }
-  if (isMat(t, kMatRoughDielectric)) {
+  } else if (isMat(t, kMatRoughDielectric)) {
+    // For GGX f / pdf is G2 / G1 (/ eta^2 through the boundary), for Beckmann's D cos sampling
+    // G2 (o.h) / (o.z h.z).
     float a = m.roughness;
     bool entering = wo.z > 0.0;
     float eta = entering ? m.ior : 1.0 / m.ior;
     vec3 o = entering ? wo : -wo;
-    if (o.z <= 0.0) return s;
     vec3 h = mfSample(m, o, a, u.xy);
     float oh = dot(o, h);
-    if (oh <= 0.0) return s;
     float F = fresnelDielectric(oh, eta);
     vec3 i;
     if (u.z < F) {
       i = reflect(-o, h);
-      if (i.z <= 0.0) return s;
+      evaluate = i.z > 0.0;
     } else {
       i = refract(-o, h, 1.0 / eta);
-      if (i.z >= 0.0 || dot(i, i) == 0.0) return s;
+      evaluate = i.z < 0.0 && dot(i, i) != 0.0;
       s.transmitted = true;
     }
+    evaluate = evaluate && o.z > 0.0 && oh > 0.0;
     s.wi = entering ? i : -i;
-    float p;
-    vec3 f = bsdfEval(m, wo, s.wi, p);
-    s.pdf = p;
-    // For GGX this is G2 / G1 (/ eta^2 through the boundary), for Beckmann's D cos sampling
-    // G2 (o.h) / (o.z h.z): both are f / pdf.
-    s.weight = p > 0.0 ? f / p : vec3(0.0);
-    return s;
-  }
-  if (wo.z <= 0.0) return s;
-  if (isMat(t, kMatMirror)) {
-    s.wi = vec3(-wo.x, -wo.y, wo.z);
-    s.weight = m.albedo;
-    s.pdf = 1.0;
-    s.delta = true;
-    return s;
-  }
-  if (isMat(t, kMatConductor)) {
-    s.wi = vec3(-wo.x, -wo.y, wo.z);
-    s.weight = m.albedo * fresnelConductor(wo.z, m.eta, m.k);
-    s.pdf = 1.0;
-    s.delta = true;
-    return s;
-  }
-  if (isMat(t, kMatRoughConductor)) {
-    float a = m.roughness;
-    vec3 h = mfSample(m, wo, a, u.xy);
-    if (dot(wo, h) <= 0.0) return s;
-    vec3 i = reflect(-wo, h);
-    if (i.z <= 0.0) return s;
-    s.wi = i;
-    s.pdf = mfReflectionPdf(m, wo, h, a);
-    vec3 F = m.albedo * fresnelConductor(dot(wo, h), m.eta, m.k);
-    if (kBeckmannUsed && m.beckmann) s.weight = F * (mfD(m, h, a) * mfG2(m, wo, i, a) / (4.0 * wo.z * max(s.pdf, 1e-12)));
-    else s.weight = F * (mfG2(m, wo, i, a) / ggxG1(wo, a));
-    return s;
-  }
-  if (isMat(t, kMatPlastic)) {
-    float ps = plasticSpecularProbability(m, wo.z);
-    if (u.z < ps) {
+  } else if (wo.z > 0.0) {
+    if (isMat(t, kMatMirror) || isMat(t, kMatConductor)) {
+      s.wi = vec3(-wo.x, -wo.y, wo.z);
+      s.weight = isMat(t, kMatConductor) ? m.albedo * fresnelConductor(wo.z, m.eta, m.k) : m.albedo;
+      s.pdf = 1.0;
+      s.delta = true;
+    } else if (isMat(t, kMatPlastic) && u.z < plasticSpecularProbability(m, wo.z)) {
+      float ps = plasticSpecularProbability(m, wo.z);
       s.wi = vec3(-wo.x, -wo.y, wo.z);
       s.weight = vec3(fresnelDielectric(wo.z, m.ior) / ps);
       s.pdf = ps;
       s.delta = true;
-      return s;
-    }
-    s.wi = sampleCosineHemisphere(u.xy);
-    float p;
-    vec3 f = bsdfEval(m, wo, s.wi, p);
-    s.pdf = p;
-    s.weight = p > 0.0 ? f / p : vec3(0.0);
-    return s;
-  }
-  if (isMat(t, kMatRoughPlastic)) {
-    float ps = plasticSpecularProbability(m, wo.z);
-    if (u.z < ps) {
-      vec3 h = mfSample(m, wo, m.roughness, u.xy);
-      s.wi = reflect(-wo, h);
     } else {
-      s.wi = sampleCosineHemisphere(u.xy);
+      // A microfacet reflection (rough conductor, rough plastic's specular part; for a rough
+      // conductor f / pdf is F G2 / G1 with GGX) or the cosine-weighted hemisphere (lambert,
+      // Oren-Nayar, the plastics' diffuse part).
+      bool microfacet = isMat(t, kMatRoughConductor) || (isMat(t, kMatRoughPlastic) && u.z < plasticSpecularProbability(m, wo.z));
+      s.wi = microfacet ? reflect(-wo, mfSample(m, wo, m.roughness, u.xy)) : sampleCosineHemisphere(u.xy);
+      evaluate = s.wi.z > 0.0;
     }
-    if (s.wi.z <= 0.0) return s;
+  }
+  if (evaluate) {
     float p;
     vec3 f = bsdfEval(m, wo, s.wi, p);
     s.pdf = p;
     s.weight = p > 0.0 ? f / p : vec3(0.0);
-    return s;
   }
-  // Lambert and Oren-Nayar: cosine-weighted hemisphere.
-  s.wi = sampleCosineHemisphere(u.xy);
-  if (s.wi.z <= 0.0) return s;
-  float p;
-  vec3 f = bsdfEval(m, wo, s.wi, p);
-  s.pdf = p;
-  s.weight = p > 0.0 ? f / p : vec3(0.0);
   return s;
 }
 
