@@ -6,21 +6,29 @@
 
 #include "common/scene.glsl"
 
-// Equirectangular convention (Tungsten's): the top row is straight up (+y), the centre column
-// looks along +x and u grows towards +z; the environment's rotation turns it about +y.
+// Equirectangular convention (Tungsten's), in the map's frame: the top row is straight up (+y),
+// the centre column looks along +x and u grows towards +z. The map's frame is the world's
+// turned by the environment's rotation about +y and its orientation (environmentToMap in
+// retile/scene.h).
+vec3 envToMap(vec3 d) {
+  return vec3(dot(frame.environmentToMap[0].xyz, d), dot(frame.environmentToMap[1].xyz, d), dot(frame.environmentToMap[2].xyz, d));
+}
+
 vec2 directionToEnvUv(vec3 d) {
-  float phi = atan(d.z, d.x) + frame.environmentTint.w;
-  float u = phi * (0.5 * INV_PI) + 0.5;
+  vec3 l = envToMap(d);
+  float u = atan(l.z, l.x) * (0.5 * INV_PI) + 0.5;
   u -= floor(u);
-  float v = acos(clamp(d.y, -1.0, 1.0)) * INV_PI;
+  float v = acos(clamp(l.y, -1.0, 1.0)) * INV_PI;
   return vec2(u, v);
 }
 
 vec3 envUvToDirection(vec2 uv) {
-  float phi = 2.0 * PI * (uv.x - 0.5) - frame.environmentTint.w;
+  float phi = 2.0 * PI * (uv.x - 0.5);
   float theta = PI * uv.y;
   float s = sin(theta);
-  return vec3(s * cos(phi), cos(theta), s * sin(phi));
+  vec3 l = vec3(s * cos(phi), cos(theta), s * sin(phi));
+  // The rows are orthonormal: the transpose takes the map's frame back to the world.
+  return l.x * frame.environmentToMap[0].xyz + l.y * frame.environmentToMap[1].xyz + l.z * frame.environmentToMap[2].xyz;
 }
 
 ivec2 envTexel(vec2 uv) {
@@ -49,7 +57,8 @@ float envPdf(vec3 d) {
   vec2 uv = directionToEnvUv(d);
   ivec2 t = envTexel(uv);
   float norm = texelFetch(uEnvCdf, 0).x;
-  float sinActual = sqrt(max(0.0, 1.0 - d.y * d.y));
+  float up = envToMap(d).y;
+  float sinActual = sqrt(max(0.0, 1.0 - up * up));
   if (norm <= 0.0 || sinActual <= 1e-6) return 0.0;
   float sinRow = sin(PI * (float(t.y) + 0.5) / float(frame.environment.w));
   vec4 info = texelFetch(uTexInfo, frame.environment.y * kTextureTexels);

@@ -112,7 +112,8 @@ struct FrameUniforms {
   ivec4 scene;          // tlasRoot, instanceCount, emitterCount, deltaLightCount
   vec4 lightPick;       // probability of picking: emitters, environment, delta lights; -
   ivec4 environment;    // type, map texture, map width, map height
-  vec4 environmentTint; // rgb multiplier (constant: the radiance), rotation about +y in radians
+  vec4 environmentTint; // rgb multiplier (constant: the radiance), -
+  vec4 environmentToMap[3]; // rows of the rotation from world directions to the map's frame (xyz)
   vec4 sceneSphere;     // bounding sphere: centre xyz, radius
   uvec4 work;           // work item count, total sample slots, selected instance + 1 (0: none),
                         // tile size of the selection counters (0: not counting)
@@ -189,7 +190,7 @@ struct DenoisePush {
 
 #ifdef __cplusplus
 static_assert(sizeof(DenoisePush) == 48);
-static_assert(sizeof(FrameUniforms) == 20 * 16);
+static_assert(sizeof(FrameUniforms) == 23 * 16);
 static_assert(sizeof(WorkItem) == 48);
 static_assert(sizeof(TracePush) == 16);
 }  // namespace retile::gpu

@@ -154,6 +154,68 @@ TEST(KnownAnswer, DiffusePlaneUnderUniformSky) {
   EXPECT_NEAR(meanOver(img, plane), 1.0, 0.01);
 }
 
+// A sky map bright (2) above its horizon and black below, over a white-ish plane facing up: the
+// plane's radiance is albedo / pi times the irradiance from the bright half it sees. Upright: 1.
+// Turned upside down by its orientation: 0. Tilted a quarter turn about x (its up along world
+// +z): a quarter of the sphere lights the plane, 0.5. Light samples (drawn in the map's frame),
+// the sky that BSDF rays hit and the density MIS weighs them by must all turn alike.
+TEST(KnownAnswer, ATiltedSkyLightsWhatItsBrightHalfFaces) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(16, 16);
+  lookStraightDown(s, 3, 20);
+  s.settings.maxBounces = 1;
+  RenderImage sky;
+  sky.width = 64;
+  sky.height = 32;
+  for (int y = 0; y < sky.height; ++y)
+    for (int x = 0; x < sky.width; ++x)
+      for (int c = 0; c < 3; ++c) sky.color.push_back(y < sky.height / 2 ? 2.0f : 0.0f);
+  const auto file = test::tempDir() / "half-sky.exr";
+  ASSERT_TRUE(writeRenderImage(sky, file).ok());
+  Texture t;
+  t.id = s.newId();
+  t.name = "half sky";
+  t.path = file;
+  t.colorSpace = TextureColorSpace::Linear;
+  s.textures.push_back(t);
+  s.environment.type = EnvironmentType::Map;
+  s.environment.map = t.id;
+  s.environment.color = Vec3{1.0f};
+  Material m;
+  m.albedo = Vec3{0.5f};
+  NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, m), Mat4::scale({1000, 1, 1000}));
+  for (auto [tilt, expected] : {std::pair{0.0f, 1.0}, std::pair{kPi, 0.0}, std::pair{kPi / 2, 0.5}}) {
+    s.environment.orientation = Mat4::rotateX(tilt);
+    s.environment.rotation = 0.4f;  // a turn about +y changes none of these
+    EXPECT_NEAR(meanOver(renderScene(*r, s, 64), plane), expected, 0.015) << "tilted by " << tilt;
+  }
+
+  // A small bright patch off to one side, mostly reached by light samples: the plane under the
+  // tilted sky is lit as the plane and camera turned the other way are under the upright sky.
+  sky.color.clear();
+  for (int y = 0; y < sky.height; ++y)
+    for (int x = 0; x < sky.width; ++x)
+      for (int c = 0; c < 3; ++c) sky.color.push_back(y >= 6 && y < 10 && x >= 10 && x < 18 ? 50.0f : 0.05f);
+  // A new texture: the renderer keeps what it loaded for a texture id.
+  t.id = s.newId();
+  t.name = "patch sky";
+  t.path = test::tempDir() / "patch-sky.exr";
+  ASSERT_TRUE(writeRenderImage(sky, t.path).ok());
+  s.textures.push_back(t);
+  s.environment.map = t.id;
+  const Mat4 tilt = Mat4::rotateZ(0.3f) * Mat4::rotateX(-0.5f), back = tilt.transposed();
+  s.environment.orientation = tilt;
+  s.environment.rotation = 0;
+  const double tilted = meanOver(renderScene(*r, s, 256), plane);
+  s.environment.orientation = Mat4{};
+  s.objects[0].transform = back * s.objects[0].transform;
+  s.camera.position = back.transformVector(s.camera.position);
+  s.camera.up = back.transformVector(s.camera.up);
+  const double upright = meanOver(renderScene(*r, s, 256), plane);
+  EXPECT_GT(upright, 0.3) << "the patch lights the plane";
+  EXPECT_NEAR(tilted, upright, 0.02 * upright);
+}
+
 // The pixel filter (filter importance sampling): a light's straight edge on a pixel boundary.
 // With a box each pixel sees only its own square; with Tungsten's tent (one pixel each way) the
 // pixel on either side of the edge takes 1/8 from across it (the tent's mass beyond half a pixel);

@@ -1,10 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <array>
 #include <fstream>
 #include <map>
 #include <sstream>
 
 #include "retile/io.h"
+#include "retile/log.h"
 #include "test_support.h"
 
 namespace retile {
@@ -184,6 +186,90 @@ TEST(Tungsten, WhatIsNotRenderedIsNamedInAWarning) {
   }
   EXPECT_EQ(media, 1);
   EXPECT_EQ(bsdfs, 1);
+}
+
+// Tungsten turns an infinite_sphere by its transform's rotation, as it turns any primitive: so a
+// direction fixed to a quad (its normal, +y in the quad's space) is the sky's up (+y in the map's
+// frame) when both have the same transform, tilted, turned and given an "up" alike.
+TEST(Tungsten, TheSkyTurnsAsAPrimitiveWithItsTransform) {
+  const char* transforms[] = {
+      R"({})",
+      R"({"rotation": [0, 30, 0]})",
+      R"({"rotation": [90, 0, 0]})",
+      R"({"rotation": [20, -70, 45], "position": [3, 1, 2], "scale": 4})",
+      R"({"up": [0, 0, 1]})",
+      R"({"up": [1, 1, 0], "rotation": [0, 90, 0]})",
+      R"([0, 0, 1, 5,  1, 0, 0, 0,  0, 1, 0, 0,  0, 0, 0, 1])"};
+  for (const char* t : transforms) {
+    SCOPED_TRACE(t);
+    auto r = importTungsten(writeScene(std::string(R"({"primitives": [
+        {"type": "infinite_sphere", "emission": 1, "transform": )") + t + R"(},
+        {"type": "quad", "name": "q", "bsdf": {"type": "lambert"}, "transform": )" + t + "}]}"));
+    ASSERT_TRUE(r.ok()) << r.error();
+    for (const auto& w : r->warnings) EXPECT_EQ(w.find("environment"), std::string::npos) << w;
+    ASSERT_EQ(r->scene.objects.size(), 1u);
+    const Vec3 quadUp = normalize(r->scene.objects[0].transform.transformVector({0, 1, 0}));
+    const Vec3 quadX = normalize(r->scene.objects[0].transform.transformVector({1, 0, 0}));
+    const Mat4 toMap = environmentToMap(r->scene.environment);
+    const Vec3 up = toMap.transformVector(quadUp), x = toMap.transformVector(quadX);
+    EXPECT_NEAR(up.x, 0, 1e-5f);
+    EXPECT_NEAR(up.y, 1, 1e-5f);
+    EXPECT_NEAR(up.z, 0, 1e-5f);
+    EXPECT_NEAR(x.x, 1, 1e-5f) << "the map's u = 0.5 column lies along the primitive's x";
+    EXPECT_NEAR(x.z, 0, 1e-5f);
+  }
+  // The artist's rotation turns a tilted sky about the world's +y: what was seen in direction d
+  // is seen in d turned about +y.
+  Environment tilted;
+  tilted.orientation = Mat4::rotateX(0.7f);
+  Environment turned = tilted;
+  turned.rotation = 0.25f;
+  const Vec3 d = normalize(Vec3{0.3f, -0.2f, 0.9f});
+  const Vec3 a = environmentToMap(turned).transformVector(Mat4::rotateY(0.25f).transformVector(d));
+  const Vec3 b = environmentToMap(tilted).transformVector(d);
+  EXPECT_NEAR(length(a - b), 0, 1e-5f);
+}
+
+// Tungsten's .wo3 mesh: vertices (position, normal, uv), then triangles with a material index.
+void writeWo3(const std::filesystem::path& file, const std::vector<Vec3>& positions,
+              const std::vector<std::array<std::int32_t, 4>>& triangles) {
+  std::ofstream out(file, std::ios::binary);
+  const std::uint64_t nv = positions.size(), nt = triangles.size();
+  out.write(reinterpret_cast<const char*>(&nv), 8);
+  for (const Vec3& p : positions) {
+    const float v[8] = {p.x, p.y, p.z, 0, 1, 0, 0, 0};
+    out.write(reinterpret_cast<const char*>(v), sizeof v);
+  }
+  out.write(reinterpret_cast<const char*>(&nt), 8);
+  for (const auto& t : triangles) out.write(reinterpret_cast<const char*>(t.data()), 16);
+}
+
+TEST(Tungsten, AMeshTakesABsdfPerMaterialIndex) {
+  auto dir = test::tempDir();
+  // Three triangles side by side: material indices 0, 1 and 5 (past the array: its last entry),
+  // and one more file whose triangles all carry index 1.
+  writeWo3(dir / "three.wo3", {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {2, 0, 0}, {3, 0, 0}, {2, 0, 1}, {4, 0, 0}, {5, 0, 0}, {4, 0, 1}},
+           {{0, 2, 1, 0}, {3, 5, 4, 1}, {6, 8, 7, 5}});
+  writeWo3(dir / "one.wo3", {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}}, {{0, 2, 1, 1}});
+  std::ofstream(dir / "scene.json") << R"({"bsdfs": [{"name": "red", "type": "lambert", "albedo": [1, 0, 0]},
+                                                     {"name": "blue", "type": "lambert", "albedo": [0, 0, 1]}],
+      "primitives": [{"type": "mesh", "name": "three", "file": "three.wo3", "bsdf": ["red", "blue"]},
+                     {"type": "mesh", "name": "one", "file": "one.wo3", "bsdf": ["red", "blue"]}]})";
+  auto r = importTungsten(dir / "scene.json");
+  ASSERT_TRUE(r.ok()) << r.error();
+  for (const auto& w : r->warnings) EXPECT_EQ(w.find("material index"), std::string::npos) << w;
+  const Scene& s = r->scene;
+  ASSERT_EQ(s.objects.size(), 4u);
+  std::vector<std::string> names;
+  for (const Object& o : s.objects) {
+    const Mesh* mesh = s.mesh(o.mesh);
+    ASSERT_TRUE(mesh && mesh->geometry);
+    const Bounds3 b = mesh->geometry->bounds();
+    names.push_back(cat(o.name, ": ", s.material(o.material)->name, " over x ", b.lo.x, "..", b.hi.x, ", ",
+                        mesh->geometry->positions.size(), " vertices"));
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"three [0]: red over x 0..1, 3 vertices", "three [1]: blue over x 2..3, 3 vertices",
+                                             "three [5]: blue over x 4..5, 3 vertices", "one: blue over x 0..1, 3 vertices"}));
 }
 
 TEST(Tungsten, BumpMapsGoToACopyOfTheBsdf) {

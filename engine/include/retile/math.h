@@ -91,6 +91,9 @@ struct Mat4 {
   Vec3 translation() const { return {m[0][3], m[1][3], m[2][3]}; }
   Mat4 inverse() const;  // general inverse; a singular matrix yields all zeros
   Mat4 transposed() const;
+  // The rotation nearest in spirit to the linear part: its x, y and z columns made orthonormal
+  // in that order (Gram-Schmidt), right-handed; identity when they are degenerate or not finite.
+  Mat4 rotationPart() const;
   bool isFinite() const;
   friend Mat4 operator*(const Mat4& a, const Mat4& b);
   friend bool operator==(const Mat4&, const Mat4&) = default;

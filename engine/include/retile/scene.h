@@ -177,10 +177,18 @@ struct Environment {
   float intensity = 1.0f;
   NodeId map = kNoNode;               // Map: an equirectangular texture
   float rotation = 0.0f;              // radians about +y
+  // The map's own frame (its up is this matrix's y axis), turned by `rotation` about +y after it.
+  // Identity but for tilted skies from imports (a Tungsten infinite_sphere rotated about x or z,
+  // or given an "up"); only its rotation part counts.
+  Mat4 orientation;
   Vec3 zenith{0.35f, 0.55f, 0.95f};   // Sky: a gradient from zenith to horizon, ground below
   Vec3 horizon{0.9f, 0.92f, 0.95f};
   Vec3 ground{0.3f, 0.28f, 0.25f};
 };
+
+// World directions to the environment map's frame: `orientation`'s rotation, turned by `rotation`
+// about +y (the map's u grows with the angle from +x towards +z, its v downwards from +y).
+Mat4 environmentToMap(const Environment& e);
 
 // How samples are spread over and around a pixel (filter importance sampling: each sample's
 // position is drawn from the filter, so a pixel's accumulation stays a plain mean and every

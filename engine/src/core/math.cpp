@@ -100,6 +100,25 @@ Mat4 Mat4::transposed() const {
   return r;
 }
 
+Mat4 Mat4::rotationPart() const {
+  Vec3 x{m[0][0], m[1][0], m[2][0]}, y{m[0][1], m[1][1], m[2][1]};
+  const float lx = length(x);
+  if (!(lx > 1e-12f) || !std::isfinite(lx)) return {};
+  x = x / lx;
+  y = y - x * dot(x, y);
+  const float ly = length(y);
+  if (!(ly > 1e-6f * lx) || !std::isfinite(ly)) return {};
+  y = y / ly;
+  const Vec3 z = cross(x, y);
+  Mat4 r;
+  for (int row = 0; row < 3; ++row) {
+    r.m[row][0] = x[row];
+    r.m[row][1] = y[row];
+    r.m[row][2] = z[row];
+  }
+  return r;
+}
+
 bool Mat4::isFinite() const {
   for (const auto& row : m)
     for (float v : row)

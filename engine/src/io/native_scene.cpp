@@ -202,6 +202,7 @@ Value nativeSceneToJson(const Scene& s) {
   env.set("intensity", e.intensity);
   env.set("map", e.map);
   env.set("rotation", e.rotation);
+  env.set("orientation", mat4(e.orientation));
   env.set("zenith", json::fromVec3(e.zenith));
   env.set("horizon", json::fromVec3(e.horizon));
   env.set("ground", json::fromVec3(e.ground));
@@ -392,6 +393,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
     r.number("intensity", &e.intensity);
     r.id("map", &e.map);
     r.number("rotation", &e.rotation);
+    r.matrix("orientation", &e.orientation);
     r.vec3("zenith", &e.zenith);
     r.vec3("horizon", &e.horizon);
     r.vec3("ground", &e.ground);

@@ -1,6 +1,7 @@
 // Tungsten / Bitterli scene.json: the format the paper's scenes come in. Conventions (transform
 // order, Euler angles, shape extents, camera field of view, bounce counting) follow Tungsten so
 // scenes look as their authors rendered them; see docs/ARCHITECTURE.md for the mapping.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -600,42 +601,81 @@ class TungstenImporter {
     for (Vec3& n : g.normals) n = normalize(n);
   }
 
-  NodeId loadMesh(const Value& p, const std::string& where) {
+  // A mesh file's triangles that take the bsdf of one material index.
+  struct MeshPart {
+    std::int32_t material = 0;
+    NodeId mesh = kNoNode;
+  };
+
+  // The mesh of a "mesh" primitive: with `split` (the primitive names several bsdfs), one part
+  // per material index its triangles carry (a .wo3 file's; an OBJ file's are all 0), each a mesh
+  // of its own; else one part, of the first triangle's index. Empty when the file is unusable.
+  std::vector<MeshPart> loadMesh(const Value& p, const std::string& where, bool split) {
     std::string f = string(p, "file");
     if (f.empty()) {
       problem(where, "mesh without a \"file\"");
-      return kNoNode;
+      return {};
     }
     bool smooth = false, recompute = false;
     if (const Value* v = p.find("smooth"); v && v->isBool()) smooth = v->asBool();
     if (const Value* v = p.find("recompute_normals"); v && v->isBool()) recompute = v->asBool();
     std::string key = cat(f, "|", smooth, recompute);
-    if (auto it = meshIds_.find(key); it != meshIds_.end()) return it->second;
+    const std::string partsKey = cat(key, "|", split);
+    if (auto it = meshParts_.find(partsKey); it != meshParts_.end()) return it->second;
     auto path = resolveScenePath(base_, f);
     if (!path) {
       warn(cat(where, ": mesh file '", f, "' not found; the primitive is skipped"));
-      return kNoNode;
+      return {};
     }
     std::vector<std::string> warnings;
     Result<MeshGeometry> g = Result<MeshGeometry>::failure("");
+    std::vector<std::int32_t> materials;  // per triangle, wo3 only
     std::string ext = extensionLower(*path);
     if (ext == "obj") g = readObjGeometry(*path, &warnings, options_);
-    else if (ext == "wo3") g = readWo3(*path);
+    else if (ext == "wo3") g = readWo3(*path, &materials);
     else g = Result<MeshGeometry>::failure(cat(path->string(), ": unsupported mesh format '.", ext, "' (obj or wo3)"));
     for (auto& w : warnings) out_.warnings.push_back(w);
     if (!g) {
       warn(cat(where, ": ", g.error(), "; the primitive is skipped"));
-      return kNoNode;
+      return {};
     }
     MeshGeometry geom = std::move(g.value());
     if (!smooth) geom.normals.clear();  // flat shading
-    else if (recompute || geom.normals.empty()) smoothNormals(geom);
-    return meshNode(key, fs::path(f).stem().string(), std::make_shared<MeshGeometry>(std::move(geom)));
+    else if (recompute || geom.normals.empty()) smoothNormals(geom);  // across the parts' seams
+    const std::string name = fs::path(f).stem().string();
+    std::vector<MeshPart> parts;
+    if (!split || materials.size() * 3 != geom.indices.size() ||
+        std::all_of(materials.begin(), materials.end(), [&](std::int32_t m) { return m == materials.front(); })) {
+      parts.push_back({materials.empty() ? 0 : materials.front(), meshNode(key, name, std::make_shared<MeshGeometry>(std::move(geom)))});
+    } else {
+      std::set<std::int32_t> indices(materials.begin(), materials.end());
+      for (std::int32_t m : indices) {
+        // The part's triangles with their vertices, renumbered.
+        auto part = std::make_shared<MeshGeometry>();
+        std::map<std::uint32_t, std::uint32_t> remap;
+        for (std::size_t t = 0; t < materials.size(); ++t) {
+          if (materials[t] != m) continue;
+          for (int k = 0; k < 3; ++k) {
+            const std::uint32_t v = geom.indices[t * 3 + static_cast<std::size_t>(k)];
+            auto [it, added] = remap.emplace(v, static_cast<std::uint32_t>(part->positions.size()));
+            if (added) {
+              part->positions.push_back(geom.positions[v]);
+              if (!geom.normals.empty()) part->normals.push_back(geom.normals[v]);
+              if (!geom.uvs.empty()) part->uvs.push_back(geom.uvs[v]);
+            }
+            part->indices.push_back(it->second);
+          }
+        }
+        parts.push_back({m, meshNode(cat(key, "|", m), cat(name, " [", m, "]"), std::move(part))});
+      }
+    }
+    meshParts_[partsKey] = parts;
+    return parts;
   }
 
   // Tungsten's binary mesh: uint64 vertex count, {pos, normal, uv} per vertex, uint64 triangle
-  // count, {3 x uint32, int32 material} per triangle.
-  Result<MeshGeometry> readWo3(const fs::path& path) {
+  // count, {3 x uint32, int32 material} per triangle. `materials` gets the kept triangles' indices.
+  Result<MeshGeometry> readWo3(const fs::path& path, std::vector<std::int32_t>* materials) {
     using R = Result<MeshGeometry>;
     auto data = readFile(path, options_.maxFileBytes);
     if (!data) return R::failure(data.error());
@@ -664,13 +704,20 @@ class TungstenImporter {
     if (!u64(&nt) || nt > (d.size() - pos) / 16) return R::failure(cat(path.string(), ": truncated or corrupt (triangle count)"));
     if (nt > options_.maxTriangles) return R::failure(cat(path.string(), ": more than ", options_.maxTriangles, " triangles"));
     g.indices.resize(nt * 3);
+    materials->clear();
     for (std::uint64_t i = 0; i < nt; ++i) {
-      std::uint32_t t[4];
-      std::memcpy(t, d.data() + pos, 16);
+      std::uint32_t t[3];
+      std::int32_t material = 0;
+      std::memcpy(t, d.data() + pos, 12);
+      std::memcpy(&material, d.data() + pos + 12, 4);
       pos += 16;
       g.indices[i * 3] = t[0];
       g.indices[i * 3 + 1] = t[1];
       g.indices[i * 3 + 2] = t[2];
+      // sanitizeGeometry keeps the triangles whose vertices exist and are finite, in order.
+      bool kept = true;
+      for (std::uint32_t v : t) kept = kept && v < nv && isFinite(g.positions[v]);
+      if (kept) materials->push_back(material);
     }
     std::size_t dropped = sanitizeGeometry(g);
     if (dropped) warn(cat(path.filename().string(), ": dropped ", dropped, " invalid triangles"));
@@ -689,12 +736,20 @@ class TungstenImporter {
     return static_cast<float>(a);
   }
 
-  void environmentFromEmission(const Value& p, const std::string& where, Vec3 rotationDeg) {
+  // The sky's frame is its transform's rotation (InfiniteSphere: _rotTransform, scale and position
+  // dropped): R = Ry(-ry) Rx(rx) Rz(rz) times the basis of any axes given. Its turn about y is
+  // the environment's rotation, the rest (tilts, an "up") its orientation.
+  void environmentFromEmission(const Value& p, const std::string& where) {
     Environment& e = out_.scene.environment;
     e.intensity = 1;
-    e.rotation = radians(-rotationDeg.y);
-    if (std::abs(rotationDeg.x) > 1e-3f || std::abs(rotationDeg.z) > 1e-3f)
-      warn(cat(where, ": only rotation about y is applied to the environment"));
+    e.rotation = 0;
+    e.orientation = Mat4{};
+    if (const Value* t = p.find("transform")) {
+      Vec3 rot{0.0f};
+      if (t->isObject()) vec3(*t, "rotation", &rot, where);
+      e.rotation = radians(-rot.y);
+      e.orientation = (Mat4::rotateY(radians(rot.y)) * transform(t, where)).rotationPart();
+    }
     const Value* em = p.find("emission");
     if (!em) em = p.find("radiance");
     float powerScale = 1;
@@ -728,9 +783,7 @@ class TungstenImporter {
     if (!v.isObject()) return;
     std::string type = string(v, "type");
     if (type == "envmap" || type == "infinite_sphere") {
-      Vec3 rot{0.0f};
-      if (const Value* t = v.find("transform"); t && t->isObject()) vec3(*t, "rotation", &rot, where);
-      environmentFromEmission(v, where, rot);
+      environmentFromEmission(v, where);
     } else {
       warn(cat(where, ": emitter type '", type, "' is not supported; skipped"));
     }
@@ -745,9 +798,7 @@ class TungstenImporter {
     const Value* tv = p.find("transform");
 
     if (type == "infinite_sphere") {
-      Vec3 rot{0.0f};
-      if (tv && tv->isObject()) vec3(*tv, "rotation", &rot, where);
-      environmentFromEmission(p, where, rot);
+      environmentFromEmission(p, where);
       return;
     }
     if (type == "skydome") {
@@ -800,19 +851,21 @@ class TungstenImporter {
       return;
     }
 
-    NodeId mesh = kNoNode;
+    std::vector<MeshPart> parts;  // one for every shape but a mesh with several material indices
     Mat4 xf = transform(tv, where, &scale, type == "quad" || type == "disk");
     if (!ok()) return;
+    const Value* bsdfs = p.find("bsdf");
+    const bool byIndex = bsdfs && bsdfs->isArray() && !bsdfs->asArray().empty();
     if (type == "mesh") {
-      mesh = loadMesh(p, where);
+      parts = loadMesh(p, where, byIndex && bsdfs->asArray().size() > 1);
     } else if (type == "quad" || type == "cube" || type == "disk") {
-      mesh = meshNode(type, type, shape(type));
+      parts.push_back({0, meshNode(type, type, shape(type))});
     } else if (type == "sphere") {
       // Tungsten's sphere radius is the largest scale; the shape stays round.
       float r = std::max({std::abs(scale.x), std::abs(scale.y), std::abs(scale.z)});
       Vec3 safe{scale.x != 0 ? r / scale.x : 0, scale.y != 0 ? r / scale.y : 0, scale.z != 0 ? r / scale.z : 0};
       xf = xf * Mat4::scale(safe);
-      mesh = meshNode(type, type, shape(type));
+      parts.push_back({0, meshNode(type, type, shape(type))});
     } else if (type == "cylinder") {
       // Round too: the radius is half the larger of the x and z scales, the height the y scale.
       float r = std::max(std::abs(scale.x), std::abs(scale.z));
@@ -820,12 +873,16 @@ class TungstenImporter {
       bool capped = true;
       if (const Value* c = p.find("capped"); c && c->isBool()) capped = c->asBool();
       std::string kind = capped ? "cylinder" : "open cylinder";
-      mesh = meshNode(kind, "cylinder", shape(kind));
+      parts.push_back({0, meshNode(kind, "cylinder", shape(kind))});
     } else {
       warn(cat(where, ": primitive type '", type, "' is not supported; skipped"));
       return;
     }
-    if (!ok() || mesh == kNoNode) return;
+    if (!ok() || parts.empty()) return;
+    if (!xf.isFinite() || xf.inverse().m[3][3] == 0.0f) {
+      warn(cat(where, ": transform is degenerate; the primitive is skipped"));
+      return;
+    }
 
     // A bump map belongs to the primitive in Tungsten and to the material here (as emission
     // does): the primitive gets its own copy of its bsdf. A constant has no slope.
@@ -838,16 +895,6 @@ class TungstenImporter {
       bumpTexture = t.texture;
       bumpStrength *= t.constant.x;  // a bitmap's scale
     }
-    Material mat;
-    mat.albedo = Vec3{1.0f};
-    if (const Value* b = p.find("bsdf")) {
-      // An array names one bsdf per material index; OBJ meshes carry index 0.
-      const Value& first = b->isArray() && !b->asArray().empty() ? b->asArray()[0] : *b;
-      if (b->isArray() && b->asArray().size() > 1)
-        warn(cat(where, ": ", b->asArray().size(), " bsdfs by material index; every triangle takes the first"));
-      mat = bsdf(first, where + ".bsdf", 0, p.find("emission") || p.find("power"));
-      if (!ok()) return;
-    }
     Vec3 emission{0.0f};
     NodeId emissionTexture = kNoNode;
     bool emissive = false;
@@ -859,64 +906,80 @@ class TungstenImporter {
     }
     if (const Value* pw = p.find("power")) {
       TextureRef t = texture(*pw, where + ".power", false);
-      const Mesh* mm = s.mesh(mesh);
-      float area = mm && mm->geometry ? worldArea(*mm->geometry, xf) : 0.0f;
+      float area = 0;  // the whole primitive's: its power spreads over every part
+      for (const MeshPart& part : parts)
+        if (const Mesh* mm = s.mesh(part.mesh); mm && mm->geometry) area += worldArea(*mm->geometry, xf);
       emission = area > 0 ? t.constant / (kPi * area) : Vec3{0.0f};
       emissionTexture = t.texture;
       emissive = true;
     }
-    NodeId materialId = kNoNode;
-    if (bumpTexture != kNoNode) {
-      mat.bumpTexture = bumpTexture;
-      mat.bumpStrength = bumpStrength;
-    }
-    if (bumpTexture != kNoNode && !emissive) {
-      // Primitives naming the same bsdf with the same bump share one copy; an inline bsdf is
-      // the primitive's own (two unnamed ones must not meet under the empty name).
-      const bool named = p.find("bsdf") && p.find("bsdf")->isString();
-      auto key = std::make_tuple(mat.name, bumpTexture, bumpStrength);
-      if (auto it = bumped_.find(key); named && it != bumped_.end()) {
-        materialId = it->second;
+
+    // An array names one bsdf per material index (Tungsten's TriangleMesh: a triangle's index
+    // picks its bsdf); an index past the array's end takes its last entry, as ours did before.
+    if (byIndex && bsdfs->asArray().size() > 1 && type != "mesh")
+      warn(cat(where, ": ", bsdfs->asArray().size(), " bsdfs by material index on a ", type, "; it takes the first"));
+    for (const MeshPart& part : parts) {
+      const std::size_t index = byIndex ? static_cast<std::size_t>(std::clamp<std::int64_t>(part.material, 0,
+                                                                     static_cast<std::int64_t>(bsdfs->asArray().size()) - 1))
+                                        : 0;
+      const Value* b = byIndex ? &bsdfs->asArray()[index] : bsdfs;
+      const std::string bsdfWhere = byIndex ? cat(where, ".bsdf[", index, "]") : where + ".bsdf";
+      Material mat;
+      mat.albedo = Vec3{1.0f};
+      if (b) {
+        mat = bsdf(*b, bsdfWhere, 0, emissive);
+        if (!ok()) return;
+      }
+      const bool named = b && b->isString();
+      NodeId materialId = kNoNode;
+      if (bumpTexture != kNoNode) {
+        mat.bumpTexture = bumpTexture;
+        mat.bumpStrength = bumpStrength;
+      }
+      if (bumpTexture != kNoNode && !emissive) {
+        // Primitives naming the same bsdf with the same bump share one copy; an inline bsdf is
+        // the primitive's own (two unnamed ones must not meet under the empty name).
+        auto key = std::make_tuple(mat.name, bumpTexture, bumpStrength);
+        if (auto it = bumped_.find(key); named && it != bumped_.end()) {
+          materialId = it->second;
+        } else {
+          Material m = mat;
+          m.id = s.newId();
+          m.name = cat(mat.name.empty() ? where : mat.name, " (bump)");
+          s.materials.push_back(m);
+          materialId = m.id;
+          if (named) bumped_[key] = m.id;
+        }
+      } else if (emissive) {
+        // Emission belongs to the primitive in Tungsten and to the material here: give each
+        // emitter its own copy of its bsdf.
+        Material m = mat;
+        m.id = s.newId();
+        m.name = cat(mat.name.empty() ? std::string("emitter") : mat.name, " (", string(p, "name", cat("light ", ++emitters_)), ")");
+        m.emission = max(emission, Vec3{0.0f});
+        m.emissionTexture = emissionTexture;
+        s.materials.push_back(m);
+        materialId = m.id;
+      } else if (!mat.name.empty() && named_.count(mat.name) && named) {
+        materialId = named_[mat.name].id;
       } else {
         Material m = mat;
         m.id = s.newId();
-        m.name = cat(mat.name.empty() ? where : mat.name, " (bump)");
+        if (m.name.empty()) m.name = cat(where, " material");
         s.materials.push_back(m);
         materialId = m.id;
-        if (named) bumped_[key] = m.id;
       }
-    } else if (emissive) {
-      // Emission belongs to the primitive in Tungsten and to the material here: give each
-      // emitter its own copy of its bsdf.
-      Material m = mat;
-      m.id = s.newId();
-      m.name = cat(mat.name.empty() ? std::string("emitter") : mat.name, " (", string(p, "name", cat("light ", ++emitters_)), ")");
-      m.emission = max(emission, Vec3{0.0f});
-      m.emissionTexture = emissionTexture;
-      s.materials.push_back(m);
-      materialId = m.id;
-    } else if (!mat.name.empty() && named_.count(mat.name) && p.find("bsdf")->isString()) {
-      materialId = named_[mat.name].id;
-    } else {
-      Material m = mat;
-      m.id = s.newId();
-      if (m.name.empty()) m.name = cat(where, " material");
-      s.materials.push_back(m);
-      materialId = m.id;
-    }
 
-    Object o;
-    o.id = s.newId();
-    const Mesh* mm = s.mesh(mesh);
-    o.name = string(p, "name", mm ? mm->name : type);
-    o.mesh = mesh;
-    o.material = materialId;
-    o.transform = xf;
-    if (!xf.isFinite() || xf.inverse().m[3][3] == 0.0f) {
-      warn(cat(where, ": transform is degenerate; the primitive is skipped"));
-      return;
+      Object o;
+      o.id = s.newId();
+      const Mesh* mm = s.mesh(part.mesh);
+      o.name = string(p, "name", mm ? mm->name : type);
+      if (parts.size() > 1) o.name = cat(o.name, " [", part.material, "]");
+      o.mesh = part.mesh;
+      o.material = materialId;
+      o.transform = xf;
+      s.objects.push_back(o);
     }
-    s.objects.push_back(o);
   }
 
   fs::path file_;
@@ -930,6 +993,7 @@ class TungstenImporter {
   std::set<std::string> missingWarned_;
   bool quietMissingTexture_ = false;
   std::map<std::string, NodeId> meshIds_;
+  std::map<std::string, std::vector<MeshPart>> meshParts_;  // a mesh file's parts, by loadMesh's key
   std::map<std::string, std::shared_ptr<const MeshGeometry>> shapes_;
   int emitters_ = 0;
   std::map<std::tuple<std::string, NodeId, float>, NodeId> bumped_;  // (bsdf, texture, strength) -> its copy

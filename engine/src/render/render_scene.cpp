@@ -670,7 +670,7 @@ void RenderSceneBuilder::packEnvironment(const Scene& scene, std::vector<std::st
   data_.environmentType = gpu::kEnvNone;
   data_.environmentMap = -1;
   data_.environmentWidth = data_.environmentHeight = 0;
-  data_.environmentRotation = e.rotation;
+  data_.environmentToMap = environmentToMap(e);
   environmentPower_ = 0;
   LinearImage map;
   Vec3 tint = e.color * e.intensity;

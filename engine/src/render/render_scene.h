@@ -69,7 +69,7 @@ struct RenderSceneData {
   int environmentMap = -1;             // texture index of the map
   int environmentWidth = 0, environmentHeight = 0;
   Vec3 environmentTint{0.0f};
-  float environmentRotation = 0;
+  Mat4 environmentToMap;               // world directions to the map's frame (a rotation)
   std::uint64_t triangleCount = 0;     // unique (per mesh) triangles
   std::uint64_t instancedTriangles = 0;
   bool alphaTested = false;            // some instance needs the cut-out test during traversal

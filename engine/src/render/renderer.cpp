@@ -411,7 +411,9 @@ struct Renderer::Impl {
                static_cast<std::int32_t>(d.deltaLights.size() / gpu::kDeltaLightTexels)};
     u.lightPick = {d.lightPick[0], d.lightPick[1], d.lightPick[2], 0};
     u.environment = {d.environmentType, d.environmentMap, d.environmentWidth, d.environmentHeight};
-    u.environmentTint = {d.environmentTint.x, d.environmentTint.y, d.environmentTint.z, d.environmentRotation};
+    u.environmentTint = {d.environmentTint.x, d.environmentTint.y, d.environmentTint.z, 0};
+    for (int r = 0; r < 3; ++r)
+      u.environmentToMap[r] = {d.environmentToMap.m[r][0], d.environmentToMap.m[r][1], d.environmentToMap.m[r][2], 0};
     Vec3 c = d.bounds.empty() ? Vec3{0.0f} : d.bounds.center();
     u.sceneSphere = {c.x, c.y, c.z, d.bounds.empty() ? 1.0f : 0.5f * length(d.bounds.extent())};
     std::uint32_t sel = countTile > 0 ? selectedInstance() : 0u;

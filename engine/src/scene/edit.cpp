@@ -152,7 +152,7 @@ Result<std::uint32_t> applyEdit(Scene& s, const Edit& edit) {
           [&](const SetEnvironment& e) -> Applied {
             const Environment& v = e.environment;
             if (!isFinite(v.color) || !std::isfinite(v.intensity) || !std::isfinite(v.rotation) ||
-                !isFinite(v.zenith) || !isFinite(v.horizon) || !isFinite(v.ground))
+                !isFinite(v.zenith) || !isFinite(v.horizon) || !isFinite(v.ground) || !v.orientation.isFinite())
               return fail("environment: a parameter is not a finite number");
             if (v.map != kNoNode && !s.texture(v.map)) return fail("environment: map texture does not exist");
             s.environment = v;

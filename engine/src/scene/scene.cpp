@@ -91,6 +91,10 @@ std::vector<float> tungstenFilterCdf(PixelFilter f) {
   return cdf;
 }
 
+Mat4 environmentToMap(const Environment& e) {
+  return e.orientation.rotationPart().transposed() * Mat4::rotateY(-e.rotation);
+}
+
 Bounds3 MeshGeometry::bounds() const {
   Bounds3 b;
   for (const Vec3& p : positions) b.grow(p);

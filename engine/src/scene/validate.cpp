@@ -160,6 +160,10 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
   checkColor(env.color, Vec3{0.0f}, "environment colour", warnings);
   clampValue(env.intensity, 0.0f, 1e9f, 1.0f, "environment intensity", warnings);
   clampValue(env.rotation, -1e4f, 1e4f, 0.0f, "environment rotation", warnings);
+  if (!env.orientation.isFinite()) {
+    warnings.push_back("environment orientation: not finite numbers; upright instead");
+    env.orientation = Mat4{};
+  }
   checkColor(env.zenith, Vec3{0.35f, 0.55f, 0.95f}, "sky zenith", warnings);
   checkColor(env.horizon, Vec3{0.9f, 0.92f, 0.95f}, "sky horizon", warnings);
   checkColor(env.ground, Vec3{0.3f, 0.28f, 0.25f}, "sky ground", warnings);
