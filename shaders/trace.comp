@@ -72,8 +72,15 @@ int selectionBase(int px, int py) {
   return int(((uint(py) / t) * cols + uint(px) / t) * uint(kSelectionCounters));
 }
 
-Material fetchMaterial(int index, vec2 uv) {
-  int base = index * kMaterialTexels;
+// The material a hit on material `index` shades with: itself or, for a blend (Material::blendWith),
+// its partner when `blendRandom` falls past the ratio; emission stays the hit material's.
+Material fetchMaterial(int index, vec2 uv, float blendRandom) {
+  int shaded = index;
+  if (hasFeature(kFeatureBlend)) {
+    int partner = floatBitsToInt(texelFetch(uMaterials, index * kMaterialTexels + 5).w);
+    if (partner >= 0 && blendRandom >= texelFetch(uMaterials, index * kMaterialTexels + 6).w) shaded = partner;
+  }
+  int base = shaded * kMaterialTexels;
   vec4 t2 = texelFetch(uMaterials, base + 2), t3 = texelFetch(uMaterials, base + 3);
   // The coating's absorption is read only when the scene has plastics.
   const bool plastics = (kMaterialMask & ((1 << kMatPlastic) | (1 << kMatRoughPlastic))) != 0;
@@ -82,8 +89,9 @@ Material fetchMaterial(int index, vec2 uv) {
   int albedoTex = floatBitsToInt(t2.w), roughTex = floatBitsToInt(t3.w);
   if (hasFeature(kFeatureTextures) && albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
   if (hasFeature(kFeatureTextures) && roughTex >= 0) m.roughness = max(m.roughness * sampleTexture(roughTex, uv).r, 1e-3);
+  if (hasFeature(kFeatureBlend)) m.emission = texelFetch(uMaterials, index * kMaterialTexels + 4).rgb;
   if (hasFeature(kFeatureEmissionTextures)) {
-    int emissionTex = floatBitsToInt(texelFetch(uMaterials, base + 5).z);
+    int emissionTex = floatBitsToInt(texelFetch(uMaterials, index * kMaterialTexels + 5).z);
     if (emissionTex >= 0) m.emission *= sampleTexture(emissionTex, uv).rgb;
   }
   return m;
@@ -335,7 +343,7 @@ bool extendPath(inout Path path, bool alive, inout Shadow shadow) {
     }
   }
 
-  Material m = fetchMaterial(floatBitsToInt(info.z), uv);
+  Material m = fetchMaterial(floatBitsToInt(info.z), uv, hasFeature(kFeatureBlend) ? rand(path.rng) : 0.0);
   vec3 wo = -rd;
   bool frontFace = dot(ng, wo) > 0.0;
 

@@ -379,6 +379,30 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   b.number(tr("Alpha"), "alpha", m.alpha, 0.0, 1.0, 1.0, 3, [edit](double v, int drag) {
     edit(tr("Alpha"), drag, [v](Material& x) { x.alpha = static_cast<float>(v); });
   });
+
+  // A blend with another material (Tungsten's mixed bsdf): this one's share, the other's the rest.
+  QStringList names{tr("(none)")};
+  std::vector<NodeId> ids{kNoNode};
+  int current = 0;
+  for (const Material& other : scene_().materials) {
+    if (other.id == id) continue;
+    if (other.id == m.blendWith) current = static_cast<int>(ids.size());
+    names << QString::fromStdString(other.name);
+    ids.push_back(other.id);
+  }
+  b.choice(tr("Blend with"), "blendWith", names, current, [this, edit, ids](int i) {
+    if (i < 0 || i >= static_cast<int>(ids.size())) return;
+    NodeId other = ids[static_cast<std::size_t>(i)];
+    edit(tr("Blend with"), 0, [other](Material& x) {
+      x.blendWith = other;
+      if (other != kNoNode && x.blendRatio >= 1.0f) x.blendRatio = 0.5f;  // else the blend shows nothing
+    });
+    rebuildLater();
+  });
+  if (m.blendWith != kNoNode)
+    b.number(tr("Blend ratio"), "blendRatio", m.blendRatio, 0.0, 1.0, 0.5, 3, [edit](double v, int drag) {
+      edit(tr("Blend ratio"), drag, [v](Material& x) { x.blendRatio = static_cast<float>(v); });
+    });
 }
 
 void PropertyPanel::texturePath(Builder& b, const Texture& t, const QString& objectName) {

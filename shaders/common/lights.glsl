@@ -36,16 +36,17 @@ ivec2 envTexel(vec2 uv) {
   return clamp(ivec2(uv * vec2(size)), ivec2(0), size - 1);
 }
 
-vec3 envTexelRadiance(ivec2 t) {
-  vec4 info = texelFetch(uTexInfo, frame.environment.y * kTextureTexels);
-  int offset = floatBitsToInt(info.x);
-  return texelFetch(uTexels, offset + t.y * frame.environment.z + t.x).rgb * frame.environmentTint.rgb;
-}
-
 vec3 envRadiance(vec3 d) {
   int type = frame.environment.x;
   if (hasFeature(kFeatureEnvConstant) && type == kEnvConstant) return frame.environmentTint.rgb;
-  if (hasFeature(kFeatureEnvMap) && type == kEnvMap) return envTexelRadiance(envTexel(directionToEnvUv(d)));
+  // Filtered between the four nearest texels, wrapping, as Tungsten's bitmaps are (an infinite
+  // sphere's map is one); light samples still pick texels by their own value (envPdf), which is
+  // unbiased with MIS: where a dark texel takes light from a bright neighbour, rays that hit the
+  // sky carry all of it.
+  if (hasFeature(kFeatureEnvMap) && type == kEnvMap) {
+    vec2 uv = directionToEnvUv(d);
+    return sampleTexture(frame.environment.y, vec2(uv.x, 1.0 - uv.y)).rgb * frame.environmentTint.rgb;
+  }
   return vec3(0.0);
 }
 

@@ -48,7 +48,8 @@ RT_CONST(int, kFeatureDeltaLights, 16)   // point, spot and directional lights
 RT_CONST(int, kFeatureTungstenShading, 32)  // ShadingConvention::Tungsten (scene.h)
 RT_CONST(int, kFeatureBump, 64)          // some material has a bump map
 RT_CONST(int, kFeatureEmissionTextures, 128)  // some emitter's emission is textured
-RT_CONST(int, kFeatureAll, 255)
+RT_CONST(int, kFeatureBlend, 256)         // some material blends with another (Material::blendWith)
+RT_CONST(int, kFeatureAll, 511)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceEmissive, 4)

@@ -404,6 +404,34 @@ TEST(Editor, AMaterialTakesABumpMapAndItsStrengthFromItsPanel) {
   EXPECT_FLOAT_EQ(w->scene().material(material)->bumpStrength, 1.0f);
 }
 
+TEST(Editor, AMaterialBlendsWithAnotherFromItsPanel) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  const NodeId material = w->scene().object(sphere)->material;
+  auto* with = w->findChild<QComboBox*>("blendWith");
+  ASSERT_TRUE(with);
+  EXPECT_EQ(with->currentIndex(), 0) << "(none)";
+  EXPECT_FALSE(w->findChild<ScrubField*>("blendRatio")) << "a ratio only once there is a partner";
+  EXPECT_EQ(with->findText(QString::fromStdString(w->scene().material(material)->name)), -1) << "not with itself";
+  const int steel = with->findText("Brushed Steel");
+  ASSERT_GT(steel, 0);
+  with->setCurrentIndex(steel);
+  const Material* m = w->scene().material(material);
+  ASSERT_TRUE(w->scene().material(m->blendWith));
+  EXPECT_EQ(w->scene().material(m->blendWith)->name, "Brushed Steel");
+  EXPECT_FLOAT_EQ(m->blendRatio, 0.5f) << "half and half to start with";
+  QTest::qWait(50);
+  auto* ratio = w->findChild<ScrubField*>("blendRatio");
+  ASSERT_TRUE(ratio);
+  ratio->setValue(0.8);
+  EXPECT_FLOAT_EQ(w->scene().material(material)->blendRatio, 0.8f);
+  w->undoStack()->undo();
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().material(material)->blendWith, kNoNode);
+  EXPECT_FLOAT_EQ(w->scene().material(material)->blendRatio, 1.0f);
+}
+
 TEST(Editor, APlasticsCoatingAbsorptionIsEditedPerChannel) {
   auto w = makeWindow();
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");

@@ -216,6 +216,52 @@ TEST(KnownAnswer, ATiltedSkyLightsWhatItsBrightHalfFaces) {
   EXPECT_NEAR(tilted, upright, 0.02 * upright);
 }
 
+// Seen straight along +x the sky's u is 0.5, the edge between the two middle columns of a map of
+// eight whose columns alternate 0 and 1: filtered between the nearest texels (as Tungsten's
+// bitmaps are) every pixel of a 2-degree view reads about 0.5; read from the nearest texel
+// alone, half of them would read 0 and half 1.
+TEST(KnownAnswer, TheSkyIsFilteredBetweenTexels) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(16, 16);
+  s.camera.position = {0, 0, 0};
+  s.camera.target = {1, 0, 0};
+  s.camera.up = {0, 1, 0};
+  s.camera.verticalFov = radians(2.0f);
+  s.environment.type = EnvironmentType::Map;
+  s.environment.map = addColumnTexture(s, test::tempDir(), "stripes", 8, 4, [](int x) { return static_cast<float>(x % 2); });
+  s.environment.color = Vec3{1.0f};
+  RenderImage img = renderScene(*r, s, 16);
+  double lo = 1, hi = 0;
+  for (std::size_t i = 0; i < img.color.size() / 3; ++i) {
+    lo = std::min<double>(lo, img.color[i * 3 + 1]);
+    hi = std::max<double>(hi, img.color[i * 3 + 1]);
+  }
+  EXPECT_GT(lo, 0.45);
+  EXPECT_LT(hi, 0.55);
+}
+
+// A blend (Tungsten's mixed bsdf) shades as either part, chosen again at every hit: a white
+// lambert blended at ratio 0.3 with a black one, under a sky of 1, reads 0.3 (1 if the blend
+// were ignored); an emitting blend keeps its emission whichever part a hit shades with.
+TEST(KnownAnswer, ABlendShadesAsEitherPartInProportion) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(16, 16);
+  lookStraightDown(s, 3, 20);
+  s.settings.maxBounces = 1;
+  s.environment.color = Vec3{1.0f};
+  Material black;
+  black.albedo = Vec3{0.0f};
+  Material white;
+  white.albedo = Vec3{1.0f};
+  white.blendWith = test::addMaterial(s, black);
+  white.blendRatio = 0.3f;
+  NodeId blend = test::addMaterial(s, white);
+  NodeId plane = test::addMeshObject(s, "plane", makeQuad(), blend, Mat4::scale({1000, 1, 1000}));
+  EXPECT_NEAR(meanOver(renderScene(*r, s, 64), plane), 0.3, 0.015);
+  s.material(blend)->emission = Vec3{2.0f};
+  EXPECT_NEAR(meanOver(renderScene(*r, s, 64), plane), 2.3, 0.03) << "the emission is the blend's, whichever part shades";
+}
+
 // The pixel filter (filter importance sampling): a light's straight edge on a pixel boundary.
 // With a box each pixel sees only its own square; with Tungsten's tent (one pixel each way) the
 // pixel on either side of the edge takes 1/8 from across it (the tent's mass beyond half a pixel);

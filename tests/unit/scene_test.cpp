@@ -125,6 +125,11 @@ TEST(Document, BadEditsAreRefusedAndChangeNothing) {
   RenderSettings rs;
   rs.width = 0;
   EXPECT_FALSE(doc.apply(SetRenderSettings{rs}).ok());
+  Material blend = doc.scene().materials[0];
+  blend.blendWith = blend.id;
+  EXPECT_FALSE(doc.apply(SetMaterial{blend}).ok()) << "not with itself";
+  blend.blendWith = 424242;
+  EXPECT_FALSE(doc.apply(SetMaterial{blend}).ok()) << "not with a material that does not exist";
   EXPECT_EQ(doc.version(), v0);
 }
 
@@ -135,6 +140,11 @@ TEST(Document, RemovingANodeClearsReferences) {
   ASSERT_TRUE(r.ok()) << r.error();
   for (const auto& m : doc.scene().materials) EXPECT_NE(m.albedoTexture, tex);
   EXPECT_FALSE(doc.apply(RemoveNode{tex}).ok());
+  Material blend = doc.scene().materials[0];
+  blend.blendWith = doc.scene().materials[1].id;
+  ASSERT_TRUE(doc.apply(SetMaterial{blend}).ok());
+  ASSERT_TRUE(doc.apply(RemoveNode{blend.blendWith}).ok());
+  EXPECT_EQ(doc.scene().material(blend.id)->blendWith, kNoNode) << "a blend with a removed material ends";
 }
 
 TEST(Document, CoalesceKeysSeparateTargetsAndKinds) {

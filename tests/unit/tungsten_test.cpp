@@ -388,23 +388,38 @@ TEST(Tungsten, APlasticCoatingAbsorbsSigmaATimesItsThickness) {
   for (const auto& w : r->warnings) EXPECT_EQ(w.find("sigma_a"), std::string::npos) << w;
 }
 
-TEST(Tungsten, AMixedBsdfIsItsWeightierPart) {
+TEST(Tungsten, AMixedBsdfBlendsItsTwoParts) {
   auto r = importTungsten(writeScene(R"({"bsdfs": [
         {"name": "gold", "type": "conductor", "material": "Au"},
         {"name": "mix", "type": "mixed", "bsdf0": "gold", "bsdf1": {"type": "lambert", "albedo": 0.2}, "ratio": 0.3, "albedo": 0.5},
-        {"name": "even", "type": "mixed", "bsdf0": "gold", "bsdf1": {"type": "lambert"}}],
-      "primitives": [{"type": "quad", "bsdf": "mix"}, {"type": "quad", "bsdf": "even"}]})"));
+        {"name": "even", "type": "mixed", "bsdf0": "gold", "bsdf1": {"type": "lambert"}},
+        {"name": "deep", "type": "mixed", "bsdf0": "mix", "bsdf1": {"type": "mixed", "bsdf0": "gold", "bsdf1": {"type": "mirror"}, "ratio": 0.2}}],
+      "primitives": [{"type": "quad", "bsdf": "mix"}, {"type": "quad", "bsdf": "even"}, {"type": "quad", "bsdf": "deep"}]})"));
   ASSERT_TRUE(r.ok()) << r.error();
-  const Material* mix = r->scene.material(r->scene.objects[0].material);
-  const Material* even = r->scene.material(r->scene.objects[1].material);
-  ASSERT_TRUE(mix && even);
+  const Scene& s = r->scene;
+  const Material* mix = s.material(s.objects[0].material);
+  const Material* even = s.material(s.objects[1].material);
+  const Material* deep = s.material(s.objects[2].material);
+  ASSERT_TRUE(mix && even && deep);
   EXPECT_EQ(mix->name, "mix");
-  EXPECT_EQ(mix->type, MaterialType::Lambert) << "ratio 0.3: bsdf1 weighs more";
-  EXPECT_NEAR(mix->albedo.y, 0.1f, 1e-6f) << "under the blend's albedo";
-  EXPECT_EQ(even->type, MaterialType::Conductor) << "Tungsten's default ratio 0.5: bsdf0";
-  EXPECT_EQ(even->metal, "Au");
+  EXPECT_EQ(mix->type, MaterialType::Conductor) << "bsdf0";
+  EXPECT_EQ(mix->metal, "Au");
+  EXPECT_NEAR(mix->albedo.y, 0.5f, 1e-6f) << "under the blend's albedo";
+  EXPECT_FLOAT_EQ(mix->blendRatio, 0.3f);
+  const Material* other = s.material(mix->blendWith);
+  ASSERT_TRUE(other);
+  EXPECT_EQ(other->type, MaterialType::Lambert);
+  EXPECT_NEAR(other->albedo.y, 0.1f, 1e-6f) << "bsdf1 under the blend's albedo too";
+  EXPECT_EQ(other->blendWith, kNoNode);
+  EXPECT_FLOAT_EQ(even->blendRatio, 0.5f) << "Tungsten's default ratio";
+  ASSERT_TRUE(s.material(even->blendWith));
+  EXPECT_EQ(s.material(even->blendWith)->type, MaterialType::Lambert);
+  // One level of blending: a blend among the parts is drawn as its weightier part, with a warning.
+  ASSERT_TRUE(s.material(deep->blendWith));
+  EXPECT_EQ(deep->type, MaterialType::Conductor) << "the named blend 'mix' as its bsdf0";
+  EXPECT_EQ(s.material(deep->blendWith)->type, MaterialType::Mirror) << "ratio 0.2: the inner blend's bsdf1";
   int warned = 0;
-  for (const auto& w : r->warnings) warned += w.find("a blend of two bsdfs is rendered as its") != std::string::npos;
+  for (const auto& w : r->warnings) warned += w.find("a blend inside a blend is rendered as its") != std::string::npos;
   EXPECT_EQ(warned, 2);
 }
 

@@ -120,6 +120,12 @@ struct Material {
   // slope is scaled by bumpStrength.
   NodeId bumpTexture = kNoNode;
   float bumpStrength = 1.0f;
+  // A blend of two materials, as Tungsten's `mixed` bsdf: a surface shades as this material with
+  // probability blendRatio and as `blendWith` otherwise, chosen again at every hit, which
+  // averages to ratio * this + (1 - ratio) * other. Emission, coverage and bump stay this one's.
+  // kNoNode: no blend. The other material's own blend is not followed.
+  NodeId blendWith = kNoNode;
+  float blendRatio = 1.0f;
 
   // Every texture reference, for code that visits them all (deletion, validation, copies).
   std::array<NodeId, 5> textures() const { return {albedoTexture, roughnessTexture, alphaTexture, bumpTexture, emissionTexture}; }

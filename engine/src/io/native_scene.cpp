@@ -272,6 +272,8 @@ Value nativeSceneToJson(const Scene& s) {
     v.set("bump_texture", m.bumpTexture);
     v.set("emission_texture", m.emissionTexture);
     v.set("bump_strength", m.bumpStrength);
+    v.set("blend_with", m.blendWith);
+    v.set("blend_ratio", m.blendRatio);
     materials.push_back(std::move(v));
   }
   root.set("materials", std::move(materials));
@@ -489,6 +491,8 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.id("bump_texture", &m.bumpTexture);
       r.id("emission_texture", &m.emissionTexture);
       r.number("bump_strength", &m.bumpStrength);
+      r.id("blend_with", &m.blendWith);
+      r.number("blend_ratio", &m.blendRatio);
       s.materials.push_back(std::move(m));
     }
   if (auto* a = list("objects"))
@@ -542,6 +546,11 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
         out.warnings.push_back(cat(file.string(), ": material '", m.name, "' names missing texture ", *t));
         *t = kNoNode;
       }
+  for (Material& m : s.materials)
+    if (m.blendWith != kNoNode && (!s.material(m.blendWith) || m.blendWith == m.id)) {
+      out.warnings.push_back(cat(file.string(), ": material '", m.name, "' blends with missing material ", m.blendWith));
+      m.blendWith = kNoNode;
+    }
   for (Object& o : s.objects) {
     if (o.mesh != kNoNode && !s.mesh(o.mesh)) return R::failure(cat(file.string(), ": object '", o.name, "' names missing mesh ", o.mesh));
     if (o.material != kNoNode && !s.material(o.material)) {

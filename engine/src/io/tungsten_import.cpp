@@ -295,30 +295,58 @@ class TungstenImporter {
       return m;
     }
     if (type == "mixed") {
-      // Tungsten's blend, albedo * (ratio * bsdf0 + (1 - ratio) * bsdf1), has no counterpart:
-      // the part that weighs more stands for it, under the blend's albedo.
+      // Tungsten's blend, albedo * (ratio * bsdf0 + (1 - ratio) * bsdf1): this material is bsdf0
+      // under the blend's albedo and blends (Material::blendWith) with a copy of bsdf1 under it.
+      // A blend inside a blend is drawn as its weightier part.
       float ratio = 0.5f;
       if (const Value* r = v.find("ratio")) {
         TextureRef t = texture(*r, where + ".ratio", true);
         ratio = std::clamp(luminance(t.constant), 0.0f, 1.0f);
         if (t.isTexture) warn(cat(where, ": a textured blend ratio is taken as its constant factor"));
       }
-      const char* part = ratio >= 0.5f ? "bsdf0" : "bsdf1";
-      const Value* chosen = v.find(part);
-      if (!chosen) {
-        problem(where, cat("mixed bsdf without \"", part, "\""));
+      auto part = [&](const char* key) {
+        const Value* pv = v.find(key);
+        if (!pv) {
+          problem(where, cat("mixed bsdf without \"", key, "\""));
+          return Material{};
+        }
+        const bool outer = !inBlend_;
+        inBlend_ = true;
+        Material p = bsdf(*pv, cat(where, ".", key), depth + 1);
+        if (outer) inBlend_ = false;
+        if (p.blendWith != kNoNode) {
+          warn(cat(where, ".", key, ": a blend inside a blend is rendered as its bsdf0"));
+          p.blendWith = kNoNode;
+          p.blendRatio = 1;
+        }
+        if (const Value* a = v.find("albedo")) {
+          TextureRef t = texture(*a, where + ".albedo", false);
+          p.albedo = p.albedo * t.constant;
+          if (t.isTexture && p.albedoTexture == kNoNode) p.albedoTexture = t.texture;
+        }
+        return p;
+      };
+      const std::string name = m.name;
+      if (inBlend_) {
+        const char* key = ratio >= 0.5f ? "bsdf0" : "bsdf1";
+        m = part(key);
+        m.name = name;
+        m.blendWith = kNoNode;
+        m.blendRatio = 1;
+        warn(cat(where, ": a blend inside a blend is rendered as its ", key, " (ratio ", ratio, ")"));
         return m;
       }
-      Material base = bsdf(*chosen, cat(where, ".", part), depth + 1);
-      std::string name = m.name;
-      m = base;
+      Material other = part("bsdf1");
+      m = part("bsdf0");
+      if (!ok()) return m;
       m.name = name;
-      if (const Value* a = v.find("albedo")) {
-        TextureRef t = texture(*a, where + ".albedo", false);
-        m.albedo = m.albedo * t.constant;
-        if (t.isTexture && m.albedoTexture == kNoNode) m.albedoTexture = t.texture;
-      }
-      warn(cat(where, ": a blend of two bsdfs is rendered as its ", part, " (ratio ", ratio, ")"));
+      other.blendWith = kNoNode;
+      other.blendRatio = 1;
+      other.id = out_.scene.newId();
+      other.name = cat(name.empty() ? where : name, " (bsdf1)");
+      out_.scene.materials.push_back(other);
+      m.blendWith = other.id;
+      m.blendRatio = ratio;
       return m;
     }
     if (const Value* a = v.find("albedo")) {
@@ -996,6 +1024,7 @@ class TungstenImporter {
   std::map<std::string, std::vector<MeshPart>> meshParts_;  // a mesh file's parts, by loadMesh's key
   std::map<std::string, std::shared_ptr<const MeshGeometry>> shapes_;
   int emitters_ = 0;
+  bool inBlend_ = false;  // reading the parts of a mixed bsdf (Material::blendWith is one level deep)
   std::map<std::tuple<std::string, NodeId, float>, NodeId> bumped_;  // (bsdf, texture, strength) -> its copy
 };
 

@@ -187,6 +187,7 @@ std::uint32_t RenderSceneData::features() const {
   if (tungstenShading) f |= gpu::kFeatureTungstenShading;
   if (materialBump) f |= gpu::kFeatureBump;
   if (emissionTextures) f |= gpu::kFeatureEmissionTextures;
+  if (materialBlend) f |= gpu::kFeatureBlend;
   return f;
 }
 
@@ -321,7 +322,7 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
 }
 
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture, int roughnessTexture, int alphaTexture,
-                                                    int bumpTexture, int emissionTexture) {
+                                                    int bumpTexture, int emissionTexture, int blendWith) {
   Vec3 eta = m.eta, k = m.k;
   if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
   const bool rough = isMicrofacet(m.type);
@@ -339,8 +340,8 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
           vec4{roughness, ior, std::clamp(m.alpha, 0.0f, 1.0f), std::clamp(fdrInt, 0.0f, 1.0f)},
           v4(eta, bitsOf(albedoTexture)), v4(k, bitsOf(roughnessTexture)),
           v4(max(m.emission, Vec3{0.0f}), bitsOf(alphaTexture)),
-          vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, bitsOf(emissionTexture), 0},
-          v4(max(m.coatingAbsorption, Vec3{0.0f}), 0)};
+          vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, bitsOf(emissionTexture), bitsOf(blendWith)},
+          v4(max(m.coatingAbsorption, Vec3{0.0f}), std::isfinite(m.blendRatio) ? std::clamp(m.blendRatio, 0.0f, 1.0f) : 1.0f)};
 }
 
 void RenderSceneBuilder::packMaterials(const Scene& scene) {
@@ -349,7 +350,10 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
   data_.materialTextures = false;
   data_.materialBump = false;
   data_.emissionTextures = false;
+  data_.materialBlend = false;
   materialIndex_.clear();
+  // Every material's index first: a blend names its partner by index.
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) materialIndex_[scene.materials[i].id] = static_cast<int>(i);
   auto pack = [&](const Material& m) {
     data_.materialTypes |= 1u << static_cast<int>(m.type);
     // The kernel compiles Beckmann's distribution in only for scenes that use it.
@@ -358,14 +362,16 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     if (textureIndex(m.albedoTexture) >= 0 || textureIndex(m.roughnessTexture) >= 0) data_.materialTextures = true;
     if (textureIndex(m.bumpTexture) >= 0 && m.bumpStrength != 0) data_.materialBump = true;
     if (textureIndex(m.emissionTexture) >= 0 && m.emissive()) data_.emissionTextures = true;
+    int blendWith = -1;
+    if (auto it = materialIndex_.find(m.blendWith); it != materialIndex_.end() && m.blendWith != m.id && m.blendRatio < 1.0f) {
+      blendWith = it->second;
+      data_.materialBlend = true;
+    }
     auto texels = packMaterial(m, textureIndex(m.albedoTexture), textureIndex(m.roughnessTexture), textureIndex(m.alphaTexture),
-                               textureIndex(m.bumpTexture), textureIndex(m.emissionTexture));
+                               textureIndex(m.bumpTexture), textureIndex(m.emissionTexture), blendWith);
     data_.materials.insert(data_.materials.end(), texels.begin(), texels.end());
   };
-  for (const Material& m : scene.materials) {
-    materialIndex_[m.id] = static_cast<int>(data_.materials.size() / gpu::kMaterialTexels);
-    pack(m);
-  }
+  for (const Material& m : scene.materials) pack(m);
   defaultMaterial_ = static_cast<int>(data_.materials.size() / gpu::kMaterialTexels);
   Material fallback;
   fallback.albedo = Vec3{0.6f};

@@ -27,11 +27,13 @@ namespace retile {
 using gpu::vec4;
 
 // A material as the shaders read it (kMaterialTexels texels: the first five and the seventh
-// unpacked by unpackMaterial in shaders/common/bsdf.glsl, the sixth, bump map and emission
-// texture, read by trace.comp), with its textures' indices (-1: none). Roughness and IOR are clamped to what the
-// BSDF code can sample.
+// unpacked by unpackMaterial in shaders/common/bsdf.glsl, the sixth, bump map, emission texture
+// and the material blended with, and the seventh's w, the blend's ratio, read by trace.comp),
+// with its textures' and blend partner's indices (-1: none). Roughness and IOR are clamped to
+// what the BSDF code can sample.
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture = -1, int roughnessTexture = -1,
-                                                    int alphaTexture = -1, int bumpTexture = -1, int emissionTexture = -1);
+                                                    int alphaTexture = -1, int bumpTexture = -1, int emissionTexture = -1,
+                                                    int blendWith = -1);
 
 // Which arrays changed in the last update, so the uploader copies only those.
 enum DirtyArrays : std::uint32_t {
@@ -77,6 +79,7 @@ struct RenderSceneData {
   bool materialTextures = false;       // some material reads an albedo or roughness texture
   bool materialBump = false;           // some material has a bump map
   bool emissionTextures = false;       // some emissive material has an emission texture
+  bool materialBlend = false;          // some material blends with another
 
   bool tungstenShading = false;        // RenderSettings::shading is Tungsten's
   std::uint32_t features() const;      // kFeature... (layouts.h) of what the arrays hold

@@ -22,8 +22,10 @@ bool finite(float v) { return std::isfinite(v); }
 
 std::string checkMaterial(const Scene& s, const Material& m) {
   if (!isFinite(m.albedo) || !isFinite(m.emission) || !isFinite(m.eta) || !isFinite(m.k) || !isFinite(m.coatingAbsorption) ||
-      !finite(m.roughness) || !finite(m.ior) || !finite(m.alpha) || !finite(m.bumpStrength))
+      !finite(m.roughness) || !finite(m.ior) || !finite(m.alpha) || !finite(m.bumpStrength) || !finite(m.blendRatio))
     return cat("material '", m.name, "': a parameter is not a finite number");
+  if (m.blendWith != kNoNode && (m.blendWith == m.id || !s.material(m.blendWith)))
+    return cat("material '", m.name, "': it cannot blend with material ", m.blendWith);
   for (NodeId t : m.textures())
     if (t != kNoNode && !s.texture(t)) return cat("material '", m.name, "': texture ", t, " does not exist");
   return {};
@@ -200,9 +202,11 @@ Result<std::uint32_t> applyEdit(Scene& s, const Edit& edit) {
               if (o.mesh == id) o.mesh = kNoNode;
               if (o.material == id) o.material = kNoNode;
             }
-            for (Material& m : s.materials)
+            for (Material& m : s.materials) {
               for (NodeId* t : m.textureSlots())
                 if (*t == id) *t = kNoNode;
+              if (m.blendWith == id) m.blendWith = kNoNode;
+            }
             if (s.environment.map == id) {
               s.environment.map = kNoNode;
               s.environment.type = EnvironmentType::Constant;

@@ -137,6 +137,7 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
     clampValue(m.ior, 0.1f, 10.0f, 1.5f, what + ": index of refraction", warnings);
     clampValue(m.alpha, 0.0f, 1.0f, 1.0f, what + ": coverage", warnings);
     clampValue(m.bumpStrength, -1e4f, 1e4f, 1.0f, what + ": bump strength", warnings);
+    clampValue(m.blendRatio, 0.0f, 1.0f, 1.0f, what + ": blend ratio", warnings);
     if (!finiteNonNegative(m.eta) || !finiteNonNegative(m.k)) {
       warnings.push_back(cat(what, ": its complex index of refraction is negative or not finite; copper instead"));
       m.metal = "Cu";
