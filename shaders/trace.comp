@@ -32,7 +32,12 @@ layout(set = 0, binding = 15, std430) buffer Selection { uint selectionCounts[];
 
 layout(push_constant) uniform Push { TracePush push; };
 
-float warpSlot(int i) { return frame.filterWarp[i >> 2][i & 3]; }
+// The pixel filter's table (frame.filterWarp's 36 values) in a texel buffer: each lane reads its
+// own slot, and a storage buffer read at a different index in each lane is a loop over the eight
+// lanes on lavapipe (the table's 16 such reads a segment cost the spaceship 10 %).
+layout(set = 0, binding = 16) uniform samplerBuffer uFilterWarp;
+
+float warpSlot(int i) { return texelFetch(uFilterWarp, i).x; }
 
 // Tungsten's table (FilterSampling::Tungsten) at step i = 0..30: slot i - 1 holds it, step 0's is 0.
 float tungstenCdf(int i) { return i <= 0 ? 0.0 : warpSlot(i - 1); }
@@ -41,10 +46,12 @@ float tungstenCdf(int i) { return i <= 0 ? 0.0 : warpSlot(i - 1); }
 // CDF, linear between its 33 tabulated points (layouts.h), or exact for a tent, or as Tungsten
 // draws it (ReconstructionFilter::sample: the first step whose CDF exceeds the draw, searched from
 // step 1, so the draw lands one step further out than the weight it was drawn with).
+// Only the way the scene's filter is drawn is compiled in (kFeatureFilter...): every lane runs
+// this for every segment, whether it starts a path or not.
 float filterOffset(float u) {
   float tent = frame.filterWarp[8].w;
-  if (tent > 0.0) return tent * (u < 0.5 ? sqrt(2.0 * u) - 1.0 : 1.0 - sqrt(2.0 - 2.0 * u));
-  if (tent < 0.0) {
+  if (hasFeature(kFeatureFilterTent) && tent > 0.0) return tent * (u < 0.5 ? sqrt(2.0 * u) - 1.0 : 1.0 - sqrt(2.0 - 2.0 * u));
+  if (hasFeature(kFeatureFilterTungsten) && tent < 0.0) {
     bool negative = u < 0.5;
     float xi = negative ? 2.0 * u : 2.0 * u - 1.0;
     int lo = 1, hi = 30;  // the first step in 1..29 with CDF > xi, else 30
@@ -58,9 +65,10 @@ float filterOffset(float u) {
     float offset = -tent * (float(lo) + (xi - c0) / max(c1 - c0, 1e-9)) / 31.0;
     return negative ? -offset : offset;
   }
+  if (!hasFeature(kFeatureFilterTable)) return 0.0;
   float t = u * float(kFilterWarpSegments);
   int i = min(int(t), kFilterWarpSegments - 1);
-  float a = frame.filterWarp[i >> 2][i & 3], b = frame.filterWarp[(i + 1) >> 2][(i + 1) & 3];
+  float a = warpSlot(i), b = warpSlot(i + 1);
   return mix(a, b, t - float(i));
 }
 

@@ -49,7 +49,12 @@ RT_CONST(int, kFeatureTungstenShading, 32)  // ShadingConvention::Tungsten (scen
 RT_CONST(int, kFeatureBump, 64)          // some material has a bump map
 RT_CONST(int, kFeatureEmissionTextures, 128)  // some emitter's emission is textured
 RT_CONST(int, kFeatureBlend, 256)         // some material blends with another (Material::blendWith)
-RT_CONST(int, kFeatureAll, 511)
+// How a sample's offset in its pixel is drawn (exactly one): the filter's tabulated inverse CDF, a
+// tent's exact inverse, or Tungsten's table searched as Tungsten searches it (render_scene.h).
+RT_CONST(int, kFeatureFilterTable, 512)
+RT_CONST(int, kFeatureFilterTent, 1024)
+RT_CONST(int, kFeatureFilterTungsten, 2048)
+RT_CONST(int, kFeatureAll, 4095)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceEmissive, 4)

@@ -177,6 +177,12 @@ std::uint64_t RenderSceneData::deviceBytes() const {
          v(textureInfo) + v(texels) + v(emitters) + v(emitterAlias) + v(deltaLights) + v(environmentCdf);
 }
 
+int filterFeature(const RenderSettings& s) {
+  if (s.filterSampling == FilterSampling::Tungsten && (s.pixelFilter == PixelFilter::Tent || s.pixelFilter == PixelFilter::Gaussian))
+    return gpu::kFeatureFilterTungsten;
+  return s.pixelFilter == PixelFilter::Tent ? gpu::kFeatureFilterTent : gpu::kFeatureFilterTable;
+}
+
 std::uint32_t RenderSceneData::features() const {
   std::uint32_t f = 0;
   if (materialTextures) f |= gpu::kFeatureTextures;
@@ -188,7 +194,7 @@ std::uint32_t RenderSceneData::features() const {
   if (materialBump) f |= gpu::kFeatureBump;
   if (emissionTextures) f |= gpu::kFeatureEmissionTextures;
   if (materialBlend) f |= gpu::kFeatureBlend;
-  return f;
+  return f | static_cast<std::uint32_t>(filterFeature);
 }
 
 int RenderSceneBuilder::textureIndex(NodeId id) const {
@@ -205,6 +211,7 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
   if (first_) flags = kUpdateAll;
   first_ = false;
   data_.tungstenShading = scene.settings.shading == ShadingConvention::Tungsten;  // a kernel variant, no array
+  data_.filterFeature = filterFeature(scene.settings);                          // likewise
   timing_ = {};
   std::uint32_t dirty = 0;
   if (flags & kUpdateTextures || flags & kUpdateEnvironment) {

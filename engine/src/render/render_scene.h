@@ -35,6 +35,10 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
                                                     int alphaTexture = -1, int bumpTexture = -1, int emissionTexture = -1,
                                                     int blendWith = -1);
 
+// How the trace kernel draws a sample's offset in its pixel for these settings: one of the
+// gpu::kFeatureFilter... bits (Tungsten draws its tent and Gaussian from a table of its own).
+int filterFeature(const RenderSettings& s);
+
 // Which arrays changed in the last update, so the uploader copies only those.
 enum DirtyArrays : std::uint32_t {
   kDirtyGeometry = 1u << 0,   // meshTraversal, triangleShading
@@ -82,6 +86,7 @@ struct RenderSceneData {
   bool materialBlend = false;          // some material blends with another
 
   bool tungstenShading = false;        // RenderSettings::shading is Tungsten's
+  int filterFeature = gpu::kFeatureFilterTable;  // filterFeature(RenderSettings)
   std::uint32_t features() const;      // kFeature... (layouts.h) of what the arrays hold
 
   std::uint64_t deviceBytes() const;

@@ -31,7 +31,7 @@ constexpr VkBufferUsageFlags kStorageUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
 enum TraceBinding : std::uint32_t {
   kBindFrame = 0, kBindWork = 1, kBindTraversal = 2, kBindTriShade = 3, kBindInstances = 4, kBindMaterials = 5,
   kBindTexInfo = 6, kBindTexels = 7, kBindEmitters = 8, kBindAlias = 9, kBindDelta = 10, kBindEnvCdf = 11,
-  kBindSamples = 12, kBindAux = 13, kBindStats = 14, kBindSelection = 15,
+  kBindSamples = 12, kBindAux = 13, kBindStats = 14, kBindSelection = 15, kBindFilterWarp = 16,
 };
 
 std::uint32_t groupsFor(std::uint64_t invocations, std::uint32_t local, std::uint32_t* groupsY) {
@@ -78,6 +78,7 @@ struct Renderer::Impl {
 
   Buffer frameUbo, work, stats, selection;
   Buffer traversal, triShade, instances, materials, texInfo, texels, emitters, alias, delta, envCdf;
+  Buffer filterWarp;  // FrameUniforms::filterWarp's values again, for the trace kernel (trace.comp warpSlot)
   Buffer samples, aux, accum, accumAux;
   Buffer history, reuseItems;  // verified reuse: allocated on first use, dropped on resize
 
@@ -130,6 +131,7 @@ struct Renderer::Impl {
     stats = Buffer(ctx, gpu::kStatsCount * sizeof(std::uint32_t), kStorageUsage, true, "ray statistics");
     selection = Buffer(ctx, 16, kStorageUsage, true, "selection counters");
     work = Buffer(ctx, sizeof(gpu::WorkItem) * 64, kStorageUsage, true, "work items");
+    filterWarp = Buffer(ctx, sizeof(gpu::FrameUniforms::filterWarp), kTexelUsage, true, "pixel filter table");
   }
 
 #ifdef RETILE_VULKAN_VALIDATION
@@ -198,7 +200,7 @@ struct Renderer::Impl {
                                Binding::UniformTexel, Binding::UniformTexel,
                                Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel,
                                Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel, Binding::Storage,
-                               Binding::Storage, Binding::Storage, Binding::Storage},
+                               Binding::Storage, Binding::Storage, Binding::Storage, Binding::UniformTexel},
           static_cast<std::uint32_t>(sizeof(gpu::TracePush)),
           std::vector<vk::ShaderDefine>{{"RETILE_ALPHA_TEST", alpha ? "1" : "0"},
                                         {"RETILE_MATERIALS", std::to_string(materialTypes)},
@@ -227,6 +229,7 @@ struct Renderer::Impl {
     t.bind(kBindEnvCdf, envCdf, VK_FORMAT_R32_SFLOAT);
     t.bind(kBindStats, stats);
     t.bind(kBindSelection, selection);
+    t.bind(kBindFilterWarp, filterWarp, VK_FORMAT_R32_SFLOAT);
     if (samples.valid()) {
       t.bind(kBindSamples, samples);
       t.bind(kBindAux, aux);
@@ -419,8 +422,8 @@ struct Renderer::Impl {
     std::uint32_t sel = countTile > 0 ? selectedInstance() : 0u;
     u.work = {itemCount, static_cast<std::uint32_t>(slots), sel, sel ? static_cast<std::uint32_t>(countTile) : 0u};
     // Tungsten draws its box exactly, and has no other filter the table could stand for.
-    const bool tungsten = sceneSettings.filterSampling == FilterSampling::Tungsten &&
-                          (sceneSettings.pixelFilter == PixelFilter::Tent || sceneSettings.pixelFilter == PixelFilter::Gaussian);
+    const int drawn = filterFeature(sceneSettings);
+    const bool tungsten = drawn == gpu::kFeatureFilterTungsten;
     if (warpFilter != sceneSettings.pixelFilter || warpWidth != sceneSettings.filterWidth || warpTungsten != tungsten ||
         warp.empty()) {
       warpFilter = sceneSettings.pixelFilter;
@@ -435,8 +438,9 @@ struct Renderer::Impl {
     // The tent's inverse CDF has an infinite slope at its ends, where the table's straight pieces
     // put too many samples: the shader inverts it exactly when this (its radius) is set.
     const float radius = 0.5f * std::clamp(warpWidth, 0.01f, 16.0f);
-    u.filterWarp[8].w = tungsten ? -radius : warpFilter == PixelFilter::Tent ? radius : 0.0f;
+    u.filterWarp[8].w = tungsten ? -radius : drawn == gpu::kFeatureFilterTent ? radius : 0.0f;
     frameUbo.upload(&u, sizeof u);
+    filterWarp.upload(u.filterWarp, sizeof u.filterWarp);  // host-visible: a copy of 144 bytes
   }
 
   std::uint64_t submitFrame(const std::vector<TileWork>& tiles, const FrameOptions& options, bool copyImage) {
@@ -774,6 +778,9 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   if (f & static_cast<std::uint32_t>(gpu::kFeatureTungstenShading)) out.push_back("Tungsten's shading normals");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureBump)) out.push_back("bump maps");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureEmissionTextures)) out.push_back("emission textures");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureBlend)) out.push_back("blends");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTent)) out.push_back("exact tent filter");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTungsten)) out.push_back("Tungsten's filter table");
   return out;
 }
 double Renderer::lastBlasSeconds() const { return impl_->builder.lastTiming().blas; }
