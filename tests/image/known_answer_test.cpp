@@ -47,16 +47,16 @@ double meanOver(const RenderImage& img, NodeId object, int* count = nullptr) {
   return n ? sum / n : 0.0;
 }
 
-// A linear grey texture of `width` x `height` texels whose column x holds value(x), written to
-// `dir` as EXR and added to the scene.
+// A linear grey texture of `width` x `height` texels, texel (x, y) (row y from the top) holding
+// value(x, y), written to `dir` as EXR and added to the scene.
 template <class Value>
-NodeId addColumnTexture(Scene& s, const std::filesystem::path& dir, const std::string& name, int width, int height, Value value) {
+NodeId addImageTexture(Scene& s, const std::filesystem::path& dir, const std::string& name, int width, int height, Value value) {
   RenderImage img;
   img.width = width;
   img.height = height;
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x)
-      for (int c = 0; c < 3; ++c) img.color.push_back(value(x));
+      for (int c = 0; c < 3; ++c) img.color.push_back(value(x, y));
   const auto file = dir / (name + ".exr");
   EXPECT_TRUE(writeRenderImage(img, file).ok()) << file;
   Texture t;
@@ -66,6 +66,12 @@ NodeId addColumnTexture(Scene& s, const std::filesystem::path& dir, const std::s
   t.colorSpace = TextureColorSpace::Linear;
   s.textures.push_back(t);
   return t.id;
+}
+
+// The same, whose column x holds value(x).
+template <class Value>
+NodeId addColumnTexture(Scene& s, const std::filesystem::path& dir, const std::string& name, int width, int height, Value value) {
+  return addImageTexture(s, dir, name, width, height, [&](int x, int) { return value(x); });
 }
 
 TEST(KnownAnswer, WhiteFurnaceConvexObject) {
@@ -164,22 +170,9 @@ TEST(KnownAnswer, ATiltedSkyLightsWhatItsBrightHalfFaces) {
   Scene s = test::emptyScene(16, 16);
   lookStraightDown(s, 3, 20);
   s.settings.maxBounces = 1;
-  RenderImage sky;
-  sky.width = 64;
-  sky.height = 32;
-  for (int y = 0; y < sky.height; ++y)
-    for (int x = 0; x < sky.width; ++x)
-      for (int c = 0; c < 3; ++c) sky.color.push_back(y < sky.height / 2 ? 2.0f : 0.0f);
-  const auto file = test::tempDir() / "half-sky.exr";
-  ASSERT_TRUE(writeRenderImage(sky, file).ok());
-  Texture t;
-  t.id = s.newId();
-  t.name = "half sky";
-  t.path = file;
-  t.colorSpace = TextureColorSpace::Linear;
-  s.textures.push_back(t);
+  const auto dir = test::tempDir();
   s.environment.type = EnvironmentType::Map;
-  s.environment.map = t.id;
+  s.environment.map = addImageTexture(s, dir, "half sky", 64, 32, [](int, int y) { return y < 16 ? 2.0f : 0.0f; });
   s.environment.color = Vec3{1.0f};
   Material m;
   m.albedo = Vec3{0.5f};
@@ -192,17 +185,8 @@ TEST(KnownAnswer, ATiltedSkyLightsWhatItsBrightHalfFaces) {
 
   // A small bright patch off to one side, mostly reached by light samples: the plane under the
   // tilted sky is lit as the plane and camera turned the other way are under the upright sky.
-  sky.color.clear();
-  for (int y = 0; y < sky.height; ++y)
-    for (int x = 0; x < sky.width; ++x)
-      for (int c = 0; c < 3; ++c) sky.color.push_back(y >= 6 && y < 10 && x >= 10 && x < 18 ? 50.0f : 0.05f);
-  // A new texture: the renderer keeps what it loaded for a texture id.
-  t.id = s.newId();
-  t.name = "patch sky";
-  t.path = test::tempDir() / "patch-sky.exr";
-  ASSERT_TRUE(writeRenderImage(sky, t.path).ok());
-  s.textures.push_back(t);
-  s.environment.map = t.id;
+  s.environment.map = addImageTexture(s, dir, "patch sky", 64, 32,
+                                      [](int x, int y) { return y >= 6 && y < 10 && x >= 10 && x < 18 ? 50.0f : 0.05f; });
   const Mat4 tilt = Mat4::rotateZ(0.3f) * Mat4::rotateX(-0.5f), back = tilt.transposed();
   s.environment.orientation = tilt;
   s.environment.rotation = 0;
