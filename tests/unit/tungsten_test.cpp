@@ -272,6 +272,20 @@ TEST(Tungsten, AMeshTakesABsdfPerMaterialIndex) {
                                              "three [5]: blue over x 4..5, 3 vertices", "one: blue over x 0..1, 3 vertices"}));
 }
 
+TEST(Tungsten, ABsdfEveryUserOfWhichTookACopyIsNotKept) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [
+        {"name": "lamp", "type": "lambert"}, {"name": "wall", "type": "lambert"}, {"name": "spare", "type": "mirror"}],
+      "primitives": [{"type": "quad", "name": "a", "bsdf": "lamp", "emission": 5},
+                     {"type": "quad", "name": "b", "bsdf": "lamp", "emission": 2},
+                     {"type": "quad", "name": "c", "bsdf": "wall", "emission": 1},
+                     {"type": "quad", "name": "d", "bsdf": "wall"}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  std::vector<std::string> names;
+  for (const Material& m : r->scene.materials) names.push_back(m.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"wall", "spare", "lamp (a)", "lamp (b)", "wall (c)"}))
+      << "'lamp' only ever became the emitters' copies; 'wall' is used as it is, 'spare' by nothing";
+}
+
 TEST(Tungsten, BumpMapsGoToACopyOfTheBsdf) {
   auto dir = test::tempDir();
   {

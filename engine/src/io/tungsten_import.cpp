@@ -110,6 +110,7 @@ class TungstenImporter {
     if (!ok()) return R::failure(error_);
     if (s.objects.empty() && s.environment.type == EnvironmentType::Constant && maxComponent(s.environment.color) <= 0)
       return fail("the scene has no geometry and no light");
+    dropReplacedBsdfs();
     return std::move(out_);
   }
 
@@ -127,6 +128,17 @@ class TungstenImporter {
       return;
     }
     warn(cat("camera: focus_pivot '", focusPivot_, "' names no primitive; focused at focus_distance"));
+  }
+
+  // A named bsdf every user of which took a copy of it (emitters, bump maps) would sit in the
+  // material list unused, beside its copies: it goes. Bsdfs the file defines but no primitive
+  // names stay, for the artist to assign.
+  void dropReplacedBsdfs() {
+    Scene& s = out_.scene;
+    std::set<NodeId> used;
+    for (const Object& o : s.objects) used.insert(o.material);
+    for (const Material& m : s.materials) used.insert(m.blendWith);
+    std::erase_if(s.materials, [&](const Material& m) { return copied_.count(m.id) && !used.count(m.id); });
   }
 
   bool ok() const { return error_.empty(); }
@@ -971,6 +983,7 @@ class TungstenImporter {
         if (auto it = bumped_.find(key); named && it != bumped_.end()) {
           materialId = it->second;
         } else {
+          if (named) copied_.insert(mat.id);
           Material m = mat;
           m.id = s.newId();
           m.name = cat(mat.name.empty() ? where : mat.name, " (bump)");
@@ -981,6 +994,7 @@ class TungstenImporter {
       } else if (emissive) {
         // Emission belongs to the primitive in Tungsten and to the material here: give each
         // emitter its own copy of its bsdf.
+        if (named) copied_.insert(mat.id);
         Material m = mat;
         m.id = s.newId();
         m.name = cat(mat.name.empty() ? std::string("emitter") : mat.name, " (", string(p, "name", cat("light ", ++emitters_)), ")");
@@ -1024,7 +1038,8 @@ class TungstenImporter {
   std::map<std::string, std::vector<MeshPart>> meshParts_;  // a mesh file's parts, by loadMesh's key
   std::map<std::string, std::shared_ptr<const MeshGeometry>> shapes_;
   int emitters_ = 0;
-  bool inBlend_ = false;  // reading the parts of a mixed bsdf (Material::blendWith is one level deep)
+  bool inBlend_ = false;
+  std::set<NodeId> copied_;  // named bsdfs some primitive took a copy of (dropReplacedBsdfs)  // reading the parts of a mixed bsdf (Material::blendWith is one level deep)
   std::map<std::tuple<std::string, NodeId, float>, NodeId> bumped_;  // (bsdf, texture, strength) -> its copy
 };
 
