@@ -61,8 +61,12 @@ QColor headerColor(NodeKind k) {
 
 // Sockets are coloured by what flows through them, so a compatible pair is recognisable at a glance.
 QColor socketColor(const QString& socket) {
-  return socket == QLatin1String("material") ? QColor(96, 210, 128) : QColor(236, 196, 72);
+  return socket == QLatin1String("material") || socket == QLatin1String("blend") ? QColor(96, 210, 128) : QColor(236, 196, 72);
 }
+
+// A material's input that takes the material it blends with (Material::blendWith), below its
+// texture inputs.
+const QString kBlendInput = QStringLiteral("blend");
 
 // A material node's texture inputs, top to bottom, and the fields they set.
 struct TextureInput {
@@ -179,6 +183,14 @@ class EditBuilder {
       c.material = from;
       return set(c);
     }
+    if (input == kBlendInput) {
+      const Material* m = scene_.material(to);
+      if (!m || from == to || (from != kNoNode && !scene_.material(from)) || m->blendWith == from) return false;
+      Material c = *m;
+      c.blendWith = from;
+      if (from != kNoNode && c.blendRatio >= 1.0f) c.blendRatio = 0.5f;  // else the blend shows nothing
+      return set(c);
+    }
     NodeId Material::*slot = textureSlot(input);
     const Material* m = scene_.material(to);
     if (!slot || !m || (from != kNoNode && !scene_.texture(from)) || m->*slot == from) return false;
@@ -199,6 +211,11 @@ class EditBuilder {
         if (o.material == id) users.push_back(o.id);
       for (NodeId u : users)
         if (!assign(u, QStringLiteral("material"), kNoNode)) return false;
+      std::vector<NodeId> blends;
+      for (const Material& b : scene_.materials)
+        if (b.blendWith == id) blends.push_back(b.id);
+      for (NodeId b : blends)
+        if (!assign(b, kBlendInput, kNoNode)) return false;
       return step(AddMaterial{copy}, RemoveNode{id});
     }
     if (const Texture* t = scene_.texture(id)) {
@@ -482,8 +499,10 @@ void NodeGraphView::resetLayout() {
   if (QLineEdit* open = rename_) static_cast<RenameEdit&>(*open).cancelled();
   pendingSelection_.clear();
   setSelection({});
-  for (Material& m : copiedMaterials_)
+  for (Material& m : copiedMaterials_) {
     for (NodeId* t : m.textureSlots()) *t = kNoNode;
+    m.blendWith = kNoNode;
+  }
   pasteCount_ = 0;
   positions_.clear();
   rebuild();
@@ -528,6 +547,7 @@ void NodeGraphView::rebuild() {
     if (m.emissive()) sub += tr(", emissive");
     GraphNodeItem* n = add(m.id, NodeKind::Material, m.name, sub);
     n->inputs = textureInputs();
+    n->inputs << kBlendInput;
     n->output = QStringLiteral("material");
     // An emitter shows its light's hue; its albedo is usually black.
     const float peak = std::max({m.emission.x, m.emission.y, m.emission.z});
@@ -591,9 +611,11 @@ void NodeGraphView::rebuild() {
   };
   for (const Object& o : scene_.objects)
     if (o.material != kNoNode) addLink(o.material, o.id, QStringLiteral("material"));
-  for (const Material& m : scene_.materials)
+  for (const Material& m : scene_.materials) {
     for (const QString& slot : textureInputs())
       if (m.*textureSlot(slot) != kNoNode) addLink(m.*textureSlot(slot), m.id, slot);
+    if (m.blendWith != kNoNode) addLink(m.blendWith, m.id, kBlendInput);
+  }
 
   setSelection(selection);
   updateLinkPaths();
@@ -746,6 +768,7 @@ NodeId NodeGraphView::linkSource(NodeId to, const QString& input) const {
 
 bool NodeGraphView::accepts(NodeId from, NodeId to, const QString& input) const {
   if (input == QLatin1String("material")) return scene_.material(from) && scene_.object(to);
+  if (input == kBlendInput) return from != to && scene_.material(from) && scene_.material(to);
   return isTextureInput(input) && scene_.texture(from) && scene_.material(to);
 }
 
@@ -956,6 +979,7 @@ bool NodeGraphView::paste() {
     // The copy may come from before its textures were deleted: keep only what still exists.
     for (NodeId* t : m.textureSlots())
       if (*t != kNoNode && !scene_.texture(*t)) *t = kNoNode;
+    if (m.blendWith != kNoNode && !scene_.material(m.blendWith)) m.blendWith = kNoNode;  // likewise its partner
     if (!b.step(RemoveNode{m.id}, AddMaterial{m})) return false;
     positions_[m.id] = copiedPositions_[k++] + offset;
     made.push_back(m.id);

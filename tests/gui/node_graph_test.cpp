@@ -31,7 +31,8 @@ std::string describe(const Scene& s) {
   };
   for (const Material& m : sorted(s.materials))
     out << "M" << m.id << " " << m.name << " " << static_cast<int>(m.type) << " " << m.albedo.x << " " << m.roughness
-        << " " << m.albedoTexture << " " << m.roughnessTexture << " " << m.alphaTexture << " " << m.bumpTexture << "\n";
+        << " " << m.albedoTexture << " " << m.roughnessTexture << " " << m.alphaTexture << " " << m.bumpTexture << " "
+        << m.blendWith << "\n";
   for (const Object& o : sorted(s.objects))
     out << "O" << o.id << " " << o.name << " " << o.mesh << " " << o.material << "\n";
   for (const Texture& t : sorted(s.textures)) out << "T" << t.id << " " << t.name << "\n";
@@ -209,6 +210,27 @@ TEST_F(NodeGraph, DraggingSocketsLinksAndDraggingTheLinkOffUnlinks) {
   EXPECT_EQ(edits.size(), count);
   EXPECT_FALSE(view.link(steel, ground, "albedo"));
   EXPECT_FALSE(view.link(steel, sphere, "material")) << "already linked: nothing to do";
+}
+
+TEST_F(NodeGraph, AMaterialOntoAnothersBlendInputBlendsThem) {
+  const NodeId steel = named(scene().materials, "Brushed Steel");
+  const NodeId ground = named(scene().materials, "Ground");
+  drag(at(view.socketScenePos(steel, "material", true)), at(view.socketScenePos(ground, "blend", false)));
+  ASSERT_EQ(edits.size(), 1u);
+  EXPECT_EQ(scene().material(ground)->blendWith, steel);
+  EXPECT_FLOAT_EQ(scene().material(ground)->blendRatio, 0.5f) << "half and half to start with";
+  EXPECT_EQ(view.linkSource(ground, "blend"), steel);
+  EXPECT_FALSE(view.link(ground, ground, "blend")) << "not with itself";
+  EXPECT_FALSE(view.link(named(scene().textures, "Checker"), ground, "blend")) << "a texture is no material";
+  // Deleting the partner ends the blend, and undoing brings both back.
+  const Scene before = scene();
+  view.selectNodes({steel});
+  QTest::keyClick(&view, Qt::Key_Delete);
+  ASSERT_EQ(edits.size(), 2u);
+  EXPECT_FALSE(scene().material(steel));
+  EXPECT_EQ(scene().material(ground)->blendWith, kNoNode);
+  undo(edits.back());
+  EXPECT_EQ(describe(scene()), describe(before));
 }
 
 TEST_F(NodeGraph, DeleteRemovesTheSelectionAndTheBeforesRestoreEveryReference) {
