@@ -187,8 +187,7 @@ class EditBuilder {
       const Material* m = scene_.material(to);
       if (!m || from == to || (from != kNoNode && !scene_.material(from)) || m->blendWith == from) return false;
       Material c = *m;
-      c.blendWith = from;
-      if (from != kNoNode && c.blendRatio >= 1.0f) c.blendRatio = 0.5f;  // else the blend shows nothing
+      c.setBlendWith(from);
       return set(c);
     }
     NodeId Material::*slot = textureSlot(input);

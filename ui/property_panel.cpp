@@ -105,6 +105,24 @@ class PropertyPanel::Builder {
     return c;
   }
 
+  // "(none)" or one of `nodes` by name (all but `skip`), `current` chosen; `apply` gets the id picked.
+  template <class Node>
+  QComboBox* nodeChoice(const QString& name, const QString& objectName, const std::vector<Node>& nodes, NodeId current,
+                        std::function<void(NodeId)> apply, NodeId skip = kNoNode) {
+    QStringList names{PropertyPanel::tr("(none)")};
+    std::vector<NodeId> ids{kNoNode};
+    int index = 0;
+    for (const Node& n : nodes) {
+      if (n.id == skip) continue;
+      if (n.id == current) index = static_cast<int>(ids.size());
+      names << QString::fromStdString(n.name);
+      ids.push_back(n.id);
+    }
+    return choice(name, objectName, names, index, [apply, ids](int i) {
+      if (i >= 0 && i < static_cast<int>(ids.size())) apply(ids[static_cast<std::size_t>(i)]);
+    });
+  }
+
   void row(const QString& name, QWidget* w) { form_->addRow(name, w); }
 
   void connectField(ScrubField* f, std::function<void(double, int)> apply) {
@@ -240,19 +258,8 @@ void PropertyPanel::buildObject(Builder& b, const Object& o) {
       x.transform = compose(t);
     });
   });
-  QStringList names{tr("(none)")};
-  std::vector<NodeId> ids{kNoNode};
-  int current = 0;
-  for (const Material& m : scene_().materials) {
-    if (m.id == o.material) current = static_cast<int>(ids.size());
-    names << QString::fromStdString(m.name);
-    ids.push_back(m.id);
-  }
-  b.choice(tr("Material"), "materialAssignment", names, current, [edit, ids](int i) {
-    if (i < 0 || i >= static_cast<int>(ids.size())) return;
-    NodeId m = ids[static_cast<std::size_t>(i)];
-    edit(tr("Assign material"), 0, [m](Object& x) { x.material = m; });
-  });
+  b.nodeChoice(tr("Material"), "materialAssignment", scene_().materials, o.material,
+               [edit](NodeId m) { edit(tr("Assign material"), 0, [m](Object& x) { x.material = m; }); });
 }
 
 void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
@@ -340,18 +347,8 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
                            Slot{"Bump texture", "bumpTexture", &Material::bumpTexture},
                            Slot{"Emission texture", "emissionTexture", &Material::emissionTexture}}) {
     if (slot.field == &Material::roughnessTexture && !rough) continue;
-    QStringList names{tr("(none)")};
-    std::vector<NodeId> ids{kNoNode};
-    int current = 0;
-    for (const Texture& t : scene_().textures) {
-      if (t.id == m.*slot.field) current = static_cast<int>(ids.size());
-      names << QString::fromStdString(t.name);
-      ids.push_back(t.id);
-    }
     auto field = slot.field;
-    b.choice(tr(slot.label), slot.name, names, current, [this, edit, ids, field](int i) {
-      if (i < 0 || i >= static_cast<int>(ids.size())) return;
-      NodeId t = ids[static_cast<std::size_t>(i)];
+    b.nodeChoice(tr(slot.label), slot.name, scene_().textures, m.*field, [this, edit, field](NodeId t) {
       edit(tr("Assign texture"), 0, [t, field](Material& x) { x.*field = t; });
       rebuildLater();
     });
@@ -381,24 +378,10 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   });
 
   // A blend with another material (Tungsten's mixed bsdf): this one's share, the other's the rest.
-  QStringList names{tr("(none)")};
-  std::vector<NodeId> ids{kNoNode};
-  int current = 0;
-  for (const Material& other : scene_().materials) {
-    if (other.id == id) continue;
-    if (other.id == m.blendWith) current = static_cast<int>(ids.size());
-    names << QString::fromStdString(other.name);
-    ids.push_back(other.id);
-  }
-  b.choice(tr("Blend with"), "blendWith", names, current, [this, edit, ids](int i) {
-    if (i < 0 || i >= static_cast<int>(ids.size())) return;
-    NodeId other = ids[static_cast<std::size_t>(i)];
-    edit(tr("Blend with"), 0, [other](Material& x) {
-      x.blendWith = other;
-      if (other != kNoNode && x.blendRatio >= 1.0f) x.blendRatio = 0.5f;  // else the blend shows nothing
-    });
+  b.nodeChoice(tr("Blend with"), "blendWith", scene_().materials, m.blendWith, [this, edit](NodeId other) {
+    edit(tr("Blend with"), 0, [other](Material& x) { x.setBlendWith(other); });
     rebuildLater();
-  });
+  }, id);
   if (m.blendWith != kNoNode)
     b.number(tr("Blend ratio"), "blendRatio", m.blendRatio, 0.0, 1.0, 0.5, 3, [edit](double v, int drag) {
       edit(tr("Blend ratio"), drag, [v](Material& x) { x.blendRatio = static_cast<float>(v); });

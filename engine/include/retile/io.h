@@ -52,6 +52,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const std::
 
 // Replaces every NaN/Inf position triangle and every out-of-range index; returns how many
 // triangles were dropped. Shared by all importers so the renderer only sees finite geometry.
-std::size_t sanitizeGeometry(MeshGeometry& g);
+// `perTriangle` (one entry per input triangle, e.g. a material index) keeps the kept ones' entries.
+std::size_t sanitizeGeometry(MeshGeometry& g, std::vector<std::int32_t>* perTriangle = nullptr);
 
 }  // namespace retile

@@ -126,6 +126,12 @@ struct Material {
   // kNoNode: no blend. The other material's own blend is not followed.
   NodeId blendWith = kNoNode;
   float blendRatio = 1.0f;
+  // Blends with `other` (kNoNode: no more); a ratio of 1, which would show nothing of it, becomes
+  // half and half.
+  void setBlendWith(NodeId other) {
+    blendWith = other;
+    if (other != kNoNode && blendRatio >= 1.0f) blendRatio = 0.5f;
+  }
 
   // Every texture reference, for code that visits them all (deletion, validation, copies).
   std::array<NodeId, 5> textures() const { return {albedoTexture, roughnessTexture, alphaTexture, bumpTexture, emissionTexture}; }

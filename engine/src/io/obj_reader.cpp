@@ -154,7 +154,7 @@ Result<MeshGeometry> readObjGeometry(const std::filesystem::path& file, std::vec
   return g;
 }
 
-std::size_t sanitizeGeometry(MeshGeometry& g) {
+std::size_t sanitizeGeometry(MeshGeometry& g, std::vector<std::int32_t>* perTriangle) {
   std::size_t n = g.positions.size();
   if (g.normals.size() != n) g.normals.clear();
   if (g.uvs.size() != n) g.uvs.clear();
@@ -172,6 +172,7 @@ std::size_t sanitizeGeometry(MeshGeometry& g) {
       if (idx >= n || !isFinite(g.positions[idx])) ok = false;
     }
     if (ok) {
+      if (perTriangle && i / 3 < perTriangle->size()) (*perTriangle)[kept.size() / 3] = (*perTriangle)[i / 3];
       kept.insert(kept.end(), g.indices.begin() + static_cast<std::ptrdiff_t>(i),
                   g.indices.begin() + static_cast<std::ptrdiff_t>(i) + 3);
     } else {
@@ -179,6 +180,7 @@ std::size_t sanitizeGeometry(MeshGeometry& g) {
     }
   }
   dropped += (g.indices.size() % 3) ? 1 : 0;
+  if (perTriangle) perTriangle->resize(std::min(perTriangle->size(), kept.size() / 3));
   g.indices = std::move(kept);
   // Every position a kept triangle uses is finite now; one that is not belongs to no triangle (a
   // dropped one, or a face a reader skipped) but would still reach the bounds.

@@ -316,6 +316,9 @@ class TungstenImporter {
         ratio = std::clamp(luminance(t.constant), 0.0f, 1.0f);
         if (t.isTexture) warn(cat(where, ": a textured blend ratio is taken as its constant factor"));
       }
+      TextureRef albedo;  // Tungsten's default: 1
+      if (const Value* a = v.find("albedo")) albedo = texture(*a, where + ".albedo", false);
+      // A part under the blend's albedo, itself no blend.
       auto part = [&](const char* key) {
         const Value* pv = v.find(key);
         if (!pv) {
@@ -331,11 +334,8 @@ class TungstenImporter {
           p.blendWith = kNoNode;
           p.blendRatio = 1;
         }
-        if (const Value* a = v.find("albedo")) {
-          TextureRef t = texture(*a, where + ".albedo", false);
-          p.albedo = p.albedo * t.constant;
-          if (t.isTexture && p.albedoTexture == kNoNode) p.albedoTexture = t.texture;
-        }
+        p.albedo = p.albedo * albedo.constant;
+        if (albedo.isTexture && p.albedoTexture == kNoNode) p.albedoTexture = albedo.texture;
         return p;
       };
       const std::string name = m.name;
@@ -343,8 +343,6 @@ class TungstenImporter {
         const char* key = ratio >= 0.5f ? "bsdf0" : "bsdf1";
         m = part(key);
         m.name = name;
-        m.blendWith = kNoNode;
-        m.blendRatio = 1;
         warn(cat(where, ": a blend inside a blend is rendered as its ", key, " (ratio ", ratio, ")"));
         return m;
       }
@@ -352,8 +350,6 @@ class TungstenImporter {
       m = part("bsdf0");
       if (!ok()) return m;
       m.name = name;
-      other.blendWith = kNoNode;
-      other.blendRatio = 1;
       other.id = out_.scene.newId();
       other.name = cat(name.empty() ? where : name, " (bsdf1)");
       out_.scene.materials.push_back(other);
@@ -689,23 +685,26 @@ class TungstenImporter {
       parts.push_back({materials.empty() ? 0 : materials.front(), meshNode(key, name, std::make_shared<MeshGeometry>(std::move(geom)))});
     } else {
       std::set<std::int32_t> indices(materials.begin(), materials.end());
+      std::vector<std::uint32_t> remap(geom.positions.size(), UINT32_MAX);  // whole-mesh vertex -> the part's
       for (std::int32_t m : indices) {
         // The part's triangles with their vertices, renumbered.
         auto part = std::make_shared<MeshGeometry>();
-        std::map<std::uint32_t, std::uint32_t> remap;
+        std::vector<std::uint32_t> used;
         for (std::size_t t = 0; t < materials.size(); ++t) {
           if (materials[t] != m) continue;
           for (int k = 0; k < 3; ++k) {
             const std::uint32_t v = geom.indices[t * 3 + static_cast<std::size_t>(k)];
-            auto [it, added] = remap.emplace(v, static_cast<std::uint32_t>(part->positions.size()));
-            if (added) {
+            if (remap[v] == UINT32_MAX) {
+              remap[v] = static_cast<std::uint32_t>(part->positions.size());
+              used.push_back(v);
               part->positions.push_back(geom.positions[v]);
               if (!geom.normals.empty()) part->normals.push_back(geom.normals[v]);
               if (!geom.uvs.empty()) part->uvs.push_back(geom.uvs[v]);
             }
-            part->indices.push_back(it->second);
+            part->indices.push_back(remap[v]);
           }
         }
+        for (std::uint32_t v : used) remap[v] = UINT32_MAX;
         parts.push_back({m, meshNode(cat(key, "|", m), cat(name, " [", m, "]"), std::move(part))});
       }
     }
@@ -744,22 +743,13 @@ class TungstenImporter {
     if (!u64(&nt) || nt > (d.size() - pos) / 16) return R::failure(cat(path.string(), ": truncated or corrupt (triangle count)"));
     if (nt > options_.maxTriangles) return R::failure(cat(path.string(), ": more than ", options_.maxTriangles, " triangles"));
     g.indices.resize(nt * 3);
-    materials->clear();
+    materials->resize(nt);
     for (std::uint64_t i = 0; i < nt; ++i) {
-      std::uint32_t t[3];
-      std::int32_t material = 0;
-      std::memcpy(t, d.data() + pos, 12);
-      std::memcpy(&material, d.data() + pos + 12, 4);
+      std::memcpy(&g.indices[i * 3], d.data() + pos, 12);
+      std::memcpy(&(*materials)[i], d.data() + pos + 12, 4);
       pos += 16;
-      g.indices[i * 3] = t[0];
-      g.indices[i * 3 + 1] = t[1];
-      g.indices[i * 3 + 2] = t[2];
-      // sanitizeGeometry keeps the triangles whose vertices exist and are finite, in order.
-      bool kept = true;
-      for (std::uint32_t v : t) kept = kept && v < nv && isFinite(g.positions[v]);
-      if (kept) materials->push_back(material);
     }
-    std::size_t dropped = sanitizeGeometry(g);
+    std::size_t dropped = sanitizeGeometry(g, materials);
     if (dropped) warn(cat(path.filename().string(), ": dropped ", dropped, " invalid triangles"));
     if (g.indices.empty()) return R::failure(cat(path.string(), ": contains no triangles"));
     return g;
@@ -955,7 +945,7 @@ class TungstenImporter {
     }
 
     // An array names one bsdf per material index (Tungsten's TriangleMesh: a triangle's index
-    // picks its bsdf); an index past the array's end takes its last entry, as ours did before.
+    // picks its bsdf); an index past the array's end takes its last entry.
     if (byIndex && bsdfs->asArray().size() > 1 && type != "mesh")
       warn(cat(where, ": ", bsdfs->asArray().size(), " bsdfs by material index on a ", type, "; it takes the first"));
     for (const MeshPart& part : parts) {
@@ -1038,8 +1028,8 @@ class TungstenImporter {
   std::map<std::string, std::vector<MeshPart>> meshParts_;  // a mesh file's parts, by loadMesh's key
   std::map<std::string, std::shared_ptr<const MeshGeometry>> shapes_;
   int emitters_ = 0;
-  bool inBlend_ = false;
-  std::set<NodeId> copied_;  // named bsdfs some primitive took a copy of (dropReplacedBsdfs)  // reading the parts of a mixed bsdf (Material::blendWith is one level deep)
+  bool inBlend_ = false;     // reading the parts of a mixed bsdf (Material::blendWith is one level deep)
+  std::set<NodeId> copied_;  // named bsdfs some primitive took a copy of (dropReplacedBsdfs)
   std::map<std::tuple<std::string, NodeId, float>, NodeId> bumped_;  // (bsdf, texture, strength) -> its copy
 };
 

@@ -422,7 +422,7 @@ struct Renderer::Impl {
     std::uint32_t sel = countTile > 0 ? selectedInstance() : 0u;
     u.work = {itemCount, static_cast<std::uint32_t>(slots), sel, sel ? static_cast<std::uint32_t>(countTile) : 0u};
     // Tungsten draws its box exactly, and has no other filter the table could stand for.
-    const int drawn = filterFeature(sceneSettings);
+    const int drawn = d.filterFeature;  // the compiled kernel's
     const bool tungsten = drawn == gpu::kFeatureFilterTungsten;
     if (warpFilter != sceneSettings.pixelFilter || warpWidth != sceneSettings.filterWidth || warpTungsten != tungsten ||
         warp.empty()) {
