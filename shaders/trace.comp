@@ -303,6 +303,7 @@ bool extendPath(inout Path path, bool alive, inout Shadow shadow) {
     vec3 Le = envRadiance(rd);
     vec3 added = path.beta * Le;
     if (!path.specular) added *= powerHeuristic(path.prevPdf, frame.lightPick.y * envPdf(rd));
+    if (hasFeature(kFeatureSun)) added += path.beta * sunsSeen(rd, path.specular, path.prevPdf);
     path.L += added;
     // The sky seen directly or through mirrors and glass is emission to the denoiser, like a light.
     if (path.auxDepth >= kInfinity) path.auxEmission += added;

@@ -445,6 +445,11 @@ void PropertyPanel::buildLight(Builder& b, const Light& l) {
         if (length(d) > 1e-6f) x.direction = d;  // a zero direction is refused, not sent
       });
     });
+  if (l.type == LightType::Directional)
+    b.number(tr("Sun angular radius"), "angularRadius", degrees(l.angularRadius), 0.0, 90.0, degrees(defaults.angularRadius), 2,
+             [edit](double v, int drag) {
+               edit(tr("Sun angular radius"), drag, [v](Light& x) { x.angularRadius = radians(static_cast<float>(v)); });
+             });
   if (l.type == LightType::Spot) {
     b.number(tr("Cone half angle"), "spotAngle", degrees(l.spotAngle), 0.5, 89.0, degrees(defaults.spotAngle), 1,
              [edit](double v, int drag) { edit(tr("Spot angle"), drag, [v](Light& x) { x.spotAngle = radians(static_cast<float>(v)); }); });

@@ -1,6 +1,6 @@
 // Light sources for next-event estimation and MIS: emissive triangles (alias table by power),
 // the environment (constant, or an equirectangular map importance-sampled by luminance) and
-// delta lights (point, spot, directional).
+// delta lights (point, spot, directional) and suns (directional lights with a disc).
 #ifndef RETILE_LIGHTS_GLSL
 #define RETILE_LIGHTS_GLSL
 
@@ -155,13 +155,26 @@ LightSample sampleLight(vec3 p, vec3 u) {
   }
   int n = frame.scene.w;
   if (!hasFeature(kFeatureDeltaLights) || n == 0) return ls;
-  int i = min(int(u.x * float(n)), n - 1);
+  float scaled = u.x * float(n);
+  int i = min(int(scaled), n - 1);
   vec4 a = texelFetch(uDeltaLights, i * kDeltaLightTexels);
   vec4 b = texelFetch(uDeltaLights, i * kDeltaLightTexels + 1);
   vec4 c = texelFetch(uDeltaLights, i * kDeltaLightTexels + 2);
   int type = floatBitsToInt(a.w);
   ls.delta = true;
   ls.pdf = frame.lightPick.z / float(n);
+  if (hasFeature(kFeatureSun) && type == kLightSun) {
+    // Uniform over the disc's cone; the pick's leftover fraction is again uniform.
+    float oneMinusCos = clamp(scaled - float(i), 0.0, 1.0) * b.w;
+    float sinT = sqrt(max(0.0, oneMinusCos * (2.0 - oneMinusCos))), phi = 2.0 * PI * u.y;
+    vec3 axis = -b.xyz, tx, ty;
+    makeFrame(axis, tx, ty);
+    ls.dir = normalize(sinT * (cos(phi) * tx + sin(phi) * ty) + (1.0 - oneMinusCos) * axis);
+    ls.radiance = c.rgb;
+    ls.pdf /= c.w;
+    ls.delta = false;
+    return ls;
+  }
   if (type == kLightDirectional) {
     ls.dir = -b.xyz;
     ls.radiance = c.rgb;
@@ -179,6 +192,22 @@ LightSample sampleLight(vec3 p, vec3 u) {
   }
   ls.radiance = c.rgb * (falloff / d2);
   return ls;
+}
+
+// What the suns' discs add along direction d, out of the scene, each weighted against its light
+// samples (unless the ray came off a delta lobe, which no light sample can stand in for).
+vec3 sunsSeen(vec3 d, bool specular, float bsdfPdf) {
+  vec3 seen = vec3(0.0);
+  int n = frame.scene.w;
+  for (int i = 0; i < int(frame.lightPick.w); ++i) {
+    loopIterations++;
+    vec4 b = texelFetch(uDeltaLights, i * kDeltaLightTexels + 1);
+    vec4 c = texelFetch(uDeltaLights, i * kDeltaLightTexels + 2);
+    bool inside = 1.0 + dot(d, b.xyz) <= b.w;
+    float w = specular ? 1.0 : powerHeuristic(bsdfPdf, frame.lightPick.z / (float(n) * c.w));
+    seen += inside ? c.rgb * w : vec3(0.0);
+  }
+  return seen;
 }
 
 // pdf with which sampleLight would have chosen the emitter point hit by a BSDF ray.

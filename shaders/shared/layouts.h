@@ -24,7 +24,9 @@ RT_CONST(int, kInstanceTexels, 5)   // shading: world-to-object rows 0..2 | - tr
 RT_CONST(int, kMaterialTexels, 7)   // see render/render_scene.cpp packMaterial
 RT_CONST(int, kTextureTexels, 3)    // offset w h kind | on.rgb resU | off.rgb resV
 RT_CONST(int, kEmitterTexels, 5)    // v0.xyz area | e1.xyz instance | e2.xyz triangle | radiance.rgb pick pdf | normal.xyz emission texture
-RT_CONST(int, kDeltaLightTexels, 4) // position.xyz type | direction.xyz cosOuter | intensity.rgb cosInner | -
+// position.xyz type | direction.xyz cosOuter | intensity.rgb cosInner | -; a sun (kLightSun):
+// - type | direction.xyz 1 - cos(angular radius) | radiance.rgb solid angle | -
+RT_CONST(int, kDeltaLightTexels, 4)
 
 // The traversal buffer holds every triangle (packed triangle p at texel p * kTriTexels), then the
 // mesh BVHs, the instance BVH and one record per instance. An item names one record of it:
@@ -54,7 +56,8 @@ RT_CONST(int, kFeatureBlend, 256)         // some material blends with another (
 RT_CONST(int, kFeatureFilterTable, 512)
 RT_CONST(int, kFeatureFilterTent, 1024)
 RT_CONST(int, kFeatureFilterTungsten, 2048)
-RT_CONST(int, kFeatureAll, 4095)
+RT_CONST(int, kFeatureSun, 4096)  // some directional light has a disc (Light::angularRadius)
+RT_CONST(int, kFeatureAll, 8191)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceEmissive, 4)
@@ -85,6 +88,9 @@ RT_CONST(int, kTexChecker, 1)
 RT_CONST(int, kLightPoint, 0)
 RT_CONST(int, kLightSpot, 1)
 RT_CONST(int, kLightDirectional, 2)
+// A directional light with a disc: sampled over its cone, not a delta light, and seen by rays
+// that leave the scene towards it. Suns come first among the lights (frame.lightPick.w counts them).
+RT_CONST(int, kLightSun, 3)
 
 RT_CONST(int, kEnvNone, 0)
 RT_CONST(int, kEnvConstant, 1)
@@ -116,7 +122,7 @@ struct FrameUniforms {
   vec4 cameraForward;   // xyz (unit), the distance of the plane in focus along it
   uvec4 image;          // width, height, seed, maxBounces
   ivec4 scene;          // tlasRoot, instanceCount, emitterCount, deltaLightCount
-  vec4 lightPick;       // probability of picking: emitters, environment, delta lights; -
+  vec4 lightPick;       // probability of picking: emitters, environment, lights (of the delta lights' array); suns
   ivec4 environment;    // type, map texture, map width, map height
   vec4 environmentTint; // rgb multiplier (constant: the radiance), -
   vec4 environmentToMap[3]; // rows of the rotation from world directions to the map's frame (xyz)

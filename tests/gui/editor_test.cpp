@@ -447,6 +447,37 @@ TEST(Editor, APlasticsCoatingAbsorptionIsEditedPerChannel) {
   EXPECT_EQ(w->scene().material(material)->coatingAbsorption.y, 0.0f) << "absorption is not negative";
 }
 
+TEST(Editor, ADirectionalLightsSunTakesItsAngularRadiusFromItsPanel) {
+  auto w = makeWindow();
+  Scene s = makeDefaultScene();
+  Light sun;
+  sun.id = s.newId();
+  sun.name = "Sun";
+  sun.type = LightType::Directional;
+  s.lights.push_back(sun);
+  const auto file = retile::test::tempDir() / "sun.retile";
+  ASSERT_TRUE(saveNativeScene(s, file).ok());
+  ASSERT_TRUE(w->openFile(file)) << w->lastError().toStdString();
+  QTest::qWait(50);
+  bool picked = false;
+  for (QTreeWidgetItemIterator it(w->outliner()); *it && !picked; ++it)
+    if ((*it)->text(0) == "Sun") {
+      w->outliner()->clearSelection();
+      (*it)->setSelected(true);
+      picked = true;
+    }
+  ASSERT_TRUE(picked);
+  auto* radius = w->properties()->findChild<ScrubField*>("angularRadius");
+  ASSERT_TRUE(radius) << "a directional light's panel has the sun's angular radius";
+  radius->setValue(2.5);
+  ASSERT_EQ(w->scene().lights.size(), 1u);
+  EXPECT_NEAR(degrees(w->scene().lights[0].angularRadius), 2.5f, 1e-4f);
+  const std::uint64_t version = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; })) << "the edit reached the engine";
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().lights[0].angularRadius, 0.0f);
+}
+
 TEST(Editor, ScrubbingAFieldIsOneUndoStepAndEscCancelsTyping) {
   auto w = makeWindow();
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");

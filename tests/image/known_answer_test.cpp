@@ -368,6 +368,49 @@ TEST(KnownAnswer, ABumpMapTiltsTheNormalByItsSlope) {
   EXPECT_NEAR(meanOver(renderScene(*r, s, 16), plane), flat, 0.01 * flat) << "no slope, no tilt";
 }
 
+// A sun of irradiance E overhead, with a disc of angular radius a, lights a white plane by
+// E (1 + cos a) / 2 / pi: its radiance E / (solid angle) over the cone's projected area
+// pi sin^2 a. Light samples over the cone and BSDF rays that leave towards it share the
+// answer through MIS; a wide disc makes both count. Seen directly, the disc is that radiance.
+TEST(KnownAnswer, ASunsDiscLightsAndShowsAsItsRadiance) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(16, 16);
+  lookStraightDown(s, 3, 2);
+  s.settings.maxBounces = 1;
+  Material white;
+  white.albedo = Vec3{1.0f};
+  NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, white), Mat4::scale({4, 1, 4}));
+  Light sun;
+  sun.id = s.newId();
+  sun.type = LightType::Directional;
+  sun.direction = {0, -1, 0};
+  sun.intensity = 2.0f;
+  s.lights.push_back(sun);
+  for (float degreesWide : {0.0f, 0.5f, 30.0f, 60.0f}) {
+    s.lights[0].angularRadius = radians(degreesWide);
+    double expected = 2.0 * (1.0 + std::cos(radians(degreesWide))) / 2.0 / kPi;
+    EXPECT_NEAR(meanOver(renderScene(*r, s, 64), plane), expected, 0.015 * expected) << degreesWide << " degrees";
+  }
+
+  // Looking up into a disc of 20 degrees with a field of view of 10: every pixel is in it.
+  s.objects.clear();
+  s.camera.position = {0, 0, 0};
+  s.camera.target = {0, 1, 0};
+  s.camera.up = {0, 0, -1};
+  s.camera.verticalFov = radians(10.0f);
+  s.lights[0].angularRadius = radians(20.0f);
+  RenderImage sky = renderScene(*r, s, 4);
+  double mean = 0;
+  for (std::size_t i = 1; i < sky.color.size(); i += 3) mean += sky.color[i];
+  mean /= static_cast<double>(sky.color.size() / 3);
+  const double radiance = 2.0 / (2 * kPi * (1 - std::cos(radians(20.0f))));
+  EXPECT_NEAR(mean, radiance, 1e-3 * radiance);
+  // Turned away, it is not there.
+  s.lights[0].direction = {0, 1, 0};
+  RenderImage away = renderScene(*r, s, 4);
+  EXPECT_EQ(*std::max_element(away.color.begin(), away.color.end()), 0.0f);
+}
+
 TEST(KnownAnswer, ATexturedEmitterLightsAsItsLitPartAlone) {
   // A 1x1 emitter whose texture is 1 over its half u < 0.5 and 0 over the rest lights the floor
   // below as a 0.5x1 emitter over that half does: light samples (which pick points over the

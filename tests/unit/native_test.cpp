@@ -45,6 +45,20 @@ void expectSameScene(const Scene& a, const Scene& b) {
     EXPECT_EQ(a.objects[i].material, b.objects[i].material);
     EXPECT_EQ(a.objects[i].visible, b.objects[i].visible);
   }
+  ASSERT_EQ(a.lights.size(), b.lights.size());
+  for (std::size_t i = 0; i < a.lights.size(); ++i) {
+    const Light &x = a.lights[i], &y = b.lights[i];
+    EXPECT_EQ(x.id, y.id);
+    EXPECT_EQ(x.type, y.type);
+    EXPECT_EQ(x.color, y.color);
+    EXPECT_EQ(x.intensity, y.intensity);
+    EXPECT_EQ(x.position, y.position);
+    EXPECT_EQ(x.direction, y.direction);
+    EXPECT_EQ(x.spotAngle, y.spotAngle);
+    EXPECT_EQ(x.spotBlend, y.spotBlend);
+    EXPECT_EQ(x.visible, y.visible);
+    EXPECT_EQ(x.angularRadius, y.angularRadius);
+  }
   ASSERT_EQ(a.textures.size(), b.textures.size());
   EXPECT_EQ(a.camera.position, b.camera.position);
   EXPECT_EQ(a.camera.verticalFov, b.camera.verticalFov);
@@ -88,14 +102,16 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   s.environment.orientation = Mat4::rotateZ(0.3f) * Mat4::rotateX(-1.2f);
   s.environment.rotation = 0.7f;
   s.lights.push_back(Light{s.newId(), "Key", LightType::Spot, {1, 0.9f, 0.8f}, 3.5f, {1, 2, 3}, {0, -1, 0}, 0.4f, 0.2f, true});
+  s.lights.push_back(Light{s.newId(), "Sun", LightType::Directional, {1, 1, 1}, 2.0f, {}, {0, -1, 1}, 0.5f, 0.1f, true, 0.01f});
   auto dir = test::tempDir();
   auto file = dir / "scene.retile";
   ASSERT_TRUE(saveNativeScene(s, file).ok());
   auto back = loadNativeScene(file);
   ASSERT_TRUE(back.ok()) << back.error();
   expectSameScene(s, back->scene);
-  ASSERT_EQ(back->scene.lights.size(), 1u);
+  ASSERT_EQ(back->scene.lights.size(), 2u);
   EXPECT_EQ(back->scene.lights[0].type, LightType::Spot);
+  EXPECT_EQ(back->scene.lights[1].angularRadius, 0.01f);
   EXPECT_EQ(back->scene.lights[0].intensity, 3.5f);
   EXPECT_EQ(back->scene.settings.pixelFilter, PixelFilter::BlackmanHarris);
   EXPECT_EQ(back->scene.settings.filterWidth, 1.75f);

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -369,6 +371,30 @@ TEST(Tungsten, PointLightsAndCylindersAreImported) {
       Vec3 out = std::abs(c.y) > 0.4999f && std::abs(std::abs(n.y) - length(n)) < 1e-6f ? Vec3{0, c.y, 0} : Vec3{c.x, 0, c.z};
       EXPECT_GT(dot(n, out), 0.0f) << "triangle " << t / 3;
     }
+}
+
+// Tungsten's infinite_sphere_cap is a disc of the sky around the transform's +y: a sun of that
+// angular radius whose disc keeps the cap's radiance.
+TEST(Tungsten, ASkyCapIsASunWithItsDisc) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [{"name": "a", "type": "lambert"}], "primitives": [
+        {"type": "quad", "bsdf": "a"},
+        {"type": "infinite_sphere_cap", "cap_angle": 2, "emission": [100, 50, 0],
+         "transform": {"rotation": [0, 0, 90]}},
+        {"type": "infinite_sphere_cap", "cap_angle": 180, "emission": 1}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  ASSERT_EQ(s.lights.size(), 2u);
+  const Light& sun = s.lights[0];
+  EXPECT_EQ(sun.type, LightType::Directional);
+  EXPECT_NEAR(sun.angularRadius, radians(2.0f), 1e-7f);
+  // +y turned a quarter about z points along -x; the light travels the other way.
+  EXPECT_NEAR(sun.direction.x, 1.0f, 1e-5f);
+  const float solidAngle = 2 * kPi * (1 - std::cos(radians(2.0f)));
+  EXPECT_NEAR(sun.intensity * sun.color.x / solidAngle, 100.0f, 1e-2f);
+  EXPECT_NEAR(sun.intensity * sun.color.y / solidAngle, 50.0f, 1e-2f);
+  EXPECT_NEAR(s.lights[1].angularRadius, kPi / 2, 1e-6f) << "at most a hemisphere";
+  EXPECT_TRUE(std::any_of(r->warnings.begin(), r->warnings.end(),
+                          [](const std::string& w) { return w.find("cap_angle 180") != std::string::npos; }));
 }
 
 TEST(Tungsten, TexturedEmissionKeepsItsTexture) {

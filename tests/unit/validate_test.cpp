@@ -93,6 +93,11 @@ TEST(Validate, ValuesOutsideTheirRangesAreClampedOrReset) {
   spot.type = LightType::Spot;
   spot.spotAngle = 9;
   s.lights.push_back(spot);
+  Light sun;
+  sun.name = "Sun";
+  sun.type = LightType::Directional;
+  sun.angularRadius = kNaN;
+  s.lights.push_back(sun);
   s.environment.color = {kInf, 0, 0};
   s.settings.width = 0;
   s.settings.height = 1000000;
@@ -107,9 +112,10 @@ TEST(Validate, ValuesOutsideTheirRangesAreClampedOrReset) {
   EXPECT_EQ(r.ior, 1.5f);
   EXPECT_EQ(r.alpha, 1.0f);
   EXPECT_EQ(r.metal, "Cu");
-  ASSERT_EQ(s.lights.size(), 1u);
+  ASSERT_EQ(s.lights.size(), 2u);
   EXPECT_EQ(s.lights[0].name, "Spot");
   EXPECT_LE(s.lights[0].spotAngle, 1.5707964f);
+  EXPECT_EQ(s.lights[1].angularRadius, 0.0f);
   EXPECT_EQ(s.environment.color, Vec3(0.0f));
   EXPECT_EQ(s.settings.width, 1);
   EXPECT_EQ(s.settings.height, kMaxImageSide);

@@ -169,6 +169,10 @@ struct Light {
   float spotAngle = radians(30.0f);   // spot: half angle of the cone
   float spotBlend = 0.1f;             // spot: fraction of the cone that falls off
   bool visible = true;
+  // Directional: the angular radius of the sun's disc. 0 is a delta light (hard shadows, seen by
+  // no ray); wider, the disc casts soft shadows and shows in mirrors and glass, with the same
+  // irradiance (intensity) facing it.
+  float angularRadius = 0.0f;
 };
 
 struct Camera {

@@ -303,6 +303,7 @@ Value nativeSceneToJson(const Scene& s) {
     v.set("direction", json::fromVec3(l.direction));
     v.set("spot_angle", l.spotAngle);
     v.set("spot_blend", l.spotBlend);
+    v.set("angular_radius", l.angularRadius);
     v.set("visible", l.visible);
     lights.push_back(std::move(v));
   }
@@ -520,6 +521,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.vec3("direction", &l.direction);
       r.number("spot_angle", &l.spotAngle);
       r.number("spot_blend", &l.spotBlend);
+      r.number("angular_radius", &l.angularRadius);
       r.boolean("visible", &l.visible);
       s.lights.push_back(std::move(l));
     }

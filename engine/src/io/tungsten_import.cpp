@@ -840,7 +840,8 @@ class TungstenImporter {
       return;
     }
     if (type == "infinite_sphere_cap") {
-      // A small bright cap is a sun: a directional light carrying the cap's irradiance.
+      // A cap of the sky is a sun whose disc is the cap: its radiance is the cap's, which a
+      // directional light of the cap's solid angle times that radiance gives (Light::angularRadius).
       Mat4 m = transform(tv, where);
       float cap = 10;
       number(p, "cap_angle", &cap, where);
@@ -851,7 +852,9 @@ class TungstenImporter {
       l.name = string(p, "name", "sun");
       l.type = LightType::Directional;
       l.direction = -normalize(m.transformVector({0, 1, 0}));
-      float solidAngle = 2 * kPi * (1 - std::cos(radians(cap)));
+      l.angularRadius = std::isfinite(cap) ? std::clamp(radians(cap), 0.0f, kPi / 2) : radians(10.0f);
+      if (!(cap >= 0 && cap <= 90)) warn(cat(where, ": cap_angle ", cap, " is taken as ", degrees(l.angularRadius), " degrees"));
+      float solidAngle = 2 * kPi * (1 - std::cos(l.angularRadius));
       float power = maxComponent(radiance) * solidAngle;
       l.color = power > 0 ? radiance / maxComponent(radiance) : Vec3{1.0f};
       l.intensity = power;

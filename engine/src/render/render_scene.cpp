@@ -190,6 +190,7 @@ std::uint32_t RenderSceneData::features() const {
   if (environmentType == gpu::kEnvMap) f |= gpu::kFeatureEnvMap;
   if (!emitters.empty()) f |= gpu::kFeatureEmitters;
   if (!deltaLights.empty()) f |= gpu::kFeatureDeltaLights;
+  if (suns > 0) f |= gpu::kFeatureSun;
   if (tungstenShading) f |= gpu::kFeatureTungstenShading;
   if (materialBump) f |= gpu::kFeatureBump;
   if (emissionTextures) f |= gpu::kFeatureEmissionTextures;
@@ -594,9 +595,29 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
   deltaPower_ = 0;
   Bounds3 b = data_.bounds;
   float radius = b.empty() ? 1.0f : 0.5f * length(b.extent());
-  for (const Light& l : scene.lights) {
-    if (!l.visible || l.intensity <= 0 || maxComponent(l.color) <= 0) continue;
+  data_.suns = 0;
+  auto isSun = [](const Light& l) { return l.type == LightType::Directional && l.angularRadius > 0; };
+  std::vector<const Light*> lights;  // suns first: rays that leave the scene look for them alone
+  for (const Light& l : scene.lights)
+    if (l.visible && l.intensity > 0 && maxComponent(l.color) > 0) lights.push_back(&l);
+  std::stable_partition(lights.begin(), lights.end(), [&](const Light* l) { return isSun(*l); });
+  for (const Light* light : lights) {
+    const Light& l = *light;
     Vec3 intensity = l.color * l.intensity;
+    if (isSun(l)) {
+      // The disc's radiance gives the light's intensity as irradiance facing it, as near as a
+      // small disc does (exactly E (1 + cos) / 2 for a disc of any size).
+      float half = 0.5f * std::min(l.angularRadius, kPi / 2);
+      float oneMinusCos = 2 * std::sin(half) * std::sin(half);  // no cancellation for small discs
+      float solidAngle = 2 * kPi * oneMinusCos;
+      data_.deltaLights.push_back(v4(Vec3{0.0f}, bitsOf(gpu::kLightSun)));
+      data_.deltaLights.push_back(v4(normalize(l.direction), oneMinusCos));
+      data_.deltaLights.push_back(v4(intensity / solidAngle, solidAngle));
+      data_.deltaLights.push_back({0, 0, 0, 0});
+      deltaPower_ += kPi * radius * radius * luminance(intensity);
+      ++data_.suns;
+      continue;
+    }
     int type = l.type == LightType::Point ? gpu::kLightPoint : l.type == LightType::Spot ? gpu::kLightSpot : gpu::kLightDirectional;
     float cosOuter = std::cos(std::clamp(l.spotAngle, 0.001f, kPi / 2));
     float cosInner = std::cos(std::clamp(l.spotAngle * (1 - std::clamp(l.spotBlend, 0.0f, 1.0f)), 0.0f, kPi / 2));

@@ -64,7 +64,8 @@ struct RenderSceneData {
   std::vector<std::uint16_t> texels;   // RGBA16F, all bitmaps
   std::vector<vec4> emitters;          // kEmitterTexels per emissive triangle
   std::vector<vec4> emitterAlias;      // one per emitter: (keep probability, alias index, -, -)
-  std::vector<vec4> deltaLights;       // kDeltaLightTexels per light
+  std::vector<vec4> deltaLights;       // kDeltaLightTexels per light, suns first
+  int suns = 0;                        // directional lights with a disc (kLightSun)
   std::vector<float> environmentCdf;   // marginal (h+1) then conditional rows (w+1 each)
 
   std::vector<NodeId> instanceObject;  // instance index -> object id

@@ -412,7 +412,7 @@ struct Renderer::Impl {
     u.scene = {d.tlasRoot, static_cast<std::int32_t>(d.instanceObject.size()),
                static_cast<std::int32_t>(d.emitters.size() / gpu::kEmitterTexels),
                static_cast<std::int32_t>(d.deltaLights.size() / gpu::kDeltaLightTexels)};
-    u.lightPick = {d.lightPick[0], d.lightPick[1], d.lightPick[2], 0};
+    u.lightPick = {d.lightPick[0], d.lightPick[1], d.lightPick[2], static_cast<float>(d.suns)};
     u.environment = {d.environmentType, d.environmentMap, d.environmentWidth, d.environmentHeight};
     u.environmentTint = {d.environmentTint.x, d.environmentTint.y, d.environmentTint.z, 0};
     for (int r = 0; r < 3; ++r)
@@ -779,6 +779,7 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   if (f & static_cast<std::uint32_t>(gpu::kFeatureBump)) out.push_back("bump maps");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureEmissionTextures)) out.push_back("emission textures");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureBlend)) out.push_back("blends");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureSun)) out.push_back("suns with a disc");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTent)) out.push_back("exact tent filter");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTungsten)) out.push_back("Tungsten's filter table");
   return out;

@@ -155,6 +155,7 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
   for (Light& l : scene.lights) {
     clampValue(l.spotAngle, 1e-3f, 1.5707963f, radians(30.0f), cat("light '", l.name, "': spot angle"), warnings);
     clampValue(l.spotBlend, 0.0f, 1.0f, 0.1f, cat("light '", l.name, "': spot blend"), warnings);
+    clampValue(l.angularRadius, 0.0f, 1.5707963f, 0.0f, cat("light '", l.name, "': angular radius"), warnings);
   }
 
   Environment& env = scene.environment;
