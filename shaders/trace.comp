@@ -157,7 +157,7 @@ struct Path {
 };
 
 // The shadow ray of a path vertex's next-event estimation. It is traced with the next segment's
-// extension ray, in one loop (traceRays): the path's own next segment, or, when the path ended at
+// extension ray, in one loop (Trace): the path's own next segment, or, when the path ended at
 // that vertex, the first segment of the path the invocation starts next, so that no segment is
 // spent on it alone (a segment costs the shading code for all eight lanes).
 struct Shadow {
@@ -281,17 +281,13 @@ void resolveShadow(inout Path path, inout Shadow shadow, Hit sh) {
   shadow.pending = false;
 }
 
-// Traces one segment of the path and shades its hit: emission, next-event estimation (its shadow
-// ray is traced with the next segment) and the next direction. Returns false when the path has
-// ended.
-bool extendPath(inout Path path, bool alive, inout Shadow shadow) {
+// Shades the hit of the path's last segment (its ray from path.ro along path.rd): emission,
+// next-event estimation (its shadow ray is traced with the next segment) and the next direction.
+// Returns false when the path has ended.
+bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   int selected = int(frame.work.z) - 1;
   int maxBounces = int(frame.image.w);
   vec3 ro = path.ro, rd = path.rd;
-  Hit hit, sh;
-  traceRays(alive, ro, rd, rand(path.rng), shadow.pending, shadow.origin, shadow.dir, shadow.tMax, shadow.random, hit, sh);
-  resolveShadow(path, shadow, sh);
-  if (!alive) return false;
   if (path.depth == 0) primaryRays++; else bounceRays++;
   if (path.selBase >= 0 && hit.prim >= 0 && hit.instance == selected) {
     // Direct hits, then reflections weighted (maxBounces + 1) / depth: 4, 2, 1 at 3 bounces.
@@ -478,16 +474,36 @@ void main() {
   bool alive = false;
   Shadow shadow;
   shadow.pending = false;
+  // Read once, here: inside a loop or a branch, a storage buffer read is a loop over the lanes on
+  // lavapipe, even at a uniform address (read in every traversal step, these two cost the
+  // spaceship about 10 % of its samples/s).
+  const int root = frame.scene.x;
+  const bool noGeometry = frame.scene.y == 0;
+  Trace tr;
+  beginTrace(tr, root, false, vec3(0.0), vec3(0.0, 0.0, 1.0), 0.0, false, vec3(0.0), vec3(0.0, 0.0, 1.0), 0.0, 0.0);
+  // The traversal stack: its top entry in Trace::top, the ones below it in this array. lavapipe
+  // turns an access to a per-invocation array at a varying index into a loop over the eight lanes
+  // with a branch per lane on the lane's mask. So each iteration reads and writes the array once,
+  // outside any branch, whatever the step: it reads the entry a pop would bring to the top and
+  // writes the top to the slot a push would move it to. That write is harmless when nothing is
+  // pushed (the slot is above the array's part of the stack). Outside every branch a lane's mask
+  // changes only when its query ends, so the per-lane branches predict well; inside the push
+  // branch they mispredicted, and the two accesses took a quarter of the time. Keeping the top
+  // eight entries in variables instead cost registers (spilled) and shifts on every push and pop.
+  // The last slot takes the spill of a full stack.
+  // It is main's own: as a global, the same array cost 8 % of the spaceship's samples/s.
+  int stackBelow[kStackSize];
+  const uint readyLanes = uint(gl_SubgroupSize) * uint(kTraceReadyLanes) / 8u;
   uint cutPaths = 0u;
   uint maxSegment = 0u;
   // Every lane's count is the eight's here: the last synchronisation of an iteration (after the
-  // segment) is also the first of the next.
+  // traversal) is also the first of the next.
   for (;;) {
     loopIterations++;
     if (loopIterations > kLoopBudget || loopIterations + 2u * maxSegment > kLoopLimit) {
-      // Out of loop budget (the same decision in every lane): paths end as they stand (a shadow
-      // ray still to trace is dropped, from an ended path too), and slots not yet started keep
-      // the weight 0 the renderer cleared them to.
+      // Out of loop budget (the same decision in every lane): paths end as they stand, their rays
+      // in flight or not (a shadow ray still to trace is dropped, from an ended path too), and
+      // slots not yet started keep the weight 0 the renderer cleared them to.
       if (alive) {
         cutPaths++;
         writeSample(path, true);
@@ -495,23 +511,49 @@ void main() {
       if (next < push.slotCount) cutPaths += (push.slotCount - next + push.invocations - 1u) / push.invocations;
       break;
     }
-    if (!alive && next < push.slotCount) {
-      path = startPath(push.slotOffset + next);
-      next += push.invocations;
-      alive = true;
+    // The lanes whose rays are done take their hits, shade, and set off their next rays; the
+    // others' rays are still in flight (the traversal loop below).
+    bool ready = tr.done;
+    if (ready && !tr.idle) {
+      resolveShadow(path, shadow, tr.blocker);
+      if (alive && !shadeSegment(path, shadow, tr.closest)) alive = false;
     }
-    // Only the lanes that started a path ran findItem's loop; every lane takes its count here,
-    // before the extension ray's loop, which the others may run longest.
-    syncLoopIterations();
-    if (subgroupAll(!alive && !shadow.pending)) break;
-    uint segmentStart = loopIterations;
-    if ((alive || shadow.pending) && !extendPath(path, alive, shadow)) alive = false;
-    syncLoopIterations();
-    maxSegment = max(maxSegment, loopIterations - segmentStart);
     // Every lane writes its path's state every iteration, the ended ones included (again): a
     // store outside any branch keeps lavapipe's per-lane store branches predictable, where one
     // made only by the lanes whose paths ended mispredicts. A path's last write is its result.
     writeSample(path, !alive);
+    if (ready && !alive && next < push.slotCount) {
+      path = startPath(push.slotOffset + next);
+      next += push.invocations;
+      alive = true;
+    }
+    // Only the lanes that started a path ran findItem's loop, and only some lanes the sky map's
+    // searches: every lane takes the count here, before the traversal loop.
+    syncLoopIterations();
+    if (ready)
+      beginTrace(tr, root, alive, path.ro, path.rd, alive ? rand(path.rng) : 0.0, shadow.pending, shadow.origin, shadow.dir,
+                 shadow.tMax, shadow.random);
+    if (subgroupAll(tr.idle)) break;
+    uint segmentStart = loopIterations;
+    // Trace until enough of the eight are done (kTraceReadyLanes of every eight): lavapipe runs a
+    // loop as long as its slowest lane, and waiting for all eight left a lane idle more than half
+    // the time. The lanes that are done leave with their hits for the shading code above and come
+    // back with new rays; the others go on where they stopped. Lanes given nothing (Trace::idle)
+    // do not count as waiting, so the last paths of an invocation run to the end. Some lane has a
+    // ray here, so the loop has work when it starts.
+    while (!noGeometry) {
+      loopIterations++;
+      int below = stackBelow[clamp(tr.stackSize - 2, 0, kStackSize - 1)];  // the top after a pop
+      stackBelow[clamp(tr.stackSize - 1, 0, kStackSize - 1)] = tr.top;     // where a push moves the top
+      traceStep(tr, below, root);
+      // One reduction (each is a loop over the lanes on lavapipe): the lanes done in the low
+      // byte, the ones waiting to be shaded above it.
+      uint count = subgroupAdd(tr.done ? (tr.idle ? 1u : 257u) : 0u);
+      if ((count & 255u) == gl_SubgroupSize || (count >> 8u) >= readyLanes) break;
+    }
+    if (noGeometry) tr.done = true;  // nothing to hit
+    syncLoopIterations();
+    maxSegment = max(maxSegment, loopIterations - segmentStart);
   }
   atomicAdd(rayCounts[0], primaryRays);
   atomicAdd(rayCounts[1], bounceRays);

@@ -176,12 +176,73 @@ vec3 safeInverse(vec3 d) {
               abs(d.z) > eps ? 1.0 / d.z : (d.z >= 0.0 ? 1e30 : -1e30));
 }
 
-// Two rays, one after the other in one loop: the closest hit of an extension ray (when first)
-// and any opaque hit of a shadow ray up to tMax2 (when second; prim -1 when nothing blocks it). A
-// ray not traced comes back as a miss. One loop for both: lavapipe runs eight lanes in lock-step
-// and a loop as long as its slowest lane, so the eight extension rays and then the eight shadow
-// rays in two loops ran the longest of each (157 loop iterations per spaceship path against 131
-// in one loop), and the loop's code is compiled once.
+// A lane's rays in flight: the closest hit of an extension ray (when `first`) and then any opaque
+// hit of its path's shadow ray up to tMax2 (when `second`; prim -1 when nothing blocks it),
+// traced one after the other in one loop (traceStep, in trace.comp's main). A ray not traced comes back as a miss. One
+// loop for both: lavapipe runs eight lanes in lock-step and a loop as long as its slowest lane,
+// so the eight extension rays and then the eight shadow rays in two loops ran the longest of each
+// (157 loop iterations per spaceship path against 131 in one loop), and the loop's code is
+// compiled once. The state outlives the loop: a lane whose rays are not done when the loop ends
+// goes on with them in the next.
+struct Trace {
+  bool second;    // a shadow ray follows the extension ray
+  bool onShadow;  // the lane traces the shadow ray now
+  bool done;      // both rays are traced: closest and blocker hold their hits
+  bool idle;      // it was given nothing to trace
+  vec3 origin, dir, invDir;  // the current ray, in world space
+  float rayRandom;
+  vec3 origin2, dir2, invDir2;
+  float tMax2, random2;
+  vec3 o, d, invD;  // the current ray in the space of the instance it is in
+  int item, top, stackSize;
+  int instance, instFlags;
+  int instanceSp;  // stack depth on entering the current instance: popping back to it leaves
+  Hit hit;         // the current ray's so far
+  Hit closest, blocker;
+};
+
+// `root` is frame.scene.x, the instance BVH's root, read once by the caller: a storage buffer
+// read is a loop over the lanes on lavapipe, even at a uniform address.
+void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, float random1, bool second, vec3 origin2, vec3 dir2,
+                float tMax2, float random2) {
+  Hit miss;
+  miss.t = kInfinity;
+  miss.prim = -1;
+  miss.instance = -1;
+  miss.u = 0.0;
+  miss.v = 0.0;
+  tr.closest = miss;
+  tr.blocker = miss;
+  tr.blocker.t = tMax2;
+  tr.idle = !(first || second);
+  tr.done = tr.idle;
+  tr.second = second;
+  tr.onShadow = !first;
+  tr.hit = miss;
+  // A lane with nothing to trace visits the root with a ray that enters nothing (see traceStep).
+  tr.hit.t = tr.idle ? -1.0 : (tr.onShadow ? tMax2 : kInfinity);
+  tr.origin2 = origin2;
+  tr.dir2 = dir2;
+  tr.invDir2 = safeInverse(dir2);
+  tr.tMax2 = tMax2;
+  tr.random2 = random2;
+  tr.origin = tr.onShadow ? origin2 : origin1;
+  tr.dir = tr.onShadow ? dir2 : dir1;
+  tr.invDir = tr.onShadow ? tr.invDir2 : safeInverse(dir1);
+  tr.rayRandom = tr.onShadow ? random2 : random1;
+  tr.o = tr.origin;
+  tr.d = tr.dir;
+  tr.invD = tr.invDir;
+  tr.item = root;
+  tr.top = 0;
+  tr.stackSize = 0;
+  tr.instance = -1;
+  tr.instFlags = 0;
+  tr.instanceSp = -1;
+}
+
+// One step of a lane's traversal (see traceStep's caller in trace.comp, which holds the stack:
+// `below` is the entry a pop brings to the top).
 //
 // lavapipe (Mesa 22.3) runs both sides of every branch with lanes masked off: an if skips no
 // code, even when no lane takes it. A loop iteration therefore costs all the code in its body,
@@ -189,49 +250,8 @@ vec3 safeInverse(vec3 d) {
 // take one of its four children, test one triangle, or enter an instance), and all three read
 // their record through the same four texel fetches of the one traversal buffer. Testing up to two leaves of four
 // triangles in the visiting iteration, as before, made every iteration pay for 24 fetches.
-void traceRays(bool first, vec3 origin1, vec3 dir1, float random1, bool second, vec3 origin2, vec3 dir2, float tMax2,
-               float random2, out Hit closest, out Hit shadow) {
-  Hit hit;
-  hit.t = kInfinity;
-  hit.prim = -1;
-  hit.instance = -1;
-  hit.u = 0.0;
-  hit.v = 0.0;
-  closest = hit;
-  shadow = hit;
-  shadow.t = tMax2;
-  if (frame.scene.y == 0 || !(first || second)) return;
-  bool onShadow = !first;  // the lane traces the shadow ray now
-  bool done = false;
-  hit.t = onShadow ? tMax2 : kInfinity;
-  vec3 invDir2 = safeInverse(dir2);
-  vec3 origin = onShadow ? origin2 : origin1, dir = onShadow ? dir2 : dir1;
-  float rayRandom = onShadow ? random2 : random1;
-
-  // The traversal stack: its top entry in a variable, the ones below it in an array. lavapipe
-  // turns an access to a per-invocation array at a varying index into a loop over the eight
-  // lanes with a branch per lane on the lane's mask. So each iteration reads and writes the
-  // array once, outside any branch, whatever the step: it reads the entry a pop would bring to
-  // the top and writes the top to the slot a push would move it to. That write is harmless when
-  // nothing is pushed (the slot is above the array's part of the stack). Outside every branch a
-  // lane's mask changes only when its query ends, so the per-lane branches predict well; inside
-  // the push branch they mispredicted, and the two accesses took a quarter of the time. Keeping
-  // the top eight entries in variables instead cost registers (spilled) and shifts on every push
-  // and pop.
-  int top = 0;
-  int stackSize = 0;
-  int stackBelow[kStackSize];  // entries under the top; the last slot takes the spill of a full stack
-  int item = frame.scene.x;  // the instance BVH's root
-  vec3 invDir = onShadow ? invDir2 : safeInverse(dir1);
-  vec3 o = origin, d = dir, invD = invDir;
-  int instance = -1;
-  int instFlags = 0;
-  int instanceSp = -1;  // stack depth on entering the current instance: popping back to it leaves
-
-  for (;;) {
-    loopIterations++;
-    int below = stackBelow[clamp(stackSize - 2, 0, kStackSize - 1)];  // the top after a pop
-    stackBelow[clamp(stackSize - 1, 0, kStackSize - 1)] = top;       // where a push moves the top
+void traceStep(inout Trace tr, int below, int root) {
+    int item = tr.item;
     int at = item >> kItemOffsetShift;
     int kind = item & 3;
     vec4 r0 = texelFetch(uTraversal, at), r1 = texelFetch(uTraversal, at + 1);
@@ -245,8 +265,9 @@ void traceRays(bool first, vec3 origin1, vec3 dir1, float random1, bool second, 
       // pushed (see above): the one child left, or, with more left, the node itself, with the
       // position to go on from in its item's count bits. Its next visit tests the boxes again,
       // against the hit found meanwhile.
+      vec3 invD = tr.invD;
       uvec3 e = (uvec3(floatBitsToUint(r0.w)) >> uvec3(0u, 8u, 16u)) & 255u;
-      vec3 base = (r0.xyz - o) * invD;
+      vec3 base = (r0.xyz - tr.o) * invD;
       vec3 scaled = uintBitsToFloat(e << 23u) * invD;
       uvec4 qa = floatBitsToUint(r2), qb = floatBitsToUint(r3);
       // The planes a ray enters and leaves by: lo and hi swap where the direction is negative.
@@ -269,7 +290,7 @@ void traceRays(bool first, vec3 origin1, vec3 dir1, float random1, bool second, 
       tNear = mix(tNear, t, greaterThan(t, tNear));
       t = base.z + vec4((uvec4(outZ) >> bytes) & 255u) * scaled.z;
       tFar = mix(tFar, t, lessThan(t, tFar)) * kSlabSlack;
-      tFar = mix(vec4(hit.t), tFar, lessThan(tFar, vec4(hit.t)));
+      tFar = mix(vec4(tr.hit.t), tFar, lessThan(tFar, vec4(tr.hit.t)));
       ivec4 children = floatBitsToInt(r1);
       // An empty slot's box is inside out (render/bvh.cpp quantize), but in a node of no extent
       // far from the origin its planes can round to one point: its item says it is empty.
@@ -286,89 +307,88 @@ void traceRays(bool first, vec3 origin1, vec3 dir1, float random1, bool second, 
       // What is pushed: the one child left, as it is, or the node, to go on from pos + 1.
       uint rest = left & (left - 1u);
       int otherChild = childAt(children, (order >> uint(2 * findLSB(rest))) & 3u);
-      if (rest != 0u && stackSize < kStackSize) {
-        top = (rest & (rest - 1u)) == 0u ? otherChild : (item & ~12) | ((pos + 1) << 2);
-        stackSize++;
+      if (rest != 0u && tr.stackSize < kStackSize) {
+        tr.top = (rest & (rest - 1u)) == 0u ? otherChild : (item & ~12) | ((pos + 1) << 2);
+        tr.stackSize++;
       }
     } else if (kind == kItemTriangles) {
       // Moeller-Trumbore against v0 = r0.xyz, e1 = r1.xyz, e2 = r2.xyz.
+      vec3 d = tr.d;
       vec3 pv = cross(d, r2.xyz);
       float det = dot(r1.xyz, pv);
       float inv = 1.0 / det;
-      vec3 s = o - r0.xyz;
+      vec3 s = tr.o - r0.xyz;
       float uu = dot(s, pv) * inv;
       vec3 q = cross(s, r1.xyz);
       float vv = dot(d, q) * inv;
       float tt = dot(r2.xyz, q) * inv;
-      bool found = det != 0.0 && uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < hit.t;
+      bool found = det != 0.0 && uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < tr.hit.t;
       int p = floatBitsToInt(r0.w);
 #if RETILE_ALPHA_TEST
-      if (found && (instFlags & kInstanceAlphaTested) != 0) found = alphaPasses(instance, p, uu, vv, rayRandom);
+      if (found && (tr.instFlags & kInstanceAlphaTested) != 0) found = alphaPasses(tr.instance, p, uu, vv, tr.rayRandom);
 #endif
       if (found) {
-        hit.t = tt;
-        hit.u = uu;
-        hit.v = vv;
-        hit.prim = p;
-        hit.instance = instance;
-        finished = onShadow;
+        tr.hit.t = tt;
+        tr.hit.u = uu;
+        tr.hit.v = vv;
+        tr.hit.prim = p;
+        tr.hit.instance = tr.instance;
+        finished = tr.onShadow;
       }
       // The rest of the leaf: one triangle further on, one fewer to go.
       if ((item & 12) != 0) next = item + ((kTriTexels << kItemOffsetShift) - 4);
     } else {
       // Enter an instance: transform the ray (t is preserved because d is not renormalised).
-      instance = floatBitsToInt(r3.y);
-      instFlags = floatBitsToInt(r3.z);
-      o = vec3(dot(r0.xyz, origin) + r0.w, dot(r1.xyz, origin) + r1.w, dot(r2.xyz, origin) + r2.w);
-      d = vec3(dot(r0.xyz, dir), dot(r1.xyz, dir), dot(r2.xyz, dir));
-      invD = safeInverse(d);
-      instanceSp = stackSize;
+      tr.instance = floatBitsToInt(r3.y);
+      tr.instFlags = floatBitsToInt(r3.z);
+      vec3 origin = tr.origin, dir = tr.dir;
+      tr.o = vec3(dot(r0.xyz, origin) + r0.w, dot(r1.xyz, origin) + r1.w, dot(r2.xyz, origin) + r2.w);
+      tr.d = vec3(dot(r0.xyz, dir), dot(r1.xyz, dir), dot(r2.xyz, dir));
+      tr.invD = safeInverse(tr.d);
+      tr.instanceSp = tr.stackSize;
       next = floatBitsToInt(r3.x);
     }
     if (next < 0 && !finished) {
-      finished = stackSize == 0;
+      finished = tr.stackSize == 0;
       if (!finished) {
-        next = top;
-        top = below;
-        stackSize--;
+        next = tr.top;
+        tr.top = below;
+        tr.stackSize--;
       }
     }
-    if (finished && (onShadow || !second)) {
-      // Both rays done. The lane stays in the loop until the eight are done, visiting the root
-      // with a ray that enters nothing: a lane that left the loop made every iteration's stack
-      // write, masked for it, reload its slot and mispredict.
-      if (!done) {
-        if (onShadow) shadow = hit; else closest = hit;
+    if (finished && (tr.onShadow || !tr.second)) {
+      // Both rays done. The lane stays in the loop until it ends, visiting the root with a ray
+      // that enters nothing: a lane that left the loop made every iteration's stack write,
+      // masked for it, reload its slot and mispredict.
+      if (!tr.done) {
+        if (tr.onShadow) tr.blocker = tr.hit; else tr.closest = tr.hit;
       }
-      done = true;
-      hit.t = -1.0;
-      stackSize = 0;
-      next = frame.scene.x;
+      tr.done = true;
+      tr.hit.t = -1.0;
+      tr.stackSize = 0;
+      next = root;
     } else if (finished) {
       // The extension ray is done: the shadow ray starts at the instance BVH's root.
-      closest = hit;
-      onShadow = true;
-      hit.t = tMax2;
-      hit.prim = -1;
-      origin = origin2;
-      dir = dir2;
-      invDir = invDir2;
-      rayRandom = random2;
-      stackSize = 0;
-      next = frame.scene.x;
+      tr.closest = tr.hit;
+      tr.onShadow = true;
+      tr.hit.t = tr.tMax2;
+      tr.hit.prim = -1;
+      tr.origin = tr.origin2;
+      tr.dir = tr.dir2;
+      tr.invDir = tr.invDir2;
+      tr.rayRandom = tr.random2;
+      tr.stackSize = 0;
+      next = root;
     }
-    if (stackSize < instanceSp || finished) {
+    if (tr.stackSize < tr.instanceSp || finished) {
       // Back from the instance to world space (or to the shadow ray's).
-      o = origin;
-      d = dir;
-      invD = invDir;
-      instance = -1;
-      instanceSp = -1;
+      tr.o = tr.origin;
+      tr.d = tr.dir;
+      tr.invD = tr.invDir;
+      tr.instance = -1;
+      tr.instanceSp = -1;
     }
-    item = next;
-    if (subgroupAll(done)) break;
-  }
-  syncLoopIterations();
+    tr.item = next;
 }
 
 #endif

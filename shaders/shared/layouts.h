@@ -97,6 +97,9 @@ RT_CONST(int, kEnvConstant, 1)
 RT_CONST(int, kEnvMap, 2)
 
 RT_CONST(int, kTraceWorkgroup, 64)
+// The traversal loop ends when this many lanes of every eight have their rays done (scene.glsl
+// traverse): the ones done are shaded while the rest wait, their rays half traced.
+RT_CONST(int, kTraceReadyLanes, 6)
 RT_CONST(int, kStatsCount, 8)  // counters the trace pass writes (see trace.comp)
 // The trace pass stops its paths once its loop-iteration count passes this (see trace.comp).
 RT_CONST(uint, kLoopBudget, 30000u)

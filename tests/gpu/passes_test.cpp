@@ -558,8 +558,11 @@ TEST(TracePass, EightLanesOutOfLoopBudgetOverManyTilesStopCleanly) {
   ASSERT_GT(all.cutPaths, 0u) << "the frame should need more than lavapipe's limit in one subgroup";
   TracedComparison c = compareTraced(a, b);
   EXPECT_GT(c.traced, 800);
-  // At most the eight paths in flight when the budget ran out differ; every other path is exact.
-  EXPECT_LE(c.differing, 8) << c.differing << " of " << c.traced << " traced pixels differ from the reference";
+  // At most two paths a lane differ, those in flight when the budget ran out: the lane's path,
+  // and the one it ended whose last shadow ray was still to trace with the new path's first ray
+  // (a lane whose rays are not done when the traversal loop ends keeps them while the others
+  // are shaded). Every other path is exact.
+  EXPECT_LE(c.differing, 16) << c.differing << " of " << c.traced << " traced pixels differ from the reference";
 }
 
 }  // namespace
