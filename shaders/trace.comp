@@ -5,6 +5,7 @@
 // hit's albedo, normal, depth and instance for the accumulate pass.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_vote : require
+#extension GL_KHR_shader_subgroup_ballot : require
 
 #include "common/rng.glsl"
 #include "common/bsdf.glsl"
@@ -456,6 +457,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
 }
 
 void main() {
+  frame = frameBuffer;  // see scene.glsl
   uint invocation = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * uint(kTraceWorkgroup) + gl_LocalInvocationID.x;
   // This invocation's slots are invocation, invocation + invocations, ...: neighbouring lanes
   // start on neighbouring pixels. Invocations past the end take part in the loop with no slots,
@@ -474,9 +476,8 @@ void main() {
   bool alive = false;
   Shadow shadow;
   shadow.pending = false;
-  // Read once, here: inside a loop or a branch, a storage buffer read is a loop over the lanes on
-  // lavapipe, even at a uniform address (read in every traversal step, these two cost the
-  // spaceship about 10 % of its samples/s).
+  // Read once, here (read from the storage buffer in every traversal step, these two cost the
+  // spaceship about 10 % of its samples/s; see frame in scene.glsl).
   const int root = frame.scene.x;
   const bool noGeometry = frame.scene.y == 0;
   Trace tr;
@@ -533,7 +534,11 @@ void main() {
     if (ready)
       beginTrace(tr, root, alive, path.ro, path.rd, alive ? rand(path.rng) : 0.0, shadow.pending, shadow.origin, shadow.dir,
                  shadow.tMax, shadow.random);
-    if (subgroupAll(tr.idle)) break;
+    // The loop below ends when no more than this many lanes are still busy: idle lanes are done
+    // from the start and never wait, so counting the busy ones is enough.
+    uint idleLanes = subgroupBallotBitCount(subgroupBallot(tr.idle));
+    if (idleLanes == gl_SubgroupSize) break;
+    uint busyAtExit = idleLanes + readyLanes >= gl_SubgroupSize ? 0u : gl_SubgroupSize - readyLanes - idleLanes;
     uint segmentStart = loopIterations;
     // Trace until enough of the eight are done (kTraceReadyLanes of every eight): lavapipe runs a
     // loop as long as its slowest lane, and waiting for all eight left a lane idle more than half
@@ -546,10 +551,9 @@ void main() {
       int below = stackBelow[clamp(tr.stackSize - 2, 0, kStackSize - 1)];  // the top after a pop
       stackBelow[clamp(tr.stackSize - 1, 0, kStackSize - 1)] = tr.top;     // where a push moves the top
       traceStep(tr, below, root);
-      // One reduction (each is a loop over the lanes on lavapipe): the lanes done in the low
-      // byte, the ones waiting to be shaded above it.
-      uint count = subgroupAdd(tr.done ? (tr.idle ? 1u : 257u) : 0u);
-      if ((count & 255u) == gl_SubgroupSize || (count >> 8u) >= readyLanes) break;
+      // One ballot a step: a subgroup operation is a loop over the lanes on lavapipe, and a
+      // ballot's has no branch in it (subgroupAdd's, with one, took a tenth of the loop's time).
+      if (subgroupBallotBitCount(subgroupBallot(!tr.done)) <= busyAtExit) break;
     }
     if (noGeometry) tr.done = true;  // nothing to hit
     syncLoopIterations();
