@@ -274,11 +274,10 @@ void resolveShadow(inout Path path, inout Shadow shadow, Hit sh) {
   int selected = int(frame.work.z) - 1;
   if (shadow.selBase >= 0 && sh.prim >= 0 && sh.instance == selected) atomicAdd(selectionCounts[shadow.selBase + 2], 1u);
   bool visible = sh.prim < 0;
-  // The path is still this invocation's (it goes on, or no path has started since it ended).
-  bool own = !shadow.ended || path.slot == shadow.slot;
-  if (visible && own) path.L += shadow.L;
+  // An ended path's sample was written when it ended (the lane may have started another since).
+  if (visible && !shadow.ended) path.L += shadow.L;
   bool valid = !(any(isnan(shadow.full)) || any(isinf(shadow.full)));
-  if (visible && !own) samples[shadow.slot] = valid ? vec4(shadow.full, 1.0) : vec4(0.0);
+  if (visible && shadow.ended) samples[shadow.slot] = valid ? vec4(shadow.full, 1.0) : vec4(0.0);
   shadow.pending = false;
 }
 
@@ -463,7 +462,7 @@ void main() {
   // start on neighbouring pixels. Invocations past the end take part in the loop with no slots,
   // so that every lane of the eight sees every iteration and loopIterations stays exact.
   uint next = invocation < push.invocations ? invocation : push.slotCount;
-  // Until its first path starts, a lane writes to the spare slot past the frame's last.
+  // Until its first path starts, a lane's slot is the spare one past the frame's last (it writes none).
   Path path;
   path.slot = frame.work.y;
   path.L = vec3(0.0);
@@ -514,15 +513,16 @@ void main() {
     }
     // The lanes whose rays are done take their hits, shade, and set off their next rays; the
     // others' rays are still in flight (the traversal loop below).
-    bool ready = tr.done;
+    bool ready = tr.done, ended = false;
     if (ready && !tr.idle) {
       resolveShadow(path, shadow, tr.blocker);
-      if (alive && !shadeSegment(path, shadow, tr.closest)) alive = false;
+      ended = alive && !shadeSegment(path, shadow, tr.closest);
+      alive = alive && !ended;
     }
-    // Every lane writes its path's state every iteration, the ended ones included (again): a
-    // store outside any branch keeps lavapipe's per-lane store branches predictable, where one
-    // made only by the lanes whose paths ended mispredicts. A path's last write is its result.
-    writeSample(path, !alive);
+    // A path's sample is written once, when it ends. (Written by every lane every iteration, as
+    // it was to keep lavapipe's per-lane store branches predictable, the four stores, each a loop
+    // over the lanes and over the components, took a tenth of the time.)
+    if (ended) writeSample(path, true);
     if (ready && !alive && next < push.slotCount) {
       path = startPath(push.slotOffset + next);
       next += push.invocations;
