@@ -556,7 +556,8 @@ void main() {
       if (subgroupBallotBitCount(subgroupBallot(!tr.done)) <= busyAtExit) break;
     }
     if (noGeometry) tr.done = true;  // nothing to hit
-    syncLoopIterations();
+    // Every lane ran every iteration of that loop (its exit is the same in all), so the counts,
+    // equal before it, still are.
     maxSegment = max(maxSegment, loopIterations - segmentStart);
   }
   atomicAdd(rayCounts[0], primaryRays);
