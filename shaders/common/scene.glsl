@@ -182,12 +182,12 @@ vec3 safeInverse(vec3 d) {
 
 // A lane's rays in flight: the closest hit of an extension ray (when `first`) and then any opaque
 // hit of its path's shadow ray up to tMax2 (when `second`; prim -1 when nothing blocks it),
-// traced one after the other in one loop (traceStep, in trace.comp's main). A ray not traced comes back as a miss. One
-// loop for both: lavapipe runs eight lanes in lock-step and a loop as long as its slowest lane,
-// so the eight extension rays and then the eight shadow rays in two loops ran the longest of each
-// (157 loop iterations per spaceship path against 131 in one loop), and the loop's code is
-// compiled once. The state outlives the loop: a lane whose rays are not done when the loop ends
-// goes on with them in the next.
+// traced one after the other in one loop (of traceStep, in trace.comp's main). A ray not traced
+// comes back as a miss. One loop for both: lavapipe runs eight lanes in lock-step and a loop as
+// long as its slowest lane, so the eight extension rays and then the eight shadow rays in two
+// loops ran the longest of each (157 loop iterations per spaceship path against 131 in one loop),
+// and the loop's code is compiled once. The state outlives the loop: a lane whose rays are not
+// done when the loop ends goes on with them in the next.
 struct Trace {
   bool second;    // a shadow ray follows the extension ray
   bool onShadow;  // the lane traces the shadow ray now
@@ -206,8 +206,8 @@ struct Trace {
 };
 
 // `root` is frame.scene.x, the instance BVH's root, which the caller reads once.
-void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, float random1, bool second, vec3 origin2, vec3 dir2,
-                float tMax2, float random2) {
+void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, float random1, bool second,
+                vec3 origin2, vec3 dir2, float tMax2, float random2) {
   Hit miss;
   miss.t = kInfinity;
   miss.prim = -1;
@@ -244,8 +244,9 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, f
   tr.instanceSp = -1;
 }
 
-// One step of a lane's traversal (see traceStep's caller in trace.comp, which holds the stack:
-// `below` is the entry a pop brings to the top).
+// One step of a lane's traversal. The caller (trace.comp's main) holds the stack below the top
+// entry: `below` is the entry a pop brings to the top, and tr.top is already in the slot a push
+// moves it to.
 //
 // lavapipe (Mesa 22.3) runs both sides of every branch with lanes masked off: an if skips no
 // code, even when no lane takes it. A loop iteration therefore costs all the code in its body,
@@ -254,144 +255,144 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, f
 // their record through the same four texel fetches of the one traversal buffer. Testing up to two leaves of four
 // triangles in the visiting iteration, as before, made every iteration pay for 24 fetches.
 void traceStep(inout Trace tr, int below, int root) {
-    int item = tr.item;
-    int at = item >> kItemOffsetShift;
-    int kind = item & 3;
-    vec4 r0 = texelFetch(uTraversal, at), r1 = texelFetch(uTraversal, at + 1);
-    vec4 r2 = texelFetch(uTraversal, at + 2), r3 = texelFetch(uTraversal, at + 3);
-    int next = -1;
-    bool finished = false;
-    if (kind == kItemNode) {
-      // Four child boxes, quantised (render/bvh.h QuantizedNode): a plane's distance is
-      // (origin - o) / d + q * scale / d, each axis for the four children at once. The children
-      // are taken in the node's order for the ray's octant, one per visit, and one entry is
-      // pushed (see above): the one child left, or, with more left, the node itself, with the
-      // position to go on from in its item's count bits. Its next visit tests the boxes again,
-      // against the hit found meanwhile.
-      vec3 invD = tr.invD;
-      uvec3 e = (uvec3(floatBitsToUint(r0.w)) >> uvec3(0u, 8u, 16u)) & 255u;
-      vec3 base = (r0.xyz - tr.o) * invD;
-      vec3 scaled = uintBitsToFloat(e << 23u) * invD;
-      uvec4 qa = floatBitsToUint(r2), qb = floatBitsToUint(r3);
-      // The planes a ray enters and leaves by: lo and hi swap where the direction is negative.
-      bool bx = invD.x < 0.0, by = invD.y < 0.0, bz = invD.z < 0.0;
-      uint inX = bx ? qa.w : qa.x, outX = bx ? qa.x : qa.w;
-      uint inY = by ? qb.x : qa.y, outY = by ? qa.y : qb.x;
-      uint inZ = bz ? qb.y : qa.z, outZ = bz ? qa.z : qb.y;
-      const uvec4 bytes = uvec4(0u, 8u, 16u, 24u);
-      // Axis by axis, so that few values are live at once. Selects rather than min and max:
-      // lavapipe gives those NaN semantics at three instructions each, and no NaN reaches here
-      // (safeInverse keeps invD finite).
-      vec4 tNear = base.x + vec4((uvec4(inX) >> bytes) & 255u) * scaled.x;
-      tNear = mix(vec4(0.0), tNear, greaterThan(tNear, vec4(0.0)));
-      vec4 tFar = base.x + vec4((uvec4(outX) >> bytes) & 255u) * scaled.x;
-      vec4 t = base.y + vec4((uvec4(inY) >> bytes) & 255u) * scaled.y;
-      tNear = mix(tNear, t, greaterThan(t, tNear));
-      t = base.y + vec4((uvec4(outY) >> bytes) & 255u) * scaled.y;
-      tFar = mix(tFar, t, lessThan(t, tFar));
-      t = base.z + vec4((uvec4(inZ) >> bytes) & 255u) * scaled.z;
-      tNear = mix(tNear, t, greaterThan(t, tNear));
-      t = base.z + vec4((uvec4(outZ) >> bytes) & 255u) * scaled.z;
-      tFar = mix(tFar, t, lessThan(t, tFar)) * kSlabSlack;
-      tFar = mix(vec4(tr.hit.t), tFar, lessThan(tFar, vec4(tr.hit.t)));
-      ivec4 children = floatBitsToInt(r1);
-      // An empty slot's box is inside out (render/bvh.cpp quantize), but in a node of no extent
-      // far from the origin its planes can round to one point: its item says it is empty.
-      ivec4 entered = ivec4(lessThanEqual(tNear, tFar)) * ivec4(greaterThanEqual(children, ivec4(0)));
-      int octant = int(bx) | (int(by) << 1) | (int(bz) << 2);
-      uint order = ((octant < 4 ? qb.z : qb.w) >> (8u * uint(octant & 3))) & 255u;
-      uvec4 slots = (uvec4(order) >> uvec4(0u, 2u, 4u, 6u)) & 3u;
-      uint inSlots = uint(entered.x | (entered.y << 1) | (entered.z << 2) | (entered.w << 3));
-      uvec4 inOrder = (uvec4(inSlots) >> slots) & 1u;
-      uint left = (inOrder.x | (inOrder.y << 1) | (inOrder.z << 2) | (inOrder.w << 3)) & (15u << uint((item >> 2) & 3));
-      int pos = findLSB(left);
-      uint slot = (order >> uint(2 * pos)) & 3u;
-      if (left != 0u) next = childAt(children, slot);
-      // What is pushed: the one child left, as it is, or the node, to go on from pos + 1.
-      uint rest = left & (left - 1u);
-      int otherChild = childAt(children, (order >> uint(2 * findLSB(rest))) & 3u);
-      if (rest != 0u && tr.stackSize < kStackSize) {
-        tr.top = (rest & (rest - 1u)) == 0u ? otherChild : (item & ~12) | ((pos + 1) << 2);
-        tr.stackSize++;
-      }
-    } else if (kind == kItemTriangles) {
-      // Moeller-Trumbore against v0 = r0.xyz, e1 = r1.xyz, e2 = r2.xyz.
-      vec3 d = tr.d;
-      vec3 pv = cross(d, r2.xyz);
-      float det = dot(r1.xyz, pv);
-      float inv = 1.0 / det;
-      vec3 s = tr.o - r0.xyz;
-      float uu = dot(s, pv) * inv;
-      vec3 q = cross(s, r1.xyz);
-      float vv = dot(d, q) * inv;
-      float tt = dot(r2.xyz, q) * inv;
-      bool found = det != 0.0 && uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < tr.hit.t;
-      int p = floatBitsToInt(r0.w);
+  int item = tr.item;
+  int at = item >> kItemOffsetShift;
+  int kind = item & 3;
+  vec4 r0 = texelFetch(uTraversal, at), r1 = texelFetch(uTraversal, at + 1);
+  vec4 r2 = texelFetch(uTraversal, at + 2), r3 = texelFetch(uTraversal, at + 3);
+  int next = -1;
+  bool finished = false;
+  if (kind == kItemNode) {
+    // Four child boxes, quantised (render/bvh.h QuantizedNode): a plane's distance is
+    // (origin - o) / d + q * scale / d, each axis for the four children at once. The children
+    // are taken in the node's order for the ray's octant, one per visit, and one entry is
+    // pushed (see the stack in trace.comp's main): the one child left, or, with more left, the
+    // node itself, with the position to go on from in its item's count bits. Its next visit
+    // tests the boxes again, against the hit found meanwhile.
+    vec3 invD = tr.invD;
+    uvec3 e = (uvec3(floatBitsToUint(r0.w)) >> uvec3(0u, 8u, 16u)) & 255u;
+    vec3 base = (r0.xyz - tr.o) * invD;
+    vec3 scaled = uintBitsToFloat(e << 23u) * invD;
+    uvec4 qa = floatBitsToUint(r2), qb = floatBitsToUint(r3);
+    // The planes a ray enters and leaves by: lo and hi swap where the direction is negative.
+    bool bx = invD.x < 0.0, by = invD.y < 0.0, bz = invD.z < 0.0;
+    uint inX = bx ? qa.w : qa.x, outX = bx ? qa.x : qa.w;
+    uint inY = by ? qb.x : qa.y, outY = by ? qa.y : qb.x;
+    uint inZ = bz ? qb.y : qa.z, outZ = bz ? qa.z : qb.y;
+    const uvec4 bytes = uvec4(0u, 8u, 16u, 24u);
+    // Axis by axis, so that few values are live at once. Selects rather than min and max:
+    // lavapipe gives those NaN semantics at three instructions each, and no NaN reaches here
+    // (safeInverse keeps invD finite).
+    vec4 tNear = base.x + vec4((uvec4(inX) >> bytes) & 255u) * scaled.x;
+    tNear = mix(vec4(0.0), tNear, greaterThan(tNear, vec4(0.0)));
+    vec4 tFar = base.x + vec4((uvec4(outX) >> bytes) & 255u) * scaled.x;
+    vec4 t = base.y + vec4((uvec4(inY) >> bytes) & 255u) * scaled.y;
+    tNear = mix(tNear, t, greaterThan(t, tNear));
+    t = base.y + vec4((uvec4(outY) >> bytes) & 255u) * scaled.y;
+    tFar = mix(tFar, t, lessThan(t, tFar));
+    t = base.z + vec4((uvec4(inZ) >> bytes) & 255u) * scaled.z;
+    tNear = mix(tNear, t, greaterThan(t, tNear));
+    t = base.z + vec4((uvec4(outZ) >> bytes) & 255u) * scaled.z;
+    tFar = mix(tFar, t, lessThan(t, tFar)) * kSlabSlack;
+    tFar = mix(vec4(tr.hit.t), tFar, lessThan(tFar, vec4(tr.hit.t)));
+    ivec4 children = floatBitsToInt(r1);
+    // An empty slot's box is inside out (render/bvh.cpp quantize), but in a node of no extent
+    // far from the origin its planes can round to one point: its item says it is empty.
+    ivec4 entered = ivec4(lessThanEqual(tNear, tFar)) * ivec4(greaterThanEqual(children, ivec4(0)));
+    int octant = int(bx) | (int(by) << 1) | (int(bz) << 2);
+    uint order = ((octant < 4 ? qb.z : qb.w) >> (8u * uint(octant & 3))) & 255u;
+    uvec4 slots = (uvec4(order) >> uvec4(0u, 2u, 4u, 6u)) & 3u;
+    uint inSlots = uint(entered.x | (entered.y << 1) | (entered.z << 2) | (entered.w << 3));
+    uvec4 inOrder = (uvec4(inSlots) >> slots) & 1u;
+    uint left = (inOrder.x | (inOrder.y << 1) | (inOrder.z << 2) | (inOrder.w << 3)) & (15u << uint((item >> 2) & 3));
+    int pos = findLSB(left);
+    uint slot = (order >> uint(2 * pos)) & 3u;
+    if (left != 0u) next = childAt(children, slot);
+    // What is pushed: the one child left, as it is, or the node, to go on from pos + 1.
+    uint rest = left & (left - 1u);
+    int otherChild = childAt(children, (order >> uint(2 * findLSB(rest))) & 3u);
+    if (rest != 0u && tr.stackSize < kStackSize) {
+      tr.top = (rest & (rest - 1u)) == 0u ? otherChild : (item & ~12) | ((pos + 1) << 2);
+      tr.stackSize++;
+    }
+  } else if (kind == kItemTriangles) {
+    // Moeller-Trumbore against v0 = r0.xyz, e1 = r1.xyz, e2 = r2.xyz.
+    vec3 d = tr.d;
+    vec3 pv = cross(d, r2.xyz);
+    float det = dot(r1.xyz, pv);
+    float inv = 1.0 / det;
+    vec3 s = tr.o - r0.xyz;
+    float uu = dot(s, pv) * inv;
+    vec3 q = cross(s, r1.xyz);
+    float vv = dot(d, q) * inv;
+    float tt = dot(r2.xyz, q) * inv;
+    bool found = det != 0.0 && uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < tr.hit.t;
+    int p = floatBitsToInt(r0.w);
 #if RETILE_ALPHA_TEST
-      if (found && (tr.instFlags & kInstanceAlphaTested) != 0) found = alphaPasses(tr.instance, p, uu, vv, tr.rayRandom);
+    if (found && (tr.instFlags & kInstanceAlphaTested) != 0) found = alphaPasses(tr.instance, p, uu, vv, tr.rayRandom);
 #endif
-      if (found) {
-        tr.hit.t = tt;
-        tr.hit.u = uu;
-        tr.hit.v = vv;
-        tr.hit.prim = p;
-        tr.hit.instance = tr.instance;
-        finished = tr.onShadow;
-      }
-      // The rest of the leaf: one triangle further on, one fewer to go.
-      if ((item & 12) != 0) next = item + ((kTriTexels << kItemOffsetShift) - 4);
-    } else {
-      // Enter an instance: transform the ray (t is preserved because d is not renormalised).
-      tr.instance = floatBitsToInt(r3.y);
-      tr.instFlags = floatBitsToInt(r3.z);
-      vec3 origin = tr.origin, dir = tr.dir;
-      tr.o = vec3(dot(r0.xyz, origin) + r0.w, dot(r1.xyz, origin) + r1.w, dot(r2.xyz, origin) + r2.w);
-      tr.d = vec3(dot(r0.xyz, dir), dot(r1.xyz, dir), dot(r2.xyz, dir));
-      tr.invD = safeInverse(tr.d);
-      tr.instanceSp = tr.stackSize;
-      next = floatBitsToInt(r3.x);
+    if (found) {
+      tr.hit.t = tt;
+      tr.hit.u = uu;
+      tr.hit.v = vv;
+      tr.hit.prim = p;
+      tr.hit.instance = tr.instance;
+      finished = tr.onShadow;
     }
-    if (next < 0 && !finished) {
-      finished = tr.stackSize == 0;
-      if (!finished) {
-        next = tr.top;
-        tr.top = below;
-        tr.stackSize--;
-      }
+    // The rest of the leaf: one triangle further on, one fewer to go.
+    if ((item & 12) != 0) next = item + ((kTriTexels << kItemOffsetShift) - 4);
+  } else {
+    // Enter an instance: transform the ray (t is preserved because d is not renormalised).
+    tr.instance = floatBitsToInt(r3.y);
+    tr.instFlags = floatBitsToInt(r3.z);
+    vec3 origin = tr.origin, dir = tr.dir;
+    tr.o = vec3(dot(r0.xyz, origin) + r0.w, dot(r1.xyz, origin) + r1.w, dot(r2.xyz, origin) + r2.w);
+    tr.d = vec3(dot(r0.xyz, dir), dot(r1.xyz, dir), dot(r2.xyz, dir));
+    tr.invD = safeInverse(tr.d);
+    tr.instanceSp = tr.stackSize;
+    next = floatBitsToInt(r3.x);
+  }
+  if (next < 0 && !finished) {
+    finished = tr.stackSize == 0;
+    if (!finished) {
+      next = tr.top;
+      tr.top = below;
+      tr.stackSize--;
     }
-    if (finished && (tr.onShadow || !tr.second)) {
-      // Both rays done. The lane stays in the loop until it ends, visiting the root with a ray
-      // that enters nothing: a lane that left the loop made every iteration's stack write,
-      // masked for it, reload its slot and mispredict.
-      if (!tr.done) {
-        if (tr.onShadow) tr.blocker = tr.hit; else tr.closest = tr.hit;
-      }
-      tr.done = true;
-      tr.hit.t = -1.0;
-      tr.stackSize = 0;
-      next = root;
-    } else if (finished) {
-      // The extension ray is done: the shadow ray starts at the instance BVH's root.
-      tr.closest = tr.hit;
-      tr.onShadow = true;
-      tr.hit.t = tr.tMax2;
-      tr.hit.prim = -1;
-      tr.origin = tr.origin2;
-      tr.dir = tr.dir2;
-      tr.invDir = tr.invDir2;
-      tr.rayRandom = tr.random2;
-      tr.stackSize = 0;
-      next = root;
+  }
+  if (finished && (tr.onShadow || !tr.second)) {
+    // Both rays done. The lane stays in the loop until it ends, visiting the root with a ray
+    // that enters nothing: a lane that left the loop made every iteration's stack write,
+    // masked for it, reload its slot and mispredict.
+    if (!tr.done) {
+      if (tr.onShadow) tr.blocker = tr.hit; else tr.closest = tr.hit;
     }
-    if (tr.stackSize < tr.instanceSp || finished) {
-      // Back from the instance to world space (or to the shadow ray's).
-      tr.o = tr.origin;
-      tr.d = tr.dir;
-      tr.invD = tr.invDir;
-      tr.instance = -1;
-      tr.instanceSp = -1;
-    }
-    tr.item = next;
+    tr.done = true;
+    tr.hit.t = -1.0;
+    tr.stackSize = 0;
+    next = root;
+  } else if (finished) {
+    // The extension ray is done: the shadow ray starts at the instance BVH's root.
+    tr.closest = tr.hit;
+    tr.onShadow = true;
+    tr.hit.t = tr.tMax2;
+    tr.hit.prim = -1;
+    tr.origin = tr.origin2;
+    tr.dir = tr.dir2;
+    tr.invDir = tr.invDir2;
+    tr.rayRandom = tr.random2;
+    tr.stackSize = 0;
+    next = root;
+  }
+  if (tr.stackSize < tr.instanceSp || finished) {
+    // Back from the instance to world space (or to the shadow ray's).
+    tr.o = tr.origin;
+    tr.d = tr.dir;
+    tr.invD = tr.invDir;
+    tr.instance = -1;
+    tr.instanceSp = -1;
+  }
+  tr.item = next;
 }
 
 #endif
