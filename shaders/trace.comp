@@ -551,8 +551,9 @@ void main() {
       int below = stackBelow[clamp(tr.stackSize - 2, 0, kStackSize - 1)];  // the top after a pop
       stackBelow[clamp(tr.stackSize - 1, 0, kStackSize - 1)] = tr.top;     // where a push moves the top
       traceStep(tr, below, root);
-      // One ballot a step: a subgroup operation is a loop over the lanes on lavapipe, and a
-      // ballot's has no branch in it (subgroupAdd's, with one, took a tenth of the loop's time).
+      // One ballot a step: a subgroup operation is a loop over the lanes on lavapipe, which holds
+      // about a tenth of this loop's time (subgroupAdd's loop as much; checking every second
+      // step, with the step written twice in the loop, was slower).
       if (subgroupBallotBitCount(subgroupBallot(!tr.done)) <= busyAtExit) break;
     }
     if (noGeometry) tr.done = true;  // nothing to hit

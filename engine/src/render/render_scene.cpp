@@ -596,7 +596,9 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
   Bounds3 b = data_.bounds;
   float radius = b.empty() ? 1.0f : 0.5f * length(b.extent());
   data_.suns = 0;
-  auto isSun = [](const Light& l) { return l.type == LightType::Directional && l.angularRadius > 0; };
+  // Below 1e-4 radians (0.006 degrees) a disc is drawn as the delta light it nearly is: its solid
+  // angle would underflow in the radiance's division.
+  auto isSun = [](const Light& l) { return l.type == LightType::Directional && l.angularRadius > 1e-4f; };
   std::vector<const Light*> lights;  // suns first: rays that leave the scene look for them alone
   for (const Light& l : scene.lights)
     if (l.visible && l.intensity > 0 && maxComponent(l.color) > 0) lights.push_back(&l);
@@ -605,8 +607,8 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
     const Light& l = *light;
     Vec3 intensity = l.color * l.intensity;
     if (isSun(l)) {
-      // The disc's radiance gives the light's intensity as irradiance facing it, as near as a
-      // small disc does (exactly E (1 + cos) / 2 for a disc of any size).
+      // The disc's radiance is the intensity over its solid angle: a small disc lights what faces
+      // it as the delta light of that intensity does, a wider one by E (1 + cos radius) / 2.
       float half = 0.5f * std::min(l.angularRadius, kPi / 2);
       float oneMinusCos = 2 * std::sin(half) * std::sin(half);  // no cancellation for small discs
       float solidAngle = 2 * kPi * oneMinusCos;

@@ -43,7 +43,9 @@ std::string checkLight(const Light& l) {
   if (!isFinite(l.color) || !isFinite(l.position) || !isFinite(l.direction) || !finite(l.intensity) ||
       !finite(l.spotAngle) || !finite(l.spotBlend) || !finite(l.angularRadius))
     return cat("light '", l.name, "': a parameter is not a finite number");
-  if (l.angularRadius < 0 || l.angularRadius > kPi / 2) return cat("light '", l.name, "': the angular radius must be between 0 and 90 degrees");
+  // radians(90) in float may round a hair past pi / 2.
+  if (l.angularRadius < 0 || l.angularRadius > kPi / 2 + 1e-6f)
+    return cat("light '", l.name, "': the angular radius must be between 0 and 90 degrees");
   return {};
 }
 
