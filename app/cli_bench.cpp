@@ -189,6 +189,9 @@ int benchThroughput(const ThroughputOptions& o) {
   std::printf("frame time     %.1f ms (device), %.1f ms (wall)\n", sec / frames * 1e3, wall / frames * 1e3);
   std::printf("scene upload   %.3f s (BVH bottom level %.3f s, top level %.4f s)\n", setup, renderer.lastBlasSeconds(),
               renderer.lastTlasSeconds());
+  std::string kernel;
+  for (const std::string& f : renderer.kernelFeatures()) kernel += (kernel.empty() ? "" : ", ") + f;
+  std::printf("kernel         %s\n", kernel.c_str());
   std::printf("top level      %llu references to %llu instances\n",
               static_cast<unsigned long long>(renderer.sceneInstanceReferences()),
               static_cast<unsigned long long>(renderer.sceneInstances()));

@@ -138,6 +138,7 @@ struct Path {
   uint slot;
   Rng rng;
   vec3 ro, rd;
+  ivec2 from;  // the triangle (prim, instance) ro is on, which the ray cannot hit; -1 for none
   vec3 L, beta;
   float etaScale;
   bool specular;  // the last bounce was a delta lobe (the camera ray counts as one)
@@ -164,6 +165,7 @@ struct Path {
 struct Shadow {
   bool pending;
   vec3 origin, dir;
+  ivec2 from;  // as Path::from
   float tMax, random;
   vec3 L;      // what it adds when nothing blocks it
   bool ended;  // its path has ended: its sample is then rewritten as full when nothing blocks it
@@ -197,6 +199,7 @@ Path startPath(uint slot) {
   path.rd = normalize(frame.cameraForward.xyz + ndc.x * tanHalf * frame.cameraRight.w * frame.cameraRight.xyz -
                       ndc.y * tanHalf * frame.cameraUp.xyz);
   path.ro = frame.cameraPosition.xyz;
+  path.from = ivec2(-1);
   float aperture = frame.cameraUp.w;
   if (aperture > 0.0) {
     // A thin lens: the ray leaves a point of the lens disc (uniform over its area) for the point
@@ -413,6 +416,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
         if (maxComponent(f) > 0.0) {
           float w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, bsdfPdf);
           shadow.origin = offsetRay(pos, sideL > 0.0 ? ngs : -ngs);
+          shadow.from = ivec2(hit.prim, hit.instance);
           shadow.dir = ls.dir;
           shadow.tMax = ls.dist >= kInfinity ? kInfinity : ls.dist * (1.0 - 1e-4);
           shadow.random = rand(path.rng);
@@ -443,6 +447,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   path.prevPdf = bs.pdf;
   path.prevPos = pos;
   path.ro = offsetRay(pos, sideI > 0.0 ? ngs : -ngs);
+  path.from = ivec2(hit.prim, hit.instance);
   path.rd = wi;
   path.depth++;
 
@@ -480,7 +485,7 @@ void main() {
   const int root = frame.scene.x;
   const bool noGeometry = frame.scene.y == 0;
   Trace tr;
-  beginTrace(tr, root, false, vec3(0.0), vec3(0.0, 0.0, 1.0), 0.0, false, vec3(0.0), vec3(0.0, 0.0, 1.0), 0.0, 0.0);
+  beginTrace(tr, root, false, vec3(0.0), vec3(0.0, 0.0, 1.0), ivec2(-1), 0.0, false, vec3(0.0), vec3(0.0, 0.0, 1.0), ivec2(-1), 0.0, 0.0);
   // The traversal stack: its top entry in Trace::top, the ones below it in this array. lavapipe
   // turns an access to a per-invocation array at a varying index into a loop over the eight lanes
   // with a branch per lane on the lane's mask. So each iteration reads and writes the array once,
@@ -532,7 +537,7 @@ void main() {
     // searches: every lane takes the count here, before the traversal loop.
     syncLoopIterations();
     if (ready)
-      beginTrace(tr, root, alive, path.ro, path.rd, alive ? rand(path.rng) : 0.0, shadow.pending, shadow.origin, shadow.dir,
+      beginTrace(tr, root, alive, path.ro, path.rd, path.from, alive ? rand(path.rng) : 0.0, shadow.pending, shadow.origin, shadow.dir, shadow.from,
                  shadow.tMax, shadow.random);
     // The loop below ends when no more than this many lanes are still busy: idle lanes are done
     // from the start and never wait, so counting the busy ones is enough.

@@ -194,10 +194,15 @@ struct Trace {
   bool done;      // both rays are traced: closest and blocker hold their hits
   bool idle;      // it was given nothing to trace
   vec3 origin, dir, invDir;  // the current ray, in world space
+  // The triangle (prim, instance) the current ray leaves, which it cannot hit again (a triangle is
+  // flat). The offset origin alone did not keep rays off a large triangle: the intersection's
+  // rounding grows with the triangle's size, the offset with the origin's magnitude.
+  ivec2 from;
   float rayRandom;
   vec3 origin2, dir2, invDir2;
+  ivec2 from2;
   float tMax2, random2;
-  vec3 o, d, invD;  // the current ray in the space of the instance it is in
+  vec3 o, d, invD;  // the current ray in the space of the instance it is in (kFeatureInstanceTransforms)
   int item, top, stackSize;
   int instance, instFlags;
   int instanceSp;  // stack depth on entering the current instance: popping back to it leaves
@@ -206,8 +211,8 @@ struct Trace {
 };
 
 // `root` is frame.scene.x, the instance BVH's root, which the caller reads once.
-void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, float random1, bool second,
-                vec3 origin2, vec3 dir2, float tMax2, float random2) {
+void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, ivec2 from1, float random1, bool second,
+                vec3 origin2, vec3 dir2, ivec2 from2, float tMax2, float random2) {
   Hit miss;
   miss.t = kInfinity;
   miss.prim = -1;
@@ -233,6 +238,8 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, f
   tr.dir = tr.onShadow ? dir2 : dir1;
   tr.invDir = tr.onShadow ? tr.invDir2 : safeInverse(dir1);
   tr.rayRandom = tr.onShadow ? random2 : random1;
+  tr.from = tr.onShadow ? from2 : from1;
+  tr.from2 = from2;
   tr.o = tr.origin;
   tr.d = tr.dir;
   tr.invD = tr.invDir;
@@ -255,6 +262,11 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, f
 // their record through the same four texel fetches of the one traversal buffer. Testing up to two leaves of four
 // triangles in the visiting iteration, as before, made every iteration pay for 24 fetches.
 void traceStep(inout Trace tr, int below, int root) {
+  // Without instance transforms the ray in an instance's space is the world's, and the loop
+  // carries nine values fewer (tr.o, d and invD are then never read, and compiled out).
+  const bool transforms = hasFeature(kFeatureInstanceTransforms);
+  vec3 rayO = transforms ? tr.o : tr.origin, rayD = transforms ? tr.d : tr.dir;
+  vec3 rayInvD = transforms ? tr.invD : tr.invDir;
   int item = tr.item;
   int at = item >> kItemOffsetShift;
   int kind = item & 3;
@@ -269,9 +281,9 @@ void traceStep(inout Trace tr, int below, int root) {
     // pushed (see the stack in trace.comp's main): the one child left, or, with more left, the
     // node itself, with the position to go on from in its item's count bits. Its next visit
     // tests the boxes again, against the hit found meanwhile.
-    vec3 invD = tr.invD;
+    vec3 invD = rayInvD;
     uvec3 e = (uvec3(floatBitsToUint(r0.w)) >> uvec3(0u, 8u, 16u)) & 255u;
-    vec3 base = (r0.xyz - tr.o) * invD;
+    vec3 base = (r0.xyz - rayO) * invD;
     vec3 scaled = uintBitsToFloat(e << 23u) * invD;
     uvec4 qa = floatBitsToUint(r2), qb = floatBitsToUint(r3);
     // The planes a ray enters and leaves by: lo and hi swap where the direction is negative.
@@ -317,17 +329,18 @@ void traceStep(inout Trace tr, int below, int root) {
     }
   } else if (kind == kItemTriangles) {
     // Moeller-Trumbore against v0 = r0.xyz, e1 = r1.xyz, e2 = r2.xyz.
-    vec3 d = tr.d;
+    vec3 d = rayD;
     vec3 pv = cross(d, r2.xyz);
     float det = dot(r1.xyz, pv);
     float inv = 1.0 / det;
-    vec3 s = tr.o - r0.xyz;
+    vec3 s = rayO - r0.xyz;
     float uu = dot(s, pv) * inv;
     vec3 q = cross(s, r1.xyz);
     float vv = dot(d, q) * inv;
     float tt = dot(r2.xyz, q) * inv;
-    bool found = det != 0.0 && uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < tr.hit.t;
     int p = floatBitsToInt(r0.w);
+    bool found = det != 0.0 && uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < tr.hit.t &&
+                 (p != tr.from.x || tr.instance != tr.from.y);
 #if RETILE_ALPHA_TEST
     if (found && (tr.instFlags & kInstanceAlphaTested) != 0) found = alphaPasses(tr.instance, p, uu, vv, tr.rayRandom);
 #endif
@@ -345,10 +358,12 @@ void traceStep(inout Trace tr, int below, int root) {
     // Enter an instance: transform the ray (t is preserved because d is not renormalised).
     tr.instance = floatBitsToInt(r3.y);
     tr.instFlags = floatBitsToInt(r3.z);
-    vec3 origin = tr.origin, dir = tr.dir;
-    tr.o = vec3(dot(r0.xyz, origin) + r0.w, dot(r1.xyz, origin) + r1.w, dot(r2.xyz, origin) + r2.w);
-    tr.d = vec3(dot(r0.xyz, dir), dot(r1.xyz, dir), dot(r2.xyz, dir));
-    tr.invD = safeInverse(tr.d);
+    if (transforms) {
+      vec3 origin = tr.origin, dir = tr.dir;
+      tr.o = vec3(dot(r0.xyz, origin) + r0.w, dot(r1.xyz, origin) + r1.w, dot(r2.xyz, origin) + r2.w);
+      tr.d = vec3(dot(r0.xyz, dir), dot(r1.xyz, dir), dot(r2.xyz, dir));
+      tr.invD = safeInverse(tr.d);
+    }
     tr.instanceSp = tr.stackSize;
     next = floatBitsToInt(r3.x);
   }
@@ -381,6 +396,7 @@ void traceStep(inout Trace tr, int below, int root) {
     tr.dir = tr.dir2;
     tr.invDir = tr.invDir2;
     tr.rayRandom = tr.random2;
+    tr.from = tr.from2;
     tr.stackSize = 0;
     next = root;
   }

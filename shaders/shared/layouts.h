@@ -57,7 +57,8 @@ RT_CONST(int, kFeatureFilterTable, 512)
 RT_CONST(int, kFeatureFilterTent, 1024)
 RT_CONST(int, kFeatureFilterTungsten, 2048)
 RT_CONST(int, kFeatureSun, 4096)  // some directional light has a disc (Light::angularRadius)
-RT_CONST(int, kFeatureAll, 8191)
+RT_CONST(int, kFeatureInstanceTransforms, 8192)  // some instance is not in world space as it is
+RT_CONST(int, kFeatureAll, 16383)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceEmissive, 4)

@@ -200,6 +200,42 @@ TEST(KnownAnswer, ATiltedSkyLightsWhatItsBrightHalfFaces) {
   EXPECT_NEAR(tilted, upright, 0.02 * upright);
 }
 
+// Meshes are packed where their objects first put them (render_scene.h), and an object moved
+// afterwards is reached through its instance's transform from there: the picture is the one of a
+// scene packed with the object where it now is. A cube over a plane under a white sky, turned
+// and moved after packing: the plane's shadowed light, and which pixels see the cube.
+TEST(KnownAnswer, AnObjectMovedAfterPackingRendersAsIfPackedThere) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(32, 32);
+  lookStraightDown(s, 6, 60);
+  s.settings.maxBounces = 2;
+  s.environment.color = Vec3{1.0f};
+  Material m;
+  m.albedo = Vec3{0.5f};
+  const NodeId mat = test::addMaterial(s, m);
+  const NodeId plane = test::addMeshObject(s, "plane", makeQuad(), mat, Mat4::scale({10, 1, 10}));
+  const NodeId cube = test::addMeshObject(s, "cube", makeCube(), mat, Mat4::translate({-1, 1, 0}) * Mat4::scale(Vec3{0.5f}));
+  r->setScene(s);
+  s.object(cube)->transform = Mat4::translate({1, 1.5f, 0.5f}) * Mat4::rotateY(0.6f) * Mat4::scale({0.8f, 0.4f, 1.2f});
+  r->updateScene(s, kUpdateInstances);
+  RenderRequest req;
+  req.samplesPerPixel = 128;
+  const RenderImage moved = r->render(req);
+  const RenderImage packed = renderScene(*r, s, 128);
+  int cubeMoved = 0, cubePacked = 0, differ = 0;
+  for (std::size_t i = 0; i < moved.objectId.size(); ++i) {
+    cubeMoved += moved.objectId[i] == cube;
+    cubePacked += packed.objectId[i] == cube;
+    differ += moved.objectId[i] != packed.objectId[i];
+  }
+  EXPECT_GT(cubePacked, 20) << "the cube is in view";
+  EXPECT_NEAR(cubeMoved, cubePacked, 3);
+  EXPECT_LE(differ, 4) << "pixels whose first hit differs (at an edge either may round either way)";
+  const double lit = meanOver(packed, plane);
+  EXPECT_LT(lit, 0.5 * 0.99) << "the cube shades part of the plane";
+  EXPECT_NEAR(meanOver(moved, plane), lit, 0.01 * lit);
+}
+
 // Seen straight along +x the sky's u is 0.5, the edge between the two middle columns of a map of
 // eight whose columns alternate 0 and 1: filtered between the nearest texels (as Tungsten's
 // bitmaps are) every pixel of a 2-degree view reads about 0.5; read from the nearest texel

@@ -378,5 +378,77 @@ TEST(RenderScene, PackedTrianglesSurviveMeshesComingAndGoing) {
   check("the first removed", 500);
 }
 
+// A mesh is packed where its first object puts it, and a small mesh shared by objects elsewhere
+// is copied for each, so that no instance needs a transform and the kernel carries none; an
+// object moved later is reached through its instance's transform from where it was packed.
+TEST(RenderScene, MeshesArePackedWhereTheirObjectsPutThem) {
+  Scene s = test::emptyScene(8, 8);
+  const NodeId mat = test::addMaterial(s, Material{});
+  const Mat4 t1 = Mat4::translate({2, 0, -1}) * Mat4::rotateY(0.7f) * Mat4::scale({2, 1, 0.5f});
+  const NodeId rod = test::addMeshObject(s, "rod", diagonalRod({1, 1, 1}, 300, 1), mat, t1);
+  const auto quad = makeQuad();
+  test::addMeshObject(s, "quad", quad, mat, Mat4::translate({0, -1, 0}) * Mat4::scale(Vec3{5}));
+  test::addMeshObject(s, "quad again", quad, mat, Mat4::translate({0, 4, 0}) * Mat4::rotateX(kPi));
+  Object* moved = s.object(rod);
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  const auto transforms = static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms);
+  auto worldToPacked = [&](NodeId object) {
+    const RenderSceneData& d = builder.data();
+    for (std::size_t i = 0; i < d.instanceObject.size(); ++i)
+      if (d.instanceObject[i] == object) {
+        Mat4 m;
+        for (int r = 0; r < 3; ++r) {
+          const vec4 row = d.instances[i * gpu::kInstanceTexels + static_cast<std::size_t>(r)];
+          m.m[r][0] = row.x, m.m[r][1] = row.y, m.m[r][2] = row.z, m.m[r][3] = row.w;
+        }
+        return m;
+      }
+    ADD_FAILURE() << "no instance of object " << object;
+    return Mat4{};
+  };
+  EXPECT_EQ(builder.data().features() & transforms, 0u);
+  EXPECT_EQ(builder.data().triangleCount, 300u + 2u + 2u) << "the quad copied for its second object";
+  for (std::size_t i = 0; i < builder.data().instanceObject.size(); ++i)
+    EXPECT_EQ(worldToPacked(builder.data().instanceObject[i]), Mat4::identity());
+  // The rod's triangles are packed in world space: its first vertex, placed, is a packed one.
+  const MeshGeometry& g = *s.mesh(moved->mesh)->geometry;
+  const Vec3 first = t1.transformPoint(g.positions[g.indices[0]]);
+  bool found = false;
+  for (std::size_t p = 0; p < builder.data().triangleCount && !found; ++p) {
+    const vec4* t = builder.data().meshTraversal.data() + p * gpu::kTriTexels;
+    found = length(Vec3{t[0].x, t[0].y, t[0].z} - first) < 1e-5f;
+  }
+  EXPECT_TRUE(found) << "the rod's first vertex, placed, is packed";
+
+  // Moved: its instance maps the world to where the rod was packed.
+  const Mat4 t2 = Mat4::translate({-3, 1, 0}) * Mat4::rotateZ(0.3f);
+  moved->transform = t2;
+  builder.update(s, kUpdateInstances, nullptr);
+  EXPECT_NE(builder.data().features() & transforms, 0u);
+  const Vec3 v = g.positions[g.indices[4]];
+  EXPECT_LT(length(worldToPacked(rod).transformPoint(t2.transformPoint(v)) - t1.transformPoint(v)), 1e-4f);
+  // Back where it was packed: no transform again.
+  moved->transform = t1;
+  builder.update(s, kUpdateInstances, nullptr);
+  EXPECT_EQ(builder.data().features() & transforms, 0u);
+
+  // Truly instanced (copies would double the triangles): one mesh, and transforms.
+  test::addMeshObject(s, "rod again", s.mesh(moved->mesh)->geometry, mat, Mat4::translate({0, 0, 5}));
+  builder.update(s, kUpdateGeometry, nullptr);
+  EXPECT_EQ(builder.data().triangleCount, 302u);
+  EXPECT_NE(builder.data().features() & transforms, 0u);
+}
+
+// A mirrored transform is not packed: it would turn the triangles' winding, which says which
+// side of an emitter shines.
+TEST(RenderScene, AMirroredObjectKeepsItsTransform) {
+  Scene s = test::emptyScene(8, 8);
+  test::addMeshObject(s, "mirrored", makeQuad(), test::addMaterial(s, Material{}), Mat4::scale({-1, 1, 1}));
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  EXPECT_NE(builder.data().features() & static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms), 0u);
+}
+
 }  // namespace
 }  // namespace retile

@@ -195,6 +195,7 @@ std::uint32_t RenderSceneData::features() const {
   if (materialBump) f |= gpu::kFeatureBump;
   if (emissionTextures) f |= gpu::kFeatureEmissionTextures;
   if (materialBlend) f |= gpu::kFeatureBlend;
+  if (instanceTransforms) f |= gpu::kFeatureInstanceTransforms;
   return f | static_cast<std::uint32_t>(filterFeature);
 }
 
@@ -248,44 +249,137 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
   return dirty;
 }
 
+namespace {
+// A transform a mesh can be packed with: affine, finite, invertible and not mirrored (a mirror
+// would turn its triangles' winding, which says which side of an emitter shines), with a finite
+// inverse that undoes it.
+bool packable(const Mat4& t) {
+  for (const auto& row : t.m)
+    for (float v : row)
+      if (!std::isfinite(v)) return false;
+  if (t.m[3][0] != 0 || t.m[3][1] != 0 || t.m[3][2] != 0 || t.m[3][3] != 1) return false;
+  const auto& m = t.m;
+  const double det = static_cast<double>(m[0][0]) * (static_cast<double>(m[1][1]) * m[2][2] - static_cast<double>(m[1][2]) * m[2][1]) -
+                     static_cast<double>(m[0][1]) * (static_cast<double>(m[1][0]) * m[2][2] - static_cast<double>(m[1][2]) * m[2][0]) +
+                     static_cast<double>(m[0][2]) * (static_cast<double>(m[1][0]) * m[2][1] - static_cast<double>(m[1][1]) * m[2][0]);
+  if (!(det > 0)) return false;
+  const Mat4 inv = t.inverse();
+  for (const auto& row : inv.m)
+    for (float v : row)
+      if (!std::isfinite(v)) return false;
+  return inv.m[3][3] == 1;
+}
+}  // namespace
+
+Mat4 RenderSceneBuilder::placement(const Mat4& objectTransform, const MeshEntry& mesh) {
+  if (mesh.placed == Mat4::identity()) return objectTransform;
+  if (objectTransform == mesh.placed) return Mat4::identity();  // exactly, not by rounding
+  return objectTransform * mesh.placedInverse;
+}
+
+const RenderSceneBuilder::MeshEntry* RenderSceneBuilder::entryOf(const Object& o) const {
+  auto it = meshOf_.find(o.mesh);
+  if (it == meshOf_.end()) return nullptr;
+  // A copy made before the object took another mesh is not its.
+  if (auto c = copyOf_.find(o.id); c != copyOf_.end() && c->second->geometry == it->second->geometry) return c->second;
+  return it->second;
+}
+
+// Packs e.geometry's triangles and BVH into e, placed by `place` when it can be (packable).
+void RenderSceneBuilder::packMesh(MeshEntry& e, const Mat4* place) {
+  const MeshGeometry& g = *e.geometry;
+  std::vector<Vec3> placedPositions, placedNormals;
+  if (place && packable(*place) && !(*place == Mat4::identity())) {
+    placedPositions.reserve(g.positions.size());
+    for (Vec3 v : g.positions) placedPositions.push_back(place->transformPoint(v));
+    // Placed, a hostile file's huge coordinates could overflow: such a mesh keeps its own space.
+    if (std::all_of(placedPositions.begin(), placedPositions.end(), [](Vec3 v) { return std::isfinite(v.x + v.y + v.z); })) {
+      e.placed = *place;
+      e.placedInverse = e.placed.inverse();
+      // Normals by the inverse transpose, not renormalised: interpolating them then equals
+      // interpolating the mesh's own and transforming (the shader normalises).
+      const Mat4 normalMatrix = e.placedInverse.transposed();
+      placedNormals.reserve(g.normals.size());
+      for (Vec3 v : g.normals) placedNormals.push_back(normalMatrix.transformVector(v));
+    } else {
+      placedPositions = {};
+    }
+  }
+  const bool moved = !(e.placed == Mat4::identity());
+  const std::vector<Vec3>& positions = moved ? placedPositions : g.positions;
+  const std::vector<Vec3>& normals = moved ? placedNormals : g.normals;
+  std::size_t n = g.triangleCount();
+  std::vector<Bounds3> boxes(n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) boxes[i].grow(positions[g.indices[i * 3 + static_cast<std::size_t>(k)]]);
+  // A leaf's item carries its triangle count in two bits (layouts.h).
+  static_assert(BvhBuildOptions{}.maxLeafSize <= gpu::kMaxLeafTriangles);
+  e.bvh = buildBvh(boxes);
+  e.steps = expectedSteps(e.bvh, [](std::uint32_t) { return 1.0f; });
+  e.triangles.resize(n * gpu::kTriTexels);
+  e.shading.resize(n * gpu::kTriShadeTexels);
+  bool hasN = !normals.empty(), hasUv = !g.uvs.empty();
+  for (std::size_t p = 0; p < n; ++p) {
+    std::size_t src = e.bvh.primOrder[p];
+    std::uint32_t i0 = g.indices[src * 3], i1 = g.indices[src * 3 + 1], i2 = g.indices[src * 3 + 2];
+    Vec3 v0 = positions[i0], v1 = positions[i1], v2 = positions[i2];
+    e.triangles[p * 3 + 0] = v4(v0, 0);
+    e.triangles[p * 3 + 1] = v4(v1 - v0, 0);
+    e.triangles[p * 3 + 2] = v4(v2 - v0, 0);
+    Vec3 n0 = hasN ? normals[i0] : Vec3{}, n1 = hasN ? normals[i1] : Vec3{}, n2 = hasN ? normals[i2] : Vec3{};
+    Vec2 t0 = hasUv ? g.uvs[i0] : Vec2{}, t1 = hasUv ? g.uvs[i1] : Vec2{}, t2 = hasUv ? g.uvs[i2] : Vec2{};
+    // Zero normals (from NaN in the file) fall back to the geometric normal in the shader.
+    bool useN = hasN && dot(n0, n0) > 0 && dot(n1, n1) > 0 && dot(n2, n2) > 0;
+    e.shading[p * 4 + 0] = v4(n0, t0.x);
+    e.shading[p * 4 + 1] = v4(n1, t0.y);
+    e.shading[p * 4 + 2] = v4(n2, t1.x);
+    e.shading[p * 4 + 3] = {t1.y, t2.x, t2.y, useN ? 1.0f : 0.0f};
+  }
+}
+
 void RenderSceneBuilder::packGeometry(const Scene& scene) {
   for (auto& [key, e] : meshes_) e.used = false;
   meshOf_.clear();
+  copyOf_.clear();
+  // A mesh is packed where its first object puts it. An object that puts a shared mesh elsewhere
+  // gets a copy packed where it puts it, so that no instance needs a transform, while the
+  // copies stay few: at most an eighth more triangles (a scene of truly instanced meshes keeps
+  // one of each, and its transforms).
+  std::unordered_map<const MeshGeometry*, const Mat4*> firstPlace;
+  std::vector<const Object*> elsewhere;
+  std::size_t unique = 0, copied = 0;
+  for (const Object& o : scene.objects) {
+    const Mesh* m = scene.mesh(o.mesh);
+    if (!m || !m->geometry || m->geometry->indices.empty()) continue;
+    auto [it, first] = firstPlace.try_emplace(m->geometry.get(), &o.transform);
+    if (first) {
+      unique += m->geometry->triangleCount();
+    } else if (!(o.transform == *it->second) && packable(o.transform)) {
+      elsewhere.push_back(&o);
+      copied += m->geometry->triangleCount();
+    }
+  }
   for (const Mesh& m : scene.meshes) {
     if (!m.geometry || m.geometry->indices.empty()) continue;
-    auto [it, inserted] = meshes_.try_emplace(m.geometry.get());
+    auto [it, inserted] = meshes_.try_emplace({m.geometry.get(), kNoNode});
     MeshEntry& e = it->second;
     e.used = true;
     meshOf_[m.id] = &e;
     if (!inserted) continue;
     e.geometry = m.geometry;
-    const MeshGeometry& g = *m.geometry;
-    std::size_t n = g.triangleCount();
-    std::vector<Bounds3> boxes(n);
-    for (std::size_t i = 0; i < n; ++i)
-      for (int k = 0; k < 3; ++k) boxes[i].grow(g.positions[g.indices[i * 3 + static_cast<std::size_t>(k)]]);
-    // A leaf's item carries its triangle count in two bits (layouts.h).
-    static_assert(BvhBuildOptions{}.maxLeafSize <= gpu::kMaxLeafTriangles);
-    e.bvh = buildBvh(boxes);
-    e.steps = expectedSteps(e.bvh, [](std::uint32_t) { return 1.0f; });
-    e.triangles.resize(n * gpu::kTriTexels);
-    e.shading.resize(n * gpu::kTriShadeTexels);
-    bool hasN = !g.normals.empty(), hasUv = !g.uvs.empty();
-    for (std::size_t p = 0; p < n; ++p) {
-      std::size_t src = e.bvh.primOrder[p];
-      std::uint32_t i0 = g.indices[src * 3], i1 = g.indices[src * 3 + 1], i2 = g.indices[src * 3 + 2];
-      Vec3 v0 = g.positions[i0], v1 = g.positions[i1], v2 = g.positions[i2];
-      e.triangles[p * 3 + 0] = v4(v0, 0);
-      e.triangles[p * 3 + 1] = v4(v1 - v0, 0);
-      e.triangles[p * 3 + 2] = v4(v2 - v0, 0);
-      Vec3 n0 = hasN ? g.normals[i0] : Vec3{}, n1 = hasN ? g.normals[i1] : Vec3{}, n2 = hasN ? g.normals[i2] : Vec3{};
-      Vec2 t0 = hasUv ? g.uvs[i0] : Vec2{}, t1 = hasUv ? g.uvs[i1] : Vec2{}, t2 = hasUv ? g.uvs[i2] : Vec2{};
-      // Zero normals (from NaN in the file) fall back to the geometric normal in the shader.
-      bool useN = hasN && dot(n0, n0) > 0 && dot(n1, n1) > 0 && dot(n2, n2) > 0;
-      e.shading[p * 4 + 0] = v4(n0, t0.x);
-      e.shading[p * 4 + 1] = v4(n1, t0.y);
-      e.shading[p * 4 + 2] = v4(n2, t1.x);
-      e.shading[p * 4 + 3] = {t1.y, t2.x, t2.y, useN ? 1.0f : 0.0f};
+    auto place = firstPlace.find(m.geometry.get());
+    packMesh(e, place == firstPlace.end() ? nullptr : place->second);
+  }
+  if (copied <= unique / 8) {
+    for (const Object* o : elsewhere) {
+      const Mesh* m = scene.mesh(o->mesh);
+      auto [it, inserted] = meshes_.try_emplace({m->geometry.get(), o->id});
+      MeshEntry& e = it->second;
+      e.used = true;
+      copyOf_[o->id] = &e;
+      if (!inserted) continue;
+      e.geometry = m->geometry;
+      packMesh(e, &o->transform);
     }
   }
   std::erase_if(meshes_, [](const auto& kv) { return !kv.second.used; });
@@ -390,16 +484,18 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   struct Candidate {
     const Object* object;
     const MeshEntry* mesh;
+    Mat4 transform;  // from the mesh's packed space to world space
     Bounds3 bounds;
   };
   std::vector<Candidate> cands;
   for (const Object& o : scene.objects) {
     if (!o.visible) continue;
-    auto it = meshOf_.find(o.mesh);
-    if (it == meshOf_.end()) continue;
-    Bounds3 b = transformBounds(o.transform, it->second->bvh.bounds);
+    const MeshEntry* mesh = entryOf(o);
+    if (!mesh) continue;
+    const Mat4 t = placement(o.transform, *mesh);
+    Bounds3 b = transformBounds(t, mesh->bvh.bounds);
     if (b.empty()) continue;
-    cands.push_back({&o, it->second, b});
+    cands.push_back({&o, mesh, t, b});
   }
 
   // Where instances overlap, a ray inside their union is inside every one of their boxes and
@@ -436,7 +532,7 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
       for (std::size_t k = 0; k < kBvhWidth; ++k) {
         const std::int32_t index = n.index[k], count = n.count[k];
         if (count < 0) continue;
-        const Bounds3 world = transformBounds(c.object->transform, n.box[k]);
+        const Bounds3 world = transformBounds(c.transform, n.box[k]);
         if (count == 0)
           children.push_back({refs[r].cand, traversalItem(nodes + std::int64_t{index} * gpu::kNodeTexels, gpu::kItemNode, 1), index, world});
         else
@@ -515,6 +611,7 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   data_.bounds = tlas.bounds;
   data_.instancedTriangles = 0;
   data_.alphaTested = false;
+  data_.instanceTransforms = false;
   std::vector<int> flagsOf(cands.size(), 0);
   std::vector<Mat4> inverseOf(cands.size());
   for (std::size_t i = 0; i < cands.size(); ++i) {
@@ -525,7 +622,8 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     if (mat && mat->emissive()) flags |= gpu::kInstanceEmissive;
     if (flags & gpu::kInstanceAlphaTested) data_.alphaTested = true;
     flagsOf[i] = flags;
-    inverseOf[i] = c.object->transform.inverse();
+    inverseOf[i] = c.transform.inverse();
+    if (!(c.transform == Mat4::identity())) data_.instanceTransforms = true;
     const Mat4& inv = inverseOf[i];
     for (int r = 0; r < 3; ++r) data_.instances.push_back({inv.m[r][0], inv.m[r][1], inv.m[r][2], inv.m[r][3]});
     data_.instances.push_back(ints(0, static_cast<std::int32_t>(c.mesh->triOffset), materialIndex(c.object->material), -1));
@@ -553,8 +651,9 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
     const Object* o = scene.object(data_.instanceObject[i]);
     const Material* mat = o ? scene.material(o->material) : nullptr;
     if (!mat || !mat->emissive()) continue;
-    const MeshEntry* mesh = meshOf_.at(o->mesh);
-    Mat4 normalMatrix = o->transform.inverse().transposed();
+    const MeshEntry* mesh = entryOf(*o);
+    const Mat4 transform = placement(o->transform, *mesh);
+    Mat4 normalMatrix = transform.inverse().transposed();
     auto first = static_cast<std::int32_t>(data_.emitters.size() / gpu::kEmitterTexels);
     data_.instances[i * gpu::kInstanceTexels + 3].w = bitsOf(first);
     // Light samples pick triangles by power: a textured emitter's is its texture's mean times its
@@ -568,9 +667,9 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
       Vec3 v0{t[0].x, t[0].y, t[0].z};
       Vec3 e1{t[1].x, t[1].y, t[1].z};
       Vec3 e2{t[2].x, t[2].y, t[2].z};
-      Vec3 w0 = o->transform.transformPoint(v0);
-      Vec3 w1 = o->transform.transformPoint(v0 + e1);
-      Vec3 w2 = o->transform.transformPoint(v0 + e2);
+      Vec3 w0 = transform.transformPoint(v0);
+      Vec3 w1 = transform.transformPoint(v0 + e1);
+      Vec3 w2 = transform.transformPoint(v0 + e2);
       Vec3 c = cross(w1 - w0, w2 - w0);
       float area = 0.5f * length(c);
       // The front side is the object-space winding normal carried by the normal matrix, so a

@@ -3,7 +3,9 @@
 //
 // Updates follow the edit's UpdateFlags so that the cost of an edit matches what it changed:
 // a transform repacks instances, the top-level BVH and emitters, never mesh data; mesh BVHs are
-// cached by geometry and shared by every instance of a mesh.
+// cached by geometry and shared by every instance of a mesh. A mesh is packed in the space its
+// first object puts it in (MeshEntry::placed), so that a scene whose objects have not moved since
+// it was packed needs no instance transforms, and the kernel for it carries none.
 //
 // Threads: owned and used by one thread (the render thread).
 #pragma once
@@ -77,7 +79,7 @@ struct RenderSceneData {
   int environmentWidth = 0, environmentHeight = 0;
   Vec3 environmentTint{0.0f};
   Mat4 environmentToMap;               // world directions to the map's frame (a rotation)
-  std::uint64_t triangleCount = 0;     // unique (per mesh) triangles
+  std::uint64_t triangleCount = 0;     // packed triangles: each mesh's once, and the copies of small shared ones
   std::uint64_t instancedTriangles = 0;
   bool alphaTested = false;            // some instance needs the cut-out test during traversal
   std::uint32_t materialTypes = 0;     // bit kMat... of each material type present
@@ -85,6 +87,7 @@ struct RenderSceneData {
   bool materialBump = false;           // some material has a bump map
   bool emissionTextures = false;       // some emissive material has an emission texture
   bool materialBlend = false;          // some material blends with another
+  bool instanceTransforms = false;     // some instance's transform is not the identity
 
   bool tungstenShading = false;        // RenderSettings::shading is Tungsten's
   int filterFeature = gpu::kFeatureFilterTable;  // filterFeature(RenderSettings)
@@ -117,8 +120,13 @@ class RenderSceneBuilder {
     std::vector<float> steps;      // expectedSteps of each BVH node
     std::int32_t rootItem = -1;    // in data_.meshTraversal
     std::uint32_t triOffset = 0;   // global index of its first packed triangle (in data_ once placed)
+    // The transform its vertices were packed with (its first object's, or the one it is a copy
+    // for): an object's instance maps world space to it.
+    Mat4 placed, placedInverse;
     bool used = false;
   };
+  // An object's transform from its mesh's packed space to world space.
+  static Mat4 placement(const Mat4& objectTransform, const MeshEntry& mesh);
   // Decoding is the slow part of a texture update; bitmaps of unchanged textures are kept.
   struct Decoded {
     std::string signature;
@@ -138,13 +146,17 @@ class RenderSceneBuilder {
   int materialIndex(NodeId id) const;
 
   RenderSceneData data_;
-  std::map<const MeshGeometry*, MeshEntry> meshes_;
+  // By geometry, with the object a copy is for (kNoNode: the entry every other object shares).
+  std::map<std::pair<const MeshGeometry*, NodeId>, MeshEntry> meshes_;
   std::unordered_map<NodeId, Decoded> decoded_;
   std::unordered_map<NodeId, int> textureIndex_;
   // Each texture's mean RGB as packed: a textured emitter's share of the light samples.
   std::unordered_map<NodeId, Vec3> textureMean_;
   std::unordered_map<NodeId, int> materialIndex_;
-  std::unordered_map<NodeId, const MeshEntry*> meshOf_;  // mesh node id -> entry
+  std::unordered_map<NodeId, const MeshEntry*> meshOf_;  // mesh node id -> its shared entry
+  std::unordered_map<NodeId, const MeshEntry*> copyOf_;  // object id -> its own copy, if it has one
+  const MeshEntry* entryOf(const Object& o) const;
+  void packMesh(MeshEntry& e, const Mat4* place);
   int defaultMaterial_ = 0;
   float emitterPower_ = 0;
   float environmentPower_ = 0;

@@ -780,6 +780,7 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   if (f & static_cast<std::uint32_t>(gpu::kFeatureEmissionTextures)) out.push_back("emission textures");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureBlend)) out.push_back("blends");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureSun)) out.push_back("suns with a disc");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms)) out.push_back("instance transforms");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTent)) out.push_back("exact tent filter");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTungsten)) out.push_back("Tungsten's filter table");
   return out;
