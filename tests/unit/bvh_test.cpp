@@ -433,10 +433,13 @@ TEST(RenderScene, MeshesArePackedWhereTheirObjectsPutThem) {
   builder.update(s, kUpdateInstances, nullptr);
   EXPECT_EQ(builder.data().features() & transforms, 0u);
 
-  // Truly instanced (copies would double the triangles): one mesh, and transforms.
-  test::addMeshObject(s, "rod again", s.mesh(moved->mesh)->geometry, mat, Mat4::translate({0, 0, 5}));
+  // Truly instanced (a copy would add more than 65536 triangles and an eighth): one of each
+  // mesh, and transforms.
+  const auto big = diagonalRod({-1, 1, 1}, 70000, 3);
+  test::addMeshObject(s, "big", big, mat, Mat4::identity());
+  test::addMeshObject(s, "big again", big, mat, Mat4::translate({0, 0, 5}));
   builder.update(s, kUpdateGeometry, nullptr);
-  EXPECT_EQ(builder.data().triangleCount, 302u);
+  EXPECT_EQ(builder.data().triangleCount, 300u + 2u + 70000u);
   EXPECT_NE(builder.data().features() & transforms, 0u);
 }
 

@@ -343,8 +343,8 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
   copyOf_.clear();
   // A mesh is packed where its first object puts it. An object that puts a shared mesh elsewhere
   // gets a copy packed where it puts it, so that no instance needs a transform, while the
-  // copies stay few: at most an eighth more triangles (a scene of truly instanced meshes keeps
-  // one of each, and its transforms).
+  // copies stay few: at most an eighth more triangles, or 65536 (8 MiB), whichever is more (a
+  // scene of truly instanced meshes keeps one of each, and its transforms).
   std::unordered_map<const MeshGeometry*, const Mat4*> firstPlace;
   std::vector<const Object*> elsewhere;
   std::size_t unique = 0, copied = 0;
@@ -370,7 +370,7 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
     auto place = firstPlace.find(m.geometry.get());
     packMesh(e, place == firstPlace.end() ? nullptr : place->second);
   }
-  if (copied <= unique / 8) {
+  if (copied <= std::max<std::size_t>(unique / 8, 65536)) {
     for (const Object* o : elsewhere) {
       const Mesh* m = scene.mesh(o->mesh);
       auto [it, inserted] = meshes_.try_emplace({m->geometry.get(), o->id});
