@@ -1,6 +1,7 @@
 // Each compute pass on its own, with inputs whose outputs are known exactly.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <span>
@@ -422,6 +423,28 @@ TEST(TracePass, FirstHitsMatchABruteForceReference) {
   const FirstHitCheck c = compareFirstHits(*r, s, *soup, placements, ids);
   EXPECT_GT(c.hits, c.checked / 2) << "the soup should fill most of the view";
   EXPECT_LE(c.disagree, c.checked / 500) << c.disagree << " of " << c.checked << " pixels see another first hit than brute force";
+}
+
+// A scene packed where its objects are runs without instance transforms; the kernel its first
+// move switches to is compiled ahead (Renderer::prepareMoves), so the move compiles nothing.
+TEST(TracePass, TheKernelForMovesIsReadyBeforeTheFirstMove) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = wallScene(16, 16, Vec3{1.0f});
+  r->setScene(s);
+  auto hasTransforms = [&] {
+    const auto f = r->kernelFeatures();
+    return std::find(f.begin(), f.end(), "instance transforms") != f.end();
+  };
+  EXPECT_FALSE(hasTransforms());
+  const std::size_t compiled = r->kernelsCompiled();
+  r->prepareMoves();
+  EXPECT_EQ(r->kernelsCompiled(), compiled + 1);
+  s.objects[0].transform = Mat4::translate({0.1f, 0, 0}) * s.objects[0].transform;
+  r->updateScene(s, kUpdateInstances);
+  EXPECT_TRUE(hasTransforms());
+  EXPECT_EQ(r->kernelsCompiled(), compiled + 1) << "the move compiled a kernel";
+  r->prepareMoves();
+  EXPECT_EQ(r->kernelsCompiled(), compiled + 1) << "a scene with transforms needs no other";
 }
 
 // Instances whose boxes hold each other's geometry are entered at subtrees of their BVHs

@@ -189,6 +189,11 @@ class Renderer {
   // What the trace kernel was compiled with for this scene ("lambert", "rough plastic",
   // "alpha test", "textures", "emitters", ...): a scene pays only for what it uses.
   std::vector<std::string> kernelFeatures() const;
+  // Compiles, ahead of need, the kernel a move switches to: a scene packed where its objects are
+  // runs without instance transforms (render/render_scene.h), and its first move would otherwise
+  // wait for that kernel (about 0.3 s on lavapipe). Nothing for a scene that has them.
+  void prepareMoves();
+  std::size_t kernelsCompiled() const;  // trace kernel variants compiled so far, for tests
   std::uint64_t sceneTriangles() const;
   // The instance BVH's leaves: one per visible object, more where objects overlap and their own
   // BVHs are entered at subtrees (render/render_scene.cpp, re-braiding).

@@ -121,6 +121,8 @@ class RenderSession {
   void submitFrame(bool readImage = true);
   FrameRecord finishFrame();
   std::size_t framesInFlight() const;  // submitted and not finished
+  // Renderer::prepareMoves: the render thread calls it once its first frame is out.
+  void prepareMoves();
 
 
  private:

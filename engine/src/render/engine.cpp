@@ -154,6 +154,7 @@ void Engine::run() {
   RegionRect region;
   int restarts = 0;  // devices started since the last frame that made it
   std::uint64_t submitted = 0;
+  bool movesPrepared = false;  // the session's kernel for moved objects (RenderSession::prepareMoves)
   while (!stop_) {
     bool changed = false;
     for (auto& entry : queue_.drain()) {
@@ -214,6 +215,11 @@ void Engine::run() {
         throw Error("the device was lost (injected by EngineOptions::failFrame)");
       session->submitFrame(true);
       if (session->framesInFlight() > 1) publish(session->finishFrame());
+      // Once the first picture is out, before the first drag can ask for it.
+      if (!movesPrepared && last) {
+        session->prepareMoves();
+        movesPrepared = true;
+      }
     } catch (const std::exception& e) {
       // A failed frame (device lost, out of memory) takes the session's GPU state with it, not its
       // scene, which holds every edit applied so far: rendering starts again on a new device with
@@ -234,6 +240,7 @@ void Engine::run() {
         session->select(selection);
         if (!region.empty()) session->setRegion(region);
         last.reset();
+        movesPrepared = false;
         std::lock_guard lock(mutex_);
         device_ = session->deviceName();
       } catch (const std::exception& again) {

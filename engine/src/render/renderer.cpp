@@ -191,7 +191,9 @@ struct Renderer::Impl {
 
   // Picks the trace kernel the scene needs, compiling it on first use (about 0.3 s on lavapipe,
   // on the render thread; the SPIR-V is cached on disk).
-  void selectTrace(bool alpha, std::uint32_t materialTypes, std::uint32_t features) {
+  void selectTrace(bool alpha, std::uint32_t materialTypes, std::uint32_t features) { trace = traceVariant(alpha, materialTypes, features); }
+
+  vk::ComputePipeline* traceVariant(bool alpha, std::uint32_t materialTypes, std::uint32_t features) {
     auto& slot = traceVariants[{alpha, materialTypes, features}];
     if (!slot) {
       slot = std::make_unique<vk::ComputePipeline>(
@@ -206,7 +208,7 @@ struct Renderer::Impl {
                                         {"RETILE_MATERIALS", std::to_string(materialTypes)},
                                         {"RETILE_FEATURES", std::to_string(features)}});
     }
-    trace = slot.get();
+    return slot.get();
   }
 
   void bindAll() {
@@ -761,6 +763,14 @@ void FrameStats::add(const FrameStats& later) {
   maxSegmentIterations = std::max(maxSegmentIterations, later.maxSegmentIterations);
   pathsPerInvocation = later.pathsPerInvocation;
 }
+
+void Renderer::prepareMoves() {
+  const RenderSceneData& d = impl_->builder.data();
+  if (!impl_->hasScene) return;
+  impl_->traceVariant(d.alphaTested, d.materialTypes, d.features() | static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms));
+}
+
+std::size_t Renderer::kernelsCompiled() const { return impl_->traceVariants.size(); }
 
 std::vector<std::string> Renderer::kernelFeatures() const {
   const RenderSceneData& d = impl_->builder.data();

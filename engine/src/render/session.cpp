@@ -624,6 +624,8 @@ FrameRecord RenderSession::finishFrame() {
 
 std::size_t RenderSession::framesInFlight() const { return impl_->pending.size(); }
 
+void RenderSession::prepareMoves() { impl_->renderer.prepareMoves(); }
+
 FrameRecord RenderSession::renderFrame(bool readImage) {
   RETILE_ASSERT(impl_->pending.empty(), "renderFrame while pipelined frames are unfinished");
   submitFrame(readImage);
