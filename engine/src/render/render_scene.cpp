@@ -258,10 +258,9 @@ bool packable(const Mat4& t) {
     for (float v : row)
       if (!std::isfinite(v)) return false;
   if (t.m[3][0] != 0 || t.m[3][1] != 0 || t.m[3][2] != 0 || t.m[3][3] != 1) return false;
-  const auto& m = t.m;
-  const double det = static_cast<double>(m[0][0]) * (static_cast<double>(m[1][1]) * m[2][2] - static_cast<double>(m[1][2]) * m[2][1]) -
-                     static_cast<double>(m[0][1]) * (static_cast<double>(m[1][0]) * m[2][2] - static_cast<double>(m[1][2]) * m[2][0]) +
-                     static_cast<double>(m[0][2]) * (static_cast<double>(m[1][0]) * m[2][1] - static_cast<double>(m[1][1]) * m[2][0]);
+  auto m = [&](int r, int c) { return static_cast<double>(t.m[r][c]); };
+  const double det = m(0, 0) * (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1)) - m(0, 1) * (m(1, 0) * m(2, 2) - m(1, 2) * m(2, 0)) +
+                     m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0));
   if (!(det > 0)) return false;
   const Mat4 inv = t.inverse();
   for (const auto& row : inv.m)

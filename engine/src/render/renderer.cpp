@@ -189,10 +189,13 @@ struct Renderer::Impl {
     bindAll();
   }
 
-  // Picks the trace kernel the scene needs, compiling it on first use (about 0.3 s on lavapipe,
-  // on the render thread; the SPIR-V is cached on disk).
-  void selectTrace(bool alpha, std::uint32_t materialTypes, std::uint32_t features) { trace = traceVariant(alpha, materialTypes, features); }
+  // Picks the trace kernel the scene needs.
+  void selectTrace(bool alpha, std::uint32_t materialTypes, std::uint32_t features) {
+    trace = traceVariant(alpha, materialTypes, features);
+  }
 
+  // A trace kernel variant, compiled on first use (about 0.3 s on lavapipe, on the render thread;
+  // the SPIR-V is cached on disk).
   vk::ComputePipeline* traceVariant(bool alpha, std::uint32_t materialTypes, std::uint32_t features) {
     auto& slot = traceVariants[{alpha, materialTypes, features}];
     if (!slot) {
@@ -765,8 +768,8 @@ void FrameStats::add(const FrameStats& later) {
 }
 
 void Renderer::prepareMoves() {
-  const RenderSceneData& d = impl_->builder.data();
   if (!impl_->hasScene) return;
+  const RenderSceneData& d = impl_->builder.data();
   impl_->traceVariant(d.alphaTested, d.materialTypes, d.features() | static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms));
 }
 
