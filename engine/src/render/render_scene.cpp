@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <numeric>
+#include <optional>
 
 #include "core/files.h"
 #include "io/image_io.h"
@@ -250,23 +251,22 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
 }
 
 namespace {
-// A transform a mesh can be packed with: affine, finite, invertible and not mirrored (a mirror
-// would turn its triangles' winding, which says which side of an emitter shines), with a finite
-// inverse that undoes it.
-bool packable(const Mat4& t) {
-  for (const auto& row : t.m)
-    for (float v : row)
-      if (!std::isfinite(v)) return false;
-  if (t.m[3][0] != 0 || t.m[3][1] != 0 || t.m[3][2] != 0 || t.m[3][3] != 1) return false;
+bool finite(const Mat4& t) {
+  return std::all_of(&t.m[0][0], &t.m[0][0] + 16, [](float v) { return std::isfinite(v); });
+}
+
+// The inverse of a transform a mesh can be packed with: affine, finite, invertible and not
+// mirrored (a mirror would turn its triangles' winding, which says which side of an emitter
+// shines), with a finite affine inverse. Nothing for any other.
+std::optional<Mat4> packedInverse(const Mat4& t) {
+  if (!finite(t) || t.m[3][0] != 0 || t.m[3][1] != 0 || t.m[3][2] != 0 || t.m[3][3] != 1) return std::nullopt;
   auto m = [&](int r, int c) { return static_cast<double>(t.m[r][c]); };
   const double det = m(0, 0) * (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1)) - m(0, 1) * (m(1, 0) * m(2, 2) - m(1, 2) * m(2, 0)) +
                      m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0));
-  if (!(det > 0)) return false;
+  if (!(det > 0)) return std::nullopt;
   const Mat4 inv = t.inverse();
-  for (const auto& row : inv.m)
-    for (float v : row)
-      if (!std::isfinite(v)) return false;
-  return inv.m[3][3] == 1;
+  if (!finite(inv) || inv.m[3][3] != 1) return std::nullopt;
+  return inv;
 }
 }  // namespace
 
@@ -284,17 +284,18 @@ const RenderSceneBuilder::MeshEntry* RenderSceneBuilder::entryOf(const Object& o
   return it->second;
 }
 
-// Packs e.geometry's triangles and BVH into e, placed by `place` when it can be (packable).
+// Packs e.geometry's triangles and BVH into e, placed by `place` when it can be (packedInverse).
 void RenderSceneBuilder::packMesh(MeshEntry& e, const Mat4* place) {
   const MeshGeometry& g = *e.geometry;
   std::vector<Vec3> placedPositions, placedNormals;
-  if (place && packable(*place) && !(*place == Mat4::identity())) {
+  const std::optional<Mat4> inverse = place && !(*place == Mat4::identity()) ? packedInverse(*place) : std::nullopt;
+  if (inverse) {
     placedPositions.reserve(g.positions.size());
     for (Vec3 v : g.positions) placedPositions.push_back(place->transformPoint(v));
     // Placed, a hostile file's huge coordinates could overflow: such a mesh keeps its own space.
     if (std::all_of(placedPositions.begin(), placedPositions.end(), [](Vec3 v) { return std::isfinite(v.x + v.y + v.z); })) {
       e.placed = *place;
-      e.placedInverse = e.placed.inverse();
+      e.placedInverse = *inverse;
       // Normals by the inverse transpose, not renormalised: interpolating them then equals
       // interpolating the mesh's own and transforming (the shader normalises).
       const Mat4 normalMatrix = e.placedInverse.transposed();
@@ -353,7 +354,7 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
     auto [it, first] = firstPlace.try_emplace(m->geometry.get(), &o.transform);
     if (first) {
       unique += m->geometry->triangleCount();
-    } else if (!(o.transform == *it->second) && packable(o.transform)) {
+    } else if (!(o.transform == *it->second) && packedInverse(o.transform)) {
       elsewhere.push_back(&o);
       copied += m->geometry->triangleCount();
     }
