@@ -271,12 +271,13 @@ bool endPath(Path path, inout Shadow shadow) {
 }
 
 // A shadow ray traced: its path's light, or its ended path's sample rewritten.
-void resolveShadow(inout Path path, inout Shadow shadow, Hit sh) {
+// `blocker`: the instance that blocks the shadow ray, -1 when nothing does (Trace::blocker).
+void resolveShadow(inout Path path, inout Shadow shadow, int blocker) {
   if (!shadow.pending) return;
   shadowRays++;
   int selected = int(frame.work.z) - 1;
-  if (shadow.selBase >= 0 && sh.prim >= 0 && sh.instance == selected) atomicAdd(selectionCounts[shadow.selBase + 2], 1u);
-  bool visible = sh.prim < 0;
+  if (shadow.selBase >= 0 && blocker >= 0 && blocker == selected) atomicAdd(selectionCounts[shadow.selBase + 2], 1u);
+  bool visible = blocker < 0;
   // An ended path's sample was written when it ended (the lane may have started another since).
   if (visible && !shadow.ended) path.L += shadow.L;
   bool valid = !(any(isnan(shadow.full)) || any(isinf(shadow.full)));
@@ -521,7 +522,7 @@ void main() {
     bool ready = tr.done, ended = false;
     if (ready && !tr.idle) {
       resolveShadow(path, shadow, tr.blocker);
-      ended = alive && !shadeSegment(path, shadow, tr.closest);
+      ended = alive && !shadeSegment(path, shadow, tr.hit);
       alive = alive && !ended;
     }
     // A path's sample is written once, when it ends. (Written by every lane every iteration, as

@@ -181,17 +181,22 @@ vec3 safeInverse(vec3 d) {
 }
 
 // A lane's rays in flight: the closest hit of an extension ray (when `first`) and then any opaque
-// hit of its path's shadow ray up to tMax2 (when `second`; prim -1 when nothing blocks it),
-// traced one after the other in one loop (of traceStep, in trace.comp's main). A ray not traced
-// comes back as a miss. One loop for both: lavapipe runs eight lanes in lock-step and a loop as
-// long as its slowest lane, so the eight extension rays and then the eight shadow rays in two
-// loops ran the longest of each (157 loop iterations per spaceship path against 131 in one loop),
-// and the loop's code is compiled once. The state outlives the loop: a lane whose rays are not
-// done when the loop ends goes on with them in the next.
+// hit of its path's shadow ray up to tMax2 (when `second`), traced one after the other in one loop
+// (of traceStep, in trace.comp's main). A ray not traced comes back as a miss. One loop for both:
+// lavapipe runs eight lanes in lock-step and a loop as long as its slowest lane, so the eight
+// extension rays and then the eight shadow rays in two loops ran the longest of each (157 loop
+// iterations per spaceship path against 131 in one loop), and the loop's code is compiled once.
+// The state outlives the loop: a lane whose rays are not done when the loop ends goes on with
+// them in the next.
+//
+// Every value here is carried through every iteration of that loop, and one written in a branch
+// costs a select in every iteration (lavapipe runs both sides of a branch), so the state is kept
+// small: the extension ray's hit stays in `hit` while the shadow ray is traced (any hit ends a
+// shadow ray, so its distance limit stays tMax2 and only what blocks it is kept: `blocker`).
 struct Trace {
   bool second;    // a shadow ray follows the extension ray
-  bool onShadow;  // the lane traces the shadow ray now
-  bool done;      // both rays are traced: closest and blocker hold their hits
+  bool onShadow;  // the lane traces the shadow ray now (also once done: then tMax2 is -1)
+  bool done;      // both rays are traced: hit and blocker hold what they found
   bool idle;      // it was given nothing to trace
   vec3 origin, dir, invDir;  // the current ray, in world space
   // The triangle (prim, instance) the current ray leaves, which it cannot hit again (a triangle is
@@ -206,8 +211,8 @@ struct Trace {
   int item, top, stackSize;
   int instance, instFlags;
   int instanceSp;  // stack depth on entering the current instance: popping back to it leaves
-  Hit hit;         // the current ray's so far
-  Hit closest, blocker;
+  Hit hit;         // the extension ray's closest hit so far (a miss when it was not traced)
+  int blocker;     // the instance that blocks the shadow ray, -1 when nothing does
 };
 
 // `root` is frame.scene.x, the instance BVH's root, which the caller reads once.
@@ -219,16 +224,15 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, i
   miss.instance = -1;
   miss.u = 0.0;
   miss.v = 0.0;
-  tr.closest = miss;
-  tr.blocker = miss;
-  tr.blocker.t = tMax2;
+  tr.hit = miss;
+  tr.blocker = -1;
   tr.idle = !(first || second);
   tr.done = tr.idle;
   tr.second = second;
+  // A lane with nothing to trace visits the root with a ray that enters nothing (see traceStep):
+  // its limit, tMax2, is negative.
   tr.onShadow = !first;
-  tr.hit = miss;
-  // A lane with nothing to trace visits the root with a ray that enters nothing (see traceStep).
-  tr.hit.t = tr.idle ? -1.0 : (tr.onShadow ? tMax2 : kInfinity);
+  tMax2 = tr.idle ? -1.0 : tMax2;
   tr.origin2 = origin2;
   tr.dir2 = dir2;
   tr.invDir2 = safeInverse(dir2);
@@ -267,6 +271,8 @@ void traceStep(inout Trace tr, int below, int root) {
   const bool transforms = hasFeature(kFeatureInstanceTransforms);
   vec3 rayO = transforms ? tr.o : tr.origin, rayD = transforms ? tr.d : tr.dir;
   vec3 rayInvD = transforms ? tr.invD : tr.invDir;
+  // How far the current ray looks: a shadow ray to its light, an extension ray to its hit so far.
+  float tLimit = tr.onShadow ? tr.tMax2 : tr.hit.t;
   int item = tr.item;
   int at = item >> kItemOffsetShift;
   int kind = item & 3;
@@ -306,7 +312,7 @@ void traceStep(inout Trace tr, int below, int root) {
     tNear = mix(tNear, t, greaterThan(t, tNear));
     t = base.z + vec4((uvec4(outZ) >> bytes) & 255u) * scaled.z;
     tFar = mix(tFar, t, lessThan(t, tFar)) * kSlabSlack;
-    tFar = mix(vec4(tr.hit.t), tFar, lessThan(tFar, vec4(tr.hit.t)));
+    tFar = mix(vec4(tLimit), tFar, lessThan(tFar, vec4(tLimit)));
     ivec4 children = floatBitsToInt(r1);
     // An empty slot's box is inside out (render/bvh.cpp quantize), but in a node of no extent
     // far from the origin its planes can round to one point: its item says it is empty.
@@ -339,18 +345,21 @@ void traceStep(inout Trace tr, int below, int root) {
     float vv = dot(d, q) * inv;
     float tt = dot(r2.xyz, q) * inv;
     int p = floatBitsToInt(r0.w);
-    bool found = det != 0.0 && uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < tr.hit.t &&
+    bool found = det != 0.0 && uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < tLimit &&
                  (p != tr.from.x || tr.instance != tr.from.y);
 #if RETILE_ALPHA_TEST
     if (found && (tr.instFlags & kInstanceAlphaTested) != 0) found = alphaPasses(tr.instance, p, uu, vv, tr.rayRandom);
 #endif
-    if (found) {
+    if (found && tr.onShadow) {
+      tr.blocker = tr.instance;
+      finished = true;
+    }
+    if (found && !tr.onShadow) {
       tr.hit.t = tt;
       tr.hit.u = uu;
       tr.hit.v = vv;
       tr.hit.prim = p;
       tr.hit.instance = tr.instance;
-      finished = tr.onShadow;
     }
     // The rest of the leaf: one triangle further on, one fewer to go.
     if ((item & 12) != 0) next = item + ((kTriTexels << kItemOffsetShift) - 4);
@@ -377,21 +386,16 @@ void traceStep(inout Trace tr, int below, int root) {
   }
   if (finished && (tr.onShadow || !tr.second)) {
     // Both rays done. The lane stays in the loop until it ends, visiting the root with a ray
-    // that enters nothing: a lane that left the loop made every iteration's stack write,
-    // masked for it, reload its slot and mispredict.
-    if (!tr.done) {
-      if (tr.onShadow) tr.blocker = tr.hit; else tr.closest = tr.hit;
-    }
+    // that enters nothing (a negative limit): a lane that left the loop made every iteration's
+    // stack write, masked for it, reload its slot and mispredict.
     tr.done = true;
-    tr.hit.t = -1.0;
+    tr.onShadow = true;
+    tr.tMax2 = -1.0;
     tr.stackSize = 0;
     next = root;
   } else if (finished) {
     // The extension ray is done: the shadow ray starts at the instance BVH's root.
-    tr.closest = tr.hit;
     tr.onShadow = true;
-    tr.hit.t = tr.tMax2;
-    tr.hit.prim = -1;
     tr.origin = tr.origin2;
     tr.dir = tr.dir2;
     tr.invDir = tr.invDir2;
