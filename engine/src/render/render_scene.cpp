@@ -323,17 +323,17 @@ void RenderSceneBuilder::packMesh(MeshEntry& e, const Mat4* place) {
     std::size_t src = e.bvh.primOrder[p];
     std::uint32_t i0 = g.indices[src * 3], i1 = g.indices[src * 3 + 1], i2 = g.indices[src * 3 + 2];
     Vec3 v0 = positions[i0], v1 = positions[i1], v2 = positions[i2];
-    e.triangles[p * 3 + 0] = v4(v0, 0);
-    e.triangles[p * 3 + 1] = v4(v1 - v0, 0);
-    e.triangles[p * 3 + 2] = v4(v2 - v0, 0);
+    e.triangles[p * gpu::kTriTexels + 0] = v4(v0, 0);
+    e.triangles[p * gpu::kTriTexels + 1] = v4(v1 - v0, 0);
+    e.triangles[p * gpu::kTriTexels + 2] = v4(v2 - v0, 0);
     Vec3 n0 = hasN ? normals[i0] : Vec3{}, n1 = hasN ? normals[i1] : Vec3{}, n2 = hasN ? normals[i2] : Vec3{};
     Vec2 t0 = hasUv ? g.uvs[i0] : Vec2{}, t1 = hasUv ? g.uvs[i1] : Vec2{}, t2 = hasUv ? g.uvs[i2] : Vec2{};
     // Zero normals (from NaN in the file) fall back to the geometric normal in the shader.
     bool useN = hasN && dot(n0, n0) > 0 && dot(n1, n1) > 0 && dot(n2, n2) > 0;
-    e.shading[p * 4 + 0] = v4(n0, t0.x);
-    e.shading[p * 4 + 1] = v4(n1, t0.y);
-    e.shading[p * 4 + 2] = v4(n2, t1.x);
-    e.shading[p * 4 + 3] = {t1.y, t2.x, t2.y, useN ? 1.0f : 0.0f};
+    e.shading[p * gpu::kTriShadeTexels + 0] = v4(n0, t0.x);
+    e.shading[p * gpu::kTriShadeTexels + 1] = v4(n1, t0.y);
+    e.shading[p * gpu::kTriShadeTexels + 2] = v4(n2, t1.x);
+    e.shading[p * gpu::kTriShadeTexels + 3] = {t1.y, t2.x, t2.y, useN ? 1.0f : 0.0f};
   }
 }
 
