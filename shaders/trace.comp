@@ -126,7 +126,9 @@ int findItem(uint slot) {
     int mid = (lo + hi + 1) >> 1;
     if (items[mid].info.y <= slot) lo = mid; else hi = mid - 1;
   }
-  syncLoopIterations();
+  // No synchronisation here (a subgroup operation is a loop over the lanes): the only other loop
+  // of a path's start runs the same iterations in every lane that starts one, so main's, after
+  // the paths are started, takes the exact count.
   return lo;
 }
 
@@ -406,8 +408,9 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
     vec3 lu = vec3(rand(path.rng), rand(path.rng), rand(path.rng));
     LightSample ls = sampleLight(pos, lu);
     // Only some of these lanes ran the sky map's search loops: all of them take the count here,
-    // or a lane that did not search would miss iterations the others ran.
-    syncLoopIterations();
+    // or a lane that did not search would miss iterations the others ran. Without a sky map no
+    // lane runs a loop here, and the lanes' counts are still equal.
+    if (hasFeature(kFeatureEnvMap)) syncLoopIterations();
     if (ls.pdf > 0.0 && maxComponent(ls.radiance) > 0.0) {
       float sideL = dot(ls.dir, ngs);
       bool sameSide = sideL > 0.0;
