@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Compares the samples/s of two retile binaries on one scene, in rounds that run both, and prints
+# each round and the mean of the per-round ratio B/A with its standard error.
+#
+# Why rounds: this machine's speed drifts by 10 % and more over minutes, so two figures taken
+# minutes apart do not compare; the two runs of a round see nearly the same machine. The order
+# alternates (AB, BA, AB, ...) so that a drift within a round does not favour one binary. The
+# standard error assumes rounds independent, which the drift makes only roughly true: take
+# differences under about three standard errors as noise (docs/MEASUREMENTS.md).
+#
+# usage: scripts/ab-throughput.sh BIN_A BIN_B ROUNDS SCENE [retile bench throughput options]
+# e.g.   scripts/ab-throughput.sh /tmp/retile-before build/bin/retile 8 \
+#          ../shared/scenes/spaceship/scene.json --size 320x180 --frames 64
+set -euo pipefail
+if [ $# -lt 4 ]; then
+  sed -n 2,13p "$0" | sed 's/^# \{0,1\}//'
+  exit 2
+fi
+a="$1" b="$2" rounds="$3"
+shift 3
+for bin in "$a" "$b"; do
+  [ -x "$bin" ] || { echo "error: $bin is not an executable" >&2; exit 2; }
+done
+case "$rounds" in '' | *[!0-9]* | 0) echo "error: ROUNDS must be a positive integer, not '$rounds'" >&2; exit 2 ;; esac
+
+# samples/s (M) and loop iterations per path of one run.
+measure() {
+  local out rate iter
+  out="$("$1" bench throughput "${@:2}" 2>&1)" || { echo "error: $1 bench throughput failed:" >&2; echo "$out" >&2; return 1; }
+  rate="$(echo "$out" | awk '$1 == "samples/s" {print $2}')"
+  iter="$(echo "$out" | awk '$1 == "paths" {print $2}')"
+  [ -n "$rate" ] || { echo "error: no samples/s from $1:" >&2; echo "$out" >&2; return 1; }
+  echo "$rate ${iter:-?}"
+}
+
+printf '%5s %10s %10s %8s   %s\n' round "A M/s" "B M/s" "B/A" "loop iterations per path (A, B)"
+results=""
+for ((i = 1; i <= rounds; i++)); do
+  # Command substitution, not a pipe into read, so that a failed run stops the script (set -e).
+  if ((i % 2)); then
+    ma="$(measure "$a" "$@")"
+    mb="$(measure "$b" "$@")"
+  else
+    mb="$(measure "$b" "$@")"
+    ma="$(measure "$a" "$@")"
+  fi
+  read -r ra ia <<<"$ma"
+  read -r rb ib <<<"$mb"
+  printf '%5d %10s %10s %8.4f   %s, %s\n' "$i" "$ra" "$rb" "$(awk -v x="$ra" -v y="$rb" 'BEGIN {print y / x}')" "$ia" "$ib"
+  results+="$ra $rb"$'\n'
+done
+echo "$results" | awk 'NF == 2 {r = $2 / $1; s += r; ss += r * r; sa += $1; sb += $2; n++}
+  END {
+    m = s / n; v = n > 1 ? (ss - n * m * m) / (n - 1) : 0; if (v < 0) v = 0
+    printf "means: A %.3f M, B %.3f M samples/s; B/A %.4f, standard error %.4f over %d rounds\n", sa / n, sb / n, m, sqrt(v / n), n
+  }'
