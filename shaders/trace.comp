@@ -528,6 +528,10 @@ void main() {
       ended = alive && !shadeSegment(path, shadow, tr.hit);
       alive = alive && !ended;
     }
+    // The lanes whose path missed ran the suns' loop (sunsSeen), one iteration a sun, and the
+    // others did not: every lane counts it, whether or not one ran it. That may count it once too
+    // often, which only stops paths a little earlier, and costs no synchronisation.
+    if (hasFeature(kFeatureSun)) loopIterations += uint(frame.lightPick.w);
     // A path's sample is written once, when it ends. (Written by every lane every iteration, as
     // it was to keep lavapipe's per-lane store branches predictable, the four stores, each a loop
     // over the lanes and over the components, took a tenth of the time.)

@@ -199,8 +199,8 @@ LightSample sampleLight(vec3 p, vec3 u) {
 vec3 sunsSeen(vec3 d, bool specular, float bsdfPdf) {
   vec3 seen = vec3(0.0);
   int n = frame.scene.w;
+  // Its iterations are counted in trace.comp's main, in every lane (see loopIterations).
   for (int i = 0; i < int(frame.lightPick.w); ++i) {
-    loopIterations++;
     vec4 b = texelFetch(uDeltaLights, i * kDeltaLightTexels + 1);
     vec4 c = texelFetch(uDeltaLights, i * kDeltaLightTexels + 2);
     bool inside = 1.0 + dot(d, b.xyz) <= b.w;

@@ -57,14 +57,19 @@ bool hasFeature(int feature) { return (RETILE_FEATURES & feature) != 0; }
 // lavapipe (gallivm) runs eight invocations in lock-step and ends every loop of those eight once
 // 65535 loop iterations have run, counted over all loops together, silently: a ray cut off there
 // misses what it should hit. One loop iteration is counted while any of the eight runs it (and,
-// as measured, twice for each iteration counted here). Each
-// invocation keeps that count in loopIterations: it counts its own iterations and, after every
-// loop, takes the maximum over the lanes running with it. That maximum is exact for our loops: a
-// loop's lanes run a prefix of its iterations, no loop nests inside another one except the path
-// loop of trace.comp (which synchronises after each segment), and every lane that ran a loop takes part
-// in the next synchronisation (trace.comp synchronises where lanes part ways: after starting
-// paths, which only some lanes do, and after the light sample). A path stops before the count can reach the
-// limit (kLoopBudget in trace.comp); the renderer reports both. Real GPUs have no such limit.
+// as measured, twice for each iteration counted here). Each invocation keeps that count in
+// loopIterations: it counts its own iterations, and takes the maximum over the lanes running with
+// it (syncLoopIterations) after each loop whose iterations differ between lanes, before another
+// such loop (a lane's sum over two of them can fall short of the sum of their maxima). That
+// maximum is exact for our loops: a loop's lanes run a prefix of its iterations, no loop nests
+// inside another one except the path loop of trace.comp (which synchronises after each segment),
+// and every lane that ran a loop takes part in the next synchronisation. trace.comp synchronises
+// where lanes part ways: after starting paths, which only some lanes do (a path's start has one
+// such loop, the work-item search), and after the light sample in scenes with a sky map (its
+// searches). The suns' loop, which only the lanes whose path missed run, is counted in every lane
+// instead (an upper bound). Each synchronisation is a loop over the lanes on lavapipe, so there are no more of
+// them than that. A path stops before the count can reach the limit (kLoopBudget in trace.comp);
+// the renderer reports both. Real GPUs have no such limit.
 uint loopIterations = 0u;
 
 void syncLoopIterations() { loopIterations = subgroupMax(loopIterations); }
