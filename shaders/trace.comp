@@ -126,9 +126,9 @@ int findItem(uint slot) {
     int mid = (lo + hi + 1) >> 1;
     if (items[mid].info.y <= slot) lo = mid; else hi = mid - 1;
   }
-  // No synchronisation here (a subgroup operation is a loop over the lanes): the only other loop
-  // of a path's start runs the same iterations in every lane that starts one, so main's, after
-  // the paths are started, takes the exact count.
+  // No synchronisation here (a subgroup operation is a loop over the lanes): nothing after it in
+  // a path's start counts iterations, so main's synchronisation, after the paths are started,
+  // takes the same maximum.
   return lo;
 }
 
@@ -407,10 +407,6 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   if (!isDeltaMaterial(m) && (frame.lightPick.x + frame.lightPick.y + frame.lightPick.z) > 0.0) {
     vec3 lu = vec3(rand(path.rng), rand(path.rng), rand(path.rng));
     LightSample ls = sampleLight(pos, lu);
-    // Only some of these lanes ran the sky map's search loops: all of them take the count here,
-    // or a lane that did not search would miss iterations the others ran. Without a sky map no
-    // lane runs a loop here, and the lanes' counts are still equal.
-    if (hasFeature(kFeatureEnvMap)) syncLoopIterations();
     if (ls.pdf > 0.0 && maxComponent(ls.radiance) > 0.0) {
       float sideL = dot(ls.dir, ngs);
       bool sameSide = sideL > 0.0;
@@ -528,9 +524,13 @@ void main() {
       ended = alive && !shadeSegment(path, shadow, tr.hit);
       alive = alive && !ended;
     }
-    // The lanes whose path missed ran the suns' loop (sunsSeen), one iteration a sun, and the
-    // others did not: every lane counts it, whether or not one ran it. That may count it once too
-    // often, which only stops paths a little earlier, and costs no synchronisation.
+    // Loops only some lanes ran while shading (see loopIterations in scene.glsl), before the
+    // work-item search, whose count differs between the lanes that start a path. The sky map's
+    // searches, in the lanes that sampled it: every lane takes the count. The suns' loop, one
+    // iteration a sun, in the lanes whose path missed: every lane counts it, whether or not one
+    // ran it, which may count it once too often (paths then stop a little earlier) and costs no
+    // synchronisation, a loop over the lanes on lavapipe.
+    if (hasFeature(kFeatureEnvMap)) syncLoopIterations();
     if (hasFeature(kFeatureSun)) loopIterations += uint(frame.lightPick.w);
     // A path's sample is written once, when it ends. (Written by every lane every iteration, as
     // it was to keep lavapipe's per-lane store branches predictable, the four stores, each a loop
