@@ -119,16 +119,21 @@ vec3 offsetRay(vec3 p, vec3 n) {
               abs(p.z) < origin ? p.z + floatScale * n.z : pi.z);
 }
 
+// The work item that holds `slot`. Every lane runs it in every pass, for a slot of its own or
+// any, with the same number of iterations (enough for the longest search), so that the lanes'
+// loop counts stay equal without a synchronisation (a loop over the lanes on lavapipe; see
+// loopIterations in scene.glsl).
 int findItem(uint slot) {
-  int lo = 0, hi = int(frame.work.x) - 1;
-  while (lo < hi) {
+  int n = int(frame.work.x);
+  int steps = n > 1 ? findMSB(n - 1) + 1 : 0;  // each step leaves at most half the range, rounded up
+  int lo = 0, hi = n - 1;
+  for (int k = 0; k < steps; ++k) {
     loopIterations++;
     int mid = (lo + hi + 1) >> 1;
-    if (items[mid].info.y <= slot) lo = mid; else hi = mid - 1;
+    bool right = items[mid].info.y <= slot;
+    lo = lo < hi && right ? mid : lo;
+    hi = lo < hi && !right ? mid - 1 : hi;
   }
-  // No synchronisation here (a subgroup operation is a loop over the lanes): nothing after it in
-  // a path's start counts iterations, so main's synchronisation, after the paths are started,
-  // takes the same maximum.
   return lo;
 }
 
@@ -178,8 +183,9 @@ struct Shadow {
 
 uint primaryRays = 0u, bounceRays = 0u, shadowRays = 0u;
 
-Path startPath(uint slot) {
-  WorkItem item = items[findItem(slot)];
+// `found`: findItem(slot).
+Path startPath(uint slot, int found) {
+  WorkItem item = items[found];
   uint inItem = slot - item.info.y;
   uint pixels = uint(item.rect.z * item.rect.w);
   uint rep = inItem / pixels;
@@ -524,26 +530,27 @@ void main() {
       ended = alive && !shadeSegment(path, shadow, tr.hit);
       alive = alive && !ended;
     }
-    // Loops only some lanes ran while shading (see loopIterations in scene.glsl), before the
-    // work-item search, whose count differs between the lanes that start a path. The sky map's
+    // Loops only some lanes ran while shading (see loopIterations in scene.glsl). The sky map's
     // searches, in the lanes that sampled it: every lane takes the count. The suns' loop, one
     // iteration a sun, in the lanes whose path missed: every lane counts it, whether or not one
     // ran it, which may count it once too often (paths then stop a little earlier) and costs no
-    // synchronisation, a loop over the lanes on lavapipe.
+    // synchronisation, a loop over the lanes on lavapipe. After this the lanes' counts are equal,
+    // and every other loop of the pass (the work-item search, the traversal) runs the same
+    // iterations in every lane.
     if (hasFeature(kFeatureEnvMap)) syncLoopIterations();
     if (hasFeature(kFeatureSun)) loopIterations += uint(frame.lightPick.w);
     // A path's sample is written once, when it ends. (Written by every lane every iteration, as
     // it was to keep lavapipe's per-lane store branches predictable, the four stores, each a loop
     // over the lanes and over the components, took a tenth of the time.)
     if (ended) writeSample(path, true);
-    if (ready && !alive && next < push.slotCount) {
-      path = startPath(push.slotOffset + next);
+    bool starts = ready && !alive && next < push.slotCount;
+    // Every lane searches, outside any branch, so that every lane counts the search's iterations.
+    int found = findItem(push.slotOffset + (starts ? next : 0u));
+    if (starts) {
+      path = startPath(push.slotOffset + next, found);
       next += push.invocations;
       alive = true;
     }
-    // Only the lanes that started a path ran findItem's loop, and only some lanes the sky map's
-    // searches: every lane takes the count here, before the traversal loop.
-    syncLoopIterations();
     if (ready)
       beginTrace(tr, root, alive, path.ro, path.rd, path.from, alive ? rand(path.rng) : 0.0, shadow.pending, shadow.origin, shadow.dir, shadow.from,
                  shadow.tMax, shadow.random);

@@ -63,14 +63,14 @@ bool hasFeature(int feature) { return (RETILE_FEATURES & feature) != 0; }
 // such loop (a lane's sum over two of them can fall short of the sum of their maxima). That
 // maximum is exact for our loops: a loop's lanes run a prefix of its iterations, no loop nests
 // inside another one except the path loop of trace.comp (which synchronises after each segment),
-// and every lane that ran a loop takes part in the next synchronisation. trace.comp's main
-// synchronises where lanes part ways: after shading in scenes with a sky map (the lanes that
-// sampled it searched it), and after starting paths, which only some lanes do (a path's start
-// has one such loop, the work-item search). The suns' loop, which only the lanes whose path
-// missed run, is counted in every lane instead (an upper bound). Each synchronisation is a loop
-// over the lanes on lavapipe, so there are no more of them than that. A path stops before the
-// count can reach the limit (kLoopBudget in trace.comp); the renderer reports both. Real GPUs
-// have no such limit.
+// and every lane that ran a loop takes part in the next synchronisation. Each synchronisation is
+// a loop over the lanes on lavapipe, so there is one only where lanes part ways and run loops
+// that others do not: after shading, in scenes with a sky map (the lanes that sampled it searched
+// it). Elsewhere every lane runs the same iterations: the work-item search runs in every lane,
+// for a fixed number of steps, whether or not the lane starts a path, and the suns' loop, which
+// only the lanes whose path missed run, is counted in every lane (an upper bound). A path stops
+// before the count can reach the limit (kLoopBudget in trace.comp); the renderer reports both.
+// Real GPUs have no such limit.
 uint loopIterations = 0u;
 
 void syncLoopIterations() { loopIterations = subgroupMax(loopIterations); }
