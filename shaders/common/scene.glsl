@@ -174,9 +174,11 @@ bool alphaPasses(int instance, int prim, float u, float v, float rayRandom) {
   return r < alpha;
 }
 
-// children[slot], by selects: a varying index into a vector would become a loop over the lanes.
-int childAt(ivec4 children, uint slot) {
-  return slot == 0u ? children.x : (slot == 1u ? children.y : (slot == 2u ? children.z : children.w));
+// The item of a node's child in `slot` (layouts.h), from the node's layout.
+int childItem(uint slot, uint innerCount, uint starts, uint innerBase, uint leafBase, int leafKind) {
+  bool inner = slot < innerCount;
+  uint unit = inner ? innerBase + slot : leafBase + ((starts >> (4u * slot)) & 15u);
+  return (int(unit * uint(kUnitTexels)) << kItemOffsetShift) | (inner ? kItemNode : leafKind);
 }
 
 vec3 safeInverse(vec3 d) {
@@ -269,7 +271,7 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, i
 // code, even when no lane takes it. A loop iteration therefore costs all the code in its body,
 // whichever step each lane is at. So one iteration does one step of any kind (visit a node to
 // take one of its four children, test one triangle, or enter an instance), and all three read
-// their record through the same four texel fetches of the one traversal buffer. Testing up to two leaves of four
+// their record through the same three texel fetches of the one traversal buffer. Testing up to two leaves of four
 // triangles in the visiting iteration, as before, made every iteration pay for 24 fetches.
 void traceStep(inout Trace tr, int below, int root) {
   // Without instance transforms the ray in an instance's space is the world's, and the loop
@@ -282,22 +284,25 @@ void traceStep(inout Trace tr, int below, int root) {
   int item = tr.item;
   int at = item >> kItemOffsetShift;
   int kind = item & 3;
-  vec4 r0 = texelFetch(uTraversal, at), r1 = texelFetch(uTraversal, at + 1);
-  vec4 r2 = texelFetch(uTraversal, at + 2), r3 = texelFetch(uTraversal, at + 3);
+  vec4 r0 = texelFetch(uTraversal, at), r1 = texelFetch(uTraversal, at + 1), r2 = texelFetch(uTraversal, at + 2);
+  // Only an instance's transform needs a fourth.
+  vec4 r3 = vec4(0.0);
+  if (transforms) r3 = texelFetch(uTraversal, at + 3);
   int next = -1;
   bool finished = false;
   if (kind == kItemNode) {
     // Four child boxes, quantised (render/bvh.h QuantizedNode): a plane's distance is
     // (origin - o) / d + q * scale / d, each axis for the four children at once. The children
-    // are taken in the node's order for the ray's octant, one per visit, and one entry is
-    // pushed (see the stack in trace.comp's main): the one child left, or, with more left, the
-    // node itself, with the position to go on from in its item's count bits. Its next visit
-    // tests the boxes again, against the hit found meanwhile.
+    // are taken nearest entry first, one per visit, and one entry is pushed (see the stack in
+    // trace.comp's main): the one child left, or, with more left, the node itself, with the
+    // position to go on from in its item's count bits. Its next visit tests the boxes again,
+    // against the hit found meanwhile, and ranks them as before (the entry distances do not
+    // depend on the hit).
     vec3 invD = rayInvD;
     uvec3 e = (uvec3(floatBitsToUint(r0.w)) >> uvec3(0u, 8u, 16u)) & 255u;
     vec3 base = (r0.xyz - rayO) * invD;
     vec3 scaled = uintBitsToFloat(e << 23u) * invD;
-    uvec4 qa = floatBitsToUint(r2), qb = floatBitsToUint(r3);
+    uvec4 qa = floatBitsToUint(r1), qb = floatBitsToUint(r2);
     // The planes a ray enters and leaves by: lo and hi swap where the direction is negative.
     bool bx = invD.x < 0.0, by = invD.y < 0.0, bz = invD.z < 0.0;
     uint inX = bx ? qa.w : qa.x, outX = bx ? qa.x : qa.w;
@@ -305,8 +310,8 @@ void traceStep(inout Trace tr, int below, int root) {
     uint inZ = bz ? qb.y : qa.z, outZ = bz ? qa.z : qb.y;
     const uvec4 bytes = uvec4(0u, 8u, 16u, 24u);
     // Axis by axis, so that few values are live at once. Selects rather than min and max:
-    // lavapipe gives those NaN semantics at three instructions each, and no NaN reaches here
-    // (safeInverse keeps invD finite).
+    // lavapipe gives those NaN semantics at three instructions each. tNear is never NaN (a
+    // distance only replaces a smaller one), so the ranks below are a strict order.
     vec4 tNear = base.x + vec4((uvec4(inX) >> bytes) & 255u) * scaled.x;
     tNear = mix(vec4(0.0), tNear, greaterThan(tNear, vec4(0.0)));
     vec4 tFar = base.x + vec4((uvec4(outX) >> bytes) & 255u) * scaled.x;
@@ -319,22 +324,30 @@ void traceStep(inout Trace tr, int below, int root) {
     t = base.z + vec4((uvec4(outZ) >> bytes) & 255u) * scaled.z;
     tFar = mix(tFar, t, lessThan(t, tFar)) * kSlabSlack;
     tFar = mix(vec4(tLimit), tFar, lessThan(tFar, vec4(tLimit)));
-    ivec4 children = floatBitsToInt(r1);
-    // An empty slot's box is inside out (render/bvh.cpp quantize), but in a node of no extent
-    // far from the origin its planes can round to one point: its item says it is empty.
-    ivec4 entered = ivec4(lessThanEqual(tNear, tFar)) * ivec4(greaterThanEqual(children, ivec4(0)));
-    int octant = int(bx) | (int(by) << 1) | (int(bz) << 2);
-    uint order = ((octant < 4 ? qb.z : qb.w) >> (8u * uint(octant & 3))) & 255u;
-    uvec4 slots = (uvec4(order) >> uvec4(0u, 2u, 4u, 6u)) & 3u;
-    uint inSlots = uint(entered.x | (entered.y << 1) | (entered.z << 2) | (entered.w << 3));
-    uvec4 inOrder = (uvec4(inSlots) >> slots) & 1u;
-    uint left = (inOrder.x | (inOrder.y << 1) | (inOrder.z << 2) | (inOrder.w << 3)) & (15u << uint((item >> 2) & 3));
+    // The children (layouts.h): inner ones first, one unit each from `inner` on, then leaves,
+    // whose runs start where the layout says, from `leaves` on.
+    uint shape = (floatBitsToUint(r0.w) >> 24) | ((qb.z >> (kBaseBits - 8)) & 0x3f00u) | ((qb.w >> (kBaseBits - 14)) & 0xfc000u);
+    uint innerCount = (shape >> kLayoutInner) & 7u;
+    int leafKind = (shape & (1u << kLayoutInstances)) != 0u ? kItemInstance : kItemTriangles;
+    uint starts = (shape >> (kLayoutStarts - 4)) & ~15u;  // four bits a slot, slot 0's 0
+    const uint baseMask = (1u << kBaseBits) - 1u;
+    uint innerBase = qb.z & baseMask, leafBase = qb.w & baseMask;
+    ivec4 entered = ivec4(lessThanEqual(tNear, tFar)) * ivec4(lessThan(uvec4(0u, 1u, 2u, 3u), uvec4((shape >> kLayoutUsed) & 7u)));
+    // Each child's rank, nearest entry first, ties in slot order (render/bvh.cpp childRanks).
+    bool c01 = tNear.y < tNear.x, c02 = tNear.z < tNear.x, c03 = tNear.w < tNear.x;
+    bool c12 = tNear.z < tNear.y, c13 = tNear.w < tNear.y, c23 = tNear.w < tNear.z;
+    uvec4 rank = uvec4(uint(c01) + uint(c02) + uint(c03), uint(!c01) + uint(c12) + uint(c13),
+                       uint(!c02) + uint(!c12) + uint(c23), uint(!c03) + uint(!c13) + uint(!c23));
+    uint inOrder = (uint(entered.x) << rank.x) | (uint(entered.y) << rank.y) | (uint(entered.z) << rank.z) | (uint(entered.w) << rank.w);
+    uint left = inOrder & (15u << uint((item >> 2) & 3));
     int pos = findLSB(left);
-    uint slot = (order >> uint(2 * pos)) & 3u;
-    if (left != 0u) next = childAt(children, slot);
-    // What is pushed: the one child left, as it is, or the node, to go on from pos + 1.
     uint rest = left & (left - 1u);
-    int otherChild = childAt(children, (order >> uint(2 * findLSB(rest))) & 3u);
+    int pos2 = findLSB(rest);
+    uint slot = rank.x == uint(pos) ? 0u : (rank.y == uint(pos) ? 1u : (rank.z == uint(pos) ? 2u : 3u));
+    uint slot2 = rank.x == uint(pos2) ? 0u : (rank.y == uint(pos2) ? 1u : (rank.z == uint(pos2) ? 2u : 3u));
+    if (left != 0u) next = childItem(slot, innerCount, starts, innerBase, leafBase, leafKind);
+    // What is pushed: the one child left, as it is, or the node, to go on from pos + 1.
+    int otherChild = childItem(slot2, innerCount, starts, innerBase, leafBase, leafKind);
     if (rest != 0u && tr.stackSize < kStackSize) {
       tr.top = (rest & (rest - 1u)) == 0u ? otherChild : (item & ~12) | ((pos + 1) << 2);
       tr.stackSize++;
@@ -367,20 +380,20 @@ void traceStep(inout Trace tr, int below, int root) {
       tr.hit.prim = p;
       tr.hit.instance = tr.instance;
     }
-    // The rest of the leaf: one triangle further on, one fewer to go.
-    if ((item & 12) != 0) next = item + ((kTriTexels << kItemOffsetShift) - 4);
+    // The rest of the leaf: one triangle further on, until the run's last.
+    if (r1.w == 0.0) next = item + (kTriTexels << kItemOffsetShift);
   } else {
     // Enter an instance: transform the ray (t is preserved because d is not renormalised).
-    tr.instance = floatBitsToInt(r3.y);
-    tr.instFlags = floatBitsToInt(r3.z);
+    tr.instance = floatBitsToInt(r0.y);
+    tr.instFlags = floatBitsToInt(r0.z);
     if (transforms) {
       vec3 origin = tr.origin, dir = tr.dir;
-      tr.o = vec3(dot(r0.xyz, origin) + r0.w, dot(r1.xyz, origin) + r1.w, dot(r2.xyz, origin) + r2.w);
-      tr.d = vec3(dot(r0.xyz, dir), dot(r1.xyz, dir), dot(r2.xyz, dir));
+      tr.o = vec3(dot(r1.xyz, origin) + r1.w, dot(r2.xyz, origin) + r2.w, dot(r3.xyz, origin) + r3.w);
+      tr.d = vec3(dot(r1.xyz, dir), dot(r2.xyz, dir), dot(r3.xyz, dir));
       tr.invD = safeInverse(tr.d);
     }
     tr.instanceSp = tr.stackSize;
-    next = floatBitsToInt(r3.x);
+    next = floatBitsToInt(r0.x);
   }
   if (next < 0 && !finished) {
     finished = tr.stackSize == 0;

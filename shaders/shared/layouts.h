@@ -16,9 +16,9 @@ struct alignas(16) ivec4 { std::int32_t x, y, z, w; };
 #endif
 
 // Texels (RGBA32F) per record in the read-only scene buffers.
-RT_CONST(int, kNodeTexels, 4)       // origin.xyz exponents | 4 child items | lo.xyz hi.x | hi.yz order (render/bvh.h QuantizedNode)
-RT_CONST(int, kTriTexels, 3)        // v0.xyz triangle index | e1 = v1 - v0 | e2 = v2 - v0 (object space)
-RT_CONST(int, kInstanceRecordTexels, 4)  // world-to-object rows 0..2 | root item, instance, flags, -
+RT_CONST(int, kNodeTexels, 3)       // origin.xyz exponents | lo.xyz hi.x | hi.yz, inner and leaves (render/bvh.h QuantizedNode; below)
+RT_CONST(int, kTriTexels, 3)        // v0.xyz triangle index | e1 = v1 - v0, last of its run | e2 = v2 - v0 (object space)
+RT_CONST(int, kInstanceRecordTexels, 6)  // root item, instance, flags, - | world-to-object rows 0..2 | -
 RT_CONST(int, kTriShadeTexels, 4)   // n0.xyz uv0.x | n1.xyz uv0.y | n2.xyz uv1.x | uv1.y uv2.xy hasNormals
 RT_CONST(int, kInstanceTexels, 5)   // shading: world-to-object rows 0..2 | - triOffset material emitterOffset | objectIndex+1 flags
 RT_CONST(int, kMaterialTexels, 7)   // see render/render_scene.cpp packMaterial
@@ -29,15 +29,32 @@ RT_CONST(int, kEmitterTexels, 5)    // v0.xyz area | e1.xyz instance | e2.xyz tr
 RT_CONST(int, kDeltaLightTexels, 4)
 
 // The traversal buffer holds every triangle (packed triangle p at texel p * kTriTexels), then the
-// mesh BVHs, the instance BVH and one record per instance. An item names one record of it:
-// texel offset << kItemOffsetShift | n << 2 | kind, or -1 for none. A run of up to
-// kMaxLeafTriangles consecutive triangles is one item (a BVH leaf), n its triangles - 1; for a
-// node, n is the rank of the child to take next (scene.glsl traceRay), 0 in the buffer.
+// mesh BVHs, the instance BVH and one record per reference to an instance. An item names one of
+// its records: texel offset << kItemOffsetShift | n << 2 | kind. A BVH leaf's item names its
+// first triangle (n 0), whose run of up to kMaxLeafTriangles ends at the one marked last; for a
+// node, n is the rank of the child to take next (scene.glsl traceStep), 0 where a node names it.
 RT_CONST(int, kItemNode, 0)
 RT_CONST(int, kItemTriangles, 1)
 RT_CONST(int, kItemInstance, 2)
 RT_CONST(int, kItemOffsetShift, 4)
 RT_CONST(int, kMaxLeafTriangles, 4)  // render/bvh.h maxLeafSize for mesh BVHs
+// A node names its children without items, to fit 48 bytes: a traversal step costs its texel
+// fetches, about 5 % of the spaceship's time each (docs/MEASUREMENTS.md). Its slots hold inner
+// children first, then leaves, then nothing (render/bvh.h buildBvh orders them so). Bits 0..25 of
+// its third texel's z and w are two bases, in units of kUnitTexels texels: `inner`, where its
+// inner children are, one unit each in slot order, and `leaves`, where its leaves' records are,
+// one run after another in slot order (a triangle is a unit, an instance record two). The 20 bits
+// above its exponents and the two bases are the children's layout: first bits 24..31 of the
+// first texel's w, then 26..31 of the third's z and w. In it: the inner children (kLayoutInner),
+// the used slots (kLayoutUsed), whether the leaves are instance records (kLayoutInstances) and,
+// from kLayoutStarts on, four bits for each of slots 1..3: where its leaf starts, in units from
+// `leaves` (0 for an inner slot). A run of triangles ends at the triangle whose e1.w is 1.
+RT_CONST(int, kUnitTexels, 3)
+RT_CONST(int, kBaseBits, 26)
+RT_CONST(int, kLayoutInner, 0)      // 3 bits
+RT_CONST(int, kLayoutUsed, 3)       // 3 bits
+RT_CONST(int, kLayoutInstances, 6)  // 1 bit
+RT_CONST(int, kLayoutStarts, 7)     // 12 bits
 RT_CONST(int, kMaxTraversalTexels, 134217728)  // 2^27: items stay positive; also lavapipe's texel-buffer limit
 
 // What a scene has besides geometry and materials (RenderSceneData::features). The renderer

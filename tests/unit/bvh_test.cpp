@@ -100,6 +100,50 @@ TEST(Bvh, DegenerateInputs) {
   for (std::int32_t count : empty.nodes[0].count) EXPECT_LT(count, 0);
 }
 
+// The GPU's 48-byte node names its children by where the first inner child and the first leaf's
+// record are (layouts.h), so the builder must lay them out one after another in slot order.
+TEST(Bvh, ChildrenLieWhereTwoBasesFindThem) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1, 1);
+  for (int leafSize : {1, 4}) {
+    std::vector<Bounds3> boxes;
+    for (int i = 0; i < 3000; ++i) {
+      Bounds3 b;
+      Vec3 c{u(rng) * 8, u(rng) * 8, u(rng) * 8};
+      b.grow(c);
+      b.grow(c + Vec3{u(rng), u(rng), u(rng)} * 0.2f);
+      boxes.push_back(b);
+    }
+    BvhBuildOptions options;
+    options.maxLeafSize = leafSize;
+    const Bvh bvh = buildBvh(boxes, options);
+    std::vector<int> seen(boxes.size(), 0);
+    for (std::size_t k = 0; k < bvh.nodes.size(); ++k) {
+      const BvhNode& n = bvh.nodes[k];
+      int inner = 0, used = 0;
+      std::int32_t nextLeaf = -1;
+      for (std::size_t c = 0; c < kBvhWidth; ++c) {
+        if (n.count[c] < 0) continue;
+        ASSERT_EQ(used++, static_cast<int>(c)) << "node " << k << ": an empty slot before a used one";
+        if (n.count[c] == 0) {
+          ASSERT_EQ(inner, static_cast<int>(c)) << "node " << k << ": an inner child after a leaf";
+          EXPECT_EQ(n.index[c], n.index[0] + inner) << "node " << k << ": inner children apart";
+          EXPECT_GT(n.index[c], static_cast<std::int32_t>(k)) << "a child before its parent";
+          ++inner;
+          continue;
+        }
+        if (nextLeaf >= 0) {
+          EXPECT_EQ(n.index[c], nextLeaf) << "node " << k << ": leaves apart";
+        }
+        nextLeaf = n.index[c] + n.count[c];
+        EXPECT_LE(n.count[c], leafSize);
+        for (std::int32_t i = n.index[c]; i < nextLeaf; ++i) ++seen[bvh.primOrder[static_cast<std::size_t>(i)]];
+      }
+    }
+    for (std::size_t p = 0; p < seen.size(); ++p) ASSERT_EQ(seen[p], 1) << "primitive " << p << " in " << seen[p] << " leaves";
+  }
+}
+
 TEST(Bvh, AdversarialDepthIsBounded) {
   // Exponentially spaced triangles push SAH towards one-primitive peels.
   std::vector<Bounds3> boxes;

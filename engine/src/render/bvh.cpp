@@ -232,6 +232,9 @@ Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options
       kids[open] = static_cast<std::uint32_t>(o.left);
       kids[count++] = static_cast<std::uint32_t>(o.right);
     }
+    // Inner children first, then leaves (render/bvh.h BvhNode).
+    std::stable_partition(kids.begin(), kids.begin() + static_cast<std::ptrdiff_t>(count),
+                          [&](std::uint32_t kid) { return bn[kid].left >= 0 && kid != behind[k]; });
     BvhNode w;
     for (std::size_t c = 0; c < count; ++c) {
       const BuildNode& ch = bn[kids[c]];
@@ -250,6 +253,22 @@ Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options
     out.nodes.push_back(w);
   }
   out.depth = std::max(out.depth, 1);
+
+  // Breadth first, a node's inner children are consecutive already; its leaves' runs are made so
+  // by renumbering the primitives node by node, each node's leaves in slot order.
+  std::vector<std::uint32_t> order;
+  order.reserve(out.primOrder.size());
+  for (BvhNode& n : out.nodes) {
+    for (std::size_t c = 0; c < kBvhWidth; ++c) {
+      if (n.count[c] <= 0) continue;
+      const auto first = static_cast<std::size_t>(n.index[c]);
+      n.index[c] = static_cast<std::int32_t>(order.size());
+      order.insert(order.end(), out.primOrder.begin() + static_cast<std::ptrdiff_t>(first),
+                   out.primOrder.begin() + static_cast<std::ptrdiff_t>(first + static_cast<std::size_t>(n.count[c])));
+    }
+  }
+  RETILE_ASSERT(order.size() == out.primOrder.size(), "a primitive in no leaf, or in two");
+  out.primOrder = std::move(order);
   return out;
 }
 
@@ -286,19 +305,6 @@ QuantizedNode quantize(const BvhNode& node) {
       q.lo[a] |= lo << (8 * c);
       q.hi[a] |= hi << (8 * c);
     }
-  }
-  for (std::uint32_t octant = 0; octant < 8; ++octant) {
-    // Along the octant's diagonal, the smaller a centre's projection, the nearer; empty slots last.
-    const Vec3 dir{octant & 1 ? -1.0f : 1.0f, octant & 2 ? -1.0f : 1.0f, octant & 4 ? -1.0f : 1.0f};
-    std::array<int, kBvhWidth> slots{0, 1, 2, 3};
-    auto key = [&](int c) {
-      const auto k = static_cast<std::size_t>(c);
-      return node.count[k] < 0 ? std::numeric_limits<float>::infinity() : dot(node.box[k].lo * 0.5f + node.box[k].hi * 0.5f, dir);
-    };
-    std::stable_sort(slots.begin(), slots.end(), [&](int x, int y) { return key(x) < key(y); });
-    std::uint32_t bits = 0;
-    for (int i = 0; i < kBvhWidth; ++i) bits |= static_cast<std::uint32_t>(slots[static_cast<std::size_t>(i)]) << (2 * i);
-    q.order[octant / 4] |= bits << (8 * (octant % 4));
   }
   return q;
 }
@@ -369,11 +375,12 @@ bool intersectTriangle(Vec3 o, Vec3 d, Vec3 v0, Vec3 v1, Vec3 v2, float tMax, fl
 
 namespace {
 // The shader's test of a node's four child boxes (shaders/common/scene.glsl), operation for
-// operation: which children the ray enters before tMax (bit c for slot c).
-int enteredChildren(const BvhNode& n, const QuantizedNode& q, Vec3 o, Vec3 inv, float tMax) {
-  float lo[kBvhWidth], hi[kBvhWidth];
+// operation: which children the ray enters before tMax (bit c for slot c), and where it enters
+// each (never NaN: a distance only replaces a smaller one).
+int enteredChildren(const BvhNode& n, const QuantizedNode& q, Vec3 o, Vec3 inv, float tMax, float (&near)[kBvhWidth]) {
+  float hi[kBvhWidth];
   for (int c = 0; c < kBvhWidth; ++c) {
-    lo[c] = 0.0f;
+    near[c] = 0.0f;
     hi[c] = std::numeric_limits<float>::infinity();
   }
   for (int a = 0; a < 3; ++a) {
@@ -383,16 +390,29 @@ int enteredChildren(const BvhNode& n, const QuantizedNode& q, Vec3 o, Vec3 inv, 
       float t0 = base + static_cast<float>((q.lo[a] >> (8 * c)) & 255u) * step;
       float t1 = base + static_cast<float>((q.hi[a] >> (8 * c)) & 255u) * step;
       if (inv[a] < 0.0f) std::swap(t0, t1);
-      lo[c] = t0 > lo[c] ? t0 : lo[c];
+      near[c] = t0 > near[c] ? t0 : near[c];
       hi[c] = t1 < hi[c] ? t1 : hi[c];
     }
   }
   int mask = 0;
   for (int c = 0; c < kBvhWidth; ++c) {
     const float far = hi[c] * kSlabSlack;
-    if (lo[c] <= (far < tMax ? far : tMax) && n.count[static_cast<std::size_t>(c)] >= 0) mask |= 1 << c;
+    if (near[c] <= (far < tMax ? far : tMax) && n.count[static_cast<std::size_t>(c)] >= 0) mask |= 1 << c;
   }
   return mask;
+}
+
+std::array<int, kBvhWidth> childRanks(const float (&near)[kBvhWidth]) {
+  // Nearer first, ties in slot order: a strict total order, as the keys are never NaN.
+  std::array<int, kBvhWidth> rank{};
+  for (int i = 0; i < kBvhWidth; ++i)
+    for (int j = i + 1; j < kBvhWidth; ++j) {
+      if (near[j] < near[i])
+        ++rank[static_cast<std::size_t>(i)];
+      else
+        ++rank[static_cast<std::size_t>(j)];
+    }
+  return rank;
 }
 }  // namespace
 
@@ -425,13 +445,15 @@ RayHit traverseClosest(const Bvh& bvh, std::span<const Vec3> tris, Vec3 o, Vec3 
     } else {
       const BvhNode& n = bvh.nodes[static_cast<std::size_t>(at.index)];
       const QuantizedNode q = quantize(n);
-      const int mask = enteredChildren(n, q, o, inv, hit.t);
-      // The node's order for the ray's octant, from position at.from on.
-      const int octant = (inv.x < 0.0f ? 1 : 0) | (inv.y < 0.0f ? 2 : 0) | (inv.z < 0.0f ? 4 : 0);
-      const std::uint32_t order = (q.order[octant / 4] >> (8 * (octant % 4))) & 255u;
+      float near[kBvhWidth];
+      const int mask = enteredChildren(n, q, o, inv, hit.t, near);
+      // The children entered, nearest first, from position at.from of that order on.
+      const std::array<int, kBvhWidth> rank = childRanks(near);
+      int slotAt[kBvhWidth];
+      for (int c = 0; c < kBvhWidth; ++c) slotAt[rank[static_cast<std::size_t>(c)]] = c;
       int open[kBvhWidth], opened = 0, first = -1;
       for (int i = at.from; i < kBvhWidth; ++i) {
-        const int slot = static_cast<int>((order >> (2 * i)) & 3u);
+        const int slot = slotAt[i];
         if (!(mask >> slot & 1)) continue;
         if (first < 0) first = i;
         open[opened++] = slot;

@@ -5,8 +5,9 @@
 // children. On lavapipe every loop iteration of the traversal pays for the whole loop body
 // (shaders/common/scene.glsl), so what counts is the number of steps a ray takes; a four-wide node
 // decides among four children in one step, and its child boxes, quantised to 8 bits per plane
-// relative to the node's box, keep a node in the 64 bytes a binary node took
-// (docs/MEASUREMENTS.md has the figures).
+// relative to the node's box, keep a node in 48 bytes, less than a binary node took
+// (docs/MEASUREMENTS.md has the figures). A node names its children by two bases only (layouts.h),
+// which buildBvh's order makes possible.
 #pragma once
 
 #include <array>
@@ -23,7 +24,9 @@ constexpr int kBvhWidth = 4;
 
 // A node as built. Slot c: count[c] > 0 is a leaf of count[c] primitives starting at index[c] (in
 // the packed primitive order); count[c] == 0 an inner node at index[c]; count[c] < 0 an empty
-// slot. Used slots come first.
+// slot. Inner children come first, then leaves, then empty slots. A node's inner children are
+// consecutive nodes and its leaves' primitives consecutive runs, each in slot order, so that the
+// GPU's node needs only where the first of each starts.
 struct BvhNode {
   std::array<Bounds3, kBvhWidth> box;
   std::array<std::int32_t, kBvhWidth> index{};
@@ -34,14 +37,11 @@ struct BvhNode {
 // scale, and for each child an 8-bit lower and upper plane (child c in bits 8c..8c+7 of lo[axis]
 // and hi[axis]). Every child's box contains the box it was made from (origin + q * scale, in
 // float arithmetic, rounds outwards).
-// order[o / 4] holds, in bits 8 (o % 4).., the slots in the order a ray of octant o (bit k set: a
-// negative direction along axis k) takes them: nearest centre first, two bits per position.
 struct QuantizedNode {
   float origin[3];
   std::uint32_t exponents;  // biased exponent of axis k's scale in bits 8k..8k+7
   std::uint32_t lo[3];
   std::uint32_t hi[3];
-  std::uint32_t order[2];
 };
 QuantizedNode quantize(const BvhNode& node);
 float quantizedScale(const QuantizedNode& q, int axis);
@@ -73,7 +73,7 @@ Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options
 std::vector<float> expectedSteps(const Bvh& bvh, const std::function<float(std::uint32_t)>& primCost);
 
 // Reference traversal of a packed triangle BVH, mirroring the shader (quantised boxes, children
-// in the node's order for the ray's octant, one stack entry pushed per visit), for tests.
+// nearest entry first, one stack entry pushed per visit), for tests.
 struct RayHit {
   float t = 0;
   float u = 0, v = 0;

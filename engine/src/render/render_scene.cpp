@@ -53,33 +53,63 @@ std::vector<vec4> aliasTable(const std::vector<float>& weights) {
   return table;
 }
 
-// The item naming `count` records of `kind` at texel `offset` of the traversal buffer (layouts.h).
-std::int32_t traversalItem(std::int64_t offset, int kind, std::int32_t count) {
+// The item naming the record of `kind` at texel `offset` of the traversal buffer (layouts.h).
+std::int32_t traversalItem(std::int64_t offset, int kind) {
   if (offset + 4 > gpu::kMaxTraversalTexels)
     throw Error(cat("the scene's triangles and BVHs need more than ", gpu::kMaxTraversalTexels / 1048576,
-                    " M texels (about 27 M triangles), more than the renderer's one traversal buffer holds"));
-  return static_cast<std::int32_t>((offset << gpu::kItemOffsetShift) | ((count - 1) << 2) | kind);
+                    " M texels (about 35 M triangles), more than the renderer's one traversal buffer holds"));
+  return static_cast<std::int32_t>((offset << gpu::kItemOffsetShift) | kind);
+}
+
+// The unit (layouts.h kUnitTexels) at texel `offset` of the traversal buffer, as a node's base.
+std::uint32_t traversalUnit(std::int64_t offset) {
+  RETILE_ASSERT(offset % gpu::kUnitTexels == 0, cat("texel ", offset, " is not at a unit"));
+  traversalItem(offset, gpu::kItemNode);  // the same limit
+  static_assert(gpu::kMaxTraversalTexels / gpu::kUnitTexels < (1 << gpu::kBaseBits));
+  return static_cast<std::uint32_t>(offset / gpu::kUnitTexels);
 }
 
 // Appends `nodes` (render/bvh.h, child indices local to them) to `out`, a part of the traversal
-// buffer that starts at its texel `outBase`: inner children become node items, leaves whatever
-// `leafItem(index, count)` names.
-template <class LeafItem>
-void appendNodes(std::vector<vec4>& out, const std::vector<BvhNode>& nodes, std::int64_t outBase, LeafItem leafItem) {
-  std::int64_t base = outBase + static_cast<std::int64_t>(out.size());
-  auto child = [&](std::int32_t index, std::int32_t count) {
-    if (count < 0) return std::int32_t{-1};
-    if (count == 0) return traversalItem(base + static_cast<std::int64_t>(index) * gpu::kNodeTexels, gpu::kItemNode, 1);
-    return leafItem(index, count);
-  };
+// buffer that starts at its texel `outBase`. Their leaves' records are at texel `leafBase`, one
+// unit per triangle of a mesh BVH, or two per reference of the instance BVH (`instances`).
+void appendNodes(std::vector<vec4>& out, const std::vector<BvhNode>& nodes, std::int64_t outBase, std::int64_t leafBase,
+                 bool instances) {
+  const std::int64_t base = outBase + static_cast<std::int64_t>(out.size());
+  const std::int64_t leafTexels = instances ? gpu::kInstanceRecordTexels : gpu::kTriTexels;
+  static_assert(gpu::kNodeTexels == gpu::kUnitTexels && gpu::kTriTexels == gpu::kUnitTexels &&
+                gpu::kInstanceRecordTexels % gpu::kUnitTexels == 0);
   auto word = [](std::uint32_t u) { return std::bit_cast<float>(u); };
   for (const BvhNode& n : nodes) {
     const QuantizedNode q = quantize(n);
-    out.push_back({q.origin[0], q.origin[1], q.origin[2], word(q.exponents)});
-    out.push_back(ints(child(n.index[0], n.count[0]), child(n.index[1], n.count[1]), child(n.index[2], n.count[2]),
-                       child(n.index[3], n.count[3])));
+    // The children's layout (layouts.h): inner ones, then leaves, each consecutive, then none.
+    std::uint32_t innerCount = 0, used = 0, starts = 0;
+    std::int32_t leaf = -1, units = 0;  // the first leaf's record; units of the leaves so far
+    for (std::size_t c = 0; c < kBvhWidth; ++c) {
+      const std::int32_t index = n.index[c], count = n.count[c];
+      if (count < 0) continue;
+      RETILE_ASSERT(used == c, "a node's empty slot before a used one");
+      ++used;
+      if (count == 0) {
+        RETILE_ASSERT(innerCount == c && index == n.index[0] + static_cast<std::int32_t>(c), "a node's inner children out of order");
+        ++innerCount;
+        continue;
+      }
+      RETILE_ASSERT(instances ? count == 1 : count <= gpu::kMaxLeafTriangles, cat("a leaf of ", count));
+      if (leaf < 0) leaf = index;
+      RETILE_ASSERT(index == leaf + (instances ? units / 2 : units), "a node's leaves are not consecutive");
+      if (c > 0) starts |= static_cast<std::uint32_t>(units) << (4 * (c - 1));
+      units += instances ? 2 : count;
+    }
+    const std::uint32_t innerUnit = innerCount == 0 ? 0 : traversalUnit(base + std::int64_t{n.index[0]} * gpu::kNodeTexels);
+    const std::int64_t leafTexel = leafBase + std::int64_t{leaf} * leafTexels;
+    const std::uint32_t leafUnit = leaf < 0 ? 0 : traversalUnit(leafTexel);
+    if (leaf >= 0) traversalUnit(leafTexel + std::int64_t{units - 1} * gpu::kUnitTexels);  // the last within the limit too
+    const std::uint32_t layout = innerCount << gpu::kLayoutInner | used << gpu::kLayoutUsed |
+                                 (instances ? 1u : 0u) << gpu::kLayoutInstances | starts << gpu::kLayoutStarts;
+    out.push_back({q.origin[0], q.origin[1], q.origin[2], word(q.exponents | (layout & 255u) << 24)});
     out.push_back({word(q.lo[0]), word(q.lo[1]), word(q.lo[2]), word(q.hi[0])});
-    out.push_back({word(q.hi[1]), word(q.hi[2]), word(q.order[0]), word(q.order[1])});
+    out.push_back({word(q.hi[1]), word(q.hi[2]), word(innerUnit | (layout >> 8 & 63u) << gpu::kBaseBits),
+                   word(leafUnit | (layout >> 14) << gpu::kBaseBits)});
   }
 }
 
@@ -335,6 +365,10 @@ void RenderSceneBuilder::packMesh(MeshEntry& e, const Mat4* place) {
     e.shading[p * gpu::kTriShadeTexels + 2] = v4(n2, t1.x);
     e.shading[p * gpu::kTriShadeTexels + 3] = {t1.y, t2.x, t2.y, useN ? 1.0f : 0.0f};
   }
+  // Where each leaf's run ends (layouts.h): traversal goes on to the next triangle until then.
+  for (const BvhNode& node : e.bvh.nodes)
+    for (std::size_t c = 0; c < kBvhWidth; ++c)
+      if (node.count[c] > 0) e.triangles[static_cast<std::size_t>(node.index[c] + node.count[c] - 1) * gpu::kTriTexels + 1].w = 1.0f;
 }
 
 void RenderSceneBuilder::packGeometry(const Scene& scene) {
@@ -415,11 +449,8 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
   data_.triangleCount = triangles;
   for (auto& [key, e] : meshes_) {
     auto base = static_cast<std::int64_t>(data_.meshTraversal.size());
-    e.rootItem = traversalItem(base, gpu::kItemNode, 1);
-    const std::int64_t triOffset = e.triOffset;  // a structured binding cannot be captured before C++20's P1091 in clang 14
-    appendNodes(data_.meshTraversal, e.bvh.nodes, 0, [&](std::int32_t index, std::int32_t count) {
-      return traversalItem((triOffset + index) * gpu::kTriTexels, gpu::kItemTriangles, count);
-    });
+    e.rootItem = traversalItem(base, gpu::kItemNode);
+    appendNodes(data_.meshTraversal, e.bvh.nodes, 0, std::int64_t{e.triOffset} * gpu::kTriTexels, false);
   }
 }
 
@@ -512,6 +543,7 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     std::int32_t item;  // where traversal enters the instance's BVH
     std::int32_t node;  // that BVH's node index when item is an inner node, else -1
     Bounds3 bounds;     // world space
+    std::int32_t triangles = 0;  // a leaf's, when item is one
   };
   auto braid = [&](std::size_t budget) {
     std::vector<Ref> refs;
@@ -534,10 +566,10 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
         if (count < 0) continue;
         const Bounds3 world = transformBounds(c.transform, n.box[k]);
         if (count == 0)
-          children.push_back({refs[r].cand, traversalItem(nodes + std::int64_t{index} * gpu::kNodeTexels, gpu::kItemNode, 1), index, world});
+          children.push_back({refs[r].cand, traversalItem(nodes + std::int64_t{index} * gpu::kNodeTexels, gpu::kItemNode), index, world});
         else
-          children.push_back({refs[r].cand, traversalItem((std::int64_t{c.mesh->triOffset} + index) * gpu::kTriTexels, gpu::kItemTriangles, count),
-                              -1, world});
+          children.push_back({refs[r].cand, traversalItem((std::int64_t{c.mesh->triOffset} + index) * gpu::kTriTexels, gpu::kItemTriangles),
+                              -1, world, count});
       }
       if (children.size() < 2) continue;  // a leaf root: nothing to open
       const std::size_t first = refs.size();
@@ -566,7 +598,7 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
       *cost = expectedSteps(bvh, [&](std::uint32_t p) {
         const Ref& r = (*refs)[bvh.primOrder[p]];
         if (r.node >= 0) return 1.0f + cands[r.cand].mesh->steps[static_cast<std::size_t>(r.node)];
-        return 1.0f + static_cast<float>(((r.item >> 2) & 3) + 1);  // a leaf: its triangles
+        return 1.0f + static_cast<float>(r.triangles);  // a leaf: its triangles
       })[0];
     }
     return bvh;
@@ -601,11 +633,8 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   auto base = static_cast<std::int64_t>(data_.meshTraversal.size());
   auto records = base + static_cast<std::int64_t>(tlas.nodes.size()) * gpu::kNodeTexels;
   data_.topTraversal.clear();
-  data_.tlasRoot = traversalItem(base, gpu::kItemNode, 1);
-  appendNodes(data_.topTraversal, tlas.nodes, base, [&](std::int32_t index, std::int32_t count) {
-    RETILE_ASSERT(count == 1, cat("a top-level leaf of ", count, " references"));
-    return traversalItem(records + static_cast<std::int64_t>(index) * gpu::kInstanceRecordTexels, gpu::kItemInstance, 1);
-  });
+  data_.tlasRoot = traversalItem(base, gpu::kItemNode);
+  appendNodes(data_.topTraversal, tlas.nodes, base, records, true);
   data_.instances.clear();
   data_.instanceObject.clear();
   data_.bounds = tlas.bounds;
@@ -634,8 +663,9 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   for (std::uint32_t p : tlas.primOrder) {
     const Ref& r = refs[p];
     const Mat4& inv = inverseOf[r.cand];
-    for (int row = 0; row < 3; ++row) data_.topTraversal.push_back({inv.m[row][0], inv.m[row][1], inv.m[row][2], inv.m[row][3]});
     data_.topTraversal.push_back(ints(r.item, static_cast<std::int32_t>(r.cand), flagsOf[r.cand], 0));
+    for (int row = 0; row < 3; ++row) data_.topTraversal.push_back({inv.m[row][0], inv.m[row][1], inv.m[row][2], inv.m[row][3]});
+    data_.topTraversal.insert(data_.topTraversal.end(), gpu::kInstanceRecordTexels - 4, vec4{});
   }
   data_.instanceReferences = refs.size();
   RETILE_ASSERT(records + static_cast<std::int64_t>(refs.size()) * gpu::kInstanceRecordTexels ==
