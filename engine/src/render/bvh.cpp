@@ -403,11 +403,11 @@ int enteredChildren(const BvhNode& n, const QuantizedNode& q, Vec3 o, Vec3 inv, 
 }
 
 std::array<int, kBvhWidth> childRanks(const float (&near)[kBvhWidth]) {
-  // Nearer first, ties in slot order: a strict total order, as the keys are never NaN.
+  // Nearer first, ties in reverse slot order: a strict total order, as the keys are never NaN.
   std::array<int, kBvhWidth> rank{};
   for (int i = 0; i < kBvhWidth; ++i)
     for (int j = i + 1; j < kBvhWidth; ++j) {
-      if (near[j] < near[i])
+      if (near[j] <= near[i])
         ++rank[static_cast<std::size_t>(i)];
       else
         ++rank[static_cast<std::size_t>(j)];
