@@ -332,6 +332,8 @@ void traceStep(inout Trace tr, int below, int root) {
     uint starts = (shape >> (kLayoutStarts - 4)) & ~15u;  // four bits a slot, slot 0's 0
     const uint baseMask = (1u << kBaseBits) - 1u;
     uint innerBase = qb.z & baseMask, leafBase = qb.w & baseMask;
+    // An empty slot's box is inside out (render/bvh.cpp quantize), but in a node of no extent far
+    // from the origin its planes can round to one point: the count of used slots says it is empty.
     ivec4 entered = ivec4(lessThanEqual(tNear, tFar)) * ivec4(lessThan(uvec4(0u, 1u, 2u, 3u), uvec4((shape >> kLayoutUsed) & 7u)));
     // Each child's rank, nearest entry first (render/bvh.cpp childRanks). Ties, frequent where the
     // ray starts inside several boxes, go to the later slot: leaves before inner children, and

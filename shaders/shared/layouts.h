@@ -38,8 +38,8 @@ RT_CONST(int, kItemTriangles, 1)
 RT_CONST(int, kItemInstance, 2)
 RT_CONST(int, kItemOffsetShift, 4)
 RT_CONST(int, kMaxLeafTriangles, 4)  // render/bvh.h maxLeafSize for mesh BVHs
-// A node names its children without items, to fit 48 bytes: a traversal step costs its texel
-// fetches, about 5 % of the spaceship's time each (docs/MEASUREMENTS.md). Its slots hold inner
+// A node names its children without items, to fit 48 bytes, so that a traversal step fetches three
+// texels instead of four (docs/MEASUREMENTS.md, fourteenth session). Its slots hold inner
 // children first, then leaves, then nothing (render/bvh.h buildBvh orders them so). Bits 0..25 of
 // its third texel's z and w are two bases, in units of kUnitTexels texels: `inner`, where its
 // inner children are, one unit each in slot order, and `leaves`, where its leaves' records are,
