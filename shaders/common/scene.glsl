@@ -177,7 +177,7 @@ bool alphaPasses(int instance, int prim, float u, float v, float rayRandom) {
 // The item of a node's child in `slot` (layouts.h), from the node's layout.
 int childItem(uint slot, uint innerCount, uint starts, uint innerBase, uint leafBase, int leafKind) {
   bool inner = slot < innerCount;
-  uint unit = inner ? innerBase + slot : leafBase + ((starts >> (4u * slot)) & 15u);
+  uint unit = inner ? innerBase + slot : leafBase + ((starts >> (uint(kStartBits) * slot)) & ((1u << kStartBits) - 1u));
   return (int(unit * uint(kUnitTexels)) << kItemOffsetShift) | (inner ? kItemNode : leafKind);
 }
 
@@ -329,7 +329,7 @@ void traceStep(inout Trace tr, int below, int root) {
     uint shape = (floatBitsToUint(r0.w) >> 24) | ((qb.z >> (kBaseBits - 8)) & 0x3f00u) | ((qb.w >> (kBaseBits - 14)) & 0xfc000u);
     uint innerCount = (shape >> kLayoutInner) & 7u;
     int leafKind = (shape & (1u << kLayoutInstances)) != 0u ? kItemInstance : kItemTriangles;
-    uint starts = (shape >> (kLayoutStarts - 4)) & ~15u;  // four bits a slot, slot 0's 0
+    uint starts = (shape >> (kLayoutStarts - kStartBits)) & ~((1u << kStartBits) - 1u);  // a field a slot, slot 0's 0
     const uint baseMask = (1u << kBaseBits) - 1u;
     uint innerBase = qb.z & baseMask, leafBase = qb.w & baseMask;
     // An empty slot's box is inside out (render/bvh.cpp quantize), but in a node of no extent far

@@ -54,7 +54,8 @@ RT_CONST(int, kBaseBits, 26)
 RT_CONST(int, kLayoutInner, 0)      // 3 bits
 RT_CONST(int, kLayoutUsed, 3)       // 3 bits
 RT_CONST(int, kLayoutInstances, 6)  // 1 bit
-RT_CONST(int, kLayoutStarts, 7)     // 12 bits
+RT_CONST(int, kLayoutStarts, 7)     // 12 bits: kStartBits for each of slots 1..3
+RT_CONST(int, kStartBits, 4)
 RT_CONST(int, kMaxTraversalTexels, 134217728)  // 2^27: items stay positive; also lavapipe's texel-buffer limit
 
 // What a scene has besides geometry and materials (RenderSceneData::features). The renderer

@@ -97,13 +97,15 @@ void appendNodes(std::vector<vec4>& out, const std::vector<BvhNode>& nodes, std:
       RETILE_ASSERT(instances ? count == 1 : count <= gpu::kMaxLeafTriangles, cat("a leaf of ", count));
       if (leaf < 0) leaf = index;
       RETILE_ASSERT(index == leaf + (instances ? units / 2 : units), "a node's leaves are not consecutive");
-      if (c > 0) starts |= static_cast<std::uint32_t>(units) << (4 * (c - 1));
+      if (c > 0) starts |= static_cast<std::uint32_t>(units) << (gpu::kStartBits * (c - 1));
       units += instances ? 2 : count;
     }
     const std::uint32_t innerUnit = innerCount == 0 ? 0 : traversalUnit(base + std::int64_t{n.index[0]} * gpu::kNodeTexels);
-    const std::int64_t leafTexel = leafBase + std::int64_t{leaf} * leafTexels;
-    const std::uint32_t leafUnit = leaf < 0 ? 0 : traversalUnit(leafTexel);
-    if (leaf >= 0) traversalUnit(leafTexel + std::int64_t{units - 1} * gpu::kUnitTexels);  // the last within the limit too
+    std::uint32_t leafUnit = 0;
+    if (leaf >= 0) {
+      leafUnit = traversalUnit(leafBase + std::int64_t{leaf} * leafTexels);
+      traversalUnit(gpu::kUnitTexels * (std::int64_t{leafUnit} + units - 1));  // the last within the limit too
+    }
     const std::uint32_t layout = innerCount << gpu::kLayoutInner | used << gpu::kLayoutUsed |
                                  (instances ? 1u : 0u) << gpu::kLayoutInstances | starts << gpu::kLayoutStarts;
     out.push_back({q.origin[0], q.origin[1], q.origin[2], word(q.exponents | (layout & 255u) << 24)});
