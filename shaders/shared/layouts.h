@@ -70,13 +70,15 @@ RT_CONST(int, kFeatureBump, 64)          // some material has a bump map
 RT_CONST(int, kFeatureEmissionTextures, 128)  // some emitter's emission is textured
 RT_CONST(int, kFeatureBlend, 256)         // some material blends with another (Material::blendWith)
 // How a sample's offset in its pixel is drawn (exactly one): the filter's tabulated inverse CDF, a
-// tent's exact inverse, or Tungsten's table searched as Tungsten searches it (render_scene.h).
+// tent's exact inverse, Tungsten's table searched as Tungsten searches it (its Gaussian), or
+// Tungsten's tent table, whose steps are found in closed form (render_scene.h).
 RT_CONST(int, kFeatureFilterTable, 512)
 RT_CONST(int, kFeatureFilterTent, 1024)
 RT_CONST(int, kFeatureFilterTungsten, 2048)
 RT_CONST(int, kFeatureSun, 4096)  // some directional light has a disc (Light::angularRadius)
 RT_CONST(int, kFeatureInstanceTransforms, 8192)  // some instance is not in world space as it is
-RT_CONST(int, kFeatureAll, 16383)
+RT_CONST(int, kFeatureFilterTungstenTent, 16384)
+RT_CONST(int, kFeatureAll, 32767)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceEmissive, 4)
@@ -155,7 +157,8 @@ struct FrameUniforms {
   // inverse CDF of the scene's pixel filter (filter importance sampling), 33 values, packed; the
   // last slot (filterWarp[8].w): a tent's radius, inverted exactly instead (0: use the table);
   // negative: minus the radius of a filter drawn as Tungsten draws it, whose table's CDF at steps
-  // 1..30 then fills the first 30 slots (retile/scene.h, FilterSampling).
+  // 1..30 then fills the first 30 slots (retile/scene.h, FilterSampling); filterWarp[8].z is then
+  // 1 for Tungsten's tent, whose CDF the shader computes instead, and 0 for its Gaussian.
   vec4 filterWarp[9];
 };
 

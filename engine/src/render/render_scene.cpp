@@ -211,8 +211,8 @@ std::uint64_t RenderSceneData::deviceBytes() const {
 }
 
 int filterFeature(const RenderSettings& s) {
-  if (s.filterSampling == FilterSampling::Tungsten && (s.pixelFilter == PixelFilter::Tent || s.pixelFilter == PixelFilter::Gaussian))
-    return gpu::kFeatureFilterTungsten;
+  if (s.filterSampling == FilterSampling::Tungsten && s.pixelFilter == PixelFilter::Tent) return gpu::kFeatureFilterTungstenTent;
+  if (s.filterSampling == FilterSampling::Tungsten && s.pixelFilter == PixelFilter::Gaussian) return gpu::kFeatureFilterTungsten;
   return s.pixelFilter == PixelFilter::Tent ? gpu::kFeatureFilterTent : gpu::kFeatureFilterTable;
 }
 

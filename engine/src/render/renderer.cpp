@@ -428,7 +428,7 @@ struct Renderer::Impl {
     u.work = {itemCount, static_cast<std::uint32_t>(slots), sel, sel ? static_cast<std::uint32_t>(countTile) : 0u};
     // Tungsten draws its box exactly, and has no other filter the table could stand for.
     const int drawn = d.filterFeature;  // the compiled kernel's
-    const bool tungsten = drawn == gpu::kFeatureFilterTungsten;
+    const bool tungsten = drawn == gpu::kFeatureFilterTungsten || drawn == gpu::kFeatureFilterTungstenTent;
     if (warpFilter != sceneSettings.pixelFilter || warpWidth != sceneSettings.filterWidth || warpTungsten != tungsten ||
         warp.empty()) {
       warpFilter = sceneSettings.pixelFilter;
@@ -444,6 +444,8 @@ struct Renderer::Impl {
     // put too many samples: the shader inverts it exactly when this (its radius) is set.
     const float radius = 0.5f * std::clamp(warpWidth, 0.01f, 16.0f);
     u.filterWarp[8].w = tungsten ? -radius : drawn == gpu::kFeatureFilterTent ? radius : 0.0f;
+    // Which of Tungsten's two (a kernel compiled with every feature has the code for both).
+    u.filterWarp[8].z = drawn == gpu::kFeatureFilterTungstenTent ? 1.0f : 0.0f;
     frameUbo.upload(&u, sizeof u);
     filterWarp.upload(u.filterWarp, sizeof u.filterWarp);  // host-visible: a copy of 144 bytes
   }
@@ -796,6 +798,7 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   if (f & static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms)) out.push_back("instance transforms");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTent)) out.push_back("exact tent filter");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTungsten)) out.push_back("Tungsten's filter table");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTungstenTent)) out.push_back("Tungsten's tent");
   return out;
 }
 double Renderer::lastBlasSeconds() const { return impl_->builder.lastTiming().blas; }
