@@ -212,40 +212,37 @@ float orenNayarFactor(Material m, vec3 wo, vec3 wi) {
   return A + B * cosPhi * sinAlpha * tanBeta;
 }
 
+// D, G2 and the density with which mfSample draws h, sharing what they have in common (Lambda of
+// o, D).
+struct MicrofacetTerms {
+  float D, G2, normalPdf;
+};
+
+MicrofacetTerms microfacetTerms(Material m, vec3 o, vec3 i, vec3 h, float a) {
+  MicrofacetTerms r;
+  r.D = mfD(m, h, a);
+  float lo = mfLambda(m, o, a), li = mfLambda(m, i, a);
+  r.G2 = m.separable ? 1.0 / ((1.0 + lo) * (1.0 + li)) : 1.0 / (1.0 + lo + li);
+  r.normalPdf = kBeckmannUsed && m.beckmann ? r.D * max(h.z, 0.0) : r.D * (1.0 / (1.0 + lo)) * max(dot(o, h), 0.0) / o.z;
+  return r;
+}
+
 // f * |cos(wi)| and the pdf sample() would have for wi. Zero for delta lobes.
+//
+// The three microfacet types share one evaluation of their half vector, D, G2 and pdf, and the
+// dielectric ones one Fresnel term: lavapipe runs the code of every type the kernel has for every
+// lane, and one copy of it per type made the spaceship's shading code (rough dielectric, rough
+// plastic and rough conductor, two calls a segment) several times longer.
 vec3 bsdfEval(Material m, vec3 wo, vec3 wi, out float pdf) {
   pdf = 0.0;
   int t = m.type;
-  if (isMat(t, kMatRoughDielectric)) {
-    float a = m.roughness;
-    bool entering = wo.z > 0.0;
-    float eta = entering ? m.ior : 1.0 / m.ior;
-    vec3 o = entering ? wo : -wo;
-    vec3 i = entering ? wi : -wi;
-    if (o.z <= 0.0 || i.z == 0.0) return vec3(0.0);
-    if (i.z > 0.0) {
-      vec3 h = normalize(o + i);
-      float F = fresnelDielectric(dot(o, h), eta);
-      float D = mfD(m, h, a);
-      pdf = F * mfReflectionPdf(m, o, h, a);
-      return vec3(F * D * mfG2(m, o, i, a) / (4.0 * o.z));
-    }
-    vec3 h = -(o + eta * i);
-    float hl = length(h);
-    if (hl <= 0.0) return vec3(0.0);
-    h /= hl;
-    if (h.z < 0.0) h = -h;
-    float oh = dot(o, h), ih = dot(i, h);
-    if (oh <= 0.0 || ih >= 0.0) return vec3(0.0);
-    float F = fresnelDielectric(oh, eta);
-    float D = mfD(m, h, a);
-    float denom = oh + eta * ih;
-    float jac = eta * eta * abs(ih) / (denom * denom);
-    pdf = (1.0 - F) * mfNormalPdf(m, o, h, a) * jac;
-    float f = abs(ih) * oh / (o.z * abs(i.z)) * (1.0 - F) * D * mfG2(m, o, i, a) / (denom * denom);
-    return m.albedo * (f * abs(i.z));
-  }
-  if (wo.z <= 0.0 || wi.z <= 0.0 || isDeltaMaterial(m)) return vec3(0.0);
+  bool roughDielectric = isMat(t, kMatRoughDielectric), roughPlastic = isMat(t, kMatRoughPlastic);
+  bool roughConductor = isMat(t, kMatRoughConductor);
+  // A rough dielectric is evaluated from the side wo is on, as if that were the outside.
+  bool entering = wo.z > 0.0;
+  bool flip = roughDielectric && !entering;
+  vec3 o = flip ? -wo : wo, i = flip ? -wi : wi;
+  if (roughDielectric ? (o.z <= 0.0 || i.z == 0.0) : (wo.z <= 0.0 || wi.z <= 0.0 || isDeltaMaterial(m))) return vec3(0.0);
   if (isMat(t, kMatLambert)) {
     pdf = wi.z * INV_PI;
     return m.albedo * (INV_PI * wi.z);
@@ -259,25 +256,41 @@ vec3 bsdfEval(Material m, vec3 wo, vec3 wi, out float pdf) {
     pdf = (1.0 - ps) * wi.z * INV_PI;
     return plasticDiffuse(m, wo, wi) * wi.z;
   }
-  if (isMat(t, kMatRoughPlastic)) {
-    float a = m.roughness;
-    vec3 h = normalize(wo + wi);
-    float F = fresnelDielectric(dot(wo, h), m.ior);
-    float D = mfD(m, h, a);
-    float spec = F * D * mfG2(m, wo, wi, a) / (4.0 * wo.z * wi.z);
-    float ps = plasticSpecularProbability(m, wo.z);
-    pdf = ps * mfReflectionPdf(m, wo, h, a) + (1.0 - ps) * wi.z * INV_PI;
-    return (vec3(spec) + plasticDiffuse(m, wo, wi)) * wi.z;
+  if (!(roughDielectric || roughPlastic || roughConductor)) return vec3(0.0);
+  float a = m.roughness;
+  float eta = roughDielectric ? (entering ? m.ior : 1.0 / m.ior) : m.ior;
+  // Through the boundary (a rough dielectric's i below) the half vector is the refraction's.
+  bool through = roughDielectric && i.z < 0.0;
+  vec3 h = through ? -(o + eta * i) : o + i;
+  float hl = length(h);
+  if (hl <= 0.0) return vec3(0.0);
+  h /= hl;
+  if (h.z < 0.0) h = -h;
+  float oh = dot(o, h), ih = dot(i, h);
+  if (through && (oh <= 0.0 || ih >= 0.0)) return vec3(0.0);
+  MicrofacetTerms mf = microfacetTerms(m, o, i, h, a);
+  const bool dielectricFresnel = (kMaterialMask & ((1 << kMatRoughDielectric) | (1 << kMatRoughPlastic))) != 0;
+  float F = dielectricFresnel ? fresnelDielectric(oh, eta) : 1.0;
+  if (through) {
+    float denom = oh + eta * ih;
+    float jac = eta * eta * abs(ih) / (denom * denom);
+    pdf = (1.0 - F) * mf.normalPdf * jac;
+    float f = abs(ih) * oh / (o.z * abs(i.z)) * (1.0 - F) * mf.D * mf.G2 / (denom * denom);
+    return m.albedo * (f * abs(i.z));
   }
-  if (isMat(t, kMatRoughConductor)) {
-    float a = m.roughness;
-    vec3 h = normalize(wo + wi);
-    float D = mfD(m, h, a);
-    vec3 F = fresnelConductor(dot(wo, h), m.eta, m.k);
-    pdf = mfReflectionPdf(m, wo, h, a);
-    return m.albedo * F * (D * mfG2(m, wo, wi, a) / (4.0 * wo.z));
+  float reflectionPdf = mf.normalPdf / (4.0 * max(oh, 1e-12));
+  if (roughDielectric) {
+    pdf = F * reflectionPdf;
+    return vec3(F * mf.D * mf.G2 / (4.0 * o.z));
   }
-  return vec3(0.0);
+  if (roughConductor) {
+    pdf = reflectionPdf;
+    return m.albedo * fresnelConductor(oh, m.eta, m.k) * (mf.D * mf.G2 / (4.0 * wo.z));
+  }
+  float spec = F * mf.D * mf.G2 / (4.0 * wo.z * wi.z);
+  float ps = plasticSpecularProbability(m, wo.z);
+  pdf = ps * reflectionPdf + (1.0 - ps) * wi.z * INV_PI;
+  return (vec3(spec) + plasticDiffuse(m, wo, wi)) * wi.z;
 }
 
 // Delta lobes are weighed where they are drawn; every other direction is weighed by the one
@@ -295,6 +308,13 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
   s.transmitted = false;
   bool evaluate = false;  // s.wi is a non-delta lobe's, to weigh by f / pdf
   int t = m.type;
+  // One microfacet normal drawn, from the side wo is on (the only side an opaque type samples),
+  // and the plastics' specular probability computed once, for whichever type uses them.
+  const int microfacetTypes = (1 << kMatRoughDielectric) | (1 << kMatRoughPlastic) | (1 << kMatRoughConductor);
+  vec3 h = vec3(0.0, 0.0, 1.0);
+  if ((kMaterialMask & microfacetTypes) != 0) h = mfSample(m, wo.z > 0.0 ? wo : -wo, m.roughness, u.xy);
+  const int plastics = (1 << kMatPlastic) | (1 << kMatRoughPlastic);
+  float ps = (kMaterialMask & plastics) != 0 ? plasticSpecularProbability(m, wo.z) : 0.0;
   if (isMat(t, kMatDielectric) || isMat(t, kMatThinSheet)) {
     bool entering = wo.z > 0.0;
     float cosO = abs(wo.z);
@@ -331,11 +351,9 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
   } else if (isMat(t, kMatRoughDielectric)) {
     // For GGX f / pdf is G2 / G1 (/ eta^2 through the boundary), for Beckmann's D cos sampling
     // G2 (o.h) / (o.z h.z).
-    float a = m.roughness;
     bool entering = wo.z > 0.0;
     float eta = entering ? m.ior : 1.0 / m.ior;
     vec3 o = entering ? wo : -wo;
-    vec3 h = mfSample(m, o, a, u.xy);
     float oh = dot(o, h);
     float F = fresnelDielectric(oh, eta);
     vec3 i;
@@ -355,8 +373,7 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
       s.weight = isMat(t, kMatConductor) ? m.albedo * fresnelConductor(wo.z, m.eta, m.k) : m.albedo;
       s.pdf = 1.0;
       s.delta = true;
-    } else if (isMat(t, kMatPlastic) && u.z < plasticSpecularProbability(m, wo.z)) {
-      float ps = plasticSpecularProbability(m, wo.z);
+    } else if (isMat(t, kMatPlastic) && u.z < ps) {
       s.wi = vec3(-wo.x, -wo.y, wo.z);
       s.weight = vec3(fresnelDielectric(wo.z, m.ior) / ps);
       s.pdf = ps;
@@ -365,8 +382,8 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
       // A microfacet reflection (rough conductor, rough plastic's specular part; for a rough
       // conductor f / pdf is F G2 / G1 with GGX) or the cosine-weighted hemisphere (lambert,
       // Oren-Nayar, the plastics' diffuse part).
-      bool microfacet = isMat(t, kMatRoughConductor) || (isMat(t, kMatRoughPlastic) && u.z < plasticSpecularProbability(m, wo.z));
-      s.wi = microfacet ? reflect(-wo, mfSample(m, wo, m.roughness, u.xy)) : sampleCosineHemisphere(u.xy);
+      bool microfacet = isMat(t, kMatRoughConductor) || (isMat(t, kMatRoughPlastic) && u.z < ps);
+      s.wi = microfacet ? reflect(-wo, h) : sampleCosineHemisphere(u.xy);
       evaluate = s.wi.z > 0.0;
     }
   }
