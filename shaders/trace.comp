@@ -356,8 +356,8 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   vec3 pos = ro + hit.t * rd;
 
   // Normals go to world space with the inverse transpose, i.e. the transposed world-to-object rows.
-  vec3 e1 = texelFetch(uTraversal, hit.prim * kTriTexels + 1).xyz;
-  vec3 e2 = texelFetch(uTraversal, hit.prim * kTriTexels + 2).xyz;
+  vec3 e1 = imageLoad(uTraversal, hit.prim * kTriTexels + 1).xyz;
+  vec3 e2 = imageLoad(uTraversal, hit.prim * kTriTexels + 2).xyz;
   vec3 ngObj = cross(e1, e2);
   vec3 ng = normalize(r0.xyz * ngObj.x + r1.xyz * ngObj.y + r2.xyz * ngObj.z);
   vec4 s0 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 0);

@@ -160,7 +160,8 @@ struct Renderer::Impl {
         const VkDeviceSize room = std::min<VkDeviceSize>(
             meshBytes + (2 * d.topTraversal.size() + 256) * sizeof(gpu::vec4), gpu::kMaxTraversalTexels * sizeof(gpu::vec4));
         if (!traversal.valid() || traversal.size() < need || traversal.size() > 2 * room + 65536)
-          traversal = Buffer(ctx, std::max(room, need), kTexelUsage, false, "BVH and triangles");
+          traversal = Buffer(ctx, std::max(room, need), kTexelUsage | VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT, false,
+                             "BVH and triangles");
         traversal.upload(d.meshTraversal.data(), meshBytes, 0);
         traversal.upload(d.topTraversal.data(), need - meshBytes, meshBytes);
       } else {
@@ -201,7 +202,7 @@ struct Renderer::Impl {
     if (!slot) {
       slot = std::make_unique<vk::ComputePipeline>(
           ctx, "trace.comp",
-          std::vector<Binding>{Binding::Storage, Binding::Storage, Binding::UniformTexel, Binding::UniformTexel,
+          std::vector<Binding>{Binding::Storage, Binding::Storage, Binding::StorageTexel, Binding::UniformTexel,
                                Binding::UniformTexel, Binding::UniformTexel,
                                Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel,
                                Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel, Binding::Storage,
