@@ -61,18 +61,24 @@ float filterOffset(float u) {
   if (hasFeature(kFeatureFilterTent) && tent > 0.0) return tent * (u < 0.5 ? sqrt(2.0 * u) - 1.0 : 1.0 - sqrt(2.0 - 2.0 * u));
   if (hasFeature(kFeatureFilterTungstenTent) && tent < 0.0 && frame.filterWarp[8].z > 0.0) {
     // As below, with the step found without the table: its search (seven reads a side, each a
-    // call over the eight lanes) cost the spaceship 8 % of its samples/s. The CDF is
-    // tungstenTentCdf's, equal to the table's up to its float sums' rounding.
+    // call over the eight lanes, in every lane of every pass) cost the spaceship about 5 % of its
+    // samples/s (docs/MEASUREMENTS.md). The CDF is tungstenTentCdf's, equal to the table's up to
+    // its float sums' rounding.
     bool negative = u < 0.5;
     float xi = negative ? 2.0 * u : 2.0 * u - 1.0;
     float x = 0.5 * (63.0 - sqrt(max(3969.0 - 3968.0 * xi, 0.0)));  // tungstenTentCdf(x) = xi
     int lo = clamp(int(x) + 1, 1, 30);
     float c0 = tungstenTentCdf(lo - 1), c1 = tungstenTentCdf(lo);
     // The root's rounding can put it a step off: the step is the first whose CDF exceeds xi.
-    bool down = xi < c0 && lo > 1, up = xi >= c1 && lo < 30;
-    lo += up ? 1 : (down ? -1 : 0);
-    c0 = up ? c1 : (down ? tungstenTentCdf(lo - 1) : c0);
-    c1 = down ? tungstenTentCdf(lo) : (up ? tungstenTentCdf(lo) : c1);
+    if (xi < c0 && lo > 1) {
+      lo--;
+      c1 = c0;
+      c0 = tungstenTentCdf(lo - 1);
+    } else if (xi >= c1 && lo < 30) {
+      lo++;
+      c0 = c1;
+      c1 = tungstenTentCdf(lo);
+    }
     float offset = -tent * (float(lo) + (xi - c0) / max(c1 - c0, 1e-9)) / 31.0;
     return negative ? -offset : offset;
   }
