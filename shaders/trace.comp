@@ -112,12 +112,18 @@ int selectionBase(int px, int py) {
 }
 
 // The material a hit on material `index` shades with: itself or, for a blend (Material::blendWith),
-// its partner when `blendRandom` falls past the ratio; emission stays the hit material's.
+// its partner when `blendRandom` falls past the ratio (times its texture's channel mean at uv,
+// where it has one); emission stays the hit material's.
 Material fetchMaterial(int index, vec2 uv, float blendRandom) {
   int shaded = index;
   if (hasFeature(kFeatureBlend)) {
     int partner = floatBitsToInt(texelFetch(uMaterials, index * kMaterialTexels + 5).w);
-    if (partner >= 0 && blendRandom >= texelFetch(uMaterials, index * kMaterialTexels + 6).w) shaded = partner;
+    float ratio = texelFetch(uMaterials, index * kMaterialTexels + 6).w;
+    if (hasFeature(kFeatureTextures)) {
+      int ratioTex = floatBitsToInt(texelFetch(uMaterials, index * kMaterialTexels + 7).x);
+      if (partner >= 0 && ratioTex >= 0) ratio *= dot(sampleTexture(ratioTex, uv).rgb, vec3(1.0 / 3.0));
+    }
+    if (partner >= 0 && blendRandom >= ratio) shaded = partner;
   }
   int base = shaded * kMaterialTexels;
   vec4 t2 = texelFetch(uMaterials, base + 2), t3 = texelFetch(uMaterials, base + 3);

@@ -77,7 +77,8 @@ constexpr TextureInput kTextureInputs[] = {{"albedo", &Material::albedoTexture},
                                            {"roughness", &Material::roughnessTexture},
                                            {"alpha", &Material::alphaTexture},
                                            {"bump", &Material::bumpTexture},
-                                           {"emission", &Material::emissionTexture}};
+                                           {"emission", &Material::emissionTexture},
+                                           {"blend ratio", &Material::blendRatioTexture}};
 
 const QStringList& textureInputs() {
   static const QStringList inputs = [] {

@@ -382,10 +382,18 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     edit(tr("Blend with"), 0, [other](Material& x) { x.setBlendWith(other); });
     rebuildLater();
   }, id);
-  if (m.blendWith != kNoNode)
+  if (m.blendWith != kNoNode) {
     b.number(tr("Blend ratio"), "blendRatio", m.blendRatio, 0.0, 1.0, 0.5, 3, [edit](double v, int drag) {
       edit(tr("Blend ratio"), drag, [v](Material& x) { x.blendRatio = static_cast<float>(v); });
     });
+    // A mask that varies the ratio over the surface (the mean of its channels scales it).
+    b.nodeChoice(tr("Blend ratio texture"), "blendRatioTexture", scene_().textures, m.blendRatioTexture, [this, edit](NodeId t) {
+      edit(tr("Assign texture"), 0, [t](Material& x) { x.blendRatioTexture = t; });
+      rebuildLater();
+    });
+    const Texture* tex = scene_().texture(m.blendRatioTexture);
+    if (tex && tex->kind == TextureKind::File) texturePath(b, *tex, "blendRatioTexturePath");
+  }
 }
 
 void PropertyPanel::texturePath(Builder& b, const Texture& t, const QString& objectName) {

@@ -426,6 +426,13 @@ TEST(Editor, AMaterialBlendsWithAnotherFromItsPanel) {
   ASSERT_TRUE(ratio);
   ratio->setValue(0.8);
   EXPECT_FLOAT_EQ(w->scene().material(material)->blendRatio, 0.8f);
+  auto* mask = w->findChild<QComboBox*>("blendRatioTexture");
+  ASSERT_TRUE(mask) << "a texture for the ratio once there is a partner";
+  ASSERT_GT(mask->count(), 1) << "the default scene has textures";
+  mask->setCurrentIndex(1);
+  EXPECT_NE(w->scene().material(material)->blendRatioTexture, kNoNode);
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().material(material)->blendRatioTexture, kNoNode);
   w->undoStack()->undo();
   w->undoStack()->undo();
   EXPECT_EQ(w->scene().material(material)->blendWith, kNoNode);

@@ -282,6 +282,41 @@ TEST(KnownAnswer, ABlendShadesAsEitherPartInProportion) {
   EXPECT_NEAR(meanOver(renderScene(*r, s, 64), plane), 2.3, 0.03) << "the emission is the blend's, whichever part shades";
 }
 
+// A blend whose ratio has a texture (Tungsten's textured `ratio`): the ratio is the constant
+// times the texture's channel mean where the surface is hit. A white lambert blended with a black
+// one at 0.8 times a mask of 1 over u < 0.5 and 0.25 over the rest, under a sky of 1, reads 0.8
+// over the one half and 0.2 over the other (both 0.8 if the texture were ignored).
+TEST(KnownAnswer, ATexturedBlendRatioVariesOverTheSurface) {
+  RETILE_RENDERER_OR_SKIP(r);
+  auto dir = test::tempDir();
+  Scene s = test::emptyScene(32, 32);
+  lookStraightDown(s, 3, 16);  // the unit quad fills the frame
+  s.settings.maxBounces = 1;
+  s.environment.color = Vec3{1.0f};
+  Material black;
+  black.albedo = Vec3{0.0f};
+  Material white;
+  white.albedo = Vec3{1.0f};
+  white.blendWith = test::addMaterial(s, black);
+  white.blendRatio = 0.8f;
+  white.blendRatioTexture = addColumnTexture(s, dir, "mask", 64, 1, [](int x) { return x < 32 ? 1.0f : 0.25f; });
+  NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, white), Mat4::identity());
+  const RenderImage img = renderScene(*r, s, 256);
+  // Image x runs along world x and u: the mask's edge is down the middle; its texels are
+  // filtered across it, so the columns next to it are left out.
+  double left = 0, right = 0;
+  int nLeft = 0, nRight = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * img.width + x;
+      ASSERT_EQ(img.objectId[i], plane) << "the quad fills the frame";
+      if (x < 12) left += img.color[i * 3 + 1], ++nLeft;
+      if (x >= 20) right += img.color[i * 3 + 1], ++nRight;
+    }
+  EXPECT_NEAR(left / nLeft, 0.8, 0.02);
+  EXPECT_NEAR(right / nRight, 0.2, 0.015);
+}
+
 // The pixel filter (filter importance sampling): a light's straight edge on a pixel boundary.
 // With a box each pixel sees only its own square; with Tungsten's tent (one pixel each way) the
 // pixel on either side of the edge takes 1/8 from across it (the tent's mass beyond half a pixel);

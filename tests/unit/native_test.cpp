@@ -99,6 +99,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   ASSERT_GE(s.materials.size(), 2u);
   s.materials[0].blendWith = s.materials[1].id;
   s.materials[0].blendRatio = 0.25f;
+  s.materials[0].blendRatioTexture = s.textures[0].id;
   s.environment.orientation = Mat4::rotateZ(0.3f) * Mat4::rotateX(-1.2f);
   s.environment.rotation = 0.7f;
   s.lights.push_back(Light{s.newId(), "Key", LightType::Spot, {1, 0.9f, 0.8f}, 3.5f, {1, 2, 3}, {0, -1, 0}, 0.4f, 0.2f, true});
@@ -123,6 +124,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.materials[0].emissionTexture, s.textures[0].id);
   EXPECT_EQ(back->scene.materials[0].coatingAbsorption, Vec3(0.1f, 0.2f, 0.3f));
   EXPECT_EQ(back->scene.materials[0].blendWith, s.materials[1].id);
+  EXPECT_EQ(back->scene.materials[0].blendRatioTexture, s.textures[0].id);
   EXPECT_EQ(back->scene.materials[0].blendRatio, 0.25f);
   EXPECT_EQ(back->scene.environment.orientation, s.environment.orientation);
   EXPECT_EQ(back->scene.environment.rotation, 0.7f);

@@ -463,6 +463,28 @@ TEST(Tungsten, AMixedBsdfBlendsItsTwoParts) {
   EXPECT_EQ(warned, 2);
 }
 
+// A textured ratio is kept as the blend's ratio texture, read as data, its scale the constant.
+TEST(Tungsten, ATexturedBlendRatioKeepsItsTexture) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [
+        {"name": "a", "type": "mixed", "bsdf0": {"type": "lambert"}, "bsdf1": {"type": "mirror"}, "ratio": "mask.png"},
+        {"name": "b", "type": "mixed", "bsdf0": {"type": "lambert"}, "bsdf1": {"type": "mirror"},
+         "ratio": {"type": "bitmap", "file": "mask.png", "scale": 0.5}}],
+      "primitives": [{"type": "quad", "bsdf": "a"}, {"type": "quad", "bsdf": "b"}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  for (int i = 0; i < 2; ++i) {
+    const Material* m = s.material(s.objects[i].material);
+    ASSERT_TRUE(m);
+    ASSERT_TRUE(s.material(m->blendWith));
+    const Texture* t = s.texture(m->blendRatioTexture);
+    ASSERT_TRUE(t) << m->name;
+    EXPECT_EQ(t->path.filename(), "mask.png");
+    EXPECT_EQ(t->colorSpace, TextureColorSpace::Raw) << "a ratio is data";
+    EXPECT_FLOAT_EQ(m->blendRatio, i == 0 ? 1.0f : 0.5f) << m->name;
+  }
+  for (const auto& w : r->warnings) EXPECT_EQ(w.find("blend ratio"), std::string::npos) << w;
+}
+
 TEST(Tungsten, MissingMeshIsSkippedWithAWarning) {
   auto file = writeScene(R"({"primitives": [
       {"type": "mesh", "file": "nowhere.obj"},

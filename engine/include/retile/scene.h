@@ -126,6 +126,9 @@ struct Material {
   // kNoNode: no blend. The other material's own blend is not followed.
   NodeId blendWith = kNoNode;
   float blendRatio = 1.0f;
+  // Multiplies blendRatio, where the surface is hit, by the mean of this texture's channels, read
+  // as data (Tungsten's textured `ratio`, its channels averaged). kNoNode: the ratio is constant.
+  NodeId blendRatioTexture = kNoNode;
   // Blends with `other` (kNoNode: no more); a ratio of 1, which would show nothing of it, becomes
   // half and half.
   void setBlendWith(NodeId other) {
@@ -134,9 +137,11 @@ struct Material {
   }
 
   // Every texture reference, for code that visits them all (deletion, validation, copies).
-  std::array<NodeId, 5> textures() const { return {albedoTexture, roughnessTexture, alphaTexture, bumpTexture, emissionTexture}; }
-  std::array<NodeId*, 5> textureSlots() {
-    return {&albedoTexture, &roughnessTexture, &alphaTexture, &bumpTexture, &emissionTexture};
+  std::array<NodeId, 6> textures() const {
+    return {albedoTexture, roughnessTexture, alphaTexture, bumpTexture, emissionTexture, blendRatioTexture};
+  }
+  std::array<NodeId*, 6> textureSlots() {
+    return {&albedoTexture, &roughnessTexture, &alphaTexture, &bumpTexture, &emissionTexture, &blendRatioTexture};
   }
 
   bool emissive() const { return emission.x > 0 || emission.y > 0 || emission.z > 0; }

@@ -274,6 +274,7 @@ Value nativeSceneToJson(const Scene& s) {
     v.set("bump_strength", m.bumpStrength);
     v.set("blend_with", m.blendWith);
     v.set("blend_ratio", m.blendRatio);
+    v.set("blend_ratio_texture", m.blendRatioTexture);
     materials.push_back(std::move(v));
   }
   root.set("materials", std::move(materials));
@@ -494,6 +495,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.number("bump_strength", &m.bumpStrength);
       r.id("blend_with", &m.blendWith);
       r.number("blend_ratio", &m.blendRatio);
+      r.id("blend_ratio_texture", &m.blendRatioTexture);
       s.materials.push_back(std::move(m));
     }
   if (auto* a = list("objects"))

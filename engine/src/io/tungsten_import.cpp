@@ -311,10 +311,13 @@ class TungstenImporter {
       // under the blend's albedo and blends (Material::blendWith) with a copy of bsdf1 under it.
       // A blend inside a blend is drawn as its weightier part.
       float ratio = 0.5f;
+      NodeId ratioTexture = kNoNode;
       if (const Value* r = v.find("ratio")) {
+        // A bitmap ratio is read as data, its channels averaged (Tungsten's REQUEST_AVERAGE),
+        // times the bitmap's scale.
         TextureRef t = texture(*r, where + ".ratio", true);
         ratio = std::clamp(luminance(t.constant), 0.0f, 1.0f);
-        if (t.isTexture) warn(cat(where, ": a textured blend ratio is taken as its constant factor"));
+        if (t.isTexture) ratioTexture = t.texture;
       }
       TextureRef albedo;  // Tungsten's default: 1
       if (const Value* a = v.find("albedo")) albedo = texture(*a, where + ".albedo", false);
@@ -355,6 +358,7 @@ class TungstenImporter {
       out_.scene.materials.push_back(other);
       m.blendWith = other.id;
       m.blendRatio = ratio;
+      m.blendRatioTexture = ratioTexture;
       return m;
     }
     if (const Value* a = v.find("albedo")) {

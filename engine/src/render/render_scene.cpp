@@ -457,7 +457,7 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
 }
 
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture, int roughnessTexture, int alphaTexture,
-                                                    int bumpTexture, int emissionTexture, int blendWith) {
+                                                    int bumpTexture, int emissionTexture, int blendWith, int blendRatioTexture) {
   Vec3 eta = m.eta, k = m.k;
   if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
   const bool rough = isMicrofacet(m.type);
@@ -476,7 +476,8 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
           v4(eta, bitsOf(albedoTexture)), v4(k, bitsOf(roughnessTexture)),
           v4(max(m.emission, Vec3{0.0f}), bitsOf(alphaTexture)),
           vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, bitsOf(emissionTexture), bitsOf(blendWith)},
-          v4(max(m.coatingAbsorption, Vec3{0.0f}), std::isfinite(m.blendRatio) ? std::clamp(m.blendRatio, 0.0f, 1.0f) : 1.0f)};
+          v4(max(m.coatingAbsorption, Vec3{0.0f}), std::isfinite(m.blendRatio) ? std::clamp(m.blendRatio, 0.0f, 1.0f) : 1.0f),
+          vec4{bitsOf(blendRatioTexture), 0, 0, 0}};
 }
 
 void RenderSceneBuilder::packMaterials(const Scene& scene) {
@@ -497,13 +498,19 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     if (textureIndex(m.albedoTexture) >= 0 || textureIndex(m.roughnessTexture) >= 0) data_.materialTextures = true;
     if (textureIndex(m.bumpTexture) >= 0 && m.bumpStrength != 0) data_.materialBump = true;
     if (textureIndex(m.emissionTexture) >= 0 && m.emissive()) data_.emissionTextures = true;
-    int blendWith = -1;
-    if (auto it = materialIndex_.find(m.blendWith); it != materialIndex_.end() && m.blendWith != m.id && m.blendRatio < 1.0f) {
+    int blendWith = -1, ratioTexture = -1;
+    const bool texturedRatio = textureIndex(m.blendRatioTexture) >= 0;
+    if (auto it = materialIndex_.find(m.blendWith);
+        it != materialIndex_.end() && m.blendWith != m.id && (m.blendRatio < 1.0f || texturedRatio)) {
       blendWith = it->second;
       data_.materialBlend = true;
+      if (texturedRatio) {
+        ratioTexture = textureIndex(m.blendRatioTexture);
+        data_.materialTextures = true;
+      }
     }
     auto texels = packMaterial(m, textureIndex(m.albedoTexture), textureIndex(m.roughnessTexture), textureIndex(m.alphaTexture),
-                               textureIndex(m.bumpTexture), textureIndex(m.emissionTexture), blendWith);
+                               textureIndex(m.bumpTexture), textureIndex(m.emissionTexture), blendWith, ratioTexture);
     data_.materials.insert(data_.materials.end(), texels.begin(), texels.end());
   };
   for (const Material& m : scene.materials) pack(m);

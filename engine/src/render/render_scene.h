@@ -30,12 +30,12 @@ using gpu::vec4;
 
 // A material as the shaders read it (kMaterialTexels texels: the first five and the seventh
 // unpacked by unpackMaterial in shaders/common/bsdf.glsl, the sixth, bump map, emission texture
-// and the material blended with, and the seventh's w, the blend's ratio, read by trace.comp),
-// with its textures' and blend partner's indices (-1: none). Roughness and IOR are clamped to
-// what the BSDF code can sample.
+// and the material blended with, the seventh's w, the blend's ratio, and the eighth's x, the
+// texture that scales it, read by trace.comp), with its textures' and blend partner's indices
+// (-1: none). Roughness and IOR are clamped to what the BSDF code can sample.
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture = -1, int roughnessTexture = -1,
                                                     int alphaTexture = -1, int bumpTexture = -1, int emissionTexture = -1,
-                                                    int blendWith = -1);
+                                                    int blendWith = -1, int blendRatioTexture = -1);
 
 // How the trace kernel draws a sample's offset in its pixel for these settings: one of the
 // gpu::kFeatureFilter... bits (Tungsten draws its tent and Gaussian from a table of its own).
