@@ -499,9 +499,10 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   path.rd = wi;
   path.depth++;
 
-  // Russian roulette after a few bounces, keeping the expected value.
+  // Russian roulette after a few bounces, keeping the expected value (Roulette, scene.h).
   if (path.depth > 3) {
-    float q = max(0.05, 1.0 - maxComponent(path.beta * path.etaScale));
+    float m = maxComponent(path.beta * path.etaScale);
+    float q = hasFeature(kFeatureTungstenRoulette) ? (m < 0.1 ? 1.0 - m : 0.0) : max(0.05, 1.0 - m);
     if (rand(path.rng) < q) return endPath(path, shadow);
     path.beta /= 1.0 - q;
   }

@@ -580,6 +580,12 @@ void PropertyPanel::buildRender(Builder& b) {
              if (i < 0 || i > 1) return;
              edit(tr("Shading normals"), 0, [i](RenderSettings& x) { x.shading = static_cast<ShadingConvention>(i); });
            });
+  // And with its Russian roulette, so that a sample is the same work as in Tungsten (see Roulette).
+  b.choice(tr("Russian roulette"), "roulette", {tr("Standard"), tr("As Tungsten plays it")}, static_cast<int>(r.roulette),
+           [edit](int i) {
+             if (i < 0 || i > 1) return;
+             edit(tr("Russian roulette"), 0, [i](RenderSettings& x) { x.roulette = static_cast<Roulette>(i); });
+           });
   b.label(tr("Resolution"), tr("%1 x %2 (the viewport's size times the render scale)").arg(renderSize_.width()).arg(renderSize_.height()));
 }
 

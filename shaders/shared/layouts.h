@@ -78,7 +78,8 @@ RT_CONST(int, kFeatureFilterTungsten, 2048)
 RT_CONST(int, kFeatureSun, 4096)  // some directional light has a disc (Light::angularRadius)
 RT_CONST(int, kFeatureInstanceTransforms, 8192)  // some instance is not in world space as it is
 RT_CONST(int, kFeatureFilterTungstenTent, 16384)
-RT_CONST(int, kFeatureAll, 32767)
+RT_CONST(int, kFeatureTungstenRoulette, 32768)  // Roulette::Tungsten (scene.h)
+RT_CONST(int, kFeatureAll, 65535)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceEmissive, 4)

@@ -695,6 +695,16 @@ TEST(EditorDefects, ThePixelFilterIsARenderSettingWithUndo) {
   ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == shaded; }));
   w->undoStack()->undo();
   EXPECT_EQ(w->scene().settings.shading, ShadingConvention::Consistent);
+  // And its Russian roulette, another trace kernel.
+  auto* roulette = w->findChild<QComboBox*>("roulette");
+  ASSERT_TRUE(roulette);
+  EXPECT_EQ(roulette->currentIndex(), static_cast<int>(Roulette::Standard));
+  roulette->setCurrentIndex(static_cast<int>(Roulette::Tungsten));
+  EXPECT_EQ(w->scene().settings.roulette, Roulette::Tungsten);
+  const std::uint64_t played = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == played; }));
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().settings.roulette, Roulette::Standard);
 }
 
 }  // namespace

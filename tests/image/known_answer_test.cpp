@@ -124,26 +124,31 @@ TEST(KnownAnswer, WhiteFurnaceLosslessMaterials) {
 
 TEST(KnownAnswer, ClosedFurnaceWithBounceLimit) {
   // Inside a sphere that emits Le and reflects rho, a path of at most B bounces sees
-  // Le * (1 + rho + ... + rho^B). Exercises emitter sampling, MIS, roulette and the bounce limit.
+  // Le * (1 + rho + ... + rho^B). Exercises emitter sampling, MIS, roulette (either rule: with
+  // rho 0.5, Tungsten's plays from the fourth bounce on) and the bounce limit.
   RETILE_RENDERER_OR_SKIP(r);
-  Scene s = test::emptyScene(16, 16);
-  s.camera = test::frontCamera(60);
-  const float rho = 0.5f, le = 1.0f;
-  const int bounces = 6;
-  s.settings.maxBounces = bounces;
-  Material m;
-  m.albedo = Vec3{rho};
-  m.emission = Vec3{le};
-  // Reversed winding and normals turn the sphere's front side, and so its emission, inwards.
-  // (A negative scale would not: transformed normals keep pointing out of the surface.)
-  auto inside = std::make_shared<MeshGeometry>(*makeSphere(24, 48));
-  for (std::size_t t = 0; t < inside->indices.size(); t += 3) std::swap(inside->indices[t + 1], inside->indices[t + 2]);
-  for (Vec3& n : inside->normals) n = -n;
-  test::addMeshObject(s, "inside", inside, test::addMaterial(s, m), Mat4::scale(Vec3{3.0f}));
-  RenderImage img = renderScene(*r, s, 256);
-  double expected = le * (1 - std::pow(rho, bounces + 1)) / (1 - rho);
-  double mean = test::meanLuminance(img, 0, 0, 16, 16);
-  EXPECT_NEAR(mean, expected, expected * 0.01) << "expected " << expected;
+  for (Roulette roulette : {Roulette::Standard, Roulette::Tungsten}) {
+    SCOPED_TRACE(roulette == Roulette::Tungsten ? "Tungsten's roulette" : "standard roulette");
+    Scene s = test::emptyScene(16, 16);
+    s.camera = test::frontCamera(60);
+    s.settings.roulette = roulette;
+    const float rho = 0.5f, le = 1.0f;
+    const int bounces = 6;
+    s.settings.maxBounces = bounces;
+    Material m;
+    m.albedo = Vec3{rho};
+    m.emission = Vec3{le};
+    // Reversed winding and normals turn the sphere's front side, and so its emission, inwards.
+    // (A negative scale would not: transformed normals keep pointing out of the surface.)
+    auto inside = std::make_shared<MeshGeometry>(*makeSphere(24, 48));
+    for (std::size_t t = 0; t < inside->indices.size(); t += 3) std::swap(inside->indices[t + 1], inside->indices[t + 2]);
+    for (Vec3& n : inside->normals) n = -n;
+    test::addMeshObject(s, "inside", inside, test::addMaterial(s, m), Mat4::scale(Vec3{3.0f}));
+    RenderImage img = renderScene(*r, s, 256);
+    double expected = le * (1 - std::pow(rho, bounces + 1)) / (1 - rho);
+    double mean = test::meanLuminance(img, 0, 0, 16, 16);
+    EXPECT_NEAR(mean, expected, expected * 0.01) << "expected " << expected;
+  }
 }
 
 TEST(KnownAnswer, DiffusePlaneUnderUniformSky) {

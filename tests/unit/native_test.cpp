@@ -90,6 +90,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   s.settings.filterWidth = 1.75f;
   s.settings.filterSampling = FilterSampling::Tungsten;
   s.settings.shading = ShadingConvention::Tungsten;
+  s.settings.roulette = Roulette::Tungsten;
   s.materials[0].separableShadowing = true;
   ASSERT_FALSE(s.textures.empty());
   s.materials[0].bumpTexture = s.textures[0].id;
@@ -118,6 +119,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.settings.filterWidth, 1.75f);
   EXPECT_EQ(back->scene.settings.filterSampling, FilterSampling::Tungsten);
   EXPECT_EQ(back->scene.settings.shading, ShadingConvention::Tungsten);
+  EXPECT_EQ(back->scene.settings.roulette, Roulette::Tungsten);
   EXPECT_TRUE(back->scene.materials[0].separableShadowing);
   EXPECT_EQ(back->scene.materials[0].bumpTexture, s.textures[0].id);
   EXPECT_EQ(back->scene.materials[0].bumpStrength, -2.5f);

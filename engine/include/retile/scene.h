@@ -240,6 +240,12 @@ enum class FilterSampling { Exact, Tungsten };
 // and paths may cross the true surface. Smooth meshes then shade differently where the shading
 // normal and the true surface disagree, mostly at their rims.
 enum class ShadingConvention { Consistent, Tungsten };
+// When a path may end early (Russian roulette), keeping the expected value. Standard: after three
+// bounces, each bounce survives with its throughput's largest channel, at most 0.95. Tungsten's:
+// after three bounces, only a throughput below 0.1 plays, and survives with that. Tungsten's ends
+// fewer paths, so a sample costs more and varies less (docs/MEASUREMENTS.md); Tungsten files use
+// it so that a sample is the same work and the same estimate as in Tungsten.
+enum class Roulette { Standard, Tungsten };
 constexpr int kTungstenFilterSteps = 31;
 // The Tungsten table's CDF at steps 1..30 (step 0's is 0, step 31's is 1), for tent and Gaussian.
 std::vector<float> tungstenFilterCdf(PixelFilter f);
@@ -258,6 +264,7 @@ struct RenderSettings {
   float filterWidth = 1.5f;
   FilterSampling filterSampling = FilterSampling::Exact;  // Tungsten scene files: Tungsten
   ShadingConvention shading = ShadingConvention::Consistent;  // Tungsten files: what their integrator asks
+  Roulette roulette = Roulette::Standard;                     // Tungsten files: Tungsten's
 };
 
 class Scene {

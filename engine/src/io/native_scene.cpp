@@ -182,6 +182,7 @@ Value nativeSceneToJson(const Scene& s) {
   // Only scenes that came from Tungsten files say it; everything else draws the filter exactly.
   if (s.settings.filterSampling == FilterSampling::Tungsten) settings.set("filter_sampling", "tungsten");
   if (s.settings.shading == ShadingConvention::Tungsten) settings.set("shading", "tungsten");
+  if (s.settings.roulette == Roulette::Tungsten) settings.set("roulette", "tungsten");
   root.set("settings", settings);
 
   Value cam(json::Object{});
@@ -379,6 +380,11 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
     if (shading == "tungsten") s.settings.shading = ShadingConvention::Tungsten;
     else if (!shading.empty() && shading != "consistent")
       r.problem("shading", cat("unknown shading '", shading, "' (consistent, tungsten)"));
+    std::string roulette;
+    r.string("roulette", &roulette);
+    if (roulette == "tungsten") s.settings.roulette = Roulette::Tungsten;
+    else if (!roulette.empty() && roulette != "standard")
+      r.problem("roulette", cat("unknown roulette '", roulette, "' (standard, tungsten)"));
   }
   if (const Value* v = root.find("camera")) {
     Reader r(&error, "camera", v);

@@ -76,6 +76,7 @@ class TungstenImporter {
       if (const Value* v = in->find("enable_two_sided_shading"); v && v->isBool()) twoSided = v->asBool();
     }
     s.settings.shading = !consistency && twoSided ? ShadingConvention::Tungsten : ShadingConvention::Consistent;
+    s.settings.roulette = Roulette::Tungsten;
     if (!twoSided) warn("integrator: one-sided shading (enable_two_sided_shading: false) is rendered two-sided");
     if (const Value* r = root.find("renderer"); r && r->isObject()) {
       float spp;

@@ -225,6 +225,7 @@ std::uint32_t RenderSceneData::features() const {
   if (!deltaLights.empty()) f |= gpu::kFeatureDeltaLights;
   if (suns > 0) f |= gpu::kFeatureSun;
   if (tungstenShading) f |= gpu::kFeatureTungstenShading;
+  if (tungstenRoulette) f |= gpu::kFeatureTungstenRoulette;
   if (materialBump) f |= gpu::kFeatureBump;
   if (emissionTextures) f |= gpu::kFeatureEmissionTextures;
   if (materialBlend) f |= gpu::kFeatureBlend;
@@ -246,6 +247,7 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
   if (first_) flags = kUpdateAll;
   first_ = false;
   data_.tungstenShading = scene.settings.shading == ShadingConvention::Tungsten;  // a kernel variant, no array
+  data_.tungstenRoulette = scene.settings.roulette == Roulette::Tungsten;        // likewise
   data_.filterFeature = filterFeature(scene.settings);                          // likewise
   timing_ = {};
   std::uint32_t dirty = 0;

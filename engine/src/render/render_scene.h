@@ -90,6 +90,7 @@ struct RenderSceneData {
   bool instanceTransforms = false;     // some instance's transform is not the identity
 
   bool tungstenShading = false;        // RenderSettings::shading is Tungsten's
+  bool tungstenRoulette = false;       // RenderSettings::roulette is Tungsten's
   int filterFeature = gpu::kFeatureFilterTable;  // filterFeature(RenderSettings)
   std::uint32_t features() const;      // kFeature... (layouts.h) of what the arrays hold
 

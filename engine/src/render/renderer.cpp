@@ -800,6 +800,7 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTent)) out.push_back("exact tent filter");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTungsten)) out.push_back("Tungsten's filter table");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTungstenTent)) out.push_back("Tungsten's tent");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureTungstenRoulette)) out.push_back("Tungsten's roulette");
   return out;
 }
 double Renderer::lastBlasSeconds() const { return impl_->builder.lastTiming().blas; }
