@@ -88,7 +88,11 @@ struct RoomOptions {
   int frames = 8;
   int maxBounces = 16;
   std::string writeScene;  // also save the first room as a native scene, to look at
+  std::string roulette = "standard";
 };
+
+// --roulette: the rule by name (standard, tungsten).
+Roulette rouletteNamed(const std::string& name) { return name == "tungsten" ? Roulette::Tungsten : Roulette::Standard; }
 
 // "100k,1M,4M" -> counts; k and M multiply by a thousand and a million.
 std::vector<std::uint64_t> parseCounts(const std::string& text) {
@@ -126,7 +130,8 @@ int benchRoom(const RoomOptions& o) {
   std::printf("%10s %11s %9s %9s %9s %10s %9s | bytes per triangle: %6s %6s %6s %6s %6s\n", "triangles", "samples/s",
               "iter/path", "build s", "objects", "device MiB", "peak RSS", "total", "tris", "BVH", "shade", "other");
   for (std::uint64_t n : counts) {
-    const Scene scene = makeFurnishedRoom(n);
+    Scene scene = makeFurnishedRoom(n);
+    scene.settings.roulette = rouletteNamed(o.roulette);
     if (!o.writeScene.empty() && n == counts.front()) {
       if (auto saved = saveNativeScene(scene, o.writeScene); !saved) return std::fprintf(stderr, "error: %s\n", saved.error().c_str()), 1;
     }
@@ -156,6 +161,7 @@ struct ThroughputOptions {
   ImageSize size{256, 256};
   int frames = 16;
   std::optional<int> maxBounces, paths;
+  std::string roulette;  // empty: the scene's
 };
 
 int benchThroughput(const ThroughputOptions& o) {
@@ -164,6 +170,7 @@ int benchThroughput(const ThroughputOptions& o) {
   if (o.paths) options.pathsPerInvocation = *o.paths;
   auto loaded = loadScene(o.scene);
   if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
+  if (!o.roulette.empty()) loaded->scene.settings.roulette = rouletteNamed(o.roulette);
 
   Renderer renderer;
   auto t0 = Clock::now();
@@ -416,6 +423,9 @@ void addBench(CLI::App& app, int* status) {
   addInt(*cmd, "--paths", &throughput->paths, 1, 1 << 20, "paths per trace invocation",
          "chosen from the last frame's cost")
       ->type_name("P");
+  cmd->add_option("--roulette", throughput->roulette, "Russian roulette: standard or tungsten (default: the scene's)")
+      ->type_name("RULE")
+      ->check(oneOf("roulette", {"standard", "tungsten"}));
   cmd->callback([throughput, status] { *status = benchThroughput(*throughput); });
 
   cmd = bench->add_subcommand("bvh", "BVH build time for a tessellated surface of N triangles");
@@ -464,6 +474,9 @@ void addBench(CLI::App& app, int* status) {
   addInt(*cmd, "--frames", &room->frames, 1, 100000, "frames timed per size");
   addInt(*cmd, "--max-bounces", &room->maxBounces, 0, 1024, "bounce limit");
   cmd->add_option("--write-scene", room->writeScene, "also save the first room as a native scene (.retile)")->type_name("FILE");
+  cmd->add_option("--roulette", room->roulette, "Russian roulette: standard or tungsten (default: standard)")
+      ->type_name("RULE")
+      ->check(oneOf("roulette", {"standard", "tungsten"}));
   cmd->callback([room, status] { *status = benchRoom(*room); });
 
   cmd = bench->add_subcommand("scale", "Samples/s and memory against triangle count (16 k to 2 M)");
