@@ -113,17 +113,25 @@ int selectionBase(int px, int py) {
 
 // The material a hit on material `index` shades with: itself or, for a blend (Material::blendWith),
 // its partner when `blendRandom` falls past the ratio (times its texture's channel mean at uv,
-// where it has one); emission stays the hit material's.
+// where it has one), and so on along the partner's own blend, kMaxBlendChain materials at most;
+// emission stays the hit material's.
 Material fetchMaterial(int index, vec2 uv, float blendRandom) {
   int shaded = index;
   if (hasFeature(kFeatureBlend)) {
-    int partner = floatBitsToInt(texelFetch(uMaterials, index * kMaterialTexels + 5).w);
-    float ratio = texelFetch(uMaterials, index * kMaterialTexels + 6).w;
-    if (hasFeature(kFeatureTextures)) {
-      int ratioTex = floatBitsToInt(texelFetch(uMaterials, index * kMaterialTexels + 7).x);
-      if (partner >= 0 && ratioTex >= 0) ratio *= dot(sampleTexture(ratioTex, uv).rgb, vec3(1.0 / 3.0));
+    float u = blendRandom;
+    for (int k = 1; k < kMaxBlendChain; ++k) {
+      int partner = floatBitsToInt(texelFetch(uMaterials, shaded * kMaterialTexels + 5).w);
+      if (partner < 0) break;
+      float ratio = texelFetch(uMaterials, shaded * kMaterialTexels + 6).w;
+      if (hasFeature(kFeatureTextures)) {
+        int ratioTex = floatBitsToInt(texelFetch(uMaterials, shaded * kMaterialTexels + 7).x);
+        if (ratioTex >= 0) ratio *= dot(sampleTexture(ratioTex, uv).rgb, vec3(1.0 / 3.0));
+      }
+      if (u < ratio) break;
+      // The number left over is uniform again over what remains: the next blend draws from it.
+      u = (u - ratio) / max(1.0 - ratio, 1e-6);
+      shaded = partner;
     }
-    if (partner >= 0 && blendRandom >= ratio) shaded = partner;
   }
   int base = shaded * kMaterialTexels;
   vec4 t2 = texelFetch(uMaterials, base + 2), t3 = texelFetch(uMaterials, base + 3);

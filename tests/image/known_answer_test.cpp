@@ -287,6 +287,29 @@ TEST(KnownAnswer, ABlendShadesAsEitherPartInProportion) {
   EXPECT_NEAR(meanOver(renderScene(*r, s, 64), plane), 2.3, 0.03) << "the emission is the blend's, whichever part shades";
 }
 
+// A blend whose partner blends in its turn (Tungsten's blends of blends): white at 0.4, else
+// white at 0.5, else black, under a sky of 1, reads 0.4 + 0.6 * 0.5 = 0.7 (0.4 + 0.6 = 1 if the
+// partner's own blend were not followed).
+TEST(KnownAnswer, ABlendOfABlendShadesAsTheChainSays) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(16, 16);
+  lookStraightDown(s, 3, 20);
+  s.settings.maxBounces = 1;
+  s.environment.color = Vec3{1.0f};
+  Material black;
+  black.albedo = Vec3{0.0f};
+  Material second;
+  second.albedo = Vec3{1.0f};
+  second.blendWith = test::addMaterial(s, black);
+  second.blendRatio = 0.5f;
+  Material first;
+  first.albedo = Vec3{1.0f};
+  first.blendWith = test::addMaterial(s, second);
+  first.blendRatio = 0.4f;
+  NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, first), Mat4::scale({1000, 1, 1000}));
+  EXPECT_NEAR(meanOver(renderScene(*r, s, 64), plane), 0.7, 0.02);
+}
+
 // A blend whose ratio has a texture (Tungsten's textured `ratio`): the ratio is the constant
 // times the texture's channel mean where the surface is hit. A white lambert blended with a black
 // one at 0.8 times a mask of 1 over u < 0.5 and 0.25 over the rest, under a sky of 1, reads 0.8

@@ -455,13 +455,64 @@ TEST(Tungsten, AMixedBsdfBlendsItsTwoParts) {
   EXPECT_FLOAT_EQ(even->blendRatio, 0.5f) << "Tungsten's default ratio";
   ASSERT_TRUE(s.material(even->blendWith));
   EXPECT_EQ(s.material(even->blendWith)->type, MaterialType::Lambert);
-  // One level of blending: a blend among the parts is drawn as its weightier part, with a warning.
-  ASSERT_TRUE(s.material(deep->blendWith));
-  EXPECT_EQ(deep->type, MaterialType::Conductor) << "the named blend 'mix' as its bsdf0";
-  EXPECT_EQ(s.material(deep->blendWith)->type, MaterialType::Mirror) << "ratio 0.2: the inner blend's bsdf1";
+  // Blends in both parts make no chain: bsdf0's blend (the named 'mix') is drawn as its first
+  // part, and bsdf1's chain goes on after it.
+  EXPECT_EQ(deep->type, MaterialType::Conductor) << "the named blend 'mix' as its first part";
+  EXPECT_FLOAT_EQ(deep->blendRatio, 0.5f);
+  const Material* inner = s.material(deep->blendWith);
+  ASSERT_TRUE(inner);
+  EXPECT_EQ(inner->type, MaterialType::Conductor) << "bsdf1's blend: gold, then the mirror";
+  EXPECT_FLOAT_EQ(inner->blendRatio, 0.2f);
+  ASSERT_TRUE(s.material(inner->blendWith));
+  EXPECT_EQ(s.material(inner->blendWith)->type, MaterialType::Mirror);
   int warned = 0;
-  for (const auto& w : r->warnings) warned += w.find("a blend inside a blend is rendered as its") != std::string::npos;
-  EXPECT_EQ(warned, 2);
+  for (const auto& w : r->warnings) warned += w.find("rendered as its first part") != std::string::npos;
+  EXPECT_EQ(warned, 1);
+}
+
+// Blends of blends become chains the kernel follows (Material::blendWith of a partner): a blend
+// in bsdf1 goes on after bsdf0; a blend in bsdf0 goes after bsdf1, the ratio turned round. The
+// outer albedo reaches every material of the chain.
+TEST(Tungsten, BlendsOfBlendsBecomeChains) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [
+        {"name": "right", "type": "mixed", "ratio": 0.4, "albedo": 0.5, "bsdf0": {"type": "lambert", "albedo": 0.9},
+         "bsdf1": {"type": "mixed", "ratio": 0.25, "bsdf0": {"type": "conductor"}, "bsdf1": {"type": "mirror"}}},
+        {"name": "left", "type": "mixed", "ratio": 0.6, "bsdf1": {"type": "lambert"},
+         "bsdf0": {"type": "mixed", "ratio": 0.5, "bsdf0": {"type": "conductor"}, "bsdf1": {"type": "mirror"}}}],
+      "primitives": [{"type": "quad", "bsdf": "right"}, {"type": "quad", "bsdf": "left"}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  auto chain = [&](const Material* m) {
+    std::vector<const Material*> out;
+    while (m && out.size() < 8) {
+      out.push_back(m);
+      m = m->blendWith != kNoNode ? s.material(m->blendWith) : nullptr;
+    }
+    return out;
+  };
+  auto right = chain(s.material(s.objects[0].material));
+  ASSERT_EQ(right.size(), 3u);
+  EXPECT_EQ(right[0]->type, MaterialType::Lambert);
+  EXPECT_FLOAT_EQ(right[0]->blendRatio, 0.4f);
+  EXPECT_NEAR(right[0]->albedo.x, 0.45f, 1e-6f);
+  EXPECT_EQ(right[1]->type, MaterialType::Conductor);
+  EXPECT_FLOAT_EQ(right[1]->blendRatio, 0.25f);
+  EXPECT_NEAR(right[1]->albedo.x, 0.5f, 1e-6f) << "under the outer albedo";
+  EXPECT_EQ(right[2]->type, MaterialType::Mirror);
+  EXPECT_NEAR(right[2]->albedo.x, 0.5f, 1e-6f) << "under the outer albedo";
+  auto left = chain(s.material(s.objects[1].material));
+  ASSERT_EQ(left.size(), 3u);
+  EXPECT_EQ(left[0]->type, MaterialType::Lambert) << "bsdf1 first";
+  EXPECT_FLOAT_EQ(left[0]->blendRatio, 0.4f) << "1 - 0.6";
+  EXPECT_EQ(left[1]->type, MaterialType::Conductor);
+  EXPECT_FLOAT_EQ(left[1]->blendRatio, 0.5f);
+  EXPECT_EQ(left[2]->type, MaterialType::Mirror);
+  for (const auto& w : r->warnings) EXPECT_EQ(w.find("blend"), std::string::npos) << w;
+  // Nothing left over: every material is an object's or in a chain.
+  std::set<NodeId> used;
+  for (const Object& o : s.objects) used.insert(o.material);
+  for (const Material& m : s.materials) used.insert(m.blendWith);
+  for (const Material& m : s.materials) EXPECT_TRUE(used.count(m.id) || m.name == "right" || m.name == "left") << m.name;
 }
 
 // A textured ratio is kept as the blend's ratio texture, read as data, its scale the constant.

@@ -89,6 +89,9 @@ constexpr bool isMicrofacet(MaterialType t) {
   return t == MaterialType::RoughPlastic || t == MaterialType::RoughConductor || t == MaterialType::RoughDielectric;
 }
 
+// Materials a hit follows through blends, the first included (Material::blendWith).
+constexpr int kMaxBlendChain = 4;
+
 struct Material {
   NodeId id = kNoNode;
   std::string name;
@@ -123,7 +126,8 @@ struct Material {
   // A blend of two materials, as Tungsten's `mixed` bsdf: a surface shades as this material with
   // probability blendRatio and as `blendWith` otherwise, chosen again at every hit, which
   // averages to ratio * this + (1 - ratio) * other. Emission, coverage and bump stay this one's.
-  // kNoNode: no blend. The other material's own blend is not followed.
+  // kNoNode: no blend. The other material's own blend is followed in its turn, kMaxBlendChain
+  // materials in all at most: blends of blends, as Tungsten files nest them.
   NodeId blendWith = kNoNode;
   float blendRatio = 1.0f;
   // Multiplies blendRatio, where the surface is hit, by the mean of this texture's channels, read

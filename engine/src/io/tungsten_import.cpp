@@ -131,6 +131,47 @@ class TungstenImporter {
     warn(cat("camera: focus_pivot '", focusPivot_, "' names no primitive; focused at focus_distance"));
   }
 
+  // A blend's part under the blend's albedo. Where the part is itself a chain of blends, the
+  // materials after it are copied under the albedo too (they may be a named bsdf's, which keeps
+  // its own); the copies replace what the part's own blend had made for it alone.
+  void underAlbedo(Material& p, const TextureRef& albedo, int depth = 0) {
+    p.albedo = p.albedo * albedo.constant;
+    if (albedo.isTexture && p.albedoTexture == kNoNode) p.albedoTexture = albedo.texture;
+    const Material* next = p.blendWith != kNoNode ? out_.scene.material(p.blendWith) : nullptr;
+    if (!next) return;
+    if (albedo.constant == Vec3{1.0f} && !albedo.isTexture) return;  // nothing changes: shared as it is
+    Material copy = *next;
+    copied_.insert(next->id);
+    if (depth + 2 < kMaxBlendChain) underAlbedo(copy, albedo, depth + 1);
+    else copy.blendWith = kNoNode;
+    copy.id = out_.scene.newId();
+    out_.scene.materials.push_back(copy);
+    p.blendWith = copy.id;
+  }
+  // Materials in the chain of blends that starts at m (m itself counts).
+  int chainLength(const Material& m) const {
+    int n = 1;
+    for (const Material* at = &m; at->blendWith != kNoNode && n < 16; ++n) {
+      at = out_.scene.material(at->blendWith);
+      if (!at) break;
+    }
+    return n;
+  }
+  // Ends the chain at m after `keep` materials; the last one kept is copied without its blend.
+  void cutChain(Material& m, int keep) {
+    if (keep <= 1 || m.blendWith == kNoNode) {
+      m.blendWith = kNoNode;
+      return;
+    }
+    const Material* next = out_.scene.material(m.blendWith);
+    if (!next) return;
+    Material copy = *next;
+    cutChain(copy, keep - 1);
+    copy.id = out_.scene.newId();
+    out_.scene.materials.push_back(copy);
+    m.blendWith = copy.id;
+  }
+
   // A named bsdf every user of which took a copy of it (emitters, bump maps) would sit in the
   // material list unused, beside its copies: it goes. Bsdfs the file defines but no primitive
   // names stay, for the artist to assign.
@@ -310,7 +351,9 @@ class TungstenImporter {
     if (type == "mixed") {
       // Tungsten's blend, albedo * (ratio * bsdf0 + (1 - ratio) * bsdf1): this material is bsdf0
       // under the blend's albedo and blends (Material::blendWith) with a copy of bsdf1 under it.
-      // A blend inside a blend is drawn as its weightier part.
+      // A part that is a blend itself comes back as the first material of its chain of blends,
+      // which the kernel follows: bsdf1's chain goes on after bsdf0; a chain in bsdf0 goes after
+      // bsdf1 instead (the ratio turned round), where the ratio is a constant and bsdf1 no chain.
       float ratio = 0.5f;
       NodeId ratioTexture = kNoNode;
       if (const Value* r = v.find("ratio")) {
@@ -322,44 +365,46 @@ class TungstenImporter {
       }
       TextureRef albedo;  // Tungsten's default: 1
       if (const Value* a = v.find("albedo")) albedo = texture(*a, where + ".albedo", false);
-      // A part under the blend's albedo, itself no blend.
       auto part = [&](const char* key) {
         const Value* pv = v.find(key);
         if (!pv) {
           problem(where, cat("mixed bsdf without \"", key, "\""));
           return Material{};
         }
-        const bool outer = !inBlend_;
-        inBlend_ = true;
         Material p = bsdf(*pv, cat(where, ".", key), depth + 1);
-        if (outer) inBlend_ = false;
-        if (p.blendWith != kNoNode) {
-          warn(cat(where, ".", key, ": a blend inside a blend is rendered as its bsdf0"));
-          p.blendWith = kNoNode;
-          p.blendRatio = 1;
-        }
-        p.albedo = p.albedo * albedo.constant;
-        if (albedo.isTexture && p.albedoTexture == kNoNode) p.albedoTexture = albedo.texture;
+        underAlbedo(p, albedo);
         return p;
       };
       const std::string name = m.name;
-      if (inBlend_) {
-        const char* key = ratio >= 0.5f ? "bsdf0" : "bsdf1";
-        m = part(key);
-        m.name = name;
-        warn(cat(where, ": a blend inside a blend is rendered as its ", key, " (ratio ", ratio, ")"));
-        return m;
-      }
-      Material other = part("bsdf1");
-      m = part("bsdf0");
+      Material zero = part("bsdf0"), one = part("bsdf1");
       if (!ok()) return m;
+      Material* first = &zero;
+      Material* rest = &one;
+      float firstRatio = ratio;
+      if (zero.blendWith != kNoNode && one.blendWith == kNoNode && ratioTexture == kNoNode) {
+        first = &one;
+        rest = &zero;
+        firstRatio = 1.0f - ratio;
+      } else if (zero.blendWith != kNoNode) {
+        warn(cat(where, ".bsdf0: a blend in a blend whose ratio is a texture or whose bsdf1 is a blend too is "
+                        "rendered as its first part"));
+        zero.blendWith = kNoNode;
+        zero.blendRatio = 1;
+        zero.blendRatioTexture = kNoNode;
+      }
+      if (chainLength(*rest) + 1 > kMaxBlendChain) {
+        warn(cat(where, ": blends nested more than ", kMaxBlendChain, " materials deep; the deepest are left out"));
+        cutChain(*rest, kMaxBlendChain - 1);
+      }
+      const bool reversed = first == &one;
+      rest->id = out_.scene.newId();
+      rest->name = cat(name.empty() ? where : name, reversed ? " (bsdf0)" : " (bsdf1)");
+      out_.scene.materials.push_back(*rest);
+      m = *first;
       m.name = name;
-      other.id = out_.scene.newId();
-      other.name = cat(name.empty() ? where : name, " (bsdf1)");
-      out_.scene.materials.push_back(other);
-      m.blendWith = other.id;
-      m.blendRatio = ratio;
-      m.blendRatioTexture = ratioTexture;
+      m.blendWith = rest->id;
+      m.blendRatio = firstRatio;
+      m.blendRatioTexture = reversed ? kNoNode : ratioTexture;
       return m;
     }
     if (const Value* a = v.find("albedo")) {
@@ -1036,7 +1081,6 @@ class TungstenImporter {
   std::map<std::string, std::vector<MeshPart>> meshParts_;  // a mesh file's parts, by loadMesh's key
   std::map<std::string, std::shared_ptr<const MeshGeometry>> shapes_;
   int emitters_ = 0;
-  bool inBlend_ = false;     // reading the parts of a mixed bsdf (Material::blendWith is one level deep)
   std::set<NodeId> copied_;  // named bsdfs some primitive took a copy of (dropReplacedBsdfs)
   std::map<std::tuple<std::string, NodeId, float>, NodeId> bumped_;  // (bsdf, texture, strength) -> its copy
 };

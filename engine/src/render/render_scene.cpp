@@ -458,6 +458,8 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
   }
 }
 
+static_assert(gpu::kMaxBlendChain == kMaxBlendChain, "the kernel follows as many blends as the scene allows");
+
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture, int roughnessTexture, int alphaTexture,
                                                     int bumpTexture, int emissionTexture, int blendWith, int blendRatioTexture) {
   Vec3 eta = m.eta, k = m.k;
