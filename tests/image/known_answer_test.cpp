@@ -265,20 +265,30 @@ TEST(KnownAnswer, TheSkyIsFilteredBetweenTexels) {
   EXPECT_LT(hi, 0.55);
 }
 
+// Seen from 3 above the origin, looking down, under a sky of radiance 1 and one bounce: a lambert
+// surface there reads its albedo.
+Scene underUnitSky(int width, int height, float fovDegrees) {
+  Scene s = test::emptyScene(width, height);
+  lookStraightDown(s, 3, fovDegrees);
+  s.settings.maxBounces = 1;
+  s.environment.color = Vec3{1.0f};
+  return s;
+}
+
+Material grey(float albedo) {
+  Material m;
+  m.albedo = Vec3{albedo};
+  return m;
+}
+
 // A blend (Tungsten's mixed bsdf) shades as either part, chosen again at every hit: a white
 // lambert blended at ratio 0.3 with a black one, under a sky of 1, reads 0.3 (1 if the blend
 // were ignored); an emitting blend keeps its emission whichever part a hit shades with.
 TEST(KnownAnswer, ABlendShadesAsEitherPartInProportion) {
   RETILE_RENDERER_OR_SKIP(r);
-  Scene s = test::emptyScene(16, 16);
-  lookStraightDown(s, 3, 20);
-  s.settings.maxBounces = 1;
-  s.environment.color = Vec3{1.0f};
-  Material black;
-  black.albedo = Vec3{0.0f};
-  Material white;
-  white.albedo = Vec3{1.0f};
-  white.blendWith = test::addMaterial(s, black);
+  Scene s = underUnitSky(16, 16, 20);
+  Material white = grey(1.0f);
+  white.blendWith = test::addMaterial(s, grey(0.0f));
   white.blendRatio = 0.3f;
   NodeId blend = test::addMaterial(s, white);
   NodeId plane = test::addMeshObject(s, "plane", makeQuad(), blend, Mat4::scale({1000, 1, 1000}));
@@ -292,18 +302,11 @@ TEST(KnownAnswer, ABlendShadesAsEitherPartInProportion) {
 // partner's own blend were not followed).
 TEST(KnownAnswer, ABlendOfABlendShadesAsTheChainSays) {
   RETILE_RENDERER_OR_SKIP(r);
-  Scene s = test::emptyScene(16, 16);
-  lookStraightDown(s, 3, 20);
-  s.settings.maxBounces = 1;
-  s.environment.color = Vec3{1.0f};
-  Material black;
-  black.albedo = Vec3{0.0f};
-  Material second;
-  second.albedo = Vec3{1.0f};
-  second.blendWith = test::addMaterial(s, black);
+  Scene s = underUnitSky(16, 16, 20);
+  Material second = grey(1.0f);
+  second.blendWith = test::addMaterial(s, grey(0.0f));
   second.blendRatio = 0.5f;
-  Material first;
-  first.albedo = Vec3{1.0f};
+  Material first = grey(1.0f);
   first.blendWith = test::addMaterial(s, second);
   first.blendRatio = 0.4f;
   NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, first), Mat4::scale({1000, 1, 1000}));
@@ -317,15 +320,9 @@ TEST(KnownAnswer, ABlendOfABlendShadesAsTheChainSays) {
 TEST(KnownAnswer, ATexturedBlendRatioVariesOverTheSurface) {
   RETILE_RENDERER_OR_SKIP(r);
   auto dir = test::tempDir();
-  Scene s = test::emptyScene(32, 32);
-  lookStraightDown(s, 3, 16);  // the unit quad fills the frame
-  s.settings.maxBounces = 1;
-  s.environment.color = Vec3{1.0f};
-  Material black;
-  black.albedo = Vec3{0.0f};
-  Material white;
-  white.albedo = Vec3{1.0f};
-  white.blendWith = test::addMaterial(s, black);
+  Scene s = underUnitSky(32, 32, 16);  // the unit quad fills the frame
+  Material white = grey(1.0f);
+  white.blendWith = test::addMaterial(s, grey(0.0f));
   white.blendRatio = 0.8f;
   white.blendRatioTexture = addColumnTexture(s, dir, "mask", 64, 1, [](int x) { return x < 32 ? 1.0f : 0.25f; });
   NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, white), Mat4::identity());
