@@ -166,6 +166,7 @@ class TungstenImporter {
     const Material* next = out_.scene.material(m.blendWith);
     if (!next) return;
     Material copy = *next;
+    copied_.insert(next->id);  // dropped if nothing else uses it
     cutChain(copy, keep - 1);
     copy.id = out_.scene.newId();
     out_.scene.materials.push_back(copy);
@@ -388,6 +389,7 @@ class TungstenImporter {
       } else if (zero.blendWith != kNoNode) {
         warn(cat(where, ".bsdf0: a blend in a blend whose ratio is a texture or whose bsdf1 is a blend too is "
                         "rendered as its first part"));
+        copied_.insert(zero.blendWith);  // dropped if nothing else uses it
         zero.blendWith = kNoNode;
         zero.blendRatio = 1;
         zero.blendRatioTexture = kNoNode;
