@@ -298,6 +298,30 @@ TEST(Bvh, ExpectedStepsFollowTheSurfaceAreaHeuristic) {
   EXPECT_FLOAT_EQ(steps[0], 1.0f + (6.0f * 5.0f + 6.0f) / root);
 }
 
+// The collapse chooses each node's children and leaves for the least expected steps: allowed
+// larger leaves, it can only do as well or better, as the binary tree it collapses is the same.
+TEST(Bvh, LargerLeavesNeverCostMoreExpectedSteps) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  std::vector<Bounds3> boxes(3000);
+  for (Bounds3& b : boxes) {
+    // Clusters of small boxes and some long ones, so that leaves and cuts have choices to make.
+    const Vec3 c{std::floor(unit(rng) * 6) + unit(rng) * 0.3f, unit(rng), unit(rng) * 4};
+    const float size = unit(rng) < 0.1f ? 1.0f : 0.02f;
+    b.grow(c);
+    b.grow(c + Vec3{unit(rng), unit(rng), unit(rng)} * size);
+  }
+  float previous = std::numeric_limits<float>::infinity();
+  for (int leafSize = 1; leafSize <= kMaxLeafSize; ++leafSize) {
+    BvhBuildOptions options;
+    options.maxLeafSize = leafSize;
+    const Bvh bvh = buildBvh(boxes, options);
+    const float steps = expectedSteps(bvh, [](std::uint32_t) { return 1.0f; })[0];
+    EXPECT_LE(steps, previous * 1.00001f) << "leaves of up to " << leafSize;
+    previous = steps;
+  }
+}
+
 // Small triangles along the diagonal from -corner to corner: a thin rod whose box is mostly empty.
 std::shared_ptr<const MeshGeometry> diagonalRod(Vec3 corner, std::uint32_t triangles, std::uint32_t seed) {
   auto soup = std::make_shared<MeshGeometry>();

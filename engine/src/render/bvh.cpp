@@ -60,8 +60,8 @@ struct Builder {
     }
   }
 
-  // Returns the split position in [start, start+count) or start when a leaf is best.
-  std::uint32_t split(std::uint32_t start, std::uint32_t count, const Bounds3& bounds) {
+  // Returns the split position in (start, start+count).
+  std::uint32_t split(std::uint32_t start, std::uint32_t count) {
     Bounds3 cb;
     for (std::uint32_t i = start; i < start + count; ++i) cb.grow(centroids[order[i]]);
     const int nb = opt.bins;
@@ -108,15 +108,8 @@ struct Builder {
         }
       }
     }
-    float parentArea = std::max(bounds.area(), 1e-30f);
-    float leafCost = opt.intersectionCost * static_cast<float>(count);
-    float splitCost = opt.traversalCost + opt.intersectionCost * bestCost / parentArea;
-    bool mustSplit = count > static_cast<std::uint32_t>(opt.maxLeafSize);
-    if (bestAxis < 0 || (!mustSplit && splitCost >= leafCost)) {
-      if (!mustSplit) return start;
-      // All centroids coincide (or SAH found nothing): split the range in the middle.
-      return start + count / 2;
-    }
+    // All centroids coincide (or SAH found nothing): split the range in the middle.
+    if (bestAxis < 0) return start + count / 2;
     const double lo = cb.lo[bestAxis];
     const double scale = nb / (static_cast<double>(cb.hi[bestAxis]) - lo);
     auto mid = std::partition(order.begin() + start, order.begin() + start + count,
@@ -140,7 +133,7 @@ struct Builder {
   }
 
   void build() {
-    nodes.reserve(boxes.size() * 2 / static_cast<std::size_t>(std::max(1, opt.maxLeafSize - 1)) + 1);
+    nodes.reserve(boxes.size() * 2);
     BuildNode root;
     root.start = 0;
     root.count = static_cast<std::uint32_t>(boxes.size());
@@ -155,12 +148,12 @@ struct Builder {
       Item it = stack.back();
       stack.pop_back();
       BuildNode n = nodes[it.node];
+      // Down to single primitives: which subtrees become leaves is the collapse's choice.
       if (n.count <= 1) continue;
       if (it.depth >= kSahDepthLimit && n.count <= static_cast<std::uint32_t>(opt.maxLeafSize)) continue;
       // Past a depth, SAH may keep peeling off single primitives of adversarial inputs; a median
       // split bounds the rest to log2(count) levels, so the GPU's fixed traversal stack holds.
-      std::uint32_t m = it.depth < kSahDepthLimit ? split(n.start, n.count, n.bounds) : medianSplit(n.start, n.count);
-      if (m == n.start) continue;  // leaf
+      std::uint32_t m = it.depth < kSahDepthLimit ? split(n.start, n.count) : medianSplit(n.start, n.count);
       BuildNode l, r;
       l.start = n.start;
       l.count = m - n.start;
@@ -191,6 +184,110 @@ constexpr float kSlabSlack = 1.0000004f;
 // scale a power of two).
 float gridPlane(float origin, std::uint32_t q, float scale) { return origin + static_cast<float>(q) * scale; }
 
+// The pieces of cut `id` of binary node n's subtree (see collapseCosts), in `out`; their count.
+// Cut 0 is n's two children; 1 to 7 open one or two of those further.
+std::size_t cutPieces(const std::vector<BuildNode>& bn, std::int32_t n, std::uint8_t id, std::array<std::int32_t, kBvhWidth>& out) {
+  auto kidsOf = [&](std::int32_t i) { return std::pair{bn[static_cast<std::size_t>(i)].left, bn[static_cast<std::size_t>(i)].right}; };
+  auto [l, r] = kidsOf(n);
+  std::size_t count = 0;
+  auto put = [&](std::int32_t i) { out[count++] = i; };
+  switch (id) {
+    case 0: put(l), put(r); break;
+    case 1: put(kidsOf(l).first), put(kidsOf(l).second), put(r); break;
+    case 2: put(l), put(kidsOf(r).first), put(kidsOf(r).second); break;
+    case 3: put(kidsOf(l).first), put(kidsOf(l).second), put(kidsOf(r).first), put(kidsOf(r).second); break;
+    case 4: put(kidsOf(kidsOf(l).first).first), put(kidsOf(kidsOf(l).first).second), put(kidsOf(l).second), put(r); break;
+    case 5: put(kidsOf(l).first), put(kidsOf(kidsOf(l).second).first), put(kidsOf(kidsOf(l).second).second), put(r); break;
+    case 6: put(l), put(kidsOf(kidsOf(r).first).first), put(kidsOf(kidsOf(r).first).second), put(kidsOf(r).second); break;
+    default: put(l), put(kidsOf(r).first), put(kidsOf(kidsOf(r).second).first), put(kidsOf(kidsOf(r).second).second); break;
+  }
+  return count;
+}
+
+// Whether cut `id` exists at n: the nodes it opens are inner.
+bool cutExists(const std::vector<BuildNode>& bn, std::int32_t n, std::uint8_t id) {
+  auto inner = [&](std::int32_t i) { return i >= 0 && bn[static_cast<std::size_t>(i)].left >= 0; };
+  const BuildNode& b = bn[static_cast<std::size_t>(n)];
+  const std::int32_t l = b.left, r = b.right;
+  switch (id) {
+    case 0: return inner(n);
+    case 1: return inner(l);
+    case 2: return inner(r);
+    case 3: return inner(l) && inner(r);
+    case 4: return inner(l) && inner(bn[static_cast<std::size_t>(l)].left);
+    case 5: return inner(l) && inner(bn[static_cast<std::size_t>(l)].right);
+    case 6: return inner(r) && inner(bn[static_cast<std::size_t>(r)].left);
+    default: return inner(r) && inner(bn[static_cast<std::size_t>(r)].right);
+  }
+}
+
+// Per binary node: the cut its four-wide node takes, and whether it is a leaf where it is a piece.
+struct Collapse {
+  std::vector<std::uint8_t> cut;
+  std::vector<std::uint8_t> leaf;
+};
+
+// Visits of a four-wide node by a ray that enters it, as the shader takes them: one, and one more
+// for each child entered past the second (max(1, e - 1) for e entered). Children are taken as
+// entered independently, each with the chance of its area over the node's.
+float expectedVisits(const std::array<float, kBvhWidth>& p, std::size_t count) {
+  // The distribution of the number entered (Poisson binomial), up to four.
+  std::array<float, kBvhWidth + 1> dist{1.0f, 0, 0, 0, 0};
+  for (std::size_t c = 0; c < count; ++c)
+    for (std::size_t k = c + 1; k-- > 0;) dist[k + 1] += dist[k] * p[c], dist[k] *= 1.0f - p[c];
+  return 1.0f + dist[3] + 2.0f * dist[4];
+}
+
+// The least expected steps of each binary subtree, bottom up (children come after their parents
+// in the build array), as area times steps: a piece is a leaf of its primitives (when it has no
+// more than a leaf may hold), one step each, or a four-wide node of its best cut. Cuts are the
+// eight ways to split a node into two to four pieces; the best over them is exact for this model
+// (a node's cost depends on its pieces' costs alone), where opening the largest child was greedy.
+Collapse collapseCosts(const std::vector<BuildNode>& bn, std::span<const std::uint32_t> order, const BvhBuildOptions& opt) {
+  // The steps of the primitives before each position of the build's order.
+  std::vector<float> before(order.size() + 1, 0.0f);
+  for (std::size_t i = 0; i < order.size(); ++i) before[i + 1] = before[i] + (opt.primCost ? opt.primCost(order[i]) : 1.0f);
+  Collapse plan;
+  plan.cut.assign(bn.size(), 0);
+  plan.leaf.assign(bn.size(), 0);
+  std::vector<float> piece(bn.size(), 0.0f);
+  for (std::size_t k = bn.size(); k-- > 0;) {
+    const BuildNode& n = bn[k];
+    const float area = n.bounds.area();
+    const float asLeaf = (before[n.start + n.count] - before[n.start]) * area;
+    const bool mayLeaf = n.left < 0 || n.count <= static_cast<std::uint32_t>(opt.maxLeafSize);
+    if (n.left < 0) {
+      piece[k] = asLeaf;
+      plan.leaf[k] = 1;
+      continue;
+    }
+    float best = std::numeric_limits<float>::infinity();
+    for (std::uint8_t id = 0; id < 8; ++id) {
+      if (!cutExists(bn, static_cast<std::int32_t>(k), id)) continue;
+      std::array<std::int32_t, kBvhWidth> kids{};
+      const std::size_t count = cutPieces(bn, static_cast<std::int32_t>(k), id, kids);
+      std::array<float, kBvhWidth> p{};
+      float inside = 0;
+      for (std::size_t c = 0; c < count; ++c) {
+        const auto kid = static_cast<std::size_t>(kids[c]);
+        p[c] = area > 0 ? std::min(bn[kid].bounds.area() / area, 1.0f) : 1.0f;
+        inside += piece[kid];
+      }
+      const float cost = area * expectedVisits(p, count) + inside;
+      if (cost < best) {
+        best = cost;
+        plan.cut[k] = id;
+      }
+    }
+    piece[k] = best;
+    if (mayLeaf && asLeaf <= best) {
+      piece[k] = asLeaf;
+      plan.leaf[k] = 1;
+    }
+  }
+  return plan;
+}
+
 }  // namespace
 
 Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options) {
@@ -206,46 +303,37 @@ Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options
   b.build();
   out.bounds = b.nodes[0].bounds;
 
-  // Collapse to four-wide nodes: a node takes its binary node's children and opens the inner
-  // child of largest surface area until it has kBvhWidth (opening the largest takes out the
-  // steps most rays would spend on it). Breadth first, so children follow their parents.
+  // Collapse to four-wide nodes, choosing each node's children (a cut of its binary subtree, at
+  // most four pieces) and which pieces become leaves, so that the expected steps of a ray
+  // entering the root are least (collapseCosts). Breadth first, so children follow their parents.
   const auto& bn = b.nodes;
+  const Collapse plan = collapseCosts(bn, out.primOrder, options);
   std::vector<std::uint32_t> behind{0};  // the binary node each four-wide node stands for
   std::vector<int> level{1};
   for (std::size_t k = 0; k < behind.size(); ++k) {
-    const BuildNode& n = bn[behind[k]];
-    // A fixed array, not a vector: this runs once per node of every mesh built.
-    std::array<std::uint32_t, kBvhWidth> kids{};
+    std::array<std::int32_t, kBvhWidth> kids{};
     std::size_t count = 0;
-    if (n.left < 0) {
-      kids[count++] = behind[k];  // the root is a leaf
+    const bool rootLeaf = k == 0 && plan.leaf[0];
+    if (rootLeaf) {
+      kids[count++] = 0;
     } else {
-      kids[count++] = static_cast<std::uint32_t>(n.left);
-      kids[count++] = static_cast<std::uint32_t>(n.right);
+      count = cutPieces(bn, static_cast<std::int32_t>(behind[k]), plan.cut[behind[k]], kids);
     }
-    while (count < kids.size()) {
-      std::size_t open = count;
-      for (std::size_t c = 0; c < count; ++c)
-        if (bn[kids[c]].left >= 0 && (open == count || bn[kids[c]].bounds.area() > bn[kids[open]].bounds.area())) open = c;
-      if (open == count) break;
-      const BuildNode& o = bn[kids[open]];
-      kids[open] = static_cast<std::uint32_t>(o.left);
-      kids[count++] = static_cast<std::uint32_t>(o.right);
-    }
+    auto isLeaf = [&](std::int32_t kid) { return plan.leaf[static_cast<std::size_t>(kid)] != 0; };
     // Inner children first, then leaves (render/bvh.h BvhNode).
     std::stable_partition(kids.begin(), kids.begin() + static_cast<std::ptrdiff_t>(count),
-                          [&](std::uint32_t kid) { return bn[kid].left >= 0 && kid != behind[k]; });
+                          [&](std::int32_t kid) { return !rootLeaf && !isLeaf(kid); });
     BvhNode w;
     for (std::size_t c = 0; c < count; ++c) {
-      const BuildNode& ch = bn[kids[c]];
+      const BuildNode& ch = bn[static_cast<std::size_t>(kids[c])];
       w.box[c] = ch.bounds;
-      if (ch.left < 0 || kids[c] == behind[k]) {
+      if (rootLeaf || isLeaf(kids[c])) {
         w.index[c] = static_cast<std::int32_t>(ch.start);
         w.count[c] = static_cast<std::int32_t>(ch.count);
       } else {
         w.index[c] = static_cast<std::int32_t>(behind.size());
         w.count[c] = 0;
-        behind.push_back(kids[c]);
+        behind.push_back(static_cast<std::uint32_t>(kids[c]));
         level.push_back(level[k] + 1);
         out.depth = std::max(out.depth, level[k] + 1);
       }
@@ -331,24 +419,23 @@ std::vector<float> expectedSteps(const Bvh& bvh, const std::function<float(std::
     for (std::size_t c = 0; c < kBvhWidth; ++c)
       if (n.count[c] >= 0) box.grow(n.box[c]);
     const float area = box.area();
-    float entered = 0;  // expected children entered
-    float inside = 0;   // expected steps inside them
+    float inside = 0;  // expected steps inside the children entered
+    std::array<float, kBvhWidth> p{};
+    std::size_t used = 0;
     for (std::size_t c = 0; c < kBvhWidth; ++c) {
       if (n.count[c] < 0) continue;
+      // A box without area (a line or a point): every ray that reaches it enters every child.
+      const float chance = area > 0 ? std::min(n.box[c].area() / area, 1.0f) : 1.0f;
+      p[used++] = chance;
       float cost = 0;
       if (n.count[c] == 0) {
         cost = steps[static_cast<std::size_t>(n.index[c])];
       } else {
         for (std::int32_t i = 0; i < n.count[c]; ++i) cost += primCost(static_cast<std::uint32_t>(n.index[c] + i));
       }
-      // A box without area (a line or a point): every ray that reaches it enters every child.
-      const float p = area > 0 ? n.box[c].area() / area : 1.0f;
-      entered += p;
-      inside += p * cost;
+      inside += chance * cost;
     }
-    // A visit takes one child and pushes the rest: the one left as it is, more than one by
-    // pushing the node again; so n children entered cost max(1, n - 1) visits.
-    steps[k] = std::max(1.0f, entered - 1.0f) + inside;
+    steps[k] = expectedVisits(p, used) + inside;
   }
   return steps;
 }

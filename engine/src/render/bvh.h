@@ -1,8 +1,9 @@
 // Bounding volume hierarchies on the CPU, packed for the GPU. Pure computation: no Vulkan, any
 // thread, testable without a device.
 //
-// The hierarchy is four-wide: a binary SAH build collapsed so that each node holds up to four
-// children. On lavapipe every loop iteration of the traversal pays for the whole loop body
+// The hierarchy is four-wide: a binary SAH build, down to single primitives, collapsed so that
+// each node holds up to four children, where which children and which leaves are chosen for the
+// fewest expected traversal steps. On lavapipe every loop iteration of the traversal pays for the whole loop body
 // (shaders/common/scene.glsl), so what counts is the number of steps a ray takes; a four-wide node
 // decides among four children in one step, and its child boxes, quantised to 8 bits per plane
 // relative to the node's box, keep a node in 48 bytes, less than a binary node took
@@ -21,6 +22,7 @@
 namespace retile {
 
 constexpr int kBvhWidth = 4;
+constexpr int kMaxLeafSize = 4;  // the default: a mesh leaf's triangles
 
 // A node as built. Slot c: count[c] > 0 is a leaf of count[c] primitives starting at index[c] (in
 // the packed primitive order); count[c] == 0 an inner node at index[c]; count[c] < 0 an empty
@@ -48,10 +50,10 @@ float quantizedScale(const QuantizedNode& q, int axis);
 Bounds3 dequantize(const QuantizedNode& q, int child);
 
 struct BvhBuildOptions {
-  int maxLeafSize = 4;     // leaves never hold more (forced splits beyond it)
-  int bins = 16;           // SAH bins per axis
-  float traversalCost = 1.0f;
-  float intersectionCost = 1.0f;
+  int maxLeafSize = kMaxLeafSize;  // leaves never hold more
+  int bins = 16;        // SAH bins per axis
+  // The traversal steps of input primitive i (a leaf's cost is its primitives'); one when unset.
+  std::function<float(std::uint32_t)> primCost;
 };
 
 struct Bvh {
@@ -61,7 +63,8 @@ struct Bvh {
   int depth = 0;
 };
 
-// Builds with binned SAH over the given primitive boxes, then collapses to four-wide nodes. An
+// Builds with binned SAH over the given primitive boxes, then collapses to four-wide nodes (for
+// the fewest expected steps, as expectedSteps counts them, with options.primCost for leaves). An
 // empty input yields a single root with empty slots, so traversal code needs no special case.
 // depth counts the levels of four-wide nodes.
 Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options = {});

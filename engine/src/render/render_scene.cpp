@@ -347,7 +347,7 @@ void RenderSceneBuilder::packMesh(MeshEntry& e, const Mat4* place) {
   for (std::size_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) boxes[i].grow(positions[g.indices[i * 3 + static_cast<std::size_t>(k)]]);
   // A leaf's item carries its triangle count in two bits (layouts.h).
-  static_assert(BvhBuildOptions{}.maxLeafSize <= gpu::kMaxLeafTriangles);
+  static_assert(kMaxLeafSize <= gpu::kMaxLeafTriangles);
   e.bvh = buildBvh(boxes);
   e.steps = expectedSteps(e.bvh, [](std::uint32_t) { return 1.0f; });
   e.triangles.resize(n * gpu::kTriTexels);
@@ -605,15 +605,15 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     std::vector<Bounds3> boxes;
     boxes.reserve(refs->size());
     for (const Ref& r : *refs) boxes.push_back(r.bounds);
+    // Entering a reference is one step, then its subtree's.
+    auto steps = [&](std::uint32_t i) {
+      const Ref& r = (*refs)[i];
+      if (r.node >= 0) return 1.0f + cands[r.cand].mesh->steps[static_cast<std::size_t>(r.node)];
+      return 1.0f + static_cast<float>(r.triangles);  // a leaf: its triangles
+    };
+    opt.primCost = steps;
     Bvh bvh = buildBvh(boxes, opt);
-    if (cost) {
-      // Entering a reference is one step, then its subtree's.
-      *cost = expectedSteps(bvh, [&](std::uint32_t p) {
-        const Ref& r = (*refs)[bvh.primOrder[p]];
-        if (r.node >= 0) return 1.0f + cands[r.cand].mesh->steps[static_cast<std::size_t>(r.node)];
-        return 1.0f + static_cast<float>(r.triangles);  // a leaf: its triangles
-      })[0];
-    }
+    if (cost) *cost = expectedSteps(bvh, [&](std::uint32_t p) { return steps(bvh.primOrder[p]); })[0];
     return bvh;
   };
   std::vector<Ref> refs;
