@@ -398,6 +398,27 @@ TEST(Tungsten, ASkyCapIsASunWithItsDisc) {
                           [](const std::string& w) { return w.find("cap_angle 180") != std::string::npos; }));
 }
 
+// A cap that names a skydome is the dome's sun: it points where the dome's +y does, before or
+// after the cap in the file, and its own transform is not used.
+TEST(Tungsten, ASkyCapTiedToASkydomeFollowsTheDome) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [{"name": "a", "type": "lambert"}], "primitives": [
+        {"type": "quad", "bsdf": "a"},
+        {"type": "infinite_sphere_cap", "cap_angle": 1, "emission": 10, "skydome": "sky",
+         "transform": {"rotation": [90, 0, 0]}},
+        {"type": "skydome", "name": "sky", "transform": {"rotation": [0, 0, 90]}},
+        {"type": "infinite_sphere_cap", "cap_angle": 1, "emission": 10, "skydome": "nowhere"}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  ASSERT_EQ(s.lights.size(), 2u);
+  // The dome's +y turned a quarter about z points along -x; the sun's light travels along +x.
+  EXPECT_NEAR(s.lights[0].direction.x, 1.0f, 1e-5f);
+  EXPECT_NEAR(s.lights[0].direction.y, 0.0f, 1e-5f);
+  // Naming no primitive, the cap keeps its own transform (here none: straight down), and says so.
+  EXPECT_NEAR(s.lights[1].direction.y, -1.0f, 1e-5f);
+  EXPECT_TRUE(std::any_of(r->warnings.begin(), r->warnings.end(),
+                          [](const std::string& w) { return w.find("skydome 'nowhere' names no primitive") != std::string::npos; }));
+}
+
 TEST(Tungsten, TexturedEmissionKeepsItsTexture) {
   auto r = importTungsten(writeScene(R"({"primitives": [
       {"type": "quad", "name": "screen", "emission": {"type": "bitmap", "file": "tv.png", "scale": 4}},

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <set>
 #include <tuple>
 
@@ -91,6 +92,7 @@ class TungstenImporter {
     }
     if (const Value* p = root.find("primitives"); p && ok()) {
       if (!p->isArray()) return fail("primitives: expected an array");
+      primitives_ = p;
       for (std::size_t i = 0; i < p->asArray().size() && ok(); ++i) primitive(p->asArray()[i], cat("primitives[", i, "]"));
       if (!focusPivot_.empty() && ok()) focusOn(*p);
     }
@@ -119,16 +121,23 @@ class TungstenImporter {
   // The thin lens focuses as far as the origin of the primitive focus_pivot names (Tungsten's
   // ThinlensCamera::prepareForRender), else where focus_distance says.
   void focusOn(const Value& primitives) {
-    for (std::size_t i = 0; i < primitives.asArray().size(); ++i) {
-      const Value& p = primitives.asArray()[i];
-      if (!p.isObject() || string(p, "name") != focusPivot_) continue;
-      Vec3 origin{0.0f};
-      if (const Value* t = p.find("transform")) origin = transform(t, cat("primitives[", i, "].transform")).transformPoint({0, 0, 0});
-      float d = length(origin - out_.scene.camera.position);
+    if (std::optional<Mat4> m = transformOfPrimitive(primitives, focusPivot_)) {
+      float d = length(m->transformPoint({0, 0, 0}) - out_.scene.camera.position);
       if (std::isfinite(d) && d > 0) out_.scene.camera.focusDistance = d;
       return;
     }
     warn(cat("camera: focus_pivot '", focusPivot_, "' names no primitive; focused at focus_distance"));
+  }
+
+  // The transform of the first primitive called `name` (the identity when it has none), or
+  // nothing when no primitive is.
+  std::optional<Mat4> transformOfPrimitive(const Value& primitives, const std::string& name) {
+    for (std::size_t i = 0; i < primitives.asArray().size(); ++i) {
+      const Value& p = primitives.asArray()[i];
+      if (!p.isObject() || string(p, "name") != name) continue;
+      return transform(p.find("transform"), cat("primitives[", i, "].transform"));
+    }
+    return std::nullopt;
   }
 
   // A blend's part under the blend's albedo. Where the part is itself a chain of blends, the
@@ -895,6 +904,14 @@ class TungstenImporter {
       // A cap of the sky is a sun whose disc is the cap: its radiance is the cap's, which a
       // directional light of the cap's solid angle times that radiance gives (Light::angularRadius).
       Mat4 m = transform(tv, where);
+      // Tied to a skydome (Tungsten's InfiniteSphereCap::prepareForRender): the cap is the dome's
+      // sun, around the dome's +y, whatever the cap's own transform says.
+      if (std::string dome = string(p, "skydome"); !dome.empty() && primitives_) {
+        if (std::optional<Mat4> d = transformOfPrimitive(*primitives_, dome))
+          m = *d;
+        else
+          warn(cat(where, ": skydome '", dome, "' names no primitive; the cap keeps its own direction"));
+      }
       float cap = 10;
       number(p, "cap_angle", &cap, where);
       Vec3 radiance{1.0f};
@@ -1076,6 +1093,7 @@ class TungstenImporter {
   std::string error_;
   std::map<std::string, Material> named_;
   std::string focusPivot_;  // the thin lens camera's focus_pivot
+  const Value* primitives_ = nullptr;  // the file's primitives, while they are imported
   std::map<std::string, NodeId> textures_;
   std::set<std::string> missingWarned_;
   bool quietMissingTexture_ = false;
