@@ -184,41 +184,33 @@ constexpr float kSlabSlack = 1.0000004f;
 // scale a power of two).
 float gridPlane(float origin, std::uint32_t q, float scale) { return origin + static_cast<float>(q) * scale; }
 
-// The pieces of cut `id` of binary node n's subtree (see collapseCosts), in `out`; their count.
-// Cut 0 is n's two children; 1 to 7 open one or two of those further.
+// The pieces of cut `id` of binary node n's subtree (see collapseCosts), in `out`; their count, 0
+// where the cut does not exist (a node it opens is a leaf). Cut 0 is n's two children; 1 to 7
+// open one or two of those further.
 std::size_t cutPieces(const std::vector<BuildNode>& bn, std::int32_t n, std::uint8_t id, std::array<std::int32_t, kBvhWidth>& out) {
-  auto kidsOf = [&](std::int32_t i) { return std::pair{bn[static_cast<std::size_t>(i)].left, bn[static_cast<std::size_t>(i)].right}; };
-  auto [l, r] = kidsOf(n);
   std::size_t count = 0;
+  bool exists = true;
   auto put = [&](std::int32_t i) { out[count++] = i; };
-  switch (id) {
-    case 0: put(l), put(r); break;
-    case 1: put(kidsOf(l).first), put(kidsOf(l).second), put(r); break;
-    case 2: put(l), put(kidsOf(r).first), put(kidsOf(r).second); break;
-    case 3: put(kidsOf(l).first), put(kidsOf(l).second), put(kidsOf(r).first), put(kidsOf(r).second); break;
-    case 4: put(kidsOf(kidsOf(l).first).first), put(kidsOf(kidsOf(l).first).second), put(kidsOf(l).second), put(r); break;
-    case 5: put(kidsOf(l).first), put(kidsOf(kidsOf(l).second).first), put(kidsOf(kidsOf(l).second).second), put(r); break;
-    case 6: put(l), put(kidsOf(kidsOf(r).first).first), put(kidsOf(kidsOf(r).first).second), put(kidsOf(r).second); break;
-    default: put(l), put(kidsOf(r).first), put(kidsOf(kidsOf(r).second).first), put(kidsOf(kidsOf(r).second).second); break;
-  }
-  return count;
-}
-
-// Whether cut `id` exists at n: the nodes it opens are inner.
-bool cutExists(const std::vector<BuildNode>& bn, std::int32_t n, std::uint8_t id) {
-  auto inner = [&](std::int32_t i) { return i >= 0 && bn[static_cast<std::size_t>(i)].left >= 0; };
-  const BuildNode& b = bn[static_cast<std::size_t>(n)];
-  const std::int32_t l = b.left, r = b.right;
-  switch (id) {
-    case 0: return inner(n);
-    case 1: return inner(l);
-    case 2: return inner(r);
-    case 3: return inner(l) && inner(r);
-    case 4: return inner(l) && inner(bn[static_cast<std::size_t>(l)].left);
-    case 5: return inner(l) && inner(bn[static_cast<std::size_t>(l)].right);
-    case 6: return inner(r) && inner(bn[static_cast<std::size_t>(r)].left);
-    default: return inner(r) && inner(bn[static_cast<std::size_t>(r)].right);
-  }
+  // Opens node i: its two children, or a failed cut when it is a leaf.
+  auto open = [&](std::int32_t i, auto&& then) {
+    const BuildNode& b = bn[static_cast<std::size_t>(i)];
+    if (b.left < 0) exists = false;
+    else then(b.left, b.right);
+  };
+  open(n, [&](std::int32_t l, std::int32_t r) {
+    auto both = [&](std::int32_t a, std::int32_t b) { put(a), put(b); };
+    switch (id) {
+      case 0: put(l), put(r); break;
+      case 1: open(l, both), put(r); break;
+      case 2: put(l), open(r, both); break;
+      case 3: open(l, both), open(r, both); break;
+      case 4: open(l, [&](std::int32_t a, std::int32_t b) { open(a, both), put(b); }), put(r); break;
+      case 5: open(l, [&](std::int32_t a, std::int32_t b) { put(a), open(b, both); }), put(r); break;
+      case 6: put(l), open(r, [&](std::int32_t a, std::int32_t b) { open(a, both), put(b); }); break;
+      default: put(l), open(r, [&](std::int32_t a, std::int32_t b) { put(a), open(b, both); }); break;
+    }
+  });
+  return exists ? count : 0;
 }
 
 // Per binary node: the cut its four-wide node takes, and whether it is a leaf where it is a piece.
@@ -263,9 +255,9 @@ Collapse collapseCosts(const std::vector<BuildNode>& bn, std::span<const std::ui
     }
     float best = std::numeric_limits<float>::infinity();
     for (std::uint8_t id = 0; id < 8; ++id) {
-      if (!cutExists(bn, static_cast<std::int32_t>(k), id)) continue;
       std::array<std::int32_t, kBvhWidth> kids{};
       const std::size_t count = cutPieces(bn, static_cast<std::int32_t>(k), id, kids);
+      if (count == 0) continue;
       std::array<float, kBvhWidth> p{};
       float inside = 0;
       for (std::size_t c = 0; c < count; ++c) {
@@ -313,21 +305,18 @@ Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options
   for (std::size_t k = 0; k < behind.size(); ++k) {
     std::array<std::int32_t, kBvhWidth> kids{};
     std::size_t count = 0;
-    const bool rootLeaf = k == 0 && plan.leaf[0];
-    if (rootLeaf) {
-      kids[count++] = 0;
-    } else {
+    if (k == 0 && plan.leaf[0])
+      kids[count++] = 0;  // the root is a leaf
+    else
       count = cutPieces(bn, static_cast<std::int32_t>(behind[k]), plan.cut[behind[k]], kids);
-    }
     auto isLeaf = [&](std::int32_t kid) { return plan.leaf[static_cast<std::size_t>(kid)] != 0; };
     // Inner children first, then leaves (render/bvh.h BvhNode).
-    std::stable_partition(kids.begin(), kids.begin() + static_cast<std::ptrdiff_t>(count),
-                          [&](std::int32_t kid) { return !rootLeaf && !isLeaf(kid); });
+    std::stable_partition(kids.begin(), kids.begin() + static_cast<std::ptrdiff_t>(count), [&](std::int32_t kid) { return !isLeaf(kid); });
     BvhNode w;
     for (std::size_t c = 0; c < count; ++c) {
       const BuildNode& ch = bn[static_cast<std::size_t>(kids[c])];
       w.box[c] = ch.bounds;
-      if (rootLeaf || isLeaf(kids[c])) {
+      if (isLeaf(kids[c])) {
         w.index[c] = static_cast<std::int32_t>(ch.start);
         w.count[c] = static_cast<std::int32_t>(ch.count);
       } else {
