@@ -279,6 +279,9 @@ void traceStep(inout Trace tr, int below, int root) {
   // Without instance transforms the ray in an instance's space is the world's, and the loop
   // carries nine values fewer (tr.o, d and invD are then never read, and compiled out).
   const bool transforms = hasFeature(kFeatureInstanceTransforms);
+  // With the instances' nodes copied into the instance BVH there are no records to enter, and a
+  // triangle names its instance itself.
+  const bool direct = hasFeature(kFeatureDirectReferences) && !transforms;
   vec3 rayO = transforms ? tr.o : tr.origin, rayD = transforms ? tr.d : tr.dir;
   vec3 rayInvD = transforms ? tr.invD : tr.invDir;
   // How far the current ray looks: a shadow ray to its light, an extension ray to its hit so far.
@@ -330,7 +333,7 @@ void traceStep(inout Trace tr, int below, int root) {
     // whose runs start where the layout says, from `leaves` on.
     uint shape = (floatBitsToUint(r0.w) >> 24) | ((qb.z >> (kBaseBits - 8)) & 0x3f00u) | ((qb.w >> (kBaseBits - 14)) & 0xfc000u);
     uint innerCount = (shape >> kLayoutInner) & 7u;
-    int leafKind = (shape & (1u << kLayoutInstances)) != 0u ? kItemInstance : kItemTriangles;
+    int leafKind = !direct && (shape & (1u << kLayoutInstances)) != 0u ? kItemInstance : kItemTriangles;
     uint starts = (shape >> (kLayoutStarts - kStartBits)) & ~((1u << kStartBits) - 1u);  // a field a slot, slot 0's 0
     const uint baseMask = (1u << kBaseBits) - 1u;
     uint innerBase = qb.z & baseMask, leafBase = qb.w & baseMask;
@@ -372,13 +375,15 @@ void traceStep(inout Trace tr, int below, int root) {
     float vv = dot(d, q) * inv;
     float tt = dot(r2.xyz, q) * inv;
     int p = floatBitsToInt(r0.w);
+    int instance = direct ? floatBitsToInt(r2.w) & kTriInstanceMask : tr.instance;
     bool found = det != 0.0 && uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < tLimit &&
-                 (p != tr.from.x || tr.instance != tr.from.y);
+                 (p != tr.from.x || instance != tr.from.y);
 #if RETILE_ALPHA_TEST
-    if (found && (tr.instFlags & kInstanceAlphaTested) != 0) found = alphaPasses(tr.instance, p, uu, vv, tr.rayRandom);
+    bool alphaTested = direct ? (floatBitsToInt(r2.w) & kTriAlphaTested) != 0 : (tr.instFlags & kInstanceAlphaTested) != 0;
+    if (found && alphaTested) found = alphaPasses(instance, p, uu, vv, tr.rayRandom);
 #endif
     if (found && tr.onShadow) {
-      tr.blocker = tr.instance;
+      tr.blocker = instance;
       finished = true;
     }
     if (found && !tr.onShadow) {
@@ -386,11 +391,11 @@ void traceStep(inout Trace tr, int below, int root) {
       tr.hit.u = uu;
       tr.hit.v = vv;
       tr.hit.prim = p;
-      tr.hit.instance = tr.instance;
+      tr.hit.instance = instance;
     }
     // The rest of the leaf: one triangle further on, until the run's last.
     if (r1.w == 0.0) next = item + (kTriTexels << kItemOffsetShift);
-  } else {
+  } else if (!direct) {
     // Enter an instance: transform the ray (t is preserved because d is not renormalised).
     tr.instance = floatBitsToInt(r0.y);
     tr.instFlags = floatBitsToInt(r0.z);

@@ -17,7 +17,7 @@ struct alignas(16) ivec4 { std::int32_t x, y, z, w; };
 
 // Texels (RGBA32F) per record in the read-only scene buffers.
 RT_CONST(int, kNodeTexels, 3)       // origin.xyz exponents | lo.xyz hi.x | hi.yz, inner and leaves (render/bvh.h QuantizedNode; below)
-RT_CONST(int, kTriTexels, 3)        // v0.xyz triangle index | e1 = v1 - v0, last of its run | e2 = v2 - v0 (object space)
+RT_CONST(int, kTriTexels, 3)        // v0.xyz triangle index | e1 = v1 - v0, last of its run | e2 = v2 - v0 (object space) instance (kFeatureDirectReferences)
 RT_CONST(int, kInstanceRecordTexels, 6)  // root item, instance, flags, - | world-to-object rows 0..2 | -
 RT_CONST(int, kTriShadeTexels, 4)   // n0.xyz uv0.x | n1.xyz uv0.y | n2.xyz uv1.x | uv1.y uv2.xy hasNormals
 RT_CONST(int, kInstanceTexels, 5)   // shading: world-to-object rows 0..2 | - triOffset material emitterOffset | objectIndex+1 flags
@@ -38,6 +38,8 @@ RT_CONST(int, kItemNode, 0)
 RT_CONST(int, kItemTriangles, 1)
 RT_CONST(int, kItemInstance, 2)
 RT_CONST(int, kItemOffsetShift, 4)
+RT_CONST(int, kTriInstanceMask, 0x3fffffff)  // e2.w with kFeatureDirectReferences: the instance
+RT_CONST(int, kTriAlphaTested, 0x40000000)   // and its kInstanceAlphaTested flag
 RT_CONST(int, kMaxLeafTriangles, 4)  // render/bvh.h maxLeafSize for mesh BVHs
 // A node names its children without items, to fit 48 bytes, so that a traversal step fetches three
 // texels instead of four (docs/MEASUREMENTS.md, fourteenth session). Its slots hold inner
@@ -80,7 +82,13 @@ RT_CONST(int, kFeatureSun, 4096)  // some directional light has a disc (Light::a
 RT_CONST(int, kFeatureInstanceTransforms, 8192)  // some instance is not in world space as it is
 RT_CONST(int, kFeatureFilterTungstenTent, 16384)
 RT_CONST(int, kFeatureTungstenRoulette, 32768)  // Roulette::Tungsten (scene.h)
-RT_CONST(int, kFeatureAll, 65535)
+// The instance BVH's leaves are the instances' own top nodes and triangles, copied into its part
+// of the buffer, not instance records: a ray goes from the instance BVH into an instance without
+// a step of its own, and a triangle names its instance in e2.w (kTriInstanceMask, with
+// kTriAlphaTested). Only for scenes without instance transforms whose triangles each belong to
+// one instance (render_scene.cpp packInstances); ignored with kFeatureInstanceTransforms.
+RT_CONST(int, kFeatureDirectReferences, 65536)
+RT_CONST(int, kFeatureAll, 131071)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceEmissive, 4)

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <set>
 #include <span>
 
 #include "gpu_support.h"
@@ -482,6 +483,51 @@ TEST(TracePass, InstancesEnteredAtSubtreesHitWhatBruteForceHits) {
   EXPECT_GT(c.hits, c.checked / 20);
   EXPECT_LE(c.disagree, c.checked / 500) << "after a move: " << c.disagree << " of " << c.checked
                                          << " pixels see another first hit than brute force";
+}
+
+// The instance BVH packed direct (layouts.h kFeatureDirectReferences) against the same scene
+// entered through instance records: the same hits, so the same image to the bit, colours,
+// objects and depths. A cut-out (its flag then travels with the triangles) and hiding an object
+// (which numbers the instances anew) are part of it.
+TEST(TracePass, DirectReferencesTraceWhatInstanceRecordsTrace) {
+  RETILE_RENDERER_OR_SKIP(direct);
+  RendererOptions options;
+  options.directReferences = false;
+  std::string why;
+  auto records = test::makeRenderer(&why, options);
+  ASSERT_TRUE(records) << why;
+  Scene s = makeDefaultScene();
+  ASSERT_GE(s.objects.size(), 3u);
+  Material* cutOut = s.material(s.objects[1].material);
+  ASSERT_NE(cutOut, nullptr);
+  cutOut->alpha = 0.5f;
+  auto features = [](const Renderer& r) { return r.kernelFeatures(); };
+  auto has = [](const std::vector<std::string>& f, const char* name) { return std::find(f.begin(), f.end(), name) != f.end(); };
+  RenderRequest req;
+  req.width = 48;
+  req.height = 27;
+  req.samplesPerPixel = 2;
+  req.seed = 5;
+  for (int round = 0; round < 2; ++round) {
+    if (round == 0) {
+      direct->setScene(s);
+      records->setScene(s);
+    } else {
+      s.objects[0].visible = false;
+      direct->updateScene(s, kUpdateInstances);
+      records->updateScene(s, kUpdateInstances);
+    }
+    EXPECT_TRUE(has(features(*direct), "direct references")) << "round " << round;
+    EXPECT_TRUE(has(features(*direct), "alpha test"));
+    EXPECT_FALSE(has(features(*records), "direct references"));
+    const RenderImage a = direct->render(req), b = records->render(req);
+    EXPECT_EQ(a.color, b.color) << "round " << round;
+    EXPECT_EQ(a.objectId, b.objectId) << "round " << round;
+    EXPECT_EQ(a.depth, b.depth) << "round " << round;
+    const std::set<NodeId> seen(a.objectId.begin(), a.objectId.end());
+    EXPECT_GE(seen.size(), 3u) << "round " << round << ": several objects in view";
+    EXPECT_EQ(seen.count(s.objects[0].id), round == 0 ? 1u : 0u) << "round " << round;
+  }
 }
 
 // One frame of the default scene traced with `paths` paths per invocation.

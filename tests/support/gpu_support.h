@@ -11,7 +11,7 @@
 
 namespace retile::test {
 
-std::unique_ptr<Renderer> makeRenderer(std::string* whyNot);
+std::unique_ptr<Renderer> makeRenderer(std::string* whyNot, const RendererOptions& options = {});
 bool requireDevice();  // CI is set: no device is a failure
 
 #define RETILE_RENDERER_OR_SKIP(var)                                                  \

@@ -127,11 +127,11 @@ bool requireDevice() {
   return ci && *ci && std::string(ci) != "0" && std::string(ci) != "false";
 }
 
-std::unique_ptr<Renderer> makeRenderer(std::string* whyNot) {
+std::unique_ptr<Renderer> makeRenderer(std::string* whyNot, const RendererOptions& options) {
   // Only a missing driver or device skips; a shader or pipeline that fails to build throws on and
   // fails the test.
   try {
-    return std::make_unique<Renderer>();
+    return std::make_unique<Renderer>(options);
   } catch (const NoDeviceError& e) {
     *whyNot = e.what();
     return nullptr;

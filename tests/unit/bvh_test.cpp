@@ -336,8 +336,8 @@ std::shared_ptr<const MeshGeometry> diagonalRod(Vec3 corner, std::uint32_t trian
 }
 
 // Instances that overlap are entered at subtrees of their BVHs, so that the instance BVH can
-// separate what their boxes share; instances apart keep one reference each. A move keeps the
-// choice and repacks the same number of references.
+// separate what their boxes share; instances apart keep one reference each. The choice is made
+// anew when the instance BVH stops being direct, and then kept while objects move.
 TEST(RenderScene, OverlappingInstancesAreEnteredAtSubtrees) {
   Scene s = test::emptyScene(8, 8);
   const NodeId mat = test::addMaterial(s, Material{});
@@ -346,12 +346,23 @@ TEST(RenderScene, OverlappingInstancesAreEnteredAtSubtrees) {
   const NodeId b = test::addMeshObject(s, "b", diagonalRod({1, -1, 1}, 2000, 2), mat, Mat4::identity());
   RenderSceneBuilder builder;
   builder.update(s, kUpdateAll, nullptr);
-  const std::size_t references = builder.data().instanceReferences;
+  EXPECT_TRUE(builder.data().directReferences);
   EXPECT_EQ(builder.data().instanceObject.size(), 2u);
-  EXPECT_GT(references, 2u);
-  // A move repacks the instance BVH with the same choice.
+  EXPECT_GT(builder.data().instanceReferences, 2u);
+  // The first move gives b a transform: no longer direct, and the count is chosen anew, as for
+  // records from the start.
   Object* moved = s.object(b);
   ASSERT_NE(moved, nullptr);
+  moved->transform = Mat4::translate({0.1f, 0, 0}) * moved->transform;
+  EXPECT_NE(builder.update(s, kUpdateInstances, nullptr) & kDirtyInstances, 0u);
+  EXPECT_FALSE(builder.data().directReferences);
+  const std::size_t references = builder.data().instanceReferences;
+  RenderSceneBuilder records;
+  records.setDirectReferences(false);
+  records.update(s, kUpdateAll, nullptr);
+  EXPECT_EQ(references, records.data().instanceReferences);
+  EXPECT_GT(references, 2u);
+  // Later moves repack the instance BVH with the same choice.
   moved->transform = Mat4::translate({0.1f, 0, 0}) * moved->transform;
   EXPECT_NE(builder.update(s, kUpdateInstances, nullptr) & kDirtyInstances, 0u);
   EXPECT_EQ(builder.data().instanceReferences, references);
@@ -364,6 +375,9 @@ TEST(RenderScene, InstancesApartKeepOneReferenceEach) {
   for (int i = 0; i < 6; ++i)
     test::addMeshObject(s, "ball", sphere, mat, Mat4::translate({4.0f * static_cast<float>(i), 0, 0}));
   RenderSceneBuilder builder;
+  // Entered through records, where each reference costs a step. (Direct, opening the balls costs
+  // nothing more, and the surface area heuristic may open them.)
+  builder.setDirectReferences(false);
   builder.update(s, kUpdateAll, nullptr);
   EXPECT_EQ(builder.data().instanceObject.size(), 6u);
   EXPECT_EQ(builder.data().instanceReferences, 6u);

@@ -20,6 +20,9 @@ namespace retile {
 struct RendererOptions {
   std::string device;       // a substring of the device name or an index; RETILE_DEVICE overrides
   bool validation = false;  // Vulkan validation layers (debug builds turn them on)
+  // Pack the instance BVH direct where the scene allows (no instance records to step through);
+  // off for comparisons. The hits are the same either way.
+  bool directReferences = true;
 };
 
 // A rectangle of pixels that receives `quality` samples each in one frame. Pixel samples use

@@ -7,7 +7,9 @@
 #include <cmath>
 #include <cstring>
 #include <numeric>
+#include <functional>
 #include <optional>
+#include <unordered_set>
 
 #include "core/files.h"
 #include "io/image_io.h"
@@ -69,6 +71,22 @@ std::uint32_t traversalUnit(std::int64_t offset) {
   return static_cast<std::uint32_t>(offset / gpu::kUnitTexels);
 }
 
+// Appends a node's three texels (layouts.h): n's boxes, quantised, its slots' layout (innerCount
+// inner children, `used` slots, leaves of instance records or of triangles, where slots 1..3's
+// leaves start) and its two bases, the leaves' `leafUnits` units from leafUnit on.
+void pushNode(std::vector<vec4>& out, const BvhNode& n, std::uint32_t innerCount, std::uint32_t used, bool instances,
+              std::uint32_t starts, std::uint32_t innerUnit, std::uint32_t leafUnit, std::int32_t leafUnits) {
+  if (leafUnits > 0) traversalUnit(gpu::kUnitTexels * (std::int64_t{leafUnit} + leafUnits - 1));  // the last within the limit too
+  auto word = [](std::uint32_t u) { return std::bit_cast<float>(u); };
+  const QuantizedNode q = quantize(n);
+  const std::uint32_t layout = innerCount << gpu::kLayoutInner | used << gpu::kLayoutUsed |
+                               (instances ? 1u : 0u) << gpu::kLayoutInstances | starts << gpu::kLayoutStarts;
+  out.push_back({q.origin[0], q.origin[1], q.origin[2], word(q.exponents | (layout & 255u) << 24)});
+  out.push_back({word(q.lo[0]), word(q.lo[1]), word(q.lo[2]), word(q.hi[0])});
+  out.push_back({word(q.hi[1]), word(q.hi[2]), word(innerUnit | (layout >> 8 & 63u) << gpu::kBaseBits),
+                 word(leafUnit | (layout >> 14) << gpu::kBaseBits)});
+}
+
 // Appends `nodes` (render/bvh.h, child indices local to them) to `out`, a part of the traversal
 // buffer that starts at its texel `outBase`. Their leaves' records are at texel `leafBase`, one
 // unit per triangle of a mesh BVH, or two per reference of the instance BVH (`instances`).
@@ -78,9 +96,7 @@ void appendNodes(std::vector<vec4>& out, const std::vector<BvhNode>& nodes, std:
   const std::int64_t leafTexels = instances ? gpu::kInstanceRecordTexels : gpu::kTriTexels;
   static_assert(gpu::kNodeTexels == gpu::kUnitTexels && gpu::kTriTexels == gpu::kUnitTexels &&
                 gpu::kInstanceRecordTexels % gpu::kUnitTexels == 0);
-  auto word = [](std::uint32_t u) { return std::bit_cast<float>(u); };
   for (const BvhNode& n : nodes) {
-    const QuantizedNode q = quantize(n);
     // The children's layout (layouts.h): inner ones, then leaves, each consecutive, then none.
     std::uint32_t innerCount = 0, used = 0, starts = 0;
     std::int32_t leaf = -1, units = 0;  // the first leaf's record; units of the leaves so far
@@ -101,18 +117,82 @@ void appendNodes(std::vector<vec4>& out, const std::vector<BvhNode>& nodes, std:
       units += instances ? 2 : count;
     }
     const std::uint32_t innerUnit = innerCount == 0 ? 0 : traversalUnit(base + std::int64_t{n.index[0]} * gpu::kNodeTexels);
-    std::uint32_t leafUnit = 0;
-    if (leaf >= 0) {
-      leafUnit = traversalUnit(leafBase + std::int64_t{leaf} * leafTexels);
-      traversalUnit(gpu::kUnitTexels * (std::int64_t{leafUnit} + units - 1));  // the last within the limit too
-    }
-    const std::uint32_t layout = innerCount << gpu::kLayoutInner | used << gpu::kLayoutUsed |
-                                 (instances ? 1u : 0u) << gpu::kLayoutInstances | starts << gpu::kLayoutStarts;
-    out.push_back({q.origin[0], q.origin[1], q.origin[2], word(q.exponents | (layout & 255u) << 24)});
-    out.push_back({word(q.lo[0]), word(q.lo[1]), word(q.lo[2]), word(q.hi[0])});
-    out.push_back({word(q.hi[1]), word(q.hi[2]), word(innerUnit | (layout >> 8 & 63u) << gpu::kBaseBits),
-                   word(leafUnit | (layout >> 14) << gpu::kBaseBits)});
+    const std::uint32_t leafUnit = leaf < 0 ? 0 : traversalUnit(leafBase + std::int64_t{leaf} * leafTexels);
+    pushNode(out, n, innerCount, used, instances, starts, innerUnit, leafUnit, units);
   }
+}
+
+// What the instance BVH's leaf p references when it is packed direct: the record at texel
+// `texel` of the traversal buffer, an inner node of a mesh BVH or a run of `triangles`.
+struct DirectRef {
+  std::int64_t texel;
+  bool node;
+  std::int32_t triangles;
+};
+
+// Appends the instance BVH `nodes` to `out`, the top part of the traversal buffer from its texel
+// outBase, with each leaf (one reference) replaced by what it references (layouts.h
+// kFeatureDirectReferences), copied from `mesh`, the first part: a mesh BVH's inner node becomes
+// an inner child, a copy of that node, whose children stay where they are; a run of triangles
+// stays a leaf, a copy of the run placed after the nodes. The copies let a node's children stay
+// consecutive, as its two bases require, and cost 48 bytes a reference, a few hundred kB at most.
+void appendDirectTop(std::vector<vec4>& out, std::int64_t outBase, const std::vector<BvhNode>& nodes,
+                     const std::function<DirectRef(std::int32_t)>& refOf, const std::vector<vec4>& mesh) {
+  // The nodes in output order: a node of the instance BVH (tlas >= 0) or a copy. Each node's
+  // inner children, its own then its copies, are consecutive from inner[node].
+  struct Unit {
+    std::int32_t tlas;
+    std::int64_t copyFrom;
+  };
+  std::vector<Unit> units{{0, -1}};
+  std::vector<std::size_t> inner(nodes.size(), 0);
+  for (std::size_t i = 0; i < units.size(); ++i) {
+    if (units[i].tlas < 0) continue;
+    const BvhNode& n = nodes[static_cast<std::size_t>(units[i].tlas)];
+    inner[static_cast<std::size_t>(units[i].tlas)] = units.size();
+    for (std::size_t c = 0; c < kBvhWidth; ++c)
+      if (n.count[c] == 0) units.push_back({n.index[c], -1});
+    for (std::size_t c = 0; c < kBvhWidth; ++c)
+      if (n.count[c] > 0)
+        if (const DirectRef r = refOf(n.index[c]); r.node) units.push_back({-1, r.texel});
+  }
+  const std::int64_t first = outBase + static_cast<std::int64_t>(out.size());
+  const std::int64_t leafBase = first + static_cast<std::int64_t>(units.size()) * gpu::kNodeTexels;
+  std::vector<vec4> leaves;
+  for (const Unit& u : units) {
+    if (u.tlas < 0) {
+      out.insert(out.end(), mesh.begin() + u.copyFrom, mesh.begin() + u.copyFrom + gpu::kNodeTexels);
+      continue;
+    }
+    const BvhNode& n = nodes[static_cast<std::size_t>(u.tlas)];
+    BvhNode slots;  // n's children in the order layouts.h asks for: inner ones, then leaves
+    std::uint32_t innerCount = 0, used = 0, starts = 0;
+    std::int32_t leafUnits = 0;
+    const auto leafUnit = static_cast<std::uint32_t>((leafBase + static_cast<std::int64_t>(leaves.size())) / gpu::kUnitTexels);
+    auto take = [&](std::size_t c, std::int32_t count) {
+      slots.box[used] = n.box[c];
+      slots.count[used] = count;
+      ++used;
+    };
+    for (std::size_t c = 0; c < kBvhWidth; ++c)
+      if (n.count[c] == 0) take(c, 0), ++innerCount;
+    for (std::size_t c = 0; c < kBvhWidth; ++c)
+      if (n.count[c] > 0 && refOf(n.index[c]).node) take(c, 0), ++innerCount;
+    for (std::size_t c = 0; c < kBvhWidth; ++c) {
+      if (n.count[c] <= 0) continue;
+      const DirectRef r = refOf(n.index[c]);
+      if (r.node) continue;
+      if (used > 0) starts |= static_cast<std::uint32_t>(leafUnits) << (gpu::kStartBits * (used - 1));
+      take(c, r.triangles);
+      leaves.insert(leaves.end(), mesh.begin() + r.texel, mesh.begin() + r.texel + std::int64_t{r.triangles} * gpu::kTriTexels);
+      leafUnits += r.triangles;
+    }
+    const std::uint32_t innerUnit =
+        innerCount == 0 ? 0 : traversalUnit(first + static_cast<std::int64_t>(inner[static_cast<std::size_t>(u.tlas)]) * gpu::kNodeTexels);
+    pushNode(out, slots, innerCount, used, false, starts, innerUnit, leafUnits > 0 ? traversalUnit(std::int64_t{leafUnit} * gpu::kUnitTexels) : 0,
+             leafUnits);
+  }
+  out.insert(out.end(), leaves.begin(), leaves.end());
 }
 
 std::string textureSignature(const Texture& t, const std::filesystem::path& base) {
@@ -230,6 +310,7 @@ std::uint32_t RenderSceneData::features() const {
   if (emissionTextures) f |= gpu::kFeatureEmissionTextures;
   if (materialBlend) f |= gpu::kFeatureBlend;
   if (instanceTransforms) f |= gpu::kFeatureInstanceTransforms;
+  if (directReferences) f |= gpu::kFeatureDirectReferences;
   return f | static_cast<std::uint32_t>(filterFeature);
 }
 
@@ -274,6 +355,7 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
   if (flags & (kUpdateInstances | kUpdateLights)) {
     auto t = Clock::now();
     packInstances(scene, (flags & kUpdateGeometry) != 0);
+    if (renumbered_) dirty |= kDirtyGeometry;
     timing_.tlas = secondsSince(t);
     t = Clock::now();
     packEmitters(scene);
@@ -346,7 +428,8 @@ void RenderSceneBuilder::packMesh(MeshEntry& e, const Mat4* place) {
   std::vector<Bounds3> boxes(n);
   for (std::size_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) boxes[i].grow(positions[g.indices[i * 3 + static_cast<std::size_t>(k)]]);
-  // A leaf's item carries its triangle count in two bits (layouts.h).
+  // A node's layout has four bits for where each leaf's run starts, and the shader tests runs of at most
+  // kMaxLeafTriangles (layouts.h).
   static_assert(kMaxLeafSize <= gpu::kMaxLeafTriangles);
   e.bvh = buildBvh(boxes);
   e.steps = expectedSteps(e.bvh, [](std::uint32_t) { return 1.0f; });
@@ -598,6 +681,17 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     }
     return refs;
   };
+  // Direct references (layouts.h kFeatureDirectReferences) need every instance in world space as
+  // packed, and each triangle in one instance only, as it names it.
+  bool transforms = false, shared = false;
+  {
+    std::unordered_set<const MeshEntry*> seen;
+    for (const Candidate& c : cands) {
+      transforms = transforms || !(c.transform == Mat4::identity());
+      shared = shared || !seen.insert(c.mesh).second;
+    }
+  }
+  const bool direct = directReferences_ && !transforms && !shared;
   BvhBuildOptions opt;
   opt.maxLeafSize = 1;  // a TLAS leaf is one reference: traversal enters its subtree directly
   auto build = [&](std::size_t factor, std::vector<Ref>* refs, float* cost) {
@@ -605,11 +699,12 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     std::vector<Bounds3> boxes;
     boxes.reserve(refs->size());
     for (const Ref& r : *refs) boxes.push_back(r.bounds);
-    // Entering a reference is one step, then its subtree's.
+    // Entering a reference is one step, unless packed direct, then its subtree's.
+    const float enter = direct ? 0.0f : 1.0f;
     auto steps = [&](std::uint32_t i) {
       const Ref& r = (*refs)[i];
-      if (r.node >= 0) return 1.0f + cands[r.cand].mesh->steps[static_cast<std::size_t>(r.node)];
-      return 1.0f + static_cast<float>(r.triangles);  // a leaf: its triangles
+      if (r.node >= 0) return enter + cands[r.cand].mesh->steps[static_cast<std::size_t>(r.node)];
+      return enter + static_cast<float>(r.triangles);  // a leaf: its triangles
     };
     opt.primCost = steps;
     Bvh bvh = buildBvh(boxes, opt);
@@ -618,9 +713,12 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   };
   std::vector<Ref> refs;
   Bvh tlas;
-  if (chooseBraid || cands.size() != braidInstances_) {
+  // Direct, a reference costs no step of its own, so the factor chosen then would cost a step a
+  // reference once a move turns direct off: it is chosen anew.
+  if (chooseBraid || cands.size() != braidInstances_ || direct != braidDirect_) {
     braidFactor_ = 1;
     braidInstances_ = cands.size();
+    braidDirect_ = direct;
     tlas = build(1, &refs, &braidCost_);
     std::size_t previous = refs.size();
     for (std::size_t factor = 2; factor <= kMaxBraidFactor; factor *= 2) {
@@ -642,12 +740,12 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   }
 
   // The top part of the traversal buffer: the instance BVH, then one record per reference (in
-  // the BVH's packed order).
+  // the BVH's packed order), or, direct, what the references name.
   auto base = static_cast<std::int64_t>(data_.meshTraversal.size());
   auto records = base + static_cast<std::int64_t>(tlas.nodes.size()) * gpu::kNodeTexels;
   data_.topTraversal.clear();
   data_.tlasRoot = traversalItem(base, gpu::kItemNode);
-  appendNodes(data_.topTraversal, tlas.nodes, base, records, true);
+  data_.directReferences = direct;
   data_.instances.clear();
   data_.instanceObject.clear();
   data_.bounds = tlas.bounds;
@@ -673,6 +771,28 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     data_.instanceObject.push_back(c.object->id);
     data_.instancedTriangles += c.mesh->bvh.primOrder.size();
   }
+  // Direct, each triangle names its instance; the instances' numbers change when objects are
+  // added, removed, hidden or shown, and then the meshes' part is uploaded again.
+  renumbered_ = false;
+  for (std::size_t i = 0; direct && i < cands.size(); ++i) {
+    const float named = bitsOf(static_cast<std::int32_t>(i) | ((flagsOf[i] & gpu::kInstanceAlphaTested) ? gpu::kTriAlphaTested : 0));
+    const std::size_t from = cands[i].mesh->triOffset, to = from + cands[i].mesh->bvh.primOrder.size();
+    for (std::size_t p = from; p < to; ++p) {
+      float& w = data_.meshTraversal[p * gpu::kTriTexels + 2].w;
+      if (std::bit_cast<std::uint32_t>(w) != std::bit_cast<std::uint32_t>(named)) renumbered_ = true;
+      w = named;
+    }
+  }
+  data_.instanceReferences = refs.size();
+  if (direct) {
+    // After the numbering: the copies of triangles carry it too.
+    appendDirectTop(data_.topTraversal, base, tlas.nodes, [&](std::int32_t p) {
+      const Ref& r = refs[tlas.primOrder[static_cast<std::size_t>(p)]];
+      return DirectRef{r.item >> gpu::kItemOffsetShift, r.node >= 0, r.triangles};
+    }, data_.meshTraversal);
+    return;
+  }
+  appendNodes(data_.topTraversal, tlas.nodes, base, records, true);
   for (std::uint32_t p : tlas.primOrder) {
     const Ref& r = refs[p];
     const Mat4& inv = inverseOf[r.cand];
@@ -680,7 +800,6 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     for (int row = 0; row < 3; ++row) data_.topTraversal.push_back({inv.m[row][0], inv.m[row][1], inv.m[row][2], inv.m[row][3]});
     data_.topTraversal.insert(data_.topTraversal.end(), gpu::kInstanceRecordTexels - 4, vec4{});
   }
-  data_.instanceReferences = refs.size();
   RETILE_ASSERT(records + static_cast<std::int64_t>(refs.size()) * gpu::kInstanceRecordTexels ==
                     base + static_cast<std::int64_t>(data_.topTraversal.size()),
                 "instance records out of place");

@@ -5,7 +5,9 @@
 // a transform repacks instances, the top-level BVH and emitters, never mesh data; mesh BVHs are
 // cached by geometry and shared by every instance of a mesh. A mesh is packed in the space its
 // first object puts it in (MeshEntry::placed), so that a scene whose objects have not moved since
-// it was packed needs no instance transforms, and the kernel for it carries none.
+// it was packed needs no instance transforms, and the kernel for it carries none; such a scene's
+// instance BVH leads straight into the meshes' BVHs where each triangle has one instance
+// (layouts.h kFeatureDirectReferences).
 //
 // Threads: owned and used by one thread (the render thread).
 #pragma once
@@ -88,6 +90,7 @@ struct RenderSceneData {
   bool emissionTextures = false;       // some emissive material has an emission texture
   bool materialBlend = false;          // some material blends with another
   bool instanceTransforms = false;     // some instance's transform is not the identity
+  bool directReferences = false;       // the instance BVH is packed direct (layouts.h kFeatureDirectReferences)
 
   bool tungstenShading = false;        // RenderSettings::shading is Tungsten's
   bool tungstenRoulette = false;       // RenderSettings::roulette is Tungsten's
@@ -103,6 +106,9 @@ class RenderSceneBuilder {
   // Warnings (missing textures and the substitutes used) are appended to `warnings`.
   std::uint32_t update(const Scene& scene, std::uint32_t flags, std::vector<std::string>* warnings);
   const RenderSceneData& data() const { return data_; }
+  // Whether the instance BVH may be packed direct (layouts.h kFeatureDirectReferences) where the
+  // scene allows; off, every reference is entered through its record, as for comparisons.
+  void setDirectReferences(bool on) { directReferences_ = on; }
 
   // Seconds spent in the last update, by part, for the benchmarks.
   struct Timing {
@@ -163,10 +169,13 @@ class RenderSceneBuilder {
   float environmentPower_ = 0;
   float deltaPower_ = 0;
   bool first_ = true;
+  bool directReferences_ = true;
+  bool renumbered_ = false;  // packInstances changed the instances triangles name
   // Re-braiding (packInstances): references per instance tried up to kMaxBraidFactor, and at most
   // kMaxBraidReferences in all; the factor chosen, for how many instances, at what expected cost.
   static constexpr std::size_t kMaxBraidFactor = 64, kMaxBraidReferences = 16384;
   std::size_t braidFactor_ = 1, braidInstances_ = 0;
+  bool braidDirect_ = false;  // whether the factor was chosen for a direct instance BVH
   float braidCost_ = 0;
   Timing timing_;
 };

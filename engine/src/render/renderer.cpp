@@ -75,6 +75,7 @@ struct Renderer::Impl {
   Denoiser denoiser{ctx};
   bool displayCurrent = false;  // the denoiser's display matches the accumulation (readback takes it)
   RenderSceneBuilder builder;
+  bool directReferences = true;  // RendererOptions::directReferences, for each scene's builder
 
   Buffer frameUbo, work, stats, selection;
   Buffer traversal, triShade, instances, materials, texInfo, texels, emitters, alias, delta, envCdf;
@@ -126,6 +127,7 @@ struct Renderer::Impl {
         std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::Storage, Binding::Storage, Binding::Storage,
                              Binding::Storage, Binding::Storage},
         static_cast<std::uint32_t>(sizeof(gpu::AccumulatePush)));
+    directReferences = o.directReferences;
     frameUbo = Buffer(ctx, sizeof(gpu::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                       true, "frame constants");
     stats = Buffer(ctx, gpu::kStatsCount * sizeof(std::uint32_t), kStorageUsage, true, "ray statistics");
@@ -704,6 +706,7 @@ bool Renderer::cpuDevice() const { return impl_->ctx.isCpuDevice(); }
 
 std::vector<std::string> Renderer::setScene(const Scene& scene) {
   impl_->builder = RenderSceneBuilder{};
+  impl_->builder.setDirectReferences(impl_->directReferences);
   return updateScene(scene, kUpdateAll);
 }
 
@@ -773,7 +776,10 @@ void FrameStats::add(const FrameStats& later) {
 void Renderer::prepareMoves() {
   if (!impl_->hasScene) return;
   const RenderSceneData& d = impl_->builder.data();
-  impl_->traceVariant(d.alphaTested, d.materialTypes, d.features() | static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms));
+  // A move gives an instance a transform, and then no reference is packed direct.
+  impl_->traceVariant(d.alphaTested, d.materialTypes,
+                      (d.features() | static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms)) &
+                          ~static_cast<std::uint32_t>(gpu::kFeatureDirectReferences));
 }
 
 std::size_t Renderer::kernelsCompiled() const { return impl_->traceVariants.size(); }
@@ -797,6 +803,7 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   if (f & static_cast<std::uint32_t>(gpu::kFeatureBlend)) out.push_back("blends");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureSun)) out.push_back("suns with a disc");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms)) out.push_back("instance transforms");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureDirectReferences)) out.push_back("direct references");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTent)) out.push_back("exact tent filter");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTungsten)) out.push_back("Tungsten's filter table");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTungstenTent)) out.push_back("Tungsten's tent");
