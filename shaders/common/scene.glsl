@@ -44,7 +44,7 @@ const int kStackSize = 128;
 #define RETILE_ALPHA_TEST 1
 #endif
 const float kInfinity = 1e30;
-// A quantised box's exit distance is taken this much further (render/bvh.cpp kSlabSlack).
+// A quantised box's exit distance is taken this much further (render/bvh.h kSlabSlack).
 const float kSlabSlack = 1.0000004;
 
 // The scene's features (kFeature... in layouts.h). lavapipe runs every branch, taken or not (see

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "render/bvh.h"
+#include "render/packed_trace.h"
 #include "render/render_scene.h"
 #include "scene/primitives.h"
 #include "retile/io.h"
@@ -366,6 +367,82 @@ TEST(RenderScene, OverlappingInstancesAreEnteredAtSubtrees) {
   moved->transform = Mat4::translate({0.1f, 0, 0}) * moved->transform;
   EXPECT_NE(builder.update(s, kUpdateInstances, nullptr) & kDirtyInstances, 0u);
   EXPECT_EQ(builder.data().instanceReferences, references);
+}
+
+// The kernel's traversal mirrored on the CPU (tracePacked) finds what brute force finds, over an
+// instance BVH packed direct and one entered through records, with instances opened at subtrees
+// (crossing rods), a shared mesh and, after a move, an instance transform. Direct costs fewer
+// steps on the same rays: no step enters an instance.
+TEST(RenderScene, PackedTraversalFindsWhatBruteForceFinds) {
+  Scene s = test::emptyScene(8, 8);
+  const NodeId mat = test::addMaterial(s, Material{});
+  test::addMeshObject(s, "a", diagonalRod({1, 1, 1}, 1500, 1), mat, Mat4::identity());
+  const NodeId b = test::addMeshObject(s, "b", diagonalRod({1, -1, 1}, 1500, 2), mat, Mat4::identity());
+  // Small soups all over the middle: opened, their references are runs of triangles.
+  for (std::uint32_t i = 0; i < 40; ++i) test::addMeshObject(s, "crumbs", diagonalRod({0.6f, 0.6f, -0.6f}, 12, 10 + i), mat, Mat4::identity());
+  const auto sphere = makeSphere(12, 24);
+  test::addMeshObject(s, "ball", sphere, mat, Mat4::translate({0.3f, 0.2f, -0.4f}) * Mat4::scale(Vec3{0.5f}));
+  test::addMeshObject(s, "ball 2", sphere, mat, Mat4::translate({-0.6f, -0.3f, 0.5f}) * Mat4::scale(Vec3{0.4f}));
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  struct Ray {
+    Vec3 o, d;
+  };
+  std::vector<Ray> rays;
+  for (int i = 0; i < 1500; ++i) {
+    // From anywhere around, mostly towards the middle, where the objects are.
+    const Vec3 o = Vec3{unit(rng), unit(rng), unit(rng)} * 1.5f, towards = Vec3{unit(rng), unit(rng), unit(rng)} * 0.7f;
+    if (length(towards - o) < 0.1f) continue;
+    rays.push_back({o, normalize(towards - o)});
+  }
+  auto check = [&](const RenderSceneBuilder& builder, const char* what) {
+    const RenderSceneData& d = builder.data();
+    std::uint64_t steps = 0;
+    int hits = 0, wrong = 0;
+    for (const Ray& r : rays) {
+      // Brute force over every object's triangles, in world space.
+      float best = 1e30f;
+      NodeId bestObject = kNoNode;
+      for (const Object& o : s.objects) {
+        const MeshGeometry& g = *s.mesh(o.mesh)->geometry;
+        for (std::size_t t = 0; t < g.triangleCount(); ++t) {
+          const Vec3 v0 = o.transform.transformPoint(g.positions[g.indices[3 * t]]);
+          const Vec3 v1 = o.transform.transformPoint(g.positions[g.indices[3 * t + 1]]);
+          const Vec3 v2 = o.transform.transformPoint(g.positions[g.indices[3 * t + 2]]);
+          float tt, u, v;
+          if (intersectTriangle(r.o, r.d, v0, v1, v2, best, &tt, &u, &v) && tt > 0) {
+            best = tt;
+            bestObject = o.id;
+          }
+        }
+      }
+      const PackedTrace p = tracePacked(d.meshTraversal, d.topTraversal, d.tlasRoot, d.directReferences, r.o, r.d, 1e30f);
+      steps += p.steps;
+      const NodeId found = p.prim < 0 ? kNoNode : d.instanceObject.at(static_cast<std::size_t>(p.instance));
+      if (bestObject != kNoNode) ++hits;
+      if (found != bestObject || (found != kNoNode && std::abs(p.t - best) > 1e-4f * (1 + best))) ++wrong;
+    }
+    EXPECT_GT(hits, static_cast<int>(rays.size()) / 4) << what;
+    EXPECT_LE(wrong, static_cast<int>(rays.size()) / 500) << what << ": " << wrong << " rays find another hit than brute force";
+    return steps;
+  };
+  RenderSceneBuilder direct, records;
+  records.setDirectReferences(false);
+  direct.update(s, kUpdateAll, nullptr);
+  records.update(s, kUpdateAll, nullptr);
+  ASSERT_TRUE(direct.data().directReferences);
+  ASSERT_FALSE(records.data().directReferences);
+  EXPECT_GT(direct.data().instanceReferences, direct.data().instanceObject.size()) << "the rods are entered at subtrees";
+  const std::uint64_t directSteps = check(direct, "direct");
+  const std::uint64_t recordSteps = check(records, "records");
+  EXPECT_LT(directSteps, recordSteps);
+  Object* moved = s.object(b);
+  ASSERT_NE(moved, nullptr);
+  moved->transform = Mat4::translate({0.2f, 0.1f, 0}) * Mat4::rotateY(0.3f);
+  direct.update(s, kUpdateInstances, nullptr);
+  EXPECT_FALSE(direct.data().directReferences) << "a transform turns direct off";
+  EXPECT_TRUE(direct.data().instanceTransforms);
+  check(direct, "after a move");
 }
 
 TEST(RenderScene, InstancesApartKeepOneReferenceEach) {

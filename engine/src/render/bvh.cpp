@@ -176,9 +176,6 @@ struct Builder {
 // the shader computes a plane's distance as (origin - o) / d + q * scale / d, whose rounding
 // differs from that of the exact box's slab test by a few ulps of the node's size.
 constexpr float kQuantisedPad = 1.0f / (1 << 20);
-// And the exit distance is taken a few ulps further, for rays from afar, where the rounding of
-// the distances themselves exceeds the pad (the shader's kSlabSlack).
-constexpr float kSlabSlack = 1.0000004f;
 
 // A plane of the grid, in the float arithmetic of dequantize (q * scale is exact: q < 2^8 and
 // scale a power of two).

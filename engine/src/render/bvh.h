@@ -46,6 +46,9 @@ struct QuantizedNode {
   std::uint32_t hi[3];
 };
 QuantizedNode quantize(const BvhNode& node);
+// A quantised box's exit distance is taken this much further, for rays from afar, where the
+// rounding of the distances themselves exceeds the pad its planes keep (the shader's kSlabSlack).
+constexpr float kSlabSlack = 1.0000004f;
 float quantizedScale(const QuantizedNode& q, int axis);
 Bounds3 dequantize(const QuantizedNode& q, int child);
 

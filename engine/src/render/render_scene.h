@@ -172,11 +172,13 @@ class RenderSceneBuilder {
   bool directReferences_ = true;
   bool renumbered_ = false;  // packInstances changed the instances triangles name
   // Re-braiding (packInstances): references per instance tried up to kMaxBraidFactor, and at most
-  // kMaxBraidReferences in all; the factor chosen, for how many instances, at what expected cost.
+  // kMaxBraidReferences in all; the factor chosen, for how many instances, and the mean steps
+  // of the sample rays it was chosen by, and how many.
   static constexpr std::size_t kMaxBraidFactor = 64, kMaxBraidReferences = 16384;
   std::size_t braidFactor_ = 1, braidInstances_ = 0;
   bool braidDirect_ = false;  // whether the factor was chosen for a direct instance BVH
-  float braidCost_ = 0;
+  float braidSteps_ = 0;
+  std::size_t braidRays_ = 0;
   Timing timing_;
 };
 
