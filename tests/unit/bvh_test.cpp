@@ -404,6 +404,7 @@ TEST(RenderScene, PackedTraversalFindsWhatBruteForceFinds) {
       float best = 1e30f;
       NodeId bestObject = kNoNode;
       for (const Object& o : s.objects) {
+        if (!o.visible) continue;
         const MeshGeometry& g = *s.mesh(o.mesh)->geometry;
         for (std::size_t t = 0; t < g.triangleCount(); ++t) {
           const Vec3 v0 = o.transform.transformPoint(g.positions[g.indices[3 * t]]);
@@ -436,6 +437,13 @@ TEST(RenderScene, PackedTraversalFindsWhatBruteForceFinds) {
   const std::uint64_t directSteps = check(direct, "direct");
   const std::uint64_t recordSteps = check(records, "records");
   EXPECT_LT(directSteps, recordSteps);
+  // Hiding and showing an object keeps every instance's number: the triangles that carry it
+  // are not uploaded again.
+  s.objects[0].visible = false;
+  EXPECT_EQ(direct.update(s, kUpdateInstances, nullptr) & kDirtyGeometry, 0u);
+  check(direct, "one hidden");
+  s.objects[0].visible = true;
+  EXPECT_EQ(direct.update(s, kUpdateInstances, nullptr) & kDirtyGeometry, 0u);
   Object* moved = s.object(b);
   ASSERT_NE(moved, nullptr);
   moved->transform = Mat4::translate({0.2f, 0.1f, 0}) * Mat4::rotateY(0.3f);
@@ -443,6 +451,25 @@ TEST(RenderScene, PackedTraversalFindsWhatBruteForceFinds) {
   EXPECT_FALSE(direct.data().directReferences) << "a transform turns direct off";
   EXPECT_TRUE(direct.data().instanceTransforms);
   check(direct, "after a move");
+}
+
+// A hidden object keeps its instance (and its number) but is neither reached nor a light.
+TEST(RenderScene, AHiddenEmitterLightsNothing) {
+  Scene s = test::emptyScene(8, 8);
+  Material lamp;
+  lamp.emission = Vec3{4.0f};
+  const NodeId light = test::addMeshObject(s, "lamp", makeQuad(), test::addMaterial(s, lamp), Mat4::identity());
+  test::addMeshObject(s, "floor", makeQuad(), test::addMaterial(s, Material{}), Mat4::translate({0, -1, 0}));
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  EXPECT_EQ(builder.data().emitters.size(), 2u * gpu::kEmitterTexels);
+  EXPECT_NE(builder.data().features() & gpu::kFeatureEmitters, 0u);
+  s.object(light)->visible = false;
+  builder.update(s, kUpdateInstances, nullptr);
+  EXPECT_TRUE(builder.data().emitters.empty());
+  EXPECT_EQ(builder.data().features() & gpu::kFeatureEmitters, 0u);
+  EXPECT_EQ(builder.data().instanceObject.size(), 2u);
+  EXPECT_EQ(builder.data().instanceReferences, 1u) << "only the floor is in the instance BVH";
 }
 
 TEST(RenderScene, InstancesApartKeepOneReferenceEach) {

@@ -667,16 +667,21 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     const MeshEntry* mesh;
     Mat4 transform;  // from the mesh's packed space to world space
     Bounds3 bounds;
+    bool visible;
   };
+  // Hidden objects are instances too, with no reference in the instance BVH: so an instance's
+  // number does not change when another is hidden or shown, and with direct references (below)
+  // the triangles that carry it need not be uploaded again.
   std::vector<Candidate> cands;
+  std::size_t visible = 0;
   for (const Object& o : scene.objects) {
-    if (!o.visible) continue;
     const MeshEntry* mesh = entryOf(o);
     if (!mesh) continue;
     const Mat4 t = placement(o.transform, *mesh);
     Bounds3 b = transformBounds(t, mesh->bvh.bounds);
     if (b.empty()) continue;
-    cands.push_back({&o, mesh, t, b});
+    cands.push_back({&o, mesh, t, b, o.visible});
+    visible += o.visible ? 1 : 0;
   }
 
   // Where instances overlap, a ray inside their union is inside every one of their boxes and
@@ -684,10 +689,10 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   // BVHs (partial re-braiding, after Benthin et al. 2017): starting from each instance's root,
   // the reference with the largest box is replaced by its children (up to four) until there are
   // `factor` references per instance. A reference is entered like an instance, at its subtree.
-  // Where instances do not overlap, opening them only adds steps, so the factor is the one whose
-  // instance BVH the surface area heuristic expects to cost the fewest steps. It is chosen when
-  // the objects or meshes change, and kept while objects move, so that a move builds one
-  // instance BVH, whose size stays proportional to the number of objects.
+  // Where instances do not overlap, opening them gains nothing, so the factor is chosen by the
+  // steps it costs sample rays (below). It is chosen when the objects or meshes change, and kept
+  // while objects move, so that a move builds one instance BVH, whose size stays proportional to
+  // the number of objects.
   struct Ref {
     std::uint32_t cand;
     std::int32_t item;  // where traversal enters the instance's BVH
@@ -698,7 +703,8 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   auto braid = [&](std::size_t budget) {
     std::vector<Ref> refs;
     refs.reserve(budget);
-    for (std::uint32_t c = 0; c < cands.size(); ++c) refs.push_back({c, cands[c].mesh->rootItem, 0, cands[c].bounds});
+    for (std::uint32_t c = 0; c < cands.size(); ++c)
+      if (cands[c].visible) refs.push_back({c, cands[c].mesh->rootItem, 0, cands[c].bounds});
     auto smaller = [&](std::size_t a, std::size_t b) { return refs[a].bounds.area() < refs[b].bounds.area(); };
     std::vector<std::size_t> open(refs.size());  // a max-heap by area of the references that can still be opened
     std::iota(open.begin(), open.end(), std::size_t{0});
@@ -741,6 +747,7 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   {
     std::unordered_set<const MeshEntry*> seen;
     for (const Candidate& c : cands) {
+      if (!c.visible) continue;
       transforms = transforms || !(c.transform == Mat4::identity());
       shared = shared || !seen.insert(c.mesh).second;
     }
@@ -749,7 +756,7 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   BvhBuildOptions opt;
   opt.maxLeafSize = 1;  // a TLAS leaf is one reference: traversal enters its subtree directly
   auto build = [&](std::size_t factor, std::vector<Ref>* refs) {
-    *refs = braid(std::max(cands.size(), std::min(cands.size() * factor, kMaxBraidReferences)));
+    *refs = braid(std::max(visible, std::min(visible * factor, kMaxBraidReferences)));
     std::vector<Bounds3> boxes;
     boxes.reserve(refs->size());
     for (const Ref& r : *refs) boxes.push_back(r.bounds);
@@ -778,21 +785,22 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     int flags = 0;
     if (mat && (mat->alpha < 1.0f || textureIndex(mat->alphaTexture) >= 0)) flags |= gpu::kInstanceAlphaTested;
     if (mat && mat->emissive()) flags |= gpu::kInstanceEmissive;
-    if (flags & gpu::kInstanceAlphaTested) data_.alphaTested = true;
+    if (c.visible && (flags & gpu::kInstanceAlphaTested)) data_.alphaTested = true;
     flagsOf[i] = flags;
     inverseOf[i] = c.transform.inverse();
-    if (!(c.transform == Mat4::identity())) data_.instanceTransforms = true;
+    if (c.visible && !(c.transform == Mat4::identity())) data_.instanceTransforms = true;
     const Mat4& inv = inverseOf[i];
     for (int r = 0; r < 3; ++r) data_.instances.push_back({inv.m[r][0], inv.m[r][1], inv.m[r][2], inv.m[r][3]});
     data_.instances.push_back(ints(0, static_cast<std::int32_t>(c.mesh->triOffset), materialIndex(c.object->material), -1));
     data_.instances.push_back(ints(static_cast<std::int32_t>(i) + 1, flags, 0, 0));
     data_.instanceObject.push_back(c.object->id);
-    data_.instancedTriangles += c.mesh->bvh.primOrder.size();
+    if (c.visible) data_.instancedTriangles += c.mesh->bvh.primOrder.size();
   }
   // Direct, each triangle names its instance; the instances' numbers change when objects are
-  // added, removed, hidden or shown, and then the meshes' part is uploaded again.
+  // added or removed (or a cut-out's flag changes), and then the meshes' part is uploaded again.
   renumbered_ = false;
   for (std::size_t i = 0; direct && i < cands.size(); ++i) {
+    if (!cands[i].visible) continue;
     const float named = bitsOf(static_cast<std::int32_t>(i) | ((flagsOf[i] & gpu::kInstanceAlphaTested) ? gpu::kTriAlphaTested : 0));
     const std::size_t from = cands[i].mesh->triOffset, to = from + cands[i].mesh->bvh.primOrder.size();
     for (std::size_t p = from; p < to; ++p) {
@@ -842,9 +850,9 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   std::vector<Ref> refs;
   Bvh tlas;
   std::vector<vec4> top;
-  if (chooseBraid || cands.size() != braidInstances_ || direct != braidDirect_) {
+  if (chooseBraid || visible != braidInstances_ || direct != braidDirect_) {
     braidFactor_ = 1;
-    braidInstances_ = cands.size();
+    braidInstances_ = visible;
     braidDirect_ = direct;
     tlas = build(1, &refs);
     top = pack(tlas, refs);
@@ -891,7 +899,7 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
   std::size_t count = data_.instanceObject.size();
   for (std::size_t i = 0; i < count; ++i) {
     const Object* o = scene.object(data_.instanceObject[i]);
-    const Material* mat = o ? scene.material(o->material) : nullptr;
+    const Material* mat = o && o->visible ? scene.material(o->material) : nullptr;
     if (!mat || !mat->emissive()) continue;
     const MeshEntry* mesh = entryOf(*o);
     const Mat4 transform = placement(o->transform, *mesh);

@@ -72,7 +72,7 @@ struct RenderSceneData {
   int suns = 0;                        // directional lights with a disc (kLightSun)
   std::vector<float> environmentCdf;   // marginal (h+1) then conditional rows (w+1 each)
 
-  std::vector<NodeId> instanceObject;  // instance index -> object id
+  std::vector<NodeId> instanceObject;  // instance index -> object id (hidden objects too, never reached)
   std::size_t instanceReferences = 0;  // leaves of the instance BVH: instances or their subtrees
   Bounds3 bounds;
   float lightPick[3] = {0, 0, 0};      // emitters, environment, delta lights

@@ -417,7 +417,7 @@ struct Renderer::Impl {
     u.cameraForward = {forward.x, forward.y, forward.z, camera.focusDistance};
     u.image = {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height), seed,
                static_cast<std::uint32_t>(std::max(maxBounces, 0))};
-    u.scene = {d.tlasRoot, static_cast<std::int32_t>(d.instanceObject.size()),
+    u.scene = {d.tlasRoot, static_cast<std::int32_t>(d.instanceReferences),
                static_cast<std::int32_t>(d.emitters.size() / gpu::kEmitterTexels),
                static_cast<std::int32_t>(d.deltaLights.size() / gpu::kDeltaLightTexels)};
     u.lightPick = {d.lightPick[0], d.lightPick[1], d.lightPick[2], static_cast<float>(d.suns)};
