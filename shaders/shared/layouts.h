@@ -30,7 +30,8 @@ RT_CONST(int, kEmitterTexels, 5)    // v0.xyz area | e1.xyz instance | e2.xyz tr
 RT_CONST(int, kDeltaLightTexels, 4)
 
 // The traversal buffer holds every triangle (packed triangle p at texel p * kTriTexels), then the
-// mesh BVHs, the instance BVH and one record per reference to an instance. An item names one of
+// mesh BVHs, the instance BVH and one record per reference to an instance (or, with
+// kFeatureDirectReferences, copies of the nodes and triangle runs the references name). An item names one of
 // its records: texel offset << kItemOffsetShift | n << 2 | kind. A BVH leaf's item names its
 // first triangle (n 0), whose run of up to kMaxLeafTriangles ends at the one marked last; for a
 // node, n is the rank of the child to take next (scene.glsl traceStep), 0 where a node names it.

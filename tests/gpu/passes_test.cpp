@@ -426,26 +426,36 @@ TEST(TracePass, FirstHitsMatchABruteForceReference) {
   EXPECT_LE(c.disagree, c.checked / 500) << c.disagree << " of " << c.checked << " pixels see another first hit than brute force";
 }
 
-// A scene packed where its objects are runs without instance transforms; the kernel its first
-// move switches to is compiled ahead (Renderer::prepareMoves), so the move compiles nothing.
+// A scene packed where its objects are runs without instance transforms, with direct
+// references; the kernels its first move and a duplicate in place switch to are compiled ahead
+// (Renderer::prepareMoves), so neither edit compiles anything.
 TEST(TracePass, TheKernelForMovesIsReadyBeforeTheFirstMove) {
   RETILE_RENDERER_OR_SKIP(r);
   Scene s = wallScene(16, 16, Vec3{1.0f});
   r->setScene(s);
-  auto hasTransforms = [&] {
+  auto has = [&](const char* feature) {
     const auto f = r->kernelFeatures();
-    return std::find(f.begin(), f.end(), "instance transforms") != f.end();
+    return std::find(f.begin(), f.end(), feature) != f.end();
   };
-  EXPECT_FALSE(hasTransforms());
+  EXPECT_FALSE(has("instance transforms"));
+  EXPECT_TRUE(has("direct references"));
   const std::size_t compiled = r->kernelsCompiled();
   r->prepareMoves();
-  EXPECT_EQ(r->kernelsCompiled(), compiled + 1);
+  EXPECT_EQ(r->kernelsCompiled(), compiled + 2);
+  // A duplicate in place shares the original's mesh: no transform, no direct references.
+  Object copy = s.objects[0];
+  copy.id = s.newId();
+  s.objects.push_back(copy);
+  r->updateScene(s, kUpdateInstances | kUpdateLights);
+  EXPECT_FALSE(has("instance transforms"));
+  EXPECT_FALSE(has("direct references"));
+  EXPECT_EQ(r->kernelsCompiled(), compiled + 2) << "the duplicate compiled a kernel";
   s.objects[0].transform = Mat4::translate({0.1f, 0, 0}) * s.objects[0].transform;
   r->updateScene(s, kUpdateInstances);
-  EXPECT_TRUE(hasTransforms());
-  EXPECT_EQ(r->kernelsCompiled(), compiled + 1) << "the move compiled a kernel";
+  EXPECT_TRUE(has("instance transforms"));
+  EXPECT_EQ(r->kernelsCompiled(), compiled + 2) << "the move compiled a kernel";
   r->prepareMoves();
-  EXPECT_EQ(r->kernelsCompiled(), compiled + 1) << "a scene with transforms needs no other";
+  EXPECT_EQ(r->kernelsCompiled(), compiled + 2) << "a scene with transforms needs no other";
 }
 
 // Instances whose boxes hold each other's geometry are entered at subtrees of their BVHs
@@ -488,7 +498,7 @@ TEST(TracePass, InstancesEnteredAtSubtreesHitWhatBruteForceHits) {
 // The instance BVH packed direct (layouts.h kFeatureDirectReferences) against the same scene
 // entered through instance records: the same hits, so the same image to the bit, colours,
 // objects and depths. A cut-out (its flag then travels with the triangles) and hiding an object
-// (which numbers the instances anew) are part of it.
+// (which leaves its instance unreached) are part of it.
 TEST(TracePass, DirectReferencesTraceWhatInstanceRecordsTrace) {
   RETILE_RENDERER_OR_SKIP(direct);
   RendererOptions options;

@@ -194,12 +194,14 @@ class Renderer {
   std::vector<std::string> kernelFeatures() const;
   // Compiles, ahead of need, the kernel a move switches to: a scene packed where its objects are
   // runs without instance transforms (render/render_scene.h), and its first move would otherwise
-  // wait for that kernel (about 0.3 s on lavapipe). Nothing for a scene that has them.
+  // wait for that kernel (about 0.3 s on lavapipe); with direct references also the kernel for
+  // an object duplicated in place. Nothing for a scene that has transforms.
   void prepareMoves();
   std::size_t kernelsCompiled() const;  // trace kernel variants compiled so far, for tests
   std::uint64_t sceneTriangles() const;
-  // The instance BVH's leaves: one per visible object, more where objects overlap and their own
-  // BVHs are entered at subtrees (render/render_scene.cpp, re-braiding).
+  // Instances: one per object with geometry, hidden ones too (they keep their numbers, and no
+  // ray reaches them). References, the instance BVH's leaves: one per visible object, more where
+  // objects overlap and their own BVHs are entered at subtrees (render/render_scene.cpp).
   std::uint64_t sceneInstances() const;
   std::uint64_t sceneInstanceReferences() const;
   // Seconds the last setScene/updateScene spent building BVHs (bottom level, top level).

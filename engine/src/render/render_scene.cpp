@@ -136,7 +136,8 @@ struct DirectRef {
 // kFeatureDirectReferences), copied from `mesh`, the first part: a mesh BVH's inner node becomes
 // an inner child, a copy of that node, whose children stay where they are; a run of triangles
 // stays a leaf, a copy of the run placed after the nodes. The copies let a node's children stay
-// consecutive, as its two bases require, and cost 48 bytes a reference, a few hundred kB at most.
+// consecutive, as its two bases require, and cost 48 bytes a node and up to 192 a run (at most
+// kMaxBraidReferences of them: 3 MiB).
 void appendDirectTop(std::vector<vec4>& out, std::int64_t outBase, const std::vector<BvhNode>& nodes,
                      const std::function<DirectRef(std::int32_t)>& refOf, const std::vector<vec4>& mesh) {
   // The nodes in output order: a node of the instance BVH (tlas >= 0) or a copy. Each node's
@@ -153,9 +154,11 @@ void appendDirectTop(std::vector<vec4>& out, std::int64_t outBase, const std::ve
     inner[static_cast<std::size_t>(units[i].tlas)] = units.size();
     for (std::size_t c = 0; c < kBvhWidth; ++c)
       if (n.count[c] == 0) units.push_back({n.index[c], -1});
-    for (std::size_t c = 0; c < kBvhWidth; ++c)
+    for (std::size_t c = 0; c < kBvhWidth; ++c) {
+      RETILE_ASSERT(n.count[c] <= 1, "an instance BVH leaf of more than one reference");
       if (n.count[c] > 0)
         if (const DirectRef r = refOf(n.index[c]); r.node) units.push_back({-1, r.texel});
+    }
   }
   const std::int64_t first = outBase + static_cast<std::int64_t>(out.size());
   const std::int64_t leafBase = first + static_cast<std::int64_t>(units.size()) * gpu::kNodeTexels;
@@ -356,7 +359,7 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
   if (flags & (kUpdateInstances | kUpdateLights)) {
     auto t = Clock::now();
     packInstances(scene, (flags & kUpdateGeometry) != 0);
-    if (renumbered_) dirty |= kDirtyGeometry;
+    if (renamed_) dirty |= kDirtyTriangleNames;
     timing_.tlas = secondsSince(t);
     t = Clock::now();
     packEmitters(scene);
@@ -796,17 +799,24 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     data_.instanceObject.push_back(c.object->id);
     if (c.visible) data_.instancedTriangles += c.mesh->bvh.primOrder.size();
   }
-  // Direct, each triangle names its instance; the instances' numbers change when objects are
-  // added or removed (or a cut-out's flag changes), and then the meshes' part is uploaded again.
-  renumbered_ = false;
-  for (std::size_t i = 0; direct && i < cands.size(); ++i) {
-    if (!cands[i].visible) continue;
-    const float named = bitsOf(static_cast<std::int32_t>(i) | ((flagsOf[i] & gpu::kInstanceAlphaTested) ? gpu::kTriAlphaTested : 0));
-    const std::size_t from = cands[i].mesh->triOffset, to = from + cands[i].mesh->bvh.primOrder.size();
-    for (std::size_t p = from; p < to; ++p) {
-      float& w = data_.meshTraversal[p * gpu::kTriTexels + 2].w;
-      if (std::bit_cast<std::uint32_t>(w) != std::bit_cast<std::uint32_t>(named)) renumbered_ = true;
-      w = named;
+  // Direct, each triangle names its instance: a visible object's, or where none uses its mesh
+  // a hidden one's, so that showing it later changes nothing. The names change when objects are
+  // added or removed (or a cut-out's flag changes), and then the meshes' part is uploaded again;
+  // a mesh whose triangles already name the right instance is not touched.
+  renamed_ = false;
+  if (direct) {
+    std::unordered_map<const MeshEntry*, std::size_t> namer;
+    for (std::size_t i = 0; i < cands.size(); ++i)
+      if (cands[i].visible) namer[cands[i].mesh] = i;
+    for (std::size_t i = 0; i < cands.size(); ++i)
+      if (!cands[i].visible) namer.try_emplace(cands[i].mesh, i);
+    for (const auto& [mesh, i] : namer) {
+      const std::uint32_t name = static_cast<std::uint32_t>(i) | ((flagsOf[i] & gpu::kInstanceAlphaTested) ? gpu::kTriAlphaTested : 0u);
+      if (mesh->named == name) continue;
+      mesh->named = name;
+      renamed_ = true;
+      const std::size_t from = mesh->triOffset, to = from + mesh->bvh.primOrder.size();
+      for (std::size_t p = from; p < to; ++p) data_.meshTraversal[p * gpu::kTriTexels + 2].w = std::bit_cast<float>(name);
     }
   }
 
@@ -841,12 +851,13 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
 
   // How far instances are opened: the factor whose packing costs sample rays the fewest
   // traversal steps, counted as the kernel counts them (tracePacked). The surface area
-  // heuristic, used before, assumes rays come from outside every box; here rays start on
-  // surfaces, inside the boxes of the instances around them, and the heuristic kept the
-  // spaceship's parts, all in one place, at 16 references each where 1024 took 17 % fewer steps.
-  // A factor must save 1 % of the steps to be taken: more references cost memory and build time.
-  // Direct, a reference costs no step of its own, so the factor chosen then would cost a step a
-  // reference once a move turns direct off: it is chosen anew.
+  // heuristic, used before, assumes rays come from outside every box; a path's rays start on
+  // surfaces, inside the boxes of the instances around them, and the heuristic kept the living
+  // room's objects whole where 16 references each take 10 % fewer loop iterations a path. A
+  // factor must save 1 % of the steps to be taken: more references cost memory and build time.
+  // The rays leave the camera as it is when the factor is chosen. Direct, a reference costs no
+  // step of its own, so the factor chosen then would cost a step a reference once a move turns
+  // direct off: it is chosen anew whenever the packing turns direct or back.
   std::vector<Ref> refs;
   Bvh tlas;
   std::vector<vec4> top;
@@ -882,8 +893,6 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
         top = std::move(packed);
       }
     }
-    braidSteps_ = rays.empty() ? 0.0f : static_cast<float>(static_cast<double>(best) / static_cast<double>(rays.size()));
-    braidRays_ = rays.size();
   } else {
     tlas = build(braidFactor_, &refs);
     top = pack(tlas, refs);

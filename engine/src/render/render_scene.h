@@ -51,6 +51,7 @@ enum DirtyArrays : std::uint32_t {
   kDirtyTextures = 1u << 3,   // textureInfo, texels
   kDirtyEmitters = 1u << 4,   // emitters, emitterAlias, deltaLights
   kDirtyEnvironment = 1u << 5,
+  kDirtyTriangleNames = 1u << 6,  // meshTraversal only: the instances its triangles name (direct)
   kDirtyAllArrays = 0xffu,
 };
 
@@ -120,8 +121,9 @@ class RenderSceneBuilder {
   struct MeshEntry {
     std::shared_ptr<const MeshGeometry> geometry;  // keeps the key alive
     Bvh bvh;
-    // kTriTexels and kTriShadeTexels per triangle, packed order (w of the first unset), from the
-    // BVH build until packGeometry moves them into RenderSceneData; empty after.
+    // kTriTexels and kTriShadeTexels per triangle, packed order (w of the first unset, and of
+    // the third until an instance is named in it), from the BVH build until packGeometry moves
+    // them into RenderSceneData; empty after.
     std::vector<vec4> triangles;
     std::vector<vec4> shading;
     std::vector<float> steps;      // expectedSteps of each BVH node
@@ -131,6 +133,10 @@ class RenderSceneBuilder {
     // for): an object's instance maps world space to it.
     Mat4 placed, placedInverse;
     bool used = false;
+    // What its packed triangles' third texel's w holds (layouts.h kTriInstanceMask), so that
+    // naming an instance again costs nothing when it is the same; kUnnamed when never written.
+    static constexpr std::uint32_t kUnnamed = 0xffffffffu;
+    mutable std::uint32_t named = kUnnamed;
   };
   // An object's transform from its mesh's packed space to world space.
   static Mat4 placement(const Mat4& objectTransform, const MeshEntry& mesh);
@@ -170,15 +176,12 @@ class RenderSceneBuilder {
   float deltaPower_ = 0;
   bool first_ = true;
   bool directReferences_ = true;
-  bool renumbered_ = false;  // packInstances changed the instances triangles name
+  bool renamed_ = false;  // packInstances changed the instances triangles name
   // Re-braiding (packInstances): references per instance tried up to kMaxBraidFactor, and at most
-  // kMaxBraidReferences in all; the factor chosen, for how many instances, and the mean steps
-  // of the sample rays it was chosen by, and how many.
+  // kMaxBraidReferences in all; the factor chosen, for how many visible instances, and whether for a direct instance BVH.
   static constexpr std::size_t kMaxBraidFactor = 64, kMaxBraidReferences = 16384;
   std::size_t braidFactor_ = 1, braidInstances_ = 0;
-  bool braidDirect_ = false;  // whether the factor was chosen for a direct instance BVH
-  float braidSteps_ = 0;
-  std::size_t braidRays_ = 0;
+  bool braidDirect_ = false;
   Timing timing_;
 };
 

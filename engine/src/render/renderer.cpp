@@ -128,6 +128,7 @@ struct Renderer::Impl {
                              Binding::Storage, Binding::Storage},
         static_cast<std::uint32_t>(sizeof(gpu::AccumulatePush)));
     directReferences = o.directReferences;
+    builder.setDirectReferences(directReferences);
     frameUbo = Buffer(ctx, sizeof(gpu::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                       true, "frame constants");
     stats = Buffer(ctx, gpu::kStatsCount * sizeof(std::uint32_t), kStorageUsage, true, "ray statistics");
@@ -152,10 +153,10 @@ struct Renderer::Impl {
   void upload(std::uint32_t dirty) {
     completeInFlight();  // the frame in flight uses what this touches
     const RenderSceneData& d = builder.data();
-    if (dirty & (kDirtyGeometry | kDirtyInstances)) {
+    if (dirty & (kDirtyGeometry | kDirtyInstances | kDirtyTriangleNames)) {
       VkDeviceSize meshBytes = d.meshTraversal.size() * sizeof(gpu::vec4);
       VkDeviceSize need = meshBytes + d.topTraversal.size() * sizeof(gpu::vec4);
-      if (dirty & kDirtyGeometry || !traversal.valid() || traversal.size() < need) {
+      if (dirty & (kDirtyGeometry | kDirtyTriangleNames) || !traversal.valid() || traversal.size() < need) {
         // Room for the top part to grow, so that adding objects does not re-upload the meshes.
         // The two parts are copied in place: a joined copy on the host would add the size of
         // every mesh to the peak memory of loading a scene.
@@ -337,7 +338,7 @@ struct Renderer::Impl {
     const auto& objects = builder.data().instanceObject;
     for (std::size_t i = 0; i < objects.size(); ++i)
       if (objects[i] == selectedObject) return static_cast<std::uint32_t>(i + 1);
-    return 0;  // hidden or removed: nothing to count
+    return 0;  // removed: nothing to count (a hidden object's instance is never reached)
   }
 
   // Lays the counters out for `tileSize` (clearing them when it changes).
@@ -776,10 +777,11 @@ void FrameStats::add(const FrameStats& later) {
 void Renderer::prepareMoves() {
   if (!impl_->hasScene) return;
   const RenderSceneData& d = impl_->builder.data();
-  // A move gives an instance a transform, and then no reference is packed direct.
-  impl_->traceVariant(d.alphaTested, d.materialTypes,
-                      (d.features() | static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms)) &
-                          ~static_cast<std::uint32_t>(gpu::kFeatureDirectReferences));
+  // A move gives an instance a transform, and then no reference is packed direct. An object
+  // duplicated in place shares its mesh with the original: no transform, but not direct either.
+  const auto direct = static_cast<std::uint32_t>(gpu::kFeatureDirectReferences);
+  impl_->traceVariant(d.alphaTested, d.materialTypes, (d.features() | static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms)) & ~direct);
+  if (d.features() & direct) impl_->traceVariant(d.alphaTested, d.materialTypes, d.features() & ~direct);
 }
 
 std::size_t Renderer::kernelsCompiled() const { return impl_->traceVariants.size(); }
