@@ -472,6 +472,20 @@ TEST(RenderScene, AHiddenEmitterLightsNothing) {
   EXPECT_EQ(builder.data().instanceReferences, 1u) << "only the floor is in the instance BVH";
 }
 
+// The sample rays that choose how far instances are opened do not depend on the camera seeing
+// the scene: looking away from the crossing rods, the choice is the same as looking at them.
+TEST(RenderScene, ACameraLookingAwayStillOpensOverlappingInstances) {
+  Scene s = test::emptyScene(8, 8);
+  const NodeId mat = test::addMaterial(s, Material{});
+  test::addMeshObject(s, "a", diagonalRod({1, 1, 1}, 2000, 1), mat, Mat4::identity());
+  test::addMeshObject(s, "b", diagonalRod({1, -1, 1}, 2000, 2), mat, Mat4::identity());
+  s.camera.position = {0, 0, 5};
+  s.camera.target = {0, 0, 10};
+  RenderSceneBuilder away;
+  away.update(s, kUpdateAll, nullptr);
+  EXPECT_GT(away.data().instanceReferences, 2u);
+}
+
 TEST(RenderScene, InstancesApartKeepOneReferenceEach) {
   Scene s = test::emptyScene(8, 8);
   const NodeId mat = test::addMaterial(s, Material{});

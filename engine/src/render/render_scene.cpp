@@ -618,13 +618,23 @@ struct SampleRay {
 constexpr float kRayFar = 1e30f;
 constexpr int kSamplePaths = 1024;
 
+// A visible instance's triangles, where sample paths may start when the camera sees little.
+struct SampleSurface {
+  std::uint32_t triOffset, triangles;
+  const Mat4* toWorld;  // from the mesh's packed space
+};
+
 // Rays as a path tracer sends them, to count what a packing costs: from the camera through
 // random points of the image, then two diffuse bounces (cosine-weighted, on the side the ray
-// came from) from where they hit, traced through the packing given (mesh, top, root). A fixed
-// sequence, so that a scene gets the same choice each time it is packed. The shadow rays a path
-// also sends are not among them. placementOf(instance): the instance's transform to world space.
+// came from) from where they hit, traced through the packing given (mesh, top, root). Where
+// fewer than a quarter of the camera's rays hit anything (a camera inside a wall or looking
+// away), as many paths again start on the visible triangles (chosen by count) with one bounce,
+// so that the choice still sees the geometry the camera will turn to. A fixed sequence, so that
+// a scene gets the same choice each time it is packed. The shadow rays a path also sends are
+// not among them. placementOf(instance): the instance's transform to world space.
 std::vector<SampleRay> sampleRays(const Scene& scene, const std::vector<vec4>& mesh, const std::vector<vec4>& top, std::int32_t root,
-                                  bool direct, const std::function<const Mat4&(std::int32_t)>& placementOf) {
+                                  bool direct, std::span<const SampleSurface> surfaces,
+                                  const std::function<const Mat4&(std::int32_t)>& placementOf) {
   std::vector<SampleRay> rays;
   std::uint32_t state = 0x9e3779b9u;
   auto random = [&] {  // xorshift32: the same numbers on every platform, unlike <random>'s distributions
@@ -633,32 +643,59 @@ std::vector<SampleRay> sampleRays(const Scene& scene, const std::vector<vec4>& m
     state ^= state << 5;
     return static_cast<float>(state >> 8) * (1.0f / 16777216.0f);
   };
-  const Camera& cam = scene.camera;
-  const Mat4 toWorld = Mat4::lookAt(cam.position, cam.target, cam.up);
-  const float tanHalf = std::tan(0.5f * std::clamp(cam.verticalFov, 1e-3f, 3.1f));
-  const float aspect = scene.settings.height > 0 ? static_cast<float>(scene.settings.width) / static_cast<float>(scene.settings.height) : 1.0f;
-  for (int path = 0; path < kSamplePaths; ++path) {
-    const float x = (2 * random() - 1) * tanHalf * aspect, y = (2 * random() - 1) * tanHalf;
-    SampleRay ray{cam.position, normalize(toWorld.transformVector(Vec3{x, y, -1}))};
-    for (int bounce = 0; bounce < 3; ++bounce) {
+  // A cosine-weighted direction about n, and the point `at` off the surface towards n by a
+  // little more than its coordinates' rounding.
+  auto leave = [&](Vec3 at, Vec3 n) {
+    const float offset = 1e-4f * (1.0f + std::max({std::abs(at.x), std::abs(at.y), std::abs(at.z)}));
+    const float r = std::sqrt(random()), phi = 2 * kPi * random();
+    const Vec3 a = std::abs(n.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    const Vec3 u = normalize(cross(a, n)), v = cross(n, u);
+    return SampleRay{at + n * offset, normalize(u * (r * std::cos(phi)) + v * (r * std::sin(phi)) + n * std::sqrt(std::max(0.0f, 1 - r * r)))};
+  };
+  // Traces a path from `ray` for up to `bounces` bounces; whether its first ray hit.
+  auto follow = [&](SampleRay ray, int bounces) {
+    bool hitFirst = false;
+    for (int bounce = 0; bounce <= bounces; ++bounce) {
       if (!std::isfinite(ray.origin.x + ray.origin.y + ray.origin.z + ray.direction.x + ray.direction.y + ray.direction.z)) break;
       rays.push_back(ray);
       const PackedTrace hit = tracePacked(mesh, top, root, direct, ray.origin, ray.direction, kRayFar);
-      if (hit.prim < 0 || bounce == 2) break;
+      hitFirst = hitFirst || (bounce == 0 && hit.prim >= 0);
+      if (hit.prim < 0 || bounce == bounces) break;
       const vec4* t = mesh.data() + static_cast<std::size_t>(hit.prim) * gpu::kTriTexels;
       Vec3 n = cross(Vec3{t[1].x, t[1].y, t[1].z}, Vec3{t[2].x, t[2].y, t[2].z});
       if (hit.instance >= 0) n = placementOf(hit.instance).inverse().transposed().transformVector(n);
       if (!(length(n) > 0)) break;
       n = normalize(n);
-      if (dot(n, ray.direction) > 0) n = -n;
-      const Vec3 at = ray.origin + ray.direction * hit.t;
-      // Off the surface by a little more than its coordinates' rounding.
-      const float offset = 1e-4f * (1.0f + std::max({std::abs(at.x), std::abs(at.y), std::abs(at.z)}));
-      const float r = std::sqrt(random()), phi = 2 * kPi * random();
-      const Vec3 a = std::abs(n.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-      const Vec3 u = normalize(cross(a, n)), v = cross(n, u);
-      ray = {at + n * offset, normalize(u * (r * std::cos(phi)) + v * (r * std::sin(phi)) + n * std::sqrt(std::max(0.0f, 1 - r * r)))};
+      ray = leave(ray.origin + ray.direction * hit.t, dot(n, ray.direction) > 0 ? -n : n);
     }
+    return hitFirst;
+  };
+  const Camera& cam = scene.camera;
+  const Mat4 toWorld = Mat4::lookAt(cam.position, cam.target, cam.up);
+  const float tanHalf = std::tan(0.5f * std::clamp(cam.verticalFov, 1e-3f, 3.1f));
+  const float aspect = scene.settings.height > 0 ? static_cast<float>(scene.settings.width) / static_cast<float>(scene.settings.height) : 1.0f;
+  int seen = 0;
+  for (int path = 0; path < kSamplePaths; ++path) {
+    const float x = (2 * random() - 1) * tanHalf * aspect, y = (2 * random() - 1) * tanHalf;
+    seen += follow({cam.position, normalize(toWorld.transformVector(Vec3{x, y, -1}))}, 2) ? 1 : 0;
+  }
+  std::vector<std::uint64_t> before;  // triangles of the surfaces before each
+  std::uint64_t total = 0;
+  for (const SampleSurface& f : surfaces) {
+    before.push_back(total);
+    total += f.triangles;
+  }
+  for (int path = 0; seen < kSamplePaths / 4 && total > 0 && path < kSamplePaths; ++path) {
+    const auto k = std::min(static_cast<std::uint64_t>(random() * static_cast<float>(total)), total - 1);
+    const std::size_t f = static_cast<std::size_t>(std::upper_bound(before.begin(), before.end(), k) - before.begin()) - 1;
+    const vec4* t = mesh.data() + (std::size_t{surfaces[f].triOffset} + (k - before[f])) * gpu::kTriTexels;
+    const Vec3 v0{t[0].x, t[0].y, t[0].z}, e1{t[1].x, t[1].y, t[1].z}, e2{t[2].x, t[2].y, t[2].z};
+    const float r = std::sqrt(random()), b = random();
+    const Mat4& m = *surfaces[f].toWorld;
+    const Vec3 n = m.inverse().transposed().transformVector(cross(e1, e2));
+    if (!(length(n) > 0)) continue;
+    const Vec3 side = normalize(n) * (random() < 0.5f ? 1.0f : -1.0f);
+    follow(leave(m.transformPoint(v0 + e1 * (r * (1 - b)) + e2 * (r * b)), side), 1);
   }
   return rays;
 }
@@ -867,7 +904,10 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     braidDirect_ = direct;
     tlas = build(1, &refs);
     top = pack(tlas, refs);
-    const std::vector<SampleRay> rays = sampleRays(scene, data_.meshTraversal, top, data_.tlasRoot, direct, [&](std::int32_t instance) -> const Mat4& {
+    std::vector<SampleSurface> surfaces;
+    for (const Candidate& c : cands)
+      if (c.visible) surfaces.push_back({c.mesh->triOffset, static_cast<std::uint32_t>(c.mesh->bvh.primOrder.size()), &c.transform});
+    const std::vector<SampleRay> rays = sampleRays(scene, data_.meshTraversal, top, data_.tlasRoot, direct, surfaces, [&](std::int32_t instance) -> const Mat4& {
       return cands[static_cast<std::size_t>(instance)].transform;
     });
     auto stepsOf = [&](const std::vector<vec4>& packed) {
