@@ -358,8 +358,7 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
   }
   if (flags & (kUpdateInstances | kUpdateLights)) {
     auto t = Clock::now();
-    packInstances(scene, (flags & kUpdateGeometry) != 0);
-    if (renamed_) dirty |= kDirtyTriangleNames;
+    if (packInstances(scene, (flags & kUpdateGeometry) != 0)) dirty |= kDirtyTriangleNames;
     timing_.tlas = secondsSince(t);
     t = Clock::now();
     packEmitters(scene);
@@ -701,7 +700,7 @@ std::vector<SampleRay> sampleRays(const Scene& scene, const std::vector<vec4>& m
 }
 }  // namespace
 
-void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
+bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   struct Candidate {
     const Object* object;
     const MeshEntry* mesh;
@@ -816,7 +815,7 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   data_.instanceObject.clear();
   data_.instancedTriangles = 0;
   data_.alphaTested = false;
-  data_.instanceTransforms = false;
+  data_.instanceTransforms = transforms;
   std::vector<int> flagsOf(cands.size(), 0);
   std::vector<Mat4> inverseOf(cands.size());
   for (std::size_t i = 0; i < cands.size(); ++i) {
@@ -828,7 +827,6 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     if (c.visible && (flags & gpu::kInstanceAlphaTested)) data_.alphaTested = true;
     flagsOf[i] = flags;
     inverseOf[i] = c.transform.inverse();
-    if (c.visible && !(c.transform == Mat4::identity())) data_.instanceTransforms = true;
     const Mat4& inv = inverseOf[i];
     for (int r = 0; r < 3; ++r) data_.instances.push_back({inv.m[r][0], inv.m[r][1], inv.m[r][2], inv.m[r][3]});
     data_.instances.push_back(ints(0, static_cast<std::int32_t>(c.mesh->triOffset), materialIndex(c.object->material), -1));
@@ -840,7 +838,7 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   // a hidden one's, so that showing it later changes nothing. The names change when objects are
   // added or removed (or a cut-out's flag changes), and then the meshes' part is uploaded again;
   // a mesh whose triangles already name the right instance is not touched.
-  renamed_ = false;
+  bool renamed = false;
   if (direct) {
     std::unordered_map<const MeshEntry*, std::size_t> namer;
     for (std::size_t i = 0; i < cands.size(); ++i)
@@ -851,7 +849,7 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
       const std::uint32_t name = static_cast<std::uint32_t>(i) | ((flagsOf[i] & gpu::kInstanceAlphaTested) ? gpu::kTriAlphaTested : 0u);
       if (mesh->named == name) continue;
       mesh->named = name;
-      renamed_ = true;
+      renamed = true;
       const std::size_t from = mesh->triOffset, to = from + mesh->bvh.primOrder.size();
       for (std::size_t p = from; p < to; ++p) data_.meshTraversal[p * gpu::kTriTexels + 2].w = std::bit_cast<float>(name);
     }
@@ -940,6 +938,7 @@ void RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   data_.bounds = tlas.bounds;
   data_.topTraversal = std::move(top);
   data_.instanceReferences = refs.size();
+  return renamed;
 }
 
 void RenderSceneBuilder::packEmitters(const Scene& scene) {

@@ -149,7 +149,8 @@ class RenderSceneBuilder {
 
   void packGeometry(const Scene& scene);
   // chooseBraid: choose how far instances are opened (packInstances), as when meshes change.
-  void packInstances(const Scene& scene, bool chooseBraid);
+  // Returns whether triangles were renamed (kDirtyTriangleNames).
+  bool packInstances(const Scene& scene, bool chooseBraid);
   void packMaterials(const Scene& scene);
   void packTextures(const Scene& scene, std::vector<std::string>* warnings);
   void packEmitters(const Scene& scene);
@@ -176,7 +177,6 @@ class RenderSceneBuilder {
   float deltaPower_ = 0;
   bool first_ = true;
   bool directReferences_ = true;
-  bool renamed_ = false;  // packInstances changed the instances triangles name
   // Re-braiding (packInstances): references per instance tried up to kMaxBraidFactor, and at most
   // kMaxBraidReferences in all; the factor chosen, for how many visible instances, and whether for a direct instance BVH.
   static constexpr std::size_t kMaxBraidFactor = 64, kMaxBraidReferences = 16384;
