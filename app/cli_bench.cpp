@@ -278,6 +278,53 @@ int benchEdit(int edits) {
   return 0;
 }
 
+// Edit cost on a real scene: the first move of its first visible object (which, in a scene
+// packed without instance transforms, turns direct references off), further moves, showing or
+// hiding it, and changing its material, each through a RenderSession as the render thread applies
+// them. None may trace sample rays to choose the braid factor again (render_scene.cpp).
+int benchEditScene(const std::string& path, int edits) {
+  auto loaded = loadScene(path);
+  if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
+  Scene& scene = loaded->scene;
+  scene.settings.width = 64;
+  scene.settings.height = 36;
+  auto it = std::find_if(scene.objects.begin(), scene.objects.end(), [](const Object& o) { return o.visible; });
+  const Material* material = it == scene.objects.end() ? nullptr : scene.material(it->material);
+  if (!material) return std::fprintf(stderr, "error: %s: no visible object with a material to edit\n", path.c_str()), 1;
+  Object o = *it;
+  Material mat = *material;
+  auto t0 = Clock::now();
+  RenderSession session(scene, MethodSettings{});
+  const double upload = std::chrono::duration<double>(Clock::now() - t0).count();
+  session.renderFrame(false);
+  session.prepareMoves();  // as the render thread does once its first frame is out
+  auto timed = [&session](const Edit& e) {
+    const auto a = Clock::now();
+    session.applyEdit(e);
+    return std::chrono::duration<double, std::milli>(Clock::now() - a).count();
+  };
+  auto moved = [&o] {
+    o.transform = Mat4::translate({0.001f, 0, 0}) * o.transform;
+    return SetObject{o};
+  };
+  const double firstMove = timed(moved());
+  double moveMs = 0, visibilityMs = 0, materialMs = 0;
+  for (int i = 0; i < edits; ++i) {
+    moveMs += timed(moved());
+    o.visible = !o.visible;
+    visibilityMs += timed(SetObject{o});
+    mat.roughness = 0.1f + 0.01f * static_cast<float>(i % 50);
+    materialMs += timed(SetMaterial{mat});
+  }
+  std::printf("scene            %s (%zu objects; edited: %s)\n", path.c_str(), scene.objects.size(), o.name.c_str());
+  std::printf("upload           %.3f s\n", upload);
+  std::printf("first move       %.3f ms\n", firstMove);
+  std::printf("move             %.3f ms/edit\n", moveMs / edits);
+  std::printf("show or hide     %.3f ms/edit\n", visibilityMs / edits);
+  std::printf("material         %.3f ms/edit\n", materialMs / edits);
+  return 0;
+}
+
 // The denoiser's cost: the whole frame denoised and composed, against a frame of 1 spp traced and
 // accumulated at the same size (what the denoise variants add to each frame of the global method
 // and of continuous refinement; incremental passes denoise only a growing region, now and then).
@@ -433,11 +480,14 @@ void addBench(CLI::App& app, int* status) {
   addInt(*cmd, "--triangles", triangles.get(), 1, 50'000'000, "triangles");
   cmd->callback([triangles, status] { *status = benchBvh(*triangles); });
 
-  cmd = bench->add_subcommand(
-      "edit", "Cost of moving an object and changing its material against mesh size (16 k to 2 M triangles)");
+  cmd = bench->add_subcommand("edit",
+                              "Cost of moving an object and changing its material against mesh size (16 k to 2 M "
+                              "triangles), or of moving, showing or hiding and recolouring an object of --scene");
   auto edits = std::make_shared<int>(20);
+  auto editScene = std::make_shared<std::string>();
   addInt(*cmd, "--edits", edits.get(), 1, 10000, "edits of each kind timed per mesh size");
-  cmd->callback([edits, status] { *status = benchEdit(*edits); });
+  cmd->add_option("--scene", *editScene, "time the edits on this scene's first visible object instead")->type_name("SCENE");
+  cmd->callback([edits, editScene, status] { *status = editScene->empty() ? benchEdit(*edits) : benchEditScene(*editScene, *edits); });
 
   cmd = bench->add_subcommand(
       "frames", "The editor's frames/s (render thread and mailbox), at rest or while an object is dragged");

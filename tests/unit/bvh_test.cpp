@@ -1,6 +1,7 @@
 // The packed BVH agrees with brute-force intersection: the GPU traverses the same layout.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <limits>
 #include <random>
@@ -484,6 +485,44 @@ TEST(RenderScene, ACameraLookingAwayStillOpensOverlappingInstances) {
   RenderSceneBuilder away;
   away.update(s, kUpdateAll, nullptr);
   EXPECT_GT(away.data().instanceReferences, 2u);
+}
+
+// Choosing how far to open the instances traces sample rays, tens of milliseconds on a big
+// scene, which an edit would add to the editor's next frame. So showing, hiding, adding or
+// moving an object keeps the factor (the first move, which turns direct references off, finds the
+// factor for records chosen with the direct one); it is chosen again when meshes change or the
+// visible instances grow or shrink by more than an eighth.
+TEST(RenderScene, SmallEditsKeepTheBraidFactor) {
+  Scene s = test::emptyScene(8, 8);
+  const NodeId mat = test::addMaterial(s, Material{});
+  std::vector<NodeId> rods;
+  for (std::uint32_t i = 0; i < 16; ++i)
+    rods.push_back(test::addMeshObject(s, "rod", diagonalRod({1, i % 2 ? 1.0f : -1.0f, 1}, 200, i + 1), mat, Mat4::identity()));
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  ASSERT_TRUE(builder.data().directReferences);
+  const std::uint64_t chosen = builder.braidChoices();
+  EXPECT_EQ(chosen, 1u);
+  auto object = [&](NodeId id) -> Object& { return *std::find_if(s.objects.begin(), s.objects.end(), [&](const Object& o) { return o.id == id; }); };
+
+  object(rods[3]).visible = false;
+  builder.update(s, kUpdateInstances, nullptr);
+  object(rods[3]).visible = true;
+  builder.update(s, kUpdateInstances, nullptr);
+  EXPECT_EQ(builder.braidChoices(), chosen);
+
+  object(rods[5]).transform = Mat4::translate({0.1f, 0, 0});
+  builder.update(s, kUpdateInstances, nullptr);
+  EXPECT_FALSE(builder.data().directReferences);
+  EXPECT_EQ(builder.braidChoices(), chosen) << "the first move chose the factor again";
+
+  // Three of sixteen hidden: more than an eighth.
+  for (int i = 0; i < 3; ++i) object(rods[static_cast<std::size_t>(i)]).visible = false;
+  builder.update(s, kUpdateInstances, nullptr);
+  EXPECT_EQ(builder.braidChoices(), chosen + 1);
+
+  builder.update(s, kUpdateGeometry | kUpdateInstances, nullptr);
+  EXPECT_EQ(builder.braidChoices(), chosen + 2);
 }
 
 TEST(RenderScene, InstancesApartKeepOneReferenceEach) {

@@ -794,13 +794,13 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   const bool direct = directReferences_ && !transforms && !shared;
   BvhBuildOptions opt;
   opt.maxLeafSize = 1;  // a TLAS leaf is one reference: traversal enters its subtree directly
-  auto build = [&](std::size_t factor, std::vector<Ref>* refs) {
+  auto build = [&](std::size_t factor, bool packDirect, std::vector<Ref>* refs) {
     *refs = braid(std::max(visible, std::min(visible * factor, kMaxBraidReferences)));
     std::vector<Bounds3> boxes;
     boxes.reserve(refs->size());
     for (const Ref& r : *refs) boxes.push_back(r.bounds);
     // Entering a reference is one step, unless packed direct, then its subtree's.
-    const float enter = direct ? 0.0f : 1.0f;
+    const float enter = packDirect ? 0.0f : 1.0f;
     opt.primCost = [&, enter](std::uint32_t i) {
       const Ref& r = (*refs)[i];
       if (r.node >= 0) return enter + cands[r.cand].mesh->steps[static_cast<std::size_t>(r.node)];
@@ -859,9 +859,9 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   // the BVH's packed order), or, direct, what the references name (copied after the numbering,
   // so that copies of triangles carry it too).
   const auto base = static_cast<std::int64_t>(data_.meshTraversal.size());
-  auto pack = [&](const Bvh& tlas, const std::vector<Ref>& refs) {
+  auto pack = [&](const Bvh& tlas, const std::vector<Ref>& refs, bool packDirect) {
     std::vector<vec4> top;
-    if (direct) {
+    if (packDirect) {
       appendDirectTop(top, base, tlas.nodes, [&](std::int32_t p) {
         const Ref& r = refs[tlas.primOrder[static_cast<std::size_t>(p)]];
         return DirectRef{r.item >> gpu::kItemOffsetShift, r.node >= 0, r.triangles};
@@ -890,50 +890,74 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   // surfaces, inside the boxes of the instances around them, and the heuristic kept the living
   // room's objects whole where 16 references each take 10 % fewer loop iterations a path. A
   // factor must save 1 % of the steps to be taken: more references cost memory and build time.
-  // The rays leave the camera as it is when the factor is chosen. Direct, a reference costs no
-  // step of its own, so the factor chosen then would cost a step a reference once a move turns
-  // direct off: it is chosen anew whenever the packing turns direct or back.
+  // The rays leave the camera as it is when the factor is chosen.
+  //
+  // Choosing costs tens of milliseconds (the spaceship 30, a room of a million triangles 60), so
+  // it is done when meshes change or the visible instances have grown or shrunk by more than an
+  // eighth since, not for every object shown, hidden, added or removed, which would delay the
+  // editor's next frame by as much. Direct, a reference costs no step of its own, so the factor
+  // for records differs: it is chosen with the direct one, from the same rays, so that the first
+  // move (which turns direct off) need not choose.
+  const bool drifted = visible > braidInstances_ + braidInstances_ / 8 || visible + braidInstances_ / 8 < braidInstances_;
+  if (chooseBraid || drifted) {
+    braidInstances_ = visible;
+    braidKnown_ = {false, false};
+  }
   std::vector<Ref> refs;
   Bvh tlas;
   std::vector<vec4> top;
-  if (chooseBraid || visible != braidInstances_ || direct != braidDirect_) {
-    braidFactor_ = 1;
-    braidInstances_ = visible;
-    braidDirect_ = direct;
-    tlas = build(1, &refs);
-    top = pack(tlas, refs);
+  if (!braidKnown_[direct]) {
+    ++braidChoices_;
+    std::vector<Ref> probeRefs;  // the rays are traced through the packing of factor 1
+    const Bvh probe = build(1, direct, &probeRefs);
+    const std::vector<vec4> probeTop = pack(probe, probeRefs, direct);
     std::vector<SampleSurface> surfaces;
     for (const Candidate& c : cands)
       if (c.visible) surfaces.push_back({c.mesh->triOffset, static_cast<std::uint32_t>(c.mesh->bvh.primOrder.size()), &c.transform});
-    const std::vector<SampleRay> rays = sampleRays(scene, data_.meshTraversal, top, data_.tlasRoot, direct, surfaces, [&](std::int32_t instance) -> const Mat4& {
+    const std::vector<SampleRay> rays = sampleRays(scene, data_.meshTraversal, probeTop, data_.tlasRoot, direct, surfaces, [&](std::int32_t instance) -> const Mat4& {
       return cands[static_cast<std::size_t>(instance)].transform;
     });
-    auto stepsOf = [&](const std::vector<vec4>& packed) {
+    auto stepsOf = [&](const std::vector<vec4>& packed, bool packDirect) {
       std::uint64_t steps = 0;
-      for (const SampleRay& r : rays) steps += tracePacked(data_.meshTraversal, packed, data_.tlasRoot, direct, r.origin, r.direction, kRayFar).steps;
+      for (const SampleRay& r : rays) steps += tracePacked(data_.meshTraversal, packed, data_.tlasRoot, packDirect, r.origin, r.direction, kRayFar).steps;
       return steps;
     };
-    std::uint64_t best = stepsOf(top);
-    std::size_t previous = refs.size();
-    for (std::size_t factor = 2; factor <= kMaxBraidFactor && !rays.empty(); factor *= 2) {
-      std::vector<Ref> tried;
-      Bvh bvh = build(factor, &tried);
-      const bool opened = tried.size() > previous;
-      previous = tried.size();
-      if (!opened) break;  // nothing left to open, or the cap reached
-      std::vector<vec4> packed = pack(bvh, tried);
-      const std::uint64_t steps = stepsOf(packed);
-      if (static_cast<double>(steps) < 0.99 * static_cast<double>(best)) {
-        best = steps;
-        braidFactor_ = factor;
-        refs = std::move(tried);
-        tlas = std::move(bvh);
-        top = std::move(packed);
+    // The factor for packing `packDirect`, and with `keep` its instance BVH and packing.
+    auto choose = [&](bool packDirect, bool keep) {
+      std::vector<Ref> bestRefs;
+      Bvh bestTlas = build(1, packDirect, &bestRefs);
+      std::vector<vec4> bestTop = pack(bestTlas, bestRefs, packDirect);
+      std::uint64_t best = stepsOf(bestTop, packDirect);
+      std::size_t factor = 1, previous = bestRefs.size();
+      for (std::size_t f = 2; f <= kMaxBraidFactor && !rays.empty(); f *= 2) {
+        std::vector<Ref> tried;
+        Bvh bvh = build(f, packDirect, &tried);
+        const bool opened = tried.size() > previous;
+        previous = tried.size();
+        if (!opened) break;  // nothing left to open, or the cap reached
+        std::vector<vec4> packed = pack(bvh, tried, packDirect);
+        const std::uint64_t steps = stepsOf(packed, packDirect);
+        if (static_cast<double>(steps) < 0.99 * static_cast<double>(best)) {
+          best = steps;
+          factor = f;
+          bestRefs = std::move(tried);
+          bestTlas = std::move(bvh);
+          bestTop = std::move(packed);
+        }
       }
-    }
+      if (keep) {
+        refs = std::move(bestRefs);
+        tlas = std::move(bestTlas);
+        top = std::move(bestTop);
+      }
+      braidFactor_[packDirect] = factor;
+      braidKnown_[packDirect] = true;
+    };
+    choose(direct, true);
+    if (direct && !braidKnown_[false]) choose(false, false);
   } else {
-    tlas = build(braidFactor_, &refs);
-    top = pack(tlas, refs);
+    tlas = build(braidFactor_[direct], direct, &refs);
+    top = pack(tlas, refs, direct);
   }
   data_.bounds = tlas.bounds;
   data_.topTraversal = std::move(top);

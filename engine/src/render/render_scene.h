@@ -116,6 +116,8 @@ class RenderSceneBuilder {
     double blas = 0, tlas = 0, textures = 0, emitters = 0, environment = 0;
   };
   const Timing& lastTiming() const { return timing_; }
+  // How many times the instance BVH's braid factor was chosen (packInstances), for the tests.
+  std::uint64_t braidChoices() const { return braidChoices_; }
 
  private:
   struct MeshEntry {
@@ -178,10 +180,13 @@ class RenderSceneBuilder {
   bool first_ = true;
   bool directReferences_ = true;
   // Re-braiding (packInstances): references per instance tried up to kMaxBraidFactor, and at most
-  // kMaxBraidReferences in all; the factor chosen, for how many visible instances, and whether for a direct instance BVH.
+  // kMaxBraidReferences in all; the factors chosen for records and for a direct instance BVH
+  // (indexed by direct), whether each is chosen, and for how many visible instances.
   static constexpr std::size_t kMaxBraidFactor = 64, kMaxBraidReferences = 16384;
-  std::size_t braidFactor_ = 1, braidInstances_ = 0;
-  bool braidDirect_ = false;
+  std::array<std::size_t, 2> braidFactor_{1, 1};
+  std::array<bool, 2> braidKnown_{false, false};
+  std::size_t braidInstances_ = 0;
+  std::uint64_t braidChoices_ = 0;
   Timing timing_;
 };
 
