@@ -909,8 +909,8 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   if (!braidKnown_[direct]) {
     ++braidChoices_;
     std::vector<Ref> probeRefs;  // the rays are traced through the packing of factor 1
-    const Bvh probe = build(1, direct, &probeRefs);
-    const std::vector<vec4> probeTop = pack(probe, probeRefs, direct);
+    Bvh probe = build(1, direct, &probeRefs);
+    std::vector<vec4> probeTop = pack(probe, probeRefs, direct);
     std::vector<SampleSurface> surfaces;
     for (const Candidate& c : cands)
       if (c.visible) surfaces.push_back({c.mesh->triOffset, static_cast<std::uint32_t>(c.mesh->bvh.primOrder.size()), &c.transform});
@@ -922,11 +922,20 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
       for (const SampleRay& r : rays) steps += tracePacked(data_.meshTraversal, packed, data_.tlasRoot, packDirect, r.origin, r.direction, kRayFar).steps;
       return steps;
     };
-    // The factor for packing `packDirect`, and with `keep` its instance BVH and packing.
+    // The factor for packing `packDirect`, and with `keep` its instance BVH and packing. Factor 1
+    // in the current packing is the probe's.
     auto choose = [&](bool packDirect, bool keep) {
       std::vector<Ref> bestRefs;
-      Bvh bestTlas = build(1, packDirect, &bestRefs);
-      std::vector<vec4> bestTop = pack(bestTlas, bestRefs, packDirect);
+      Bvh bestTlas;
+      std::vector<vec4> bestTop;
+      if (packDirect == direct) {
+        bestRefs = std::move(probeRefs);
+        bestTlas = std::move(probe);
+        bestTop = std::move(probeTop);
+      } else {
+        bestTlas = build(1, packDirect, &bestRefs);
+        bestTop = pack(bestTlas, bestRefs, packDirect);
+      }
       std::uint64_t best = stepsOf(bestTop, packDirect);
       std::size_t factor = 1, previous = bestRefs.size();
       for (std::size_t f = 2; f <= kMaxBraidFactor && !rays.empty(); f *= 2) {
