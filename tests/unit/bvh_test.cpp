@@ -491,7 +491,7 @@ TEST(RenderScene, ACameraLookingAwayStillOpensOverlappingInstances) {
 // scene, which an edit would add to the editor's next frame. So showing, hiding, adding or
 // moving an object keeps the factor (the first move, which turns direct references off, finds the
 // factor for records chosen with the direct one); it is chosen again when meshes change or the
-// visible instances grow or shrink by more than an eighth.
+// visible objects differ from those of the last choice by more than an eighth.
 TEST(RenderScene, SmallEditsKeepTheBraidFactor) {
   Scene s = test::emptyScene(8, 8);
   const NodeId mat = test::addMaterial(s, Material{});
@@ -503,21 +503,39 @@ TEST(RenderScene, SmallEditsKeepTheBraidFactor) {
   ASSERT_TRUE(builder.data().directReferences);
   const std::uint64_t chosen = builder.braidChoices();
   EXPECT_EQ(chosen, 1u);
+  const std::size_t opened = builder.data().instanceReferences;
+  // The overlapping rods are opened, and with records too (as a builder that packs only records
+  // chooses for this scene), which the first move below must find.
+  EXPECT_GT(opened, rods.size());
+  RenderSceneBuilder records;
+  records.setDirectReferences(false);
+  records.update(s, kUpdateAll, nullptr);
+  const std::size_t openedForRecords = records.data().instanceReferences;
+  EXPECT_GT(openedForRecords, rods.size());
   auto object = [&](NodeId id) -> Object& { return *std::find_if(s.objects.begin(), s.objects.end(), [&](const Object& o) { return o.id == id; }); };
 
+  // Hidden and shown again, then two of sixteen hidden (an eighth).
   object(rods[3]).visible = false;
   builder.update(s, kUpdateInstances, nullptr);
   object(rods[3]).visible = true;
   builder.update(s, kUpdateInstances, nullptr);
+  EXPECT_EQ(builder.data().instanceReferences, opened);
+  object(rods[0]).visible = false;
+  object(rods[1]).visible = false;
+  builder.update(s, kUpdateInstances, nullptr);
   EXPECT_EQ(builder.braidChoices(), chosen);
+  object(rods[0]).visible = true;
+  object(rods[1]).visible = true;
+  builder.update(s, kUpdateInstances, nullptr);
 
   object(rods[5]).transform = Mat4::translate({0.1f, 0, 0});
   builder.update(s, kUpdateInstances, nullptr);
   EXPECT_FALSE(builder.data().directReferences);
   EXPECT_EQ(builder.braidChoices(), chosen) << "the first move chose the factor again";
+  EXPECT_EQ(builder.data().instanceReferences, openedForRecords);
 
   // Three of sixteen hidden: more than an eighth.
-  for (int i = 0; i < 3; ++i) object(rods[static_cast<std::size_t>(i)]).visible = false;
+  for (std::size_t i = 0; i < 3; ++i) object(rods[i]).visible = false;
   builder.update(s, kUpdateInstances, nullptr);
   EXPECT_EQ(builder.braidChoices(), chosen + 1);
 

@@ -729,9 +729,8 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   // the reference with the largest box is replaced by its children (up to four) until there are
   // `factor` references per instance. A reference is entered like an instance, at its subtree.
   // Where instances do not overlap, opening them gains nothing, so the factor is chosen by the
-  // steps it costs sample rays (below). It is chosen when the objects or meshes change, and kept
-  // while objects move, so that a move builds one instance BVH, whose size stays proportional to
-  // the number of objects.
+  // steps it costs sample rays (below), and kept across small edits (when, below), so that a
+  // move builds one instance BVH, whose size stays proportional to the number of objects.
   struct Ref {
     std::uint32_t cand;
     std::int32_t item;  // where traversal enters the instance's BVH
@@ -893,14 +892,33 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   // The rays leave the camera as it is when the factor is chosen.
   //
   // Choosing costs tens of milliseconds (the spaceship 30, a room of a million triangles 60), so
-  // it is done when meshes change or the visible instances have grown or shrunk by more than an
-  // eighth since, not for every object shown, hidden, added or removed, which would delay the
-  // editor's next frame by as much. Direct, a reference costs no step of its own, so the factor
-  // for records differs: it is chosen with the direct one, from the same rays, so that the first
-  // move (which turns direct off) need not choose.
-  const bool drifted = visible > braidInstances_ + braidInstances_ / 8 || visible + braidInstances_ / 8 < braidInstances_;
-  if (chooseBraid || drifted) {
-    braidInstances_ = visible;
+  // it is done when meshes change, or when the visible objects differ from those of the last
+  // choice by more than an eighth of those (and by more than two), not for each object shown,
+  // hidden, added or removed, which would delay the editor's next frame by as much. Direct, a
+  // reference costs no step of its own, so the factor for records differs: a scene packed direct
+  // chooses it too, from the same rays, so that the first move (which turns direct off) need not
+  // choose. A scene packed with records that turns direct (its transforms undone, a duplicate
+  // removed) chooses the direct factor then.
+  std::vector<NodeId> visibleIds;
+  visibleIds.reserve(visible);
+  for (const Candidate& c : cands)
+    if (c.visible) visibleIds.push_back(c.object->id);
+  std::sort(visibleIds.begin(), visibleIds.end());
+  std::size_t differ = 0;  // objects visible now or then but not both
+  {
+    auto a = visibleIds.begin(), b = braidVisible_.begin();
+    while (a != visibleIds.end() || b != braidVisible_.end()) {
+      if (b == braidVisible_.end() || (a != visibleIds.end() && *a < *b)) ++a;
+      else if (a == visibleIds.end() || *b < *a) ++b;
+      else {
+        ++a, ++b;
+        continue;
+      }
+      ++differ;
+    }
+  }
+  if (chooseBraid || differ > std::max<std::size_t>(braidVisible_.size() / 8, 2)) {
+    braidVisible_ = std::move(visibleIds);
     braidKnown_ = {false, false};
   }
   std::vector<Ref> refs;

@@ -181,11 +181,12 @@ class RenderSceneBuilder {
   bool directReferences_ = true;
   // Re-braiding (packInstances): references per instance tried up to kMaxBraidFactor, and at most
   // kMaxBraidReferences in all; the factors chosen for records and for a direct instance BVH
-  // (indexed by direct), whether each is chosen, and for how many visible instances.
+  // (indexed by direct) and whether each is chosen; the visible objects when the choices were
+  // last made anew, sorted.
   static constexpr std::size_t kMaxBraidFactor = 64, kMaxBraidReferences = 16384;
   std::array<std::size_t, 2> braidFactor_{1, 1};
   std::array<bool, 2> braidKnown_{false, false};
-  std::size_t braidInstances_ = 0;
+  std::vector<NodeId> braidVisible_;
   std::uint64_t braidChoices_ = 0;
   Timing timing_;
 };
