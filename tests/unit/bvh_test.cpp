@@ -474,7 +474,7 @@ TEST(RenderScene, AHiddenEmitterLightsNothing) {
 }
 
 // The sample rays that choose how far instances are opened do not depend on the camera seeing
-// the scene: looking away from the crossing rods, the choice is the same as looking at them.
+// the scene: looking away from the crossing rods, they are still opened.
 TEST(RenderScene, ACameraLookingAwayStillOpensOverlappingInstances) {
   Scene s = test::emptyScene(8, 8);
   const NodeId mat = test::addMaterial(s, Material{});

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <numeric>
 #include <functional>
+#include <iterator>
 #include <optional>
 #include <unordered_set>
 
@@ -620,7 +621,8 @@ constexpr int kSamplePaths = 1024;
 // A visible instance's triangles, where sample paths may start when the camera sees little.
 struct SampleSurface {
   std::uint32_t triOffset, triangles;
-  const Mat4* toWorld;  // from the mesh's packed space
+  const Mat4* toWorld;    // from the mesh's packed space
+  const Mat4* fromWorld;  // its inverse
 };
 
 // Rays as a path tracer sends them, to count what a packing costs: from the camera through
@@ -630,10 +632,10 @@ struct SampleSurface {
 // away), as many paths again start on the visible triangles (chosen by count) with one bounce,
 // so that the choice still sees the geometry the camera will turn to. A fixed sequence, so that
 // a scene gets the same choice each time it is packed. The shadow rays a path also sends are
-// not among them. placementOf(instance): the instance's transform to world space.
+// not among them. fromWorldOf(instance): the inverse of the instance's transform to world space.
 std::vector<SampleRay> sampleRays(const Scene& scene, const std::vector<vec4>& mesh, const std::vector<vec4>& top, std::int32_t root,
                                   bool direct, std::span<const SampleSurface> surfaces,
-                                  const std::function<const Mat4&(std::int32_t)>& placementOf) {
+                                  const std::function<const Mat4&(std::int32_t)>& fromWorldOf) {
   std::vector<SampleRay> rays;
   std::uint32_t state = 0x9e3779b9u;
   auto random = [&] {  // xorshift32: the same numbers on every platform, unlike <random>'s distributions
@@ -662,7 +664,7 @@ std::vector<SampleRay> sampleRays(const Scene& scene, const std::vector<vec4>& m
       if (hit.prim < 0 || bounce == bounces) break;
       const vec4* t = mesh.data() + static_cast<std::size_t>(hit.prim) * gpu::kTriTexels;
       Vec3 n = cross(Vec3{t[1].x, t[1].y, t[1].z}, Vec3{t[2].x, t[2].y, t[2].z});
-      if (hit.instance >= 0) n = placementOf(hit.instance).inverse().transposed().transformVector(n);
+      if (hit.instance >= 0) n = fromWorldOf(hit.instance).transposed().transformVector(n);
       if (!(length(n) > 0)) break;
       n = normalize(n);
       ray = leave(ray.origin + ray.direction * hit.t, dot(n, ray.direction) > 0 ? -n : n);
@@ -691,7 +693,7 @@ std::vector<SampleRay> sampleRays(const Scene& scene, const std::vector<vec4>& m
     const Vec3 v0{t[0].x, t[0].y, t[0].z}, e1{t[1].x, t[1].y, t[1].z}, e2{t[2].x, t[2].y, t[2].z};
     const float r = std::sqrt(random()), b = random();
     const Mat4& m = *surfaces[f].toWorld;
-    const Vec3 n = m.inverse().transposed().transformVector(cross(e1, e2));
+    const Vec3 n = surfaces[f].fromWorld->transposed().transformVector(cross(e1, e2));
     if (!(length(n) > 0)) continue;
     const Vec3 side = normalize(n) * (random() < 0.5f ? 1.0f : -1.0f);
     follow(leave(m.transformPoint(v0 + e1 * (r * (1 - b)) + e2 * (r * b)), side), 1);
@@ -904,36 +906,26 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   for (const Candidate& c : cands)
     if (c.visible) visibleIds.push_back(c.object->id);
   std::sort(visibleIds.begin(), visibleIds.end());
-  std::size_t differ = 0;  // objects visible now or then but not both
-  {
-    auto a = visibleIds.begin(), b = braidVisible_.begin();
-    while (a != visibleIds.end() || b != braidVisible_.end()) {
-      if (b == braidVisible_.end() || (a != visibleIds.end() && *a < *b)) ++a;
-      else if (a == visibleIds.end() || *b < *a) ++b;
-      else {
-        ++a, ++b;
-        continue;
-      }
-      ++differ;
-    }
-  }
-  if (chooseBraid || differ > std::max<std::size_t>(braidVisible_.size() / 8, 2)) {
+  std::vector<NodeId> differ;  // objects visible now or then but not both
+  std::set_symmetric_difference(visibleIds.begin(), visibleIds.end(), braidVisible_.begin(), braidVisible_.end(), std::back_inserter(differ));
+  if (chooseBraid || differ.size() > std::max<std::size_t>(braidVisible_.size() / 8, 2)) {
     braidVisible_ = std::move(visibleIds);
-    braidKnown_ = {false, false};
+    braidFactor_ = {0, 0};
   }
   std::vector<Ref> refs;
   Bvh tlas;
   std::vector<vec4> top;
-  if (!braidKnown_[direct]) {
+  if (braidFactor_[direct] == 0) {
     ++braidChoices_;
     std::vector<Ref> probeRefs;  // the rays are traced through the packing of factor 1
     Bvh probe = build(1, direct, &probeRefs);
     std::vector<vec4> probeTop = pack(probe, probeRefs, direct);
     std::vector<SampleSurface> surfaces;
-    for (const Candidate& c : cands)
-      if (c.visible) surfaces.push_back({c.mesh->triOffset, static_cast<std::uint32_t>(c.mesh->bvh.primOrder.size()), &c.transform});
+    for (std::size_t i = 0; i < cands.size(); ++i)
+      if (cands[i].visible)
+        surfaces.push_back({cands[i].mesh->triOffset, static_cast<std::uint32_t>(cands[i].mesh->bvh.primOrder.size()), &cands[i].transform, &inverseOf[i]});
     const std::vector<SampleRay> rays = sampleRays(scene, data_.meshTraversal, probeTop, data_.tlasRoot, direct, surfaces, [&](std::int32_t instance) -> const Mat4& {
-      return cands[static_cast<std::size_t>(instance)].transform;
+      return inverseOf[static_cast<std::size_t>(instance)];
     });
     auto stepsOf = [&](const std::vector<vec4>& packed, bool packDirect) {
       std::uint64_t steps = 0;
@@ -978,10 +970,9 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
         top = std::move(bestTop);
       }
       braidFactor_[packDirect] = factor;
-      braidKnown_[packDirect] = true;
     };
     choose(direct, true);
-    if (direct && !braidKnown_[false]) choose(false, false);
+    if (direct && braidFactor_[false] == 0) choose(false, false);
   } else {
     tlas = build(braidFactor_[direct], direct, &refs);
     top = pack(tlas, refs, direct);

@@ -181,11 +181,10 @@ class RenderSceneBuilder {
   bool directReferences_ = true;
   // Re-braiding (packInstances): references per instance tried up to kMaxBraidFactor, and at most
   // kMaxBraidReferences in all; the factors chosen for records and for a direct instance BVH
-  // (indexed by direct) and whether each is chosen; the visible objects when the choices were
-  // last made anew, sorted.
+  // (indexed by direct; 0 until chosen); the visible objects when the choices were last made
+  // anew, sorted.
   static constexpr std::size_t kMaxBraidFactor = 64, kMaxBraidReferences = 16384;
-  std::array<std::size_t, 2> braidFactor_{1, 1};
-  std::array<bool, 2> braidKnown_{false, false};
+  std::array<std::size_t, 2> braidFactor_{0, 0};
   std::vector<NodeId> braidVisible_;
   std::uint64_t braidChoices_ = 0;
   Timing timing_;
