@@ -1,6 +1,7 @@
 // retile compare: how far a render is from another renderer's reference, in units of our own
 // noise (issue 15's acceptance): block-averaged relative RMSE against the reference and, with a
-// second render of ours at another seed, against that (the noise floor).
+// second render of ours at another seed, against that (the noise floor), and how much of the
+// difference both renders' noise can explain (blockNoise).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -73,6 +74,7 @@ int runCompare(const CompareOptions& o) {
   }
   auto view = [&](std::size_t i) { return MetricImage{images[i].rgb.data(), images[i].width, images[i].height}; };
   BlockComparison c = compareBlocks(view(0), view(1), block, exclude);
+  BlockNoise noise;  // with --noise
   std::printf("compared: %d of %d %dx%d blocks\n", c.blocks, c.cols * c.rows, block, block);
   std::printf("mean RGB: %.6g against %.6g (%+.3f %%)\n", c.meanA, c.meanRef,
               c.meanRef > 0 ? 100.0 * (c.meanA / c.meanRef - 1.0) : 0.0);
@@ -91,17 +93,42 @@ int runCompare(const CompareOptions& o) {
       std::printf("  block %2d: %.4f against a floor of %.4f, ratio %.2f\n", size, cs.relativeRmse, ns.relativeRmse,
                   ns.relativeRmse > 0 ? cs.relativeRmse / ns.relativeRmse : std::numeric_limits<double>::infinity());
     }
+    noise = blockNoise(view(0), view(2), view(1), block, exclude);
+    std::printf("noise of the block means, estimated from the spread of each block's pixels (the reference's is an\n"
+                "upper bound: differences at pixel scale, such as edges, count as its noise):\n");
+    std::printf("  ours %.4f, the reference's %.4f: with no bias the ratio would be about %.2f\n", noise.ours,
+                noise.reference, noise.expectedRatio);
+    std::printf("  block differences in units of both renders' noise: mean square %.2f (1 when only noise differs); "
+                "%d of %d blocks beyond 3 (noise alone: %.1f)\n",
+                noise.meanSquaredZ, noise.beyond3, noise.blocks, 0.0027 * noise.blocks);
   }
   std::vector<std::size_t> order(c.errorShare.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
   order.erase(std::remove_if(order.begin(), order.end(), [&](std::size_t b) { return std::isnan(c.errorShare[b]); }), order.end());
   std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) { return c.errorShare[p] > c.errorShare[q]; });
-  if (worst > 0 && !order.empty()) std::printf("largest shares of the error (block at pixel x, y: share, luminance against reference):\n");
+  const bool withZ = !noise.z.empty();
+  if (worst > 0 && !order.empty())
+    std::printf("largest shares of the error (block at pixel x, y: share, luminance against reference%s):\n",
+                withZ ? ", difference in units of its noise" : "");
   for (std::size_t k = 0; k < order.size() && k < static_cast<std::size_t>(worst); ++k) {
     std::size_t b = order[k];
     int x = static_cast<int>(b % static_cast<std::size_t>(c.cols)) * block, y = static_cast<int>(b / static_cast<std::size_t>(c.cols)) * block;
-    std::printf("  %4d, %4d: %5.1f %%  %.4g against %.4g (%+.0f %%)\n", x, y, 100.0 * c.errorShare[b], c.lumA[b], c.lumRef[b],
+    std::printf("  %4d, %4d: %5.1f %%  %.4g against %.4g (%+.0f %%)", x, y, 100.0 * c.errorShare[b], c.lumA[b], c.lumRef[b],
                 c.lumRef[b] > 0 ? 100.0 * (c.lumA[b] / c.lumRef[b] - 1.0) : 0.0);
+    if (withZ && !std::isnan(noise.z[b])) std::printf("  z %+.1f", noise.z[b]);
+    std::printf("\n");
+  }
+  if (withZ && worst > 0 && noise.beyond3 > 0) {
+    // Small but certain differences: in smooth, low-noise regions a bias too small to carry a
+    // share of the error still stands out against the noise.
+    std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) { return std::abs(noise.z[p]) > std::abs(noise.z[q]); });
+    std::printf("largest differences in units of their noise (block at pixel x, y: z, luminance against reference):\n");
+    for (std::size_t k = 0; k < order.size() && k < static_cast<std::size_t>(worst) && std::abs(noise.z[order[k]]) > 3.0; ++k) {
+      std::size_t b = order[k];
+      int x = static_cast<int>(b % static_cast<std::size_t>(c.cols)) * block, y = static_cast<int>(b / static_cast<std::size_t>(c.cols)) * block;
+      std::printf("  %4d, %4d: z %+6.1f  %.4g against %.4g (%+.1f %%)\n", x, y, noise.z[b], c.lumA[b], c.lumRef[b],
+                  c.lumRef[b] > 0 ? 100.0 * (c.lumA[b] / c.lumRef[b] - 1.0) : 0.0);
+    }
   }
   return 0;
 }

@@ -2,6 +2,7 @@
 
 #include <fstream>
 
+#include "core/process.h"
 #include "io/image_io.h"
 #include "retile/color.h"
 #include "retile/scene.h"
@@ -52,6 +53,26 @@ TEST(Color, TungstenGammaTexturesDecodeWithTungstensTable) {
   auto srgb = loadTextureImage(t, file.parent_path());
   ASSERT_TRUE(srgb.ok());
   EXPECT_NEAR(srgb->rgba[3 * 4] * 255.0f, 13.08f, 0.01f);
+}
+
+// A half EXR (Tungsten's references are) holds values below half's smallest normal, 6.1e-5, as
+// denormals; OpenImageIO converts them correctly only when the thread keeps denormals, and
+// the editor's threads flush them (flushDenormals). Read with them flushed, as the CLI reads.
+TEST(Color, HalfExrReadsValuesBelowHalfsSmallestNormal) {
+  RenderImage im;
+  im.width = 4;
+  im.height = 1;
+  im.color = {2.6e-5f, 2.6e-5f, 2.6e-5f, 8e-7f, 8e-7f, 8e-7f, 3e-6f, 3e-6f, 3e-6f, 0.25f, 0.25f, 0.25f};
+  const auto file = test::tempDir() / "dark-half.exr";
+  ASSERT_TRUE(writeRenderImage(im, file, {}).ok());
+  KeepDenormals restore;  // the test's own flags, put back at the end
+  flushDenormals();
+  auto back = readImageRaw(file);
+  ASSERT_TRUE(back.ok()) << back.error();
+  ASSERT_EQ(back->width, 4);
+  for (std::size_t p = 0; p < 4; ++p)
+    for (std::size_t c = 0; c < 3; ++c)
+      EXPECT_NEAR(back->rgba[4 * p + c], im.color[3 * p + c], 2e-3f * im.color[3 * p + c] + 6e-8f) << "pixel " << p;
 }
 
 TEST(Color, DisplayViews) {

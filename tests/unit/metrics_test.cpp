@@ -210,5 +210,45 @@ TEST(Metrics, BlockComparisonAveragesBlocksAndLeavesOutExcludedPixels) {
   EXPECT_TRUE(std::isnan(c.errorShare[0]));
 }
 
+TEST(Metrics, BlockNoiseTellsAReferencesNoiseFromABias) {
+  // 256x256, 256 blocks: a smooth picture, our two renders with pixel noise 0.05 and the
+  // reference with 0.1. With no bias the distance to the reference is sqrt((1 + 4) / 2) = 1.58
+  // times the floor, and every block's difference is noise.
+  const int w = 256, h = 256;
+  std::mt19937 rng(3);
+  std::normal_distribution<float> unit(0.0f, 1.0f);
+  std::vector<float> truth(w * h * 3), a(truth.size()), b(truth.size()), ref(truth.size());
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) truth[(y * w + x) * 3 + c] = 0.3f + 0.4f * float(x) / w + 0.1f * float(c);
+  auto noisy = [&](std::vector<float>& out, float sigma) {
+    for (std::size_t i = 0; i < truth.size(); ++i) out[i] = truth[i] + sigma * unit(rng);
+  };
+  noisy(a, 0.05f);
+  noisy(b, 0.05f);
+  noisy(ref, 0.1f);
+  const MetricImage ia{a.data(), w, h}, ib{b.data(), w, h};
+  BlockNoise n = blockNoise(ia, ib, {ref.data(), w, h}, 16);
+  EXPECT_EQ(n.blocks, 256);
+  EXPECT_NEAR(n.reference / n.ours, 2.0, 0.1);
+  EXPECT_NEAR(n.expectedRatio, std::sqrt(2.5), 0.08);
+  const double ratio = compareBlocks(ia, {ref.data(), w, h}, 16).relativeRmse / compareBlocks(ia, ib, 16).relativeRmse;
+  EXPECT_NEAR(ratio, n.expectedRatio, 0.3) << "the ratio noise alone gives";
+  EXPECT_NEAR(n.meanSquaredZ, 1.0, 0.25);
+  EXPECT_LE(n.beyond3, 3);
+
+  // Ten blocks of the reference 0.05 darker, eight standard errors of the difference
+  // (sqrt(0.05^2 + 0.1^2) / 16 = 0.007): each stands out; the noise estimates barely move.
+  for (int k = 0; k < 10; ++k)
+    for (int y = 16 * k; y < 16 * k + 16; ++y)
+      for (int x = 32; x < 48; ++x)
+        for (int c = 0; c < 3; ++c) ref[(y * w + x) * 3 + c] -= 0.05f;
+  BlockNoise biased = blockNoise(ia, ib, {ref.data(), w, h}, 16);
+  EXPECT_NEAR(biased.reference / n.reference, 1.0, 0.01);
+  EXPECT_EQ(biased.beyond3, 10 + n.beyond3);
+  for (int k = 0; k < 10; ++k) EXPECT_GT(biased.z[static_cast<std::size_t>(k * 16 + 2)], 5.0) << "block row " << k;
+  EXPECT_GT(biased.meanSquaredZ, n.meanSquaredZ + 10 * 25.0 / 256);
+}
+
 }  // namespace
 }  // namespace retile

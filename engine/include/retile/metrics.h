@@ -77,4 +77,29 @@ struct BlockComparison {
 
 BlockComparison compareBlocks(MetricImage a, MetricImage ref, int block, const std::vector<PixelRect>& exclude = {});
 
+// How much of compareBlocks(a, ref) noise can explain, given b, a second render of ours at
+// another seed. The floor compareBlocks(a, b) holds only our noise; a reference noisier than our
+// renders (another renderer's sampling of a caustic, say) raises the distance to it with no bias
+// at all. Each block's noise is estimated from the spread of its pixels, taking pixel noise as
+// independent: ours from a - b (twice our pixel variance), the reference's from
+// ref - (a + b) / 2 (its pixel variance plus half ours). Differences at pixel scale (an edge
+// placed a little apart, another filter) count as the reference's noise, so that estimate is an
+// upper bound; block means are little moved by them. Same grid and exclusions as compareBlocks.
+struct BlockNoise {
+  // The block means' standard errors, summed in squares over blocks and channels, relative to
+  // the reference's block means as BlockComparison::relativeRmse is.
+  double ours = 0.0, reference = 0.0;
+  // compareBlocks(a, ref) / compareBlocks(a, b) to expect when the renderers differ by noise
+  // alone: sqrt((ours^2 + reference^2) / (2 ours^2)).
+  double expectedRatio = 0.0;
+  // Per block (row-major; NaN where left out): mean luminance of a minus ref's, in units of the
+  // standard error of that difference. Mean of z^2 near 1, and about 0.27 % of blocks past 3, when
+  // only noise differs.
+  std::vector<double> z;
+  double meanSquaredZ = 0.0;
+  int beyond3 = 0, blocks = 0;
+};
+
+BlockNoise blockNoise(MetricImage a, MetricImage b, MetricImage ref, int block, const std::vector<PixelRect>& exclude = {});
+
 }  // namespace retile

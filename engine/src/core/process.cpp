@@ -28,10 +28,26 @@ constexpr bool kAddressSanitizer = false;
 
 namespace retile {
 
+#if defined(__SSE__)
+constexpr unsigned kFlushToZero = 0x8000, kDenormalsAreZero = 0x0040;
+#endif
+
 void flushDenormals() {
 #if defined(__SSE__)
-  constexpr unsigned kFlushToZero = 0x8000, kDenormalsAreZero = 0x0040;
   _mm_setcsr(_mm_getcsr() | kFlushToZero | kDenormalsAreZero);
+#endif
+}
+
+KeepDenormals::KeepDenormals() {
+#if defined(__SSE__)
+  saved_ = _mm_getcsr();
+  _mm_setcsr(saved_ & ~(kFlushToZero | kDenormalsAreZero));
+#endif
+}
+
+KeepDenormals::~KeepDenormals() {
+#if defined(__SSE__)
+  _mm_setcsr(saved_);
 #endif
 }
 

@@ -46,8 +46,24 @@ void releaseFreedMemory();
 // and each denormal operand costs a microcode assist: on the spaceship, the four-wide BVH
 // traced 15 % more samples per second with them flushed (docs/MEASUREMENTS.md). Vulkan 1.2's
 // float controls would say it per shader, but lavapipe offers no flush-to-zero. Call before the
-// Vulkan device is created (its worker threads inherit); nothing Retile computes needs denormals.
+// Vulkan device is created (its worker threads inherit). Little Retile computes needs denormals;
+// what does runs under KeepDenormals.
 void flushDenormals();
+
+// Undoes flushDenormals for the calling thread while it lives, and puts the flags back as they
+// were when it ends. Code that needs denormals runs under one: OpenImageIO's half-to-float
+// conversion, for one, turns a half below 6.1e-5 into a value up to 30 times too small when
+// denormals are treated as zero (a reference EXR's dark backdrop read as 8e-7 instead of 2.6e-5).
+class KeepDenormals {
+ public:
+  KeepDenormals();
+  ~KeepDenormals();
+  KeepDenormals(const KeepDenormals&) = delete;
+  KeepDenormals& operator=(const KeepDenormals&) = delete;
+
+ private:
+  unsigned saved_ = 0;
+};
 
 // Directory of the running executable (from /proc/self/exe); empty if unknown.
 std::filesystem::path executableDirectory();

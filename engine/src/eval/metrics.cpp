@@ -270,13 +270,50 @@ std::vector<std::uint8_t> affectedPixels(const RenderImage& before, const Render
   return mask;
 }
 
+namespace {
+
+// The aligned block x block squares of a width x height image (partial ones at the right and
+// bottom edges), row-major, each with the indices of its pixels outside `exclude`; a block with
+// fewer than half its pixels left has none (it is left out).
+struct BlockGrid {
+  int cols = 0, rows = 0;
+  std::vector<std::vector<std::size_t>> pixels;
+};
+
+BlockGrid blockGrid(int width, int height, int block, const std::vector<PixelRect>& exclude) {
+  RETILE_ASSERT(block >= 1, "blocks of at least one pixel");
+  BlockGrid g;
+  g.cols = (width + block - 1) / block;
+  g.rows = (height + block - 1) / block;
+  g.pixels.resize(static_cast<std::size_t>(g.cols) * static_cast<std::size_t>(g.rows));
+  for (int by = 0; by < g.rows; ++by)
+    for (int bx = 0; bx < g.cols; ++bx) {
+      auto& in = g.pixels[static_cast<std::size_t>(by) * static_cast<std::size_t>(g.cols) + static_cast<std::size_t>(bx)];
+      int all = 0;
+      for (int y = by * block; y < std::min(height, (by + 1) * block); ++y)
+        for (int x = bx * block; x < std::min(width, (bx + 1) * block); ++x) {
+          ++all;
+          if (std::none_of(exclude.begin(), exclude.end(), [&](const PixelRect& r) { return r.contains(x, y); }))
+            in.push_back(static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x));
+        }
+      if (2 * in.size() < static_cast<std::size_t>(all)) in.clear();
+    }
+  return g;
+}
+
+double pixelLuminance(MetricImage im, std::size_t i) {
+  return 0.2126 * im.rgb[3 * i] + 0.7152 * im.rgb[3 * i + 1] + 0.0722 * im.rgb[3 * i + 2];
+}
+
+}  // namespace
+
 BlockComparison compareBlocks(MetricImage a, MetricImage ref, int block, const std::vector<PixelRect>& exclude) {
   checkSizes(a, ref);
-  RETILE_ASSERT(block >= 1, "blocks of at least one pixel");
+  const BlockGrid grid = blockGrid(a.width, a.height, block, exclude);
   BlockComparison out;
-  out.cols = (a.width + block - 1) / block;
-  out.rows = (a.height + block - 1) / block;
-  const std::size_t nb = static_cast<std::size_t>(out.cols) * static_cast<std::size_t>(out.rows);
+  out.cols = grid.cols;
+  out.rows = grid.rows;
+  const std::size_t nb = grid.pixels.size();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   out.lumA.assign(nb, nan);
   out.lumRef.assign(nb, nan);
@@ -284,39 +321,32 @@ BlockComparison compareBlocks(MetricImage a, MetricImage ref, int block, const s
   std::vector<double> squared(nb, nan);
   double sumA = 0.0, sumRef = 0.0, err = 0.0, norm = 0.0;
   std::size_t pixels = 0;
-  for (int by = 0; by < out.rows; ++by)
-    for (int bx = 0; bx < out.cols; ++bx) {
-      double ma[3] = {0, 0, 0}, mr[3] = {0, 0, 0};
-      int in = 0, all = 0;
-      for (int y = by * block; y < std::min(a.height, (by + 1) * block); ++y)
-        for (int x = bx * block; x < std::min(a.width, (bx + 1) * block); ++x) {
-          ++all;
-          if (std::any_of(exclude.begin(), exclude.end(), [&](const PixelRect& r) { return r.contains(x, y); })) continue;
-          ++in;
-          const std::size_t i = 3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(a.width) + static_cast<std::size_t>(x));
-          for (int c = 0; c < 3; ++c) {
-            ma[c] += a.rgb[i + static_cast<std::size_t>(c)];
-            mr[c] += ref.rgb[i + static_cast<std::size_t>(c)];
-          }
-        }
-      if (in == 0 || 2 * in < all) continue;
-      const std::size_t b = static_cast<std::size_t>(by) * static_cast<std::size_t>(out.cols) + static_cast<std::size_t>(bx);
-      double e = 0.0;
-      for (int c = 0; c < 3; ++c) {
-        sumA += ma[c];
-        sumRef += mr[c];
-        ma[c] /= in;
-        mr[c] /= in;
-        e += (ma[c] - mr[c]) * (ma[c] - mr[c]);
-        norm += mr[c] * mr[c];
+  for (std::size_t b = 0; b < nb; ++b) {
+    const auto& in = grid.pixels[b];
+    if (in.empty()) continue;
+    double ma[3] = {0, 0, 0}, mr[3] = {0, 0, 0};
+    for (std::size_t i : in)
+      for (std::size_t c = 0; c < 3; ++c) {
+        ma[c] += a.rgb[3 * i + c];
+        mr[c] += ref.rgb[3 * i + c];
       }
-      pixels += static_cast<std::size_t>(in);
-      squared[b] = e;
-      err += e;
-      out.lumA[b] = 0.2126 * ma[0] + 0.7152 * ma[1] + 0.0722 * ma[2];
-      out.lumRef[b] = 0.2126 * mr[0] + 0.7152 * mr[1] + 0.0722 * mr[2];
-      ++out.blocks;
+    const double n = static_cast<double>(in.size());
+    double e = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      sumA += ma[c];
+      sumRef += mr[c];
+      ma[c] /= n;
+      mr[c] /= n;
+      e += (ma[c] - mr[c]) * (ma[c] - mr[c]);
+      norm += mr[c] * mr[c];
     }
+    pixels += in.size();
+    squared[b] = e;
+    err += e;
+    out.lumA[b] = 0.2126 * ma[0] + 0.7152 * ma[1] + 0.0722 * ma[2];
+    out.lumRef[b] = 0.2126 * mr[0] + 0.7152 * mr[1] + 0.0722 * mr[2];
+    ++out.blocks;
+  }
   if (pixels > 0) {
     out.meanA = sumA / (3.0 * static_cast<double>(pixels));
     out.meanRef = sumRef / (3.0 * static_cast<double>(pixels));
@@ -324,6 +354,62 @@ BlockComparison compareBlocks(MetricImage a, MetricImage ref, int block, const s
   out.relativeRmse = norm > 0.0 ? std::sqrt(err / norm) : (err > 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
   for (std::size_t b = 0; b < nb; ++b)
     if (!std::isnan(squared[b])) out.errorShare[b] = err > 0.0 ? squared[b] / err : 0.0;
+  return out;
+}
+
+BlockNoise blockNoise(MetricImage a, MetricImage b, MetricImage ref, int block, const std::vector<PixelRect>& exclude) {
+  checkSizes(a, ref);
+  checkSizes(b, ref);
+  const BlockGrid grid = blockGrid(a.width, a.height, block, exclude);
+  BlockNoise out;
+  out.z.assign(grid.pixels.size(), std::numeric_limits<double>::quiet_NaN());
+  // Sample variance about the block's mean of d(i), over the block's pixels.
+  auto spread = [](const std::vector<std::size_t>& in, auto d) {
+    double sum = 0.0, sq = 0.0;
+    for (std::size_t i : in) {
+      const double v = d(i);
+      sum += v;
+      sq += v * v;
+    }
+    const double n = static_cast<double>(in.size());
+    return std::max(0.0, (sq - sum * sum / n) / (n - 1.0));
+  };
+  double varOurs = 0.0, varRef = 0.0, norm = 0.0, zSquared = 0.0;
+  for (std::size_t k = 0; k < grid.pixels.size(); ++k) {
+    const auto& in = grid.pixels[k];
+    if (in.size() < 2) continue;
+    const double n = static_cast<double>(in.size());
+    // Per channel and in luminance (c = 3): A - B has twice our pixel variance; Ref - (A + B) / 2
+    // has the reference's plus half ours.
+    double ours[4], theirs[4];
+    for (std::size_t c = 0; c < 4; ++c) {
+      auto value = [c](MetricImage im, std::size_t i) { return c < 3 ? double(im.rgb[3 * i + c]) : pixelLuminance(im, i); };
+      ours[c] = 0.5 * spread(in, [&](std::size_t i) { return value(a, i) - value(b, i); });
+      theirs[c] = std::max(0.0, spread(in, [&](std::size_t i) { return value(ref, i) - 0.5 * (value(a, i) + value(b, i)); }) -
+                                    0.5 * ours[c]);
+    }
+    double ma = 0.0, mr = 0.0, channel[3] = {0, 0, 0};
+    for (std::size_t i : in) {
+      ma += pixelLuminance(a, i);
+      mr += pixelLuminance(ref, i);
+      for (std::size_t c = 0; c < 3; ++c) channel[c] += ref.rgb[3 * i + c];
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+      norm += (channel[c] / n) * (channel[c] / n);  // as compareBlocks normalises
+      varOurs += ours[c] / n;
+      varRef += theirs[c] / n;
+    }
+    ++out.blocks;
+    const double se = std::sqrt((ours[3] + theirs[3]) / n), d = (ma - mr) / n;
+    out.z[k] = se > 0.0 ? d / se : (d == 0.0 ? 0.0 : std::copysign(std::numeric_limits<double>::infinity(), d));
+    zSquared += out.z[k] * out.z[k];
+    out.beyond3 += std::abs(out.z[k]) > 3.0;
+  }
+  if (out.blocks == 0) return out;
+  out.ours = norm > 0.0 ? std::sqrt(varOurs / norm) : 0.0;
+  out.reference = norm > 0.0 ? std::sqrt(varRef / norm) : 0.0;
+  out.expectedRatio = varOurs > 0.0 ? std::sqrt((varOurs + varRef) / (2.0 * varOurs)) : std::numeric_limits<double>::infinity();
+  out.meanSquaredZ = zSquared / out.blocks;
   return out;
 }
 

@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "core/files.h"
+#include "core/process.h"
 #include "retile/color.h"
 #include "retile/image.h"
 #include "retile/log.h"
@@ -58,6 +59,10 @@ Result<Decoded> decode(const std::string& name, OIIO::Filesystem::IOProxy* proxy
                           " channels is larger than the limit of ", limits.maxPixels, " pixels"));
   int nc = spec.nchannels;
   std::vector<float> tmp(pixels * static_cast<std::uint64_t>(nc));
+  // Halves below 6.1e-5 convert correctly only with denormals kept (core/process.h), so the
+  // conversion runs here, in this thread, not in OpenImageIO's pool, whose threads may flush them.
+  KeepDenormals keep;
+  in->threads(1);
   if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, tmp.data()))
     return R::failure(cat(name, ": cannot decode the image: ", in->geterror()));
   Decoded d;
