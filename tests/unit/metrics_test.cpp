@@ -234,6 +234,7 @@ TEST(Metrics, BlockNoiseTellsAReferencesNoiseFromABias) {
   EXPECT_NEAR(n.expectedRatio, std::sqrt(2.5), 0.08);
   const double ratio = compareBlocks(ia, {ref.data(), w, h}, 16).relativeRmse / compareBlocks(ia, ib, 16).relativeRmse;
   EXPECT_NEAR(ratio, n.expectedRatio, 0.3) << "the ratio noise alone gives";
+  EXPECT_NEAR(compareBlocks(ia, ib, 16).relativeRmse / (std::sqrt(2.0) * n.ours), 1.0, 0.15) << "our floor, expected";
   EXPECT_NEAR(n.meanSquaredZ, 1.0, 0.25);
   EXPECT_LE(n.beyond3, 3);
 
