@@ -55,6 +55,26 @@ struct CompareOptions {
   std::vector<std::string> exclude;
 };
 
+// How much of the distance to the reference the two renders' noise explains (blockNoise).
+void printNoise(const BlockNoise& noise, double distance) {
+  if (noise.blocks == 0) {
+    std::printf("noise of the block means: not estimated (it needs blocks of two pixels or more)\n");
+    return;
+  }
+  std::printf("noise of the block means, estimated from the spread of each block's pixels (the reference's is an\n"
+              "upper bound: differences at pixel scale, such as edges, count as its noise):\n");
+  std::printf("  ours %.4f, the reference's %.4f: with no bias the ratio would be about %.2f\n", noise.ours,
+              noise.reference, noise.expectedRatio);
+  // One pair's floor is a sum dominated by a few bright, noisy blocks: it scatters widely about
+  // its expectation, and the ratio with it (the spaceship: 1.38 to 2.42 over six pairs).
+  const double expectedFloor = std::sqrt(2.0) * noise.ours;
+  std::printf("  the floor our noise gives on average: %.4f; ratio against it %.2f\n", expectedFloor,
+              expectedFloor > 0 ? distance / expectedFloor : std::numeric_limits<double>::infinity());
+  std::printf("  block differences in units of both renders' noise: mean square %.2f (1 when only noise differs); "
+              "%d of %d blocks beyond 3 (noise alone: %.1f)\n",
+              noise.meanSquaredZ, noise.beyond3, noise.blocks, 0.0027 * noise.blocks);
+}
+
 int runCompare(const CompareOptions& o) {
   const int block = o.block, worst = o.worst;
   std::vector<PixelRect> exclude;
@@ -94,24 +114,13 @@ int runCompare(const CompareOptions& o) {
                   ns.relativeRmse > 0 ? cs.relativeRmse / ns.relativeRmse : std::numeric_limits<double>::infinity());
     }
     noise = blockNoise(view(0), view(2), view(1), block, exclude);
-    std::printf("noise of the block means, estimated from the spread of each block's pixels (the reference's is an\n"
-                "upper bound: differences at pixel scale, such as edges, count as its noise):\n");
-    std::printf("  ours %.4f, the reference's %.4f: with no bias the ratio would be about %.2f\n", noise.ours,
-                noise.reference, noise.expectedRatio);
-    // One pair's floor is a sum dominated by a few bright, noisy blocks: it scatters widely about
-    // its expectation, and the ratio with it (the spaceship: 1.38 to 2.42 over six pairs).
-    const double expectedFloor = std::sqrt(2.0) * noise.ours;
-    std::printf("  the floor our noise gives on average: %.4f; ratio against it %.2f\n", expectedFloor,
-                expectedFloor > 0 ? c.relativeRmse / expectedFloor : std::numeric_limits<double>::infinity());
-    std::printf("  block differences in units of both renders' noise: mean square %.2f (1 when only noise differs); "
-                "%d of %d blocks beyond 3 (noise alone: %.1f)\n",
-                noise.meanSquaredZ, noise.beyond3, noise.blocks, 0.0027 * noise.blocks);
+    printNoise(noise, c.relativeRmse);
   }
   std::vector<std::size_t> order(c.errorShare.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
   order.erase(std::remove_if(order.begin(), order.end(), [&](std::size_t b) { return std::isnan(c.errorShare[b]); }), order.end());
   std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) { return c.errorShare[p] > c.errorShare[q]; });
-  const bool withZ = !noise.z.empty();
+  const bool withZ = noise.blocks > 0;
   if (worst > 0 && !order.empty())
     std::printf("largest shares of the error (block at pixel x, y: share, luminance against reference%s):\n",
                 withZ ? ", difference in units of its noise" : "");
