@@ -363,16 +363,15 @@ BlockNoise blockNoise(MetricImage a, MetricImage b, MetricImage ref, int block, 
   const BlockGrid grid = blockGrid(a.width, a.height, block, exclude);
   BlockNoise out;
   out.z.assign(grid.pixels.size(), std::numeric_limits<double>::quiet_NaN());
-  // Sample variance about the block's mean of d(i), over the block's pixels.
+  // Sample variance about the block's mean of d(i), over the block's pixels (two passes: a bright
+  // light's pixels would cancel in the sum of squares).
   auto spread = [](const std::vector<std::size_t>& in, auto d) {
-    double sum = 0.0, sq = 0.0;
-    for (std::size_t i : in) {
-      const double v = d(i);
-      sum += v;
-      sq += v * v;
-    }
     const double n = static_cast<double>(in.size());
-    return std::max(0.0, (sq - sum * sum / n) / (n - 1.0));
+    double mean = 0.0, sq = 0.0;
+    for (std::size_t i : in) mean += d(i);
+    mean /= n;
+    for (std::size_t i : in) sq += (d(i) - mean) * (d(i) - mean);
+    return sq / (n - 1.0);
   };
   double varOurs = 0.0, varRef = 0.0, norm = 0.0, zSquared = 0.0;
   for (std::size_t k = 0; k < grid.pixels.size(); ++k) {
