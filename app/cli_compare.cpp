@@ -63,16 +63,16 @@ void printNoise(const BlockNoise& noise, double distance) {
   }
   std::printf("noise of the block means, estimated from the spread of each block's pixels (the reference's is an\n"
               "upper bound: differences at pixel scale, such as edges, count as its noise):\n");
-  std::printf("  ours %.4f, the reference's %.4f: with no bias the ratio would be about %.2f\n", noise.ours,
+  std::printf("  ours %.3g, the reference's %.3g: with no bias the ratio would be about %.2f\n", noise.ours,
               noise.reference, noise.expectedRatio);
-  // One pair's floor is a sum dominated by a few bright, noisy blocks: it scatters widely about
-  // its expectation, and the ratio with it (the spaceship: 1.38 to 2.42 over six pairs).
-  const double expectedFloor = std::sqrt(2.0) * noise.ours;
-  std::printf("  the floor our noise gives on average: %.4f; ratio against it %.2f\n", expectedFloor,
-              expectedFloor > 0 ? distance / expectedFloor : std::numeric_limits<double>::infinity());
+  // One pair's floor is a sum dominated by a few bright, noisy blocks: it scatters widely, mostly
+  // below its root-mean-square, and the ratio with it (the spaceship: 1.38 to 2.42 over six pairs).
+  const double rmsFloor = std::sqrt(2.0) * noise.ours;
+  std::printf("  root-mean-square floor of our noise: %.3g; ratio against it %.2f\n", rmsFloor,
+              rmsFloor > 0 ? distance / rmsFloor : std::numeric_limits<double>::infinity());
   std::printf("  block differences in units of both renders' noise: mean square %.2f (1 when only noise differs); "
               "%d of %d blocks beyond 3 (noise alone: %.1f)\n",
-              noise.meanSquaredZ, noise.beyond3, noise.blocks, 0.0027 * noise.blocks);
+              noise.meanSquaredZ, noise.beyond3, noise.scored, 0.0027 * noise.scored);
 }
 
 int runCompare(const CompareOptions& o) {
@@ -135,6 +135,7 @@ int runCompare(const CompareOptions& o) {
   if (withZ && worst > 0 && noise.beyond3 > 0) {
     // Small but certain differences: in smooth, low-noise regions a bias too small to carry a
     // share of the error still stands out against the noise.
+    order.erase(std::remove_if(order.begin(), order.end(), [&](std::size_t b) { return std::isnan(noise.z[b]); }), order.end());
     std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) { return std::abs(noise.z[p]) > std::abs(noise.z[q]); });
     std::printf("largest differences in units of their noise (block at pixel x, y: z, luminance against reference):\n");
     for (std::size_t k = 0; k < order.size() && k < static_cast<std::size_t>(worst) && std::abs(noise.z[order[k]]) > 3.0; ++k) {

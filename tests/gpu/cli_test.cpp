@@ -111,17 +111,18 @@ TEST(Cli, CompareTellsABiasFromNoiseByBlockSize) {
   EXPECT_LT(one, 1.2) << "per pixel the noise hides the bias\n" << r.out;
   EXPECT_GT(big, 3.0) << "over 32x32 blocks the bias stands out\n" << r.out;
   // Each 16x16 block's difference in units of its noise: the bias is 0.015, its standard error
-  // 0.2 / sqrt(12) / 16 = 0.0036, so the 16 biased blocks of 32 stand out at z 4.2 and the others
-  // stay within 3. The reference has no noise: with no bias the ratio would be sqrt(1 / 2).
+  // 0.2 / sqrt(12) / 16 = 0.0036, so the 16 biased blocks of 32 stand out at z 4.2 (a few may
+  // not: z scatters by 1) and the others stay within 3. The reference has no noise: with no bias the ratio would be sqrt(1 / 2).
   const std::size_t beyond = r.out.find(" blocks beyond 3");
   ASSERT_NE(beyond, std::string::npos) << r.out;
   const std::size_t countAt = r.out.rfind("; ", beyond) + 2;
   const int count = std::atoi(r.out.c_str() + countAt);
-  EXPECT_GE(count, 12) << r.out;
-  EXPECT_LE(count, 17) << r.out;
-  const std::size_t expected = r.out.find("with no bias the ratio would be about ");
+  EXPECT_GE(count, 10) << r.out;
+  EXPECT_LE(count, 18) << r.out;
+  const std::string key = "with no bias the ratio would be about ";
+  const std::size_t expected = r.out.find(key);
   ASSERT_NE(expected, std::string::npos) << r.out;
-  EXPECT_NEAR(std::atof(r.out.c_str() + expected + 38), std::sqrt(0.5), 0.05) << r.out;
+  EXPECT_NEAR(std::atof(r.out.c_str() + expected + key.size()), std::sqrt(0.5), 0.05) << r.out;
 }
 
 // Each command explains itself: `--help` at every level exits 0 and lists the command's options

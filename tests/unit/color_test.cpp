@@ -58,6 +58,8 @@ TEST(Color, TungstenGammaTexturesDecodeWithTungstensTable) {
 // A half EXR (Tungsten's references are) holds values below half's smallest normal, 6.1e-5, as
 // denormals; OpenImageIO converts them correctly only when the thread keeps denormals, and
 // the editor's threads flush them (flushDenormals). Read with them flushed, as the CLI reads.
+// Four pixels are converted in this thread whatever the reader's thread count: this checks
+// KeepDenormals, not that the conversion stays off OpenImageIO's pool (threads(1)).
 TEST(Color, HalfExrReadsValuesBelowHalfsSmallestNormal) {
   RenderImage im;
   im.width = 4;

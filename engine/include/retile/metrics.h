@@ -82,22 +82,28 @@ BlockComparison compareBlocks(MetricImage a, MetricImage ref, int block, const s
 // renders (another renderer's sampling of a caustic, say) raises the distance to it with no bias
 // at all. Each block's noise is estimated from the spread of its pixels, taking pixel noise as
 // independent: ours from a - b (twice our pixel variance), the reference's from
-// ref - (a + b) / 2 (its pixel variance plus half ours). Differences at pixel scale (an edge
-// placed a little apart, another filter) count as the reference's noise, so that estimate is an
-// upper bound; block means are little moved by them. Same grid and exclusions as compareBlocks.
+// ref - (a + b) / 2 (its pixel variance plus half ours, clamped at 0). Differences at pixel scale
+// (an edge placed a little apart, another filter) count as the reference's noise, and so does the
+// clamp, so that estimate is an upper bound; block means are little moved by them. Same grid and
+// exclusions as compareBlocks; blocks of one pixel have no spread and are not estimated.
 struct BlockNoise {
   // The block means' standard errors, summed in squares over blocks and channels, relative to
-  // the reference's block means as BlockComparison::relativeRmse is.
+  // the reference's block means as BlockComparison::relativeRmse is. sqrt(2) ours is the
+  // root-mean-square of compareBlocks(a, b): with a few noisy blocks dominating, one pair's floor
+  // is usually below it.
   double ours = 0.0, reference = 0.0;
   // compareBlocks(a, ref) / compareBlocks(a, b) to expect when the renderers differ by noise
-  // alone: sqrt((ours^2 + reference^2) / (2 ours^2)).
+  // alone, in root-mean-squares: sqrt((ours^2 + reference^2) / (2 ours^2)).
   double expectedRatio = 0.0;
-  // Per block (row-major; NaN where left out): mean luminance of a minus ref's, in units of the
-  // standard error of that difference. Mean of z^2 near 1, and about 0.27 % of blocks past 3, when
-  // only noise differs.
+  // Per block (row-major; NaN where not scored): mean luminance of a minus ref's, in units of the
+  // standard error of that difference (half-float rounding counted in). Mean of z^2 near 1, and
+  // about 0.27 % of blocks past 3, when only noise differs. A block black in all three images is
+  // not scored.
   std::vector<double> z;
   double meanSquaredZ = 0.0;
-  int beyond3 = 0, blocks = 0;
+  int beyond3 = 0;
+  int blocks = 0;  // blocks whose noise was estimated
+  int scored = 0;  // of those, blocks with a z
 };
 
 BlockNoise blockNoise(MetricImage a, MetricImage b, MetricImage ref, int block, const std::vector<PixelRect>& exclude = {});

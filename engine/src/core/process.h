@@ -52,8 +52,8 @@ void flushDenormals();
 
 // Undoes flushDenormals for the calling thread while it lives, and puts the flags back as they
 // were when it ends. Code that needs denormals runs under one: OpenImageIO's half-to-float
-// conversion, for one, turns a half below 6.1e-5 into a value up to 30 times too small when
-// denormals are treated as zero (a reference EXR's dark backdrop read as 8e-7 instead of 2.6e-5).
+// conversion, for one, reads a half below 6.1e-5 as 0 when denormals are treated as zero (a
+// reference EXR's dark backdrop block read as 7.7e-7 instead of 2.6e-5).
 class KeepDenormals {
  public:
   KeepDenormals();

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <span>
 
 #include "retile/error.h"
 
@@ -274,10 +275,13 @@ namespace {
 
 // The aligned block x block squares of a width x height image (partial ones at the right and
 // bottom edges), row-major, each with the indices of its pixels outside `exclude`; a block with
-// fewer than half its pixels left has none (it is left out).
+// fewer than half its pixels left has none (it is left out). One flat array: at blocks of one
+// pixel a vector per block would cost a megapixel image a million allocations.
 struct BlockGrid {
   int cols = 0, rows = 0;
-  std::vector<std::vector<std::size_t>> pixels;
+  std::vector<std::size_t> index, start;  // block k's pixels: index[start[k]] .. index[start[k + 1] - 1]
+  std::size_t blocks() const { return start.size() - 1; }
+  std::span<const std::size_t> pixels(std::size_t k) const { return {index.data() + start[k], start[k + 1] - start[k]}; }
 };
 
 BlockGrid blockGrid(int width, int height, int block, const std::vector<PixelRect>& exclude) {
@@ -285,18 +289,20 @@ BlockGrid blockGrid(int width, int height, int block, const std::vector<PixelRec
   BlockGrid g;
   g.cols = (width + block - 1) / block;
   g.rows = (height + block - 1) / block;
-  g.pixels.resize(static_cast<std::size_t>(g.cols) * static_cast<std::size_t>(g.rows));
+  g.index.reserve(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+  g.start.reserve(static_cast<std::size_t>(g.cols) * static_cast<std::size_t>(g.rows) + 1);
+  g.start.push_back(0);
   for (int by = 0; by < g.rows; ++by)
     for (int bx = 0; bx < g.cols; ++bx) {
-      auto& in = g.pixels[static_cast<std::size_t>(by) * static_cast<std::size_t>(g.cols) + static_cast<std::size_t>(bx)];
       int all = 0;
       for (int y = by * block; y < std::min(height, (by + 1) * block); ++y)
         for (int x = bx * block; x < std::min(width, (bx + 1) * block); ++x) {
           ++all;
           if (std::none_of(exclude.begin(), exclude.end(), [&](const PixelRect& r) { return r.contains(x, y); }))
-            in.push_back(static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x));
+            g.index.push_back(static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x));
         }
-      if (2 * in.size() < static_cast<std::size_t>(all)) in.clear();
+      if (2 * (g.index.size() - g.start.back()) < static_cast<std::size_t>(all)) g.index.resize(g.start.back());
+      g.start.push_back(g.index.size());
     }
   return g;
 }
@@ -313,7 +319,7 @@ BlockComparison compareBlocks(MetricImage a, MetricImage ref, int block, const s
   BlockComparison out;
   out.cols = grid.cols;
   out.rows = grid.rows;
-  const std::size_t nb = grid.pixels.size();
+  const std::size_t nb = grid.blocks();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   out.lumA.assign(nb, nan);
   out.lumRef.assign(nb, nan);
@@ -322,7 +328,7 @@ BlockComparison compareBlocks(MetricImage a, MetricImage ref, int block, const s
   double sumA = 0.0, sumRef = 0.0, err = 0.0, norm = 0.0;
   std::size_t pixels = 0;
   for (std::size_t b = 0; b < nb; ++b) {
-    const auto& in = grid.pixels[b];
+    const auto in = grid.pixels(b);
     if (in.empty()) continue;
     double ma[3] = {0, 0, 0}, mr[3] = {0, 0, 0};
     for (std::size_t i : in)
@@ -362,10 +368,10 @@ BlockNoise blockNoise(MetricImage a, MetricImage b, MetricImage ref, int block, 
   checkSizes(b, ref);
   const BlockGrid grid = blockGrid(a.width, a.height, block, exclude);
   BlockNoise out;
-  out.z.assign(grid.pixels.size(), std::numeric_limits<double>::quiet_NaN());
+  out.z.assign(grid.blocks(), std::numeric_limits<double>::quiet_NaN());
   // Sample variance about the block's mean of d(i), over the block's pixels (two passes: a bright
   // light's pixels would cancel in the sum of squares).
-  auto spread = [](const std::vector<std::size_t>& in, auto d) {
+  auto spread = [](std::span<const std::size_t> in, auto d) {
     const double n = static_cast<double>(in.size());
     double mean = 0.0, sq = 0.0;
     for (std::size_t i : in) mean += d(i);
@@ -374,10 +380,18 @@ BlockNoise blockNoise(MetricImage a, MetricImage b, MetricImage ref, int block, 
     return sq / (n - 1.0);
   };
   double varOurs = 0.0, varRef = 0.0, norm = 0.0, zSquared = 0.0;
-  for (std::size_t k = 0; k < grid.pixels.size(); ++k) {
-    const auto& in = grid.pixels[k];
-    if (in.size() < 2) continue;
+  for (std::size_t k = 0; k < grid.blocks(); ++k) {
+    const auto in = grid.pixels(k);
+    if (in.empty()) continue;
     const double n = static_cast<double>(in.size());
+    double ma = 0.0, mr = 0.0, channel[3] = {0, 0, 0};
+    for (std::size_t i : in) {
+      ma += pixelLuminance(a, i);
+      mr += pixelLuminance(ref, i);
+      for (std::size_t c = 0; c < 3; ++c) channel[c] += ref.rgb[3 * i + c];
+    }
+    for (std::size_t c = 0; c < 3; ++c) norm += (channel[c] / n) * (channel[c] / n);  // as compareBlocks normalises
+    if (in.size() < 2) continue;  // no spread to estimate a noise from
     // Per channel and in luminance (c = 3): A - B has twice our pixel variance; Ref - (A + B) / 2
     // has the reference's plus half ours.
     double ours[4], theirs[4];
@@ -387,28 +401,27 @@ BlockNoise blockNoise(MetricImage a, MetricImage b, MetricImage ref, int block, 
       theirs[c] = std::max(0.0, spread(in, [&](std::size_t i) { return value(ref, i) - 0.5 * (value(a, i) + value(b, i)); }) -
                                     0.5 * ours[c]);
     }
-    double ma = 0.0, mr = 0.0, channel[3] = {0, 0, 0};
-    for (std::size_t i : in) {
-      ma += pixelLuminance(a, i);
-      mr += pixelLuminance(ref, i);
-      for (std::size_t c = 0; c < 3; ++c) channel[c] += ref.rgb[3 * i + c];
-    }
     for (std::size_t c = 0; c < 3; ++c) {
-      norm += (channel[c] / n) * (channel[c] / n);  // as compareBlocks normalises
       varOurs += ours[c] / n;
       varRef += theirs[c] / n;
     }
     ++out.blocks;
-    const double se = std::sqrt((ours[3] + theirs[3]) / n), d = (ma - mr) / n;
-    out.z[k] = se > 0.0 ? d / se : (d == 0.0 ? 0.0 : std::copysign(std::numeric_limits<double>::infinity(), d));
+    // Both images' rounding to half floats (11 significant bits) counts as noise, undivided by n
+    // (in a flat region every pixel rounds the same way): a region rendered without noise would
+    // otherwise stand out at an infinite z.
+    const double rounding = std::ldexp(std::max(std::abs(ma), std::abs(mr)) / n, -11);
+    const double se = std::sqrt((ours[3] + theirs[3]) / n + 2.0 * rounding * rounding / 3.0), d = (ma - mr) / n;
+    if (!(se > 0.0)) continue;  // black in all three images: nothing to tell
+    out.z[k] = d / se;
     zSquared += out.z[k] * out.z[k];
     out.beyond3 += std::abs(out.z[k]) > 3.0;
+    ++out.scored;
   }
   if (out.blocks == 0) return out;
   out.ours = norm > 0.0 ? std::sqrt(varOurs / norm) : 0.0;
   out.reference = norm > 0.0 ? std::sqrt(varRef / norm) : 0.0;
   out.expectedRatio = varOurs > 0.0 ? std::sqrt((varOurs + varRef) / (2.0 * varOurs)) : std::numeric_limits<double>::infinity();
-  out.meanSquaredZ = zSquared / out.blocks;
+  out.meanSquaredZ = out.scored > 0 ? zSquared / out.scored : 0.0;
   return out;
 }
 
