@@ -120,15 +120,18 @@ int runCompare(const CompareOptions& o) {
   std::iota(order.begin(), order.end(), std::size_t{0});
   order.erase(std::remove_if(order.begin(), order.end(), [&](std::size_t b) { return std::isnan(c.errorShare[b]); }), order.end());
   std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) { return c.errorShare[p] > c.errorShare[q]; });
+  // Block b's top-left pixel, and how far apart its luminances are in percent.
+  auto column = [&](std::size_t b) { return static_cast<int>(b % static_cast<std::size_t>(c.cols)) * block; };
+  auto row = [&](std::size_t b) { return static_cast<int>(b / static_cast<std::size_t>(c.cols)) * block; };
+  auto apart = [&](std::size_t b) { return c.lumRef[b] > 0 ? 100.0 * (c.lumA[b] / c.lumRef[b] - 1.0) : 0.0; };
   const bool withZ = noise.blocks > 0;
   if (worst > 0 && !order.empty())
     std::printf("largest shares of the error (block at pixel x, y: share, luminance against reference%s):\n",
                 withZ ? ", difference in units of its noise" : "");
   for (std::size_t k = 0; k < order.size() && k < static_cast<std::size_t>(worst); ++k) {
     std::size_t b = order[k];
-    int x = static_cast<int>(b % static_cast<std::size_t>(c.cols)) * block, y = static_cast<int>(b / static_cast<std::size_t>(c.cols)) * block;
-    std::printf("  %4d, %4d: %5.1f %%  %.4g against %.4g (%+.0f %%)", x, y, 100.0 * c.errorShare[b], c.lumA[b], c.lumRef[b],
-                c.lumRef[b] > 0 ? 100.0 * (c.lumA[b] / c.lumRef[b] - 1.0) : 0.0);
+    std::printf("  %4d, %4d: %5.1f %%  %.4g against %.4g (%+.0f %%)", column(b), row(b), 100.0 * c.errorShare[b], c.lumA[b],
+                c.lumRef[b], apart(b));
     if (withZ && !std::isnan(noise.z[b])) std::printf("  z %+.1f", noise.z[b]);
     std::printf("\n");
   }
@@ -140,9 +143,8 @@ int runCompare(const CompareOptions& o) {
     std::printf("largest differences in units of their noise (block at pixel x, y: z, luminance against reference):\n");
     for (std::size_t k = 0; k < order.size() && k < static_cast<std::size_t>(worst) && std::abs(noise.z[order[k]]) > 3.0; ++k) {
       std::size_t b = order[k];
-      int x = static_cast<int>(b % static_cast<std::size_t>(c.cols)) * block, y = static_cast<int>(b / static_cast<std::size_t>(c.cols)) * block;
-      std::printf("  %4d, %4d: z %+6.1f  %.4g against %.4g (%+.1f %%)\n", x, y, noise.z[b], c.lumA[b], c.lumRef[b],
-                  c.lumRef[b] > 0 ? 100.0 * (c.lumA[b] / c.lumRef[b] - 1.0) : 0.0);
+      std::printf("  %4d, %4d: z %+6.1f  %.4g against %.4g (%+.1f %%)\n", column(b), row(b), noise.z[b], c.lumA[b],
+                  c.lumRef[b], apart(b));
     }
   }
   return 0;
