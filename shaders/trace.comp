@@ -498,7 +498,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   if (!tungstenShading && (bs.transmitted ? sideI * sideO >= 0.0 : sideI * sideO <= 0.0)) return endPath(path, shadow);
   path.beta *= bs.weight;
   // Roulette must not see the 1/eta^2 radiance scaling inside glass as lost energy.
-  if (bs.transmitted && !isMat(m.type, kMatThinSheet)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
+  if (bs.transmitted && !isMat(m.type, kMatThinSheet) && !isMat(m.type, kMatDiffuseTransmission)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
   path.specular = bs.delta;
   path.prevPdf = bs.pdf;
   path.prevPos = pos;

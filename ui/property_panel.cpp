@@ -276,7 +276,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   b.color(tr("Albedo"), "albedo", m.albedo, defaults.albedo, [edit](Vec3 c, int drag) {
     edit(tr("Albedo"), drag, [c](Material& x) { x.albedo = c; });
   });
-  const bool rough = isMicrofacet(m.type) || m.type == MaterialType::OrenNayar;
+  const bool rough = hasRoughness(m.type);
   if (rough) {  // smooth types ignore roughness: no field that does nothing
     // A slider as well as the field: the gesture look-dev artists use most.
     auto* row = new QWidget(body_);
@@ -318,6 +318,10 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       edit(tr("IOR"), drag, [v](Material& x) { x.ior = static_cast<float>(v); });
     });
   }
+  if (m.type == MaterialType::DiffuseTransmission)
+    b.number(tr("Transmittance"), "transmittance", m.transmittance, 0.0, 1.0, defaults.transmittance, 3, [edit](double v, int drag) {
+      edit(tr("Transmittance"), drag, [v](Material& x) { x.transmittance = static_cast<float>(v); });
+    });
   if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic)
     b.vec3(tr("Coating absorption"), "coatingAbsorption", m.coatingAbsorption, 0.01, [edit](int channel, double v, int drag) {
       edit(tr("Coating absorption"), drag,

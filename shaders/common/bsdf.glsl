@@ -12,7 +12,7 @@
 // alone: lavapipe runs every branch some lane of eight takes, and code for absent types still
 // costs registers and spills (removing the nine unused types speeds the Cornell box up by 9 %).
 #ifndef RETILE_MATERIALS
-#define RETILE_MATERIALS 0xfff
+#define RETILE_MATERIALS 0x3fff
 #endif
 const int kMaterialMask = RETILE_MATERIALS;
 bool isMat(int t, int k) { return (kMaterialMask & (1 << k)) != 0 && t == k; }
@@ -23,11 +23,12 @@ const bool kBeckmannUsed = (kMaterialMask & (1 << kMaskBeckmann)) != 0;
 struct Material {
   int type;
   vec3 albedo;
-  float roughness;   // microfacet alpha, or Oren-Nayar sigma
+  float roughness;   // microfacet alpha, Oren-Nayar sigma, or Phong's a (exponent 2 / a^2 - 2)
   bool beckmann;     // rough types: Beckmann's distribution instead of GGX
   bool separable;    // rough types: G = G1(wo) G1(wi) instead of height-correlated
   float ior;
-  float fdrInt;      // plastic: internal diffuse Fresnel reflectance of the coating
+  float fdrInt;      // plastic: internal diffuse Fresnel reflectance of the coating; diffuse
+                     // transmission: the transmittance (packMaterial)
   vec3 coating;      // plastic: the coating's absorption (sigma_a times thickness)
   vec3 eta;
   vec3 k;
@@ -68,7 +69,8 @@ bool isDeltaMaterial(Material m) {
 }
 
 bool isTransmissive(Material m) {
-  return isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric) || isMat(m.type, kMatThinSheet);
+  return isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric) || isMat(m.type, kMatThinSheet) ||
+         isMat(m.type, kMatDiffuseTransmission);
 }
 
 // Unpolarised Fresnel reflectance at a dielectric boundary; eta = n_transmitted / n_incident,
@@ -200,6 +202,8 @@ vec3 plasticDiffuse(Material m, vec3 wo, vec3 wi) {
   return base * through * (INV_PI * (1.0 - fo) * (1.0 - fi) / (m.ior * m.ior));
 }
 
+float phongExponent(Material m) { return 2.0 / (m.roughness * m.roughness) - 2.0; }
+
 float orenNayarFactor(Material m, vec3 wo, vec3 wi) {
   float s2 = m.roughness * m.roughness;
   float A = 1.0 - 0.5 * s2 / (s2 + 0.33);
@@ -242,6 +246,12 @@ vec3 bsdfEval(Material m, vec3 wo, vec3 wi, out float pdf) {
   bool entering = wo.z > 0.0;
   bool flip = roughDielectric && !entering;
   vec3 o = flip ? -wo : wo, i = flip ? -wi : wi;
+  if (isMat(t, kMatDiffuseTransmission)) {
+    // Either side may face the viewer: reflection keeps the side, transmission changes it.
+    float share = wo.z * wi.z < 0.0 ? m.fdrInt : 1.0 - m.fdrInt;
+    pdf = share * abs(wi.z) * INV_PI;
+    return m.albedo * pdf;
+  }
   if (roughDielectric ? (o.z <= 0.0 || i.z == 0.0) : (wo.z <= 0.0 || wi.z <= 0.0 || isDeltaMaterial(m))) return vec3(0.0);
   if (isMat(t, kMatLambert)) {
     pdf = wi.z * INV_PI;
@@ -250,6 +260,13 @@ vec3 bsdfEval(Material m, vec3 wo, vec3 wi, out float pdf) {
   if (isMat(t, kMatOrenNayar)) {
     pdf = wi.z * INV_PI;
     return m.albedo * (INV_PI * orenNayarFactor(m, wo, wi) * wi.z);
+  }
+  if (isMat(t, kMatPhong)) {
+    // The lobe is around the mirror direction; what of it falls below the surface is lost.
+    float n = phongExponent(m);
+    float c = pow(max(dot(vec3(-wo.xy, wo.z), wi), 0.0), n);
+    pdf = c * (n + 1.0) * (0.5 * INV_PI);
+    return m.albedo * (c * (n + 2.0) * (0.5 * INV_PI) * wi.z);
   }
   if (isMat(t, kMatPlastic)) {
     float ps = plasticSpecularProbability(m, wo.z);
@@ -367,8 +384,20 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
     }
     evaluate = evaluate && o.z > 0.0 && oh > 0.0;
     s.wi = entering ? i : -i;
+  } else if (isMat(t, kMatDiffuseTransmission)) {
+    s.wi = sampleCosineHemisphere(u.xy);
+    s.transmitted = u.z < m.fdrInt;
+    s.wi.z = (wo.z > 0.0) != s.transmitted ? s.wi.z : -s.wi.z;
+    evaluate = wo.z != 0.0 && s.wi.z != 0.0;
   } else if (wo.z > 0.0) {
-    if (isMat(t, kMatMirror) || isMat(t, kMatConductor)) {
+    if (isMat(t, kMatPhong)) {
+      // cos of the angle to the mirror direction drawn as u^(1 / (n + 1)).
+      float ct = pow(u.x, 1.0 / (phongExponent(m) + 1.0)), st = sqrt(max(0.0, 1.0 - ct * ct)), phi = 2.0 * PI * u.y;
+      vec3 r = vec3(-wo.xy, wo.z), ta, tb;
+      makeFrame(r, ta, tb);
+      s.wi = ta * (st * cos(phi)) + tb * (st * sin(phi)) + r * ct;
+      evaluate = s.wi.z > 0.0;
+    } else if (isMat(t, kMatMirror) || isMat(t, kMatConductor)) {
       s.wi = vec3(-wo.x, -wo.y, wo.z);
       s.weight = isMat(t, kMatConductor) ? m.albedo * fresnelConductor(wo.z, m.eta, m.k) : m.albedo;
       s.pdf = 1.0;

@@ -105,10 +105,12 @@ RT_CONST(int, kMatDielectric, 7)
 RT_CONST(int, kMatRoughDielectric, 8)
 RT_CONST(int, kMatThinSheet, 9)
 RT_CONST(int, kMatNull, 10)
+RT_CONST(int, kMatPhong, 11)
+RT_CONST(int, kMatDiffuseTransmission, 12)
 // Packed with a rough type (type | kMatBeckmann): Beckmann's distribution instead of GGX; and the
 // bit of the kernel's material mask that says some material has it.
 RT_CONST(int, kMatBeckmann, 256)
-RT_CONST(int, kMaskBeckmann, 11)
+RT_CONST(int, kMaskBeckmann, 13)
 // Packed with a rough type: Smith's G as the product G1(wo) G1(wi) (Material::separableShadowing).
 // A multiply more per evaluation, so no kernel variant.
 RT_CONST(int, kMatSeparable, 512)

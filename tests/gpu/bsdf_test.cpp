@@ -45,6 +45,12 @@ Material coated(Material m, float absorption) {
   return m;
 }
 
+Material transmitting(float albedo, float transmittance) {
+  Material m = material(MaterialType::DiffuseTransmission, albedo);
+  m.transmittance = transmittance;
+  return m;
+}
+
 struct Case {
   const char* name;
   Material m;
@@ -66,7 +72,10 @@ std::vector<Case> smoothLobed() {
           {"rough_dielectric_separable", separable(material(MaterialType::RoughDielectric, 1.0f, 0.3f))},
           {"rough_plastic_beckmann_separable", separable(beckmann(material(MaterialType::RoughPlastic, 0.8f, 0.4f)))},
           {"plastic_absorbing", coated(material(MaterialType::Plastic, 0.8f), 0.3f)},
-          {"rough_plastic_absorbing", coated(material(MaterialType::RoughPlastic, 0.8f, 0.3f), 0.3f)}};
+          {"rough_plastic_absorbing", coated(material(MaterialType::RoughPlastic, 0.8f, 0.3f), 0.3f)},
+          {"phong", material(MaterialType::Phong, 0.8f, 0.3f)},
+          {"phong_narrow", material(MaterialType::Phong, 0.8f, 0.12f)},
+          {"diffuse_transmission", transmitting(0.8f, 0.3f)}};
 }
 
 class Bsdfs : public ::testing::Test {
@@ -290,6 +299,58 @@ TEST_F(Bsdfs, LosslessMaterialsKeepAllEnergy) {
     EXPECT_NEAR(sampledAlbedo(material(MaterialType::Plastic, 1.0f), wo).first, 1.0, 0.01) << "cos " << cosO;
     // Over a black base the coating reflects F alone: Tungsten's dielectric without refraction.
     EXPECT_NEAR(sampledAlbedo(material(MaterialType::Plastic, 0.0f), wo).first, F, 1e-3) << "cos " << cosO;
+  }
+}
+
+// Tungsten's Phong (PhongBsdf): f cos = albedo (n + 2) / (2 pi) cos^n(alpha) cos(wi), alpha the angle
+// between wi and wo's mirror direction, nothing below the surface; its sampling density is
+// (n + 1) / (2 pi) cos^n(alpha). The exponent comes from the roughness a as 2 / a^2 - 2. At normal
+// incidence the whole lobe is above the surface and a white lobe reflects exactly everything;
+// at grazing incidence part of it is cut off.
+TEST_F(Bsdfs, PhongIsTungstensNormalisedLobe) {
+  const float a = 0.2f;
+  const double n = 2.0 / (a * a) - 2.0;  // 48
+  const Material white = material(MaterialType::Phong, 1.0f, a);
+  std::vector<BsdfQuery> q;
+  const Vec3 wo = direction(0.6f, 0.0f);
+  const Vec3 mirror{-wo.x, -wo.y, wo.z};
+  const Vec3 wis[] = {direction(0.6f, kPi), direction(0.55f, kPi + 0.1f), direction(0.7f, kPi - 0.2f), direction(0.9f, 0.0f)};
+  for (Vec3 wi : wis) q.push_back({white, wo, wi});
+  auto r = run(q);
+  for (std::size_t k = 0; k < std::size(wis); ++k) {
+    const double c = std::max(0.0, static_cast<double>(dot(mirror, wis[k])));
+    const double expected = (n + 2) / (2 * kPi) * std::pow(c, n) * wis[k].z;
+    EXPECT_NEAR(r[k].f.y, expected, 1e-3 * expected + 1e-7) << "direction " << k;
+    EXPECT_NEAR(r[k].pdf, (n + 1) / (2 * kPi) * std::pow(c, n), 1e-3 * r[k].pdf + 1e-7) << "direction " << k;
+  }
+  EXPECT_GT(r[0].f.y, 4.0f) << "the mirror direction is the lobe's peak";
+  EXPECT_LT(r[3].f.y, 1e-3f * r[0].f.y) << "far from the mirror direction the lobe is dark";
+  EXPECT_NEAR(sampledAlbedo(white, Vec3{0, 0, 1}).first, 1.0, 0.003);
+  EXPECT_LT(sampledAlbedo(material(MaterialType::Phong, 1.0f, 0.5f), direction(0.2f, 0.0f)).first, 0.8)
+      << "a wide lobe at grazing incidence loses what falls below the surface";
+}
+
+// Tungsten's diffuse_transmission: Lambertian on both sides, a share t of albedo passed through and
+// 1 - t reflected, whichever side the light comes from.
+TEST_F(Bsdfs, DiffuseTransmissionSplitsLambertBetweenTheSides) {
+  for (float side : {1.0f, -1.0f}) {
+    const Vec3 wo = direction(0.7f * side, 0.4f);
+    const Material m = transmitting(0.9f, 0.3f);
+    auto r = run({{m, wo, direction(0.5f * side, 2.0f)}, {m, wo, direction(-0.5f * side, 2.0f)}});
+    EXPECT_NEAR(r[0].f.y, 0.9 * 0.7 * 0.5 / kPi, 1e-5) << "reflected, side " << side;
+    EXPECT_NEAR(r[1].f.y, 0.9 * 0.3 * 0.5 / kPi, 1e-5) << "transmitted, side " << side;
+    std::vector<BsdfQuery> q;
+    for (int i = 0; i < 4096; ++i) q.push_back({transmitting(1.0f, 0.3f), wo, wo, {(i % 64 + 0.5f) / 64, (i / 64 + 0.5f) / 64, (i + 0.5f) / 4096}});
+    double through = 0, total = 0;
+    for (const auto& a : run(q)) {
+      total += luminance(a.weight) / 4096;
+      if (a.sampledWi.z * wo.z < 0) {
+        through += luminance(a.weight) / 4096;
+        EXPECT_TRUE(a.transmitted);
+      }
+    }
+    EXPECT_NEAR(total, 1.0, 1e-4) << "white: nothing is lost";
+    EXPECT_NEAR(through, 0.3, 1e-3) << "the transmittance passes to the other side";
   }
 }
 

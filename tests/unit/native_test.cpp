@@ -100,6 +100,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   ASSERT_GE(s.materials.size(), 2u);
   s.materials[0].blendWith = s.materials[1].id;
   s.materials[0].blendRatio = 0.25f;
+  s.materials[0].transmittance = 0.35f;
   s.materials[0].blendRatioTexture = s.textures[0].id;
   s.environment.orientation = Mat4::rotateZ(0.3f) * Mat4::rotateX(-1.2f);
   s.environment.rotation = 0.7f;
@@ -128,6 +129,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.materials[0].blendWith, s.materials[1].id);
   EXPECT_EQ(back->scene.materials[0].blendRatioTexture, s.textures[0].id);
   EXPECT_EQ(back->scene.materials[0].blendRatio, 0.25f);
+  EXPECT_EQ(back->scene.materials[0].transmittance, 0.35f);
   EXPECT_EQ(back->scene.environment.orientation, s.environment.orientation);
   EXPECT_EQ(back->scene.environment.rotation, 0.7f);
   // Saving what was loaded gives the same bytes.

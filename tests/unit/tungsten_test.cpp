@@ -191,6 +191,31 @@ TEST(Tungsten, WhatIsNotRenderedIsNamedInAWarning) {
   EXPECT_EQ(bsdfs, 1);
 }
 
+// Tungsten's phong and diffuse_transmission are their own materials, not lamberts: the exponent
+// becomes the roughness a with n = 2 / a^2 - 2 (Tungsten's default 64), the transmittance is
+// Tungsten's fixed half.
+TEST(Tungsten, PhongAndDiffuseTransmissionKeepTheirKind) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [
+        {"name": "p", "type": "phong", "exponent": 18, "albedo": 0.5},
+        {"name": "d", "type": "phong"},
+        {"name": "t", "type": "diffuse_transmission", "albedo": [0.2, 0.6, 0.3]}],
+      "primitives": [{"type": "quad", "bsdf": "p"}, {"type": "quad", "bsdf": "d"}, {"type": "quad", "bsdf": "t"}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  for (const auto& w : r->warnings) EXPECT_EQ(w.find("not supported"), std::string::npos) << w;
+  auto named = [&](const char* name) {
+    for (const Material& m : r->scene.materials)
+      if (m.name == name) return m;
+    ADD_FAILURE() << "no material " << name;
+    return Material{};
+  };
+  EXPECT_EQ(named("p").type, MaterialType::Phong);
+  EXPECT_NEAR(2 / (named("p").roughness * named("p").roughness) - 2, 18, 1e-3);
+  EXPECT_NEAR(2 / (named("d").roughness * named("d").roughness) - 2, 64, 1e-2);
+  EXPECT_EQ(named("t").type, MaterialType::DiffuseTransmission);
+  EXPECT_EQ(named("t").transmittance, 0.5f);
+  EXPECT_NEAR(named("t").albedo.y, 0.6f, 1e-6f);
+}
+
 // Tungsten turns an infinite_sphere by its transform's rotation, as it turns any primitive: so a
 // direction fixed to a quad (its normal, +y in the quad's space) is the sky's up (+y in the map's
 // frame) when both have the same transform, tilted, turned and given an "up" alike.

@@ -80,13 +80,25 @@ enum class MaterialType {
   RoughDielectric,  // GGX glass
   ThinSheet,        // thin dielectric film: reflects by Fresnel, transmits straight through
   Null,             // scatters nothing: a black emitter surface (paths end on it)
+  // Tungsten's Phong: albedo (n + 2) / (2 pi) cos^n of the angle to the mirror direction, n the
+  // exponent 2 / a^2 - 2 of the roughness a (Walter et al. 2007's match of Phong to Beckmann), so
+  // that one roughness slider means about the same on every glossy type.
+  Phong,
+  // Lambertian on both sides: (1 - transmittance) of albedo reflected, transmittance passed to
+  // the other side (Tungsten's diffuse_transmission; leaves, paper, lamp shades).
+  DiffuseTransmission,
 };
-constexpr int kMaterialTypeCount = 11;
+constexpr int kMaterialTypeCount = 13;
 const char* materialTypeName(MaterialType t);
 bool materialTypeFromName(const std::string& name, MaterialType* out);
 // The types whose roughness is a microfacet alpha and which may use Beckmann's distribution.
 constexpr bool isMicrofacet(MaterialType t) {
   return t == MaterialType::RoughPlastic || t == MaterialType::RoughConductor || t == MaterialType::RoughDielectric;
+}
+
+// The types with a roughness field: microfacet alpha, Oren-Nayar sigma, or Phong's width.
+constexpr bool hasRoughness(MaterialType t) {
+  return isMicrofacet(t) || t == MaterialType::OrenNayar || t == MaterialType::Phong;
 }
 
 // Materials a hit follows through blends, the first included (Material::blendWith).
@@ -111,6 +123,7 @@ struct Material {
   // Plastics: the coating's absorption, its sigma_a times its thickness (Tungsten's plastic):
   // the diffuse base shows through dimmed by exp(-a (1 / cos wi + 1 / cos wo)).
   Vec3 coatingAbsorption{0.0f};
+  float transmittance = 0.5f;      // diffuse transmission: the share of albedo passed through
   std::string metal = "Cu";        // conductors: a named metal (see conductorNames) or "custom"
   Vec3 eta{0.2f, 0.92f, 1.1f};     // conductors with metal == "custom"
   Vec3 k{3.9f, 2.45f, 2.14f};

@@ -264,6 +264,7 @@ Value nativeSceneToJson(const Scene& s) {
     v.set("roughness_texture", m.roughnessTexture);
     v.set("ior", m.ior);
     v.set("coating_absorption", json::fromVec3(m.coatingAbsorption));
+    v.set("transmittance", m.transmittance);
     v.set("metal", m.metal);
     v.set("eta", json::fromVec3(m.eta));
     v.set("k", json::fromVec3(m.k));
@@ -490,6 +491,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.id("roughness_texture", &m.roughnessTexture);
       r.number("ior", &m.ior);
       r.vec3("coating_absorption", &m.coatingAbsorption);
+      r.number("transmittance", &m.transmittance);
       r.string("metal", &m.metal);
       r.vec3("eta", &m.eta);
       r.vec3("k", &m.k);

@@ -496,6 +496,19 @@ class TungstenImporter {
       m.type = MaterialType::ThinSheet;
     } else if (type == "null") {
       m.type = MaterialType::Null;
+    } else if (type == "phong") {
+      m.type = MaterialType::Phong;
+      float exponent = 64;  // Tungsten's default
+      number(v, "exponent", &exponent, where);
+      if (!(exponent >= 0)) {
+        warn(cat(where, ": Phong exponent ", exponent, " is taken as 64"));
+        exponent = 64;
+      }
+      m.roughness = std::sqrt(2.0f / (exponent + 2.0f));  // the inverse of n = 2 / a^2 - 2
+    } else if (type == "diffuse_transmission") {
+      m.type = MaterialType::DiffuseTransmission;
+      m.transmittance = 0.5f;  // Tungsten's, which its files cannot change; a file of ours may
+      number(v, "transmittance", &m.transmittance, where);
     } else if (type == "forward") {
       m.type = MaterialType::Lambert;
       m.alpha = 0;  // an invisible boundary: every ray passes

@@ -556,12 +556,14 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
              (rough && m.separableShadowing ? gpu::kMatSeparable : 0);
   // Keep roughness away from zero, where GGX turns into a delta the rough code cannot sample.
   float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
-  if (rough) roughness = std::max(roughness, 1e-3f);
+  if (rough || m.type == MaterialType::Phong) roughness = std::max(roughness, 1e-3f);
   if (m.type == MaterialType::OrenNayar) roughness = std::clamp(m.roughness, 0.0f, kPi / 2);
   float ior = std::clamp(m.ior, 1.0001f, 10.0f);
   // Diffuse light inside a plastic coating reflects back this fraction at the boundary
   // (Jensen et al.'s polynomial fit of the internal diffuse Fresnel reflectance).
   float fdrInt = -1.4399f / (ior * ior) + 0.7099f / ior + 0.6681f + 0.0636f * ior;
+  // Diffuse transmission has no coating: its texel carries the transmittance instead.
+  if (m.type == MaterialType::DiffuseTransmission) fdrInt = std::isfinite(m.transmittance) ? m.transmittance : 0.5f;
   return {v4(max(m.albedo, Vec3{0.0f}), bitsOf(type)),
           vec4{roughness, ior, std::clamp(m.alpha, 0.0f, 1.0f), std::clamp(fdrInt, 0.0f, 1.0f)},
           v4(eta, bitsOf(albedoTexture)), v4(k, bitsOf(roughnessTexture)),
