@@ -23,7 +23,7 @@ void main() {
   if (q >= push.count) return;
   uint base = q * kQueryVec4s;
   Material m = unpackMaterial(queries[base], queries[base + 1u], queries[base + 2u], queries[base + 3u], queries[base + 4u],
-                              queries[base + 6u]);
+                              queries[base + 6u], queries[base + 7u], queries[base + 8u]);
   uint at = base + uint(kMaterialTexels);
   vec3 wo = queries[at].xyz, wi = queries[at + 1u].xyz, u = queries[at + 2u].xyz;
   float pdf;

@@ -138,7 +138,8 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
   // The coating's absorption is read only when the scene has plastics.
   const bool plastics = (kMaterialMask & ((1 << kMatPlastic) | (1 << kMatRoughPlastic))) != 0;
   Material m = unpackMaterial(texelFetch(uMaterials, base), texelFetch(uMaterials, base + 1), t2, t3,
-                              texelFetch(uMaterials, base + 4), plastics ? texelFetch(uMaterials, base + 6) : vec4(0.0));
+                              texelFetch(uMaterials, base + 4), plastics ? texelFetch(uMaterials, base + 6) : vec4(0.0),
+                              kCoatUsed ? texelFetch(uMaterials, base + 7) : vec4(0.0), kCoatUsed ? texelFetch(uMaterials, base + 8) : vec4(0.0));
   int albedoTex = floatBitsToInt(t2.w), roughTex = floatBitsToInt(t3.w);
   if (hasFeature(kFeatureTextures) && albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
   if (hasFeature(kFeatureTextures) && roughTex >= 0) m.roughness = max(m.roughness * sampleTexture(roughTex, uv).r, 1e-3);

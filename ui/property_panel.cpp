@@ -318,6 +318,20 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       edit(tr("IOR"), drag, [v](Material& x) { x.ior = static_cast<float>(v); });
     });
   }
+  if (!isTransmissiveType(m.type)) {
+    // A clear coat over any opaque type; 0 takes it off.
+    b.number(tr("Coat IOR"), "coatIor", m.coatIor, 0.0, 4.0, defaults.coatIor, 3, [this, id, edit](double v, int drag) {
+      const Material* cur = scene_().material(id);
+      const bool was = cur && cur->coated();
+      edit(tr("Coat IOR"), drag, [v](Material& x) { x.coatIor = static_cast<float>(v); });
+      if (was != (v > 1.0)) rebuildLater();  // the coat's absorption shows only with a coat
+    });
+    if (m.coated())
+      b.vec3(tr("Coat absorption"), "coatAbsorption", m.coatAbsorption, 0.01, [edit](int channel, double v, int drag) {
+        edit(tr("Coat absorption"), drag,
+             [channel, v](Material& x) { axisOf(x.coatAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
+      }, true);
+  }
   if (m.type == MaterialType::DiffuseTransmission)
     b.number(tr("Transmittance"), "transmittance", m.transmittance, 0.0, 1.0, defaults.transmittance, 3, [edit](double v, int drag) {
       edit(tr("Transmittance"), drag, [v](Material& x) { x.transmittance = static_cast<float>(v); });

@@ -647,12 +647,16 @@ TEST(KnownAnswer, LightsAndSkyAddUpAsEditsBringThemInAndTakeThemOut) {
 TEST(KnownAnswer, EveryMaterialGivesOnlyFiniteSamples) {
   // A non-finite path is dropped by the accumulator (its sample does not count), so a material
   // whose sampling or evaluation goes wrong shows as pixels with fewer samples than traced.
-  // Each material type lies on a plane and a sphere, lit by a sky, an area light and a point light.
+  // Each material type lies on a plane and a sphere, lit by a sky, an area light and a point light;
+  // the opaque types also under a clear coat.
   RETILE_RENDERER_OR_SKIP(r);
   for (int t = 0; t < kMaterialTypeCount; ++t) {
     auto type = static_cast<MaterialType>(t);
     if (type == MaterialType::Null) continue;
-    for (float roughness : {0.02f, 0.15f, 0.6f}) {
+    for (float roughness : {0.02f, 0.15f, 0.6f, -0.15f}) {
+      const bool coat = roughness < 0;
+      if (coat && isTransmissiveType(type)) continue;
+      roughness = std::abs(roughness);
       Scene s = test::emptyScene(24, 16);
       s.camera.position = {0, 1.0f, 3};
       s.camera.target = {0, 0.3f, 0};
@@ -662,6 +666,7 @@ TEST(KnownAnswer, EveryMaterialGivesOnlyFiniteSamples) {
       m.type = type;
       m.roughness = roughness;
       m.albedo = Vec3{0.7f};
+      if (coat) m.coatIor = 1.5f;
       NodeId mat = test::addMaterial(s, m);
       test::addMeshObject(s, "plane", makeQuad(), mat, Mat4::scale({10, 1, 10}));
       test::addMeshObject(s, "sphere", makeSphere(16, 32), mat, Mat4::translate({0, 0.5f, 0}) * Mat4::scale(Vec3{0.5f}));
@@ -680,7 +685,7 @@ TEST(KnownAnswer, EveryMaterialGivesOnlyFiniteSamples) {
       int dropped = 0;
       for (float c : img.sampleCount) dropped += spp - static_cast<int>(c);
       EXPECT_EQ(dropped, 0) << materialTypeName(type) << " at roughness " << roughness << " dropped " << dropped
-                            << " of " << img.sampleCount.size() * spp << " samples as non-finite";
+                            << " of " << img.sampleCount.size() * spp << " samples as non-finite" << (coat ? ", coated" : "");
       EXPECT_TRUE(test::allFinite(img)) << materialTypeName(type);
     }
   }

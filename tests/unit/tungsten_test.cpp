@@ -216,6 +216,44 @@ TEST(Tungsten, PhongAndDiffuseTransmissionKeepTheirKind) {
   EXPECT_NEAR(named("t").albedo.y, 0.6f, 1e-6f);
 }
 
+// Tungsten's coats: the substrate is the material, the coat's index and absorption (sigma_a times
+// thickness) ride on it; a rough coat is drawn smooth, with a warning, as is a coat over glass.
+TEST(Tungsten, CoatsKeepTheirSubstrateUnderAClearCoat) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [
+        {"name": "gold", "type": "rough_conductor", "material": "Au", "roughness": 0.2},
+        {"name": "lacquer", "type": "smooth_coat", "ior": 1.6, "thickness": 2, "sigma_a": [0.1, 0.2, 0.3], "substrate": "gold"},
+        {"name": "satin", "type": "rough_coat", "roughness": 0.3, "substrate": {"type": "lambert", "albedo": 0.4}},
+        {"name": "default", "type": "smooth_coat"},
+        {"name": "glass", "type": "smooth_coat", "substrate": {"type": "dielectric"}}],
+      "primitives": [{"type": "quad", "bsdf": "lacquer"}, {"type": "quad", "bsdf": "satin"},
+                     {"type": "quad", "bsdf": "default"}, {"type": "quad", "bsdf": "glass"}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  auto named = [&](const char* name) {
+    for (const Material& m : r->scene.materials)
+      if (m.name == name) return m;
+    ADD_FAILURE() << "no material " << name;
+    return Material{};
+  };
+  const Material lacquer = named("lacquer"), satin = named("satin"), plain = named("default");
+  EXPECT_EQ(lacquer.type, MaterialType::RoughConductor);
+  EXPECT_EQ(lacquer.metal, "Au");
+  EXPECT_FLOAT_EQ(lacquer.coatIor, 1.6f);
+  EXPECT_EQ(lacquer.coatAbsorption, Vec3(0.2f, 0.4f, 0.6f));
+  EXPECT_EQ(satin.type, MaterialType::Lambert);
+  EXPECT_FLOAT_EQ(satin.albedo.x, 0.4f);
+  EXPECT_FLOAT_EQ(satin.coatIor, 1.3f) << "Tungsten's default index";
+  EXPECT_EQ(plain.type, MaterialType::RoughConductor) << "Tungsten's default substrate";
+  int rough = 0, glass = 0, unsupported = 0;
+  for (const auto& w : r->warnings) {
+    rough += w.find("a rough coat is rendered as a smooth one") != std::string::npos;
+    glass += w.find("a coat over a dielectric substrate is rendered without the coat") != std::string::npos;
+    unsupported += w.find("not supported") != std::string::npos;
+  }
+  EXPECT_EQ(rough, 1);
+  EXPECT_EQ(glass, 1);
+  EXPECT_EQ(unsupported, 0);
+}
+
 // Tungsten turns an infinite_sphere by its transform's rotation, as it turns any primitive: so a
 // direction fixed to a quad (its normal, +y in the quad's space) is the sky's up (+y in the map's
 // frame) when both have the same transform, tilted, turned and given an "up" alike.

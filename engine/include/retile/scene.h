@@ -96,6 +96,12 @@ constexpr bool isMicrofacet(MaterialType t) {
   return t == MaterialType::RoughPlastic || t == MaterialType::RoughConductor || t == MaterialType::RoughDielectric;
 }
 
+// The types that pass light to the other side of a surface.
+constexpr bool isTransmissiveType(MaterialType t) {
+  return t == MaterialType::Dielectric || t == MaterialType::RoughDielectric || t == MaterialType::ThinSheet ||
+         t == MaterialType::DiffuseTransmission;
+}
+
 // The types with a roughness field: microfacet alpha, Oren-Nayar sigma, or Phong's width.
 constexpr bool hasRoughness(MaterialType t) {
   return isMicrofacet(t) || t == MaterialType::OrenNayar || t == MaterialType::Phong;
@@ -124,6 +130,14 @@ struct Material {
   // the diffuse base shows through dimmed by exp(-a (1 / cos wi + 1 / cos wo)).
   Vec3 coatingAbsorption{0.0f};
   float transmittance = 0.5f;      // diffuse transmission: the share of albedo passed through
+  // A clear coat over this material (Tungsten's smooth_coat): a smooth dielectric layer of index
+  // coatIor (0: none) that reflects by Fresnel and through which the material is seen with both
+  // directions refracted, dimmed inside by exp(-coatAbsorption (1 / cos + 1 / cos)) (sigma_a
+  // times thickness). No light bounces between the coat and what it covers, as in Tungsten.
+  // Transmissive types take no coat.
+  float coatIor = 0.0f;
+  Vec3 coatAbsorption{0.0f};
+  bool coated() const { return coatIor > 1.0f; }
   std::string metal = "Cu";        // conductors: a named metal (see conductorNames) or "custom"
   Vec3 eta{0.2f, 0.92f, 1.1f};     // conductors with metal == "custom"
   Vec3 k{3.9f, 2.45f, 2.14f};

@@ -265,6 +265,10 @@ Value nativeSceneToJson(const Scene& s) {
     v.set("ior", m.ior);
     v.set("coating_absorption", json::fromVec3(m.coatingAbsorption));
     v.set("transmittance", m.transmittance);
+    if (m.coatIor != 0) {
+      v.set("coat_ior", m.coatIor);
+      v.set("coat_absorption", json::fromVec3(m.coatAbsorption));
+    }
     v.set("metal", m.metal);
     v.set("eta", json::fromVec3(m.eta));
     v.set("k", json::fromVec3(m.k));
@@ -492,6 +496,8 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.number("ior", &m.ior);
       r.vec3("coating_absorption", &m.coatingAbsorption);
       r.number("transmittance", &m.transmittance);
+      r.number("coat_ior", &m.coatIor);
+      r.vec3("coat_absorption", &m.coatAbsorption);
       r.string("metal", &m.metal);
       r.vec3("eta", &m.eta);
       r.vec3("k", &m.k);

@@ -358,6 +358,38 @@ class TungstenImporter {
       }
       return m;
     }
+    if (type == "smooth_coat" || type == "rough_coat") {
+      // Tungsten's coats: a dielectric layer over a substrate bsdf (its default: a rough conductor).
+      Material base;
+      if (const Value* sv = v.find("substrate")) {
+        base = bsdf(*sv, where + ".substrate", depth + 1);
+      } else {
+        base.type = MaterialType::RoughConductor;
+        base.metal = "Cu";
+        base.roughness = 0.1f;
+        base.separableShadowing = true;
+      }
+      if (!ok()) return m;
+      float ior = 1.3f, thickness = 1;  // Tungsten's defaults
+      Vec3 sigmaA{0.0f};
+      number(v, "ior", &ior, where);
+      number(v, "thickness", &thickness, where);
+      vec3(v, "sigma_a", &sigmaA, where);
+      const std::string name = m.name;
+      m = base;
+      m.name = name;
+      if (isTransmissiveType(m.type)) {
+        warn(cat(where, ": a coat over a ", materialTypeName(m.type), " substrate is rendered without the coat"));
+      } else if (base.blendWith != kNoNode) {
+        warn(cat(where, ": a coat over a blended substrate is rendered on its first part only"));
+      }
+      if (type == "rough_coat")
+        warn(cat(where, ": a rough coat is rendered as a smooth one (its reflection is sharp, not blurred)"));
+      if (m.coated()) warn(cat(where, ": a coat over a coat is rendered with the outer coat only"));
+      m.coatIor = ior;
+      m.coatAbsorption = max(sigmaA * thickness, Vec3{0.0f});
+      return m;
+    }
     if (type == "mixed") {
       // Tungsten's blend, albedo * (ratio * bsdf0 + (1 - ratio) * bsdf1): this material is bsdf0
       // under the blend's albedo and blends (Material::blendWith) with a copy of bsdf1 under it.

@@ -559,6 +559,7 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   if (rough || m.type == MaterialType::Phong) roughness = std::max(roughness, 1e-3f);
   if (m.type == MaterialType::OrenNayar) roughness = std::clamp(m.roughness, 0.0f, kPi / 2);
   float ior = std::clamp(m.ior, 1.0001f, 10.0f);
+  const bool coated = m.coated() && std::isfinite(m.coatIor) && !isTransmissiveType(m.type);
   // Diffuse light inside a plastic coating reflects back this fraction at the boundary
   // (Jensen et al.'s polynomial fit of the internal diffuse Fresnel reflectance).
   float fdrInt = -1.4399f / (ior * ior) + 0.7099f / ior + 0.6681f + 0.0636f * ior;
@@ -570,7 +571,8 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
           v4(max(m.emission, Vec3{0.0f}), bitsOf(alphaTexture)),
           vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, bitsOf(emissionTexture), bitsOf(blendWith)},
           v4(max(m.coatingAbsorption, Vec3{0.0f}), std::isfinite(m.blendRatio) ? std::clamp(m.blendRatio, 0.0f, 1.0f) : 1.0f),
-          vec4{bitsOf(blendRatioTexture), 0, 0, 0}};
+          vec4{bitsOf(blendRatioTexture), coated ? std::min(m.coatIor, 10.0f) : 0.0f, 0, 0},
+          v4(coated ? max(m.coatAbsorption, Vec3{0.0f}) : Vec3{0.0f}, 0)};
 }
 
 void RenderSceneBuilder::packMaterials(const Scene& scene) {
@@ -588,6 +590,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     // The kernel compiles Beckmann's distribution in only for scenes that use it.
     if (m.beckmann && isMicrofacet(m.type))
       data_.materialTypes |= 1u << gpu::kMaskBeckmann;
+    if (m.coated() && !isTransmissiveType(m.type)) data_.materialTypes |= 1u << gpu::kMaskCoat;
     if (textureIndex(m.albedoTexture) >= 0 || textureIndex(m.roughnessTexture) >= 0) data_.materialTextures = true;
     if (textureIndex(m.bumpTexture) >= 0 && m.bumpStrength != 0) data_.materialBump = true;
     if (textureIndex(m.emissionTexture) >= 0 && m.emissive()) data_.emissionTextures = true;

@@ -139,6 +139,8 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
     clampValue(m.bumpStrength, -1e4f, 1e4f, 1.0f, what + ": bump strength", warnings);
     clampValue(m.blendRatio, 0.0f, 1.0f, 1.0f, what + ": blend ratio", warnings);
     clampValue(m.transmittance, 0.0f, 1.0f, 0.5f, what + ": transmittance", warnings);
+    clampValue(m.coatIor, 0.0f, 10.0f, 0.0f, what + ": coat index of refraction", warnings);
+    checkColor(m.coatAbsorption, Vec3{0.0f}, what + ": coat absorption", warnings);
     if (!finiteNonNegative(m.eta) || !finiteNonNegative(m.k)) {
       warnings.push_back(cat(what, ": its complex index of refraction is negative or not finite; copper instead"));
       m.metal = "Cu";
