@@ -326,11 +326,15 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       edit(tr("Coat IOR"), drag, [v](Material& x) { x.coatIor = static_cast<float>(v); });
       if (was != (v > 1.0)) rebuildLater();  // the coat's absorption shows only with a coat
     });
-    if (m.coated())
+    if (m.coated()) {
+      b.number(tr("Coat roughness"), "coatRoughness", m.coatRoughness, 0.0, 1.0, defaults.coatRoughness, 3, [edit](double v, int drag) {
+        edit(tr("Coat roughness"), drag, [v](Material& x) { x.coatRoughness = static_cast<float>(v); });
+      });
       b.vec3(tr("Coat absorption"), "coatAbsorption", m.coatAbsorption, 0.01, [edit](int channel, double v, int drag) {
         edit(tr("Coat absorption"), drag,
              [channel, v](Material& x) { axisOf(x.coatAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
       }, true);
+    }
   }
   if (m.type == MaterialType::DiffuseTransmission)
     b.number(tr("Transmittance"), "transmittance", m.transmittance, 0.0, 1.0, defaults.transmittance, 3, [edit](double v, int drag) {

@@ -37,6 +37,7 @@ struct Material {
   vec3 emission;
   float coatIor;        // a clear coat's index; no coat at 1 or below
   vec3 coatAbsorption;  // inside the coat, sigma_a times thickness
+  float coatRoughness;  // a rough coat's GGX alpha; 0: smooth
 };
 
 // The material's texels as render/render_scene.cpp packMaterial writes them, textures not applied.
@@ -56,6 +57,7 @@ Material unpackMaterial(vec4 t0, vec4 t1, vec4 t2, vec4 t3, vec4 t4, vec4 t6, ve
   m.coating = t6.rgb;
   m.coatIor = kCoatUsed ? t7.y : 0.0;
   m.coatAbsorption = t8.rgb;
+  m.coatRoughness = t8.w;
   return m;
 }
 
@@ -68,11 +70,14 @@ struct BsdfSample {
 };
 
 // Materials with only delta lobes: light sampling cannot reach them. Smooth plastic is not one:
-// its diffuse base takes light samples and its specular lobe is sampled inside bsdfSample.
-bool isDeltaMaterial(Material m) {
+// its diffuse base takes light samples and its specular lobe is sampled inside bsdfSample; nor is
+// a smooth metal under a rough coat.
+bool isDeltaBase(Material m) {
   return isMat(m.type, kMatConductor) || isMat(m.type, kMatMirror) || isMat(m.type, kMatDielectric) || isMat(m.type, kMatThinSheet) ||
          isMat(m.type, kMatNull);
 }
+
+bool isDeltaMaterial(Material m) { return isDeltaBase(m) && !(kCoatUsed && m.coatIor > 1.0 && m.coatRoughness > 0.0); }
 
 bool isTransmissive(Material m) {
   return isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric) || isMat(m.type, kMatThinSheet) ||
@@ -258,7 +263,7 @@ vec3 baseEval(Material m, vec3 wo, vec3 wi, out float pdf) {
     pdf = share * abs(wi.z) * INV_PI;
     return m.albedo * pdf;
   }
-  if (roughDielectric ? (o.z <= 0.0 || i.z == 0.0) : (wo.z <= 0.0 || wi.z <= 0.0 || isDeltaMaterial(m))) return vec3(0.0);
+  if (roughDielectric ? (o.z <= 0.0 || i.z == 0.0) : (wo.z <= 0.0 || wi.z <= 0.0 || isDeltaBase(m))) return vec3(0.0);
   if (isMat(t, kMatLambert)) {
     pdf = wi.z * INV_PI;
     return m.albedo * (INV_PI * wi.z);
@@ -436,6 +441,8 @@ BsdfSample baseSample(Material m, vec3 wo, vec3 u) {
 // otherwise the material below, seen through the coat with both directions refracted. Its
 // f cos is (1 - F(wo)) (1 - F(wi)) exp(-a (1 / cos wo' + 1 / cos wi')) f'(wo', wi') cos wi' times
 // the solid angle's change cos wi / (ior^2 cos wi'), primes inside the coat: symmetric in wo and wi.
+// A rough coat (Tungsten's rough_coat) reflects a GGX lobe instead of the delta, F D G1 G1 /
+// (4 cos wo), drawn by its visible normals, and weighs what is below by cos wo / cos wo' more.
 float coatSpecularProbability(Material m, float fo) {
   float t = exp(-2.0 * dot(m.coatAbsorption, vec3(1.0 / 3.0)));
   return fo / (fo + (1.0 - fo) * t);
@@ -450,8 +457,19 @@ vec3 bsdfEval(Material m, vec3 wo, vec3 wi, out float pdf) {
   float p;
   vec3 f = baseEval(m, vec3(wo.xy * inv, co), vec3(wi.xy * inv, ci), p);
   float jacobian = inv * inv * wi.z / ci;
-  pdf = (1.0 - coatSpecularProbability(m, fo)) * p * jacobian;
-  return f * exp(-m.coatAbsorption * (1.0 / co + 1.0 / ci)) * ((1.0 - fo) * (1.0 - fi) * jacobian);
+  float ps = coatSpecularProbability(m, fo);
+  pdf = (1.0 - ps) * p * jacobian;
+  f *= exp(-m.coatAbsorption * (1.0 / co + 1.0 / ci)) * ((1.0 - fo) * (1.0 - fi) * jacobian);
+  float a = m.coatRoughness;
+  if (a > 0.0) {
+    f *= wo.z / co;
+    vec3 h = normalize(wo + wi);
+    float oh = dot(wo, h);
+    float d = ggxD(h, a), g1o = ggxG1(wo, a);
+    pdf += ps * d * g1o / (4.0 * wo.z);
+    f += vec3(fresnelDielectric(oh, m.coatIor) * d * g1o * ggxG1(wi, a) / (4.0 * wo.z));
+  }
+  return f;
 }
 
 BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
@@ -466,6 +484,15 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
   float inv = 1.0 / m.coatIor, co;
   float fo = fresnelDielectric(wo.z, m.coatIor, co);
   float ps = coatSpecularProbability(m, fo);
+  if (u.z < ps && m.coatRoughness > 0.0) {
+    // The rough coat's lobe, weighed with the base's share of the same direction.
+    s.wi = reflect(-wo, sampleGgxVisibleNormal(wo, m.coatRoughness, u.xy));
+    float p;
+    vec3 f = s.wi.z > 0.0 ? bsdfEval(m, wo, s.wi, p) : vec3(0.0);
+    s.pdf = s.wi.z > 0.0 ? p : 0.0;
+    s.weight = s.pdf > 0.0 ? f / s.pdf : vec3(0.0);
+    return s;
+  }
   if (u.z < ps) {
     s.wi = vec3(-wo.xy, wo.z);
     s.weight = vec3(fo / ps);
@@ -484,6 +511,7 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
     s.delta = true;
     s.pdf = b.pdf * (1.0 - ps);
     s.weight = b.weight * exp(-m.coatAbsorption * (1.0 / co + 1.0 / ci)) * ((1.0 - fo) * (1.0 - fi) / (1.0 - ps));
+    if (m.coatRoughness > 0.0) s.weight *= wo.z / co;
     return s;
   }
   float p;

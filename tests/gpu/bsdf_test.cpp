@@ -57,6 +57,12 @@ Material clearCoated(Material m, float ior = 1.5f, float absorption = 0.0f) {
   return m;
 }
 
+Material roughCoated(Material m, float alpha, float ior = 1.5f) {
+  m.coatIor = ior;
+  m.coatRoughness = alpha;
+  return m;
+}
+
 // Unpolarised Fresnel reflectance from outside a dielectric of index eta at cos c.
 double fresnel(double c, double eta) {
   const double s2 = (1 - c * c) / (eta * eta), ct = std::sqrt(1 - s2);
@@ -91,7 +97,9 @@ std::vector<Case> smoothLobed() {
           {"diffuse_transmission", transmitting(0.8f, 0.3f)},
           {"coated_lambert", clearCoated(material(MaterialType::Lambert, 0.8f))},
           {"coated_rough_conductor", clearCoated(material(MaterialType::RoughConductor, 1.0f, 0.3f), 1.4f, 0.2f)},
-          {"coated_rough_plastic", clearCoated(material(MaterialType::RoughPlastic, 0.6f, 0.4f), 1.3f)}};
+          {"coated_rough_plastic", clearCoated(material(MaterialType::RoughPlastic, 0.6f, 0.4f), 1.3f)},
+          {"rough_coated_lambert", roughCoated(material(MaterialType::Lambert, 0.8f), 0.3f)},
+          {"rough_coated_rough_conductor", roughCoated(material(MaterialType::RoughConductor, 1.0f, 0.2f), 0.4f, 1.4f)}};
 }
 
 class Bsdfs : public ::testing::Test {
@@ -119,11 +127,11 @@ class Bsdfs : public ::testing::Test {
     return {sum / static_cast<double>(q.size()), ok / static_cast<double>(q.size())};
   }
 
-  // Midpoint quadrature over the whole sphere in (cos theta, phi): the integral of eval's
-  // f * |cos| and of its pdf.
-  std::pair<double, double> integrated(const Material& m, Vec3 wo, int nt = 256, int np = 512) {
+  // Midpoint quadrature over the whole sphere in (cos theta, phi), or the upper hemisphere alone:
+  // the integral of eval's f * |cos| and of its pdf.
+  std::pair<double, double> integrated(const Material& m, Vec3 wo, bool upperOnly = false, int nt = 256, int np = 512) {
     std::vector<BsdfQuery> q;
-    for (int i = 0; i < 2 * nt; ++i)
+    for (int i = upperOnly ? nt : 0; i < 2 * nt; ++i)
       for (int j = 0; j < np; ++j)
         q.push_back({m, wo, direction(-1.0f + (i + 0.5f) / nt, 2.0f * kPi * (j + 0.5f) / np), Vec3{0.5f}});
     const double cell = (1.0 / nt) * (2.0 * kPi / np);
@@ -167,7 +175,7 @@ TEST_F(Bsdfs, PdfIntegratesToTheFractionOfSamplesThatSucceed) {
       (void)albedo;
       // Plastic's delta coating is sampled but has no pdf in eval: its share is the rest.
       double deltaShare = 0;
-      if (c.m.type == MaterialType::Plastic || c.m.coated()) {
+      if (c.m.type == MaterialType::Plastic || (c.m.coated() && c.m.coatRoughness == 0)) {
         std::vector<BsdfQuery> q;
         for (int i = 0; i < 4096; ++i) q.push_back({c.m, wo, wo, {(i % 64 + 0.5f) / 64, (i / 64 + 0.5f) / 64, (i + 0.5f) / 4096}});
         for (const auto& a : run(q)) deltaShare += a.delta ? 1.0 / 4096 : 0.0;
@@ -188,7 +196,7 @@ TEST_F(Bsdfs, SamplingAndQuadratureAgreeOnTheDirectionalAlbedo) {
 
       double delta = 0;  // smooth plastic's coating and a clear coat reflect F(cos) as a delta
       if (c.m.type == MaterialType::Plastic) delta = fresnel(cosO, c.m.ior);
-      if (c.m.coated()) delta = fresnel(cosO, c.m.coatIor);
+      if (c.m.coated() && c.m.coatRoughness == 0) delta = fresnel(cosO, c.m.coatIor);
       EXPECT_NEAR(sampled, quadrature + delta, 0.01 * (quadrature + delta) + 0.002) << c.name << " at cos " << cosO;
     }
 }
@@ -257,6 +265,7 @@ TEST_F(Bsdfs, ReflectionIsReciprocal) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> U(0.0f, 1.0f);
   for (const Case& c : smoothLobed()) {
+    if (c.m.coatRoughness > 0) continue;  // Tungsten's rough coat is not (AClearCoatIsTungstensSmoothCoat)
     std::vector<BsdfQuery> q;
     for (int i = 0; i < 2000; ++i) {
       Vec3 a = direction(0.05f + 0.95f * U(rng), 6.283f * U(rng)), b = direction(0.05f + 0.95f * U(rng), 6.283f * U(rng));
@@ -401,6 +410,35 @@ TEST_F(Bsdfs, AClearCoatIsTungstensSmoothCoat) {
   auto r = run({{mirror, Vec3{0, 0, 1}, Vec3{0, 0, 1}, Vec3{0.5f, 0.5f, 0.99f}}});
   EXPECT_TRUE(r[0].delta);
   EXPECT_NEAR(r[0].sampledWi.z, 1.0f, 1e-5f) << "the mirror below reflects straight back out through the coat";
+}
+
+// Tungsten's rough_coat: the coat reflects as a rough dielectric's reflection lobe (GGX, both G1),
+// and what is below is the smooth coat's term times cos wo / cos wo', wo' refracted inside.
+TEST_F(Bsdfs, ARoughCoatIsTungstensRoughCoat) {
+  const float a = 0.25f, ior = 1.5f;
+  Material glass = separable(material(MaterialType::RoughDielectric, 1.0f, a, ior));
+  const Material overBlack = roughCoated(material(MaterialType::Lambert, 0.0f), a, ior);
+  const Material overWhite = roughCoated(material(MaterialType::Lambert, 1.0f), a, ior);
+  const Material smoothOverWhite = clearCoated(material(MaterialType::Lambert, 1.0f), ior);
+  const std::pair<float, float> angles[] = {{0.9f, 0.8f}, {0.5f, 0.45f}, {0.2f, 0.3f}};
+  std::vector<BsdfQuery> q;
+  for (auto [co, ci] : angles) {
+    const Vec3 wo = direction(co, 0.0f), wi = direction(ci, kPi + 0.1f);
+    for (const Material& m : {glass, overBlack, overWhite, smoothOverWhite}) q.push_back({m, wo, wi});
+  }
+  auto r = run(q);
+  for (std::size_t k = 0; k < std::size(angles); ++k) {
+    const double co = angles[k].first, coInside = std::sqrt(1 - (1 - co * co) / (ior * ior));
+    const BsdfAnswer *dielectric = &r[4 * k], *black = &r[4 * k + 1], *white = &r[4 * k + 2], *smooth = &r[4 * k + 3];
+    ASSERT_GT(dielectric->f.y, 0.0f);
+    EXPECT_NEAR(black->f.y, dielectric->f.y, 1e-4 * dielectric->f.y) << "the coat's lobe, cos " << co;
+    EXPECT_NEAR(white->f.y - black->f.y, smooth->f.y * co / coInside, 1e-4 * smooth->f.y) << "the base's share, cos " << co;
+  }
+  // Over a black base only the coat's lobe reflects: its albedo is the rough glass's reflection.
+  for (float cosO : {0.9f, 0.3f}) {
+    const Vec3 wo = direction(cosO, 0.3f);
+    EXPECT_NEAR(integrated(overBlack, wo).first, integrated(glass, wo, true).first, 1e-4) << "cos " << cosO;
+  }
 }
 
 }  // namespace

@@ -216,17 +216,19 @@ TEST(Tungsten, PhongAndDiffuseTransmissionKeepTheirKind) {
   EXPECT_NEAR(named("t").albedo.y, 0.6f, 1e-6f);
 }
 
-// Tungsten's coats: the substrate is the material, the coat's index and absorption (sigma_a times
-// thickness) ride on it; a rough coat is drawn smooth, with a warning, as is a coat over glass.
+// Tungsten's coats: the substrate is the material, the coat's index, absorption (sigma_a times
+// thickness) and roughness ride on it. A rough coat reads its absorption as "sigmaA" (Tungsten's
+// key; "sigma_a" is ignored, with a warning); a coat over glass is left out, with a warning.
 TEST(Tungsten, CoatsKeepTheirSubstrateUnderAClearCoat) {
   auto r = importTungsten(writeScene(R"({"bsdfs": [
         {"name": "gold", "type": "rough_conductor", "material": "Au", "roughness": 0.2},
         {"name": "lacquer", "type": "smooth_coat", "ior": 1.6, "thickness": 2, "sigma_a": [0.1, 0.2, 0.3], "substrate": "gold"},
-        {"name": "satin", "type": "rough_coat", "roughness": 0.3, "substrate": {"type": "lambert", "albedo": 0.4}},
+        {"name": "satin", "type": "rough_coat", "roughness": 0.3, "sigma_a": 5, "substrate": {"type": "lambert", "albedo": 0.4}},
+        {"name": "tinted", "type": "rough_coat", "sigmaA": [0.5, 0, 0], "substrate": {"type": "lambert"}},
         {"name": "default", "type": "smooth_coat"},
         {"name": "glass", "type": "smooth_coat", "substrate": {"type": "dielectric"}}],
       "primitives": [{"type": "quad", "bsdf": "lacquer"}, {"type": "quad", "bsdf": "satin"},
-                     {"type": "quad", "bsdf": "default"}, {"type": "quad", "bsdf": "glass"}]})"));
+                     {"type": "quad", "bsdf": "default"}, {"type": "quad", "bsdf": "glass"}, {"type": "quad", "bsdf": "tinted"}]})"));
   ASSERT_TRUE(r.ok()) << r.error();
   auto named = [&](const char* name) {
     for (const Material& m : r->scene.materials)
@@ -242,10 +244,15 @@ TEST(Tungsten, CoatsKeepTheirSubstrateUnderAClearCoat) {
   EXPECT_EQ(satin.type, MaterialType::Lambert);
   EXPECT_FLOAT_EQ(satin.albedo.x, 0.4f);
   EXPECT_FLOAT_EQ(satin.coatIor, 1.3f) << "Tungsten's default index";
+  EXPECT_FLOAT_EQ(satin.coatRoughness, 0.3f);
+  EXPECT_EQ(satin.coatAbsorption, Vec3(0.0f)) << "Tungsten's rough coat ignores sigma_a";
+  EXPECT_EQ(named("tinted").coatAbsorption, Vec3(0.5f, 0.0f, 0.0f));
+  EXPECT_FLOAT_EQ(named("tinted").coatRoughness, 0.02f) << "Tungsten's default roughness";
+  EXPECT_EQ(lacquer.coatRoughness, 0.0f) << "a smooth coat";
   EXPECT_EQ(plain.type, MaterialType::RoughConductor) << "Tungsten's default substrate";
   int rough = 0, glass = 0, unsupported = 0;
   for (const auto& w : r->warnings) {
-    rough += w.find("a rough coat is rendered as a smooth one") != std::string::npos;
+    rough += w.find("a rough coat's \"sigma_a\" is ignored") != std::string::npos;
     glass += w.find("a coat over a dielectric substrate is rendered without the coat") != std::string::npos;
     unsupported += w.find("not supported") != std::string::npos;
   }

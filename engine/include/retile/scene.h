@@ -137,6 +137,11 @@ struct Material {
   // Transmissive types take no coat.
   float coatIor = 0.0f;
   Vec3 coatAbsorption{0.0f};
+  // Above 0, the coat is rough (Tungsten's rough_coat): its reflection a GGX lobe of this alpha
+  // (Smith's G as the product of both G1, as Tungsten has it), and what is below seen as through
+  // the smooth coat times cos wo / cos wo' (wo toward the viewer, wo' inside), Tungsten's form,
+  // which darkens the base at grazing views and is not reciprocal.
+  float coatRoughness = 0.0f;
   bool coated() const { return coatIor > 1.0f; }
   std::string metal = "Cu";        // conductors: a named metal (see conductorNames) or "custom"
   Vec3 eta{0.2f, 0.92f, 1.1f};     // conductors with metal == "custom"

@@ -268,6 +268,7 @@ Value nativeSceneToJson(const Scene& s) {
     if (m.coatIor != 0) {
       v.set("coat_ior", m.coatIor);
       v.set("coat_absorption", json::fromVec3(m.coatAbsorption));
+      v.set("coat_roughness", m.coatRoughness);
     }
     v.set("metal", m.metal);
     v.set("eta", json::fromVec3(m.eta));
@@ -498,6 +499,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.number("transmittance", &m.transmittance);
       r.number("coat_ior", &m.coatIor);
       r.vec3("coat_absorption", &m.coatAbsorption);
+      r.number("coat_roughness", &m.coatRoughness);
       r.string("metal", &m.metal);
       r.vec3("eta", &m.eta);
       r.vec3("k", &m.k);

@@ -374,7 +374,20 @@ class TungstenImporter {
       Vec3 sigmaA{0.0f};
       number(v, "ior", &ior, where);
       number(v, "thickness", &thickness, where);
-      vec3(v, "sigma_a", &sigmaA, where);
+      const bool rough = type == "rough_coat";
+      // Tungsten's rough coat reads its absorption as "sigmaA" and ignores "sigma_a".
+      vec3(v, rough ? "sigmaA" : "sigma_a", &sigmaA, where);
+      if (rough && v.find("sigma_a") && !v.find("sigmaA"))
+        warn(cat(where, ": a rough coat's \"sigma_a\" is ignored, as Tungsten ignores it (it reads \"sigmaA\")"));
+      float coatRoughness = 0.02f;  // Tungsten's default
+      if (rough) {
+        if (const Value* r = v.find("roughness")) {
+          TextureRef t = texture(*r, where + ".roughness", true);
+          coatRoughness = luminance(t.constant);
+          if (t.isTexture) warn(cat(where, ": a rough coat's textured roughness is taken as ", coatRoughness, " everywhere"));
+        }
+        if (string(v, "distribution", "ggx") != "ggx") warn(cat(where, ": the rough coat's distribution is rendered as GGX"));
+      }
       const std::string name = m.name;
       m = base;
       m.name = name;
@@ -383,11 +396,10 @@ class TungstenImporter {
       } else if (base.blendWith != kNoNode) {
         warn(cat(where, ": a coat over a blended substrate is rendered on its first part only"));
       }
-      if (type == "rough_coat")
-        warn(cat(where, ": a rough coat is rendered as a smooth one (its reflection is sharp, not blurred)"));
       if (m.coated()) warn(cat(where, ": a coat over a coat is rendered with the outer coat only"));
       m.coatIor = ior;
       m.coatAbsorption = max(sigmaA * thickness, Vec3{0.0f});
+      m.coatRoughness = rough ? std::max(coatRoughness, 1e-3f) : 0.0f;
       return m;
     }
     if (type == "mixed") {

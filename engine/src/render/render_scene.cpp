@@ -572,7 +572,8 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
           vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, bitsOf(emissionTexture), bitsOf(blendWith)},
           v4(max(m.coatingAbsorption, Vec3{0.0f}), std::isfinite(m.blendRatio) ? std::clamp(m.blendRatio, 0.0f, 1.0f) : 1.0f),
           vec4{bitsOf(blendRatioTexture), coated ? std::min(m.coatIor, 10.0f) : 0.0f, 0, 0},
-          v4(coated ? max(m.coatAbsorption, Vec3{0.0f}) : Vec3{0.0f}, 0)};
+          v4(coated ? max(m.coatAbsorption, Vec3{0.0f}) : Vec3{0.0f},
+             coated && m.coatRoughness > 0 ? std::clamp(m.coatRoughness, 1e-3f, 1.0f) : 0.0f)};
 }
 
 void RenderSceneBuilder::packMaterials(const Scene& scene) {
