@@ -69,6 +69,17 @@ struct BsdfSample {
   bool transmitted;
 };
 
+// A failed sample: no weight; the caller ends the path.
+BsdfSample noSample() {
+  BsdfSample s;
+  s.wi = vec3(0.0, 0.0, 1.0);
+  s.weight = vec3(0.0);
+  s.pdf = 0.0;
+  s.delta = false;
+  s.transmitted = false;
+  return s;
+}
+
 // Materials with only delta lobes: light sampling cannot reach them. Smooth plastic is not one:
 // its diffuse base takes light samples and its specular lobe is sampled inside bsdfSample; nor is
 // a smooth metal under a rough coat.
@@ -328,12 +339,7 @@ vec3 baseEval(Material m, vec3 wo, vec3 wi, out float pdf) {
 // the spaceship 5 % faster). Evaluating this direction and the light sample's in one loop instead
 // of two calls (a loop not unrolled) was slower again.
 BsdfSample baseSample(Material m, vec3 wo, vec3 u) {
-  BsdfSample s;
-  s.wi = vec3(0.0, 0.0, 1.0);
-  s.weight = vec3(0.0);
-  s.pdf = 0.0;
-  s.delta = false;
-  s.transmitted = false;
+  BsdfSample s = noSample();
   bool evaluate = false;  // s.wi is a non-delta lobe's, to weigh by f / pdf
   int t = m.type;
   // One microfacet normal drawn, from the side wo is on (the only side an opaque type samples),
@@ -474,12 +480,7 @@ vec3 bsdfEval(Material m, vec3 wo, vec3 wi, out float pdf) {
 
 BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
   if (!kCoatUsed || m.coatIor <= 1.0) return baseSample(m, wo, u);
-  BsdfSample s;
-  s.wi = vec3(0.0, 0.0, 1.0);
-  s.weight = vec3(0.0);
-  s.pdf = 0.0;
-  s.delta = false;
-  s.transmitted = false;
+  BsdfSample s = noSample();
   if (wo.z <= 0.0) return s;
   float inv = 1.0 / m.coatIor, co;
   float fo = fresnelDielectric(wo.z, m.coatIor, co);
