@@ -49,6 +49,37 @@ TEST(Assimp, AnEmissionMapIsTheEmissionTexture) {
   EXPECT_EQ(t->path.filename(), "glow.png");
 }
 
+// glTF's clear coat (KHR_materials_clearcoat) becomes the material's coat, its perceptual
+// roughness squared; a factor under a half leaves the material uncoated.
+TEST(Assimp, AGltfClearCoatIsTheMaterialsCoat) {
+  auto dir = test::tempDir();
+  const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::ofstream(dir / "tri.bin", std::ios::binary).write(reinterpret_cast<const char*>(tri), sizeof tri);
+  std::ofstream(dir / "car.gltf") << R"({"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_materials_clearcoat"],
+    "materials": [
+      {"name": "paint", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.1, 0.1, 1], "metallicFactor": 0, "roughnessFactor": 0.5},
+       "extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1, "clearcoatRoughnessFactor": 0.3}}},
+      {"name": "faint", "pbrMetallicRoughness": {"metallicFactor": 0},
+       "extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 0.2}}}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]},
+               {"primitives": [{"attributes": {"POSITION": 0}, "material": 1}]}],
+    "nodes": [{"mesh": 0}, {"mesh": 1}], "scenes": [{"nodes": [0, 1]}], "scene": 0,
+    "buffers": [{"byteLength": 36, "uri": "tri.bin"}], "bufferViews": [{"buffer": 0, "byteLength": 36}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}]})";
+  auto r = importScene(dir / "car.gltf");
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Material *paint = nullptr, *faint = nullptr;
+  for (const auto& m : r->scene.materials) {
+    if (m.name == "paint") paint = &m;
+    if (m.name == "faint") faint = &m;
+  }
+  ASSERT_TRUE(paint && faint);
+  EXPECT_EQ(paint->type, MaterialType::RoughPlastic);
+  EXPECT_FLOAT_EQ(paint->coatIor, 1.5f);
+  EXPECT_NEAR(paint->coatRoughness, 0.09f, 1e-6f);
+  EXPECT_FALSE(faint->coated());
+}
+
 TEST(Assimp, CrashingFileIsReportedNotFatal) {
   RETILE_SHARED_OR_SKIP(file, "corpus/malformed/other/assimp-malformed_zero_numvertices/malformed_zero_numvertices.md2");
   auto r = importScene(file);

@@ -201,6 +201,15 @@ struct Converter {
       float ior = 1.5f;
       if (mat->Get(AI_MATKEY_REFRACTI, ior) == AI_SUCCESS && std::isfinite(ior) && ior >= 1.0f) m.ior = ior;
     }
+    // glTF's KHR_materials_clearcoat: a layer of index 1.5 over the base, weighed by its factor,
+    // which a coat has no weight for: at least half is a coat, as transmission is glass.
+    float clearcoat = 0, clearcoatRoughness = 0;
+    if (mat->Get(AI_MATKEY_CLEARCOAT_FACTOR, clearcoat) == AI_SUCCESS && clearcoat >= 0.5f && !isTransmissiveType(m.type)) {
+      m.coatIor = 1.5f;
+      mat->Get(AI_MATKEY_CLEARCOAT_ROUGHNESS_FACTOR, clearcoatRoughness);
+      const float alpha = std::isfinite(clearcoatRoughness) ? std::clamp(clearcoatRoughness, 0.0f, 1.0f) : 0.0f;
+      m.coatRoughness = alpha * alpha >= 1e-3f ? alpha * alpha : 0.0f;  // perceptual roughness, squared
+    }
     NodeId alphaTex = texture(mat, aiTextureType_OPACITY, TextureColorSpace::Raw);
     if (alphaTex != kNoNode) m.alphaTexture = alphaTex;
     return m;
