@@ -336,6 +336,10 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       }, true);
     }
   }
+  if (m.type == MaterialType::Phong)
+    b.number(tr("Diffuse ratio"), "diffuseRatio", m.diffuseRatio, 0.0, 1.0, defaults.diffuseRatio, 3, [edit](double v, int drag) {
+      edit(tr("Diffuse ratio"), drag, [v](Material& x) { x.diffuseRatio = static_cast<float>(v); });
+    });
   if (m.type == MaterialType::DiffuseTransmission)
     b.number(tr("Transmittance"), "transmittance", m.transmittance, 0.0, 1.0, defaults.transmittance, 3, [edit](double v, int drag) {
       edit(tr("Transmittance"), drag, [v](Material& x) { x.transmittance = static_cast<float>(v); });

@@ -224,7 +224,7 @@ vec3 plasticDiffuse(Material m, vec3 wo, vec3 wi) {
   return base * through * (INV_PI * (1.0 - fo) * (1.0 - fi) / (m.ior * m.ior));
 }
 
-float phongExponent(Material m) { return 2.0 / (m.roughness * m.roughness) - 2.0; }
+float phongExponent(Material m) { return max(2.0 / (m.roughness * m.roughness) - 2.0, 0.0); }
 
 float orenNayarFactor(Material m, vec3 wo, vec3 wi) {
   float s2 = m.roughness * m.roughness;
@@ -284,11 +284,13 @@ vec3 baseEval(Material m, vec3 wo, vec3 wi, out float pdf) {
     return m.albedo * (INV_PI * orenNayarFactor(m, wo, wi) * wi.z);
   }
   if (isMat(t, kMatPhong)) {
-    // The lobe is around the mirror direction; what of it falls below the surface is lost.
-    float n = phongExponent(m);
-    float c = pow(max(dot(vec3(-wo.xy, wo.z), wi), 0.0), n);
-    pdf = c * (n + 1.0) * (0.5 * INV_PI);
-    return m.albedo * (c * (n + 2.0) * (0.5 * INV_PI) * wi.z);
+    // A share r (fdrInt's texel: Tungsten's diffuse_ratio) of Lambert and 1 - r of the lobe
+    // around the mirror direction, of which what falls below the surface is lost.
+    float n = phongExponent(m), r = m.fdrInt;
+    float d = dot(vec3(-wo.xy, wo.z), wi);
+    float c = d > 0.0 ? pow(d, n) : 0.0;
+    pdf = (1.0 - r) * c * (n + 1.0) * (0.5 * INV_PI) + r * wi.z * INV_PI;
+    return m.albedo * (((1.0 - r) * c * (n + 2.0) * (0.5 * INV_PI) + r * INV_PI) * wi.z);
   }
   if (isMat(t, kMatPlastic)) {
     float ps = plasticSpecularProbability(m, wo.z);
@@ -407,8 +409,8 @@ BsdfSample baseSample(Material m, vec3 wo, vec3 u) {
     s.wi.z = (wo.z > 0.0) != s.transmitted ? s.wi.z : -s.wi.z;
     evaluate = wo.z != 0.0 && s.wi.z != 0.0;
   } else if (wo.z > 0.0) {
-    if (isMat(t, kMatPhong)) {
-      // cos of the angle to the mirror direction drawn as u^(1 / (n + 1)).
+    if (isMat(t, kMatPhong) && u.z >= m.fdrInt) {
+      // The lobe: cos of the angle to the mirror direction drawn as u^(1 / (n + 1)).
       float ct = pow(u.x, 1.0 / (phongExponent(m) + 1.0)), st = sqrt(max(0.0, 1.0 - ct * ct)), phi = 2.0 * PI * u.y;
       vec3 r = vec3(-wo.xy, wo.z), ta, tb;
       makeFrame(r, ta, tb);
@@ -448,10 +450,12 @@ BsdfSample baseSample(Material m, vec3 wo, vec3 u) {
 // f cos is (1 - F(wo)) (1 - F(wi)) exp(-a (1 / cos wo' + 1 / cos wi')) f'(wo', wi') cos wi' times
 // the solid angle's change cos wi / (ior^2 cos wi'), primes inside the coat: symmetric in wo and wi.
 // A rough coat (Tungsten's rough_coat) reflects a GGX lobe instead of the delta, F D G1 G1 /
-// (4 cos wo), drawn by its visible normals, and weighs what is below by cos wo / cos wo' more.
+// (4 cos wo), drawn by its visible normals. (Tungsten's eval has this; its sampling of the base
+// under a rough coat weighs by cos wo / cos wo' more, which its eval and the smooth coat do not.)
 float coatSpecularProbability(Material m, float fo) {
   float t = exp(-2.0 * dot(m.coatAbsorption, vec3(1.0 / 3.0)));
-  return fo / (fo + (1.0 - fo) * t);
+  // Kept below 1 so that the base is drawn however much the coat absorbs: eval still counts it.
+  return min(fo / (fo + (1.0 - fo) * t), 0.95);
 }
 
 vec3 bsdfEval(Material m, vec3 wo, vec3 wi, out float pdf) {
@@ -468,7 +472,6 @@ vec3 bsdfEval(Material m, vec3 wo, vec3 wi, out float pdf) {
   f *= exp(-m.coatAbsorption * (1.0 / co + 1.0 / ci)) * ((1.0 - fo) * (1.0 - fi) * jacobian);
   float a = m.coatRoughness;
   if (a > 0.0) {
-    f *= wo.z / co;
     vec3 h = normalize(wo + wi);
     float oh = dot(wo, h);
     float d = ggxD(h, a), g1o = ggxG1(wo, a);
@@ -485,38 +488,32 @@ BsdfSample bsdfSample(Material m, vec3 wo, vec3 u) {
   float inv = 1.0 / m.coatIor, co;
   float fo = fresnelDielectric(wo.z, m.coatIor, co);
   float ps = coatSpecularProbability(m, fo);
-  if (u.z < ps && m.coatRoughness > 0.0) {
-    // The rough coat's lobe, weighed with the base's share of the same direction.
-    s.wi = reflect(-wo, sampleGgxVisibleNormal(wo, m.coatRoughness, u.xy));
-    float p;
-    vec3 f = s.wi.z > 0.0 ? bsdfEval(m, wo, s.wi, p) : vec3(0.0);
-    s.pdf = s.wi.z > 0.0 ? p : 0.0;
-    s.weight = s.pdf > 0.0 ? f / s.pdf : vec3(0.0);
-    return s;
-  }
-  if (u.z < ps) {
+  bool coatLobe = u.z < ps;
+  if (coatLobe && m.coatRoughness <= 0.0) {
     s.wi = vec3(-wo.xy, wo.z);
     s.weight = vec3(fo / ps);
     s.pdf = ps;
     s.delta = true;
     return s;
   }
-  // What is left of u.z is uniform again, for the material below's own choice of lobe.
-  BsdfSample b = baseSample(m, vec3(wo.xy * inv, co), vec3(u.xy, (u.z - ps) / (1.0 - ps)));
+  // One call of each below, whichever lobe is drawn: lavapipe runs every branch, and each call
+  // inlines the code of every material type. What is left of u.z is uniform again, for the base's
+  // own choice of lobe.
+  BsdfSample b = baseSample(m, vec3(wo.xy * inv, co), vec3(u.xy, coatLobe ? 0.5 : (u.z - ps) / (1.0 - ps)));
   float ci = b.wi.z, cOut;
-  if (!(maxComponent(b.weight) > 0.0) || ci <= 0.0) return s;
-  float fi = fresnelDielectric(ci, inv, cOut);
-  if (fi >= 1.0) return s;  // reflected back inside: lost, as in Tungsten
-  s.wi = normalize(vec3(b.wi.xy * m.coatIor, cOut));
-  if (b.delta) {
+  float fi = fresnelDielectric(max(ci, 0.0), inv, cOut);
+  // A base sample the coat reflects back inside is lost, as in Tungsten.
+  bool through = maxComponent(b.weight) > 0.0 && ci > 0.0 && fi < 1.0;
+  s.wi = coatLobe ? reflect(-wo, sampleGgxVisibleNormal(wo, m.coatRoughness, u.xy)) : normalize(vec3(b.wi.xy * m.coatIor, cOut));
+  if (!coatLobe && through && b.delta) {
     s.delta = true;
     s.pdf = b.pdf * (1.0 - ps);
     s.weight = b.weight * exp(-m.coatAbsorption * (1.0 / co + 1.0 / ci)) * ((1.0 - fo) * (1.0 - fi) / (1.0 - ps));
-    if (m.coatRoughness > 0.0) s.weight *= wo.z / co;
     return s;
   }
-  float p;
-  vec3 f = bsdfEval(m, wo, s.wi, p);
+  // The rough coat's lobe and the base's share of each direction are weighed together.
+  float p = 0.0;
+  vec3 f = (coatLobe || through) && s.wi.z > 0.0 ? bsdfEval(m, wo, s.wi, p) : vec3(0.0);
   s.pdf = p;
   s.weight = p > 0.0 ? f / p : vec3(0.0);
   return s;

@@ -101,6 +101,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   s.materials[0].blendWith = s.materials[1].id;
   s.materials[0].blendRatio = 0.25f;
   s.materials[0].transmittance = 0.35f;
+  s.materials[0].diffuseRatio = 0.45f;
   s.materials[0].coatIor = 1.45f;
   s.materials[0].coatRoughness = 0.07f;
   s.materials[0].coatAbsorption = Vec3{0.01f, 0.02f, 0.03f};
@@ -133,6 +134,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.materials[0].blendRatioTexture, s.textures[0].id);
   EXPECT_EQ(back->scene.materials[0].blendRatio, 0.25f);
   EXPECT_EQ(back->scene.materials[0].transmittance, 0.35f);
+  EXPECT_EQ(back->scene.materials[0].diffuseRatio, 0.45f);
   EXPECT_EQ(back->scene.materials[0].coatIor, 1.45f);
   EXPECT_EQ(back->scene.materials[0].coatRoughness, 0.07f);
   EXPECT_EQ(back->scene.materials[0].coatAbsorption, Vec3(0.01f, 0.02f, 0.03f));

@@ -196,7 +196,7 @@ TEST(Tungsten, WhatIsNotRenderedIsNamedInAWarning) {
 // Tungsten's fixed half.
 TEST(Tungsten, PhongAndDiffuseTransmissionKeepTheirKind) {
   auto r = importTungsten(writeScene(R"({"bsdfs": [
-        {"name": "p", "type": "phong", "exponent": 18, "albedo": 0.5},
+        {"name": "p", "type": "phong", "exponent": 18, "diffuse_ratio": 0.35, "albedo": 0.5},
         {"name": "d", "type": "phong"},
         {"name": "t", "type": "diffuse_transmission", "albedo": [0.2, 0.6, 0.3]}],
       "primitives": [{"type": "quad", "bsdf": "p"}, {"type": "quad", "bsdf": "d"}, {"type": "quad", "bsdf": "t"}]})"));
@@ -211,14 +211,16 @@ TEST(Tungsten, PhongAndDiffuseTransmissionKeepTheirKind) {
   EXPECT_EQ(named("p").type, MaterialType::Phong);
   EXPECT_NEAR(2 / (named("p").roughness * named("p").roughness) - 2, 18, 1e-3);
   EXPECT_NEAR(2 / (named("d").roughness * named("d").roughness) - 2, 64, 1e-2);
+  EXPECT_FLOAT_EQ(named("p").diffuseRatio, 0.35f);
+  EXPECT_FLOAT_EQ(named("d").diffuseRatio, 0.2f) << "Tungsten's default";
   EXPECT_EQ(named("t").type, MaterialType::DiffuseTransmission);
   EXPECT_EQ(named("t").transmittance, 0.5f);
   EXPECT_NEAR(named("t").albedo.y, 0.6f, 1e-6f);
 }
 
 // Tungsten's coats: the substrate is the material, the coat's index, absorption (sigma_a times
-// thickness) and roughness ride on it. A rough coat reads its absorption as "sigmaA" (Tungsten's
-// key; "sigma_a" is ignored, with a warning); a coat over glass is left out, with a warning.
+// thickness) and roughness ride on it. A rough coat also takes "sigmaA", which older Tungsten
+// read; a coat over glass is left out, with a warning.
 TEST(Tungsten, CoatsKeepTheirSubstrateUnderAClearCoat) {
   auto r = importTungsten(writeScene(R"({"bsdfs": [
         {"name": "gold", "type": "rough_conductor", "material": "Au", "roughness": 0.2},
@@ -245,18 +247,18 @@ TEST(Tungsten, CoatsKeepTheirSubstrateUnderAClearCoat) {
   EXPECT_FLOAT_EQ(satin.albedo.x, 0.4f);
   EXPECT_FLOAT_EQ(satin.coatIor, 1.3f) << "Tungsten's default index";
   EXPECT_FLOAT_EQ(satin.coatRoughness, 0.3f);
-  EXPECT_EQ(satin.coatAbsorption, Vec3(0.0f)) << "Tungsten's rough coat ignores sigma_a";
+  EXPECT_EQ(satin.coatAbsorption, Vec3(5.0f));
   EXPECT_EQ(named("tinted").coatAbsorption, Vec3(0.5f, 0.0f, 0.0f));
   EXPECT_FLOAT_EQ(named("tinted").coatRoughness, 0.02f) << "Tungsten's default roughness";
   EXPECT_EQ(lacquer.coatRoughness, 0.0f) << "a smooth coat";
   EXPECT_EQ(plain.type, MaterialType::RoughConductor) << "Tungsten's default substrate";
-  int rough = 0, glass = 0, unsupported = 0;
+  EXPECT_EQ(plain.albedo, Vec3(1.0f)) << "Tungsten's default albedo";
+  EXPECT_FALSE(named("glass").coated());
+  int glass = 0, unsupported = 0;
   for (const auto& w : r->warnings) {
-    rough += w.find("a rough coat's \"sigma_a\" is ignored") != std::string::npos;
     glass += w.find("a coat over a dielectric substrate is rendered without the coat") != std::string::npos;
     unsupported += w.find("not supported") != std::string::npos;
   }
-  EXPECT_EQ(rough, 1);
   EXPECT_EQ(glass, 1);
   EXPECT_EQ(unsupported, 0);
 }

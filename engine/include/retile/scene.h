@@ -80,9 +80,10 @@ enum class MaterialType {
   RoughDielectric,  // GGX glass
   ThinSheet,        // thin dielectric film: reflects by Fresnel, transmits straight through
   Null,             // scatters nothing: a black emitter surface (paths end on it)
-  // Tungsten's Phong: albedo (n + 2) / (2 pi) cos^n of the angle to the mirror direction, n the
-  // exponent 2 / a^2 - 2 of the roughness a (Walter et al. 2007's match of Phong to Beckmann), so
-  // that one roughness slider means about the same on every glossy type.
+  // Tungsten's Phong: albedo times diffuseRatio of Lambert plus the rest in the lobe (n + 2) /
+  // (2 pi) cos^n of the angle to the mirror direction, n the exponent 2 / a^2 - 2 of the roughness
+  // a (Walter et al. 2007's match of Phong to Beckmann), so that one roughness slider means about
+  // the same on every glossy type.
   Phong,
   // Lambertian on both sides: (1 - transmittance) of albedo reflected, transmittance passed to
   // the other side (Tungsten's diffuse_transmission; leaves, paper, lamp shades).
@@ -130,6 +131,7 @@ struct Material {
   // the diffuse base shows through dimmed by exp(-a (1 / cos wi + 1 / cos wo)).
   Vec3 coatingAbsorption{0.0f};
   float transmittance = 0.5f;      // diffuse transmission: the share of albedo passed through
+  float diffuseRatio = 0.2f;       // Phong: the share of albedo reflected as Lambert (Tungsten's default)
   // A clear coat over this material (Tungsten's smooth_coat): a smooth dielectric layer of index
   // coatIor (0: none) that reflects by Fresnel and through which the material is seen with both
   // directions refracted, dimmed inside by exp(-coatAbsorption (1 / cos + 1 / cos)) (sigma_a

@@ -365,6 +365,7 @@ class TungstenImporter {
         base = bsdf(*sv, where + ".substrate", depth + 1);
       } else {
         base.type = MaterialType::RoughConductor;
+        base.albedo = Vec3{1.0f};
         base.metal = "Cu";
         base.roughness = 0.1f;
         base.separableShadowing = true;
@@ -375,10 +376,8 @@ class TungstenImporter {
       number(v, "ior", &ior, where);
       number(v, "thickness", &thickness, where);
       const bool rough = type == "rough_coat";
-      // Tungsten's rough coat reads its absorption as "sigmaA" and ignores "sigma_a".
-      vec3(v, rough ? "sigmaA" : "sigma_a", &sigmaA, where);
-      if (rough && v.find("sigma_a") && !v.find("sigmaA"))
-        warn(cat(where, ": a rough coat's \"sigma_a\" is ignored, as Tungsten ignores it (it reads \"sigmaA\")"));
+      // Tungsten's rough coat read its absorption as "sigmaA" before it took "sigma_a".
+      if (!vec3(v, "sigma_a", &sigmaA, where) && rough) vec3(v, "sigmaA", &sigmaA, where);
       float coatRoughness = 0.02f;  // Tungsten's default
       if (rough) {
         if (const Value* r = v.find("roughness")) {
@@ -393,9 +392,13 @@ class TungstenImporter {
       m.name = name;
       if (isTransmissiveType(m.type)) {
         warn(cat(where, ": a coat over a ", materialTypeName(m.type), " substrate is rendered without the coat"));
-      } else if (base.blendWith != kNoNode) {
-        warn(cat(where, ": a coat over a blended substrate is rendered on its first part only"));
+        return m;
       }
+      if (!(ior > 1.0f)) {
+        warn(cat(where, ": a coat of index ", ior, " reflects and refracts nothing; rendered without it"));
+        return m;
+      }
+      if (base.blendWith != kNoNode) warn(cat(where, ": a coat over a blended substrate is rendered on its first part only"));
       if (m.coated()) warn(cat(where, ": a coat over a coat is rendered with the outer coat only"));
       m.coatIor = ior;
       m.coatAbsorption = max(sigmaA * thickness, Vec3{0.0f});
@@ -549,10 +552,11 @@ class TungstenImporter {
         exponent = 64;
       }
       m.roughness = std::sqrt(2.0f / (exponent + 2.0f));  // the inverse of n = 2 / a^2 - 2
+      m.diffuseRatio = 0.2f;  // Tungsten's default
+      number(v, "diffuse_ratio", &m.diffuseRatio, where);
     } else if (type == "diffuse_transmission") {
       m.type = MaterialType::DiffuseTransmission;
-      m.transmittance = 0.5f;  // Tungsten's, which its files cannot change; a file of ours may
-      number(v, "transmittance", &m.transmittance, where);
+      m.transmittance = 0.5f;  // Tungsten's, which its files cannot change
     } else if (type == "forward") {
       m.type = MaterialType::Lambert;
       m.alpha = 0;  // an invisible boundary: every ray passes

@@ -547,6 +547,9 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
 
 static_assert(gpu::kMaxBlendChain == kMaxBlendChain, "the kernel follows as many blends as the scene allows");
 
+// The kernel's material mask holds a bit per type, then Beckmann's and the coat's.
+static_assert(kMaterialTypeCount <= gpu::kMaskBeckmann && gpu::kMaskBeckmann < gpu::kMaskCoat && gpu::kMaskCoat < 32);
+
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture, int roughnessTexture, int alphaTexture,
                                                     int bumpTexture, int emissionTexture, int blendWith, int blendRatioTexture) {
   Vec3 eta = m.eta, k = m.k;
@@ -563,8 +566,10 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   // Diffuse light inside a plastic coating reflects back this fraction at the boundary
   // (Jensen et al.'s polynomial fit of the internal diffuse Fresnel reflectance).
   float fdrInt = -1.4399f / (ior * ior) + 0.7099f / ior + 0.6681f + 0.0636f * ior;
-  // Diffuse transmission has no coating: its texel carries the transmittance instead.
+  // Diffuse transmission and Phong have no coating: the texel carries the transmittance or the
+  // diffuse ratio instead.
   if (m.type == MaterialType::DiffuseTransmission) fdrInt = std::isfinite(m.transmittance) ? m.transmittance : 0.5f;
+  if (m.type == MaterialType::Phong) fdrInt = std::isfinite(m.diffuseRatio) ? m.diffuseRatio : 0.2f;
   return {v4(max(m.albedo, Vec3{0.0f}), bitsOf(type)),
           vec4{roughness, ior, std::clamp(m.alpha, 0.0f, 1.0f), std::clamp(fdrInt, 0.0f, 1.0f)},
           v4(eta, bitsOf(albedoTexture)), v4(k, bitsOf(roughnessTexture)),
