@@ -30,7 +30,7 @@ struct Material {
   bool separable;    // rough types: G = G1(wo) G1(wi) instead of height-correlated
   float ior;
   float fdrInt;      // plastic: internal diffuse Fresnel reflectance of the coating; diffuse
-                     // transmission: the transmittance (packMaterial)
+                     // transmission: the transmittance; Phong: the diffuse ratio (packMaterial)
   vec3 coating;      // plastic: the coating's absorption (sigma_a times thickness)
   vec3 eta;
   vec3 k;
@@ -80,14 +80,15 @@ BsdfSample noSample() {
   return s;
 }
 
-// Materials with only delta lobes: light sampling cannot reach them. Smooth plastic is not one:
-// its diffuse base takes light samples and its specular lobe is sampled inside bsdfSample; nor is
-// a smooth metal under a rough coat.
+// The material types with only delta lobes, a coat left out.
 bool isDeltaBase(Material m) {
   return isMat(m.type, kMatConductor) || isMat(m.type, kMatMirror) || isMat(m.type, kMatDielectric) || isMat(m.type, kMatThinSheet) ||
          isMat(m.type, kMatNull);
 }
 
+// Materials with only delta lobes: light sampling cannot reach them. Smooth plastic is not one:
+// its diffuse base takes light samples and its specular lobe is sampled inside bsdfSample; nor is
+// a smooth metal under a rough coat, whose lobe takes them.
 bool isDeltaMaterial(Material m) { return isDeltaBase(m) && !(kCoatUsed && m.coatIor > 1.0 && m.coatRoughness > 0.0); }
 
 bool isTransmissive(Material m) {
