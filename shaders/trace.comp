@@ -139,7 +139,8 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
   const bool plastics = (kMaterialMask & ((1 << kMatPlastic) | (1 << kMatRoughPlastic))) != 0;
   Material m = unpackMaterial(texelFetch(uMaterials, base), texelFetch(uMaterials, base + 1), t2, t3,
                               texelFetch(uMaterials, base + 4), plastics ? texelFetch(uMaterials, base + 6) : vec4(0.0),
-                              kCoatUsed ? texelFetch(uMaterials, base + 7) : vec4(0.0), kCoatUsed ? texelFetch(uMaterials, base + 8) : vec4(0.0));
+                              kCoatUsed ? texelFetch(uMaterials, base + 7) : vec4(0.0),
+                              kCoatUsed || kMediumUsed ? texelFetch(uMaterials, base + 8) : vec4(0.0));
   int albedoTex = floatBitsToInt(t2.w), roughTex = floatBitsToInt(t3.w);
   if (hasFeature(kFeatureTextures) && albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
   if (hasFeature(kFeatureTextures) && roughTex >= 0) m.roughness = max(m.roughness * sampleTexture(roughTex, uv).r, 1e-3);
@@ -208,6 +209,7 @@ struct Path {
   float auxDepth;  // kInfinity until that hit
   float travelled; // distance along the path so far
   int auxInstance;
+  vec3 absorption;  // of the medium the path is in (kMediumUsed): inside filled glass, else 0
 };
 
 // The shadow ray of a path vertex's next-event estimation. It is traced with the next segment's
@@ -266,6 +268,7 @@ Path startPath(uint slot, int found) {
   path.L = vec3(0.0);
   path.beta = vec3(1.0);
   path.etaScale = 1.0;
+  path.absorption = vec3(0.0);
   path.specular = true;
   path.prevPdf = 0.0;
   path.prevPos = path.ro;
@@ -351,6 +354,10 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
     if (path.depth == 0) atomicAdd(selectionCounts[path.selBase], 1u);
     else atomicAdd(selectionCounts[path.selBase + 1], uint(max(maxBounces + 1, 1) / path.depth));
   }
+
+  // The segment's way through the medium it ran in; a ray that leaves the scene from inside one
+  // (glass not closed) is absorbed on its infinite way.
+  if (kMediumUsed) path.beta *= hit.prim >= 0 ? exp(-path.absorption * hit.t) : vec3(lessThanEqual(path.absorption, vec3(0.0)));
 
   if (hit.prim < 0) {
     vec3 Le = envRadiance(rd);
@@ -499,6 +506,10 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   if (!tungstenShading && (bs.transmitted ? sideI * sideO >= 0.0 : sideI * sideO <= 0.0)) return endPath(path, shadow);
   path.beta *= bs.weight;
   // Roulette must not see the 1/eta^2 radiance scaling inside glass as lost energy.
+  // Through glass the path enters its medium or leaves it for the outside (a vacuum: nesting is
+  // not tracked).
+  if (kMediumUsed && bs.transmitted && (isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric)))
+    path.absorption = woL.z > 0.0 ? m.interior : vec3(0.0);
   if (bs.transmitted && !isMat(m.type, kMatThinSheet) && !isMat(m.type, kMatDiffuseTransmission)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
   path.specular = bs.delta;
   path.prevPdf = bs.pdf;
@@ -535,6 +546,7 @@ void main() {
   path.auxDepth = kInfinity;
   path.travelled = 0.0;
   path.auxInstance = 0;
+  path.absorption = vec3(0.0);
   bool alive = false;
   Shadow shadow;
   shadow.pending = false;

@@ -336,6 +336,11 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       }, true);
     }
   }
+  if (m.type == MaterialType::Dielectric || m.type == MaterialType::RoughDielectric)
+    b.vec3(tr("Interior absorption"), "interiorAbsorption", m.interiorAbsorption, 0.01, [edit](int channel, double v, int drag) {
+      edit(tr("Interior absorption"), drag,
+           [channel, v](Material& x) { axisOf(x.interiorAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
+    }, true);
   if (m.type == MaterialType::Phong)
     b.number(tr("Diffuse ratio"), "diffuseRatio", m.diffuseRatio, 0.0, 1.0, defaults.diffuseRatio, 3, [edit](double v, int drag) {
       edit(tr("Diffuse ratio"), drag, [v](Material& x) { x.diffuseRatio = static_cast<float>(v); });

@@ -12,15 +12,16 @@
 // alone: lavapipe runs every branch some lane of eight takes, and code for absent types still
 // costs registers and spills (removing the nine unused types speeds the Cornell box up by 9 %).
 #ifndef RETILE_MATERIALS
-#define RETILE_MATERIALS 0x7fff
+#define RETILE_MATERIALS 0xffff
 #endif
 const int kMaterialMask = RETILE_MATERIALS;
 bool isMat(int t, int k) { return (kMaterialMask & (1 << k)) != 0 && t == k; }
 // Some rough material of the scene asks for Beckmann's distribution (bit kMaskBeckmann of the
 // mask): without it the Beckmann code is not compiled in.
 const bool kBeckmannUsed = (kMaterialMask & (1 << kMaskBeckmann)) != 0;
-// Likewise the clear coat (bit kMaskCoat).
+// Likewise the clear coat (bit kMaskCoat) and glass filled with an absorbing medium (kMaskMedium).
 const bool kCoatUsed = (kMaterialMask & (1 << kMaskCoat)) != 0;
+const bool kMediumUsed = (kMaterialMask & (1 << kMaskMedium)) != 0;
 
 struct Material {
   int type;
@@ -38,6 +39,7 @@ struct Material {
   float coatIor;        // a clear coat's index; no coat at 1 or below
   vec3 coatAbsorption;  // inside the coat, sigma_a times thickness
   float coatRoughness;  // a rough coat's GGX alpha; 0: smooth
+  vec3 interior;        // glass: its medium's absorption per unit of length
 };
 
 // The material's texels as render/render_scene.cpp packMaterial writes them, textures not applied.
@@ -58,6 +60,7 @@ Material unpackMaterial(vec4 t0, vec4 t1, vec4 t2, vec4 t3, vec4 t4, vec4 t6, ve
   m.coatIor = kCoatUsed ? t7.y : 0.0;
   m.coatAbsorption = t8.rgb;
   m.coatRoughness = t8.w;
+  m.interior = kMediumUsed ? t8.rgb : vec3(0.0);
   return m;
 }
 

@@ -122,6 +122,33 @@ TEST(KnownAnswer, WhiteFurnaceLosslessMaterials) {
   }
 }
 
+TEST(KnownAnswer, GlassFilledWithAnAbsorbingMediumDimsByBeersLaw) {
+  // A slab of glass one unit thick, of index 1.0001 (no Fresnel reflection, rays go straight),
+  // filled with a medium of absorption sigma, before a sky of 1: the middle of the image, where
+  // rays cross the slab head on, shows exp(-sigma) per channel; empty glass shows 1.
+  RETILE_RENDERER_OR_SKIP(r);
+  const float sigma[3] = {0.7f, 0.2f, 0.0f};
+  for (bool filled : {true, false}) {
+    Scene s = test::emptyScene(32, 32);
+    s.camera = test::frontCamera(30);
+    s.settings.maxBounces = 8;
+    s.environment.color = Vec3{1.0f};
+    Material glass;
+    glass.type = MaterialType::Dielectric;
+    glass.albedo = Vec3{1.0f};
+    glass.ior = 1.0f;
+    if (filled) glass.interiorAbsorption = {sigma[0], sigma[1], sigma[2]};
+    test::addMeshObject(s, "slab", makeCube(), test::addMaterial(s, glass), Mat4::translate({0, 0, -5}) * Mat4::scale({40, 40, 1}));
+    RenderImage img = renderScene(*r, s, 16);
+    for (int y = 14; y < 18; ++y)
+      for (int x = 14; x < 18; ++x)
+        for (int c = 0; c < 3; ++c) {
+          const double expected = filled ? std::exp(-static_cast<double>(sigma[c])) : 1.0;
+          EXPECT_NEAR(img.color[3 * (y * 32 + x) + c], expected, 2e-3) << "pixel " << x << "," << y << " channel " << c;
+        }
+  }
+}
+
 TEST(KnownAnswer, ClosedFurnaceWithBounceLimit) {
   // Inside a sphere that emits Le and reflects rho, a path of at most B bounces sees
   // Le * (1 + rho + ... + rho^B). Exercises emitter sampling, MIS, roulette (either rule: with

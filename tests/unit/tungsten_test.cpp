@@ -263,6 +263,38 @@ TEST(Tungsten, CoatsKeepTheirSubstrateUnderAClearCoat) {
   EXPECT_EQ(unsupported, 0);
 }
 
+// A homogeneous medium that only absorbs fills the glass that names it as its int_medium (sigma_a
+// times density); elsewhere, and a medium that scatters anywhere, is named in a warning.
+TEST(Tungsten, AnAbsorbingMediumFillsItsGlass) {
+  auto r = importTungsten(writeScene(R"({"media": [
+        {"name": "ink", "type": "homogeneous", "sigma_a": [0.5, 1, 2], "sigma_s": 0, "density": 2},
+        {"name": "fog", "type": "homogeneous", "sigma_a": 0.1, "sigma_s": 1}],
+      "bsdfs": [{"name": "glass", "type": "dielectric", "ior": 1.33}, {"name": "wall", "type": "lambert"}],
+      "primitives": [
+        {"type": "sphere", "name": "bottle", "bsdf": "glass", "int_medium": "ink"},
+        {"type": "sphere", "name": "empty", "bsdf": "glass"},
+        {"type": "quad", "name": "w", "bsdf": "wall", "int_medium": "ink"},
+        {"type": "sphere", "name": "misty", "bsdf": "glass", "int_medium": "fog"}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  auto materialOf = [&](const char* object) {
+    for (const Object& o : r->scene.objects)
+      if (o.name == object) return *r->scene.material(o.material);
+    ADD_FAILURE() << "no object " << object;
+    return Material{};
+  };
+  EXPECT_EQ(materialOf("bottle").interiorAbsorption, Vec3(1.0f, 2.0f, 4.0f));
+  EXPECT_FLOAT_EQ(materialOf("bottle").ior, 1.33f);
+  EXPECT_EQ(materialOf("empty").interiorAbsorption, Vec3(0.0f)) << "the shared glass stays empty";
+  EXPECT_EQ(materialOf("misty").interiorAbsorption, Vec3(0.0f));
+  int fog = 0, wall = 0;
+  for (const auto& w : r->warnings) {
+    fog += w.find("participating media are not rendered ('fog')") != std::string::npos;
+    wall += w.find("the medium 'ink' is rendered only inside glass") != std::string::npos;
+  }
+  EXPECT_EQ(fog, 1);
+  EXPECT_EQ(wall, 1);
+}
+
 // Tungsten turns an infinite_sphere by its transform's rotation, as it turns any primitive: so a
 // direction fixed to a quad (its normal, +y in the quad's space) is the sky's up (+y in the map's
 // frame) when both have the same transform, tilted, turned and given an "up" alike.

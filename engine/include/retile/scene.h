@@ -144,6 +144,11 @@ struct Material {
   // the smooth coat times cos wo / cos wo' (wo toward the viewer, wo' inside), Tungsten's form,
   // which darkens the base at grazing views and is not reciprocal.
   float coatRoughness = 0.0f;
+  // Glass (dielectric, rough dielectric): what fills it absorbs this much per unit of length,
+  // light inside dimmed by exp(-interiorAbsorption distance) (Tungsten's homogeneous int_medium
+  // that does not scatter: its sigma_a times density). Nested media are not tracked: leaving any
+  // glass leaves its medium.
+  Vec3 interiorAbsorption{0.0f};
   bool coated() const { return coatIor > 1.0f; }
   std::string metal = "Cu";        // conductors: a named metal (see conductorNames) or "custom"
   Vec3 eta{0.2f, 0.92f, 1.1f};     // conductors with metal == "custom"

@@ -266,6 +266,7 @@ Value nativeSceneToJson(const Scene& s) {
     v.set("coating_absorption", json::fromVec3(m.coatingAbsorption));
     v.set("transmittance", m.transmittance);
     v.set("diffuse_ratio", m.diffuseRatio);
+    v.set("interior_absorption", json::fromVec3(m.interiorAbsorption));
     if (m.coatIor != 0) {
       v.set("coat_ior", m.coatIor);
       v.set("coat_absorption", json::fromVec3(m.coatAbsorption));
@@ -499,6 +500,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.vec3("coating_absorption", &m.coatingAbsorption);
       r.number("transmittance", &m.transmittance);
       r.number("diffuse_ratio", &m.diffuseRatio);
+      r.vec3("interior_absorption", &m.interiorAbsorption);
       r.number("coat_ior", &m.coatIor);
       r.vec3("coat_absorption", &m.coatAbsorption);
       r.number("coat_roughness", &m.coatRoughness);

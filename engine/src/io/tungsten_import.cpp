@@ -85,10 +85,26 @@ class TungstenImporter {
         s.settings.samplesPerPixel = std::clamp(static_cast<int>(spp), 1, 1 << 20);
     }
     if (const Value* m = root.find("media"); m && m->isArray() && !m->asArray().empty()) {
+      // A homogeneous medium that only absorbs is rendered inside glass (Material::interiorAbsorption).
       std::string names;
-      for (const Value& medium : m->asArray())
-        if (medium.isObject()) names += cat(names.empty() ? "" : ", ", "'", string(medium, "name", "?"), "'");
-      warn(cat("media: participating media are not rendered (", names, "); light travels through them as through a vacuum"));
+      for (std::size_t i = 0; i < m->asArray().size(); ++i) {
+        const Value& medium = m->asArray()[i];
+        if (!medium.isObject()) continue;
+        // Read leniently: a medium that is not understood is left out with the warning below.
+        Vec3 sigmaA{0.0f}, sigmaS{0.0f};
+        float density = 1;
+        const Value *a = medium.find("sigma_a"), *sc = medium.find("sigma_s"), *d = medium.find("density");
+        const bool read = (!a || json::toVec3(*a, &sigmaA)) && (!sc || json::toVec3(*sc, &sigmaS)) && (!d || json::toFloat(*d, &density));
+        const std::string name = string(medium, "name", "?");
+        if (read && string(medium, "type") == "homogeneous" && maxComponent(sigmaS) <= 0 && density >= 0 &&
+            !medium.find("transmittance"))
+          absorbers_[name] = max(sigmaA * density, Vec3{0.0f});
+        else
+          names += cat(names.empty() ? "" : ", ", "'", name, "'");
+      }
+      if (!names.empty())
+        warn(cat("media: participating media are not rendered (", names,
+                 "); light travels through them as through a vacuum (media that only absorb are, inside glass)"));
     }
     if (const Value* p = root.find("primitives"); p && ok()) {
       if (!p->isArray()) return fail("primitives: expected an array");
@@ -1099,17 +1115,30 @@ class TungstenImporter {
         mat.bumpTexture = bumpTexture;
         mat.bumpStrength = bumpStrength;
       }
-      if (bumpTexture != kNoNode && !emissive) {
-        // Primitives naming the same bsdf with the same bump share one copy; an inline bsdf is
-        // the primitive's own (two unnamed ones must not meet under the empty name).
-        auto key = std::make_tuple(mat.name, bumpTexture, bumpStrength);
+      // An absorbing medium inside glass belongs to the primitive in Tungsten and to the material here.
+      std::string medium;
+      for (const char* side : {"int_medium", "ext_medium"}) {
+        const std::string name = string(p, side);
+        if (name.empty() || !absorbers_.count(name)) continue;
+        const bool glass = mat.type == MaterialType::Dielectric || mat.type == MaterialType::RoughDielectric;
+        if (glass && std::string(side) == "int_medium") {
+          medium = name;
+          mat.interiorAbsorption = absorbers_[name];
+        } else {
+          warn(cat(where, ": the medium '", name, "' is rendered only inside glass (an int_medium); here light passes through it"));
+        }
+      }
+      if ((bumpTexture != kNoNode || !medium.empty()) && !emissive) {
+        // Primitives naming the same bsdf with the same bump and medium share one copy; an
+        // inline bsdf is the primitive's own (two unnamed ones must not meet under the empty name).
+        auto key = std::make_tuple(mat.name, bumpTexture, bumpStrength, medium);
         if (auto it = bumped_.find(key); named && it != bumped_.end()) {
           materialId = it->second;
         } else {
           if (named) copied_.insert(mat.id);
           Material m = mat;
           m.id = s.newId();
-          m.name = cat(mat.name.empty() ? where : mat.name, " (bump)");
+          m.name = cat(mat.name.empty() ? where : mat.name, medium.empty() ? " (bump)" : cat(" (", medium, ")"));
           s.materials.push_back(m);
           materialId = m.id;
           if (named) bumped_[key] = m.id;
@@ -1163,7 +1192,9 @@ class TungstenImporter {
   std::map<std::string, std::shared_ptr<const MeshGeometry>> shapes_;
   int emitters_ = 0;
   std::set<NodeId> copied_;  // named bsdfs some primitive took a copy of (dropReplacedBsdfs)
-  std::map<std::tuple<std::string, NodeId, float>, NodeId> bumped_;  // (bsdf, texture, strength) -> its copy
+  // (bsdf, bump texture, strength, medium) -> its copy
+  std::map<std::tuple<std::string, NodeId, float, std::string>, NodeId> bumped_;
+  std::map<std::string, Vec3> absorbers_;  // media that only absorb: name -> sigma_a times density
 };
 
 }  // namespace

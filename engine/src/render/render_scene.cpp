@@ -548,7 +548,13 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
 static_assert(gpu::kMaxBlendChain == kMaxBlendChain, "the kernel follows as many blends as the scene allows");
 
 // The kernel's material mask holds a bit per type, then Beckmann's and the coat's.
-static_assert(kMaterialTypeCount <= gpu::kMaskBeckmann && gpu::kMaskBeckmann < gpu::kMaskCoat && gpu::kMaskCoat < 32);
+static_assert(kMaterialTypeCount <= gpu::kMaskBeckmann && gpu::kMaskBeckmann < gpu::kMaskCoat &&
+              gpu::kMaskCoat < gpu::kMaskMedium && gpu::kMaskMedium < 32);
+
+namespace {
+bool isGlass(MaterialType t) { return t == MaterialType::Dielectric || t == MaterialType::RoughDielectric; }
+bool filled(const Material& m) { return isGlass(m.type) && isFinite(m.interiorAbsorption) && maxComponent(m.interiorAbsorption) > 0; }
+}  // namespace
 
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture, int roughnessTexture, int alphaTexture,
                                                     int bumpTexture, int emissionTexture, int blendWith, int blendRatioTexture) {
@@ -577,7 +583,8 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
           vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, bitsOf(emissionTexture), bitsOf(blendWith)},
           v4(max(m.coatingAbsorption, Vec3{0.0f}), std::isfinite(m.blendRatio) ? std::clamp(m.blendRatio, 0.0f, 1.0f) : 1.0f),
           vec4{bitsOf(blendRatioTexture), coated ? std::min(m.coatIor, 10.0f) : 0.0f, 0, 0},
-          v4(coated ? max(m.coatAbsorption, Vec3{0.0f}) : Vec3{0.0f},
+          // The ninth holds the coat or, for glass, which takes no coat, its medium's absorption.
+          v4(coated ? max(m.coatAbsorption, Vec3{0.0f}) : filled(m) ? max(m.interiorAbsorption, Vec3{0.0f}) : Vec3{0.0f},
              coated && m.coatRoughness > 0 ? std::clamp(m.coatRoughness, 1e-3f, 1.0f) : 0.0f)};
 }
 
@@ -597,6 +604,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     if (m.beckmann && isMicrofacet(m.type))
       data_.materialTypes |= 1u << gpu::kMaskBeckmann;
     if (m.coated() && !isTransmissiveType(m.type)) data_.materialTypes |= 1u << gpu::kMaskCoat;
+    if (filled(m)) data_.materialTypes |= 1u << gpu::kMaskMedium;
     if (textureIndex(m.albedoTexture) >= 0 || textureIndex(m.roughnessTexture) >= 0) data_.materialTextures = true;
     if (textureIndex(m.bumpTexture) >= 0 && m.bumpStrength != 0) data_.materialBump = true;
     if (textureIndex(m.emissionTexture) >= 0 && m.emissive()) data_.emissionTextures = true;

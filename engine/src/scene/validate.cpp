@@ -143,6 +143,7 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
     clampValue(m.coatIor, 0.0f, 10.0f, 0.0f, what + ": coat index of refraction", warnings);
     checkColor(m.coatAbsorption, Vec3{0.0f}, what + ": coat absorption", warnings);
     clampValue(m.coatRoughness, 0.0f, 1.0f, 0.0f, what + ": coat roughness", warnings);
+    checkColor(m.interiorAbsorption, Vec3{0.0f}, what + ": interior absorption", warnings);
     if (!finiteNonNegative(m.eta) || !finiteNonNegative(m.k)) {
       warnings.push_back(cat(what, ": its complex index of refraction is negative or not finite; copper instead"));
       m.metal = "Cu";
