@@ -209,7 +209,9 @@ struct Path {
   float auxDepth;  // kInfinity until that hit
   float travelled; // distance along the path so far
   int auxInstance;
-  vec3 absorption;  // of the medium the path is in (kMediumUsed): inside filled glass, else 0
+#if RETILE_MEDIUM
+  vec3 absorption;  // of the medium the path is in: inside filled glass, else 0
+#endif
 };
 
 // The shadow ray of a path vertex's next-event estimation. It is traced with the next segment's
@@ -268,7 +270,9 @@ Path startPath(uint slot, int found) {
   path.L = vec3(0.0);
   path.beta = vec3(1.0);
   path.etaScale = 1.0;
+#if RETILE_MEDIUM
   path.absorption = vec3(0.0);
+#endif
   path.specular = true;
   path.prevPdf = 0.0;
   path.prevPos = path.ro;
@@ -357,7 +361,9 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
 
   // The segment's way through the medium it ran in; a ray that leaves the scene from inside one
   // (glass not closed) is absorbed on its infinite way.
-  if (kMediumUsed) path.beta *= hit.prim >= 0 ? exp(-path.absorption * hit.t) : vec3(lessThanEqual(path.absorption, vec3(0.0)));
+#if RETILE_MEDIUM
+  path.beta *= hit.prim >= 0 ? exp(-path.absorption * hit.t) : vec3(lessThanEqual(path.absorption, vec3(0.0)));
+#endif
 
   if (hit.prim < 0) {
     vec3 Le = envRadiance(rd);
@@ -508,8 +514,10 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   // Roulette must not see the 1/eta^2 radiance scaling inside glass as lost energy.
   // Through glass the path enters its medium or leaves it for the outside (a vacuum: nesting is
   // not tracked).
-  if (kMediumUsed && bs.transmitted && (isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric)))
+#if RETILE_MEDIUM
+  if (bs.transmitted && (isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric)))
     path.absorption = woL.z > 0.0 ? m.interior : vec3(0.0);
+#endif
   if (bs.transmitted && !isMat(m.type, kMatThinSheet) && !isMat(m.type, kMatDiffuseTransmission)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
   path.specular = bs.delta;
   path.prevPdf = bs.pdf;
@@ -546,7 +554,9 @@ void main() {
   path.auxDepth = kInfinity;
   path.travelled = 0.0;
   path.auxInstance = 0;
+#if RETILE_MEDIUM
   path.absorption = vec3(0.0);
+#endif
   bool alive = false;
   Shadow shadow;
   shadow.pending = false;

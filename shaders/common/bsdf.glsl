@@ -22,6 +22,10 @@ const bool kBeckmannUsed = (kMaterialMask & (1 << kMaskBeckmann)) != 0;
 // Likewise the clear coat (bit kMaskCoat) and glass filled with an absorbing medium (kMaskMedium).
 const bool kCoatUsed = (kMaterialMask & (1 << kMaskCoat)) != 0;
 const bool kMediumUsed = (kMaterialMask & (1 << kMaskMedium)) != 0;
+// The same for the preprocessor (bit 15 is kMaskMedium): the path's medium (trace.comp) is not
+// even declared without one: a dead field of the path measured 5 % slower on the spaceship (not settled,
+// docs/MEASUREMENTS.md).
+#define RETILE_MEDIUM ((RETILE_MATERIALS & 32768) != 0)
 
 struct Material {
   int type;
