@@ -191,6 +191,14 @@ TEST(Tungsten, WhatIsNotRenderedIsNamedInAWarning) {
   EXPECT_EQ(bsdfs, 1);
 }
 
+// The imported material of that name (a failure, and a default material, when there is none).
+Material materialNamed(const Scene& s, const std::string& name) {
+  for (const Material& m : s.materials)
+    if (m.name == name) return m;
+  ADD_FAILURE() << "no material " << name;
+  return Material{};
+}
+
 // Tungsten's phong and diffuse_transmission are their own materials, not lamberts: the exponent
 // becomes the roughness a with n = 2 / a^2 - 2 (Tungsten's default 64), the transmittance is
 // Tungsten's fixed half.
@@ -202,12 +210,7 @@ TEST(Tungsten, PhongAndDiffuseTransmissionKeepTheirKind) {
       "primitives": [{"type": "quad", "bsdf": "p"}, {"type": "quad", "bsdf": "d"}, {"type": "quad", "bsdf": "t"}]})"));
   ASSERT_TRUE(r.ok()) << r.error();
   for (const auto& w : r->warnings) EXPECT_EQ(w.find("not supported"), std::string::npos) << w;
-  auto named = [&](const char* name) {
-    for (const Material& m : r->scene.materials)
-      if (m.name == name) return m;
-    ADD_FAILURE() << "no material " << name;
-    return Material{};
-  };
+  auto named = [&](const char* name) { return materialNamed(r->scene, name); };
   EXPECT_EQ(named("p").type, MaterialType::Phong);
   EXPECT_NEAR(2 / (named("p").roughness * named("p").roughness) - 2, 18, 1e-3);
   EXPECT_NEAR(2 / (named("d").roughness * named("d").roughness) - 2, 64, 1e-2);
@@ -232,12 +235,7 @@ TEST(Tungsten, CoatsKeepTheirSubstrateUnderAClearCoat) {
       "primitives": [{"type": "quad", "bsdf": "lacquer"}, {"type": "quad", "bsdf": "satin"},
                      {"type": "quad", "bsdf": "default"}, {"type": "quad", "bsdf": "glass"}, {"type": "quad", "bsdf": "tinted"}]})"));
   ASSERT_TRUE(r.ok()) << r.error();
-  auto named = [&](const char* name) {
-    for (const Material& m : r->scene.materials)
-      if (m.name == name) return m;
-    ADD_FAILURE() << "no material " << name;
-    return Material{};
-  };
+  auto named = [&](const char* name) { return materialNamed(r->scene, name); };
   const Material lacquer = named("lacquer"), satin = named("satin"), plain = named("default");
   EXPECT_EQ(lacquer.type, MaterialType::RoughConductor);
   EXPECT_EQ(lacquer.metal, "Au");

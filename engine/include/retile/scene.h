@@ -103,6 +103,8 @@ constexpr bool isTransmissiveType(MaterialType t) {
          t == MaterialType::DiffuseTransmission;
 }
 
+constexpr bool isGlassType(MaterialType t) { return t == MaterialType::Dielectric || t == MaterialType::RoughDielectric; }
+
 // The types with a roughness field: microfacet alpha, Oren-Nayar sigma, or Phong's width.
 constexpr bool hasRoughness(MaterialType t) {
   return isMicrofacet(t) || t == MaterialType::OrenNayar || t == MaterialType::Phong;

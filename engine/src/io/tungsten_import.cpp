@@ -1120,8 +1120,7 @@ class TungstenImporter {
       for (const char* side : {"int_medium", "ext_medium"}) {
         const std::string name = string(p, side);
         if (name.empty() || !absorbers_.count(name)) continue;
-        const bool glass = mat.type == MaterialType::Dielectric || mat.type == MaterialType::RoughDielectric;
-        if (glass && std::string(side) == "int_medium") {
+        if (isGlassType(mat.type) && std::string(side) == "int_medium") {
           medium = name;
           mat.interiorAbsorption = absorbers_[name];
         } else {

@@ -552,8 +552,9 @@ static_assert(kMaterialTypeCount <= gpu::kMaskBeckmann && gpu::kMaskBeckmann < g
               gpu::kMaskCoat < gpu::kMaskMedium && gpu::kMaskMedium < 32);
 
 namespace {
-bool isGlass(MaterialType t) { return t == MaterialType::Dielectric || t == MaterialType::RoughDielectric; }
-bool filled(const Material& m) { return isGlass(m.type) && isFinite(m.interiorAbsorption) && maxComponent(m.interiorAbsorption) > 0; }
+bool filled(const Material& m) { return isGlassType(m.type) && isFinite(m.interiorAbsorption) && maxComponent(m.interiorAbsorption) > 0; }
+// Transmissive types take no coat (Material::coatIor).
+bool coatRendered(const Material& m) { return m.coated() && !isTransmissiveType(m.type); }
 }  // namespace
 
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture, int roughnessTexture, int alphaTexture,
@@ -568,7 +569,7 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   if (rough || m.type == MaterialType::Phong) roughness = std::max(roughness, 1e-3f);
   if (m.type == MaterialType::OrenNayar) roughness = std::clamp(m.roughness, 0.0f, kPi / 2);
   float ior = std::clamp(m.ior, 1.0001f, 10.0f);
-  const bool coated = m.coated() && std::isfinite(m.coatIor) && !isTransmissiveType(m.type);
+  const bool coated = coatRendered(m);
   // Diffuse light inside a plastic coating reflects back this fraction at the boundary
   // (Jensen et al.'s polynomial fit of the internal diffuse Fresnel reflectance).
   float fdrInt = -1.4399f / (ior * ior) + 0.7099f / ior + 0.6681f + 0.0636f * ior;
@@ -603,7 +604,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     // The kernel compiles Beckmann's distribution in only for scenes that use it.
     if (m.beckmann && isMicrofacet(m.type))
       data_.materialTypes |= 1u << gpu::kMaskBeckmann;
-    if (m.coated() && !isTransmissiveType(m.type)) data_.materialTypes |= 1u << gpu::kMaskCoat;
+    if (coatRendered(m)) data_.materialTypes |= 1u << gpu::kMaskCoat;
     if (filled(m)) data_.materialTypes |= 1u << gpu::kMaskMedium;
     if (textureIndex(m.albedoTexture) >= 0 || textureIndex(m.roughnessTexture) >= 0) data_.materialTextures = true;
     if (textureIndex(m.bumpTexture) >= 0 && m.bumpStrength != 0) data_.materialBump = true;
