@@ -25,16 +25,17 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// One warm-up frame (pipeline creation, first touch of buffers), then `frames` frames of 1 spp
-// over the whole image; their statistics summed, and their wall clock (warm-up excluded).
-FrameStats traceFrames(Renderer& renderer, int w, int h, int frames, const FrameOptions& options,
+// One warm-up frame (pipeline creation, first touch of buffers), then `frames` frames of `spp`
+// samples per pixel over the whole image; their statistics summed, and their wall clock (warm-up
+// excluded).
+FrameStats traceFrames(Renderer& renderer, int w, int h, int frames, int spp, const FrameOptions& options,
                        double* wallSeconds = nullptr) {
-  TileWork all{0, 0, w, h, 1, 0, true};
+  TileWork all{0, 0, w, h, spp, 0, true};
   renderer.renderFrame({all}, options);
   const auto start = Clock::now();
   FrameStats sum;
   for (int f = 0; f < frames; ++f) {
-    all.sampleBase = static_cast<std::uint32_t>(f + 1);
+    all.sampleBase = static_cast<std::uint32_t>((f + 1) * spp);
     all.restart = false;
     sum.add(renderer.renderFrame({all}, options));
   }
@@ -67,7 +68,7 @@ int benchScale(const ScaleOptions& o) {
     const double upload = std::chrono::duration<double>(Clock::now() - t0).count();
     renderer.setMaxBounces(scene.settings.maxBounces);
     renderer.resize(w, h);
-    FrameStats sum = traceFrames(renderer, w, h, frames, FrameOptions{});
+    FrameStats sum = traceFrames(renderer, w, h, frames, offlineSamplesPerFrame(w, h), FrameOptions{});
     const double rate = static_cast<double>(sum.samples) / sum.seconds;
     if (first == 0) first = rate;
     const auto tris = renderer.sceneTriangles();
@@ -87,6 +88,7 @@ struct RoomOptions {
   ImageSize size{320, 180};
   int frames = 8;
   int maxBounces = 16;
+  std::optional<int> sppPerFrame;  // empty: as retile render (offlineSamplesPerFrame)
   std::string writeScene;  // also save the first room as a native scene, to look at
   std::string roulette = "standard";
 };
@@ -141,7 +143,8 @@ int benchRoom(const RoomOptions& o) {
     const double build = std::chrono::duration<double>(Clock::now() - t0).count();
     renderer.setMaxBounces(o.maxBounces);
     renderer.resize(o.size.width, o.size.height);
-    FrameStats sum = traceFrames(renderer, o.size.width, o.size.height, o.frames, FrameOptions{});
+    FrameStats sum = traceFrames(renderer, o.size.width, o.size.height, o.frames, o.sppPerFrame.value_or(offlineSamplesPerFrame(o.size.width, o.size.height)),
+                                 FrameOptions{});
     const double rate = static_cast<double>(sum.samples) / sum.seconds;
     const double tris = static_cast<double>(renderer.sceneTriangles());
     const Renderer::SceneMemory m = renderer.sceneMemory();
@@ -160,7 +163,7 @@ struct ThroughputOptions {
   std::string scene;
   ImageSize size{256, 256};
   int frames = 16;
-  std::optional<int> maxBounces, paths;
+  std::optional<int> maxBounces, paths, sppPerFrame;
   std::string roulette;  // empty: the scene's
 };
 
@@ -179,13 +182,14 @@ int benchThroughput(const ThroughputOptions& o) {
   renderer.setMaxBounces(bounces >= 0 ? bounces : loaded->scene.settings.maxBounces);
   renderer.resize(w, h);
   double wall = 0;
-  FrameStats sum = traceFrames(renderer, w, h, frames, options, &wall);
+  const int spp = o.sppPerFrame.value_or(offlineSamplesPerFrame(w, h));
+  FrameStats sum = traceFrames(renderer, w, h, frames, spp, options, &wall);
   double sec = sum.seconds;
   auto tris = renderer.sceneTriangles();
   std::printf("scene          %s (%llu triangles)\n", o.scene.c_str(), static_cast<unsigned long long>(tris));
   std::printf("device         %s\n", renderer.deviceName().c_str());
-  std::printf("image          %dx%d, max bounces %d, %d frames of 1 spp\n", w, h,
-              bounces >= 0 ? bounces : loaded->scene.settings.maxBounces, frames);
+  std::printf("image          %dx%d, max bounces %d, %d frames of %d spp\n", w, h,
+              bounces >= 0 ? bounces : loaded->scene.settings.maxBounces, frames, spp);
   std::printf("samples/s      %.3f M\n", static_cast<double>(sum.samples) / sec * 1e-6);
   std::printf("rays/s         %.3f M total: primary %.3f M, bounce %.3f M, shadow %.3f M\n",
               static_cast<double>(sum.primaryRays + sum.bounceRays + sum.shadowRays) / sec * 1e-6,
@@ -474,7 +478,7 @@ void addBench(CLI::App& app, int* status) {
   CLI::App* bench = app.add_subcommand("bench", "Benchmarks: they print figures and never pass or fail");
   bench->require_subcommand(1);
 
-  CLI::App* cmd = bench->add_subcommand("throughput", "Samples/s, rays/s and device memory of 1-spp frames of a scene");
+  CLI::App* cmd = bench->add_subcommand("throughput", "Samples/s, rays/s and device memory of a scene, in frames as retile render traces them");
   auto throughput = std::make_shared<ThroughputOptions>();
   addScene(*cmd, &throughput->scene);
   addSize(*cmd, &throughput->size, "image size");
@@ -483,6 +487,8 @@ void addBench(CLI::App& app, int* status) {
   addInt(*cmd, "--paths", &throughput->paths, 1, 1 << 20, "paths per trace invocation",
          "chosen from the last frame's cost")
       ->type_name("P");
+  addInt(*cmd, "--spp-per-frame", &throughput->sppPerFrame, 1, 1024, "samples per pixel in each frame",
+         "as retile render: about 2^18 samples a frame");
   cmd->add_option("--roulette", throughput->roulette, "Russian roulette: standard or tungsten (default: the scene's)")
       ->type_name("RULE")
       ->check(oneOf("roulette", {"standard", "tungsten"}));
@@ -535,6 +541,8 @@ void addBench(CLI::App& app, int* status) {
                              ""));
   addSize(*cmd, &room->size, "image size");
   addInt(*cmd, "--frames", &room->frames, 1, 100000, "frames timed per size");
+  addInt(*cmd, "--spp-per-frame", &room->sppPerFrame, 1, 1024, "samples per pixel in each frame",
+         "as retile render: about 2^18 samples a frame");
   addInt(*cmd, "--max-bounces", &room->maxBounces, 0, 1024, "bounce limit");
   cmd->add_option("--write-scene", room->writeScene, "also save the first room as a native scene (.retile)")->type_name("FILE");
   cmd->add_option("--roulette", room->roulette, "Russian roulette: standard or tungsten (default: standard)")

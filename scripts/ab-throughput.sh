@@ -10,7 +10,7 @@
 #
 # usage: scripts/ab-throughput.sh BIN_A BIN_B ROUNDS SCENE [retile bench throughput options]
 # e.g.   scripts/ab-throughput.sh /tmp/retile-before build/bin/retile 8 \
-#          ../shared/scenes/spaceship/scene.json --size 320x180 --frames 64
+#          ../shared/scenes/spaceship/scene.json --size 320x180 --frames 16
 set -euo pipefail
 if [ $# -lt 4 ]; then
   sed -n 2,13p "$0" | sed 's/^# \{0,1\}//'

@@ -39,7 +39,6 @@ void main() {
   uint k = push.pixelOffset + local;
   WorkItem item = items[findItem(k)];
   uint p = k - item.pixels.x;
-  uint pixels = uint(item.rect.z * item.rect.w);
   int px = item.rect.x + int(p % uint(item.rect.z));
   int py = item.rect.y + int(p / uint(item.rect.z));
   uint pixel = uint(py) * frame.image.x + uint(px);
@@ -54,7 +53,7 @@ void main() {
   float instance = intBitsToFloat(0);
   bool haveInstance = false;
   for (uint r = 0u; r < item.info.x; ++r) {
-    uint slot = item.info.y + r * pixels + p;
+    uint slot = item.info.y + p * item.info.x + r;
     vec4 s = samples[slot];
     precise vec3 y = s.rgb - lost;
     precise vec3 t = sum + y;

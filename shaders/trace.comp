@@ -236,9 +236,8 @@ uint primaryRays = 0u, bounceRays = 0u, shadowRays = 0u;
 Path startPath(uint slot, int found) {
   WorkItem item = items[found];
   uint inItem = slot - item.info.y;
-  uint pixels = uint(item.rect.z * item.rect.w);
-  uint rep = inItem / pixels;
-  uint p = inItem - rep * pixels;
+  uint p = inItem / item.info.x;  // a pixel's q samples are neighbours (layouts.h WorkItem)
+  uint rep = inItem - p * item.info.x;
   int px = item.rect.x + int(p % uint(item.rect.z));
   int py = item.rect.y + int(p / uint(item.rect.z));
   uint width = frame.image.x, height = frame.image.y;

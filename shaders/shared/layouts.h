@@ -180,8 +180,10 @@ struct FrameUniforms {
 };
 
 // A rectangle of pixels that receives q samples each this frame. Slot s of the frame belongs to
-// the item with the largest slotStart <= s. Pixel samples use sampleBase + r as their sample
-// index, so sampling depends only on (pixel, sample index, seed).
+// the item with the largest slotStart <= s; the item's pixel p (row by row) has the q slots from
+// slotStart + p q on, so that neighbouring lanes of the trace pass start on the same pixel. Its
+// sample r uses sampleBase + r as its sample index, so sampling depends only on (pixel, sample
+// index, seed).
 struct WorkItem {
   ivec4 rect;   // x0, y0, width, height
   uvec4 info;   // q, slotStart, sampleBase, flags (kWorkRestart: replace the pixel's sums)

@@ -144,7 +144,7 @@ TEST(Cli, HelpAtEveryLevelListsTheOptions) {
       {{"import", "--help"}, {"FILE", "--save"}},
       {{"bench", "--help"}, {"throughput", "bvh", "edit", "frames", "denoise", "scale"}},
       {{"bench", "throughput", "--help"}, {"Usage: retile bench throughput", "--paths", "--frames", "--max-bounces",
-                                           "--size"}},
+                                           "--size", "--spp-per-frame"}},
       {{"bench", "frames", "--help"}, {"--seconds", "--method", "--drag", "--object"}},
       {{"bench", "edit", "--help"}, {"--edits"}},
       {{"bench", "bvh", "--help"}, {"--triangles"}},
@@ -189,6 +189,7 @@ TEST(Cli, RefusesBadValuesNamingTheOption) {
       {{"eval", "--out-dir", "d", "--cases", "burst"}, "--cases requires --stability"},
       {{"compare", "a.exr", "b.exr", "--exclude", "1,2,3"}, "--exclude: '1,2,3' is not X,Y,W,H"},
       {{"bench", "throughput", "default", "--paths", "-1"}, "--paths: -1 is outside 1..1048576"},
+      {{"bench", "throughput", "default", "--spp-per-frame", "0"}, "--spp-per-frame: 0 is outside 1..1024"},
       {{"bench", "throughput", "default", "--frames", "1e3"}, "--frames: '1e3' is not a whole number"},
       {{"bench", "fast"}, "unknown command 'fast'"},
   };

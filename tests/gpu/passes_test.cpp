@@ -563,6 +563,63 @@ TEST(TracePass, PathsPerInvocationDoNotChangeAnySample) {
   EXPECT_EQ(a.normal, b.normal);
 }
 
+// A pixel's samples may be traced in one frame or in several: the trace pass and the accumulate
+// pass must agree on which slot holds which pixel's which sample (layouts.h WorkItem), and a
+// sample's value depends only on its pixel and index.
+TEST(TracePass, SamplesInOneFrameAreTheSamplesOfSeveralFrames) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const int w = 40, h = 24, q = 5;
+  r->setScene(makeDefaultScene());
+  r->resize(w, h);
+  r->renderFrame({{0, 0, w, h, q, 0, true}});
+  const RenderImage together = r->readback();
+  for (int i = 0; i < q; ++i) r->renderFrame({{0, 0, w, h, 1, static_cast<std::uint32_t>(i), i == 0}});
+  const RenderImage apart = r->readback();
+  ASSERT_EQ(together.color.size(), apart.color.size());
+  EXPECT_EQ(together.sampleCount, apart.sampleCount);
+  int bright = 0;
+  for (std::size_t i = 0; i < apart.color.size(); ++i) {
+    ASSERT_NEAR(together.color[i], apart.color[i], 1e-5f * std::max(1.0f, std::abs(apart.color[i]))) << "value " << i;
+    bright += apart.color[i] > 0.05f;
+  }
+  EXPECT_GT(bright, static_cast<int>(apart.color.size()) / 4) << "the pixels differ, so a mixed-up slot would show";
+  EXPECT_EQ(together.normal, apart.normal);
+}
+
+// An offline render traces several samples per pixel a frame (offlineSamplesPerFrame): the
+// frames take consecutive sample indices, so the image is the one frames of one sample make.
+TEST(TracePass, AnOfflineRenderIsItsSamplesWhateverTheFrames) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const int w = 40, h = 24, spp = 150;
+  ASSERT_EQ(offlineSamplesPerFrame(w, h), 64);
+  EXPECT_EQ(offlineSamplesPerFrame(320, 180), 4);
+  EXPECT_EQ(offlineSamplesPerFrame(1920, 1080), 1);
+  EXPECT_EQ(offlineSamplesPerFrame(0, 0), 64);
+  r->setScene(makeDefaultScene());
+  RenderRequest req;
+  req.width = w;
+  req.height = h;
+  req.samplesPerPixel = spp;
+  std::vector<int> reported;
+  const RenderImage batched = r->render(req, [&](int done, int total) {
+    EXPECT_EQ(total, spp);
+    reported.push_back(done);
+    return true;
+  });
+  EXPECT_EQ(reported, (std::vector<int>{64, 128, 150}));
+  for (int i = 0; i < spp; ++i) r->renderFrame({{0, 0, w, h, 1, static_cast<std::uint32_t>(i), i == 0}});
+  const RenderImage single = r->readback();
+  ASSERT_EQ(batched.sampleCount, single.sampleCount);
+  EXPECT_EQ(batched.sampleCount[0], static_cast<float>(spp));
+  for (std::size_t i = 0; i < single.color.size(); ++i)
+    ASSERT_NEAR(batched.color[i], single.color[i], 1e-5f * std::max(1.0f, std::abs(single.color[i]))) << "value " << i;
+
+  // Stopped early, it has what it traced.
+  int frames = 0;
+  const RenderImage stopped = r->render(req, [&](int, int) { return ++frames < 2; });
+  EXPECT_EQ(stopped.sampleCount[0], 128.0f);
+}
+
 // Pixels of `cut` (a frame whose invocations ran out of loop budget) that were traced, that were
 // not (no samples), and that were traced but differ from `reference` in colour.
 struct TracedComparison {

@@ -252,8 +252,9 @@ TEST(KnownAnswer, AnObjectMovedAfterPackingRendersAsIfPackedThere) {
   r->updateScene(s, kUpdateInstances);
   RenderRequest req;
   req.samplesPerPixel = 128;
+  req.seed = 1;  // renderScene's: the same rays, so that only the geometry can tell the two apart
   const RenderImage moved = r->render(req);
-  const RenderImage packed = renderScene(*r, s, 128);
+  const RenderImage packed = renderScene(*r, s, 128, req.seed);
   int cubeMoved = 0, cubePacked = 0, differ = 0;
   for (std::size_t i = 0; i < moved.objectId.size(); ++i) {
     cubeMoved += moved.objectId[i] == cube;
@@ -262,7 +263,7 @@ TEST(KnownAnswer, AnObjectMovedAfterPackingRendersAsIfPackedThere) {
   }
   EXPECT_GT(cubePacked, 20) << "the cube is in view";
   EXPECT_NEAR(cubeMoved, cubePacked, 3);
-  EXPECT_LE(differ, 4) << "pixels whose first hit differs (at an edge either may round either way)";
+  EXPECT_LE(differ, 2) << "pixels whose first hit differs (a ray that grazes an edge may round either way)";
   const double lit = meanOver(packed, plane);
   EXPECT_LT(lit, 0.5 * 0.99) << "the cube shades part of the plane";
   EXPECT_NEAR(meanOver(moved, plane), lit, 0.01 * lit);

@@ -64,6 +64,13 @@ struct DenoiseWork {
 // The whole image denoised (global + denoise, continuous refinement, `retile render --denoise`).
 DenoiseWork wholeFrameDenoise(int width, int height, int tileSize = 16);
 
+// Samples per pixel in each frame of an offline render (Renderer::render) of a W x H image: as
+// many as make about 2^18 samples, at most 64. A frame costs a fixed few milliseconds (its
+// dispatches, and the last invocations' tail while a core waits), a twentieth of a 320x180
+// frame of one sample per pixel on lavapipe; four per frame traced the spaceship 5 % faster
+// (docs/MEASUREMENTS.md).
+int offlineSamplesPerFrame(int width, int height);
+
 struct FrameOptions {
   bool accumulate = true;    // false: trace only (a probe); readbackFrameLuminance() gives the result
   int selectionTileSize = 0; // > 0: count what the tracer sees of the selection per tile of this size
@@ -173,9 +180,9 @@ class Renderer {
   // Reads back the accumulated image (mean per pixel) and auxiliary outputs.
   RenderImage readback();
 
-  // Convenience for the command line and tests: resize, then samplesPerPixel frames of one
-  // sample per pixel each (the same-time budget W x H per frame), then read back. `progress`
-  // gets (frames done, frames total) and may return false to stop early.
+  // Convenience for the command line and tests: resize, then samplesPerPixel samples per pixel in
+  // frames of offlineSamplesPerFrame(W, H) each, then read back. `progress` gets (samples per
+  // pixel done, total) after each frame and may return false to stop early.
   // Uses the scene last given to setScene/updateScene.
   RenderImage render(const RenderRequest& request, const std::function<bool(int, int)>& progress = {},
                      FrameStats* total = nullptr);

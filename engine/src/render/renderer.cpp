@@ -392,7 +392,7 @@ struct Renderer::Impl {
       for (std::uint64_t p = 0; p < pixels; ++p) {
         double sum = 0, n = 0;
         for (std::uint32_t r = 0; r < w.info.x; ++r) {
-          const gpu::vec4& v = s[w.info.y + r * pixels + p];
+          const gpu::vec4& v = s[w.info.y + p * w.info.x + r];
           sum += 0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z;
           n += v.w;
         }
@@ -826,15 +826,17 @@ RenderImage Renderer::render(const RenderRequest& request, const std::function<b
   impl_->seed = request.seed;
   resize(w, h);
   FrameStats sum;
-  for (int f = 0; f < spp; ++f) {
+  const int perFrame = offlineSamplesPerFrame(w, h);
+  for (int done = 0; done < spp;) {
     TileWork all;
     all.width = w;
     all.height = h;
-    all.quality = 1;
-    all.sampleBase = static_cast<std::uint32_t>(f);
-    all.restart = f == 0;
+    all.quality = std::min(perFrame, spp - done);
+    all.sampleBase = static_cast<std::uint32_t>(done);
+    all.restart = done == 0;
     sum.add(renderFrame({all}, {}));
-    if (progress && !progress(f + 1, spp)) break;
+    done += all.quality;
+    if (progress && !progress(done, spp)) break;
   }
   if (request.denoise) {
     FrameOptions o;
@@ -843,6 +845,12 @@ RenderImage Renderer::render(const RenderRequest& request, const std::function<b
   }
   if (total) *total = sum;
   return readback();
+}
+
+int offlineSamplesPerFrame(int width, int height) {
+  constexpr std::int64_t kFrameSamples = 1 << 18, kMaxPerPixel = 64;
+  const std::int64_t pixels = std::max<std::int64_t>(std::int64_t{width} * height, 1);
+  return static_cast<int>(std::clamp<std::int64_t>(kFrameSamples / pixels, 1, kMaxPerPixel));
 }
 
 DenoiseWork wholeFrameDenoise(int width, int height, int tileSize) {
