@@ -49,9 +49,22 @@ FrameStats traceFrames(Renderer& renderer, int w, int h, int frames, int spp, co
 struct ScaleOptions {
   ImageSize size{320, 180};
   int frames = 16;
+  std::optional<int> sppPerFrame;  // empty: as retile render (offlineSamplesPerFrame)
 };
 
+// --spp-per-frame against the image size: a frame's slots take 64 bytes each on the device (the
+// sample and its auxiliary outputs); past 2^24 of them (1 GiB) the option is refused, a usage
+// error (exit code 2, as for values out of range), rather than the device asked for gigabytes.
+std::optional<std::string> frameTooLarge(ImageSize size, std::optional<int> sppPerFrame) {
+  if (!sppPerFrame) return std::nullopt;
+  const std::uint64_t slots = std::uint64_t(size.width) * std::uint64_t(size.height) * std::uint64_t(*sppPerFrame);
+  if (slots <= (1u << 24)) return std::nullopt;
+  return cat("--spp-per-frame: ", *sppPerFrame, " samples per pixel at ", size.width, "x", size.height, " make ", slots,
+             " samples a frame, more than 16777216");
+}
+
 int benchScale(const ScaleOptions& o) {
+  if (auto tooLarge = frameTooLarge(o.size, o.sppPerFrame)) return std::fprintf(stderr, "error: %s\n", tooLarge->c_str()), 2;
   const int w = o.size.width, h = o.size.height, frames = o.frames;
   std::printf("%10s %12s %10s %12s %14s %12s\n", "triangles", "samples/s", "vs first", "upload s", "device MiB",
               "bytes/tri");
@@ -68,7 +81,7 @@ int benchScale(const ScaleOptions& o) {
     const double upload = std::chrono::duration<double>(Clock::now() - t0).count();
     renderer.setMaxBounces(scene.settings.maxBounces);
     renderer.resize(w, h);
-    FrameStats sum = traceFrames(renderer, w, h, frames, offlineSamplesPerFrame(w, h), FrameOptions{});
+    FrameStats sum = traceFrames(renderer, w, h, frames, o.sppPerFrame.value_or(offlineSamplesPerFrame(w, h)), FrameOptions{});
     const double rate = static_cast<double>(sum.samples) / sum.seconds;
     if (first == 0) first = rate;
     const auto tris = renderer.sceneTriangles();
@@ -126,6 +139,7 @@ double peakResidentMb() {
 }
 
 int benchRoom(const RoomOptions& o) {
+  if (auto tooLarge = frameTooLarge(o.size, o.sppPerFrame)) return std::fprintf(stderr, "error: %s\n", tooLarge->c_str()), 2;
   const std::vector<std::uint64_t> counts = parseCounts(o.triangles);
   // Loop iterations per path do not drift with the machine's speed, as samples/s does.
   // The peak RSS is the process's so far, so with counts in growing order each row's is its own.
@@ -168,6 +182,7 @@ struct ThroughputOptions {
 };
 
 int benchThroughput(const ThroughputOptions& o) {
+  if (auto tooLarge = frameTooLarge(o.size, o.sppPerFrame)) return std::fprintf(stderr, "error: %s\n", tooLarge->c_str()), 2;
   const int w = o.size.width, h = o.size.height, frames = o.frames, bounces = o.maxBounces.value_or(-1);
   FrameOptions options;
   if (o.paths) options.pathsPerInvocation = *o.paths;
@@ -554,6 +569,8 @@ void addBench(CLI::App& app, int* status) {
   auto scale = std::make_shared<ScaleOptions>();
   addSize(*cmd, &scale->size, "image size");
   addInt(*cmd, "--frames", &scale->frames, 1, 100000, "frames timed per triangle count");
+  addInt(*cmd, "--spp-per-frame", &scale->sppPerFrame, 1, 1024, "samples per pixel in each frame",
+         "as retile render: about 2^18 samples a frame");
   cmd->callback([scale, status] { *status = benchScale(*scale); });
 }
 

@@ -181,7 +181,7 @@ struct FrameUniforms {
 
 // A rectangle of pixels that receives q samples each this frame. Slot s of the frame belongs to
 // the item with the largest slotStart <= s; the item's pixel p (row by row) has the q slots from
-// slotStart + p q on, so that neighbouring lanes of the trace pass start on the same pixel. Its
+// slotStart + p q on, so that the eight lanes of the trace pass start on ceil(8 / q) pixels. Its
 // sample r uses sampleBase + r as its sample index, so sampling depends only on (pixel, sample
 // index, seed).
 struct WorkItem {

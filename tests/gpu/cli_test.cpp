@@ -190,6 +190,8 @@ TEST(Cli, RefusesBadValuesNamingTheOption) {
       {{"compare", "a.exr", "b.exr", "--exclude", "1,2,3"}, "--exclude: '1,2,3' is not X,Y,W,H"},
       {{"bench", "throughput", "default", "--paths", "-1"}, "--paths: -1 is outside 1..1048576"},
       {{"bench", "throughput", "default", "--spp-per-frame", "0"}, "--spp-per-frame: 0 is outside 1..1024"},
+      {{"bench", "throughput", "default", "--size", "1920x1080", "--spp-per-frame", "1024"},
+       "--spp-per-frame: 1024 samples per pixel at 1920x1080 make 2123366400 samples a frame, more than 16777216"},
       {{"bench", "throughput", "default", "--frames", "1e3"}, "--frames: '1e3' is not a whole number"},
       {{"bench", "fast"}, "unknown command 'fast'"},
   };

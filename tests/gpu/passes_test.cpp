@@ -601,12 +601,18 @@ TEST(TracePass, AnOfflineRenderIsItsSamplesWhateverTheFrames) {
   req.height = h;
   req.samplesPerPixel = spp;
   std::vector<int> reported;
-  const RenderImage batched = r->render(req, [&](int done, int total) {
-    EXPECT_EQ(total, spp);
-    reported.push_back(done);
-    return true;
-  });
+  FrameStats stats;
+  const RenderImage batched = r->render(
+      req,
+      [&](int done, int total) {
+        EXPECT_EQ(total, spp);
+        reported.push_back(done);
+        return true;
+      },
+      &stats);
   EXPECT_EQ(reported, (std::vector<int>{64, 128, 150}));
+  EXPECT_EQ(stats.samples, static_cast<std::uint64_t>(w * h * spp));
+  EXPECT_EQ(stats.cutPaths, 0u) << "a frame of 64 samples per pixel stays within the loop budget";
   for (int i = 0; i < spp; ++i) r->renderFrame({{0, 0, w, h, 1, static_cast<std::uint32_t>(i), i == 0}});
   const RenderImage single = r->readback();
   ASSERT_EQ(batched.sampleCount, single.sampleCount);

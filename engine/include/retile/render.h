@@ -65,10 +65,10 @@ struct DenoiseWork {
 DenoiseWork wholeFrameDenoise(int width, int height, int tileSize = 16);
 
 // Samples per pixel in each frame of an offline render (Renderer::render) of a W x H image: as
-// many as make about 2^18 samples, at most 64. A frame costs a fixed few milliseconds (its
-// dispatches, and the last invocations' tail while a core waits), a twentieth of a 320x180
-// frame of one sample per pixel on lavapipe; four per frame traced the spaceship 5 % faster
-// (docs/MEASUREMENTS.md).
+// many as make about 2^18 samples, at most 64. A frame has a fixed cost on lavapipe (its
+// dispatches, and the last invocations' tail while a core waits): both cores idled 6.4 to 6.8 %
+// of a 320x180 spaceship frame of one sample per pixel, and frames of four traced it 1.14 times
+// as fast (docs/MEASUREMENTS.md).
 int offlineSamplesPerFrame(int width, int height);
 
 struct FrameOptions {
