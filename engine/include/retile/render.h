@@ -65,10 +65,10 @@ struct DenoiseWork {
 DenoiseWork wholeFrameDenoise(int width, int height, int tileSize = 16);
 
 // Samples per pixel in each frame of an offline render (Renderer::render) of a W x H image: as
-// many as make about 2^18 samples, at most 64. A frame has a fixed cost on lavapipe (its
-// dispatches, and the last invocations' tail while a core waits): both cores idled 6.4 to 6.8 %
-// of a 320x180 spaceship frame of one sample per pixel, and frames of four traced it 1.14 times
-// as fast (docs/MEASUREMENTS.md).
+// many as make about 2^18 samples, at most 64. Frames of four samples per pixel traced the
+// 320x180 spaceship 1.14 times as fast as frames of one on lavapipe, where both cores idled 6.4
+// to 6.8 % of a 1-spp frame (its dispatches, the last invocations' tail); how much of the gain
+// that idle time makes was not settled (docs/MEASUREMENTS.md).
 int offlineSamplesPerFrame(int width, int height);
 
 struct FrameOptions {
