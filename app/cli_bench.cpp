@@ -49,7 +49,7 @@ FrameStats traceFrames(Renderer& renderer, int w, int h, int frames, int spp, co
 struct ScaleOptions {
   ImageSize size{320, 180};
   int frames = 16;
-  std::optional<int> sppPerFrame;  // empty: as retile render (offlineSamplesPerFrame)
+  std::optional<int> sppPerFrame;  // empty: as retile render (frameSpp)
 };
 
 // --spp-per-frame against the image size: a frame's slots take 64 bytes each on the device (the
@@ -61,6 +61,11 @@ std::optional<std::string> frameTooLarge(ImageSize size, std::optional<int> sppP
   if (slots <= (1u << 24)) return std::nullopt;
   return cat("--spp-per-frame: ", *sppPerFrame, " samples per pixel at ", size.width, "x", size.height, " make ", slots,
              " samples a frame, more than 16777216");
+}
+
+// The samples per pixel of a benchmark's frames: --spp-per-frame, else as retile render traces.
+int frameSpp(ImageSize size, std::optional<int> sppPerFrame) {
+  return sppPerFrame.value_or(offlineSamplesPerFrame(size.width, size.height));
 }
 
 int benchScale(const ScaleOptions& o) {
@@ -81,7 +86,7 @@ int benchScale(const ScaleOptions& o) {
     const double upload = std::chrono::duration<double>(Clock::now() - t0).count();
     renderer.setMaxBounces(scene.settings.maxBounces);
     renderer.resize(w, h);
-    FrameStats sum = traceFrames(renderer, w, h, frames, o.sppPerFrame.value_or(offlineSamplesPerFrame(w, h)), FrameOptions{});
+    FrameStats sum = traceFrames(renderer, w, h, frames, frameSpp(o.size, o.sppPerFrame), FrameOptions{});
     const double rate = static_cast<double>(sum.samples) / sum.seconds;
     if (first == 0) first = rate;
     const auto tris = renderer.sceneTriangles();
@@ -101,7 +106,7 @@ struct RoomOptions {
   ImageSize size{320, 180};
   int frames = 8;
   int maxBounces = 16;
-  std::optional<int> sppPerFrame;  // empty: as retile render (offlineSamplesPerFrame)
+  std::optional<int> sppPerFrame;  // empty: as retile render (frameSpp)
   std::string writeScene;  // also save the first room as a native scene, to look at
   std::string roulette = "standard";
 };
@@ -157,8 +162,7 @@ int benchRoom(const RoomOptions& o) {
     const double build = std::chrono::duration<double>(Clock::now() - t0).count();
     renderer.setMaxBounces(o.maxBounces);
     renderer.resize(o.size.width, o.size.height);
-    FrameStats sum = traceFrames(renderer, o.size.width, o.size.height, o.frames, o.sppPerFrame.value_or(offlineSamplesPerFrame(o.size.width, o.size.height)),
-                                 FrameOptions{});
+    FrameStats sum = traceFrames(renderer, o.size.width, o.size.height, o.frames, frameSpp(o.size, o.sppPerFrame), FrameOptions{});
     const double rate = static_cast<double>(sum.samples) / sum.seconds;
     const double tris = static_cast<double>(renderer.sceneTriangles());
     const Renderer::SceneMemory m = renderer.sceneMemory();
@@ -197,7 +201,7 @@ int benchThroughput(const ThroughputOptions& o) {
   renderer.setMaxBounces(bounces >= 0 ? bounces : loaded->scene.settings.maxBounces);
   renderer.resize(w, h);
   double wall = 0;
-  const int spp = o.sppPerFrame.value_or(offlineSamplesPerFrame(w, h));
+  const int spp = frameSpp(o.size, o.sppPerFrame);
   FrameStats sum = traceFrames(renderer, w, h, frames, spp, options, &wall);
   double sec = sum.seconds;
   auto tris = renderer.sceneTriangles();

@@ -2,8 +2,8 @@
 // Path tracing pass: one invocation per sample slot. A frame's slots are spread over work items
 // (rectangles of pixels with q samples each), so global rendering (one item: q = 1 in the
 // editor, about 2^18 samples a frame offline) and tile re-rendering (many items, any q) run the
-// same kernel. Writes per-slot radiance and the first
-// hit's albedo, normal, depth and instance for the accumulate pass.
+// same kernel. Writes per-slot radiance and the first hit's albedo, normal, depth and instance
+// for the accumulate pass.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_vote : require
 #extension GL_KHR_shader_subgroup_ballot : require
@@ -541,8 +541,9 @@ void main() {
   frame = frameBuffer;  // see scene.glsl
   uint invocation = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * uint(kTraceWorkgroup) + gl_LocalInvocationID.x;
   // This invocation's slots are invocation, invocation + invocations, ...: neighbouring lanes
-  // start on neighbouring slots, a pixel's samples or neighbouring pixels. Invocations past the end take part in the loop with no slots,
-  // so that every lane of the eight sees every iteration and loopIterations stays exact.
+  // start on neighbouring slots, a pixel's samples or neighbouring pixels. Invocations past the
+  // end take part in the loop with no slots, so that every lane of the eight sees every iteration
+  // and loopIterations stays exact.
   uint next = invocation < push.invocations ? invocation : push.slotCount;
   // Until its first path starts, a lane's slot is the spare one past the frame's last (it writes none).
   Path path;

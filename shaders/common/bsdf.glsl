@@ -23,8 +23,8 @@ const bool kBeckmannUsed = (kMaterialMask & (1 << kMaskBeckmann)) != 0;
 const bool kCoatUsed = (kMaterialMask & (1 << kMaskCoat)) != 0;
 const bool kMediumUsed = (kMaterialMask & (1 << kMaskMedium)) != 0;
 // The same for the preprocessor (bit 15 is kMaskMedium): the path's medium (trace.comp) is not
-// even declared without one: a dead field of the path measured 5 % slower on the spaceship (not settled,
-// docs/MEASUREMENTS.md).
+// even declared without one, so that a scene without filled glass carries no dead field. (What
+// the field cost was within the machine's noise: docs/MEASUREMENTS.md, twenty-second session.)
 #define RETILE_MEDIUM ((RETILE_MATERIALS & 32768) != 0)
 
 struct Material {
