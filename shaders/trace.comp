@@ -142,6 +142,7 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
                               texelFetch(uMaterials, base + 4), plastics ? texelFetch(uMaterials, base + 6) : vec4(0.0),
                               kCoatUsed ? texelFetch(uMaterials, base + 7) : vec4(0.0),
                               kCoatUsed || kMediumUsed ? texelFetch(uMaterials, base + 8) : vec4(0.0));
+  if (kMediumUsed) m.scattering = texelFetch(uMaterials, base + 9);
   int albedoTex = floatBitsToInt(t2.w), roughTex = floatBitsToInt(t3.w);
   if (hasFeature(kFeatureTextures) && albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
   if (hasFeature(kFeatureTextures) && roughTex >= 0) m.roughness = max(m.roughness * sampleTexture(roughTex, uv).r, 1e-3);
@@ -211,7 +212,10 @@ struct Path {
   float travelled; // distance along the path so far
   int auxInstance;
 #if RETILE_MEDIUM
-  vec3 absorption;  // of the medium the path is in: inside filled glass, else 0
+  // Of the medium the path is in (inside filled glass, else 0): absorption and scattering per
+  // unit of length, and the phase function's asymmetry in scattering.w.
+  vec3 absorption;
+  vec4 scattering;
 #endif
 };
 
@@ -272,6 +276,7 @@ Path startPath(uint slot, int found) {
   path.etaScale = 1.0;
 #if RETILE_MEDIUM
   path.absorption = vec3(0.0);
+  path.scattering = vec4(0.0);
 #endif
   path.specular = true;
   path.prevPdf = 0.0;
@@ -345,6 +350,47 @@ void resolveShadow(inout Path path, inout Shadow shadow, int blocker) {
   shadow.pending = false;
 }
 
+// Russian roulette after a few bounces, keeping the expected value (Roulette, scene.h). Returns
+// false when the path has ended.
+bool survivesRoulette(inout Path path, inout Shadow shadow) {
+  if (path.depth > 3) {
+    float m = maxComponent(path.beta * path.etaScale);
+    float q = hasFeature(kFeatureTungstenRoulette) ? (m < 0.1 ? 1.0 - m : 0.0) : max(0.05, 1.0 - m);
+    if (rand(path.rng) < q) return endPath(path, shadow);
+    path.beta /= 1.0 - q;
+  }
+  return true;
+}
+
+#if RETILE_MEDIUM
+// The path scatters in its medium (of extinction sigmaT) `flight` along its ray, short of the
+// hit, and the phase function gives its next direction. No light is sampled here: the medium
+// fills glass, whose surface blocks shadow rays, so an emitter the path finds next counts in
+// full, as after a mirror. A scattering event is a bounce, as in Tungsten. Returns false when
+// the path has ended.
+bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, vec3 sigmaT) {
+  vec3 crossed = exp(-sigmaT * flight);
+  float pdf = dot(sigmaT * crossed, vec3(1.0 / 3.0));
+  path.travelled += flight;
+  if (path.auxDepth >= kInfinity) {
+    // The denoiser's guide: the medium's albedo where the path first scatters, facing back.
+    path.auxAlbedo = path.beta * path.scattering.rgb / max(sigmaT, vec3(1e-30));
+    path.auxNormal = -path.rd;
+    path.auxDepth = path.travelled;
+  }
+  path.beta *= pdf > 0.0 ? path.scattering.rgb * crossed / pdf : vec3(0.0);
+  if (path.depth >= int(frame.image.w) || !(maxComponent(path.beta) > 0.0)) return false;
+  vec3 pos = path.ro + flight * path.rd;
+  path.rd = sampleHenyeyGreenstein(path.rd, path.scattering.w, vec2(rand(path.rng), rand(path.rng)));
+  path.ro = pos;
+  path.from = ivec2(-1);
+  path.specular = true;
+  path.prevPos = pos;
+  path.depth++;
+  return survivesRoulette(path, shadow);
+}
+#endif
+
 // Shades the hit of the path's last segment (its ray from path.ro along path.rd): emission,
 // next-event estimation (its shadow ray is traced with the next segment) and the next direction.
 // Returns false when the path has ended.
@@ -353,17 +399,32 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   int maxBounces = int(frame.image.w);
   vec3 ro = path.ro, rd = path.rd;
   if (path.depth == 0) primaryRays++; else bounceRays++;
+  // The segment's way through the medium it ran in; a ray that leaves the scene from inside one
+  // (glass not closed) is absorbed on its infinite way. In a medium that scatters, the path may
+  // scatter before the hit, which it then does not reach.
+#if RETILE_MEDIUM
+  if (maxComponent(path.scattering.rgb) > 0.0) {
+    // Tungsten's free flight (HomogeneousMedium::sampleDistance): a distance drawn for one
+    // channel, picked evenly, and weighted by the three channels' mean pdf, so that every
+    // channel's estimate is unbiased whatever its own extinction.
+    vec3 sigmaT = path.absorption + path.scattering.rgb;
+    float sigmaC = sigmaT[min(int(rand(path.rng) * 3.0), 2)];
+    float u = rand(path.rng);
+    float flight = sigmaC > 0.0 ? -log(1.0 - u) / sigmaC : kInfinity;
+    if (flight < hit.t) return scatterInMedium(path, shadow, flight, sigmaT);
+    vec3 crossed = hit.prim >= 0 ? exp(-sigmaT * hit.t) : vec3(lessThanEqual(sigmaT, vec3(0.0)));
+    float pdf = dot(crossed, vec3(1.0 / 3.0));
+    path.beta *= pdf > 0.0 ? crossed / pdf : vec3(0.0);
+  } else {
+    path.beta *= hit.prim >= 0 ? exp(-path.absorption * hit.t) : vec3(lessThanEqual(path.absorption, vec3(0.0)));
+  }
+#endif
   if (path.selBase >= 0 && hit.prim >= 0 && hit.instance == selected) {
     // Direct hits, then reflections weighted (maxBounces + 1) / depth: 4, 2, 1 at 3 bounces.
     if (path.depth == 0) atomicAdd(selectionCounts[path.selBase], 1u);
     else atomicAdd(selectionCounts[path.selBase + 1], uint(max(maxBounces + 1, 1) / path.depth));
   }
 
-  // The segment's way through the medium it ran in; a ray that leaves the scene from inside one
-  // (glass not closed) is absorbed on its infinite way.
-#if RETILE_MEDIUM
-  path.beta *= hit.prim >= 0 ? exp(-path.absorption * hit.t) : vec3(lessThanEqual(path.absorption, vec3(0.0)));
-#endif
 
   if (hit.prim < 0) {
     vec3 Le = envRadiance(rd);
@@ -515,8 +576,10 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   // Through glass the path enters its medium or leaves it for the outside (a vacuum: nesting is
   // not tracked).
 #if RETILE_MEDIUM
-  if (bs.transmitted && (isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric)))
+  if (bs.transmitted && (isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric))) {
     path.absorption = woL.z > 0.0 ? m.interior : vec3(0.0);
+    path.scattering = woL.z > 0.0 ? m.scattering : vec4(0.0);
+  }
 #endif
   if (bs.transmitted && !isMat(m.type, kMatThinSheet) && !isMat(m.type, kMatDiffuseTransmission)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
   path.specular = bs.delta;
@@ -526,15 +589,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   path.from = ivec2(hit.prim, hit.instance);
   path.rd = wi;
   path.depth++;
-
-  // Russian roulette after a few bounces, keeping the expected value (Roulette, scene.h).
-  if (path.depth > 3) {
-    float m = maxComponent(path.beta * path.etaScale);
-    float q = hasFeature(kFeatureTungstenRoulette) ? (m < 0.1 ? 1.0 - m : 0.0) : max(0.05, 1.0 - m);
-    if (rand(path.rng) < q) return endPath(path, shadow);
-    path.beta /= 1.0 - q;
-  }
-  return true;
+  return survivesRoulette(path, shadow);
 }
 
 void main() {
@@ -557,6 +612,7 @@ void main() {
   path.auxInstance = 0;
 #if RETILE_MEDIUM
   path.absorption = vec3(0.0);
+  path.scattering = vec4(0.0);
 #endif
   bool alive = false;
   Shadow shadow;

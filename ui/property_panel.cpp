@@ -336,11 +336,20 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       }, true);
     }
   }
-  if (m.type == MaterialType::Dielectric || m.type == MaterialType::RoughDielectric)
+  if (m.type == MaterialType::Dielectric || m.type == MaterialType::RoughDielectric) {
     b.vec3(tr("Interior absorption"), "interiorAbsorption", m.interiorAbsorption, 0.01, [edit](int channel, double v, int drag) {
       edit(tr("Interior absorption"), drag,
            [channel, v](Material& x) { axisOf(x.interiorAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
     }, true);
+    b.vec3(tr("Interior scattering"), "interiorScattering", m.interiorScattering, 0.01, [edit](int channel, double v, int drag) {
+      edit(tr("Interior scattering"), drag,
+           [channel, v](Material& x) { axisOf(x.interiorScattering, channel) = std::max(0.0f, static_cast<float>(v)); });
+    }, true);
+    b.number(tr("Scattering anisotropy"), "interiorAnisotropy", m.interiorAnisotropy, -0.99, 0.99, defaults.interiorAnisotropy, 3,
+             [edit](double v, int drag) {
+               edit(tr("Scattering anisotropy"), drag, [v](Material& x) { x.interiorAnisotropy = static_cast<float>(v); });
+             });
+  }
   if (m.type == MaterialType::Phong)
     b.number(tr("Diffuse ratio"), "diffuseRatio", m.diffuseRatio, 0.0, 1.0, defaults.diffuseRatio, 3, [edit](double v, int drag) {
       edit(tr("Diffuse ratio"), drag, [v](Material& x) { x.diffuseRatio = static_cast<float>(v); });

@@ -19,7 +19,7 @@ bool isMat(int t, int k) { return (kMaterialMask & (1 << k)) != 0 && t == k; }
 // Some rough material of the scene asks for Beckmann's distribution (bit kMaskBeckmann of the
 // mask): without it the Beckmann code is not compiled in.
 const bool kBeckmannUsed = (kMaterialMask & (1 << kMaskBeckmann)) != 0;
-// Likewise the clear coat (bit kMaskCoat) and glass filled with an absorbing medium (kMaskMedium).
+// Likewise the clear coat (bit kMaskCoat) and glass filled with a medium (kMaskMedium).
 const bool kCoatUsed = (kMaterialMask & (1 << kMaskCoat)) != 0;
 const bool kMediumUsed = (kMaterialMask & (1 << kMaskMedium)) != 0;
 // The same for the preprocessor (bit 15 is kMaskMedium): the path's medium (trace.comp) is not
@@ -44,6 +44,8 @@ struct Material {
   vec3 coatAbsorption;  // inside the coat, sigma_a times thickness
   float coatRoughness;  // a rough coat's GGX alpha; 0: smooth
   vec3 interior;        // glass: its medium's absorption per unit of length
+  vec4 scattering;      // glass: its medium's scattering per unit of length, and in w the phase
+                        // function's asymmetry g (read by trace.comp, not by the BSDF)
 };
 
 // The material's texels as render/render_scene.cpp packMaterial writes them, textures not applied.
@@ -65,6 +67,7 @@ Material unpackMaterial(vec4 t0, vec4 t1, vec4 t2, vec4 t3, vec4 t4, vec4 t6, ve
   m.coatAbsorption = t8.rgb;
   m.coatRoughness = t8.w;
   m.interior = kMediumUsed ? t8.rgb : vec3(0.0);
+  m.scattering = vec4(0.0);
   return m;
 }
 

@@ -42,6 +42,22 @@ vec3 sampleUniformSphere(vec2 u) {
   return vec3(r * cos(phi), r * sin(phi), z);
 }
 
+// A direction scattered from the propagation direction d by Henyey and Greenstein's phase
+// function of asymmetry g (cos theta by its inverted CDF; near g = 0, the uniform sphere). The
+// phase function is its own pdf: the sample's weight is 1.
+vec3 sampleHenyeyGreenstein(vec3 d, float g, vec2 u) {
+  float cosTheta = 1.0 - 2.0 * u.x;
+  if (abs(g) > 1e-3) {
+    float s = (1.0 - g * g) / (1.0 - g + 2.0 * g * u.x);
+    cosTheta = clamp((1.0 + g * g - s * s) / (2.0 * g), -1.0, 1.0);
+  }
+  float sinTheta = sqrt(max(0.0, 1.0 - cosTheta * cosTheta));
+  float phi = 2.0 * PI * u.y;
+  vec3 t, b;
+  makeFrame(d, t, b);
+  return toWorld(vec3(sinTheta * cos(phi), sinTheta * sin(phi), cosTheta), t, b, d);
+}
+
 // Uniform point on a triangle (barycentrics), area-preserving square-root mapping.
 vec2 sampleTriangle(vec2 u) {
   float s = sqrt(u.x);

@@ -21,7 +21,7 @@ RT_CONST(int, kTriTexels, 3)        // v0.xyz triangle index | e1 = v1 - v0, las
 RT_CONST(int, kInstanceRecordTexels, 6)  // root item, instance, flags, - | world-to-object rows 0..2 | -
 RT_CONST(int, kTriShadeTexels, 4)   // n0.xyz uv0.x | n1.xyz uv0.y | n2.xyz uv1.x | uv1.y uv2.xy hasNormals
 RT_CONST(int, kInstanceTexels, 5)   // shading: world-to-object rows 0..2 | - triOffset material emitterOffset | objectIndex+1 flags
-RT_CONST(int, kMaterialTexels, 9)   // see render/render_scene.h packMaterial
+RT_CONST(int, kMaterialTexels, 10)   // see render/render_scene.h packMaterial
 RT_CONST(int, kMaxBlendChain, 4)    // retile::kMaxBlendChain (scene.h)
 RT_CONST(int, kTextureTexels, 3)    // offset w h kind | on.rgb resU | off.rgb resV
 RT_CONST(int, kEmitterTexels, 5)    // v0.xyz area | e1.xyz instance | e2.xyz triangle | radiance.rgb pick pdf | normal.xyz emission texture
@@ -113,7 +113,7 @@ RT_CONST(int, kMatBeckmann, 256)
 RT_CONST(int, kMaskBeckmann, 13)
 // The bit of the kernel's material mask that says some material has a clear coat (Material::coatIor).
 RT_CONST(int, kMaskCoat, 14)
-// And the bit that says some glass is filled with an absorbing medium (Material::interiorAbsorption).
+// And the bit that says some glass is filled with a medium (Material::filled).
 RT_CONST(int, kMaskMedium, 15)
 // Packed with a rough type: Smith's G as the product G1(wo) G1(wi) (Material::separableShadowing).
 // A multiply more per evaluation, so no kernel variant.

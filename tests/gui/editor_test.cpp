@@ -404,6 +404,29 @@ TEST(Editor, AMaterialTakesABumpMapAndItsStrengthFromItsPanel) {
   EXPECT_FLOAT_EQ(w->scene().material(material)->bumpStrength, 1.0f);
 }
 
+TEST(Editor, GlassTakesAScatteringMediumFromItsPanel) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  const NodeId material = w->scene().object(sphere)->material;
+  EXPECT_FALSE(w->findChild<ScrubField*>("interiorScattering0")) << "only glass holds a medium";
+  auto* type = w->findChild<QComboBox*>("materialType");
+  ASSERT_TRUE(type);
+  type->setCurrentIndex(static_cast<int>(MaterialType::Dielectric));
+  ASSERT_TRUE(QTest::qWaitFor([&] { return w->findChild<ScrubField*>("interiorScattering1") != nullptr; }, 2000));
+  w->findChild<ScrubField*>("interiorScattering1")->setValue(3.0);
+  ASSERT_TRUE(QTest::qWaitFor([&] { return w->findChild<ScrubField*>("interiorAnisotropy") != nullptr; }, 2000));
+  w->findChild<ScrubField*>("interiorAnisotropy")->setValue(0.6);
+  const Material* m = w->scene().material(material);
+  EXPECT_EQ(m->interiorScattering, Vec3(0.0f, 3.0f, 0.0f));
+  EXPECT_FLOAT_EQ(m->interiorAnisotropy, 0.6f);
+  EXPECT_TRUE(m->filled());
+  w->undoStack()->undo();
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().material(material)->interiorScattering, Vec3(0.0f));
+  EXPECT_EQ(w->scene().material(material)->interiorAnisotropy, 0.0f);
+}
+
 TEST(Editor, AMaterialBlendsWithAnotherFromItsPanel) {
   auto w = makeWindow();
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");

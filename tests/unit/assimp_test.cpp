@@ -1,6 +1,7 @@
 // Assimp runs in a child process: crashes, hangs and bad files become messages.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 
 #include "retile/io.h"
@@ -78,6 +79,44 @@ TEST(Assimp, AGltfClearCoatIsTheMaterialsCoat) {
   EXPECT_FLOAT_EQ(paint->coatIor, 1.5f);
   EXPECT_NEAR(paint->coatRoughness, 0.09f, 1e-6f);
   EXPECT_FALSE(faint->coated());
+}
+
+// glTF's transmission (KHR_materials_transmission) is glass, and its volume
+// (KHR_materials_volume) what fills it: white light turns attenuationColor after
+// attenuationDistance, an absorption of -ln(color) / distance. A thin-walled volume (thickness 0)
+// fills nothing.
+TEST(Assimp, AGltfVolumeFillsItsGlass) {
+  auto dir = test::tempDir();
+  const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::ofstream(dir / "tri.bin", std::ios::binary).write(reinterpret_cast<const char*>(tri), sizeof tri);
+  std::ofstream(dir / "wine.gltf") << R"({"asset": {"version": "2.0"},
+    "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_volume"],
+    "materials": [
+      {"name": "wine", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
+       "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
+                      "KHR_materials_volume": {"thicknessFactor": 1, "attenuationDistance": 0.5, "attenuationColor": [0.5, 0.25, 1]}}},
+      {"name": "sheet", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
+       "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
+                      "KHR_materials_volume": {"attenuationDistance": 0.5, "attenuationColor": [0.5, 0.25, 1]}}}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]},
+               {"primitives": [{"attributes": {"POSITION": 0}, "material": 1}]}],
+    "nodes": [{"mesh": 0}, {"mesh": 1}], "scenes": [{"nodes": [0, 1]}], "scene": 0,
+    "buffers": [{"byteLength": 36, "uri": "tri.bin"}], "bufferViews": [{"buffer": 0, "byteLength": 36}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}]})";
+  auto r = importScene(dir / "wine.gltf");
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Material *wine = nullptr, *sheet = nullptr;
+  for (const auto& m : r->scene.materials) {
+    if (m.name == "wine") wine = &m;
+    if (m.name == "sheet") sheet = &m;
+  }
+  ASSERT_TRUE(wine && sheet);
+  EXPECT_EQ(wine->type, MaterialType::Dielectric);
+  EXPECT_NEAR(wine->interiorAbsorption.x, 2 * std::log(2.0f), 1e-5f);
+  EXPECT_NEAR(wine->interiorAbsorption.y, 2 * std::log(4.0f), 1e-5f);
+  EXPECT_NEAR(wine->interiorAbsorption.z, 0.0f, 1e-6f);
+  EXPECT_EQ(sheet->type, MaterialType::Dielectric);
+  EXPECT_FALSE(sheet->filled()) << "thin-walled";
 }
 
 TEST(Assimp, CrashingFileIsReportedNotFatal) {

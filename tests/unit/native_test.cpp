@@ -103,6 +103,8 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   s.materials[0].transmittance = 0.35f;
   s.materials[0].diffuseRatio = 0.45f;
   s.materials[0].interiorAbsorption = Vec3{0.4f, 0.5f, 0.6f};
+  s.materials[0].interiorScattering = Vec3{1.5f, 2.5f, 3.5f};
+  s.materials[0].interiorAnisotropy = -0.25f;
   s.materials[0].coatIor = 1.45f;
   s.materials[0].coatRoughness = 0.07f;
   s.materials[0].coatAbsorption = Vec3{0.01f, 0.02f, 0.03f};
@@ -137,6 +139,8 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.materials[0].transmittance, 0.35f);
   EXPECT_EQ(back->scene.materials[0].diffuseRatio, 0.45f);
   EXPECT_EQ(back->scene.materials[0].interiorAbsorption, Vec3(0.4f, 0.5f, 0.6f));
+  EXPECT_EQ(back->scene.materials[0].interiorScattering, Vec3(1.5f, 2.5f, 3.5f));
+  EXPECT_FLOAT_EQ(back->scene.materials[0].interiorAnisotropy, -0.25f);
   EXPECT_EQ(back->scene.materials[0].coatIor, 1.45f);
   EXPECT_EQ(back->scene.materials[0].coatRoughness, 0.07f);
   EXPECT_EQ(back->scene.materials[0].coatAbsorption, Vec3(0.01f, 0.02f, 0.03f));

@@ -176,18 +176,21 @@ TEST(Tungsten, WhatIsNotRenderedIsNamedInAWarning) {
   // The volumetric caustic's medium and a bsdf per material index: the file opens, and the user
   // learns what the image leaves out.
   auto r = importTungsten(writeScene(R"({"media": [{"name": "gas", "type": "homogeneous", "sigma_s": 1}],
+      "camera": {"medium": "gas"},
       "bsdfs": [{"name": "a", "type": "lambert"}, {"name": "b", "type": "mirror"}],
       "primitives": [
         {"type": "quad", "name": "wall", "bsdf": "a", "int_medium": "gas"},
         {"type": "cube", "name": "both", "bsdf": ["a", "b"], "emission": 1}]})"));
   ASSERT_TRUE(r.ok()) << r.error();
   EXPECT_EQ(r->scene.objects.size(), 2u);
-  int media = 0, bsdfs = 0;
+  int media = 0, camera = 0, bsdfs = 0;
   for (const auto& w : r->warnings) {
-    media += w.find("participating media are not rendered ('gas')") != std::string::npos;
+    media += w.find("the medium 'gas' is rendered only inside glass") != std::string::npos;
+    camera += w.find("camera: the medium 'gas' it sits in is not rendered") != std::string::npos;
     bsdfs += w.find("primitives[1]: 2 bsdfs by material index") != std::string::npos;
   }
   EXPECT_EQ(media, 1);
+  EXPECT_EQ(camera, 1);
   EXPECT_EQ(bsdfs, 1);
 }
 
@@ -261,18 +264,26 @@ TEST(Tungsten, CoatsKeepTheirSubstrateUnderAClearCoat) {
   EXPECT_EQ(unsupported, 0);
 }
 
-// A homogeneous medium that only absorbs fills the glass that names it as its int_medium (sigma_a
-// times density); elsewhere, and a medium that scatters anywhere, is named in a warning.
-TEST(Tungsten, AnAbsorbingMediumFillsItsGlass) {
+// A homogeneous medium fills the glass that names it as its int_medium (sigma_a and sigma_s times
+// density, the phase function's asymmetry); elsewhere it is named in a warning, and so is a
+// medium of another kind.
+TEST(Tungsten, AHomogeneousMediumFillsItsGlass) {
   auto r = importTungsten(writeScene(R"({"media": [
         {"name": "ink", "type": "homogeneous", "sigma_a": [0.5, 1, 2], "sigma_s": 0, "density": 2},
-        {"name": "fog", "type": "homogeneous", "sigma_a": 0.1, "sigma_s": 1}],
+        {"name": "fog", "type": "homogeneous", "sigma_a": 0.1, "sigma_s": [1, 2, 3], "density": 0.5,
+         "phase_function": {"type": "henyey_greenstein", "g": 0.7}},
+        {"name": "milk", "type": "homogeneous", "sigma_s": 4, "phase_function": "isotropic"},
+        {"name": "sky", "type": "homogeneous", "sigma_s": 1, "phase_function": {"type": "rayleigh"}},
+        {"name": "smoke", "type": "voxel", "sigma_s": 1}],
       "bsdfs": [{"name": "glass", "type": "dielectric", "ior": 1.33}, {"name": "wall", "type": "lambert"}],
       "primitives": [
         {"type": "sphere", "name": "bottle", "bsdf": "glass", "int_medium": "ink"},
         {"type": "sphere", "name": "empty", "bsdf": "glass"},
         {"type": "quad", "name": "w", "bsdf": "wall", "int_medium": "ink"},
-        {"type": "sphere", "name": "misty", "bsdf": "glass", "int_medium": "fog"}]})"));
+        {"type": "sphere", "name": "misty", "bsdf": "glass", "int_medium": "fog"},
+        {"type": "sphere", "name": "jug", "bsdf": "glass", "int_medium": "milk"},
+        {"type": "sphere", "name": "dome", "bsdf": "glass", "int_medium": "sky"},
+        {"type": "sphere", "name": "smoky", "bsdf": "glass", "int_medium": "smoke"}]})"));
   ASSERT_TRUE(r.ok()) << r.error();
   auto materialOf = [&](const char* object) {
     for (const Object& o : r->scene.objects)
@@ -281,16 +292,27 @@ TEST(Tungsten, AnAbsorbingMediumFillsItsGlass) {
     return Material{};
   };
   EXPECT_EQ(materialOf("bottle").interiorAbsorption, Vec3(1.0f, 2.0f, 4.0f));
+  EXPECT_EQ(materialOf("bottle").interiorScattering, Vec3(0.0f));
   EXPECT_FLOAT_EQ(materialOf("bottle").ior, 1.33f);
-  EXPECT_EQ(materialOf("empty").interiorAbsorption, Vec3(0.0f)) << "the shared glass stays empty";
-  EXPECT_EQ(materialOf("misty").interiorAbsorption, Vec3(0.0f));
-  int fog = 0, wall = 0;
+  EXPECT_FALSE(materialOf("empty").filled()) << "the shared glass stays empty";
+  const Material misty = materialOf("misty");
+  EXPECT_EQ(misty.interiorAbsorption, Vec3(0.05f));
+  EXPECT_EQ(misty.interiorScattering, Vec3(0.5f, 1.0f, 1.5f));
+  EXPECT_FLOAT_EQ(misty.interiorAnisotropy, 0.7f);
+  EXPECT_EQ(materialOf("jug").interiorScattering, Vec3(4.0f));
+  EXPECT_EQ(materialOf("jug").interiorAnisotropy, 0.0f);
+  EXPECT_EQ(materialOf("dome").interiorScattering, Vec3(1.0f));
+  EXPECT_EQ(materialOf("dome").interiorAnisotropy, 0.0f) << "Rayleigh's mean cosine";
+  EXPECT_FALSE(materialOf("smoky").filled());
+  int smoke = 0, wall = 0, rayleigh = 0;
   for (const auto& w : r->warnings) {
-    fog += w.find("participating media are not rendered ('fog')") != std::string::npos;
+    smoke += w.find("media other than homogeneous ones are not rendered ('smoke')") != std::string::npos;
     wall += w.find("the medium 'ink' is rendered only inside glass") != std::string::npos;
+    rayleigh += w.find("'sky': the Rayleigh phase function is rendered isotropic") != std::string::npos;
   }
-  EXPECT_EQ(fog, 1);
+  EXPECT_EQ(smoke, 1);
   EXPECT_EQ(wall, 1);
+  EXPECT_EQ(rayleigh, 1);
 }
 
 // Tungsten turns an infinite_sphere by its transform's rotation, as it turns any primitive: so a

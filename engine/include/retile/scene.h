@@ -146,11 +146,19 @@ struct Material {
   // the smooth coat times cos wo / cos wo' (wo toward the viewer, wo' inside), Tungsten's form,
   // which darkens the base at grazing views and is not reciprocal.
   float coatRoughness = 0.0f;
-  // Glass (dielectric, rough dielectric): what fills it absorbs this much per unit of length,
-  // light inside dimmed by exp(-interiorAbsorption distance) (Tungsten's homogeneous int_medium
-  // that does not scatter: its sigma_a times density). Nested media are not tracked: leaving any
-  // glass leaves its medium.
+  // Glass (dielectric, rough dielectric) filled with a homogeneous medium (Tungsten's
+  // homogeneous int_medium: its sigma_a and sigma_s times density): per unit of length, what
+  // fills it absorbs interiorAbsorption and scatters interiorScattering, by Henyey and
+  // Greenstein's phase function of asymmetry interiorAnisotropy (-1 back, 0 even, 1 forward).
+  // Light that only crosses it is dimmed by exp(-(absorption + scattering) distance). Nested
+  // media are not tracked: leaving any glass leaves its medium.
   Vec3 interiorAbsorption{0.0f};
+  Vec3 interiorScattering{0.0f};
+  float interiorAnisotropy = 0.0f;
+  // Glass with a medium that absorbs or scatters.
+  bool filled() const {
+    return isGlassType(type) && (maxComponent(interiorAbsorption) > 0 || maxComponent(interiorScattering) > 0);
+  }
   bool coated() const { return coatIor > 1.0f; }
   std::string metal = "Cu";        // conductors: a named metal (see conductorNames) or "custom"
   Vec3 eta{0.2f, 0.92f, 1.1f};     // conductors with metal == "custom"

@@ -10,6 +10,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <new>
@@ -200,6 +201,17 @@ struct Converter {
       m.type = roughness > 0.05f ? MaterialType::RoughDielectric : MaterialType::Dielectric;
       float ior = 1.5f;
       if (mat->Get(AI_MATKEY_REFRACTI, ior) == AI_SUCCESS && std::isfinite(ior) && ior >= 1.0f) m.ior = ior;
+      // KHR_materials_volume: white light turns attenuationColor after attenuationDistance inside,
+      // an absorption of -ln(color) / distance. Only with a thickness: a thickness of 0 (the
+      // extension's default) is thin-walled, where the volume does not apply.
+      float thickness = 0, distance = 0;
+      aiColor3D color(1, 1, 1);
+      if (mat->Get(AI_MATKEY_VOLUME_THICKNESS_FACTOR, thickness) == AI_SUCCESS && thickness > 0 &&
+          mat->Get(AI_MATKEY_VOLUME_ATTENUATION_DISTANCE, distance) == AI_SUCCESS && std::isfinite(distance) && distance > 0 &&
+          mat->Get(AI_MATKEY_VOLUME_ATTENUATION_COLOR, color) == AI_SUCCESS) {
+        auto absorption = [&](float turned) { return std::isfinite(turned) ? -std::log(std::clamp(turned, 1e-6f, 1.0f)) / distance : 0.0f; };
+        m.interiorAbsorption = Vec3{absorption(color.r), absorption(color.g), absorption(color.b)};
+      }
     }
     // glTF's KHR_materials_clearcoat: a layer of index 1.5 over the base, weighed by its factor,
     // which a coat has no weight for: at least half is a coat, as transmission is glass.

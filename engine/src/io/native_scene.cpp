@@ -267,6 +267,8 @@ Value nativeSceneToJson(const Scene& s) {
     v.set("transmittance", m.transmittance);
     v.set("diffuse_ratio", m.diffuseRatio);
     v.set("interior_absorption", json::fromVec3(m.interiorAbsorption));
+    v.set("interior_scattering", json::fromVec3(m.interiorScattering));
+    v.set("interior_anisotropy", m.interiorAnisotropy);
     if (m.coatIor != 0) {
       v.set("coat_ior", m.coatIor);
       v.set("coat_absorption", json::fromVec3(m.coatAbsorption));
@@ -501,6 +503,8 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.number("transmittance", &m.transmittance);
       r.number("diffuse_ratio", &m.diffuseRatio);
       r.vec3("interior_absorption", &m.interiorAbsorption);
+      r.vec3("interior_scattering", &m.interiorScattering);
+      r.number("interior_anisotropy", &m.interiorAnisotropy);
       r.number("coat_ior", &m.coatIor);
       r.vec3("coat_absorption", &m.coatAbsorption);
       r.number("coat_roughness", &m.coatRoughness);

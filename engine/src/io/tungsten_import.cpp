@@ -85,26 +85,18 @@ class TungstenImporter {
         s.settings.samplesPerPixel = std::clamp(static_cast<int>(spp), 1, 1 << 20);
     }
     if (const Value* m = root.find("media"); m && m->isArray() && !m->asArray().empty()) {
-      // A homogeneous medium that only absorbs is rendered inside glass (Material::interiorAbsorption).
+      // A homogeneous medium is rendered inside glass (Material::filled).
       std::string names;
       for (std::size_t i = 0; i < m->asArray().size(); ++i) {
         const Value& medium = m->asArray()[i];
         if (!medium.isObject()) continue;
-        // Read leniently: a medium that is not understood is left out with the warning below.
-        Vec3 sigmaA{0.0f}, sigmaS{0.0f};
-        float density = 1;
-        const Value *a = medium.find("sigma_a"), *sc = medium.find("sigma_s"), *d = medium.find("density");
-        const bool read = (!a || json::toVec3(*a, &sigmaA)) && (!sc || json::toVec3(*sc, &sigmaS)) && (!d || json::toFloat(*d, &density));
         const std::string name = string(medium, "name", "?");
-        if (read && string(medium, "type") == "homogeneous" && maxComponent(sigmaS) <= 0 && density >= 0 &&
-            !medium.find("transmittance"))
-          absorbers_[name] = max(sigmaA * density, Vec3{0.0f});
-        else
-          names += cat(names.empty() ? "" : ", ", "'", name, "'");
+        if (auto filling = mediumFilling(medium, name)) media_[name] = *filling;
+        else names += cat(names.empty() ? "" : ", ", "'", name, "'");
       }
       if (!names.empty())
-        warn(cat("media: participating media are not rendered (", names,
-                 "); light travels through them as through a vacuum (media that only absorb are, inside glass)"));
+        warn(cat("media: participating media other than homogeneous ones are not rendered (", names,
+                 "); light travels through them as through a vacuum"));
     }
     if (const Value* p = root.find("primitives"); p && ok()) {
       if (!p->isArray()) return fail("primitives: expected an array");
@@ -695,6 +687,8 @@ class TungstenImporter {
     } else if (type != "pinhole") {
       warn(cat("camera type '", type, "' is rendered as a pinhole camera"));
     }
+    if (std::string medium = string(c, "medium"); !medium.empty())
+      warn(cat("camera: the medium '", medium, "' it sits in is not rendered (media are, inside glass); light reaches it as through a vacuum"));
     if (const Value* r = c.find("resolution")) {
       Vec2 res;
       if (!json::toVec2(*r, &res) || res.x < 1 || res.y < 1 || res.x > kMaxImageSide || res.y > kMaxImageSide)
@@ -1115,14 +1109,17 @@ class TungstenImporter {
         mat.bumpTexture = bumpTexture;
         mat.bumpStrength = bumpStrength;
       }
-      // An absorbing medium inside glass belongs to the primitive in Tungsten and to the material here.
+      // A medium inside glass belongs to the primitive in Tungsten and to the material here.
       std::string medium;
       for (const char* side : {"int_medium", "ext_medium"}) {
         const std::string name = string(p, side);
-        if (name.empty() || !absorbers_.count(name)) continue;
+        if (name.empty() || !media_.count(name)) continue;
         if (isGlassType(mat.type) && std::string(side) == "int_medium") {
           medium = name;
-          mat.interiorAbsorption = absorbers_[name];
+          const Filling& f = media_[name];
+          mat.interiorAbsorption = f.absorption;
+          mat.interiorScattering = f.scattering;
+          mat.interiorAnisotropy = f.anisotropy;
         } else {
           warn(cat(where, ": the medium '", name, "' is rendered only inside glass (an int_medium); here light passes through it"));
         }
@@ -1193,7 +1190,38 @@ class TungstenImporter {
   std::set<NodeId> copied_;  // named bsdfs some primitive took a copy of (dropReplacedBsdfs)
   // (bsdf, bump texture, strength, medium) -> its copy
   std::map<std::tuple<std::string, NodeId, float, std::string>, NodeId> bumped_;
-  std::map<std::string, Vec3> absorbers_;  // media that only absorb: name -> sigma_a times density
+  // A homogeneous medium, as glass it fills holds it (Material::interiorAbsorption and on).
+  struct Filling {
+    Vec3 absorption{0.0f}, scattering{0.0f};
+    float anisotropy = 0.0f;
+  };
+  // Tungsten's homogeneous medium: sigma_a and sigma_s times density, and its phase function
+  // (isotropic by default, as in Tungsten's Medium). Read leniently: nothing for a medium that is
+  // not understood, which is then named in a warning and left out.
+  std::optional<Filling> mediumFilling(const Value& medium, const std::string& name) {
+    Vec3 sigmaA{0.0f}, sigmaS{0.0f};
+    float density = 1;
+    const Value *a = medium.find("sigma_a"), *sc = medium.find("sigma_s"), *d = medium.find("density");
+    const bool read = (!a || json::toVec3(*a, &sigmaA)) && (!sc || json::toVec3(*sc, &sigmaS)) && (!d || json::toFloat(*d, &density));
+    if (!read || string(medium, "type") != "homogeneous" || !(density >= 0) || medium.find("transmittance")) return std::nullopt;
+    Filling f{max(sigmaA * density, Vec3{0.0f}), max(sigmaS * density, Vec3{0.0f}), 0.0f};
+    if (!isFinite(f.absorption) || !isFinite(f.scattering)) return std::nullopt;
+    if (const Value* phase = medium.find("phase_function"); phase && maxComponent(f.scattering) > 0) {
+      // Tungsten takes a phase function's type alone as a string, or an object with its parameters.
+      const std::string type = phase->isString() ? phase->asString() : phase->isObject() ? string(*phase, "type") : "";
+      float g = 0;
+      if (type == "henyey_greenstein") {
+        if (const Value* v = phase->isObject() ? phase->find("g") : nullptr; v && json::toFloat(*v, &g) && std::isfinite(g))
+          f.anisotropy = std::clamp(g, -0.99f, 0.99f);
+      } else if (type == "rayleigh") {
+        warn(cat("media: '", name, "': the Rayleigh phase function is rendered isotropic (the same mean cosine, 0)"));
+      } else if (type != "isotropic") {
+        warn(cat("media: '", name, "': unknown phase function '", type, "', rendered isotropic"));
+      }
+    }
+    return f;
+  }
+  std::map<std::string, Filling> media_;  // homogeneous media by name
 };
 
 }  // namespace

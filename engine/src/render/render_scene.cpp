@@ -552,7 +552,6 @@ static_assert(kMaterialTypeCount <= gpu::kMaskBeckmann && gpu::kMaskBeckmann < g
               gpu::kMaskCoat < gpu::kMaskMedium && gpu::kMaskMedium < 32);
 
 namespace {
-bool filled(const Material& m) { return isGlassType(m.type) && isFinite(m.interiorAbsorption) && maxComponent(m.interiorAbsorption) > 0; }
 // Transmissive types take no coat (Material::coatIor).
 bool coatRendered(const Material& m) { return m.coated() && !isTransmissiveType(m.type); }
 }  // namespace
@@ -584,9 +583,12 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
           vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, bitsOf(emissionTexture), bitsOf(blendWith)},
           v4(max(m.coatingAbsorption, Vec3{0.0f}), std::isfinite(m.blendRatio) ? std::clamp(m.blendRatio, 0.0f, 1.0f) : 1.0f),
           vec4{bitsOf(blendRatioTexture), coated ? std::min(m.coatIor, 10.0f) : 0.0f, 0, 0},
-          // The ninth holds the coat or, for glass, which takes no coat, its medium's absorption.
-          v4(coated ? max(m.coatAbsorption, Vec3{0.0f}) : filled(m) ? max(m.interiorAbsorption, Vec3{0.0f}) : Vec3{0.0f},
-             coated && m.coatRoughness > 0 ? std::clamp(m.coatRoughness, 1e-3f, 1.0f) : 0.0f)};
+          // The ninth holds the coat or, for glass, which takes no coat, its medium's absorption;
+          // the tenth the medium's scattering and its phase function's asymmetry.
+          v4(coated ? max(m.coatAbsorption, Vec3{0.0f}) : m.filled() ? max(m.interiorAbsorption, Vec3{0.0f}) : Vec3{0.0f},
+             coated && m.coatRoughness > 0 ? std::clamp(m.coatRoughness, 1e-3f, 1.0f) : 0.0f),
+          v4(m.filled() ? max(m.interiorScattering, Vec3{0.0f}) : Vec3{0.0f},
+             std::isfinite(m.interiorAnisotropy) ? std::clamp(m.interiorAnisotropy, -0.99f, 0.99f) : 0.0f)};
 }
 
 void RenderSceneBuilder::packMaterials(const Scene& scene) {
@@ -605,7 +607,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     if (m.beckmann && isMicrofacet(m.type))
       data_.materialTypes |= 1u << gpu::kMaskBeckmann;
     if (coatRendered(m)) data_.materialTypes |= 1u << gpu::kMaskCoat;
-    if (filled(m)) data_.materialTypes |= 1u << gpu::kMaskMedium;
+    if (m.filled()) data_.materialTypes |= 1u << gpu::kMaskMedium;
     if (textureIndex(m.albedoTexture) >= 0 || textureIndex(m.roughnessTexture) >= 0) data_.materialTextures = true;
     if (textureIndex(m.bumpTexture) >= 0 && m.bumpStrength != 0) data_.materialBump = true;
     if (textureIndex(m.emissionTexture) >= 0 && m.emissive()) data_.emissionTextures = true;

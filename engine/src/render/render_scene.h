@@ -30,11 +30,13 @@ namespace retile {
 
 using gpu::vec4;
 
-// A material as the shaders read it (kMaterialTexels texels: the first five, the seventh and the
-// last two unpacked by unpackMaterial in shaders/common/bsdf.glsl, the sixth, bump map, emission
-// texture and the material blended with, the seventh's w, the blend's ratio, and the eighth's x,
-// the texture that scales it, read by trace.comp; the eighth's y and the ninth, the coat), with its textures' and blend partner's indices
-// (-1: none). Roughness and IOR are clamped to what the BSDF code can sample.
+// A material as the shaders read it (kMaterialTexels texels: the first five, the seventh, the
+// eighth and the ninth unpacked by unpackMaterial in shaders/common/bsdf.glsl; the sixth, bump
+// map, emission texture and the material blended with, the seventh's w, the blend's ratio, the
+// eighth's x, the texture that scales it, and the tenth, the glass's scattering medium, read by
+// trace.comp; the eighth's y and the ninth hold the coat, or for glass its medium's absorption),
+// with its textures' and blend partner's indices (-1: none). Roughness and IOR are clamped to
+// what the BSDF code can sample.
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture = -1, int roughnessTexture = -1,
                                                     int alphaTexture = -1, int bumpTexture = -1, int emissionTexture = -1,
                                                     int blendWith = -1, int blendRatioTexture = -1);

@@ -22,7 +22,7 @@ bool finite(float v) { return std::isfinite(v); }
 
 std::string checkMaterial(const Scene& s, const Material& m) {
   if (!isFinite(m.albedo) || !isFinite(m.emission) || !isFinite(m.eta) || !isFinite(m.k) || !isFinite(m.coatingAbsorption) ||
-      !isFinite(m.coatAbsorption) || !finite(m.coatIor) || !isFinite(m.interiorAbsorption) || !finite(m.coatRoughness) ||
+      !isFinite(m.coatAbsorption) || !finite(m.coatIor) || !isFinite(m.interiorAbsorption) || !isFinite(m.interiorScattering) || !finite(m.interiorAnisotropy) || !finite(m.coatRoughness) ||
       !finite(m.roughness) || !finite(m.ior) || !finite(m.alpha) || !finite(m.bumpStrength) || !finite(m.blendRatio) ||
       !finite(m.transmittance) || !finite(m.diffuseRatio))
     return cat("material '", m.name, "': a parameter is not a finite number");

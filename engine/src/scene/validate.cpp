@@ -144,6 +144,8 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
     checkColor(m.coatAbsorption, Vec3{0.0f}, what + ": coat absorption", warnings);
     clampValue(m.coatRoughness, 0.0f, 1.0f, 0.0f, what + ": coat roughness", warnings);
     checkColor(m.interiorAbsorption, Vec3{0.0f}, what + ": interior absorption", warnings);
+    checkColor(m.interiorScattering, Vec3{0.0f}, what + ": interior scattering", warnings);
+    clampValue(m.interiorAnisotropy, -0.99f, 0.99f, 0.0f, what + ": interior anisotropy", warnings);
     if (!finiteNonNegative(m.eta) || !finiteNonNegative(m.k)) {
       warnings.push_back(cat(what, ": its complex index of refraction is negative or not finite; copper instead"));
       m.metal = "Cu";
