@@ -142,7 +142,7 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
                               texelFetch(uMaterials, base + 4), plastics ? texelFetch(uMaterials, base + 6) : vec4(0.0),
                               kCoatUsed ? texelFetch(uMaterials, base + 7) : vec4(0.0),
                               kCoatUsed || kMediumUsed ? texelFetch(uMaterials, base + 8) : vec4(0.0));
-  if (kMediumUsed) m.scattering = texelFetch(uMaterials, base + 9);
+  if (kScatteringUsed) m.scattering = texelFetch(uMaterials, base + 9);
   int albedoTex = floatBitsToInt(t2.w), roughTex = floatBitsToInt(t3.w);
   if (hasFeature(kFeatureTextures) && albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
   if (hasFeature(kFeatureTextures) && roughTex >= 0) m.roughness = max(m.roughness * sampleTexture(roughTex, uv).r, 1e-3);
@@ -205,8 +205,9 @@ struct Path {
   // reflections and what is seen through glass keep their own edges): its albedo times the
   // throughput of the chain before it, its normal, the distance along the path to it, and the
   // emission the path collects up to it (the denoiser filters the rest and adds it back, so a
-  // light's edge stays exact). An emitter that does not reflect is such a hit too. The object id
-  // is the first hit's (picking).
+  // light's edge stays exact). An emitter that does not reflect is such a hit too, and so is a
+  // point where the path scatters in a medium (scatterInMedium). The object id is the first
+  // hit's (picking).
   vec3 auxAlbedo, auxNormal, auxEmission;
   float auxDepth;  // kInfinity until that hit
   float travelled; // distance along the path so far
@@ -363,12 +364,18 @@ bool survivesRoulette(inout Path path, inout Shadow shadow) {
 }
 
 #if RETILE_MEDIUM
-// The path scatters in its medium (of extinction sigmaT) `flight` along its ray, short of the
-// hit, and the phase function gives its next direction. No light is sampled here: the medium
-// fills glass, whose surface blocks shadow rays, so an emitter the path finds next counts in
-// full, as after a mirror. A scattering event is a bounce, as in Tungsten. Returns false when
-// the path has ended.
-bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, vec3 sigmaT) {
+// What a ray keeps over `dist` through a medium of extinction sigmaT (nothing, to a light at
+// infinity, in the channels where the medium has any).
+vec3 transmittance(vec3 sigmaT, float dist) {
+  return dist >= kInfinity ? vec3(lessThanEqual(sigmaT, vec3(0.0))) : exp(-sigmaT * dist);
+}
+
+// The path scatters in its medium (of extinction sigmaT) `flight` along its ray, short of its
+// hit at hitT. As at a surface, a light is sampled (its shadow ray dimmed by the medium; the
+// glass round the medium blocks light from outside, as in Tungsten) and weighed against the
+// phase function, which then gives the next direction. A scattering event is a bounce, as in
+// Tungsten. Returns false when the path has ended.
+bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, float hitT, vec3 sigmaT) {
   vec3 crossed = exp(-sigmaT * flight);
   float pdf = dot(sigmaT * crossed, vec3(1.0 / 3.0));
   path.travelled += flight;
@@ -380,11 +387,32 @@ bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, vec3 si
   }
   path.beta *= pdf > 0.0 ? path.scattering.rgb * crossed / pdf : vec3(0.0);
   if (path.depth >= int(frame.image.w) || !(maxComponent(path.beta) > 0.0)) return false;
-  vec3 pos = path.ro + flight * path.rd;
-  path.rd = sampleHenyeyGreenstein(path.rd, path.scattering.w, vec2(rand(path.rng), rand(path.rng)));
+  // Kept short of the surface, so that rounding cannot put the point on its far side.
+  vec3 pos = path.ro + min(flight, hitT * 0.99999) * path.rd;
+  float g = path.scattering.w;
+  if ((frame.lightPick.x + frame.lightPick.y + frame.lightPick.z) > 0.0) {
+    vec3 lu = vec3(rand(path.rng), rand(path.rng), rand(path.rng));
+    LightSample ls = sampleLight(pos, lu);
+    if (ls.pdf > 0.0 && maxComponent(ls.radiance) > 0.0) {
+      float phase = henyeyGreenstein(dot(path.rd, ls.dir), g);
+      float w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, phase);
+      shadow.origin = pos;
+      shadow.from = ivec2(-1);
+      shadow.dir = ls.dir;
+      shadow.tMax = ls.dist >= kInfinity ? kInfinity : ls.dist * (1.0 - 1e-4);
+      shadow.random = rand(path.rng);
+      shadow.L = path.beta * phase * ls.radiance * transmittance(sigmaT, ls.dist) * (w / ls.pdf);
+      shadow.ended = false;
+      shadow.selBase = path.selBase;
+      shadow.pending = true;
+    }
+  }
+  vec3 next = sampleHenyeyGreenstein(path.rd, g, vec2(rand(path.rng), rand(path.rng)));
+  path.prevPdf = henyeyGreenstein(dot(path.rd, next), g);
+  path.rd = next;
   path.ro = pos;
   path.from = ivec2(-1);
-  path.specular = true;
+  path.specular = false;
   path.prevPos = pos;
   path.depth++;
   return survivesRoulette(path, shadow);
@@ -403,7 +431,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   // (glass not closed) is absorbed on its infinite way. In a medium that scatters, the path may
   // scatter before the hit, which it then does not reach.
 #if RETILE_MEDIUM
-  if (maxComponent(path.scattering.rgb) > 0.0) {
+  if (kScatteringUsed && maxComponent(path.scattering.rgb) > 0.0) {
     // Tungsten's free flight (HomogeneousMedium::sampleDistance): a distance drawn for one
     // channel, picked evenly, and weighted by the three channels' mean pdf, so that every
     // channel's estimate is unbiased whatever its own extinction.
@@ -411,7 +439,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
     float sigmaC = sigmaT[min(int(rand(path.rng) * 3.0), 2)];
     float u = rand(path.rng);
     float flight = sigmaC > 0.0 ? -log(1.0 - u) / sigmaC : kInfinity;
-    if (flight < hit.t) return scatterInMedium(path, shadow, flight, sigmaT);
+    if (flight < hit.t) return scatterInMedium(path, shadow, flight, hit.t, sigmaT);
     vec3 crossed = hit.prim >= 0 ? exp(-sigmaT * hit.t) : vec3(lessThanEqual(sigmaT, vec3(0.0)));
     float pdf = dot(crossed, vec3(1.0 / 3.0));
     path.beta *= pdf > 0.0 ? crossed / pdf : vec3(0.0);
@@ -552,6 +580,14 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
           shadow.tMax = ls.dist >= kInfinity ? kInfinity : ls.dist * (1.0 - 1e-4);
           shadow.random = rand(path.rng);
           shadow.L = path.beta * f * ls.radiance * (w / ls.pdf);
+#if RETILE_MEDIUM
+          // The shadow ray runs in the path's medium, or, through glass, in the medium on the
+          // glass's other side: its own inside when the path comes from outside, else nothing.
+          vec3 sigmaT = path.absorption + path.scattering.rgb;
+          if ((isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric)) && sideL * dot(wo, ngs) < 0.0)
+            sigmaT = frontFace ? m.interior + m.scattering.rgb : vec3(0.0);
+          shadow.L *= transmittance(sigmaT, ls.dist);
+#endif
           shadow.ended = false;
           shadow.selBase = path.selBase;
           shadow.pending = true;
@@ -576,9 +612,11 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   // Through glass the path enters its medium or leaves it for the outside (a vacuum: nesting is
   // not tracked).
 #if RETILE_MEDIUM
+  // Which side the path came from is the true surface's (as in Tungsten): a shading normal
+  // cannot carry the medium out of its glass.
   if (bs.transmitted && (isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric))) {
-    path.absorption = woL.z > 0.0 ? m.interior : vec3(0.0);
-    path.scattering = woL.z > 0.0 ? m.scattering : vec4(0.0);
+    path.absorption = frontFace ? m.interior : vec3(0.0);
+    path.scattering = frontFace ? m.scattering : vec4(0.0);
   }
 #endif
   if (bs.transmitted && !isMat(m.type, kMatThinSheet) && !isMat(m.type, kMatDiffuseTransmission)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);

@@ -12,16 +12,18 @@
 // alone: lavapipe runs every branch some lane of eight takes, and code for absent types still
 // costs registers and spills (removing the nine unused types speeds the Cornell box up by 9 %).
 #ifndef RETILE_MATERIALS
-#define RETILE_MATERIALS 0xffff
+#define RETILE_MATERIALS 0x1ffff
 #endif
 const int kMaterialMask = RETILE_MATERIALS;
 bool isMat(int t, int k) { return (kMaterialMask & (1 << k)) != 0 && t == k; }
 // Some rough material of the scene asks for Beckmann's distribution (bit kMaskBeckmann of the
 // mask): without it the Beckmann code is not compiled in.
 const bool kBeckmannUsed = (kMaterialMask & (1 << kMaskBeckmann)) != 0;
-// Likewise the clear coat (bit kMaskCoat) and glass filled with a medium (kMaskMedium).
+// Likewise the clear coat (bit kMaskCoat), glass filled with a medium (kMaskMedium) and a medium
+// that scatters (kMaskScattering: a scene whose media only absorb compiles no scattering code).
 const bool kCoatUsed = (kMaterialMask & (1 << kMaskCoat)) != 0;
 const bool kMediumUsed = (kMaterialMask & (1 << kMaskMedium)) != 0;
+const bool kScatteringUsed = (kMaterialMask & (1 << kMaskScattering)) != 0;
 // The same for the preprocessor (bit 15 is kMaskMedium): the path's medium (trace.comp) is not
 // even declared without one, so that a scene without filled glass carries no dead field. (What
 // the field cost was within the machine's noise: docs/MEASUREMENTS.md, twenty-second session.)

@@ -42,6 +42,13 @@ vec3 sampleUniformSphere(vec2 u) {
   return vec3(r * cos(phi), r * sin(phi), z);
 }
 
+// Henyey and Greenstein's phase function of asymmetry g at the cosine between the propagation
+// direction and the scattered one; it is also the pdf of sampleHenyeyGreenstein's directions.
+float henyeyGreenstein(float cosTheta, float g) {
+  float term = 1.0 + g * g - 2.0 * g * cosTheta;
+  return (0.25 * INV_PI) * (1.0 - g * g) / (term * sqrt(term));
+}
+
 // A direction scattered from the propagation direction d by Henyey and Greenstein's phase
 // function of asymmetry g (cos theta by its inverted CDF; near g = 0, the uniform sphere). The
 // phase function is its own pdf: the sample's weight is 1.

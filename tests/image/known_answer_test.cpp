@@ -123,23 +123,37 @@ TEST(KnownAnswer, WhiteFurnaceLosslessMaterials) {
   }
 }
 
+// Glass of index 1.0001 (no Fresnel reflection, rays go straight) filled with a medium.
+Material filledGlass(Vec3 absorption, Vec3 scattering = Vec3{0.0f}, float anisotropy = 0) {
+  Material glass;
+  glass.type = MaterialType::Dielectric;
+  glass.albedo = Vec3{1.0f};
+  glass.ior = 1.0f;
+  glass.interiorAbsorption = absorption;
+  glass.interiorScattering = scattering;
+  glass.interiorAnisotropy = anisotropy;
+  return glass;
+}
+
+// A 32x32 view through `glass`, a slab one unit thick and wide enough to be endless, head on,
+// before a sky of 1.
+Scene slabBeforeTheSky(const Material& glass, float fovDegrees, int maxBounces) {
+  Scene s = test::emptyScene(32, 32);
+  s.camera = test::frontCamera(fovDegrees);
+  s.settings.maxBounces = maxBounces;
+  s.environment.color = Vec3{1.0f};
+  test::addMeshObject(s, "slab", makeCube(), test::addMaterial(s, glass), Mat4::translate({0, 0, -5}) * Mat4::scale({40, 40, 1}));
+  return s;
+}
+
 TEST(KnownAnswer, GlassFilledWithAnAbsorbingMediumDimsByBeersLaw) {
-  // A slab of glass one unit thick, of index 1.0001 (no Fresnel reflection, rays go straight),
-  // filled with a medium of absorption sigma, before a sky of 1: the middle of the image, where
-  // rays cross the slab head on, shows exp(-sigma) per channel; empty glass shows 1.
+  // A slab of glass one unit thick, filled with a medium of absorption sigma, before a sky of 1:
+  // the middle of the image, where rays cross the slab head on, shows exp(-sigma) per channel;
+  // empty glass shows 1.
   RETILE_RENDERER_OR_SKIP(r);
   const float sigma[3] = {0.7f, 0.2f, 0.0f};
   for (bool filled : {true, false}) {
-    Scene s = test::emptyScene(32, 32);
-    s.camera = test::frontCamera(30);
-    s.settings.maxBounces = 8;
-    s.environment.color = Vec3{1.0f};
-    Material glass;
-    glass.type = MaterialType::Dielectric;
-    glass.albedo = Vec3{1.0f};
-    glass.ior = 1.0f;
-    if (filled) glass.interiorAbsorption = {sigma[0], sigma[1], sigma[2]};
-    test::addMeshObject(s, "slab", makeCube(), test::addMaterial(s, glass), Mat4::translate({0, 0, -5}) * Mat4::scale({40, 40, 1}));
+    Scene s = slabBeforeTheSky(filledGlass(filled ? Vec3{sigma[0], sigma[1], sigma[2]} : Vec3{0.0f}), 30, 8);
     RenderImage img = renderScene(*r, s, 16);
     for (int y = 14; y < 18; ++y)
       for (int x = 14; x < 18; ++x)
@@ -186,18 +200,7 @@ TEST(KnownAnswer, GlassFilledWithAScatteringMediumMatchesARandomWalk) {
   const Vec3 sigmaA{0.0f, 0.5f, 1.0f}, sigmaS{2.0f, 1.0f, 1.5f};
   for (float g : {0.7f, -0.5f, 0.0f}) {
     SCOPED_TRACE("g " + std::to_string(g));
-    Scene s = test::emptyScene(32, 32);
-    s.camera = test::frontCamera(4);
-    s.settings.maxBounces = 1024;
-    s.environment.color = Vec3{1.0f};
-    Material glass;
-    glass.type = MaterialType::Dielectric;
-    glass.albedo = Vec3{1.0f};
-    glass.ior = 1.0f;
-    glass.interiorAbsorption = sigmaA;
-    glass.interiorScattering = sigmaS;
-    glass.interiorAnisotropy = g;
-    test::addMeshObject(s, "slab", makeCube(), test::addMaterial(s, glass), Mat4::translate({0, 0, -5}) * Mat4::scale({40, 40, 1}));
+    Scene s = slabBeforeTheSky(filledGlass(sigmaA, sigmaS, g), 4, 1024);
     RenderImage img = renderScene(*r, s, 64);
     for (int c = 0; c < 3; ++c) {
       double mean = 0;
@@ -206,6 +209,55 @@ TEST(KnownAnswer, GlassFilledWithAScatteringMediumMatchesARandomWalk) {
       const double expected = slabEscape(sigmaT, sigmaS[c] / sigmaT, g, 400000);
       EXPECT_NEAR(mean, expected, 0.01) << "channel " << c;
     }
+  }
+}
+
+TEST(KnownAnswer, ALightInsideFilledGlassLightsItsMediumAndWhatItHolds) {
+  // Glass of index 1.0001 two units deep (y from 0 to 2), filled with a medium, holds a grey
+  // floor (y = 0.01) and a point light half a unit off the camera's axis (0.5, 1, 0); the camera
+  // looks straight down through it. With two bounces, a path samples the light once, at its
+  // first vertex inside: where it scatters in the medium or where it meets the floor. So the
+  // image is the medium's single scattering, integrated along the view ray here by Simpson's
+  // rule, plus the floor's direct light, both dimmed by the medium on every leg (to the light
+  // too). The third channel is empty: the floor's light alone, undimmed.
+  RETILE_RENDERER_OR_SKIP(r);
+  const Vec3 sigmaA{0.2f, 0.5f, 0.0f}, sigmaS{0.5f, 0.3f, 0.0f};
+  const float g = 0.5f, intensity = 10.0f, albedo = 0.8f;
+  Scene s = test::emptyScene(16, 16);
+  lookStraightDown(s, 3, 1);
+  s.settings.maxBounces = 2;
+  test::addMeshObject(s, "glass", makeCube(), test::addMaterial(s, filledGlass(sigmaA, sigmaS, g)),
+                      Mat4::translate({0, 1, 0}) * Mat4::scale({40, 2, 40}));
+  Material grey;
+  grey.albedo = Vec3{albedo};
+  test::addMeshObject(s, "floor", makeQuad(), test::addMaterial(s, grey), Mat4::translate({0, 0.01f, 0}) * Mat4::scale({4, 1, 4}));
+  Light light;
+  light.id = s.newId();
+  light.type = LightType::Point;
+  light.intensity = intensity;
+  light.position = {0.5f, 1, 0};
+  s.lights.push_back(light);
+  RenderImage img = renderScene(*r, s, 256);
+  for (int c = 0; c < 3; ++c) {
+    const double sigmaT = sigmaA[c] + sigmaS[c], depth = 1.99;
+    // The view ray runs down from the glass's top, s below it; the light is at height 1.
+    auto scattered = [&](double below) {
+      const double dy = below - 1.0, r2 = 0.25 + dy * dy, cosTheta = -dy / std::sqrt(r2);
+      const double term = 1 + g * g - 2 * g * cosTheta;
+      const double phase = (1 - g * g) / (4 * kPi * term * std::sqrt(term));
+      return sigmaS[c] * std::exp(-sigmaT * below) * phase * intensity * std::exp(-sigmaT * std::sqrt(r2)) / r2;
+    };
+    const int steps = 20000;
+    double single = scattered(0) + scattered(depth);
+    for (int i = 1; i < steps; ++i) single += (i % 2 ? 4 : 2) * scattered(depth * i / steps);
+    single *= depth / steps / 3;
+    const double toLight = std::sqrt(0.25 + 0.99 * 0.99);
+    const double floor = std::exp(-sigmaT * depth) * albedo / kPi * intensity * (0.99 / toLight) / (toLight * toLight) *
+                         std::exp(-sigmaT * toLight);
+    double mean = 0;
+    for (int i = 0; i < 16 * 16; ++i) mean += img.color[3 * i + c] / 256.0;
+    const double expected = single + floor;
+    EXPECT_NEAR(mean, expected, 0.02 * expected) << "channel " << c << ": single scattering " << single << ", floor " << floor;
   }
 }
 

@@ -266,7 +266,8 @@ TEST(Tungsten, CoatsKeepTheirSubstrateUnderAClearCoat) {
 
 // A homogeneous medium fills the glass that names it as its int_medium (sigma_a and sigma_s times
 // density, the phase function's asymmetry); elsewhere it is named in a warning, and so is a
-// medium of another kind.
+// medium of another kind, with the reason. ("isotropic" alone as a string is not Tungsten's form
+// but is read too.)
 TEST(Tungsten, AHomogeneousMediumFillsItsGlass) {
   auto r = importTungsten(writeScene(R"({"media": [
         {"name": "ink", "type": "homogeneous", "sigma_a": [0.5, 1, 2], "sigma_s": 0, "density": 2},
@@ -274,7 +275,10 @@ TEST(Tungsten, AHomogeneousMediumFillsItsGlass) {
          "phase_function": {"type": "henyey_greenstein", "g": 0.7}},
         {"name": "milk", "type": "homogeneous", "sigma_s": 4, "phase_function": "isotropic"},
         {"name": "sky", "type": "homogeneous", "sigma_s": 1, "phase_function": {"type": "rayleigh"}},
-        {"name": "smoke", "type": "voxel", "sigma_s": 1}],
+        {"name": "smoke", "type": "voxel", "sigma_s": 1},
+        {"name": "haze", "type": "homogeneous", "sigma_s": 1, "transmittance": {"type": "pulse"}},
+        {"name": "dense", "type": "homogeneous", "sigma_s": 1, "max_bounces": 2,
+         "phase_function": {"type": "henyey_greenstein", "g": 1}}],
       "bsdfs": [{"name": "glass", "type": "dielectric", "ior": 1.33}, {"name": "wall", "type": "lambert"}],
       "primitives": [
         {"type": "sphere", "name": "bottle", "bsdf": "glass", "int_medium": "ink"},
@@ -283,7 +287,9 @@ TEST(Tungsten, AHomogeneousMediumFillsItsGlass) {
         {"type": "sphere", "name": "misty", "bsdf": "glass", "int_medium": "fog"},
         {"type": "sphere", "name": "jug", "bsdf": "glass", "int_medium": "milk"},
         {"type": "sphere", "name": "dome", "bsdf": "glass", "int_medium": "sky"},
-        {"type": "sphere", "name": "smoky", "bsdf": "glass", "int_medium": "smoke"}]})"));
+        {"type": "sphere", "name": "smoky", "bsdf": "glass", "int_medium": "smoke"},
+        {"type": "sphere", "name": "hazy", "bsdf": "glass", "int_medium": "haze"},
+        {"type": "sphere", "name": "thick", "bsdf": "glass", "int_medium": "dense"}]})"));
   ASSERT_TRUE(r.ok()) << r.error();
   auto materialOf = [&](const char* object) {
     for (const Object& o : r->scene.objects)
@@ -304,15 +310,23 @@ TEST(Tungsten, AHomogeneousMediumFillsItsGlass) {
   EXPECT_EQ(materialOf("dome").interiorScattering, Vec3(1.0f));
   EXPECT_EQ(materialOf("dome").interiorAnisotropy, 0.0f) << "Rayleigh's mean cosine";
   EXPECT_FALSE(materialOf("smoky").filled());
-  int smoke = 0, wall = 0, rayleigh = 0;
+  EXPECT_FALSE(materialOf("hazy").filled());
+  EXPECT_FLOAT_EQ(materialOf("thick").interiorAnisotropy, 0.99f);
+  int smoke = 0, haze = 0, wall = 0, rayleigh = 0, g = 0, bounces = 0;
   for (const auto& w : r->warnings) {
-    smoke += w.find("media other than homogeneous ones are not rendered ('smoke')") != std::string::npos;
+    smoke += w.find("'smoke' is not rendered (a voxel medium; only homogeneous ones are)") != std::string::npos;
+    haze += w.find("'haze' is not rendered (a non-exponential transmittance)") != std::string::npos;
     wall += w.find("the medium 'ink' is rendered only inside glass") != std::string::npos;
     rayleigh += w.find("'sky': the Rayleigh phase function is rendered isotropic") != std::string::npos;
+    g += w.find("'dense': the phase function's g of 1 is rendered as 0.99") != std::string::npos;
+    bounces += w.find("'dense': its max_bounces of 2 is not kept") != std::string::npos;
   }
   EXPECT_EQ(smoke, 1);
+  EXPECT_EQ(haze, 1);
   EXPECT_EQ(wall, 1);
   EXPECT_EQ(rayleigh, 1);
+  EXPECT_EQ(g, 1);
+  EXPECT_EQ(bounces, 1);
 }
 
 // Tungsten turns an infinite_sphere by its transform's rotation, as it turns any primitive: so a

@@ -157,7 +157,8 @@ struct Material {
   float interiorAnisotropy = 0.0f;
   // Glass with a medium that absorbs or scatters.
   bool filled() const {
-    return isGlassType(type) && (maxComponent(interiorAbsorption) > 0 || maxComponent(interiorScattering) > 0);
+    return isGlassType(type) && isFinite(interiorAbsorption) && isFinite(interiorScattering) &&
+           (maxComponent(interiorAbsorption) > 0 || maxComponent(interiorScattering) > 0);
   }
   bool coated() const { return coatIor > 1.0f; }
   std::string metal = "Cu";        // conductors: a named metal (see conductorNames) or "custom"

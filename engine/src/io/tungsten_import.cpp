@@ -86,17 +86,14 @@ class TungstenImporter {
     }
     if (const Value* m = root.find("media"); m && m->isArray() && !m->asArray().empty()) {
       // A homogeneous medium is rendered inside glass (Material::filled).
-      std::string names;
       for (std::size_t i = 0; i < m->asArray().size(); ++i) {
         const Value& medium = m->asArray()[i];
         if (!medium.isObject()) continue;
         const std::string name = string(medium, "name", "?");
-        if (auto filling = mediumFilling(medium, name)) media_[name] = *filling;
-        else names += cat(names.empty() ? "" : ", ", "'", name, "'");
+        std::string why;
+        if (auto filling = mediumFilling(medium, name, &why)) media_[name] = *filling;
+        else warn(cat("media: '", name, "' is not rendered (", why, "); light travels through it as through a vacuum"));
       }
-      if (!names.empty())
-        warn(cat("media: participating media other than homogeneous ones are not rendered (", names,
-                 "); light travels through them as through a vacuum"));
     }
     if (const Value* p = root.find("primitives"); p && ok()) {
       if (!p->isArray()) return fail("primitives: expected an array");
@@ -1197,26 +1194,43 @@ class TungstenImporter {
   };
   // Tungsten's homogeneous medium: sigma_a and sigma_s times density, and its phase function
   // (isotropic by default, as in Tungsten's Medium). Read leniently: nothing for a medium that is
-  // not understood, which is then named in a warning and left out.
-  std::optional<Filling> mediumFilling(const Value& medium, const std::string& name) {
+  // not understood, with the reason in `why`; the caller names it in a warning and leaves it out.
+  std::optional<Filling> mediumFilling(const Value& medium, const std::string& name, std::string* why) {
     Vec3 sigmaA{0.0f}, sigmaS{0.0f};
     float density = 1;
     const Value *a = medium.find("sigma_a"), *sc = medium.find("sigma_s"), *d = medium.find("density");
-    const bool read = (!a || json::toVec3(*a, &sigmaA)) && (!sc || json::toVec3(*sc, &sigmaS)) && (!d || json::toFloat(*d, &density));
-    if (!read || string(medium, "type") != "homogeneous" || !(density >= 0) || medium.find("transmittance")) return std::nullopt;
+    const std::string type = string(medium, "type");
+    if (type != "homogeneous") *why = cat("a ", type.empty() ? "medium of no type" : cat(type, " medium"), "; only homogeneous ones are");
+    else if (medium.find("transmittance")) *why = "a non-exponential transmittance";
+    else if (!((!a || json::toVec3(*a, &sigmaA)) && (!sc || json::toVec3(*sc, &sigmaS)) && (!d || json::toFloat(*d, &density))))
+      *why = "sigma_a, sigma_s or density is not a number";
+    if (!why->empty()) return std::nullopt;
     Filling f{max(sigmaA * density, Vec3{0.0f}), max(sigmaS * density, Vec3{0.0f}), 0.0f};
-    if (!isFinite(f.absorption) || !isFinite(f.scattering)) return std::nullopt;
+    if (!(density >= 0) || !isFinite(f.absorption) || !isFinite(f.scattering)) {
+      *why = "a negative or infinite density or coefficient";
+      return std::nullopt;
+    }
+    // Tungsten writes its default, 1024, into every medium it saves: only a tighter limit matters.
+    float bounces = 0;
+    if (const Value* v = medium.find("max_bounces"); v && json::toFloat(*v, &bounces) && bounces < out_.scene.settings.maxBounces)
+      warn(cat("media: '", name, "': its max_bounces of ", bounces, " is not kept (the scene's limit of ",
+               out_.scene.settings.maxBounces, " bounces applies)"));
     if (const Value* phase = medium.find("phase_function"); phase && maxComponent(f.scattering) > 0) {
-      // Tungsten takes a phase function's type alone as a string, or an object with its parameters.
-      const std::string type = phase->isString() ? phase->asString() : phase->isObject() ? string(*phase, "type") : "";
+      // An object with its type (Tungsten's form); the type alone as a string is read too.
+      const std::string phaseType = phase->isString() ? phase->asString() : phase->isObject() ? string(*phase, "type") : "";
       float g = 0;
-      if (type == "henyey_greenstein") {
-        if (const Value* v = phase->isObject() ? phase->find("g") : nullptr; v && json::toFloat(*v, &g) && std::isfinite(g))
+      if (phaseType == "henyey_greenstein") {
+        const Value* v = phase->isObject() ? phase->find("g") : nullptr;
+        if (v && json::toFloat(*v, &g) && std::isfinite(g)) {
           f.anisotropy = std::clamp(g, -0.99f, 0.99f);
-      } else if (type == "rayleigh") {
+          if (f.anisotropy != g) warn(cat("media: '", name, "': the phase function's g of ", g, " is rendered as ", f.anisotropy));
+        } else if (v) {
+          warn(cat("media: '", name, "': the phase function's g is not a number; rendered isotropic"));
+        }
+      } else if (phaseType == "rayleigh") {
         warn(cat("media: '", name, "': the Rayleigh phase function is rendered isotropic (the same mean cosine, 0)"));
-      } else if (type != "isotropic") {
-        warn(cat("media: '", name, "': unknown phase function '", type, "', rendered isotropic"));
+      } else if (phaseType != "isotropic") {
+        warn(cat("media: '", name, "': unknown phase function '", phaseType, "', rendered isotropic"));
       }
     }
     return f;

@@ -549,7 +549,7 @@ static_assert(gpu::kMaxBlendChain == kMaxBlendChain, "the kernel follows as many
 
 // The kernel's material mask holds a bit per type, then Beckmann's and the coat's.
 static_assert(kMaterialTypeCount <= gpu::kMaskBeckmann && gpu::kMaskBeckmann < gpu::kMaskCoat &&
-              gpu::kMaskCoat < gpu::kMaskMedium && gpu::kMaskMedium < 32);
+              gpu::kMaskCoat < gpu::kMaskMedium && gpu::kMaskMedium < gpu::kMaskScattering && gpu::kMaskScattering < 32);
 
 namespace {
 // Transmissive types take no coat (Material::coatIor).
@@ -608,6 +608,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
       data_.materialTypes |= 1u << gpu::kMaskBeckmann;
     if (coatRendered(m)) data_.materialTypes |= 1u << gpu::kMaskCoat;
     if (m.filled()) data_.materialTypes |= 1u << gpu::kMaskMedium;
+    if (m.filled() && maxComponent(m.interiorScattering) > 0) data_.materialTypes |= 1u << gpu::kMaskScattering;
     if (textureIndex(m.albedoTexture) >= 0 || textureIndex(m.roughnessTexture) >= 0) data_.materialTextures = true;
     if (textureIndex(m.bumpTexture) >= 0 && m.bumpStrength != 0) data_.materialBump = true;
     if (textureIndex(m.emissionTexture) >= 0 && m.emissive()) data_.emissionTextures = true;
