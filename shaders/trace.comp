@@ -453,7 +453,6 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
     else atomicAdd(selectionCounts[path.selBase + 1], uint(max(maxBounces + 1, 1) / path.depth));
   }
 
-
   if (hit.prim < 0) {
     vec3 Le = envRadiance(rd);
     vec3 added = path.beta * Le;
