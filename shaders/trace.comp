@@ -363,6 +363,20 @@ bool survivesRoulette(inout Path path, inout Shadow shadow) {
   return true;
 }
 
+// Sets off the shadow ray of a next-event estimate from `origin` (on triangle `from`, or -1) to
+// the light sample, adding L when nothing blocks it; traced with the path's next segment.
+void castShadow(inout Shadow shadow, inout Path path, vec3 origin, ivec2 from, LightSample ls, vec3 L) {
+  shadow.origin = origin;
+  shadow.from = from;
+  shadow.dir = ls.dir;
+  shadow.tMax = ls.dist >= kInfinity ? kInfinity : ls.dist * (1.0 - 1e-4);
+  shadow.random = rand(path.rng);
+  shadow.L = L;
+  shadow.ended = false;
+  shadow.selBase = path.selBase;
+  shadow.pending = true;
+}
+
 #if RETILE_MEDIUM
 // What a ray keeps over `dist` through a medium of extinction sigmaT (nothing, to a light at
 // infinity, in the channels where the medium has any).
@@ -396,15 +410,7 @@ bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, float h
     if (ls.pdf > 0.0 && maxComponent(ls.radiance) > 0.0) {
       float phase = henyeyGreenstein(dot(path.rd, ls.dir), g);
       float w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, phase);
-      shadow.origin = pos;
-      shadow.from = ivec2(-1);
-      shadow.dir = ls.dir;
-      shadow.tMax = ls.dist >= kInfinity ? kInfinity : ls.dist * (1.0 - 1e-4);
-      shadow.random = rand(path.rng);
-      shadow.L = path.beta * phase * ls.radiance * transmittance(sigmaT, ls.dist) * (w / ls.pdf);
-      shadow.ended = false;
-      shadow.selBase = path.selBase;
-      shadow.pending = true;
+      castShadow(shadow, path, pos, ivec2(-1), ls, path.beta * phase * ls.radiance * transmittance(sigmaT, ls.dist) * (w / ls.pdf));
     }
   }
   vec3 next = sampleHenyeyGreenstein(path.rd, g, vec2(rand(path.rng), rand(path.rng)));
@@ -440,11 +446,11 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
     float u = rand(path.rng);
     float flight = sigmaC > 0.0 ? -log(1.0 - u) / sigmaC : kInfinity;
     if (flight < hit.t) return scatterInMedium(path, shadow, flight, hit.t, sigmaT);
-    vec3 crossed = hit.prim >= 0 ? exp(-sigmaT * hit.t) : vec3(lessThanEqual(sigmaT, vec3(0.0)));
+    vec3 crossed = transmittance(sigmaT, hit.t);  // a miss's t is kInfinity
     float pdf = dot(crossed, vec3(1.0 / 3.0));
     path.beta *= pdf > 0.0 ? crossed / pdf : vec3(0.0);
   } else {
-    path.beta *= hit.prim >= 0 ? exp(-path.absorption * hit.t) : vec3(lessThanEqual(path.absorption, vec3(0.0)));
+    path.beta *= transmittance(path.absorption, hit.t);
   }
 #endif
   if (path.selBase >= 0 && hit.prim >= 0 && hit.instance == selected) {
@@ -573,23 +579,16 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
         vec3 f = bsdfEval(m, woL, toLocal(ls.dir, t, b, nss), bsdfPdf);
         if (maxComponent(f) > 0.0) {
           float w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, bsdfPdf);
-          shadow.origin = offsetRay(pos, sideL > 0.0 ? ngs : -ngs);
-          shadow.from = ivec2(hit.prim, hit.instance);
-          shadow.dir = ls.dir;
-          shadow.tMax = ls.dist >= kInfinity ? kInfinity : ls.dist * (1.0 - 1e-4);
-          shadow.random = rand(path.rng);
-          shadow.L = path.beta * f * ls.radiance * (w / ls.pdf);
+          vec3 L = path.beta * f * ls.radiance * (w / ls.pdf);
 #if RETILE_MEDIUM
           // The shadow ray runs in the path's medium, or, through glass, in the medium on the
           // glass's other side: its own inside when the path comes from outside, else nothing.
           vec3 sigmaT = path.absorption + path.scattering.rgb;
           if ((isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric)) && sideL * dot(wo, ngs) < 0.0)
             sigmaT = frontFace ? m.interior + m.scattering.rgb : vec3(0.0);
-          shadow.L *= transmittance(sigmaT, ls.dist);
+          L *= transmittance(sigmaT, ls.dist);
 #endif
-          shadow.ended = false;
-          shadow.selBase = path.selBase;
-          shadow.pending = true;
+          castShadow(shadow, path, offsetRay(pos, sideL > 0.0 ? ngs : -ngs), ivec2(hit.prim, hit.instance), ls, L);
         }
       }
     }
