@@ -213,10 +213,11 @@ struct Path {
   float travelled; // distance along the path so far
   int auxInstance;
 #if RETILE_MEDIUM
-  // Of the medium the path is in (inside filled glass, else 0): absorption and scattering per
-  // unit of length, and the phase function's asymmetry in scattering.w.
-  vec3 absorption;
-  vec4 scattering;
+  // Of the medium the path is in (inside filled glass or a boundary, else 0): absorption and
+  // scattering per unit of length, and the phase function's asymmetry in scattering.w. And the
+  // same of the medium around that one, which the path goes back to when it leaves (crossMedium).
+  vec3 absorption, outerAbsorption;
+  vec4 scattering, outerScattering;
 #endif
 };
 
@@ -232,8 +233,14 @@ struct Shadow {
   vec3 L;      // what it adds when nothing blocks it
   bool ended;  // its path has ended: its sample is then rewritten as full when nothing blocks it
   uint slot;
-  vec3 full;
+  vec3 full;   // its ended path's sample without it
   int selBase;
+#if RETILE_BOUNDARY
+  // It may cross boundaries into other media, so the way through them is counted once it is
+  // traced (resolveShadow): the extinction of the medium it starts in, and the light's distance.
+  vec3 sigma;
+  float dist;
+#endif
 };
 
 uint primaryRays = 0u, bounceRays = 0u, shadowRays = 0u;
@@ -278,6 +285,8 @@ Path startPath(uint slot, int found) {
 #if RETILE_MEDIUM
   path.absorption = vec3(0.0);
   path.scattering = vec4(0.0);
+  path.outerAbsorption = vec3(0.0);
+  path.outerScattering = vec4(0.0);
 #endif
   path.specular = true;
   path.prevPdf = 0.0;
@@ -311,7 +320,8 @@ vec3 bumpNormal(vec3 ns, vec3 q1, vec3 q2, vec2 duv1, vec2 duv2, vec2 slope) {
 }
 
 // Surfaces whose reflection or refraction shows other objects' edges: mirrors, smooth glass and
-// metal, and their nearly smooth rough kinds. The denoiser's guides look through them.
+// metal, and their nearly smooth rough kinds. The denoiser's guides look through them, and
+// through boundaries, which shadeSegment passes before it asks.
 bool guideLooksThrough(Material m) {
   bool nearlySmooth = (isMat(m.type, kMatRoughConductor) || isMat(m.type, kMatRoughDielectric)) && m.roughness < 0.1;
   return (isDeltaMaterial(m) && !isMat(m.type, kMatNull)) || nearlySmooth;
@@ -332,22 +342,33 @@ void writeSample(Path path, bool ended) {
 bool endPath(Path path, inout Shadow shadow) {
   shadow.ended = true;
   shadow.slot = path.slot;
-  shadow.full = path.L + shadow.L;
+  shadow.full = path.L;
   return false;
 }
 
 // A shadow ray traced: its path's light, or its ended path's sample rewritten.
 // `blocker`: the instance that blocks the shadow ray, -1 when nothing does (Trace::blocker).
-void resolveShadow(inout Path path, inout Shadow shadow, int blocker) {
+void resolveShadow(inout Path path, inout Shadow shadow, int blocker, Trace tr) {
   if (!shadow.pending) return;
   shadowRays++;
   int selected = int(frame.work.z) - 1;
   if (shadow.selBase >= 0 && blocker >= 0 && blocker == selected) atomicAdd(selectionCounts[shadow.selBase + 2], 1u);
   bool visible = blocker < 0;
+  vec3 L = shadow.L;
+#if RETILE_BOUNDARY
+  // Its optical depth through the media it ran in (Trace::crossedSigma). Rounding may leave a
+  // little of a medium it entered and left; a negative depth only comes of boundaries that do
+  // not close.
+  vec3 sigma = shadow.sigma + tr.crossedSigma;
+  sigma = mix(sigma, vec3(0.0), lessThan(sigma, vec3(1e-5)));
+  vec3 depth = tr.crossedDepth + (shadow.dist >= kInfinity ? mix(vec3(0.0), vec3(kInfinity), greaterThan(sigma, vec3(0.0))) : sigma * shadow.dist);
+  L *= exp(-max(depth, vec3(0.0)));
+#endif
   // An ended path's sample was written when it ended (the lane may have started another since).
-  if (visible && !shadow.ended) path.L += shadow.L;
-  bool valid = !(any(isnan(shadow.full)) || any(isinf(shadow.full)));
-  if (visible && shadow.ended) samples[shadow.slot] = valid ? vec4(shadow.full, 1.0) : vec4(0.0);
+  if (visible && !shadow.ended) path.L += L;
+  vec3 full = shadow.full + L;
+  bool valid = !(any(isnan(full)) || any(isinf(full)));
+  if (visible && shadow.ended) samples[shadow.slot] = valid ? vec4(full, 1.0) : vec4(0.0);
   shadow.pending = false;
 }
 
@@ -363,9 +384,24 @@ bool survivesRoulette(inout Path path, inout Shadow shadow) {
   return true;
 }
 
-// Sets off the shadow ray of a next-event estimate from `origin` (on triangle `from`, or -1) to
-// the light sample, adding L when nothing blocks it; traced with the path's next segment.
-void castShadow(inout Shadow shadow, inout Path path, vec3 origin, ivec2 from, LightSample ls, vec3 L) {
+#if RETILE_MEDIUM
+// What a ray keeps over `dist` through a medium of extinction sigmaT (nothing, to a light at
+// infinity, in the channels where the medium has any).
+vec3 transmittance(vec3 sigmaT, float dist) {
+  return dist >= kInfinity ? vec3(lessThanEqual(sigmaT, vec3(0.0))) : exp(-sigmaT * dist);
+}
+#endif
+
+// Sets off the shadow ray of a next-event estimate from `origin` (on triangle `from`, or -1) in a
+// medium of extinction sigmaT to the light sample, adding L, dimmed by the media on its way, when
+// nothing blocks it; traced with the path's next segment.
+void castShadow(inout Shadow shadow, inout Path path, vec3 origin, ivec2 from, LightSample ls, vec3 L, vec3 sigmaT) {
+#if RETILE_BOUNDARY
+  shadow.sigma = sigmaT;
+  shadow.dist = ls.dist;
+#elif RETILE_MEDIUM
+  L *= transmittance(sigmaT, ls.dist);
+#endif
   shadow.origin = origin;
   shadow.from = from;
   shadow.dir = ls.dir;
@@ -378,10 +414,20 @@ void castShadow(inout Shadow shadow, inout Path path, vec3 origin, ivec2 from, L
 }
 
 #if RETILE_MEDIUM
-// What a ray keeps over `dist` through a medium of extinction sigmaT (nothing, to a light at
-// infinity, in the channels where the medium has any).
-vec3 transmittance(vec3 sigmaT, float dist) {
-  return dist >= kInfinity ? vec3(lessThanEqual(sigmaT, vec3(0.0))) : exp(-sigmaT * dist);
+// Through glass or a boundary (Material::holdsMedium) the path enters its medium across the front,
+// the one it was in becoming the one around, and goes back to that one across the back.
+void crossMedium(inout Path path, Material m, bool frontFace) {
+  if (frontFace) {
+    path.outerAbsorption = path.absorption;
+    path.outerScattering = path.scattering;
+    path.absorption = m.interior;
+    path.scattering = m.scattering;
+  } else {
+    path.absorption = path.outerAbsorption;
+    path.scattering = path.outerScattering;
+    path.outerAbsorption = vec3(0.0);
+    path.outerScattering = vec4(0.0);
+  }
 }
 
 // The path scatters in its medium (of extinction sigmaT) `flight` along its ray, short of its
@@ -410,7 +456,7 @@ bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, float h
     if (ls.pdf > 0.0 && maxComponent(ls.radiance) > 0.0) {
       float phase = henyeyGreenstein(dot(path.rd, ls.dir), g);
       float w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, phase);
-      castShadow(shadow, path, pos, ivec2(-1), ls, path.beta * phase * ls.radiance * transmittance(sigmaT, ls.dist) * (w / ls.pdf));
+      castShadow(shadow, path, pos, ivec2(-1), ls, path.beta * phase * ls.radiance * (w / ls.pdf), sigmaT);
     }
   }
   vec3 next = sampleHenyeyGreenstein(path.rd, g, vec2(rand(path.rng), rand(path.rng)));
@@ -535,6 +581,21 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
 
   path.travelled += hit.t;
   if (path.depth == 0) path.auxInstance = floatBitsToInt(info2.x);
+#if RETILE_BOUNDARY
+  if (isMat(m.type, kMatBoundary)) {
+    // No surface, only where a medium begins or ends: the path goes straight on, into the medium
+    // on the other side, as if nothing had been hit (its last vertex, pdf and lobe stay the
+    // MIS's), except that the crossing counts as a bounce, as in Tungsten (TraceBase).
+    if (path.depth >= maxBounces) return false;
+#if RETILE_MEDIUM
+    crossMedium(path, m, frontFace);
+#endif
+    path.ro = offsetRay(pos, frontFace ? -ng : ng);
+    path.from = ivec2(hit.prim, hit.instance);
+    path.depth++;
+    return survivesRoulette(path, shadow);
+  }
+#endif
   bool nullMaterial = isMat(m.type, kMatNull);
   if (path.auxDepth >= kInfinity) {
     // Up to and at the guide hit, what the path collects from lights is emission to the denoiser.
@@ -580,15 +641,16 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
         if (maxComponent(f) > 0.0) {
           float w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, bsdfPdf);
           vec3 L = path.beta * f * ls.radiance * (w / ls.pdf);
+          vec3 sigmaT = vec3(0.0);
 #if RETILE_MEDIUM
           // The shadow ray runs in the path's medium, or, through glass, in the medium on the
-          // glass's other side: its own inside when the path comes from outside, else nothing.
-          vec3 sigmaT = path.absorption + path.scattering.rgb;
+          // glass's other side: its own inside when the path comes from outside, else the one
+          // around it.
+          sigmaT = path.absorption + path.scattering.rgb;
           if ((isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric)) && sideL * dot(wo, ngs) < 0.0)
-            sigmaT = frontFace ? m.interior + m.scattering.rgb : vec3(0.0);
-          L *= transmittance(sigmaT, ls.dist);
+            sigmaT = frontFace ? m.interior + m.scattering.rgb : path.outerAbsorption + path.outerScattering.rgb;
 #endif
-          castShadow(shadow, path, offsetRay(pos, sideL > 0.0 ? ngs : -ngs), ivec2(hit.prim, hit.instance), ls, L);
+          castShadow(shadow, path, offsetRay(pos, sideL > 0.0 ? ngs : -ngs), ivec2(hit.prim, hit.instance), ls, L, sigmaT);
         }
       }
     }
@@ -606,16 +668,11 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   // Tungsten's convention has no such check (its enable_consistency_checks is off by default).
   if (!tungstenShading && (bs.transmitted ? sideI * sideO >= 0.0 : sideI * sideO <= 0.0)) return endPath(path, shadow);
   path.beta *= bs.weight;
-  // Roulette must not see the 1/eta^2 radiance scaling inside glass as lost energy.
-  // Through glass the path enters its medium or leaves it for the outside (a vacuum: nesting is
-  // not tracked).
+  // Through glass the path enters its medium or leaves it for the one around (crossMedium).
 #if RETILE_MEDIUM
   // Which side the path came from is the true surface's (as in Tungsten): a shading normal
   // cannot carry the medium out of its glass.
-  if (bs.transmitted && (isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric))) {
-    path.absorption = frontFace ? m.interior : vec3(0.0);
-    path.scattering = frontFace ? m.scattering : vec4(0.0);
-  }
+  if (bs.transmitted && (isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric))) crossMedium(path, m, frontFace);
 #endif
   if (bs.transmitted && !isMat(m.type, kMatThinSheet) && !isMat(m.type, kMatDiffuseTransmission)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
   path.specular = bs.delta;
@@ -649,6 +706,8 @@ void main() {
 #if RETILE_MEDIUM
   path.absorption = vec3(0.0);
   path.scattering = vec4(0.0);
+  path.outerAbsorption = vec3(0.0);
+  path.outerScattering = vec4(0.0);
 #endif
   bool alive = false;
   Shadow shadow;
@@ -693,7 +752,7 @@ void main() {
     // others' rays are still in flight (the traversal loop below).
     bool ready = tr.done, ended = false;
     if (ready && !tr.idle) {
-      resolveShadow(path, shadow, tr.blocker);
+      resolveShadow(path, shadow, tr.blocker, tr);
       ended = alive && !shadeSegment(path, shadow, tr.hit);
       alive = alive && !ended;
     }

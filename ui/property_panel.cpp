@@ -273,9 +273,10 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     edit(tr("Material type"), 0, [i](Material& x) { x.type = static_cast<MaterialType>(i); });
     rebuildLater();  // the type decides which fields apply
   });
-  b.color(tr("Albedo"), "albedo", m.albedo, defaults.albedo, [edit](Vec3 c, int drag) {
-    edit(tr("Albedo"), drag, [c](Material& x) { x.albedo = c; });
-  });
+  if (m.type != MaterialType::Boundary)
+    b.color(tr("Albedo"), "albedo", m.albedo, defaults.albedo, [edit](Vec3 c, int drag) {
+      edit(tr("Albedo"), drag, [c](Material& x) { x.albedo = c; });
+    });
   const bool rough = hasRoughness(m.type);
   if (rough) {  // smooth types ignore roughness: no field that does nothing
     // A slider as well as the field: the gesture look-dev artists use most.
@@ -336,7 +337,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       }, true);
     }
   }
-  if (m.type == MaterialType::Dielectric || m.type == MaterialType::RoughDielectric) {
+  if (holdsMedium(m.type)) {
     b.vec3(tr("Interior absorption"), "interiorAbsorption", m.interiorAbsorption, 0.01, [edit](int channel, double v, int drag) {
       edit(tr("Interior absorption"), drag,
            [channel, v](Material& x) { axisOf(x.interiorAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
@@ -350,6 +351,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
                edit(tr("Scattering anisotropy"), drag, [v](Material& x) { x.interiorAnisotropy = static_cast<float>(v); });
              });
   }
+  if (m.type == MaterialType::Boundary) return;  // no surface: no texture, emission, alpha or blend applies
   if (m.type == MaterialType::Phong)
     b.number(tr("Diffuse ratio"), "diffuseRatio", m.diffuseRatio, 0.0, 1.0, defaults.diffuseRatio, 3, [edit](double v, int drag) {
       edit(tr("Diffuse ratio"), drag, [v](Material& x) { x.diffuseRatio = static_cast<float>(v); });

@@ -12,7 +12,7 @@
 // alone: lavapipe runs every branch some lane of eight takes, and code for absent types still
 // costs registers and spills (removing the nine unused types speeds the Cornell box up by 9 %).
 #ifndef RETILE_MATERIALS
-#define RETILE_MATERIALS 0x1ffff
+#define RETILE_MATERIALS 0x3ffff
 #endif
 const int kMaterialMask = RETILE_MATERIALS;
 bool isMat(int t, int k) { return (kMaterialMask & (1 << k)) != 0 && t == k; }
@@ -24,10 +24,12 @@ const bool kBeckmannUsed = (kMaterialMask & (1 << kMaskBeckmann)) != 0;
 const bool kCoatUsed = (kMaterialMask & (1 << kMaskCoat)) != 0;
 const bool kMediumUsed = (kMaterialMask & (1 << kMaskMedium)) != 0;
 const bool kScatteringUsed = (kMaterialMask & (1 << kMaskScattering)) != 0;
-// The same for the preprocessor (bit 15 is kMaskMedium): the path's medium (trace.comp) is not
+// The same for the preprocessor (bit 16 is kMaskMedium): the path's medium (trace.comp) is not
 // even declared without one, so that a scene without filled glass carries no dead field. (What
 // the field cost was within the machine's noise: docs/MEASUREMENTS.md, twenty-second session.)
-#define RETILE_MEDIUM ((RETILE_MATERIALS & 32768) != 0)
+// Likewise bit 13, kMatBoundary: only then do shadow rays pass surfaces (scene.glsl traceStep).
+#define RETILE_MEDIUM ((RETILE_MATERIALS & 65536) != 0)
+#define RETILE_BOUNDARY ((RETILE_MATERIALS & 8192) != 0)
 
 struct Material {
   int type;

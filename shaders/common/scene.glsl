@@ -8,6 +8,7 @@
 
 #include "shared/layouts.h"
 #include "common/sampling.glsl"
+#include "common/bsdf.glsl"  // RETILE_BOUNDARY
 
 // A storage buffer, not a uniform buffer: lavapipe (Mesa 22.3) "inlines" uniform-buffer values that
 // decide branches into a fresh copy of the shader at every bind, and never frees the copies (the
@@ -223,6 +224,13 @@ struct Trace {
   int instanceSp;  // stack depth on entering the current instance: popping back to it leaves
   Hit hit;         // the extension ray's closest hit so far (a miss when it was not traced)
   int blocker;     // the instance that blocks the shadow ray, -1 when nothing does
+#if RETILE_BOUNDARY
+  // The boundaries (kMatBoundary) the shadow ray crossed, which do not block it, in any order: the
+  // sum of their media's extinctions, + entering across the front and - leaving, and of the same
+  // times minus the distance to the crossing. Its optical depth to a light at distance d, from a
+  // medium of extinction s, is then (s + crossedSigma) d + crossedDepth (trace.comp resolveShadow).
+  vec3 crossedSigma, crossedDepth;
+#endif
 };
 
 // `root` is frame.scene.x, the instance BVH's root, which the caller reads once.
@@ -236,6 +244,10 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, i
   miss.v = 0.0;
   tr.hit = miss;
   tr.blocker = -1;
+#if RETILE_BOUNDARY
+  tr.crossedSigma = vec3(0.0);
+  tr.crossedDepth = vec3(0.0);
+#endif
   tr.idle = !(first || second);
   tr.done = tr.idle;
   tr.second = second;
@@ -381,6 +393,20 @@ void traceStep(inout Trace tr, int below, int root) {
 #if RETILE_ALPHA_TEST
     bool alphaTested = direct ? (floatBitsToInt(r2.w) & kTriAlphaTested) != 0 : (tr.instFlags & kInstanceAlphaTested) != 0;
     if (found && alphaTested) found = alphaPasses(instance, p, uu, vv, tr.rayRandom);
+#endif
+#if RETILE_BOUNDARY
+    if (found && tr.onShadow) {
+      // A boundary is no surface: the shadow ray goes on, into the medium on its other side. det
+      // is -dot(d, the triangle's normal): positive across the front, into the boundary's medium.
+      int material = floatBitsToInt(texelFetch(uInstances, instance * kInstanceTexels + 3).z) * kMaterialTexels;
+      if ((floatBitsToInt(texelFetch(uMaterials, material).w) & kMatTypeBits) == kMatBoundary) {
+        vec3 sigma = texelFetch(uMaterials, material + 8).rgb + texelFetch(uMaterials, material + 9).rgb;
+        sigma = det > 0.0 ? sigma : -sigma;
+        tr.crossedSigma += sigma;
+        tr.crossedDepth -= sigma * tt;
+        found = false;
+      }
+    }
 #endif
     if (found && tr.onShadow) {
       tr.blocker = instance;

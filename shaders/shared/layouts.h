@@ -107,16 +107,17 @@ RT_CONST(int, kMatThinSheet, 9)
 RT_CONST(int, kMatNull, 10)
 RT_CONST(int, kMatPhong, 11)
 RT_CONST(int, kMatDiffuseTransmission, 12)
+RT_CONST(int, kMatBoundary, 13)
 // Packed with a rough type (type | kMatBeckmann): Beckmann's distribution instead of GGX; and the
 // bit of the kernel's material mask that says some material has it.
 RT_CONST(int, kMatBeckmann, 256)
-RT_CONST(int, kMaskBeckmann, 13)
+RT_CONST(int, kMaskBeckmann, 14)
 // The bit of the kernel's material mask that says some material has a clear coat (Material::coatIor).
-RT_CONST(int, kMaskCoat, 14)
+RT_CONST(int, kMaskCoat, 15)
 // And the bit that says some glass is filled with a medium (Material::filled), and the one that
 // says some such medium scatters (Material::interiorScattering).
-RT_CONST(int, kMaskMedium, 15)
-RT_CONST(int, kMaskScattering, 16)
+RT_CONST(int, kMaskMedium, 16)
+RT_CONST(int, kMaskScattering, 17)
 // Packed with a rough type: Smith's G as the product G1(wo) G1(wi) (Material::separableShadowing).
 // A multiply more per evaluation, so no kernel variant.
 RT_CONST(int, kMatSeparable, 512)

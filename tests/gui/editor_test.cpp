@@ -427,6 +427,26 @@ TEST(Editor, GlassTakesAScatteringMediumFromItsPanel) {
   EXPECT_EQ(w->scene().material(material)->interiorAnisotropy, 0.0f);
 }
 
+TEST(Editor, ABoundaryShowsItsMediumAndNoSurface) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  const NodeId material = w->scene().object(sphere)->material;
+  auto* type = w->findChild<QComboBox*>("materialType");
+  ASSERT_TRUE(type);
+  ASSERT_TRUE(w->findChild<QWidget*>("albedo"));
+  type->setCurrentIndex(static_cast<int>(MaterialType::Boundary));
+  ASSERT_TRUE(QTest::qWaitFor([&] { return w->findChild<ScrubField*>("interiorAbsorption0") != nullptr; }, 2000));
+  EXPECT_EQ(w->scene().material(material)->type, MaterialType::Boundary);
+  EXPECT_FALSE(w->findChild<QWidget*>("albedo")) << "no surface, so no colour";
+  EXPECT_FALSE(w->findChild<ScrubField*>("emission"));
+  EXPECT_FALSE(w->findChild<ScrubField*>("alpha"));
+  EXPECT_FALSE(w->findChild<QComboBox*>("blendWith"));
+  w->findChild<ScrubField*>("interiorAbsorption0")->setValue(0.5);
+  EXPECT_EQ(w->scene().material(material)->interiorAbsorption, Vec3(0.5f, 0.0f, 0.0f));
+  EXPECT_TRUE(w->scene().material(material)->filled());
+}
+
 TEST(Editor, AMaterialBlendsWithAnotherFromItsPanel) {
   auto w = makeWindow();
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");

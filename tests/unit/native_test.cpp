@@ -109,6 +109,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   s.materials[0].coatRoughness = 0.07f;
   s.materials[0].coatAbsorption = Vec3{0.01f, 0.02f, 0.03f};
   s.materials[0].blendRatioTexture = s.textures[0].id;
+  s.materials[1].type = MaterialType::Boundary;
   s.environment.orientation = Mat4::rotateZ(0.3f) * Mat4::rotateX(-1.2f);
   s.environment.rotation = 0.7f;
   s.lights.push_back(Light{s.newId(), "Key", LightType::Spot, {1, 0.9f, 0.8f}, 3.5f, {1, 2, 3}, {0, -1, 0}, 0.4f, 0.2f, true});
@@ -141,6 +142,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.materials[0].interiorAbsorption, Vec3(0.4f, 0.5f, 0.6f));
   EXPECT_EQ(back->scene.materials[0].interiorScattering, Vec3(1.5f, 2.5f, 3.5f));
   EXPECT_FLOAT_EQ(back->scene.materials[0].interiorAnisotropy, -0.25f);
+  EXPECT_EQ(back->scene.materials[1].type, MaterialType::Boundary);
   EXPECT_EQ(back->scene.materials[0].coatIor, 1.45f);
   EXPECT_EQ(back->scene.materials[0].coatRoughness, 0.07f);
   EXPECT_EQ(back->scene.materials[0].coatAbsorption, Vec3(0.01f, 0.02f, 0.03f));

@@ -194,6 +194,49 @@ TEST(Tungsten, WhatIsNotRenderedIsNamedInAWarning) {
   EXPECT_EQ(bsdfs, 1);
 }
 
+TEST(Tungsten, AForwardSurfaceBoundsItsMedium) {
+  // The volumetric caustic's set-up: gas behind an open forward quad, a lens and a light in the
+  // gas (their ext_medium). The quad becomes a boundary holding the gas; the lens stays empty
+  // glass, whose outside the path remembers; a medium nothing holds is named in a warning.
+  auto r = importTungsten(writeScene(R"({"media": [
+        {"name": "gas", "type": "homogeneous", "sigma_a": 0.5, "sigma_s": 2, "density": 0.5,
+         "phase_function": {"type": "henyey_greenstein", "g": 0.3}},
+        {"name": "haze", "type": "homogeneous", "sigma_s": 1}],
+      "bsdfs": [{"name": "frontWall", "type": "forward"}, {"name": "sphere", "type": "dielectric", "ior": 1.5},
+                {"name": "light", "type": "null"}, {"name": "open", "type": "forward"}],
+      "primitives": [
+        {"type": "quad", "name": "front", "bsdf": "frontWall", "int_medium": "gas"},
+        {"type": "sphere", "name": "lens", "bsdf": "sphere", "ext_medium": "gas"},
+        {"type": "quad", "name": "lamp", "bsdf": "light", "ext_medium": "gas", "power": 10},
+        {"type": "quad", "name": "veil", "bsdf": "open"},
+        {"type": "sphere", "name": "ball", "bsdf": "sphere", "ext_medium": "haze"}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  auto materialOf = [&](const char* object) {
+    for (const Object& o : r->scene.objects)
+      if (o.name == object) return *r->scene.material(o.material);
+    ADD_FAILURE() << "no object " << object;
+    return Material{};
+  };
+  const Material front = materialOf("front");
+  EXPECT_EQ(front.type, MaterialType::Boundary);
+  EXPECT_TRUE(front.filled());
+  EXPECT_EQ(front.interiorAbsorption, Vec3(0.25f));
+  EXPECT_EQ(front.interiorScattering, Vec3(1.0f));
+  EXPECT_FLOAT_EQ(front.interiorAnisotropy, 0.3f);
+  EXPECT_FALSE(front.emissive());
+  EXPECT_EQ(materialOf("lens").type, MaterialType::Dielectric);
+  EXPECT_FALSE(materialOf("lens").filled()) << "the gas is around it, not in it";
+  EXPECT_EQ(materialOf("veil").type, MaterialType::Boundary) << "a forward surface without a medium passes every ray";
+  EXPECT_FALSE(materialOf("veil").filled());
+  int gas = 0, haze = 0;
+  for (const auto& w : r->warnings) {
+    gas += w.find("'gas'") != std::string::npos;
+    haze += w.find("the medium 'haze' around it is rendered only inside glass or a forward boundary") != std::string::npos;
+  }
+  EXPECT_EQ(gas, 0) << "the gas is rendered as the file has it";
+  EXPECT_EQ(haze, 1);
+}
+
 // The imported material of that name (a failure, and a default material, when there is none).
 Material materialNamed(const Scene& s, const std::string& name) {
   for (const Material& m : s.materials)

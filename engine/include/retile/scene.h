@@ -88,8 +88,12 @@ enum class MaterialType {
   // Lambertian on both sides: (1 - transmittance) of albedo reflected, transmittance passed to
   // the other side (Tungsten's diffuse_transmission; leaves, paper, lamp shades).
   DiffuseTransmission,
+  // No surface at all, only where a medium begins (Tungsten's forward bsdf): every ray passes
+  // straight through, entering the interior medium (interiorAbsorption and on) across the front
+  // and leaving it across the back. Bounds fog and smoke, where glass would refract.
+  Boundary,
 };
-constexpr int kMaterialTypeCount = 13;
+constexpr int kMaterialTypeCount = 14;
 const char* materialTypeName(MaterialType t);
 bool materialTypeFromName(const std::string& name, MaterialType* out);
 // The types whose roughness is a microfacet alpha and which may use Beckmann's distribution.
@@ -100,10 +104,13 @@ constexpr bool isMicrofacet(MaterialType t) {
 // The types that pass light to the other side of a surface.
 constexpr bool isTransmissiveType(MaterialType t) {
   return t == MaterialType::Dielectric || t == MaterialType::RoughDielectric || t == MaterialType::ThinSheet ||
-         t == MaterialType::DiffuseTransmission;
+         t == MaterialType::DiffuseTransmission || t == MaterialType::Boundary;
 }
 
 constexpr bool isGlassType(MaterialType t) { return t == MaterialType::Dielectric || t == MaterialType::RoughDielectric; }
+
+// The types that may hold a medium on their inside (Material::filled).
+constexpr bool holdsMedium(MaterialType t) { return isGlassType(t) || t == MaterialType::Boundary; }
 
 // The types with a roughness field: microfacet alpha, Oren-Nayar sigma, or Phong's width.
 constexpr bool hasRoughness(MaterialType t) {
@@ -146,18 +153,19 @@ struct Material {
   // the smooth coat times cos wo / cos wo' (wo toward the viewer, wo' inside), Tungsten's form,
   // which darkens the base at grazing views and is not reciprocal.
   float coatRoughness = 0.0f;
-  // Glass (dielectric, rough dielectric) filled with a homogeneous medium (Tungsten's
-  // homogeneous int_medium: its sigma_a and sigma_s times density): per unit of length, what
-  // fills it absorbs interiorAbsorption and scatters interiorScattering, by Henyey and
-  // Greenstein's phase function of asymmetry interiorAnisotropy (-1 back, 0 even, 1 forward).
-  // Light that only crosses it is dimmed by exp(-(absorption + scattering) distance). Nested
-  // media are not tracked: leaving any glass leaves its medium.
+  // Glass (dielectric, rough dielectric) or a boundary filled with a homogeneous medium
+  // (Tungsten's homogeneous int_medium: its sigma_a and sigma_s times density): per unit of
+  // length, what fills it absorbs interiorAbsorption and scatters interiorScattering, by Henyey
+  // and Greenstein's phase function of asymmetry interiorAnisotropy (-1 back, 0 even, 1 forward).
+  // Light that only crosses it is dimmed by exp(-(absorption + scattering) distance). A path
+  // remembers one medium outside the one it is in: glass in fog leaves the fog around it, but a
+  // third level of nesting is not tracked.
   Vec3 interiorAbsorption{0.0f};
   Vec3 interiorScattering{0.0f};
   float interiorAnisotropy = 0.0f;
-  // Glass with a medium that absorbs or scatters.
+  // Glass or a boundary with a medium that absorbs or scatters.
   bool filled() const {
-    return isGlassType(type) && isFinite(interiorAbsorption) && isFinite(interiorScattering) &&
+    return holdsMedium(type) && isFinite(interiorAbsorption) && isFinite(interiorScattering) &&
            (maxComponent(interiorAbsorption) > 0 || maxComponent(interiorScattering) > 0);
   }
   bool coated() const { return coatIor > 1.0f; }
@@ -198,7 +206,8 @@ struct Material {
     return {&albedoTexture, &roughnessTexture, &alphaTexture, &bumpTexture, &emissionTexture, &blendRatioTexture};
   }
 
-  bool emissive() const { return emission.x > 0 || emission.y > 0 || emission.z > 0; }
+  // A boundary is no surface, so nothing on it shines.
+  bool emissive() const { return type != MaterialType::Boundary && (emission.x > 0 || emission.y > 0 || emission.z > 0); }
 };
 
 // Named metals with RGB complex indices of refraction (linear sRGB primaries).

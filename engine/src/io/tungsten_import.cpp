@@ -563,8 +563,7 @@ class TungstenImporter {
       m.type = MaterialType::DiffuseTransmission;
       m.transmittance = 0.5f;  // Tungsten's, which its files cannot change
     } else if (type == "forward") {
-      m.type = MaterialType::Lambert;
-      m.alpha = 0;  // an invisible boundary: every ray passes
+      m.type = MaterialType::Boundary;  // every ray passes; its primitive's int_medium fills it
     } else {
       warn(cat(where, ": bsdf type '", type, "' is not supported; rendered as lambert with its albedo"));
       m.type = MaterialType::Lambert;
@@ -685,7 +684,7 @@ class TungstenImporter {
       warn(cat("camera type '", type, "' is rendered as a pinhole camera"));
     }
     if (std::string medium = string(c, "medium"); !medium.empty())
-      warn(cat("camera: the medium '", medium, "' it sits in is not rendered (media are, inside glass); light reaches it as through a vacuum"));
+      warn(cat("camera: the medium '", medium, "' it sits in is not rendered (media are, inside glass or a forward boundary); light reaches it as through a vacuum"));
     if (const Value* r = c.find("resolution")) {
       Vec2 res;
       if (!json::toVec2(*r, &res) || res.x < 1 || res.y < 1 || res.x > kMaxImageSide || res.y > kMaxImageSide)
@@ -1106,21 +1105,23 @@ class TungstenImporter {
         mat.bumpTexture = bumpTexture;
         mat.bumpStrength = bumpStrength;
       }
-      // A medium inside glass belongs to the primitive in Tungsten and to the material here.
+      // A medium inside glass or a boundary belongs to the primitive in Tungsten and to the
+      // material here. The one outside (ext_medium) is where the path comes from, which it
+      // remembers, so it needs nothing, if something holds it inside.
       std::string medium;
-      for (const char* side : {"int_medium", "ext_medium"}) {
-        const std::string name = string(p, side);
-        if (name.empty() || !media_.count(name)) continue;
-        if (isGlassType(mat.type) && std::string(side) == "int_medium") {
+      if (const std::string name = string(p, "int_medium"); !name.empty() && media_.count(name)) {
+        if (holdsMedium(mat.type)) {
           medium = name;
           const Filling& f = media_[name];
           mat.interiorAbsorption = f.absorption;
           mat.interiorScattering = f.scattering;
           mat.interiorAnisotropy = f.anisotropy;
         } else {
-          warn(cat(where, ": the medium '", name, "' is rendered only inside glass (an int_medium); here light passes through it"));
+          warn(cat(where, ": the medium '", name, "' is rendered only inside glass or a forward boundary (an int_medium); here light passes through it"));
         }
       }
+      if (const std::string name = string(p, "ext_medium"); !name.empty() && media_.count(name) && !heldInside(name))
+        warn(cat(where, ": the medium '", name, "' around it is rendered only inside glass or a forward boundary (an int_medium), and nothing holds it; light passes through it"));
       if ((bumpTexture != kNoNode || !medium.empty()) && !emissive) {
         // Primitives naming the same bsdf with the same bump and medium share one copy; an
         // inline bsdf is the primitive's own (two unnamed ones must not meet under the empty name).
@@ -1195,6 +1196,17 @@ class TungstenImporter {
   // Tungsten's homogeneous medium: sigma_a and sigma_s times density, and its phase function
   // (isotropic by default, as in Tungsten's Medium). Read leniently: nothing for a medium that is
   // not understood, with the reason in `why`; the caller names it in a warning and leaves it out.
+  // Some primitive's int_medium names the medium.
+  bool heldInside(const std::string& name) {
+    if (!heldInside_) {
+      heldInside_.emplace();
+      if (primitives_ && primitives_->isArray())
+        for (const Value& p : primitives_->asArray())
+          if (p.isObject()) heldInside_->insert(string(p, "int_medium"));
+    }
+    return heldInside_->count(name) > 0;
+  }
+
   std::optional<Filling> mediumFilling(const Value& medium, const std::string& name, std::string* why) {
     Vec3 sigmaA{0.0f}, sigmaS{0.0f};
     float density = 1;
@@ -1236,6 +1248,7 @@ class TungstenImporter {
     return f;
   }
   std::map<std::string, Filling> media_;  // homogeneous media by name
+  std::optional<std::set<std::string>> heldInside_;  // the int_medium names, once asked for
 };
 
 }  // namespace

@@ -547,7 +547,7 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
 
 static_assert(gpu::kMaxBlendChain == kMaxBlendChain, "the kernel follows as many blends as the scene allows");
 
-// The kernel's material mask holds a bit per type, then Beckmann's and the coat's.
+// The kernel's material mask holds a bit per type, then Beckmann's, the coat's and the media's.
 static_assert(kMaterialTypeCount <= gpu::kMaskBeckmann && gpu::kMaskBeckmann < gpu::kMaskCoat &&
               gpu::kMaskCoat < gpu::kMaskMedium && gpu::kMaskMedium < gpu::kMaskScattering && gpu::kMaskScattering < 32);
 
@@ -846,7 +846,9 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     const Candidate& c = cands[i];
     const Material* mat = scene.material(c.object->material);
     int flags = 0;
-    if (mat && (mat->alpha < 1.0f || textureIndex(mat->alphaTexture) >= 0)) flags |= gpu::kInstanceAlphaTested;
+    // A boundary is crossed whole (its medium must not be left at random).
+    if (mat && mat->type != MaterialType::Boundary && (mat->alpha < 1.0f || textureIndex(mat->alphaTexture) >= 0))
+      flags |= gpu::kInstanceAlphaTested;
     if (mat && mat->emissive()) flags |= gpu::kInstanceEmissive;
     if (c.visible && (flags & gpu::kInstanceAlphaTested)) data_.alphaTested = true;
     flagsOf[i] = flags;
