@@ -320,8 +320,7 @@ vec3 bumpNormal(vec3 ns, vec3 q1, vec3 q2, vec2 duv1, vec2 duv2, vec2 slope) {
 }
 
 // Surfaces whose reflection or refraction shows other objects' edges: mirrors, smooth glass and
-// metal, and their nearly smooth rough kinds. The denoiser's guides look through them, and
-// through boundaries, which shadeSegment passes before it asks.
+// metal, and their nearly smooth rough kinds. The denoiser's guides look through them.
 bool guideLooksThrough(Material m) {
   bool nearlySmooth = (isMat(m.type, kMatRoughConductor) || isMat(m.type, kMatRoughDielectric)) && m.roughness < 0.1;
   return (isDeltaMaterial(m) && !isMat(m.type, kMatNull)) || nearlySmooth;
@@ -334,7 +333,7 @@ void writeSample(Path path, bool ended) {
   bool valid = !(any(isnan(path.L)) || any(isinf(path.L)));
   samples[path.slot] = valid ? vec4(path.L, ended ? 1.0 : 0.0) : vec4(0.0);
   aux[path.slot * kAuxVec4s] = vec4(path.auxAlbedo, path.auxDepth);
-  aux[path.slot * kAuxVec4s + 1u] = vec4(path.auxNormal, intBitsToFloat(path.auxInstance));
+  aux[path.slot * kAuxVec4s + 1u] = vec4(path.auxNormal, intBitsToFloat(abs(path.auxInstance)));
   aux[path.slot * kAuxVec4s + 2u] = vec4(path.auxEmission, 0.0);
 }
 
@@ -356,12 +355,18 @@ void resolveShadow(inout Path path, inout Shadow shadow, int blocker, Trace tr) 
   bool visible = blocker < 0;
   vec3 L = shadow.L;
 #if RETILE_BOUNDARY
-  // Its optical depth through the media it ran in (Trace::crossedSigma). Rounding may leave a
-  // little of a medium it entered and left; a negative depth only comes of boundaries that do
-  // not close.
+  // Its optical depth through the media it ran in (Trace::crossedSigma). A negative one only
+  // comes of boundaries that do not close, or of nested ones, whose media the path replaces and
+  // the sum adds (the importer warns of those).
   vec3 sigma = shadow.sigma + tr.crossedSigma;
-  sigma = mix(sigma, vec3(0.0), lessThan(sigma, vec3(1e-5)));
-  vec3 depth = tr.crossedDepth + (shadow.dist >= kInfinity ? mix(vec3(0.0), vec3(kInfinity), greaterThan(sigma, vec3(0.0))) : sigma * shadow.dist);
+  vec3 depth = tr.crossedDepth;
+  if (shadow.dist >= kInfinity) {
+    // To a light at infinity, the medium the ray ends in must be none, up to rounding.
+    float rounding = 1e-5 * (maxComponent(shadow.sigma) + tr.crossedScale);
+    depth += mix(vec3(0.0), vec3(kInfinity), greaterThan(sigma, vec3(rounding)));
+  } else {
+    depth += sigma * shadow.dist;
+  }
   L *= exp(-max(depth, vec3(0.0)));
 #endif
   // An ended path's sample was written when it ended (the lane may have started another since).
@@ -431,14 +436,16 @@ void crossMedium(inout Path path, Material m, bool frontFace) {
 }
 
 // The path scatters in its medium (of extinction sigmaT) `flight` along its ray, short of its
-// hit at hitT. As at a surface, a light is sampled (its shadow ray dimmed by the medium; the
-// glass round the medium blocks light from outside, as in Tungsten) and weighed against the
+// hit at hitT. As at a surface, a light is sampled (its shadow ray dimmed by the media on its
+// way; glass round the medium blocks light from outside, as in Tungsten, a boundary does not)
+// and weighed against the
 // phase function, which then gives the next direction. A scattering event is a bounce, as in
 // Tungsten. Returns false when the path has ended.
 bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, float hitT, vec3 sigmaT) {
   vec3 crossed = exp(-sigmaT * flight);
   float pdf = dot(sigmaT * crossed, vec3(1.0 / 3.0));
   path.travelled += flight;
+  path.auxInstance = abs(path.auxInstance);  // the medium's boundary, if the path came in by one
   if (path.auxDepth >= kInfinity) {
     // The denoiser's guide: the medium's albedo where the path first scatters, facing back.
     path.auxAlbedo = path.beta * path.scattering.rgb / max(sigmaT, vec3(1e-30));
@@ -500,8 +507,9 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   }
 #endif
   if (path.selBase >= 0 && hit.prim >= 0 && hit.instance == selected) {
-    // Direct hits, then reflections weighted (maxBounces + 1) / depth: 4, 2, 1 at 3 bounces.
-    if (path.depth == 0) atomicAdd(selectionCounts[path.selBase], 1u);
+    // Direct hits (through boundaries too: nothing is picked yet), then reflections weighted
+    // (maxBounces + 1) / depth: 4, 2, 1 at 3 bounces.
+    if (path.auxInstance <= 0) atomicAdd(selectionCounts[path.selBase], 1u);
     else atomicAdd(selectionCounts[path.selBase + 1], uint(max(maxBounces + 1, 1) / path.depth));
   }
 
@@ -580,22 +588,27 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   }
 
   path.travelled += hit.t;
-  if (path.depth == 0) path.auxInstance = floatBitsToInt(info2.x);
 #if RETILE_BOUNDARY
   if (isMat(m.type, kMatBoundary)) {
     // No surface, only where a medium begins or ends: the path goes straight on, into the medium
     // on the other side, as if nothing had been hit (its last vertex, pdf and lobe stay the
-    // MIS's), except that the crossing counts as a bounce, as in Tungsten (TraceBase).
+    // MIS's), except that the crossing counts as a bounce, as in Tungsten (TraceBase). Nothing
+    // changes its weight, so no roulette here: it would only add noise. One that holds no medium
+    // leaves the path in the one it is in (Tungsten's selectMedium keeps it too).
     if (path.depth >= maxBounces) return false;
+    if (path.auxInstance <= 0) path.auxInstance = -floatBitsToInt(info2.x);
 #if RETILE_MEDIUM
-    crossMedium(path, m, frontFace);
+    if (maxComponent(m.interior + m.scattering.rgb) > 0.0) crossMedium(path, m, frontFace);
 #endif
     path.ro = offsetRay(pos, frontFace ? -ng : ng);
     path.from = ivec2(hit.prim, hit.instance);
     path.depth++;
-    return survivesRoulette(path, shadow);
+    return true;
   }
 #endif
+  // The object picked at the pixel: the first hit (instance ids start at 1), past boundaries
+  // (held negated meanwhile: if the path scatters first or leaves the scene, the last of them).
+  if (path.auxInstance <= 0) path.auxInstance = floatBitsToInt(info2.x);
   bool nullMaterial = isMat(m.type, kMatNull);
   if (path.auxDepth >= kInfinity) {
     // Up to and at the guide hit, what the path collects from lights is emission to the denoiser.

@@ -202,8 +202,9 @@ vec3 safeInverse(vec3 d) {
 //
 // Every value here is carried through every iteration of that loop, and one written in a branch
 // costs a select in every iteration (lavapipe runs both sides of a branch), so the state is kept
-// small: the extension ray's hit stays in `hit` while the shadow ray is traced (any hit ends a
-// shadow ray, so its distance limit stays tMax2 and only what blocks it is kept: `blocker`).
+// small: the extension ray's hit stays in `hit` while the shadow ray is traced (any hit but a
+// boundary's ends a shadow ray, so its distance limit stays tMax2 and only what blocks it is
+// kept: `blocker`).
 struct Trace {
   bool second;    // a shadow ray follows the extension ray
   bool onShadow;  // the lane traces the shadow ray now (also once done: then tMax2 is -1)
@@ -229,7 +230,9 @@ struct Trace {
   // sum of their media's extinctions, + entering across the front and - leaving, and of the same
   // times minus the distance to the crossing. Its optical depth to a light at distance d, from a
   // medium of extinction s, is then (s + crossedSigma) d + crossedDepth (trace.comp resolveShadow).
+  // crossedScale sums the extinctions' sizes, to tell rounding from a medium still around.
   vec3 crossedSigma, crossedDepth;
+  float crossedScale;
 #endif
 };
 
@@ -247,6 +250,7 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, i
 #if RETILE_BOUNDARY
   tr.crossedSigma = vec3(0.0);
   tr.crossedDepth = vec3(0.0);
+  tr.crossedScale = 0.0;
 #endif
   tr.idle = !(first || second);
   tr.done = tr.idle;
@@ -401,6 +405,7 @@ void traceStep(inout Trace tr, int below, int root) {
       int material = floatBitsToInt(texelFetch(uInstances, instance * kInstanceTexels + 3).z) * kMaterialTexels;
       if ((floatBitsToInt(texelFetch(uMaterials, material).w) & kMatTypeBits) == kMatBoundary) {
         vec3 sigma = texelFetch(uMaterials, material + 8).rgb + texelFetch(uMaterials, material + 9).rgb;
+        tr.crossedScale += maxComponent(sigma);
         sigma = det > 0.0 ? sigma : -sigma;
         tr.crossedSigma += sigma;
         tr.crossedDepth -= sigma * tt;

@@ -114,8 +114,8 @@ RT_CONST(int, kMatBeckmann, 256)
 RT_CONST(int, kMaskBeckmann, 14)
 // The bit of the kernel's material mask that says some material has a clear coat (Material::coatIor).
 RT_CONST(int, kMaskCoat, 15)
-// And the bit that says some glass is filled with a medium (Material::filled), and the one that
-// says some such medium scatters (Material::interiorScattering).
+// And the bit that says some glass or boundary is filled with a medium (Material::filled), and
+// the one that says some such medium scatters (Material::interiorScattering).
 RT_CONST(int, kMaskMedium, 16)
 RT_CONST(int, kMaskScattering, 17)
 // Packed with a rough type: Smith's G as the product G1(wo) G1(wi) (Material::separableShadowing).

@@ -272,11 +272,18 @@ TEST(KnownAnswer, AMediumInsideABoundaryMatchesARandomWalk) {
   // The random-walk slab again, bounded by a boundary instead of glass: nothing at the faces at
   // all, so the walk is the same. Unlike glass, a boundary lets shadow rays through, so here a
   // scattering point's light sample reaches the sky, dimmed by the medium up to the face it
-  // leaves by: the sum of the crossings' signed depths, as the traversal finds them.
+  // leaves by: the sum of the crossings' signed depths, as the traversal finds them. The slab is
+  // mirrored (z scaled by -1) and its mesh shared with a far copy, so that rays meet it in its
+  // own space, as an instance: a crossing's side must come out the same there.
   RETILE_RENDERER_OR_SKIP(r);
   const Vec3 sigmaA{0.0f, 0.5f, 1.0f}, sigmaS{2.0f, 1.0f, 1.5f};
   const float g = 0.7f;
   Scene s = slabBeforeTheSky(boundaryOf(sigmaA, sigmaS, g), 4, 1024);
+  s.objects[0].transform = Mat4::translate({0, 0, -5}) * Mat4::scale({40, 40, -1});
+  Object copy = s.objects[0];
+  copy.id = s.newId();
+  copy.transform = Mat4::translate({1000, 0, 0});
+  s.objects.push_back(copy);
   RenderImage img = renderScene(*r, s, 64);
   for (int c = 0; c < 3; ++c) {
     double mean = 0;

@@ -201,7 +201,8 @@ TEST(Tungsten, AForwardSurfaceBoundsItsMedium) {
   auto r = importTungsten(writeScene(R"({"media": [
         {"name": "gas", "type": "homogeneous", "sigma_a": 0.5, "sigma_s": 2, "density": 0.5,
          "phase_function": {"type": "henyey_greenstein", "g": 0.3}},
-        {"name": "haze", "type": "homogeneous", "sigma_s": 1}],
+        {"name": "haze", "type": "homogeneous", "sigma_s": 1},
+        {"name": "ink", "type": "homogeneous", "sigma_a": 1}],
       "bsdfs": [{"name": "frontWall", "type": "forward"}, {"name": "sphere", "type": "dielectric", "ior": 1.5},
                 {"name": "light", "type": "null"}, {"name": "open", "type": "forward"}],
       "primitives": [
@@ -209,7 +210,10 @@ TEST(Tungsten, AForwardSurfaceBoundsItsMedium) {
         {"type": "sphere", "name": "lens", "bsdf": "sphere", "ext_medium": "gas"},
         {"type": "quad", "name": "lamp", "bsdf": "light", "ext_medium": "gas", "power": 10},
         {"type": "quad", "name": "veil", "bsdf": "open"},
-        {"type": "sphere", "name": "ball", "bsdf": "sphere", "ext_medium": "haze"}]})"));
+        {"type": "sphere", "name": "ball", "bsdf": "sphere", "ext_medium": "haze"},
+        {"type": "cube", "name": "wall", "bsdf": "light", "int_medium": "ink"},
+        {"type": "sphere", "name": "drop", "bsdf": "sphere", "ext_medium": "ink"},
+        {"type": "cube", "name": "puff", "bsdf": "open", "int_medium": "haze", "ext_medium": "gas"}]})"));
   ASSERT_TRUE(r.ok()) << r.error();
   auto materialOf = [&](const char* object) {
     for (const Object& o : r->scene.objects)
@@ -228,13 +232,18 @@ TEST(Tungsten, AForwardSurfaceBoundsItsMedium) {
   EXPECT_FALSE(materialOf("lens").filled()) << "the gas is around it, not in it";
   EXPECT_EQ(materialOf("veil").type, MaterialType::Boundary) << "a forward surface without a medium passes every ray";
   EXPECT_FALSE(materialOf("veil").filled());
-  int gas = 0, haze = 0;
+  EXPECT_EQ(materialOf("puff").interiorScattering, Vec3(1.0f));
+  int haze = 0, ink = 0, nested = 0;
   for (const auto& w : r->warnings) {
-    gas += w.find("'gas'") != std::string::npos;
     haze += w.find("the medium 'haze' around it is rendered only inside glass or a forward boundary") != std::string::npos;
+    ink += w.find("the medium 'ink' around it is rendered only inside glass") != std::string::npos;
+    nested += w.find("a boundary of 'haze' inside the medium 'gas'") != std::string::npos;
   }
-  EXPECT_EQ(gas, 0) << "the gas is rendered as the file has it";
-  EXPECT_EQ(haze, 1);
+  EXPECT_EQ(haze, 0) << "the puff holds it";
+  EXPECT_EQ(ink, 1) << "an opaque wall does not hold it";
+  EXPECT_EQ(nested, 1) << "nested boundaries' shadow rays add both media";
+  for (const auto& w : r->warnings)
+    EXPECT_EQ(w.find("'gas' around it"), std::string::npos) << "the front holds the gas: " << w;
 }
 
 // The imported material of that name (a failure, and a default material, when there is none).

@@ -8,6 +8,8 @@
 #include <optional>
 #include <set>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "core/files.h"
 #include "core/json.h"
@@ -100,6 +102,9 @@ class TungstenImporter {
       primitives_ = p;
       for (std::size_t i = 0; i < p->asArray().size() && ok(); ++i) primitive(p->asArray()[i], cat("primitives[", i, "]"));
       if (!focusPivot_.empty() && ok()) focusOn(*p);
+      for (const auto& [where, name] : outside_)
+        if (!inside_.count(name))
+          warn(cat(where, ": the medium '", name, "' around it is rendered only inside glass or a forward boundary (an int_medium), and nothing holds it; light passes through it"));
     }
     // Not Tungsten's own key, but Bitterli's living room names its sky this way (an envmap; the
     // room has no other light). Tungsten renders these files without a `constant` entry: the
@@ -1120,8 +1125,13 @@ class TungstenImporter {
           warn(cat(where, ": the medium '", name, "' is rendered only inside glass or a forward boundary (an int_medium); here light passes through it"));
         }
       }
-      if (const std::string name = string(p, "ext_medium"); !name.empty() && media_.count(name) && !heldInside(name))
-        warn(cat(where, ": the medium '", name, "' around it is rendered only inside glass or a forward boundary (an int_medium), and nothing holds it; light passes through it"));
+      if (const std::string name = string(p, "ext_medium"); !name.empty() && media_.count(name)) {
+        outside_.emplace_back(where, name);  // warned of once every primitive is read, if nothing holds it
+        if (mat.type == MaterialType::Boundary && !medium.empty())
+          warn(cat(where, ": a boundary of '", medium, "' inside the medium '", name,
+                   "': a path inside it is in '", medium, "' alone, but its shadow rays count both"));
+      }
+      if (!medium.empty()) inside_.insert(medium);
       if ((bumpTexture != kNoNode || !medium.empty()) && !emissive) {
         // Primitives naming the same bsdf with the same bump and medium share one copy; an
         // inline bsdf is the primitive's own (two unnamed ones must not meet under the empty name).
@@ -1188,7 +1198,7 @@ class TungstenImporter {
   std::set<NodeId> copied_;  // named bsdfs some primitive took a copy of (dropReplacedBsdfs)
   // (bsdf, bump texture, strength, medium) -> its copy
   std::map<std::tuple<std::string, NodeId, float, std::string>, NodeId> bumped_;
-  // A homogeneous medium, as glass it fills holds it (Material::interiorAbsorption and on).
+  // A homogeneous medium, as the glass or boundary it fills holds it (Material::interiorAbsorption and on).
   struct Filling {
     Vec3 absorption{0.0f}, scattering{0.0f};
     float anisotropy = 0.0f;
@@ -1196,17 +1206,6 @@ class TungstenImporter {
   // Tungsten's homogeneous medium: sigma_a and sigma_s times density, and its phase function
   // (isotropic by default, as in Tungsten's Medium). Read leniently: nothing for a medium that is
   // not understood, with the reason in `why`; the caller names it in a warning and leaves it out.
-  // Some primitive's int_medium names the medium.
-  bool heldInside(const std::string& name) {
-    if (!heldInside_) {
-      heldInside_.emplace();
-      if (primitives_ && primitives_->isArray())
-        for (const Value& p : primitives_->asArray())
-          if (p.isObject()) heldInside_->insert(string(p, "int_medium"));
-    }
-    return heldInside_->count(name) > 0;
-  }
-
   std::optional<Filling> mediumFilling(const Value& medium, const std::string& name, std::string* why) {
     Vec3 sigmaA{0.0f}, sigmaS{0.0f};
     float density = 1;
@@ -1248,7 +1247,8 @@ class TungstenImporter {
     return f;
   }
   std::map<std::string, Filling> media_;  // homogeneous media by name
-  std::optional<std::set<std::string>> heldInside_;  // the int_medium names, once asked for
+  std::set<std::string> inside_;  // the media some glass or boundary holds
+  std::vector<std::pair<std::string, std::string>> outside_;  // where an ext_medium is named, and the name
 };
 
 }  // namespace

@@ -614,8 +614,13 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     if (textureIndex(m.emissionTexture) >= 0 && m.emissive()) data_.emissionTextures = true;
     int blendWith = -1, ratioTexture = -1;
     const bool texturedRatio = textureIndex(m.blendRatioTexture) >= 0;
+    // A boundary blends with nothing and nothing with it: the traversal takes an instance's own
+    // material for whether its shadow rays pass, and a surface that were partly a boundary would
+    // block them all the same.
+    const Material* partner = scene.material(m.blendWith);
+    const bool boundary = m.type == MaterialType::Boundary || (partner && partner->type == MaterialType::Boundary);
     if (auto it = materialIndex_.find(m.blendWith);
-        it != materialIndex_.end() && m.blendWith != m.id && (m.blendRatio < 1.0f || texturedRatio)) {
+        !boundary && it != materialIndex_.end() && m.blendWith != m.id && (m.blendRatio < 1.0f || texturedRatio)) {
       blendWith = it->second;
       data_.materialBlend = true;
       if (texturedRatio) {

@@ -800,7 +800,7 @@ std::vector<std::string> Renderer::kernelFeatures() const {
     if (d.materialTypes & (1u << t)) out.push_back(materialTypeName(static_cast<MaterialType>(t)));
   if (d.materialTypes & (1u << gpu::kMaskBeckmann)) out.push_back("beckmann");
   if (d.materialTypes & (1u << gpu::kMaskCoat)) out.push_back("coat");
-  if (d.materialTypes & (1u << gpu::kMaskMedium)) out.push_back("filled glass");
+  if (d.materialTypes & (1u << gpu::kMaskMedium)) out.push_back("medium");
   if (d.materialTypes & (1u << gpu::kMaskScattering)) out.push_back("scattering medium");
   if (d.alphaTested) out.push_back("alpha test");
   const std::uint32_t f = d.features();
