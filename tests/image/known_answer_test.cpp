@@ -212,22 +212,17 @@ TEST(KnownAnswer, GlassFilledWithAScatteringMediumMatchesARandomWalk) {
   }
 }
 
-TEST(KnownAnswer, ALightInsideFilledGlassLightsItsMediumAndWhatItHolds) {
-  // Glass of index 1.0001 two units deep (y from 0 to 2), filled with a medium, holds a grey
-  // floor (y = 0.01) and a point light half a unit off the camera's axis (0.5, 1, 0); the camera
-  // looks straight down through it. With two bounces, a path samples the light once, at its
-  // first vertex inside: where it scatters in the medium or where it meets the floor. So the
-  // image is the medium's single scattering, integrated along the view ray here by Simpson's
-  // rule, plus the floor's direct light, both dimmed by the medium on every leg (to the light
-  // too). The third channel is empty: the floor's light alone, undimmed.
-  RETILE_RENDERER_OR_SKIP(r);
-  const Vec3 sigmaA{0.2f, 0.5f, 0.0f}, sigmaS{0.5f, 0.3f, 0.0f};
-  const float g = 0.5f, intensity = 10.0f, albedo = 0.8f;
+// A medium filling `holder` two units deep (y from 0 to 2) over a grey floor (y = 0.01), lit by
+// a point light at (0.5, lightY, 0), seen straight down from above by a 16x16 camera, with two
+// bounces. Such a path samples the light once, at its first vertex inside: where it scatters in
+// the medium or where it meets the floor (the crossing into glass or a boundary is the other
+// bounce). So the image is the medium's single scattering along the view ray plus the floor's
+// direct light, each leg dimmed where it runs inside.
+Scene mediumOverAFloor(const Material& holder, float lightY, float intensity, float albedo) {
   Scene s = test::emptyScene(16, 16);
-  lookStraightDown(s, 3, 1);
+  lookStraightDown(s, 5, 1);
   s.settings.maxBounces = 2;
-  test::addMeshObject(s, "glass", makeCube(), test::addMaterial(s, filledGlass(sigmaA, sigmaS, g)),
-                      Mat4::translate({0, 1, 0}) * Mat4::scale({40, 2, 40}));
+  test::addMeshObject(s, "holder", makeCube(), test::addMaterial(s, holder), Mat4::translate({0, 1, 0}) * Mat4::scale({40, 2, 40}));
   Material grey;
   grey.albedo = Vec3{albedo};
   test::addMeshObject(s, "floor", makeQuad(), test::addMaterial(s, grey), Mat4::translate({0, 0.01f, 0}) * Mat4::scale({4, 1, 4}));
@@ -235,29 +230,45 @@ TEST(KnownAnswer, ALightInsideFilledGlassLightsItsMediumAndWhatItHolds) {
   light.id = s.newId();
   light.type = LightType::Point;
   light.intensity = intensity;
-  light.position = {0.5f, 1, 0};
+  light.position = {0.5f, lightY, 0};
   s.lights.push_back(light);
-  RenderImage img = renderScene(*r, s, 256);
+  return s;
+}
+
+// What mediumOverAFloor's image should be in a channel of extinction sigmaT and scattering
+// sigmaS: the single scattering integrated by Simpson's rule (in *single), plus the floor's light.
+double overAFloorExpected(double sigmaT, double sigmaS, double g, double lightY, double intensity, double albedo, double* single) {
+  // Of the leg from height y to the light, the part inside (below y = 2).
+  auto inside = [&](double y, double dist) { return lightY <= 2 ? dist : dist * (2 - y) / (lightY - y); };
+  auto scattered = [&](double below) {  // `below` the top, on the view ray
+    const double y = 2 - below, up = lightY - y, r2 = 0.25 + up * up, dist = std::sqrt(r2), cosTheta = -up / dist;
+    const double term = 1 + g * g - 2 * g * cosTheta;
+    const double phase = (1 - g * g) / (4 * kPi * term * std::sqrt(term));
+    return sigmaS * std::exp(-sigmaT * below) * phase * intensity * std::exp(-sigmaT * inside(y, dist)) / r2;
+  };
+  const double depth = 1.99;
+  const int steps = 20000;
+  double sum = scattered(0) + scattered(depth);
+  for (int i = 1; i < steps; ++i) sum += (i % 2 ? 4 : 2) * scattered(depth * i / steps);
+  *single = sum * depth / steps / 3;
+  const double up = lightY - 0.01, toLight = std::sqrt(0.25 + up * up);
+  return *single + std::exp(-sigmaT * depth) * albedo / kPi * intensity * (up / toLight) / (toLight * toLight) *
+                       std::exp(-sigmaT * inside(0.01, toLight));
+}
+
+// mediumOverAFloor in a medium that absorbs (0.2, 0.5, 0) and scatters (0.5, 0.3, 0), rendered
+// at 256 spp, against overAFloorExpected within 2 %.
+void expectOverAFloor(Renderer& r, const Material& holder, float lightY, float intensity) {
+  const Vec3 sigmaA = holder.interiorAbsorption, sigmaS = holder.interiorScattering;
+  const float albedo = 0.8f;
+  RenderImage img = renderScene(r, mediumOverAFloor(holder, lightY, intensity, albedo), 256);
   for (int c = 0; c < 3; ++c) {
-    const double sigmaT = sigmaA[c] + sigmaS[c], depth = 1.99;
-    // The view ray runs down from the glass's top, s below it; the light is at height 1.
-    auto scattered = [&](double below) {
-      const double dy = below - 1.0, r2 = 0.25 + dy * dy, cosTheta = -dy / std::sqrt(r2);
-      const double term = 1 + g * g - 2 * g * cosTheta;
-      const double phase = (1 - g * g) / (4 * kPi * term * std::sqrt(term));
-      return sigmaS[c] * std::exp(-sigmaT * below) * phase * intensity * std::exp(-sigmaT * std::sqrt(r2)) / r2;
-    };
-    const int steps = 20000;
-    double single = scattered(0) + scattered(depth);
-    for (int i = 1; i < steps; ++i) single += (i % 2 ? 4 : 2) * scattered(depth * i / steps);
-    single *= depth / steps / 3;
-    const double toLight = std::sqrt(0.25 + 0.99 * 0.99);
-    const double floor = std::exp(-sigmaT * depth) * albedo / kPi * intensity * (0.99 / toLight) / (toLight * toLight) *
-                         std::exp(-sigmaT * toLight);
+    double single = 0;
+    const double expected =
+        overAFloorExpected(sigmaA[c] + sigmaS[c], sigmaS[c], holder.interiorAnisotropy, lightY, intensity, albedo, &single);
     double mean = 0;
     for (int i = 0; i < 16 * 16; ++i) mean += img.color[3 * i + c] / 256.0;
-    const double expected = single + floor;
-    EXPECT_NEAR(mean, expected, 0.02 * expected) << "channel " << c << ": single scattering " << single << ", floor " << floor;
+    EXPECT_NEAR(mean, expected, 0.02 * expected) << "channel " << c << ": single scattering " << single;
   }
 }
 
@@ -266,6 +277,16 @@ Material boundaryOf(Vec3 absorption, Vec3 scattering = Vec3{0.0f}, float anisotr
   Material m = filledGlass(absorption, scattering, anisotropy);
   m.type = MaterialType::Boundary;
   return m;
+}
+
+const Vec3 kOverAFloorAbsorption{0.2f, 0.5f, 0.0f}, kOverAFloorScattering{0.5f, 0.3f, 0.0f};
+
+TEST(KnownAnswer, ALightInsideFilledGlassLightsItsMediumAndWhatItHolds) {
+  // Glass of index 1.0001 holds the medium, the floor and the light, half a unit off the view ray
+  // (mediumOverAFloor): every leg is dimmed, to the light too. The third channel is empty: the
+  // floor's light alone, undimmed.
+  RETILE_RENDERER_OR_SKIP(r);
+  expectOverAFloor(*r, filledGlass(kOverAFloorAbsorption, kOverAFloorScattering, 0.5f), 1, 10);
 }
 
 TEST(KnownAnswer, AMediumInsideABoundaryMatchesARandomWalk) {
@@ -314,52 +335,11 @@ TEST(KnownAnswer, GlassInFogLeavesThePathInTheFog) {
 }
 
 TEST(KnownAnswer, ALightOutsideABoundaryLightsTheMediumInside) {
-  // A boundary two units deep (y from 0 to 2) holds a medium and a grey floor (y = 0.01); a
-  // point light above it (0.5, 3, 0) shines in through its top, and the camera looks straight
-  // down from above. With two bounces (the crossing of the top is one, as in Tungsten), a path
-  // samples the light once, at its first vertex inside. So the image is the single scattering
-  // along the view ray plus the floor's direct light, each leg dimmed by the medium only where
-  // it runs inside: the shadow rays' way out through the top counts, the rest does not. The
-  // third channel is empty: the floor's light alone.
+  // A boundary holds the medium and the floor; the light is one unit above it and shines in
+  // through its top (mediumOverAFloor), so a shadow ray is dimmed only on its way up to the top:
+  // its way out counts, the rest does not. The third channel is empty: the floor's light alone.
   RETILE_RENDERER_OR_SKIP(r);
-  const Vec3 sigmaA{0.2f, 0.5f, 0.0f}, sigmaS{0.5f, 0.3f, 0.0f};
-  const float g = -0.3f, intensity = 40.0f, albedo = 0.8f;
-  Scene s = test::emptyScene(16, 16);
-  lookStraightDown(s, 5, 1);
-  s.settings.maxBounces = 2;
-  test::addMeshObject(s, "fog", makeCube(), test::addMaterial(s, boundaryOf(sigmaA, sigmaS, g)),
-                      Mat4::translate({0, 1, 0}) * Mat4::scale({40, 2, 40}));
-  Material grey;
-  grey.albedo = Vec3{albedo};
-  test::addMeshObject(s, "floor", makeQuad(), test::addMaterial(s, grey), Mat4::translate({0, 0.01f, 0}) * Mat4::scale({4, 1, 4}));
-  Light light;
-  light.id = s.newId();
-  light.type = LightType::Point;
-  light.intensity = intensity;
-  light.position = {0.5f, 3, 0};
-  s.lights.push_back(light);
-  RenderImage img = renderScene(*r, s, 256);
-  for (int c = 0; c < 3; ++c) {
-    const double sigmaT = sigmaA[c] + sigmaS[c], depth = 1.99;
-    // The view ray runs down from the top, `below` under it; the light is one unit above the top.
-    auto scattered = [&](double below) {
-      const double up = 1 + below, r2 = 0.25 + up * up, dist = std::sqrt(r2), cosTheta = -up / dist;
-      const double term = 1 + g * g - 2 * g * cosTheta;
-      const double phase = (1 - g * g) / (4 * kPi * term * std::sqrt(term));
-      return sigmaS[c] * std::exp(-sigmaT * below) * phase * intensity * std::exp(-sigmaT * dist * below / up) / r2;
-    };
-    const int steps = 20000;
-    double single = scattered(0) + scattered(depth);
-    for (int i = 1; i < steps; ++i) single += (i % 2 ? 4 : 2) * scattered(depth * i / steps);
-    single *= depth / steps / 3;
-    const double toLight = std::sqrt(0.25 + 2.99 * 2.99);
-    const double floor = std::exp(-sigmaT * depth) * albedo / kPi * intensity * (2.99 / toLight) / (toLight * toLight) *
-                         std::exp(-sigmaT * toLight * depth / 2.99);
-    double mean = 0;
-    for (int i = 0; i < 16 * 16; ++i) mean += img.color[3 * i + c] / 256.0;
-    const double expected = single + floor;
-    EXPECT_NEAR(mean, expected, 0.02 * expected) << "channel " << c << ": single scattering " << single << ", floor " << floor;
-  }
+  expectOverAFloor(*r, boundaryOf(kOverAFloorAbsorption, kOverAFloorScattering, -0.3f), 3, 40);
 }
 
 TEST(KnownAnswer, ClosedFurnaceWithBounceLimit) {

@@ -194,6 +194,15 @@ TEST(Tungsten, WhatIsNotRenderedIsNamedInAWarning) {
   EXPECT_EQ(bsdfs, 1);
 }
 
+// The material of the imported object of that name (a failure, and a default material, when there
+// is none).
+Material materialOfObject(const Scene& s, const std::string& object) {
+  for (const Object& o : s.objects)
+    if (o.name == object) return *s.material(o.material);
+  ADD_FAILURE() << "no object " << object;
+  return Material{};
+}
+
 TEST(Tungsten, AForwardSurfaceBoundsItsMedium) {
   // The volumetric caustic's set-up: gas behind an open forward quad, a lens and a light in the
   // gas (their ext_medium). The quad becomes a boundary holding the gas; the lens stays empty
@@ -215,12 +224,7 @@ TEST(Tungsten, AForwardSurfaceBoundsItsMedium) {
         {"type": "sphere", "name": "drop", "bsdf": "sphere", "ext_medium": "ink"},
         {"type": "cube", "name": "puff", "bsdf": "open", "int_medium": "haze", "ext_medium": "gas"}]})"));
   ASSERT_TRUE(r.ok()) << r.error();
-  auto materialOf = [&](const char* object) {
-    for (const Object& o : r->scene.objects)
-      if (o.name == object) return *r->scene.material(o.material);
-    ADD_FAILURE() << "no object " << object;
-    return Material{};
-  };
+  auto materialOf = [&](const char* object) { return materialOfObject(r->scene, object); };
   const Material front = materialOf("front");
   EXPECT_EQ(front.type, MaterialType::Boundary);
   EXPECT_TRUE(front.filled());
@@ -343,12 +347,7 @@ TEST(Tungsten, AHomogeneousMediumFillsItsGlass) {
         {"type": "sphere", "name": "hazy", "bsdf": "glass", "int_medium": "haze"},
         {"type": "sphere", "name": "thick", "bsdf": "glass", "int_medium": "dense"}]})"));
   ASSERT_TRUE(r.ok()) << r.error();
-  auto materialOf = [&](const char* object) {
-    for (const Object& o : r->scene.objects)
-      if (o.name == object) return *r->scene.material(o.material);
-    ADD_FAILURE() << "no object " << object;
-    return Material{};
-  };
+  auto materialOf = [&](const char* object) { return materialOfObject(r->scene, object); };
   EXPECT_EQ(materialOf("bottle").interiorAbsorption, Vec3(1.0f, 2.0f, 4.0f));
   EXPECT_EQ(materialOf("bottle").interiorScattering, Vec3(0.0f));
   EXPECT_FLOAT_EQ(materialOf("bottle").ior, 1.33f);
