@@ -283,8 +283,8 @@ Path startPath(uint slot, int found) {
   path.beta = vec3(1.0);
   path.etaScale = 1.0;
 #if RETILE_MEDIUM
-  path.absorption = vec3(0.0);
-  path.scattering = vec4(0.0);
+  path.absorption = frame.cameraAbsorption.xyz;
+  path.scattering = frame.cameraScattering;
   path.outerAbsorption = vec3(0.0);
   path.outerScattering = vec4(0.0);
 #endif

@@ -334,6 +334,26 @@ TEST(KnownAnswer, GlassInFogLeavesThePathInTheFog) {
             << "pixel " << x << "," << y << " channel " << c;
 }
 
+TEST(KnownAnswer, ACameraInsideFogSeesThroughItsWayOut) {
+  // The camera in the middle of a fog box (a boundary, absorbing) five units from its walls,
+  // before a sky of 1: a ray head on shows exp(-5 sigma), the fog it starts in (mediumAround)
+  // counted up to the wall. Moved out of the box, the camera sees exp(-10 sigma) through it.
+  RETILE_RENDERER_OR_SKIP(r);
+  const float sigma[3] = {0.1f, 0.3f, 0.0f};
+  Scene s = test::emptyScene(32, 32);
+  s.camera = test::frontCamera(10);
+  s.environment.color = Vec3{1.0f};
+  test::addMeshObject(s, "fog", makeCube(), test::addMaterial(s, boundaryOf(Vec3{sigma[0], sigma[1], sigma[2]})), Mat4::scale({10, 10, 10}));
+  for (float z : {0.0f, 6.0f}) {
+    s.camera.position.z = z;
+    s.camera.target.z = z - 1;
+    RenderImage img = renderScene(*r, s, 4);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(img.color[3 * (16 * 32 + 16) + c], std::exp(-static_cast<double>(sigma[c]) * (z == 0 ? 5 : 10)), 2e-3)
+          << "camera at z " << z << ", channel " << c;
+  }
+}
+
 TEST(KnownAnswer, ALightOutsideABoundaryLightsTheMediumInside) {
   // A boundary holds the medium and the floor; the light is one unit above it and shines in
   // through its top (mediumOverAFloor), so a shadow ray is dimmed only on its way up to the top:

@@ -711,4 +711,49 @@ TEST(RenderScene, AMirroredObjectKeepsItsTransform) {
 }
 
 }  // namespace
+// The camera's medium comes from the glass or boundary around it: the way out that no way in
+// matches, along the packed scene's own rays, whether the instance BVH is packed direct, as
+// records, or with transforms.
+TEST(RenderScene, TheCameraIsInTheMediumAroundIt) {
+  Scene s = test::emptyScene(8, 8);
+  Material fog;
+  fog.type = MaterialType::Boundary;
+  fog.interiorAbsorption = Vec3{0.1f, 0.2f, 0.3f};
+  Material milk;
+  milk.type = MaterialType::Dielectric;
+  milk.interiorScattering = Vec3{5.0f};
+  milk.interiorAnisotropy = 0.3f;
+  Material lens;
+  lens.type = MaterialType::Dielectric;
+  Material veil;
+  veil.type = MaterialType::Boundary;
+  test::addMeshObject(s, "fog", makeCube(), test::addMaterial(s, fog), Mat4::scale({10, 10, 10}));
+  const NodeId milkObject = test::addMeshObject(s, "milk", makeCube(), test::addMaterial(s, milk),
+                                                Mat4::translate({2, 0, 0}) * Mat4::scale({2, 2, 2}));
+  test::addMeshObject(s, "lens", makeCube(), test::addMaterial(s, lens), Mat4::translate({-2, 0, 0}) * Mat4::scale({2, 2, 2}));
+  test::addMeshObject(s, "veil", makeCube(), test::addMaterial(s, veil), Mat4::translate({0, 0, 2}) * Mat4::scale({2, 2, 2}));
+  auto check = [&](const RenderSceneData& d, Vec3 milkAt) {
+    EXPECT_EQ(mediumAround(d, {0, 0, 0}).absorption, Vec3(0.1f, 0.2f, 0.3f)) << "in the fog, past the milk and the lens";
+    EXPECT_EQ(mediumAround(d, {0, 0, 2}).absorption, Vec3(0.1f, 0.2f, 0.3f)) << "a boundary without a medium changes nothing";
+    const MediumAt inMilk = mediumAround(d, milkAt);
+    EXPECT_EQ(inMilk.scattering, Vec3(5.0f));
+    EXPECT_EQ(inMilk.absorption, Vec3(0.0f));
+    EXPECT_FLOAT_EQ(inMilk.anisotropy, 0.3f);
+    EXPECT_EQ(mediumAround(d, {-2, 0, 0}).absorption, Vec3(0.0f)) << "empty glass holds a vacuum";
+    EXPECT_EQ(mediumAround(d, {0, 0, 20}).absorption, Vec3(0.0f)) << "outside everything";
+  };
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  EXPECT_TRUE(builder.data().directReferences);
+  check(builder.data(), {2, 0, 0});
+  RenderSceneBuilder records;
+  records.setDirectReferences(false);
+  records.update(s, kUpdateAll, nullptr);
+  check(records.data(), {2, 0, 0});
+  s.object(milkObject)->transform = Mat4::translate({2, -1, 0}) * Mat4::rotateY(0.7f) * Mat4::rotateX(0.4f) * Mat4::scale({2, 1, 2});
+  builder.update(s, kUpdateInstances, nullptr);
+  EXPECT_TRUE(builder.data().instanceTransforms);
+  check(builder.data(), {2, -1, 0});
+}
+
 }  // namespace retile

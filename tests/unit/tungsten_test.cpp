@@ -186,7 +186,7 @@ TEST(Tungsten, WhatIsNotRenderedIsNamedInAWarning) {
   int media = 0, camera = 0, bsdfs = 0;
   for (const auto& w : r->warnings) {
     media += w.find("the medium 'gas' is rendered only inside glass") != std::string::npos;
-    camera += w.find("camera: the medium 'gas' it sits in is not rendered") != std::string::npos;
+    camera += w.find("camera: the medium 'gas' it sits in is rendered only inside glass or a forward boundary, and nothing holds it") != std::string::npos;
     bsdfs += w.find("primitives[1]: 2 bsdfs by material index") != std::string::npos;
   }
   EXPECT_EQ(media, 1);
@@ -207,7 +207,7 @@ TEST(Tungsten, AForwardSurfaceBoundsItsMedium) {
   // The volumetric caustic's set-up: gas behind an open forward quad, a lens and a light in the
   // gas (their ext_medium). The quad becomes a boundary holding the gas; the lens stays empty
   // glass, whose outside the path remembers; a medium nothing holds is named in a warning.
-  auto r = importTungsten(writeScene(R"({"media": [
+  auto r = importTungsten(writeScene(R"({"camera": {"medium": "gas"}, "media": [
         {"name": "gas", "type": "homogeneous", "sigma_a": 0.5, "sigma_s": 2, "density": 0.5,
          "phase_function": {"type": "henyey_greenstein", "g": 0.3}},
         {"name": "haze", "type": "homogeneous", "sigma_s": 1},
@@ -246,8 +246,10 @@ TEST(Tungsten, AForwardSurfaceBoundsItsMedium) {
   EXPECT_EQ(haze, 0) << "the puff holds it";
   EXPECT_EQ(ink, 1) << "an opaque wall does not hold it";
   EXPECT_EQ(nested, 1) << "nested boundaries' shadow rays add both media";
-  for (const auto& w : r->warnings)
+  for (const auto& w : r->warnings) {
     EXPECT_EQ(w.find("'gas' around it"), std::string::npos) << "the front holds the gas: " << w;
+    EXPECT_EQ(w.find("camera:"), std::string::npos) << "the camera is in the gas the front holds: " << w;
+  }
 }
 
 // The imported material of that name (a failure, and a default material, when there is none).

@@ -102,6 +102,8 @@ class TungstenImporter {
       primitives_ = p;
       for (std::size_t i = 0; i < p->asArray().size() && ok(); ++i) primitive(p->asArray()[i], cat("primitives[", i, "]"));
       if (!focusPivot_.empty() && ok()) focusOn(*p);
+      if (!cameraMedium_.empty() && !inside_.count(cameraMedium_))
+        warn(cat("camera: the medium '", cameraMedium_, "' it sits in is rendered only inside glass or a forward boundary, and nothing holds it; light reaches it as through a vacuum"));
       for (const auto& [where, name] : outside_)
         if (!inside_.count(name))
           warn(cat(where, ": the medium '", name, "' around it is rendered only inside glass or a forward boundary (an int_medium), and nothing holds it; light passes through it"));
@@ -688,8 +690,9 @@ class TungstenImporter {
     } else if (type != "pinhole") {
       warn(cat("camera type '", type, "' is rendered as a pinhole camera"));
     }
-    if (std::string medium = string(c, "medium"); !medium.empty())
-      warn(cat("camera: the medium '", medium, "' it sits in is not rendered (media are, inside glass or a forward boundary); light reaches it as through a vacuum"));
+    // The renderer finds the medium around the camera itself (mediumAround): one that glass or a
+    // boundary holds. Warned of once every primitive is read, if none does.
+    cameraMedium_ = string(c, "medium");
     if (const Value* r = c.find("resolution")) {
       Vec2 res;
       if (!json::toVec2(*r, &res) || res.x < 1 || res.y < 1 || res.x > kMaxImageSide || res.y > kMaxImageSide)
@@ -1248,6 +1251,7 @@ class TungstenImporter {
   }
   std::map<std::string, Filling> media_;  // homogeneous media by name
   std::set<std::string> inside_;  // the media some glass or boundary holds
+  std::string cameraMedium_;      // the camera's
   std::vector<std::pair<std::string, std::string>> outside_;  // where an ext_medium is named, and the name
 };
 

@@ -639,6 +639,60 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
   pack(fallback);
 }
 
+MediumAt mediumAround(const RenderSceneData& d, Vec3 point) {
+  if (!(d.materialTypes & (1u << gpu::kMaskMedium)) || d.tlasRoot < 0) return {};
+  const bool transforms = d.instanceTransforms;
+  const bool direct = d.directReferences && !transforms;
+  auto intOf = [](float f) { return std::bit_cast<std::int32_t>(f); };
+  // Which holder a ray from the point leaves by a face it did not come in by (-1: none). Glass
+  // counts even empty (the path is in a vacuum inside it), a boundary only with its medium (one
+  // without leaves the path's as it is).
+  auto leftBy = [&](Vec3 dir) {
+    std::vector<std::int32_t> entered;
+    Vec3 origin = point;
+    for (int hits = 0; hits < 64; ++hits) {
+      const PackedTrace hit = tracePacked(d.meshTraversal, d.topTraversal, d.tlasRoot, direct, origin, dir, 1e30f);
+      if (hit.prim < 0 || hit.instance < 0) return -1;
+      const std::size_t base = static_cast<std::size_t>(hit.instance) * gpu::kInstanceTexels;
+      if (base + 3 >= d.instances.size()) return -1;
+      const std::int32_t material = intOf(d.instances[base + 3].z);
+      const std::size_t mbase = static_cast<std::size_t>(material) * gpu::kMaterialTexels;
+      if (material < 0 || mbase + 9 >= d.materials.size()) return -1;
+      const int type = intOf(d.materials[mbase].w) & gpu::kMatTypeBits;
+      const vec4 &interior = d.materials[mbase + 8], &scattering = d.materials[mbase + 9];
+      const bool filled = interior.x + interior.y + interior.z + scattering.x + scattering.y + scattering.z > 0;
+      const bool holder = type == gpu::kMatDielectric || type == gpu::kMatRoughDielectric || (type == gpu::kMatBoundary && filled);
+      if (holder) {
+        const vec4* t = d.meshTraversal.data() + static_cast<std::size_t>(hit.prim) * gpu::kTriTexels;
+        Vec3 n = cross(Vec3{t[1].x, t[1].y, t[1].z}, Vec3{t[2].x, t[2].y, t[2].z});
+        if (transforms) {  // the rows of the inverse transform, transposed: the normal's matrix
+          const vec4 *r = d.instances.data() + base;
+          n = Vec3{r[0].x * n.x + r[1].x * n.y + r[2].x * n.z, r[0].y * n.x + r[1].y * n.y + r[2].y * n.z,
+                   r[0].z * n.x + r[1].z * n.y + r[2].z * n.z};
+        }
+        if (dot(n, dir) < 0) {
+          entered.push_back(material);
+        } else if (!entered.empty() && entered.back() == material) {
+          entered.pop_back();
+        } else {
+          return material;
+        }
+      }
+      const Vec3 at = origin + dir * hit.t;
+      origin = at + dir * (1e-4f * (1.0f + std::max({std::abs(at.x), std::abs(at.y), std::abs(at.z)})));
+    }
+    return -1;
+  };
+  // Three directions off the axes, so that no ray runs along a wall or through an edge by design.
+  const std::int32_t votes[3] = {leftBy(normalize(Vec3{0.31f, 0.83f, 0.46f})), leftBy(normalize(Vec3{-0.72f, -0.25f, 0.64f})),
+                                 leftBy(normalize(Vec3{0.18f, -0.57f, -0.80f}))};
+  const std::int32_t material = votes[1] == votes[2] ? votes[1] : votes[0];
+  if (material < 0) return {};
+  const std::size_t mbase = static_cast<std::size_t>(material) * gpu::kMaterialTexels;
+  const vec4 &interior = d.materials[mbase + 8], &scattering = d.materials[mbase + 9];
+  return {{interior.x, interior.y, interior.z}, {scattering.x, scattering.y, scattering.z}, scattering.w};
+}
+
 namespace {
 struct SampleRay {
   Vec3 origin, direction;

@@ -103,6 +103,18 @@ struct RenderSceneData {
   std::uint64_t deviceBytes() const;
 };
 
+// A homogeneous medium as the kernel holds it (Material::interiorAbsorption and on).
+struct MediumAt {
+  Vec3 absorption{0.0f}, scattering{0.0f};
+  float anisotropy = 0;
+};
+
+// The medium a point (the camera) is in: that of the glass or boundary around it, found by rays
+// through the packed scene (tracePacked), each leaving by a face it did not enter by; the
+// answer of most of three rays. None when no material holds a medium (materialTypes), so it
+// costs a scene without one nothing. Pure computation: any thread.
+MediumAt mediumAround(const RenderSceneData& d, Vec3 point);
+
 class RenderSceneBuilder {
  public:
   // Applies `flags` (from edit.h) by refreshing the affected arrays; returns DirtyArrays.

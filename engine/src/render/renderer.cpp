@@ -436,6 +436,9 @@ struct Renderer::Impl {
       u.environmentToMap[r] = {d.environmentToMap.m[r][0], d.environmentToMap.m[r][1], d.environmentToMap.m[r][2], 0};
     Vec3 c = d.bounds.empty() ? Vec3{0.0f} : d.bounds.center();
     u.sceneSphere = {c.x, c.y, c.z, d.bounds.empty() ? 1.0f : 0.5f * length(d.bounds.extent())};
+    const MediumAt medium = mediumAround(d, camera.position);
+    u.cameraAbsorption = {medium.absorption.x, medium.absorption.y, medium.absorption.z, 0};
+    u.cameraScattering = {medium.scattering.x, medium.scattering.y, medium.scattering.z, medium.anisotropy};
     std::uint32_t sel = countTile > 0 ? selectedInstance() : 0u;
     u.work = {itemCount, static_cast<std::uint32_t>(slots), sel, sel ? static_cast<std::uint32_t>(countTile) : 0u};
     // Tungsten draws its box exactly, and has no other filter the table could stand for.
