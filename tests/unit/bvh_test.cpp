@@ -756,4 +756,24 @@ TEST(RenderScene, TheCameraIsInTheMediumAroundIt) {
   check(builder.data(), {2, -1, 0});
 }
 
+// The volumetric caustic's set-up: gas in a box of plain walls, closed by one boundary quad.
+// Rays that meet a wall first cannot tell; those through the quad can.
+TEST(RenderScene, AWallDoesNotTellTheCamerasMediumABoundaryDoes) {
+  Scene s = test::emptyScene(8, 8);
+  Material gas;
+  gas.type = MaterialType::Boundary;
+  gas.interiorScattering = Vec3{1.0f};
+  const NodeId wall = test::addMaterial(s, Material{});
+  // A unit box: five walls of a cube, and the quad across its open +z side facing out.
+  const Mat4 walls[5] = {Mat4::translate({0, -0.5f, 0}), Mat4::translate({0, 0.5f, 0}) * Mat4::rotateX(kPi),
+                         Mat4::translate({0.5f, 0, 0}) * Mat4::rotateZ(kPi / 2), Mat4::translate({-0.5f, 0, 0}) * Mat4::rotateZ(-kPi / 2),
+                         Mat4::translate({0, 0, -0.5f}) * Mat4::rotateX(kPi / 2)};
+  for (const Mat4& m : walls) test::addMeshObject(s, "wall", makeQuad(), wall, m);
+  test::addMeshObject(s, "front", makeQuad(), test::addMaterial(s, gas), Mat4::translate({0, 0, 0.5f}) * Mat4::rotateX(kPi / 2));
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  EXPECT_EQ(mediumAround(builder.data(), {0.1f, -0.2f, 0.1f}).scattering, Vec3(1.0f)) << "inside the box";
+  EXPECT_EQ(mediumAround(builder.data(), {0, 0, 3}).scattering, Vec3(0.0f)) << "before its open side";
+}
+
 }  // namespace retile

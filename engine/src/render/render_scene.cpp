@@ -9,6 +9,7 @@
 #include <numeric>
 #include <functional>
 #include <iterator>
+#include <map>
 #include <optional>
 #include <unordered_set>
 
@@ -644,29 +645,33 @@ MediumAt mediumAround(const RenderSceneData& d, Vec3 point) {
   const bool transforms = d.instanceTransforms;
   const bool direct = d.directReferences && !transforms;
   auto intOf = [](float f) { return std::bit_cast<std::int32_t>(f); };
-  // Which holder a ray from the point leaves by a face it did not come in by (-1: none). Glass
-  // counts even empty (the path is in a vacuum inside it), a boundary only with its medium (one
-  // without leaves the path's as it is).
+  // Which holder a ray from the point leaves by a face it did not come in by: -1 when it leaves
+  // the scene, kUndecided when it meets an opaque surface first (a wall does not tell which of
+  // its sides a medium is on: the volumetric caustic's gas fills a box of plain walls closed by
+  // one boundary). Glass counts even empty (the path is in a vacuum inside it), a boundary only
+  // with its medium (one without leaves the path's as it is).
+  constexpr std::int32_t kUndecided = -2;
   auto leftBy = [&](Vec3 dir) {
     std::vector<std::int32_t> entered;
     Vec3 origin = point;
     for (int hits = 0; hits < 64; ++hits) {
       const PackedTrace hit = tracePacked(d.meshTraversal, d.topTraversal, d.tlasRoot, direct, origin, dir, 1e30f);
-      if (hit.prim < 0 || hit.instance < 0) return -1;
+      if (hit.prim < 0) return -1;
       const std::size_t base = static_cast<std::size_t>(hit.instance) * gpu::kInstanceTexels;
-      if (base + 3 >= d.instances.size()) return -1;
+      if (hit.instance < 0 || base + 3 >= d.instances.size()) return kUndecided;
       const std::int32_t material = intOf(d.instances[base + 3].z);
       const std::size_t mbase = static_cast<std::size_t>(material) * gpu::kMaterialTexels;
-      if (material < 0 || mbase + 9 >= d.materials.size()) return -1;
+      if (material < 0 || mbase + 9 >= d.materials.size()) return kUndecided;
       const int type = intOf(d.materials[mbase].w) & gpu::kMatTypeBits;
       const vec4 &interior = d.materials[mbase + 8], &scattering = d.materials[mbase + 9];
       const bool filled = interior.x + interior.y + interior.z + scattering.x + scattering.y + scattering.z > 0;
-      const bool holder = type == gpu::kMatDielectric || type == gpu::kMatRoughDielectric || (type == gpu::kMatBoundary && filled);
-      if (holder) {
+      const bool glass = type == gpu::kMatDielectric || type == gpu::kMatRoughDielectric;
+      if (!glass && type != gpu::kMatBoundary) return kUndecided;
+      if (glass || filled) {
         const vec4* t = d.meshTraversal.data() + static_cast<std::size_t>(hit.prim) * gpu::kTriTexels;
         Vec3 n = cross(Vec3{t[1].x, t[1].y, t[1].z}, Vec3{t[2].x, t[2].y, t[2].z});
         if (transforms) {  // the rows of the inverse transform, transposed: the normal's matrix
-          const vec4 *r = d.instances.data() + base;
+          const vec4* r = d.instances.data() + base;
           n = Vec3{r[0].x * n.x + r[1].x * n.y + r[2].x * n.z, r[0].y * n.x + r[1].y * n.y + r[2].y * n.z,
                    r[0].z * n.x + r[1].z * n.y + r[2].z * n.z};
         }
@@ -681,12 +686,25 @@ MediumAt mediumAround(const RenderSceneData& d, Vec3 point) {
       const Vec3 at = origin + dir * hit.t;
       origin = at + dir * (1e-4f * (1.0f + std::max({std::abs(at.x), std::abs(at.y), std::abs(at.z)})));
     }
-    return -1;
+    return kUndecided;
   };
-  // Three directions off the axes, so that no ray runs along a wall or through an edge by design.
-  const std::int32_t votes[3] = {leftBy(normalize(Vec3{0.31f, 0.83f, 0.46f})), leftBy(normalize(Vec3{-0.72f, -0.25f, 0.64f})),
-                                 leftBy(normalize(Vec3{0.18f, -0.57f, -0.80f}))};
-  const std::int32_t material = votes[1] == votes[2] ? votes[1] : votes[0];
+  // Fourteen directions (the faces' and the corners' of a cube, turned off the axes, so that no
+  // ray runs along a wall or through an edge by design); the answer of most that decide.
+  const Mat4 turn = Mat4::rotateY(0.37f) * Mat4::rotateX(0.23f);
+  std::map<std::int32_t, int> votes;
+  for (int i = 0; i < 14; ++i) {
+    const Vec3 dir = i < 6 ? Vec3{i == 0 ? 1.0f : i == 1 ? -1.0f : 0.0f, i == 2 ? 1.0f : i == 3 ? -1.0f : 0.0f, i == 4 ? 1.0f : i == 5 ? -1.0f : 0.0f}
+                           : Vec3{(i - 6) & 1 ? 1.0f : -1.0f, (i - 6) & 2 ? 1.0f : -1.0f, (i - 6) & 4 ? 1.0f : -1.0f};
+    const std::int32_t v = leftBy(normalize(turn.transformVector(dir)));
+    if (v != kUndecided) ++votes[v];
+  }
+  std::int32_t material = -1;
+  int most = 0;
+  for (const auto& [m, n] : votes)
+    if (n > most) {
+      most = n;
+      material = m;
+    }
   if (material < 0) return {};
   const std::size_t mbase = static_cast<std::size_t>(material) * gpu::kMaterialTexels;
   const vec4 &interior = d.materials[mbase + 8], &scattering = d.materials[mbase + 9];

@@ -111,8 +111,9 @@ struct MediumAt {
 
 // The medium a point (the camera) is in: that of the glass or boundary around it, found by rays
 // through the packed scene (tracePacked), each leaving by a face it did not enter by; the
-// answer of most of three rays. None when no material holds a medium (materialTypes), so it
-// costs a scene without one nothing. Pure computation: any thread.
+// answer of most of fourteen rays, of those that meet no opaque surface first. None when no
+// material holds a medium (materialTypes), so it costs a scene without one nothing. Pure
+// computation: any thread.
 MediumAt mediumAround(const RenderSceneData& d, Vec3 point);
 
 class RenderSceneBuilder {
