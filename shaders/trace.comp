@@ -285,8 +285,8 @@ Path startPath(uint slot, int found) {
 #if RETILE_MEDIUM
   path.absorption = frame.cameraAbsorption.xyz;
   path.scattering = frame.cameraScattering;
-  path.outerAbsorption = vec3(0.0);
-  path.outerScattering = vec4(0.0);
+  path.outerAbsorption = frame.cameraOuterAbsorption.xyz;
+  path.outerScattering = frame.cameraOuterScattering;
 #endif
   path.specular = true;
   path.prevPdf = 0.0;

@@ -180,10 +180,13 @@ struct FrameUniforms {
   // 1..30 then fills the first 30 slots (retile/scene.h, FilterSampling); filterWarp[8].z is then
   // 1 for Tungsten's tent, whose CDF the shader computes instead, and 0 for its Gaussian.
   vec4 filterWarp[9];
-  // The medium the camera is in (renderer.cpp cameraMedium: inside glass or a boundary that holds
-  // one, else none): its absorption xyz, -; its scattering xyz and phase function's g.
+  // The medium the camera is in (render_scene.h mediaAround: inside glass or a boundary that holds
+  // one, else none): its absorption xyz, -; its scattering xyz and phase function's g. Then the
+  // same of the medium around that one.
   vec4 cameraAbsorption;
   vec4 cameraScattering;
+  vec4 cameraOuterAbsorption;
+  vec4 cameraOuterScattering;
 };
 
 // A rectangle of pixels that receives q samples each this frame. Slot s of the frame belongs to
@@ -253,7 +256,7 @@ struct DenoisePush {
 
 #ifdef __cplusplus
 static_assert(sizeof(DenoisePush) == 48);
-static_assert(sizeof(FrameUniforms) == 25 * 16);
+static_assert(sizeof(FrameUniforms) == 27 * 16);
 static_assert(sizeof(WorkItem) == 48);
 static_assert(sizeof(TracePush) == 16);
 }  // namespace retile::gpu

@@ -336,8 +336,10 @@ TEST(KnownAnswer, GlassInFogLeavesThePathInTheFog) {
 
 TEST(KnownAnswer, ACameraInsideFogSeesThroughItsWayOut) {
   // The camera in the middle of a fog box (a boundary, absorbing) five units from its walls,
-  // before a sky of 1: a ray head on shows exp(-5 sigma), the fog it starts in (mediumAround)
-  // counted up to the wall. Moved out of the box, the camera sees exp(-10 sigma) through it.
+  // before a sky of 1: a ray head on shows exp(-5 sigma), the fog it starts in (mediaAround)
+  // counted up to the wall. Moved out of the box, the camera sees exp(-10 sigma) through it. In
+  // empty glass one unit across in the fog's middle, it sees exp(-4.5 sigma): the fog around the
+  // glass is where its paths go on.
   RETILE_RENDERER_OR_SKIP(r);
   const float sigma[3] = {0.1f, 0.3f, 0.0f};
   Scene s = test::emptyScene(32, 32);
@@ -352,6 +354,11 @@ TEST(KnownAnswer, ACameraInsideFogSeesThroughItsWayOut) {
       EXPECT_NEAR(img.color[3 * (16 * 32 + 16) + c], std::exp(-static_cast<double>(sigma[c]) * (z == 0 ? 5 : 10)), 2e-3)
           << "camera at z " << z << ", channel " << c;
   }
+  s.camera = test::frontCamera(10);
+  test::addMeshObject(s, "glass", makeCube(), test::addMaterial(s, filledGlass(Vec3{0.0f})), Mat4::identity());
+  RenderImage img = renderScene(*r, s, 4);
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(img.color[3 * (16 * 32 + 16) + c], std::exp(-static_cast<double>(sigma[c]) * 4.5), 2e-3) << "in glass, channel " << c;
 }
 
 TEST(KnownAnswer, ALightOutsideABoundaryLightsTheMediumInside) {

@@ -713,7 +713,7 @@ TEST(RenderScene, AMirroredObjectKeepsItsTransform) {
 }  // namespace
 // The camera's medium comes from the glass or boundary around it: the way out that no way in
 // matches, along the packed scene's own rays, whether the instance BVH is packed direct, as
-// records, or with transforms.
+// records, or with transforms; and the medium around that one.
 TEST(RenderScene, TheCameraIsInTheMediumAroundIt) {
   Scene s = test::emptyScene(8, 8);
   Material fog;
@@ -732,15 +732,19 @@ TEST(RenderScene, TheCameraIsInTheMediumAroundIt) {
                                                 Mat4::translate({2, 0, 0}) * Mat4::scale({2, 2, 2}));
   test::addMeshObject(s, "lens", makeCube(), test::addMaterial(s, lens), Mat4::translate({-2, 0, 0}) * Mat4::scale({2, 2, 2}));
   test::addMeshObject(s, "veil", makeCube(), test::addMaterial(s, veil), Mat4::translate({0, 0, 2}) * Mat4::scale({2, 2, 2}));
+  const Vec3 fogged{0.1f, 0.2f, 0.3f};
   auto check = [&](const RenderSceneData& d, Vec3 milkAt) {
-    EXPECT_EQ(mediumAround(d, {0, 0, 0}).absorption, Vec3(0.1f, 0.2f, 0.3f)) << "in the fog, past the milk and the lens";
-    EXPECT_EQ(mediumAround(d, {0, 0, 2}).absorption, Vec3(0.1f, 0.2f, 0.3f)) << "a boundary without a medium changes nothing";
-    const MediumAt inMilk = mediumAround(d, milkAt);
-    EXPECT_EQ(inMilk.scattering, Vec3(5.0f));
-    EXPECT_EQ(inMilk.absorption, Vec3(0.0f));
-    EXPECT_FLOAT_EQ(inMilk.anisotropy, 0.3f);
-    EXPECT_EQ(mediumAround(d, {-2, 0, 0}).absorption, Vec3(0.0f)) << "empty glass holds a vacuum";
-    EXPECT_EQ(mediumAround(d, {0, 0, 20}).absorption, Vec3(0.0f)) << "outside everything";
+    EXPECT_EQ(mediaAround(d, {0, 0, 0}).in.absorption, fogged) << "in the fog, past the milk and the lens";
+    EXPECT_EQ(mediaAround(d, {0, 0, 0}).around.absorption, Vec3(0.0f));
+    EXPECT_EQ(mediaAround(d, {0, 0, 2}).in.absorption, fogged) << "a boundary without a medium changes nothing";
+    const MediaAround inMilk = mediaAround(d, milkAt);
+    EXPECT_EQ(inMilk.in.scattering, Vec3(5.0f));
+    EXPECT_EQ(inMilk.in.absorption, Vec3(0.0f));
+    EXPECT_FLOAT_EQ(inMilk.in.anisotropy, 0.3f);
+    EXPECT_EQ(inMilk.around.absorption, fogged) << "the milk is in the fog";
+    EXPECT_EQ(mediaAround(d, {-2, 0, 0}).in.absorption, Vec3(0.0f)) << "empty glass holds a vacuum";
+    EXPECT_EQ(mediaAround(d, {-2, 0, 0}).around.absorption, fogged);
+    EXPECT_EQ(mediaAround(d, {0, 0, 20}).in.absorption, Vec3(0.0f)) << "outside everything";
   };
   RenderSceneBuilder builder;
   builder.update(s, kUpdateAll, nullptr);
@@ -757,7 +761,8 @@ TEST(RenderScene, TheCameraIsInTheMediumAroundIt) {
 }
 
 // The volumetric caustic's set-up: gas in a box of plain walls, closed by one boundary quad.
-// Rays that meet a wall first cannot tell; those through the quad can.
+// Rays that meet a wall first cannot tell; those through the quad can. Turned to face into the
+// box, the quad holds the gas outside it: then only a transform of its normal done right says so.
 TEST(RenderScene, AWallDoesNotTellTheCamerasMediumABoundaryDoes) {
   Scene s = test::emptyScene(8, 8);
   Material gas;
@@ -769,11 +774,21 @@ TEST(RenderScene, AWallDoesNotTellTheCamerasMediumABoundaryDoes) {
                          Mat4::translate({0.5f, 0, 0}) * Mat4::rotateZ(kPi / 2), Mat4::translate({-0.5f, 0, 0}) * Mat4::rotateZ(-kPi / 2),
                          Mat4::translate({0, 0, -0.5f}) * Mat4::rotateX(kPi / 2)};
   for (const Mat4& m : walls) test::addMeshObject(s, "wall", makeQuad(), wall, m);
-  test::addMeshObject(s, "front", makeQuad(), test::addMaterial(s, gas), Mat4::translate({0, 0, 0.5f}) * Mat4::rotateX(kPi / 2));
-  RenderSceneBuilder builder;
-  builder.update(s, kUpdateAll, nullptr);
-  EXPECT_EQ(mediumAround(builder.data(), {0.1f, -0.2f, 0.1f}).scattering, Vec3(1.0f)) << "inside the box";
-  EXPECT_EQ(mediumAround(builder.data(), {0, 0, 3}).scattering, Vec3(0.0f)) << "before its open side";
+  const NodeId front = test::addMeshObject(s, "front", makeQuad(), test::addMaterial(s, gas), Mat4::translate({0, 0, 0.5f}) * Mat4::rotateX(kPi / 2));
+  const Vec3 inside{0.1f, -0.2f, 0.1f}, before{0.2f, 0.1f, 3.0f};
+  for (bool direct : {true, false}) {
+    RenderSceneBuilder builder;
+    builder.setDirectReferences(direct);
+    builder.update(s, kUpdateAll, nullptr);
+    EXPECT_EQ(mediaAround(builder.data(), inside).in.scattering, Vec3(1.0f)) << "inside the box";
+    EXPECT_EQ(mediaAround(builder.data(), before).in.scattering, Vec3(0.0f)) << "before its open side";
+    s.object(front)->transform = Mat4::translate({0, 0, 0.5f}) * Mat4::rotateY(0.3f) * Mat4::rotateX(-kPi / 2) * Mat4::scale({1.5f, 1, 1.5f});
+    builder.update(s, kUpdateInstances, nullptr);
+    EXPECT_TRUE(builder.data().instanceTransforms);
+    EXPECT_EQ(mediaAround(builder.data(), inside).in.scattering, Vec3(0.0f)) << "facing in, the quad holds the gas outside";
+    EXPECT_EQ(mediaAround(builder.data(), before).in.scattering, Vec3(1.0f));
+    s.object(front)->transform = Mat4::translate({0, 0, 0.5f}) * Mat4::rotateX(kPi / 2);
+  }
 }
 
 }  // namespace retile

@@ -690,7 +690,7 @@ class TungstenImporter {
     } else if (type != "pinhole") {
       warn(cat("camera type '", type, "' is rendered as a pinhole camera"));
     }
-    // The renderer finds the medium around the camera itself (mediumAround): one that glass or a
+    // The renderer finds the medium around the camera itself (mediaAround): one that glass or a
     // boundary holds. Warned of once every primitive is read, if none does.
     cameraMedium_ = string(c, "medium");
     if (const Value* r = c.find("resolution")) {

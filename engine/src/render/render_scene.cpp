@@ -640,34 +640,40 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
   pack(fallback);
 }
 
-MediumAt mediumAround(const RenderSceneData& d, Vec3 point) {
+MediaAround mediaAround(const RenderSceneData& d, Vec3 point) {
   if (!(d.materialTypes & (1u << gpu::kMaskMedium)) || d.tlasRoot < 0) return {};
   const bool transforms = d.instanceTransforms;
   const bool direct = d.directReferences && !transforms;
   auto intOf = [](float f) { return std::bit_cast<std::int32_t>(f); };
-  // Which holder a ray from the point leaves by a face it did not come in by: -1 when it leaves
-  // the scene, kUndecided when it meets an opaque surface first (a wall does not tell which of
-  // its sides a medium is on: the volumetric caustic's gas fills a box of plain walls closed by
-  // one boundary). Glass counts even empty (the path is in a vacuum inside it), a boundary only
-  // with its medium (one without leaves the path's as it is).
+  // The first two holders a ray from the point leaves by faces it did not come in by (-1: it
+  // leaves the scene first). kUndecided where it meets an opaque surface before (a wall does not
+  // tell which of its sides a medium is on: the volumetric caustic's gas fills a box of plain
+  // walls closed by one boundary), unless `throughWalls`. Glass counts even empty (the path is in
+  // a vacuum inside it), a boundary only with its medium (one without leaves the path's as it is).
   constexpr std::int32_t kUndecided = -2;
-  auto leftBy = [&](Vec3 dir) {
+  struct Left {
+    std::int32_t first = kUndecided, second = kUndecided;
+  };
+  auto leftBy = [&](Vec3 dir, bool throughWalls) {
+    Left left;
     std::vector<std::int32_t> entered;
     Vec3 origin = point;
     for (int hits = 0; hits < 64; ++hits) {
       const PackedTrace hit = tracePacked(d.meshTraversal, d.topTraversal, d.tlasRoot, direct, origin, dir, 1e30f);
-      if (hit.prim < 0) return -1;
+      if (hit.prim < 0) {
+        (left.first == kUndecided ? left.first : left.second) = -1;
+        return left;
+      }
       const std::size_t base = static_cast<std::size_t>(hit.instance) * gpu::kInstanceTexels;
-      if (hit.instance < 0 || base + 3 >= d.instances.size()) return kUndecided;
-      const std::int32_t material = intOf(d.instances[base + 3].z);
+      const std::int32_t material = hit.instance >= 0 && base + 3 < d.instances.size() ? intOf(d.instances[base + 3].z) : -1;
       const std::size_t mbase = static_cast<std::size_t>(material) * gpu::kMaterialTexels;
-      if (material < 0 || mbase + 9 >= d.materials.size()) return kUndecided;
+      if (material < 0 || mbase + 9 >= d.materials.size()) return left;
       const int type = intOf(d.materials[mbase].w) & gpu::kMatTypeBits;
       const vec4 &interior = d.materials[mbase + 8], &scattering = d.materials[mbase + 9];
       const bool filled = interior.x + interior.y + interior.z + scattering.x + scattering.y + scattering.z > 0;
       const bool glass = type == gpu::kMatDielectric || type == gpu::kMatRoughDielectric;
-      if (!glass && type != gpu::kMatBoundary) return kUndecided;
-      if (glass || filled) {
+      if (!glass && type != gpu::kMatBoundary && !throughWalls) return left;
+      if (glass || (type == gpu::kMatBoundary && filled)) {
         const vec4* t = d.meshTraversal.data() + static_cast<std::size_t>(hit.prim) * gpu::kTriTexels;
         Vec3 n = cross(Vec3{t[1].x, t[1].y, t[1].z}, Vec3{t[2].x, t[2].y, t[2].z});
         if (transforms) {  // the rows of the inverse transform, transposed: the normal's matrix
@@ -679,36 +685,56 @@ MediumAt mediumAround(const RenderSceneData& d, Vec3 point) {
           entered.push_back(material);
         } else if (!entered.empty() && entered.back() == material) {
           entered.pop_back();
+        } else if (left.first == kUndecided) {
+          left.first = material;
         } else {
-          return material;
+          left.second = material;
+          return left;
         }
       }
       const Vec3 at = origin + dir * hit.t;
       origin = at + dir * (1e-4f * (1.0f + std::max({std::abs(at.x), std::abs(at.y), std::abs(at.z)})));
     }
-    return kUndecided;
+    return left;
   };
   // Fourteen directions (the faces' and the corners' of a cube, turned off the axes, so that no
-  // ray runs along a wall or through an edge by design); the answer of most that decide.
+  // ray runs along a wall or through an edge by design). A holder left is evidence; a ray that
+  // leaves the scene is not against it (one side of an open boundary, a water surface, is its
+  // medium's), so the holder most rays leave wins, and none only when no ray leaves one. Where
+  // every ray meets a wall first, they are cast again through the walls.
   const Mat4 turn = Mat4::rotateY(0.37f) * Mat4::rotateX(0.23f);
-  std::map<std::int32_t, int> votes;
-  for (int i = 0; i < 14; ++i) {
-    const Vec3 dir = i < 6 ? Vec3{i == 0 ? 1.0f : i == 1 ? -1.0f : 0.0f, i == 2 ? 1.0f : i == 3 ? -1.0f : 0.0f, i == 4 ? 1.0f : i == 5 ? -1.0f : 0.0f}
-                           : Vec3{(i - 6) & 1 ? 1.0f : -1.0f, (i - 6) & 2 ? 1.0f : -1.0f, (i - 6) & 4 ? 1.0f : -1.0f};
-    const std::int32_t v = leftBy(normalize(turn.transformVector(dir)));
-    if (v != kUndecided) ++votes[v];
-  }
-  std::int32_t material = -1;
-  int most = 0;
-  for (const auto& [m, n] : votes)
-    if (n > most) {
-      most = n;
-      material = m;
+  Left rays[14];
+  bool decided = false;
+  for (bool throughWalls : {false, true}) {
+    for (int i = 0; i < 14; ++i) {
+      const Vec3 dir = i < 6 ? Vec3{i == 0 ? 1.0f : i == 1 ? -1.0f : 0.0f, i == 2 ? 1.0f : i == 3 ? -1.0f : 0.0f, i == 4 ? 1.0f : i == 5 ? -1.0f : 0.0f}
+                             : Vec3{(i - 6) & 1 ? 1.0f : -1.0f, (i - 6) & 2 ? 1.0f : -1.0f, (i - 6) & 4 ? 1.0f : -1.0f};
+      rays[i] = leftBy(normalize(turn.transformVector(dir)), throughWalls);
+      decided = decided || rays[i].first != kUndecided;
     }
-  if (material < 0) return {};
-  const std::size_t mbase = static_cast<std::size_t>(material) * gpu::kMaterialTexels;
-  const vec4 &interior = d.materials[mbase + 8], &scattering = d.materials[mbase + 9];
-  return {{interior.x, interior.y, interior.z}, {scattering.x, scattering.y, scattering.z}, scattering.w};
+    if (decided) break;
+  }
+  auto mostLeft = [&](std::int32_t Left::*which, std::int32_t given) {  // of the rays whose first is `given`, if any
+    std::map<std::int32_t, int> votes;
+    for (const Left& l : rays)
+      if (l.*which >= 0 && (given < 0 || l.first == given)) ++votes[l.*which];
+    std::int32_t best = -1;
+    int most = 0;
+    for (const auto& [m, n] : votes)
+      if (n > most) {
+        most = n;
+        best = m;
+      }
+    return best;
+  };
+  auto mediumOf = [&](std::int32_t material) {
+    if (material < 0) return MediumAt{};
+    const std::size_t mbase = static_cast<std::size_t>(material) * gpu::kMaterialTexels;
+    const vec4 &interior = d.materials[mbase + 8], &scattering = d.materials[mbase + 9];
+    return MediumAt{{interior.x, interior.y, interior.z}, {scattering.x, scattering.y, scattering.z}, scattering.w};
+  };
+  const std::int32_t inner = mostLeft(&Left::first, -1);
+  return {mediumOf(inner), inner < 0 ? MediumAt{} : mediumOf(mostLeft(&Left::second, inner))};
 }
 
 namespace {

@@ -109,12 +109,17 @@ struct MediumAt {
   float anisotropy = 0;
 };
 
-// The medium a point (the camera) is in: that of the glass or boundary around it, found by rays
-// through the packed scene (tracePacked), each leaving by a face it did not enter by; the
-// answer of most of fourteen rays, of those that meet no opaque surface first. None when no
-// material holds a medium (materialTypes), so it costs a scene without one nothing. Pure
-// computation: any thread.
-MediumAt mediumAround(const RenderSceneData& d, Vec3 point);
+// The medium a point (the camera) is in, and the one around that: those of the glass or
+// boundaries around it, found by fourteen rays through the packed scene (tracePacked), each
+// leaving by faces it did not enter by; a holder that most rays leave, of those that meet no
+// opaque surface first (all of them again, through walls, when none does). Two levels, as a path
+// keeps (trace.comp crossMedium). Up to 14 x 64 CPU traversals, so the renderer asks again only
+// when the camera or the scene changes; none when no material holds a medium (materialTypes). It
+// only reads `d`, which its owner (the render thread, see above) must not change meanwhile.
+struct MediaAround {
+  MediumAt in, around;
+};
+MediaAround mediaAround(const RenderSceneData& d, Vec3 point);
 
 class RenderSceneBuilder {
  public:

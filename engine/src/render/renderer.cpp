@@ -87,6 +87,11 @@ struct Renderer::Impl {
   Buffer history, reuseItems;  // verified reuse: allocated on first use, dropped on resize
 
   Camera camera;
+  // The media around the camera (mediaAround), for the position they were found at; found again
+  // when the camera moves or the scene changes (mediaKnown false).
+  MediaAround media;
+  Vec3 mediaAt{0.0f};
+  bool mediaKnown = false;
   int width = 0, height = 0;
   // Loop iterations per path in the last frame (see traceInvocations); a cautious guess until a
   // frame of the current scene has been traced.
@@ -436,9 +441,16 @@ struct Renderer::Impl {
       u.environmentToMap[r] = {d.environmentToMap.m[r][0], d.environmentToMap.m[r][1], d.environmentToMap.m[r][2], 0};
     Vec3 c = d.bounds.empty() ? Vec3{0.0f} : d.bounds.center();
     u.sceneSphere = {c.x, c.y, c.z, d.bounds.empty() ? 1.0f : 0.5f * length(d.bounds.extent())};
-    const MediumAt medium = mediumAround(d, camera.position);
-    u.cameraAbsorption = {medium.absorption.x, medium.absorption.y, medium.absorption.z, 0};
-    u.cameraScattering = {medium.scattering.x, medium.scattering.y, medium.scattering.z, medium.anisotropy};
+    if (!mediaKnown || mediaAt != camera.position) {
+      media = mediaAround(d, camera.position);
+      mediaAt = camera.position;
+      mediaKnown = true;
+    }
+    const MediumAt &in = media.in, &around = media.around;
+    u.cameraAbsorption = {in.absorption.x, in.absorption.y, in.absorption.z, 0};
+    u.cameraScattering = {in.scattering.x, in.scattering.y, in.scattering.z, in.anisotropy};
+    u.cameraOuterAbsorption = {around.absorption.x, around.absorption.y, around.absorption.z, 0};
+    u.cameraOuterScattering = {around.scattering.x, around.scattering.y, around.scattering.z, around.anisotropy};
     std::uint32_t sel = countTile > 0 ? selectedInstance() : 0u;
     u.work = {itemCount, static_cast<std::uint32_t>(slots), sel, sel ? static_cast<std::uint32_t>(countTile) : 0u};
     // Tungsten draws its box exactly, and has no other filter the table could stand for.
@@ -732,6 +744,7 @@ std::vector<std::string> Renderer::updateScene(const Scene& scene, std::uint32_t
   impl_->upload(dirty);
   if (dirty & kDirtyGeometry) releaseFreedMemory();
   impl_->camera = scene.camera;
+  impl_->mediaKnown = false;
   impl_->sceneSettings = scene.settings;
   if (!impl_->hasScene || (flags & kUpdateSettings)) impl_->setMaxBounces(scene.settings.maxBounces);
   impl_->hasScene = true;
