@@ -345,9 +345,10 @@ bool endPath(Path path, inout Shadow shadow) {
   return false;
 }
 
-// A shadow ray traced: its path's light, or its ended path's sample rewritten.
-// `blocker`: the instance that blocks the shadow ray, -1 when nothing does (Trace::blocker).
-void resolveShadow(inout Path path, inout Shadow shadow, int blocker, Trace tr) {
+// A shadow ray traced (by `tr`, whose blocker is the instance that blocks it, -1 when nothing
+// does): its path's light, or its ended path's sample rewritten.
+void resolveShadow(inout Path path, inout Shadow shadow, Trace tr) {
+  int blocker = tr.blocker;
   if (!shadow.pending) return;
   shadowRays++;
   int selected = int(frame.work.z) - 1;
@@ -438,9 +439,8 @@ void crossMedium(inout Path path, Material m, bool frontFace) {
 // The path scatters in its medium (of extinction sigmaT) `flight` along its ray, short of its
 // hit at hitT. As at a surface, a light is sampled (its shadow ray dimmed by the media on its
 // way; glass round the medium blocks light from outside, as in Tungsten, a boundary does not)
-// and weighed against the
-// phase function, which then gives the next direction. A scattering event is a bounce, as in
-// Tungsten. Returns false when the path has ended.
+// and weighed against the phase function, which then gives the next direction. A scattering
+// event is a bounce, as in Tungsten. Returns false when the path has ended.
 bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, float hitT, vec3 sigmaT) {
   vec3 crossed = exp(-sigmaT * flight);
   float pdf = dot(sigmaT * crossed, vec3(1.0 / 3.0));
@@ -687,6 +687,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   // cannot carry the medium out of its glass.
   if (bs.transmitted && (isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric))) crossMedium(path, m, frontFace);
 #endif
+  // Roulette must not see the 1/eta^2 radiance scaling inside glass as lost energy.
   if (bs.transmitted && !isMat(m.type, kMatThinSheet) && !isMat(m.type, kMatDiffuseTransmission)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
   path.specular = bs.delta;
   path.prevPdf = bs.pdf;
@@ -765,7 +766,7 @@ void main() {
     // others' rays are still in flight (the traversal loop below).
     bool ready = tr.done, ended = false;
     if (ready && !tr.idle) {
-      resolveShadow(path, shadow, tr.blocker, tr);
+      resolveShadow(path, shadow, tr);
       ended = alive && !shadeSegment(path, shadow, tr.hit);
       alive = alive && !ended;
     }

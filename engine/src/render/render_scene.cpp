@@ -618,10 +618,10 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     // A boundary blends with nothing and nothing with it: the traversal takes an instance's own
     // material for whether its shadow rays pass, and a surface that were partly a boundary would
     // block them all the same.
-    const Material* partner = scene.material(m.blendWith);
-    const bool boundary = m.type == MaterialType::Boundary || (partner && partner->type == MaterialType::Boundary);
-    if (auto it = materialIndex_.find(m.blendWith);
-        !boundary && it != materialIndex_.end() && m.blendWith != m.id && (m.blendRatio < 1.0f || texturedRatio)) {
+    const auto it = materialIndex_.find(m.blendWith);
+    const bool boundary = m.type == MaterialType::Boundary ||
+                          (it != materialIndex_.end() && scene.materials[static_cast<std::size_t>(it->second)].type == MaterialType::Boundary);
+    if (!boundary && it != materialIndex_.end() && m.blendWith != m.id && (m.blendRatio < 1.0f || texturedRatio)) {
       blendWith = it->second;
       data_.materialBlend = true;
       if (texturedRatio) {
@@ -645,6 +645,12 @@ MediaAround mediaAround(const RenderSceneData& d, Vec3 point) {
   const bool transforms = d.instanceTransforms;
   const bool direct = d.directReferences && !transforms;
   auto intOf = [](float f) { return std::bit_cast<std::int32_t>(f); };
+  auto mediumOf = [&](std::int32_t material) {
+    if (material < 0) return MediumAt{};
+    const std::size_t mbase = static_cast<std::size_t>(material) * gpu::kMaterialTexels;
+    const vec4 &interior = d.materials[mbase + 8], &scattering = d.materials[mbase + 9];
+    return MediumAt{{interior.x, interior.y, interior.z}, {scattering.x, scattering.y, scattering.z}, scattering.w};
+  };
   // The first two holders a ray from the point leaves by faces it did not come in by (-1: it
   // leaves the scene first). kUndecided where it meets an opaque surface before (a wall does not
   // tell which of its sides a medium is on: the volumetric caustic's gas fills a box of plain
@@ -669,8 +675,8 @@ MediaAround mediaAround(const RenderSceneData& d, Vec3 point) {
       const std::size_t mbase = static_cast<std::size_t>(material) * gpu::kMaterialTexels;
       if (material < 0 || mbase + 9 >= d.materials.size()) return left;
       const int type = intOf(d.materials[mbase].w) & gpu::kMatTypeBits;
-      const vec4 &interior = d.materials[mbase + 8], &scattering = d.materials[mbase + 9];
-      const bool filled = interior.x + interior.y + interior.z + scattering.x + scattering.y + scattering.z > 0;
+      const MediumAt medium = mediumOf(material);
+      const bool filled = maxComponent(medium.absorption + medium.scattering) > 0;
       const bool glass = type == gpu::kMatDielectric || type == gpu::kMatRoughDielectric;
       if (!glass && type != gpu::kMatBoundary && !throughWalls) return left;
       if (glass || (type == gpu::kMatBoundary && filled)) {
@@ -702,14 +708,14 @@ MediaAround mediaAround(const RenderSceneData& d, Vec3 point) {
   // leaves the scene is not against it (one side of an open boundary, a water surface, is its
   // medium's), so the holder most rays leave wins, and none only when no ray leaves one. Where
   // every ray meets a wall first, they are cast again through the walls.
+  static const Vec3 kDirections[14] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},  {0, -1, 0}, {0, 0, 1},  {0, 0, -1}, {1, 1, 1},
+                                       {1, 1, -1}, {1, -1, 1}, {1, -1, -1}, {-1, 1, 1}, {-1, 1, -1}, {-1, -1, 1}, {-1, -1, -1}};
   const Mat4 turn = Mat4::rotateY(0.37f) * Mat4::rotateX(0.23f);
   Left rays[14];
   bool decided = false;
   for (bool throughWalls : {false, true}) {
     for (int i = 0; i < 14; ++i) {
-      const Vec3 dir = i < 6 ? Vec3{i == 0 ? 1.0f : i == 1 ? -1.0f : 0.0f, i == 2 ? 1.0f : i == 3 ? -1.0f : 0.0f, i == 4 ? 1.0f : i == 5 ? -1.0f : 0.0f}
-                             : Vec3{(i - 6) & 1 ? 1.0f : -1.0f, (i - 6) & 2 ? 1.0f : -1.0f, (i - 6) & 4 ? 1.0f : -1.0f};
-      rays[i] = leftBy(normalize(turn.transformVector(dir)), throughWalls);
+      rays[i] = leftBy(normalize(turn.transformVector(kDirections[i])), throughWalls);
       decided = decided || rays[i].first != kUndecided;
     }
     if (decided) break;
@@ -726,12 +732,6 @@ MediaAround mediaAround(const RenderSceneData& d, Vec3 point) {
         best = m;
       }
     return best;
-  };
-  auto mediumOf = [&](std::int32_t material) {
-    if (material < 0) return MediumAt{};
-    const std::size_t mbase = static_cast<std::size_t>(material) * gpu::kMaterialTexels;
-    const vec4 &interior = d.materials[mbase + 8], &scattering = d.materials[mbase + 9];
-    return MediumAt{{interior.x, interior.y, interior.z}, {scattering.x, scattering.y, scattering.z}, scattering.w};
   };
   const std::int32_t inner = mostLeft(&Left::first, -1);
   return {mediumOf(inner), inner < 0 ? MediumAt{} : mediumOf(mostLeft(&Left::second, inner))};
