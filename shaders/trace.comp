@@ -362,7 +362,9 @@ void resolveShadow(inout Path path, inout Shadow shadow, Trace tr) {
   vec3 sigma = shadow.sigma + tr.crossedSigma;
   vec3 depth = tr.crossedDepth;
   if (shadow.dist >= kInfinity) {
-    // To a light at infinity, the medium the ray ends in must be none, up to rounding.
+    // To a light at infinity, the medium the ray ends in must be none, up to rounding: none is
+    // left of the boundaries' (whose crossings count relative to the world's medium), and the
+    // world has none either.
     float rounding = 1e-5 * (maxComponent(shadow.sigma) + tr.crossedScale);
     depth += mix(vec3(0.0), vec3(kInfinity), greaterThan(sigma, vec3(rounding)));
   } else {
@@ -421,7 +423,8 @@ void castShadow(inout Shadow shadow, inout Path path, vec3 origin, ivec2 from, L
 
 #if RETILE_MEDIUM
 // Through glass or a boundary (Material::holdsMedium) the path enters its medium across the front,
-// the one it was in becoming the one around, and goes back to that one across the back.
+// the one it was in becoming the one around, and goes back to that one across the back. Around
+// that, which a path does not remember, is taken to be the world's medium.
 void crossMedium(inout Path path, Material m, bool frontFace) {
   if (frontFace) {
     path.outerAbsorption = path.absorption;
@@ -431,8 +434,8 @@ void crossMedium(inout Path path, Material m, bool frontFace) {
   } else {
     path.absorption = path.outerAbsorption;
     path.scattering = path.outerScattering;
-    path.outerAbsorption = vec3(0.0);
-    path.outerScattering = vec4(0.0);
+    path.outerAbsorption = frame.worldAbsorption.xyz;
+    path.outerScattering = frame.worldScattering;
   }
 }
 

@@ -546,8 +546,11 @@ void NodeGraphView::rebuild() {
     QString sub = QString::fromLatin1(materialTypeName(m.type));
     if (m.emissive()) sub += tr(", emissive");
     GraphNodeItem* n = add(m.id, NodeKind::Material, m.name, sub);
-    n->inputs = textureInputs();
-    n->inputs << kBlendInput;
+    // A boundary is no surface: no texture or blend would change what it renders.
+    if (m.type != MaterialType::Boundary) {
+      n->inputs = textureInputs();
+      n->inputs << kBlendInput;
+    }
     n->output = QStringLiteral("material");
     // An emitter shows its light's hue; its albedo is usually black.
     const float peak = std::max({m.emission.x, m.emission.y, m.emission.z});
@@ -612,6 +615,7 @@ void NodeGraphView::rebuild() {
   for (const Object& o : scene_.objects)
     if (o.material != kNoNode) addLink(o.material, o.id, QStringLiteral("material"));
   for (const Material& m : scene_.materials) {
+    if (m.type == MaterialType::Boundary) continue;  // no inputs to draw its links to
     for (const QString& slot : textureInputs())
       if (m.*textureSlot(slot) != kNoNode) addLink(m.*textureSlot(slot), m.id, slot);
     if (m.blendWith != kNoNode) addLink(m.blendWith, m.id, kBlendInput);
@@ -768,8 +772,10 @@ NodeId NodeGraphView::linkSource(NodeId to, const QString& input) const {
 
 bool NodeGraphView::accepts(NodeId from, NodeId to, const QString& input) const {
   if (input == QLatin1String("material")) return scene_.material(from) && scene_.object(to);
-  if (input == kBlendInput) return from != to && scene_.material(from) && scene_.material(to);
-  return isTextureInput(input) && scene_.texture(from) && scene_.material(to);
+  const Material* m = scene_.material(to);
+  if (!m || m->type == MaterialType::Boundary) return false;  // a boundary has no inputs
+  if (input == kBlendInput) return from != to && scene_.material(from);
+  return isTextureInput(input) && scene_.texture(from);
 }
 
 const NodeGraphView::Link* NodeGraphView::insertTarget() const {

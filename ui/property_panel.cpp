@@ -575,6 +575,19 @@ void PropertyPanel::buildEnvironment(Builder& b) {
       edit(tr("Sky ground"), drag, [c](Environment& x) { x.ground = c; });
     });
   }
+  // The medium filling the world (fog), as a glass's or boundary's interior.
+  b.vec3(tr("Medium absorption"), "mediumAbsorption", e.mediumAbsorption, 0.01, [edit](int channel, double v, int drag) {
+    edit(tr("Environment medium absorption"), drag,
+         [channel, v](Environment& x) { axisOf(x.mediumAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
+  }, true);
+  b.vec3(tr("Medium scattering"), "mediumScattering", e.mediumScattering, 0.01, [edit](int channel, double v, int drag) {
+    edit(tr("Environment medium scattering"), drag,
+         [channel, v](Environment& x) { axisOf(x.mediumScattering, channel) = std::max(0.0f, static_cast<float>(v)); });
+  }, true);
+  b.number(tr("Medium anisotropy"), "mediumAnisotropy", e.mediumAnisotropy, -0.99, 0.99, defaults.mediumAnisotropy, 3,
+           [edit](double v, int drag) {
+             edit(tr("Environment medium anisotropy"), drag, [v](Environment& x) { x.mediumAnisotropy = static_cast<float>(v); });
+           });
 }
 
 void PropertyPanel::buildRender(Builder& b) {

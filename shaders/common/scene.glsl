@@ -227,7 +227,8 @@ struct Trace {
   int blocker;     // the instance that blocks the shadow ray, -1 when nothing does
 #if RETILE_BOUNDARY
   // The boundaries (kMatBoundary) the shadow ray crossed, which do not block it, in any order: the
-  // sum of their media's extinctions, + entering across the front and - leaving, and of the same
+  // sum of their media's extinctions less the world's (FrameUniforms::worldAbsorption; the empty
+  // ones count none), + entering across the front and - leaving, and of the same
   // times minus the distance to the crossing. Its optical depth to a light at distance d, from a
   // medium of extinction s, is then (s + crossedSigma) d + crossedDepth (trace.comp resolveShadow).
   // crossedScale sums the extinctions' sizes, to tell rounding from a medium still around.
@@ -406,6 +407,9 @@ void traceStep(inout Trace tr, int below, int root) {
       if ((floatBitsToInt(texelFetch(uMaterials, material).w) & kMatTypeBits) == kMatBoundary) {
         vec3 sigma = texelFetch(uMaterials, material + 8).rgb + texelFetch(uMaterials, material + 9).rgb;
         tr.crossedScale += maxComponent(sigma);
+        // The change of medium across it: from the world's (or to it) for one that holds a
+        // medium; none for an empty one, which leaves the ray's medium as it is.
+        if (maxComponent(sigma) > 0.0) sigma -= frame.worldAbsorption.xyz + frame.worldScattering.rgb;
         sigma = det > 0.0 ? sigma : -sigma;
         tr.crossedSigma += sigma;
         tr.crossedDepth -= sigma * tt;

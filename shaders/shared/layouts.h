@@ -181,12 +181,16 @@ struct FrameUniforms {
   // 1 for Tungsten's tent, whose CDF the shader computes instead, and 0 for its Gaussian.
   vec4 filterWarp[9];
   // The medium the camera is in (render_scene.h mediaAround: inside glass or a boundary that holds
-  // one, else none): its absorption xyz, -; its scattering xyz and phase function's g. Then the
+  // one, else the world's): its absorption xyz, -; its scattering xyz and phase function's g. Then the
   // same of the medium around that one.
   vec4 cameraAbsorption;
   vec4 cameraScattering;
   vec4 cameraOuterAbsorption;
   vec4 cameraOuterScattering;
+  // The world's medium (Environment::mediumAbsorption and on; zero where it has none), which a
+  // path goes back to when it leaves the outermost glass or boundary: as the camera's above.
+  vec4 worldAbsorption;
+  vec4 worldScattering;
 };
 
 // A rectangle of pixels that receives q samples each this frame. Slot s of the frame belongs to
@@ -256,7 +260,7 @@ struct DenoisePush {
 
 #ifdef __cplusplus
 static_assert(sizeof(DenoisePush) == 48);
-static_assert(sizeof(FrameUniforms) == 27 * 16);
+static_assert(sizeof(FrameUniforms) == 29 * 16);
 static_assert(sizeof(WorkItem) == 48);
 static_assert(sizeof(TracePush) == 16);
 }  // namespace retile::gpu

@@ -600,6 +600,12 @@ TEST(Editor, CameraEnvironmentAndRenderSettingsHavePanels) {
   ASSERT_TRUE(intensity);
   intensity->setValue(2.5);
   EXPECT_FLOAT_EQ(w->scene().environment.intensity, 2.5f);
+  // The world's medium (fog) from the same panel, rendered by the kernel with media compiled in.
+  auto* haze = w->properties()->findChild<ScrubField*>("mediumScattering1");
+  ASSERT_TRUE(haze);
+  haze->setValue(0.3);
+  EXPECT_EQ(w->scene().environment.mediumScattering, Vec3(0.0f, 0.3f, 0.0f));
+  EXPECT_TRUE(w->scene().environment.filled());
   const std::uint64_t version = w->documentVersion();
   ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; })) << "the edit reached the engine";
   auto* bounces = w->findChild<ScrubField*>("maxBounces");

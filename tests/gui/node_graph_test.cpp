@@ -233,6 +233,23 @@ TEST_F(NodeGraph, AMaterialOntoAnothersBlendInputBlendsThem) {
   EXPECT_EQ(describe(scene()), describe(before));
 }
 
+TEST_F(NodeGraph, ABoundaryHasNoInputs) {
+  // A boundary is no surface (Tungsten's forward bsdf): no texture or blend would change it, so
+  // its node shows no sockets for them and takes no link into one.
+  const NodeId ground = named(scene().materials, "Ground");
+  const NodeId checker = named(scene().textures, "Checker");
+  EXPECT_NE(view.socketScenePos(ground, "albedo", false), view.nodePosition(ground)) << "a surface has its inputs";
+  Material boundary = *scene().material(ground);
+  boundary.type = MaterialType::Boundary;
+  ASSERT_TRUE(doc.apply(SetMaterial{boundary}).ok());
+  view.setDocument(doc.scene());
+  EXPECT_EQ(view.socketScenePos(ground, "albedo", false), view.nodePosition(ground)) << "no albedo socket";
+  EXPECT_EQ(view.socketScenePos(ground, "blend", false), view.nodePosition(ground)) << "no blend socket";
+  EXPECT_FALSE(view.link(checker, ground, "albedo"));
+  EXPECT_FALSE(view.link(named(scene().materials, "Brushed Steel"), ground, "blend"));
+  EXPECT_TRUE(edits.empty());
+}
+
 TEST_F(NodeGraph, DeleteRemovesTheSelectionAndTheBeforesRestoreEveryReference) {
   const Scene original = scene();
   const NodeId lacquer = named(scene().materials, "Red Lacquer");

@@ -213,16 +213,24 @@ TEST(KnownAnswer, GlassFilledWithAScatteringMediumMatchesARandomWalk) {
 }
 
 // A medium filling `holder` two units deep (y from 0 to 2) over a grey floor (y = 0.01), lit by
-// a point light at (0.5, lightY, 0), seen straight down from above by a 16x16 camera, with two
-// bounces. Such a path samples the light once, at its first vertex inside: where it scatters in
-// the medium or where it meets the floor (the crossing into glass or a boundary is the other
-// bounce). So the image is the medium's single scattering along the view ray plus the floor's
-// direct light, each leg dimmed where it runs inside.
-Scene mediumOverAFloor(const Material& holder, float lightY, float intensity, float albedo) {
+// a point light at (0.5, lightY, 0), seen straight down from five units above by a 16x16 camera,
+// with two bounces. Such a path samples the light once, at its first vertex inside: where it
+// scatters in the medium or where it meets the floor (the crossing into glass or a boundary is
+// the other bounce). So the image is the medium's single scattering along the view ray plus the
+// floor's direct light, each leg dimmed where it runs inside. `everywhere`: the holder's medium
+// fills the world instead (Environment::mediumAbsorption and on), with one bounce, as there is
+// no crossing.
+Scene mediumOverAFloor(const Material& holder, float lightY, float intensity, float albedo, bool everywhere = false) {
   Scene s = test::emptyScene(16, 16);
   lookStraightDown(s, 5, 1);
-  s.settings.maxBounces = 2;
-  test::addMeshObject(s, "holder", makeCube(), test::addMaterial(s, holder), Mat4::translate({0, 1, 0}) * Mat4::scale({40, 2, 40}));
+  s.settings.maxBounces = everywhere ? 1 : 2;
+  if (everywhere) {
+    s.environment.mediumAbsorption = holder.interiorAbsorption;
+    s.environment.mediumScattering = holder.interiorScattering;
+    s.environment.mediumAnisotropy = holder.interiorAnisotropy;
+  } else {
+    test::addMeshObject(s, "holder", makeCube(), test::addMaterial(s, holder), Mat4::translate({0, 1, 0}) * Mat4::scale({40, 2, 40}));
+  }
   Material grey;
   grey.albedo = Vec3{albedo};
   test::addMeshObject(s, "floor", makeQuad(), test::addMaterial(s, grey), Mat4::translate({0, 0.01f, 0}) * Mat4::scale({4, 1, 4}));
@@ -237,35 +245,43 @@ Scene mediumOverAFloor(const Material& holder, float lightY, float intensity, fl
 
 // What mediumOverAFloor's image should be in a channel of extinction sigmaT and scattering
 // sigmaS: the single scattering integrated by Simpson's rule (in *single), plus the floor's light.
-double overAFloorExpected(double sigmaT, double sigmaS, double g, double lightY, double intensity, double albedo, double* single) {
-  // Of the leg from height y to the light, the part inside (below y = 2).
-  auto inside = [&](double y, double dist) { return lightY <= 2 ? dist : dist * (2 - y) / (lightY - y); };
+// The medium reaches up to `top` (5 where it fills the world, up to the camera); above it, the
+// world's medium absorbs `world`.
+double overAFloorExpected(double sigmaT, double sigmaS, double g, double lightY, double intensity, double albedo, double* single,
+                          double top = 2, double world = 0) {
+  // A leg from height y to the light, dimmed by the medium inside (below the top) and the world's outside.
+  auto dimmed = [&](double y, double dist) {
+    const double inside = lightY <= top ? dist : dist * (top - y) / (lightY - y);
+    return std::exp(-sigmaT * inside - world * (dist - inside));
+  };
   auto scattered = [&](double below) {  // `below` the top, on the view ray
-    const double y = 2 - below, up = lightY - y, r2 = 0.25 + up * up, dist = std::sqrt(r2), cosTheta = -up / dist;
+    const double y = top - below, up = lightY - y, r2 = 0.25 + up * up, dist = std::sqrt(r2), cosTheta = -up / dist;
     const double term = 1 + g * g - 2 * g * cosTheta;
     const double phase = (1 - g * g) / (4 * kPi * term * std::sqrt(term));
-    return sigmaS * std::exp(-sigmaT * below) * phase * intensity * std::exp(-sigmaT * inside(y, dist)) / r2;
+    return sigmaS * std::exp(-sigmaT * below) * phase * intensity * dimmed(y, dist) / r2;
   };
-  const double depth = 1.99;
+  const double above = std::exp(-world * (5 - top));  // the view ray down from the camera to the top
+  const double depth = top - 0.01;
   const int steps = 20000;
   double sum = scattered(0) + scattered(depth);
   for (int i = 1; i < steps; ++i) sum += (i % 2 ? 4 : 2) * scattered(depth * i / steps);
-  *single = sum * depth / steps / 3;
+  *single = above * sum * depth / steps / 3;
   const double up = lightY - 0.01, toLight = std::sqrt(0.25 + up * up);
-  return *single + std::exp(-sigmaT * depth) * albedo / kPi * intensity * (up / toLight) / (toLight * toLight) *
-                       std::exp(-sigmaT * inside(0.01, toLight));
+  return *single + above * std::exp(-sigmaT * depth) * albedo / kPi * intensity * (up / toLight) / (toLight * toLight) * dimmed(0.01, toLight);
 }
 
-// mediumOverAFloor in a medium that absorbs (0.2, 0.5, 0) and scatters (0.5, 0.3, 0), rendered
-// at 256 spp, against overAFloorExpected within 2 %.
-void expectOverAFloor(Renderer& r, const Material& holder, float lightY, float intensity) {
+// mediumOverAFloor in the holder's medium (kOverAFloorAbsorption and kOverAFloorScattering in the
+// tests), rendered at 256 spp, against overAFloorExpected within 2 %; `world` absorbing around it.
+void expectOverAFloor(Renderer& r, const Material& holder, float lightY, float intensity, bool everywhere = false, float world = 0) {
   const Vec3 sigmaA = holder.interiorAbsorption, sigmaS = holder.interiorScattering;
   const float albedo = 0.8f;
-  RenderImage img = renderScene(r, mediumOverAFloor(holder, lightY, intensity, albedo), 256);
+  Scene s = mediumOverAFloor(holder, lightY, intensity, albedo, everywhere);
+  if (world > 0) s.environment.mediumAbsorption = Vec3{world};
+  RenderImage img = renderScene(r, s, 256);
   for (int c = 0; c < 3; ++c) {
     double single = 0;
-    const double expected =
-        overAFloorExpected(sigmaA[c] + sigmaS[c], sigmaS[c], holder.interiorAnisotropy, lightY, intensity, albedo, &single);
+    const double expected = overAFloorExpected(sigmaA[c] + sigmaS[c], sigmaS[c], holder.interiorAnisotropy, lightY, intensity,
+                                               albedo, &single, everywhere ? 5 : 2, world);
     double mean = 0;
     for (int i = 0; i < 16 * 16; ++i) mean += img.color[3 * i + c] / 256.0;
     EXPECT_NEAR(mean, expected, 0.02 * expected) << "channel " << c << ": single scattering " << single;
@@ -367,6 +383,57 @@ TEST(KnownAnswer, ALightOutsideABoundaryLightsTheMediumInside) {
   // its way out counts, the rest does not. The third channel is empty: the floor's light alone.
   RETILE_RENDERER_OR_SKIP(r);
   expectOverAFloor(*r, boundaryOf(kOverAFloorAbsorption, kOverAFloorScattering, -0.3f), 3, 40);
+}
+
+TEST(KnownAnswer, TheWorldsMediumDimsWhatTheCameraSeesAndHidesTheSky) {
+  // The world filled with a medium that absorbs sigma (Environment::mediumAbsorption), before a
+  // sky of 1: the sky is infinitely far, so it shows in the channel that does not absorb alone.
+  // A lit wall ten units ahead shows exp(-10 sigma); with a slab of empty glass one unit thick
+  // between, exp(-9 sigma) (out of the glass, the path is back in the world's medium); from inside
+  // a fog box (a boundary) two units from its walls, exp(-2 fog - 7 sigma): the camera starts in
+  // the fog (mediaAround) and goes on into the world's medium.
+  RETILE_RENDERER_OR_SKIP(r);
+  const Vec3 sigma{0.1f, 0.3f, 0.0f}, fog{0.2f, 0.05f, 0.5f};
+  Scene s = test::emptyScene(32, 32);
+  s.camera = test::frontCamera(10);
+  s.environment.color = Vec3{1.0f};
+  s.environment.mediumAbsorption = sigma;
+  auto expectCentre = [&](Vec3 expected, const char* what) {
+    RenderImage img = renderScene(*r, s, 4);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.color[3 * (16 * 32 + 16) + c], expected[c], 2e-3) << what << ", channel " << c;
+  };
+  expectCentre(Vec3{0, 0, 1}, "the sky");
+  Material light;
+  light.albedo = Vec3{0.0f};
+  light.emission = Vec3{1.0f};
+  test::addMeshObject(s, "light", makeCube(), test::addMaterial(s, light), Mat4::translate({0, 0, -10.5f}) * Mat4::scale({40, 40, 1}));
+  auto beer = [](Vec3 depth) { return Vec3{std::exp(-depth.x), std::exp(-depth.y), std::exp(-depth.z)}; };
+  expectCentre(beer(sigma * 10.0f), "a wall ten units ahead");
+  test::addMeshObject(s, "glass", makeCube(), test::addMaterial(s, filledGlass(Vec3{0.0f})), Mat4::translate({0, 0, -5}) * Mat4::scale({40, 40, 1}));
+  expectCentre(beer(sigma * 9.0f), "through empty glass");
+  test::addMeshObject(s, "fog", makeCube(), test::addMaterial(s, boundaryOf(fog)), Mat4::scale({4, 4, 4}));
+  expectCentre(beer(fog * 2.0f + sigma * 7.0f), "from inside a fog box");
+  // The fog box grown round the glass too (z from -7 to 1): into the glass from the fog and out,
+  // then out of the fog into the world's medium, which the path no longer remembers by then.
+  s.objects.back().transform = Mat4::translate({0, 0, -3}) * Mat4::scale({50, 50, 8});
+  expectCentre(beer(fog * 6.0f + sigma * 3.0f), "through glass in a fog box");
+}
+
+TEST(KnownAnswer, TheWorldsMediumScattersALightsLight) {
+  // The medium over the floor (mediumOverAFloor) fills the world instead: the camera's paths
+  // start in it, the view ray runs in it all the way down from the camera, and so does every leg
+  // to the light.
+  RETILE_RENDERER_OR_SKIP(r);
+  expectOverAFloor(*r, filledGlass(kOverAFloorAbsorption, kOverAFloorScattering, 0.5f), 1, 10, true);
+}
+
+TEST(KnownAnswer, ABoundaryInTheWorldsMediumTradesOneMediumForTheOther) {
+  // ALightOutsideABoundaryLightsTheMediumInside in a world that absorbs 0.15 in every channel:
+  // the view ray crosses three units of the world's medium to the boundary, and a shadow ray from
+  // inside runs in the boundary's medium up to its top and in the world's above it. In the third
+  // channel the boundary holds a vacuum inside the world's medium.
+  RETILE_RENDERER_OR_SKIP(r);
+  expectOverAFloor(*r, boundaryOf(kOverAFloorAbsorption, kOverAFloorScattering, -0.3f), 3, 40, false, 0.15f);
 }
 
 TEST(KnownAnswer, ClosedFurnaceWithBounceLimit) {

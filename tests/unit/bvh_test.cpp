@@ -758,6 +758,35 @@ TEST(RenderScene, TheCameraIsInTheMediumAroundIt) {
   builder.update(s, kUpdateInstances, nullptr);
   EXPECT_TRUE(builder.data().instanceTransforms);
   check(builder.data(), {2, -1, 0});
+
+  // With the world filled too, outside every holder is the world's medium, and so is what is
+  // around the outermost one.
+  const Vec3 haze{0.01f, 0.02f, 0.04f};
+  s.environment.mediumAbsorption = haze;
+  builder.update(s, kUpdateEnvironment, nullptr);
+  EXPECT_EQ(mediaAround(builder.data(), {0, 0, 20}).in.absorption, haze) << "outside everything";
+  EXPECT_EQ(mediaAround(builder.data(), {0, 0, 20}).around.absorption, haze);
+  EXPECT_EQ(mediaAround(builder.data(), {0, 0, 0}).in.absorption, fogged);
+  EXPECT_EQ(mediaAround(builder.data(), {0, 0, 0}).around.absorption, haze) << "the fog is in the haze";
+  EXPECT_EQ(mediaAround(builder.data(), {2, -1, 0}).around.absorption, fogged);
+  // A world's medium and nothing that holds one: no rays need be cast.
+  Scene open = test::emptyScene(8, 8);
+  test::addMeshObject(open, "wall", makeCube(), test::addMaterial(open, Material{}), Mat4::identity());
+  open.environment.mediumScattering = Vec3{0.5f};
+  open.environment.mediumAnisotropy = 0.4f;
+  RenderSceneBuilder openBuilder;
+  openBuilder.update(open, kUpdateAll, nullptr);
+  const MediaAround inOpen = mediaAround(openBuilder.data(), {0, 0, 5});
+  EXPECT_EQ(inOpen.in.scattering, Vec3(0.5f));
+  EXPECT_FLOAT_EQ(inOpen.in.anisotropy, 0.4f);
+  EXPECT_EQ(inOpen.around.scattering, Vec3(0.5f));
+  // Nor need the sky be sampled for light through a medium that dims every channel of it.
+  open.environment.color = Vec3{1.0f};
+  openBuilder.update(open, kUpdateEnvironment, nullptr);
+  EXPECT_EQ(openBuilder.data().lightPick[1], 0.0f);
+  open.environment.mediumScattering = Vec3{0.5f, 0.5f, 0.0f};
+  openBuilder.update(open, kUpdateEnvironment, nullptr);
+  EXPECT_GT(openBuilder.data().lightPick[1], 0.0f) << "the third channel sees the sky";
 }
 
 // The volumetric caustic's set-up: gas in a box of plain walls, closed by one boundary quad.

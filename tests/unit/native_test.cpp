@@ -112,6 +112,9 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   s.materials[1].type = MaterialType::Boundary;
   s.environment.orientation = Mat4::rotateZ(0.3f) * Mat4::rotateX(-1.2f);
   s.environment.rotation = 0.7f;
+  s.environment.mediumAbsorption = Vec3{0.01f, 0.02f, 0.03f};
+  s.environment.mediumScattering = Vec3{0.2f, 0.1f, 0.05f};
+  s.environment.mediumAnisotropy = 0.35f;
   s.lights.push_back(Light{s.newId(), "Key", LightType::Spot, {1, 0.9f, 0.8f}, 3.5f, {1, 2, 3}, {0, -1, 0}, 0.4f, 0.2f, true});
   s.lights.push_back(Light{s.newId(), "Sun", LightType::Directional, {1, 1, 1}, 2.0f, {}, {0, -1, 1}, 0.5f, 0.1f, true, 0.01f});
   auto dir = test::tempDir();
@@ -148,6 +151,9 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.materials[0].coatAbsorption, Vec3(0.01f, 0.02f, 0.03f));
   EXPECT_EQ(back->scene.environment.orientation, s.environment.orientation);
   EXPECT_EQ(back->scene.environment.rotation, 0.7f);
+  EXPECT_EQ(back->scene.environment.mediumAbsorption, Vec3(0.01f, 0.02f, 0.03f));
+  EXPECT_EQ(back->scene.environment.mediumScattering, Vec3(0.2f, 0.1f, 0.05f));
+  EXPECT_EQ(back->scene.environment.mediumAnisotropy, 0.35f);
   // Saving what was loaded gives the same bytes.
   EXPECT_EQ(nativeSceneToString(s), nativeSceneToString(back->scene));
 }

@@ -183,15 +183,15 @@ TEST(Tungsten, WhatIsNotRenderedIsNamedInAWarning) {
         {"type": "cube", "name": "both", "bsdf": ["a", "b"], "emission": 1}]})"));
   ASSERT_TRUE(r.ok()) << r.error();
   EXPECT_EQ(r->scene.objects.size(), 2u);
-  int media = 0, camera = 0, bsdfs = 0;
+  int media = 0, bsdfs = 0;
   for (const auto& w : r->warnings) {
     media += w.find("the medium 'gas' is rendered only inside glass") != std::string::npos;
-    camera += w.find("camera: the medium 'gas' it sits in is rendered only inside glass or a forward boundary, and nothing holds it") != std::string::npos;
     bsdfs += w.find("primitives[1]: 2 bsdfs by material index") != std::string::npos;
   }
   EXPECT_EQ(media, 1);
-  EXPECT_EQ(camera, 1);
   EXPECT_EQ(bsdfs, 1);
+  // The camera's gas, which nothing holds, is the world's medium instead.
+  EXPECT_EQ(r->scene.environment.mediumScattering, Vec3(1.0f));
 }
 
 // The material of the imported object of that name (a failure, and a default material, when there
@@ -250,6 +250,39 @@ TEST(Tungsten, AForwardSurfaceBoundsItsMedium) {
     EXPECT_EQ(w.find("'gas' around it"), std::string::npos) << "the front holds the gas: " << w;
     EXPECT_EQ(w.find("camera:"), std::string::npos) << "the camera is in the gas the front holds: " << w;
   }
+}
+
+TEST(Tungsten, ACameraMediumNothingHoldsFillsTheWorld) {
+  // Fog everywhere: the camera's medium, which no glass or boundary holds, and the glass's
+  // ext_medium, becomes the world's (Environment::medium...), with no warning. An ext_medium
+  // that is neither held nor the camera's is still warned of, and so is an undefined camera medium.
+  auto r = importTungsten(writeScene(R"({"camera": {"medium": "fog"}, "media": [
+        {"name": "fog", "type": "homogeneous", "sigma_a": 0.02, "sigma_s": [0.1, 0.2, 0.3], "density": 2,
+         "phase_function": {"type": "henyey_greenstein", "g": 0.6}},
+        {"name": "ink", "type": "homogeneous", "sigma_a": 1}],
+      "bsdfs": [{"name": "glass", "type": "dielectric", "ior": 1.5}],
+      "primitives": [
+        {"type": "sphere", "name": "lens", "bsdf": "glass", "ext_medium": "fog"},
+        {"type": "sphere", "name": "drop", "bsdf": "glass", "ext_medium": "ink"}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Environment& e = r->scene.environment;
+  EXPECT_TRUE(e.filled());
+  EXPECT_EQ(e.mediumAbsorption, Vec3(0.04f));
+  EXPECT_EQ(e.mediumScattering, Vec3(0.2f, 0.4f, 0.6f));
+  EXPECT_FLOAT_EQ(e.mediumAnisotropy, 0.6f);
+  int fog = 0, ink = 0;
+  for (const auto& w : r->warnings) {
+    fog += w.find("'fog'") != std::string::npos;
+    ink += w.find("the medium 'ink' around it") != std::string::npos;
+  }
+  EXPECT_EQ(fog, 0);
+  EXPECT_EQ(ink, 1);
+
+  auto undefined = importTungsten(writeScene(R"({"camera": {"medium": "smoke"}, "primitives": [{"type": "quad", "emission": 1}]})"));
+  ASSERT_TRUE(undefined.ok()) << undefined.error();
+  EXPECT_FALSE(undefined->scene.environment.filled());
+  EXPECT_TRUE(std::any_of(undefined->warnings.begin(), undefined->warnings.end(),
+                          [](const std::string& w) { return w.find("camera: the medium 'smoke' is not defined") != std::string::npos; }));
 }
 
 // The imported material of that name (a failure, and a default material, when there is none).

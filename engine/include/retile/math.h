@@ -51,6 +51,7 @@ constexpr Vec3 min(Vec3 a, Vec3 b) { return {std::min(a.x, b.x), std::min(a.y, b
 constexpr Vec3 max(Vec3 a, Vec3 b) { return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)}; }
 inline bool isFinite(Vec3 a) { return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z); }
 constexpr float maxComponent(Vec3 a) { return std::max(a.x, std::max(a.y, a.z)); }
+constexpr float minComponent(Vec3 a) { return std::min(a.x, std::min(a.y, a.z)); }
 constexpr float luminance(Vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 constexpr float kPi = 3.14159265358979323846f;

@@ -268,6 +268,18 @@ struct Environment {
   Vec3 zenith{0.35f, 0.55f, 0.95f};   // Sky: a gradient from zenith to horizon, ground below
   Vec3 horizon{0.9f, 0.92f, 0.95f};
   Vec3 ground{0.3f, 0.28f, 0.25f};
+  // The medium that fills the world outside every glass and boundary (fog, haze; a Tungsten
+  // camera's medium that nothing holds), as Material::interiorAbsorption and on: absorption and
+  // scattering per unit of length, and the phase function's asymmetry. A path that leaves glass
+  // or a boundary with no medium around it remembered is back in this one. Where it absorbs or
+  // scatters, no light from the environment (sky, map or sun) gets through: that light comes
+  // from infinitely far through it.
+  Vec3 mediumAbsorption{0.0f}, mediumScattering{0.0f};
+  float mediumAnisotropy = 0.0f;
+  bool filled() const {
+    return isFinite(mediumAbsorption) && isFinite(mediumScattering) &&
+           (maxComponent(mediumAbsorption) > 0 || maxComponent(mediumScattering) > 0);
+  }
 };
 
 // World directions to the environment map's frame: `orientation`'s rotation, turned by `rotation`

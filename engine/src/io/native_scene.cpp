@@ -207,6 +207,9 @@ Value nativeSceneToJson(const Scene& s) {
   env.set("zenith", json::fromVec3(e.zenith));
   env.set("horizon", json::fromVec3(e.horizon));
   env.set("ground", json::fromVec3(e.ground));
+  env.set("medium_absorption", json::fromVec3(e.mediumAbsorption));
+  env.set("medium_scattering", json::fromVec3(e.mediumScattering));
+  env.set("medium_anisotropy", e.mediumAnisotropy);
   root.set("environment", env);
 
   json::Array meshes;
@@ -417,6 +420,9 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
     r.vec3("zenith", &e.zenith);
     r.vec3("horizon", &e.horizon);
     r.vec3("ground", &e.ground);
+    r.vec3("medium_absorption", &e.mediumAbsorption);
+    r.vec3("medium_scattering", &e.mediumScattering);
+    r.number("medium_anisotropy", &e.mediumAnisotropy);
   }
   auto list = [&](const char* key) -> const json::Array* {
     const Value* v = root.find(key);

@@ -92,6 +92,7 @@ class TungstenImporter {
         const Value& medium = m->asArray()[i];
         if (!medium.isObject()) continue;
         const std::string name = string(medium, "name", "?");
+        mediaNamed_.insert(name);
         std::string why;
         if (auto filling = mediumFilling(medium, name, &why)) media_[name] = *filling;
         else warn(cat("media: '", name, "' is not rendered (", why, "); light travels through it as through a vacuum"));
@@ -102,11 +103,21 @@ class TungstenImporter {
       primitives_ = p;
       for (std::size_t i = 0; i < p->asArray().size() && ok(); ++i) primitive(p->asArray()[i], cat("primitives[", i, "]"));
       if (!focusPivot_.empty() && ok()) focusOn(*p);
-      if (!cameraMedium_.empty() && !inside_.count(cameraMedium_))
-        warn(cat("camera: the medium '", cameraMedium_, "' it sits in is rendered only inside glass or a forward boundary, and nothing holds it; light reaches it as through a vacuum"));
+      // A camera's medium that nothing holds is everywhere else: the world's. One that something
+      // holds is found by the camera's position (render_scene.h mediaAround).
+      std::string world;
+      if (!cameraMedium_.empty() && !inside_.count(cameraMedium_) && media_.count(cameraMedium_)) {
+        world = cameraMedium_;
+        const Filling& f = media_[world];
+        s.environment.mediumAbsorption = f.absorption;
+        s.environment.mediumScattering = f.scattering;
+        s.environment.mediumAnisotropy = f.anisotropy;
+      } else if (!cameraMedium_.empty() && !inside_.count(cameraMedium_) && !mediaNamed_.count(cameraMedium_)) {
+        warn(cat("camera: the medium '", cameraMedium_, "' is not defined; the camera is in a vacuum"));
+      }
       for (const auto& [where, name] : outside_)
-        if (!inside_.count(name))
-          warn(cat(where, ": the medium '", name, "' around it is rendered only inside glass or a forward boundary (an int_medium), and nothing holds it; light passes through it"));
+        if (!inside_.count(name) && name != world)
+          warn(cat(where, ": the medium '", name, "' around it is rendered only inside glass or a forward boundary (an int_medium) or around the camera, and neither holds it; light passes through it"));
     }
     // Not Tungsten's own key, but Bitterli's living room names its sky this way (an envmap; the
     // room has no other light). Tungsten renders these files without a `constant` entry: the
@@ -1250,6 +1261,7 @@ class TungstenImporter {
     return f;
   }
   std::map<std::string, Filling> media_;  // homogeneous media by name
+  std::set<std::string> mediaNamed_;      // every medium's name, rendered or not
   std::set<std::string> inside_;  // the media some glass or boundary holds
   std::string cameraMedium_;      // the camera's
   std::vector<std::pair<std::string, std::string>> outside_;  // where an ext_medium is named, and the name

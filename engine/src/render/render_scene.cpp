@@ -634,6 +634,13 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     data_.materials.insert(data_.materials.end(), texels.begin(), texels.end());
   };
   for (const Material& m : scene.materials) pack(m);
+  // The world's medium compiles the same kernel code in as a material's (trace.comp RETILE_MEDIUM).
+  const Environment& env = scene.environment;
+  data_.worldMedium = env.filled() ? MediumAt{max(env.mediumAbsorption, Vec3{0.0f}), max(env.mediumScattering, Vec3{0.0f}),
+                                               std::clamp(env.mediumAnisotropy, -0.99f, 0.99f)}
+                                   : MediumAt{};
+  if (env.filled()) data_.materialTypes |= 1u << gpu::kMaskMedium;
+  if (env.filled() && maxComponent(env.mediumScattering) > 0) data_.materialTypes |= 1u << gpu::kMaskScattering;
   defaultMaterial_ = static_cast<int>(data_.materials.size() / gpu::kMaterialTexels);
   Material fallback;
   fallback.albedo = Vec3{0.6f};
@@ -641,12 +648,16 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
 }
 
 MediaAround mediaAround(const RenderSceneData& d, Vec3 point) {
-  if (!(d.materialTypes & (1u << gpu::kMaskMedium)) || d.tlasRoot < 0) return {};
+  // Outside every holder is the world's medium. Glass holds a vacuum at least, so where the world
+  // has a medium, empty glass counts too.
+  const MediaAround outside{d.worldMedium, d.worldMedium};
+  constexpr std::uint32_t kHolders = 1u << gpu::kMatDielectric | 1u << gpu::kMatRoughDielectric | 1u << gpu::kMatBoundary;
+  if (!(d.materialTypes & (1u << gpu::kMaskMedium)) || !(d.materialTypes & kHolders) || d.tlasRoot < 0) return outside;
   const bool transforms = d.instanceTransforms;
   const bool direct = d.directReferences && !transforms;
   auto intOf = [](float f) { return std::bit_cast<std::int32_t>(f); };
   auto mediumOf = [&](std::int32_t material) {
-    if (material < 0) return MediumAt{};
+    if (material < 0) return d.worldMedium;
     const std::size_t mbase = static_cast<std::size_t>(material) * gpu::kMaterialTexels;
     const vec4 &interior = d.materials[mbase + 8], &scattering = d.materials[mbase + 9];
     return MediumAt{{interior.x, interior.y, interior.z}, {scattering.x, scattering.y, scattering.z}, scattering.w};
@@ -734,7 +745,7 @@ MediaAround mediaAround(const RenderSceneData& d, Vec3 point) {
     return best;
   };
   const std::int32_t inner = mostLeft(&Left::first, -1);
-  return {mediumOf(inner), inner < 0 ? MediumAt{} : mediumOf(mostLeft(&Left::second, inner))};
+  return inner < 0 ? outside : MediaAround{mediumOf(inner), mediumOf(mostLeft(&Left::second, inner))};
 }
 
 namespace {
@@ -1355,7 +1366,9 @@ void RenderSceneBuilder::choosePickProbabilities(const Scene&) {
   // Rough powers; every present kind keeps at least 15 % so a weak but important light (a sky
   // through a small window) is never starved.
   float pe = data_.emitters.empty() ? 0.0f : std::max(emitterPower_, 1e-6f);
-  float pv = data_.environmentType == gpu::kEnvNone ? 0.0f : std::max(environmentPower_ * kPi * radius * radius, 1e-6f);
+  // No light from the environment gets through a world's medium that dims every channel.
+  const bool skyHidden = minComponent(data_.worldMedium.absorption + data_.worldMedium.scattering) > 0;
+  float pv = data_.environmentType == gpu::kEnvNone || skyHidden ? 0.0f : std::max(environmentPower_ * kPi * radius * radius, 1e-6f);
   float pd = data_.deltaLights.empty() ? 0.0f : std::max(deltaPower_, 1e-6f);
   float sum = pe + pv + pd;
   float p[3] = {0, 0, 0};

@@ -57,6 +57,12 @@ enum DirtyArrays : std::uint32_t {
   kDirtyAllArrays = 0xffu,
 };
 
+// A homogeneous medium as the kernel holds it (Material::interiorAbsorption and on).
+struct MediumAt {
+  Vec3 absorption{0.0f}, scattering{0.0f};
+  float anisotropy = 0;
+};
+
 struct RenderSceneData {
   // The traversal buffer (layouts.h), in two parts so that moving an object re-uploads only the
   // second: every triangle then every mesh BVH; the instance BVH then the instance records. Its
@@ -84,6 +90,7 @@ struct RenderSceneData {
   int environmentWidth = 0, environmentHeight = 0;
   Vec3 environmentTint{0.0f};
   Mat4 environmentToMap;               // world directions to the map's frame (a rotation)
+  MediumAt worldMedium;                // Environment::medium..., none unless filled()
   std::uint64_t triangleCount = 0;     // packed triangles: each mesh's once, and the copies of small shared ones
   std::uint64_t instancedTriangles = 0;
   bool alphaTested = false;            // some instance needs the cut-out test during traversal
@@ -103,19 +110,14 @@ struct RenderSceneData {
   std::uint64_t deviceBytes() const;
 };
 
-// A homogeneous medium as the kernel holds it (Material::interiorAbsorption and on).
-struct MediumAt {
-  Vec3 absorption{0.0f}, scattering{0.0f};
-  float anisotropy = 0;
-};
-
 // The medium a point (the camera) is in, and the one around that: those of the glass or
 // boundaries around it, found by fourteen rays through the packed scene (tracePacked), each
 // leaving by faces it did not enter by; a holder that most rays leave, of those that meet no
 // opaque surface first (all of them again, through walls, when none does). Two levels, as a path
-// keeps (trace.comp crossMedium). Up to 14 x 64 CPU traversals, so the renderer asks again only
-// when the camera or the scene changes; none when no material holds a medium (materialTypes). It
-// only reads `d`, which its owner (the render thread, see above) must not change meanwhile.
+// keeps (trace.comp crossMedium); where no holder is, the world's medium (worldMedium). Up to
+// 14 x 64 CPU traversals, so the renderer asks again only when the camera or the scene changes;
+// none without glass or boundaries, or without any medium (materialTypes). It only reads `d`,
+// which its owner (the render thread, see above) must not change meanwhile.
 struct MediaAround {
   MediumAt in, around;
 };

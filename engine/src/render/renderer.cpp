@@ -451,6 +451,9 @@ struct Renderer::Impl {
     u.cameraScattering = {in.scattering.x, in.scattering.y, in.scattering.z, in.anisotropy};
     u.cameraOuterAbsorption = {around.absorption.x, around.absorption.y, around.absorption.z, 0};
     u.cameraOuterScattering = {around.scattering.x, around.scattering.y, around.scattering.z, around.anisotropy};
+    const MediumAt& world = d.worldMedium;
+    u.worldAbsorption = {world.absorption.x, world.absorption.y, world.absorption.z, 0};
+    u.worldScattering = {world.scattering.x, world.scattering.y, world.scattering.z, world.anisotropy};
     std::uint32_t sel = countTile > 0 ? selectedInstance() : 0u;
     u.work = {itemCount, static_cast<std::uint32_t>(slots), sel, sel ? static_cast<std::uint32_t>(countTile) : 0u};
     // Tungsten draws its box exactly, and has no other filter the table could stand for.

@@ -159,8 +159,11 @@ Result<std::uint32_t> applyEdit(Scene& s, const Edit& edit) {
           [&](const SetEnvironment& e) -> Applied {
             const Environment& v = e.environment;
             if (!isFinite(v.color) || !std::isfinite(v.intensity) || !std::isfinite(v.rotation) ||
-                !isFinite(v.zenith) || !isFinite(v.horizon) || !isFinite(v.ground) || !v.orientation.isFinite())
+                !isFinite(v.zenith) || !isFinite(v.horizon) || !isFinite(v.ground) || !v.orientation.isFinite() ||
+                !isFinite(v.mediumAbsorption) || !isFinite(v.mediumScattering) || !std::isfinite(v.mediumAnisotropy))
               return fail("environment: a parameter is not a finite number");
+            if (minComponent(v.mediumAbsorption) < 0 || minComponent(v.mediumScattering) < 0 || std::abs(v.mediumAnisotropy) > 0.99f)
+              return fail("environment: the medium's absorption and scattering must not be negative, its anisotropy within -0.99..0.99");
             if (v.map != kNoNode && !s.texture(v.map)) return fail("environment: map texture does not exist");
             s.environment = v;
             return kUpdateEnvironment | kUpdateLights;

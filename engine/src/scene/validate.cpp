@@ -177,6 +177,9 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
   checkColor(env.zenith, Vec3{0.35f, 0.55f, 0.95f}, "sky zenith", warnings);
   checkColor(env.horizon, Vec3{0.9f, 0.92f, 0.95f}, "sky horizon", warnings);
   checkColor(env.ground, Vec3{0.3f, 0.28f, 0.25f}, "sky ground", warnings);
+  checkColor(env.mediumAbsorption, Vec3{0.0f}, "environment medium absorption", warnings);
+  checkColor(env.mediumScattering, Vec3{0.0f}, "environment medium scattering", warnings);
+  clampValue(env.mediumAnisotropy, -0.99f, 0.99f, 0.0f, "environment medium anisotropy", warnings);
 
   for (Texture& t : scene.textures) {
     clampInt(t.checkerResU, 1, 4096, cat("texture '", t.name, "': checker squares across"), warnings);
