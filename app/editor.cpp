@@ -6,6 +6,8 @@
 #include <QPixmap>
 #include <QScreen>
 #include <QTimer>
+#include <QTreeWidget>
+#include <QTreeWidgetItemIterator>
 
 #include "cli.h"
 #include "main_window.h"
@@ -53,12 +55,22 @@ int runEditor(int argc, char** argv, const std::string& file) {
     QObject::connect(timer, &QTimer::timeout, &window, [&window, settle, stage = 0]() mutable {
       std::uint64_t frames = window.engine()->framesRendered();
       if (stage == 0 && frames >= static_cast<std::uint64_t>(settle)) {
+        const QString wanted = qEnvironmentVariable("RETILE_SCREENSHOT_SELECT");
+        bool found = false;
         for (const Object& o : window.scene().objects)
-          if (o.name == qgetenv("RETILE_SCREENSHOT_SELECT").toStdString()) {
+          if (o.name == wanted.toStdString()) {
+            found = true;
             window.select(o.id);
             Object moved = o;
             moved.transform = Mat4::translate({0.0f, 0.08f, 0.0f}) * o.transform;
             window.edit(SetObject{o}, SetObject{moved}, QObject::tr("Move"));
+          }
+        // Anything else the outliner lists (a material, the camera, the environment): shown in Properties.
+        for (QTreeWidgetItemIterator it(window.outliner()); !found && !wanted.isEmpty() && *it; ++it)
+          if ((*it)->text(0) == wanted) {
+            found = true;
+            window.outliner()->clearSelection();
+            (*it)->setSelected(true);
           }
         stage = 1;
       } else if (stage >= 1 && ++stage > 6) {

@@ -243,6 +243,10 @@ struct Shadow {
 #endif
 };
 
+// Path::auxInstance once the path has scattered in a medium it did not enter by a boundary
+// before any hit: no object is what the pixel shows (writeSample writes 0).
+const int kPickedNothing = 0x7fffffff;
+
 uint primaryRays = 0u, bounceRays = 0u, shadowRays = 0u;
 
 // `found`: findItem(slot).
@@ -333,7 +337,8 @@ void writeSample(Path path, bool ended) {
   bool valid = !(any(isnan(path.L)) || any(isinf(path.L)));
   samples[path.slot] = valid ? vec4(path.L, ended ? 1.0 : 0.0) : vec4(0.0);
   aux[path.slot * kAuxVec4s] = vec4(path.auxAlbedo, path.auxDepth);
-  aux[path.slot * kAuxVec4s + 1u] = vec4(path.auxNormal, intBitsToFloat(abs(path.auxInstance)));
+  int picked = abs(path.auxInstance);
+  aux[path.slot * kAuxVec4s + 1u] = vec4(path.auxNormal, intBitsToFloat(picked == kPickedNothing ? 0 : picked));
   aux[path.slot * kAuxVec4s + 2u] = vec4(path.auxEmission, 0.0);
 }
 
@@ -362,11 +367,12 @@ void resolveShadow(inout Path path, inout Shadow shadow, Trace tr) {
   vec3 sigma = shadow.sigma + tr.crossedSigma;
   vec3 depth = tr.crossedDepth;
   if (shadow.dist >= kInfinity) {
-    // To a light at infinity, the medium the ray ends in must be none, up to rounding: none is
+    // To a light at infinity, the medium the ray ends in must be none: up to rounding, none is
     // left of the boundaries' (whose crossings count relative to the world's medium), and the
-    // world has none either.
+    // world, where every such ray ends, has none either, however thin.
     float rounding = 1e-5 * (maxComponent(shadow.sigma) + tr.crossedScale);
-    depth += mix(vec3(0.0), vec3(kInfinity), greaterThan(sigma, vec3(rounding)));
+    vec3 world = frame.worldAbsorption.xyz + frame.worldScattering.rgb;
+    depth += kInfinity * max(vec3(greaterThan(sigma, vec3(rounding))), vec3(greaterThan(world, vec3(0.0))));
   } else {
     depth += sigma * shadow.dist;
   }
@@ -448,7 +454,9 @@ bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, float h
   vec3 crossed = exp(-sigmaT * flight);
   float pdf = dot(sigmaT * crossed, vec3(1.0 / 3.0));
   path.travelled += flight;
-  path.auxInstance = abs(path.auxInstance);  // the medium's boundary, if the path came in by one
+  // The medium's boundary, if the path came in by one; else (the camera's or the world's medium)
+  // nothing: what the path meets after scattering is not what the pixel shows.
+  path.auxInstance = path.auxInstance == 0 ? kPickedNothing : abs(path.auxInstance);
   if (path.auxDepth >= kInfinity) {
     // The denoiser's guide: the medium's albedo where the path first scatters, facing back.
     path.auxAlbedo = path.beta * path.scattering.rgb / max(sigmaT, vec3(1e-30));

@@ -304,6 +304,31 @@ TEST(TracePass, AuxiliaryOutputsDescribeTheFirstHit) {
   EXPECT_NEAR(img.depth[c], 4.0f, 0.05f);
 }
 
+TEST(TracePass, FogPicksWhatIsSeenThroughItAndNothingBehindAScatter) {
+  // A wall four units away in a world of fog. Thin fog: most first samples reach the wall, which
+  // the pixel shows. Fog six mean free paths deep: nearly every path scatters first, and the
+  // pixel shows no object, although most scattered paths go on to meet the wall (before, they
+  // picked it). exp(-6) of 256 first samples is 0.6 reaching it.
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(16, 16);
+  s.camera = test::frontCamera(40);
+  s.settings.maxBounces = 64;
+  Material grey;
+  grey.albedo = Vec3{0.8f};
+  const NodeId wall = test::addMeshObject(s, "wall", makeQuad(), test::addMaterial(s, grey),
+                                          Mat4::translate({0, 0, -4}) * Mat4::rotateX(kPi / 2) * Mat4::scale({20, 1, 20}));
+  auto wallPixels = [&](float scattering) {
+    s.environment.mediumScattering = Vec3{scattering};
+    r->setScene(s);
+    RenderRequest req;
+    req.samplesPerPixel = 4;
+    const RenderImage img = r->render(req);
+    return static_cast<int>(std::count(img.objectId.begin(), img.objectId.end(), wall));
+  };
+  EXPECT_GT(wallPixels(0.02f), 16 * 16 * 8 / 10) << "exp(-0.08): most first samples reach it";
+  EXPECT_LE(wallPixels(1.5f), 5) << "exp(-6): almost none do";
+}
+
 TEST(TracePass, SameSeedSameImageOtherSeedOtherNoise) {
   RETILE_RENDERER_OR_SKIP(r);
   Scene s = makeDefaultScene();

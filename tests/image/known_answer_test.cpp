@@ -419,6 +419,25 @@ TEST(KnownAnswer, TheWorldsMediumDimsWhatTheCameraSeesAndHidesTheSky) {
   expectCentre(beer(fog * 6.0f + sigma * 3.0f), "through glass in a fog box");
 }
 
+TEST(KnownAnswer, AThinHazeHidesTheSkyBehindABoundary) {
+  // The random-walk slab behind a boundary (AMediumInsideABoundaryMatchesARandomWalk) in a world
+  // haze of 1e-6 in the first two channels: however thin, it is infinitely deep towards the sky,
+  // so those channels are black, shadow rays that cross the boundary out to the sky included
+  // (the slab's 2 and 1.5 per unit crossed must not make the haze look like rounding). The third
+  // channel has no haze and keeps the walk's value.
+  RETILE_RENDERER_OR_SKIP(r);
+  const Vec3 sigmaA{0.0f, 0.5f, 1.0f}, sigmaS{2.0f, 1.0f, 1.5f};
+  Scene s = slabBeforeTheSky(boundaryOf(sigmaA, sigmaS, 0.7f), 4, 1024);
+  s.environment.mediumAbsorption = Vec3{1e-6f, 1e-6f, 0.0f};
+  RenderImage img = renderScene(*r, s, 64);
+  double mean[3] = {0, 0, 0};
+  for (int i = 0; i < 32 * 32; ++i)
+    for (int c = 0; c < 3; ++c) mean[c] += img.color[3 * i + c] / (32.0 * 32.0);
+  EXPECT_EQ(mean[0], 0.0);
+  EXPECT_EQ(mean[1], 0.0);
+  EXPECT_NEAR(mean[2], slabEscape(2.5, 0.6, 0.7, 400000), 0.01);
+}
+
 TEST(KnownAnswer, TheWorldsMediumScattersALightsLight) {
   // The medium over the floor (mediumOverAFloor) fills the world instead: the camera's paths
   // start in it, the view ray runs in it all the way down from the camera, and so does every leg

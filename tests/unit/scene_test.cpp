@@ -99,6 +99,17 @@ TEST(Document, EditsAdvanceTheVersionAndReportWhatChanged) {
   r = doc.apply(SetMaterial{m});
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(r.value(), static_cast<std::uint32_t>(kUpdateMaterials));
+
+  // The world's medium alone leaves the sky as it was: nothing to decode and pack again.
+  Environment fog = doc.scene().environment;
+  fog.mediumScattering = Vec3{0.1f};
+  r = doc.apply(SetEnvironment{fog});
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.value(), static_cast<std::uint32_t>(kUpdateMaterials | kUpdateLights));
+  fog.intensity *= 2;
+  r = doc.apply(SetEnvironment{fog});
+  ASSERT_TRUE(r.ok());
+  EXPECT_TRUE(r.value() & kUpdateEnvironment);
 }
 
 TEST(Document, BadEditsAreRefusedAndChangeNothing) {
@@ -125,6 +136,17 @@ TEST(Document, BadEditsAreRefusedAndChangeNothing) {
   RenderSettings rs;
   rs.width = 0;
   EXPECT_FALSE(doc.apply(SetRenderSettings{rs}).ok());
+  for (Vec3 bad : {Vec3{-0.1f, 0, 0}, Vec3{2e6f, 0, 0}, Vec3{std::nanf(""), 0, 0}}) {
+    Environment e = doc.scene().environment;
+    e.mediumAbsorption = bad;
+    EXPECT_FALSE(doc.apply(SetEnvironment{e}).ok()) << bad.x;
+    Material m = doc.scene().materials[0];
+    m.interiorScattering = bad;
+    EXPECT_FALSE(doc.apply(SetMaterial{m}).ok()) << bad.x;
+  }
+  Environment skew = doc.scene().environment;
+  skew.mediumAnisotropy = 1;
+  EXPECT_FALSE(doc.apply(SetEnvironment{skew}).ok());
   Material blend = doc.scene().materials[0];
   blend.blendWith = blend.id;
   EXPECT_FALSE(doc.apply(SetMaterial{blend}).ok()) << "not with itself";

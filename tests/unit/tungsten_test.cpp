@@ -277,6 +277,18 @@ TEST(Tungsten, ACameraMediumNothingHoldsFillsTheWorld) {
   }
   EXPECT_EQ(fog, 0);
   EXPECT_EQ(ink, 1);
+  // Glass holding ink in the fog, with no ext_medium: Tungsten's path leaves it into a vacuum,
+  // this one back into the fog, which the user is told.
+  auto held = importTungsten(writeScene(R"({"camera": {"medium": "fog"}, "media": [
+        {"name": "fog", "type": "homogeneous", "sigma_s": 0.1}, {"name": "ink", "type": "homogeneous", "sigma_a": 1}],
+      "bsdfs": [{"name": "glass", "type": "dielectric", "ior": 1.5}],
+      "primitives": [{"type": "sphere", "name": "bottle", "bsdf": "glass", "int_medium": "ink"},
+                     {"type": "sphere", "name": "jar", "bsdf": "glass", "int_medium": "ink", "ext_medium": "fog"}]})"));
+  ASSERT_TRUE(held.ok()) << held.error();
+  EXPECT_TRUE(std::any_of(held->warnings.begin(), held->warnings.end(), [](const std::string& w) {
+    return w.find("1 glass or boundary primitives with a medium inside name another ext_medium than the camera's 'fog', the first primitives[0] (none)") !=
+           std::string::npos;
+  }));
 
   auto undefined = importTungsten(writeScene(R"({"camera": {"medium": "smoke"}, "primitives": [{"type": "quad", "emission": 1}]})"));
   ASSERT_TRUE(undefined.ok()) << undefined.error();

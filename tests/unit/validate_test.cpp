@@ -99,6 +99,9 @@ TEST(Validate, ValuesOutsideTheirRangesAreClampedOrReset) {
   sun.angularRadius = kNaN;
   s.lights.push_back(sun);
   s.environment.color = {kInf, 0, 0};
+  s.environment.mediumAbsorption = {kNaN, 0, 0};
+  s.environment.mediumScattering = {1e9f, 0.5f, 0};
+  s.environment.mediumAnisotropy = -3;
   s.settings.width = 0;
   s.settings.height = 1000000;
   s.settings.samplesPerPixel = -3;
@@ -117,6 +120,10 @@ TEST(Validate, ValuesOutsideTheirRangesAreClampedOrReset) {
   EXPECT_LE(s.lights[0].spotAngle, 1.5707964f);
   EXPECT_EQ(s.lights[1].angularRadius, 0.0f);
   EXPECT_EQ(s.environment.color, Vec3(0.0f));
+  EXPECT_EQ(s.environment.mediumAbsorption, Vec3(0.0f));
+  EXPECT_EQ(s.environment.mediumScattering, Vec3(kMaxExtinction, 0.5f, 0.0f)) << "capped, not reset";
+  EXPECT_EQ(s.environment.mediumAnisotropy, -0.99f);
+  EXPECT_TRUE(mentions(warnings, "environment medium scattering is above"));
   EXPECT_EQ(s.settings.width, 1);
   EXPECT_EQ(s.settings.height, kMaxImageSide);
   EXPECT_EQ(s.settings.samplesPerPixel, 1);

@@ -119,6 +119,9 @@ constexpr bool hasRoughness(MaterialType t) {
 
 // Materials a hit follows through blends, the first included (Material::blendWith).
 constexpr int kMaxBlendChain = 4;
+// The densest medium (absorption or scattering per unit of length) a scene may hold: beyond it
+// the kernel's sums of extinction times distance would overflow to infinity and then NaN.
+constexpr float kMaxExtinction = 1e6f;
 
 struct Material {
   NodeId id = kNoNode;
@@ -280,6 +283,7 @@ struct Environment {
     return isFinite(mediumAbsorption) && isFinite(mediumScattering) &&
            (maxComponent(mediumAbsorption) > 0 || maxComponent(mediumScattering) > 0);
   }
+  friend bool operator==(const Environment&, const Environment&) = default;
 };
 
 // World directions to the environment map's frame: `orientation`'s rotation, turned by `rotation`

@@ -112,6 +112,15 @@ class TungstenImporter {
         s.environment.mediumAbsorption = f.absorption;
         s.environment.mediumScattering = f.scattering;
         s.environment.mediumAnisotropy = f.anisotropy;
+        // Leaving a holder, Tungsten's path goes into the holder's ext_medium (a vacuum when it
+        // names none); here it goes back to the medium it came from, usually the world's.
+        std::size_t elsewhere = 0;
+        std::string first;
+        for (const auto& [where, ext] : holders_)
+          if (ext != world && elsewhere++ == 0) first = cat(where, " (", ext.empty() ? "none" : cat("'", ext, "'"), ")");
+        if (elsewhere > 0)
+          warn(cat(elsewhere, " glass or boundary primitives with a medium inside name another ext_medium than the camera's '", world,
+                   "', the first ", first, "; a path that leaves one goes back to the medium it came from"));
       } else if (!cameraMedium_.empty() && !inside_.count(cameraMedium_) && !mediaNamed_.count(cameraMedium_)) {
         warn(cat("camera: the medium '", cameraMedium_, "' is not defined; the camera is in a vacuum"));
       }
@@ -1145,7 +1154,10 @@ class TungstenImporter {
           warn(cat(where, ": a boundary of '", medium, "' inside the medium '", name,
                    "': a path inside it is in '", medium, "' alone, but its shadow rays count both"));
       }
-      if (!medium.empty()) inside_.insert(medium);
+      if (!medium.empty()) {
+        inside_.insert(medium);
+        holders_.emplace_back(where, string(p, "ext_medium"));
+      }
       if ((bumpTexture != kNoNode || !medium.empty()) && !emissive) {
         // Primitives naming the same bsdf with the same bump and medium share one copy; an
         // inline bsdf is the primitive's own (two unnamed ones must not meet under the empty name).
@@ -1263,6 +1275,7 @@ class TungstenImporter {
   std::map<std::string, Filling> media_;  // homogeneous media by name
   std::set<std::string> mediaNamed_;      // every medium's name, rendered or not
   std::set<std::string> inside_;  // the media some glass or boundary holds
+  std::vector<std::pair<std::string, std::string>> holders_;  // where a medium is held, and the ext_medium named there
   std::string cameraMedium_;      // the camera's
   std::vector<std::pair<std::string, std::string>> outside_;  // where an ext_medium is named, and the name
 };

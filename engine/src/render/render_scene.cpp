@@ -1178,8 +1178,11 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
   // angle would underflow in the radiance's division.
   auto isSun = [](const Light& l) { return l.type == LightType::Directional && l.angularRadius > 1e-4f; };
   std::vector<const Light*> lights;  // suns first: rays that leave the scene look for them alone
+  // Through a world's medium that dims every channel, no light from infinitely far gets through.
+  const bool skyHidden = data_.worldMedium.dimsEveryChannel();
   for (const Light& l : scene.lights)
-    if (l.visible && l.intensity > 0 && maxComponent(l.color) > 0) lights.push_back(&l);
+    if (l.visible && l.intensity > 0 && maxComponent(l.color) > 0 && !(skyHidden && l.type == LightType::Directional))
+      lights.push_back(&l);
   std::stable_partition(lights.begin(), lights.end(), [&](const Light* l) { return isSun(*l); });
   for (const Light* light : lights) {
     const Light& l = *light;
@@ -1367,8 +1370,7 @@ void RenderSceneBuilder::choosePickProbabilities(const Scene&) {
   // through a small window) is never starved.
   float pe = data_.emitters.empty() ? 0.0f : std::max(emitterPower_, 1e-6f);
   // No light from the environment gets through a world's medium that dims every channel.
-  const bool skyHidden = minComponent(data_.worldMedium.absorption + data_.worldMedium.scattering) > 0;
-  float pv = data_.environmentType == gpu::kEnvNone || skyHidden ? 0.0f : std::max(environmentPower_ * kPi * radius * radius, 1e-6f);
+  float pv = data_.environmentType == gpu::kEnvNone || data_.worldMedium.dimsEveryChannel() ? 0.0f : std::max(environmentPower_ * kPi * radius * radius, 1e-6f);
   float pd = data_.deltaLights.empty() ? 0.0f : std::max(deltaPower_, 1e-6f);
   float sum = pe + pv + pd;
   float p[3] = {0, 0, 0};

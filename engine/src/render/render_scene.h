@@ -61,6 +61,8 @@ enum DirtyArrays : std::uint32_t {
 struct MediumAt {
   Vec3 absorption{0.0f}, scattering{0.0f};
   float anisotropy = 0;
+  // Nothing from infinitely far gets through it in any channel.
+  bool dimsEveryChannel() const { return minComponent(absorption + scattering) > 0; }
 };
 
 struct RenderSceneData {

@@ -20,12 +20,22 @@ Applied fail(const std::string& message) { return Applied::failure(message); }
 
 bool finite(float v) { return std::isfinite(v); }
 
+// A medium's fields (a material's interior, the world's): empty when they are in range.
+std::string checkMedium(Vec3 absorption, Vec3 scattering, float anisotropy) {
+  if (minComponent(absorption) < 0 || minComponent(scattering) < 0 || maxComponent(absorption) > kMaxExtinction ||
+      maxComponent(scattering) > kMaxExtinction || !(std::abs(anisotropy) <= 0.99f))
+    return cat("a medium's absorption and scattering must be within 0..", kMaxExtinction, ", its anisotropy within -0.99..0.99");
+  return {};
+}
+
 std::string checkMaterial(const Scene& s, const Material& m) {
   if (!isFinite(m.albedo) || !isFinite(m.emission) || !isFinite(m.eta) || !isFinite(m.k) || !isFinite(m.coatingAbsorption) ||
       !isFinite(m.coatAbsorption) || !finite(m.coatIor) || !isFinite(m.interiorAbsorption) || !isFinite(m.interiorScattering) || !finite(m.interiorAnisotropy) || !finite(m.coatRoughness) ||
       !finite(m.roughness) || !finite(m.ior) || !finite(m.alpha) || !finite(m.bumpStrength) || !finite(m.blendRatio) ||
       !finite(m.transmittance) || !finite(m.diffuseRatio))
     return cat("material '", m.name, "': a parameter is not a finite number");
+  if (auto why = checkMedium(m.interiorAbsorption, m.interiorScattering, m.interiorAnisotropy); !why.empty())
+    return cat("material '", m.name, "': ", why);
   if (m.blendWith != kNoNode && (m.blendWith == m.id || !s.material(m.blendWith)))
     return cat("material '", m.name, "': it cannot blend with material ", m.blendWith);
   for (NodeId t : m.textures())
@@ -162,11 +172,17 @@ Result<std::uint32_t> applyEdit(Scene& s, const Edit& edit) {
                 !isFinite(v.zenith) || !isFinite(v.horizon) || !isFinite(v.ground) || !v.orientation.isFinite() ||
                 !isFinite(v.mediumAbsorption) || !isFinite(v.mediumScattering) || !std::isfinite(v.mediumAnisotropy))
               return fail("environment: a parameter is not a finite number");
-            if (minComponent(v.mediumAbsorption) < 0 || minComponent(v.mediumScattering) < 0 || std::abs(v.mediumAnisotropy) > 0.99f)
-              return fail("environment: the medium's absorption and scattering must not be negative, its anisotropy within -0.99..0.99");
+            if (auto why = checkMedium(v.mediumAbsorption, v.mediumScattering, v.mediumAnisotropy); !why.empty())
+              return fail("environment: " + why);
             if (v.map != kNoNode && !s.texture(v.map)) return fail("environment: map texture does not exist");
+            // Only the medium changed (a drag in its fields): no sky to decode and pack again.
+            Environment sky = v;
+            sky.mediumAbsorption = s.environment.mediumAbsorption;
+            sky.mediumScattering = s.environment.mediumScattering;
+            sky.mediumAnisotropy = s.environment.mediumAnisotropy;
+            const bool skyChanged = !(sky == s.environment);
             s.environment = v;
-            return kUpdateEnvironment | kUpdateLights;
+            return (skyChanged ? kUpdateEnvironment : kUpdateMaterials) | kUpdateLights;
           },
           [&](const SetRenderSettings& e) -> Applied {
             if (auto why = checkSettings(e.settings); !why.empty()) return fail(why);

@@ -34,6 +34,14 @@ void checkColor(Vec3& c, Vec3 fallback, const std::string& what, std::vector<std
   c = fallback;
 }
 
+// A medium's absorption or scattering: a colour, at most kMaxExtinction per channel.
+void checkMedium(Vec3& c, const std::string& what, std::vector<std::string>& warnings) {
+  checkColor(c, Vec3{0.0f}, what, warnings);
+  if (maxComponent(c) <= kMaxExtinction) return;
+  warnings.push_back(cat(what, " is above ", kMaxExtinction, " per unit of length; capped there"));
+  c = min(c, Vec3{kMaxExtinction});
+}
+
 // Keeps the triangles whose three indices are in range and whose vertices are sane; drops the
 // vertices no kept triangle uses (so the mesh's bounds, and the camera framed from them, hold only
 // real geometry); drops normals and uvs that are not one per vertex or not finite.
@@ -143,8 +151,8 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
     clampValue(m.coatIor, 0.0f, 10.0f, 0.0f, what + ": coat index of refraction", warnings);
     checkColor(m.coatAbsorption, Vec3{0.0f}, what + ": coat absorption", warnings);
     clampValue(m.coatRoughness, 0.0f, 1.0f, 0.0f, what + ": coat roughness", warnings);
-    checkColor(m.interiorAbsorption, Vec3{0.0f}, what + ": interior absorption", warnings);
-    checkColor(m.interiorScattering, Vec3{0.0f}, what + ": interior scattering", warnings);
+    checkMedium(m.interiorAbsorption, what + ": interior absorption", warnings);
+    checkMedium(m.interiorScattering, what + ": interior scattering", warnings);
     clampValue(m.interiorAnisotropy, -0.99f, 0.99f, 0.0f, what + ": interior anisotropy", warnings);
     if (!finiteNonNegative(m.eta) || !finiteNonNegative(m.k)) {
       warnings.push_back(cat(what, ": its complex index of refraction is negative or not finite; copper instead"));
@@ -177,8 +185,8 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
   checkColor(env.zenith, Vec3{0.35f, 0.55f, 0.95f}, "sky zenith", warnings);
   checkColor(env.horizon, Vec3{0.9f, 0.92f, 0.95f}, "sky horizon", warnings);
   checkColor(env.ground, Vec3{0.3f, 0.28f, 0.25f}, "sky ground", warnings);
-  checkColor(env.mediumAbsorption, Vec3{0.0f}, "environment medium absorption", warnings);
-  checkColor(env.mediumScattering, Vec3{0.0f}, "environment medium scattering", warnings);
+  checkMedium(env.mediumAbsorption, "environment medium absorption", warnings);
+  checkMedium(env.mediumScattering, "environment medium scattering", warnings);
   clampValue(env.mediumAnisotropy, -0.99f, 0.99f, 0.0f, "environment medium anisotropy", warnings);
 
   for (Texture& t : scene.textures) {
