@@ -218,6 +218,7 @@ struct Path {
   // same of the medium around that one, which the path goes back to when it leaves (crossMedium).
   vec3 absorption, outerAbsorption;
   vec4 scattering, outerScattering;
+  bool inGlass, outerInGlass;  // whether those are glass's (which blocks shadow rays)
 #endif
 };
 
@@ -291,6 +292,8 @@ Path startPath(uint slot, int found) {
   path.scattering = frame.cameraScattering;
   path.outerAbsorption = frame.cameraOuterAbsorption.xyz;
   path.outerScattering = frame.cameraOuterScattering;
+  path.inGlass = frame.cameraAbsorption.w > 0.0;
+  path.outerInGlass = frame.cameraOuterAbsorption.w > 0.0;
 #endif
   path.specular = true;
   path.prevPdf = 0.0;
@@ -435,13 +438,17 @@ void crossMedium(inout Path path, Material m, bool frontFace) {
   if (frontFace) {
     path.outerAbsorption = path.absorption;
     path.outerScattering = path.scattering;
+    path.outerInGlass = path.inGlass;
     path.absorption = m.interior;
     path.scattering = m.scattering;
+    path.inGlass = !isMat(m.type, kMatBoundary);
   } else {
     path.absorption = path.outerAbsorption;
     path.scattering = path.outerScattering;
+    path.inGlass = path.outerInGlass;
     path.outerAbsorption = frame.worldAbsorption.xyz;
     path.outerScattering = frame.worldScattering;
+    path.outerInGlass = false;
   }
 }
 
@@ -468,7 +475,11 @@ bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, float h
   // Kept short of the surface, so that rounding cannot put the point on its far side.
   vec3 pos = path.ro + min(flight, hitT * 0.99999) * path.rd;
   float g = path.scattering.w;
-  if ((frame.lightPick.x + frame.lightPick.y + frame.lightPick.z) > 0.0) {
+  // Inside glass with no light in it, a light sample's shadow ray could only meet the glass,
+  // which blocks it, so none is cast; and the next direction meets no light before the glass, so
+  // no hit needs the weight the sample would have shared.
+  bool blockedByGlass = path.inGlass && frame.worldAbsorption.w > 0.0;
+  if ((frame.lightPick.x + frame.lightPick.y + frame.lightPick.z) > 0.0 && !blockedByGlass) {
     vec3 lu = vec3(rand(path.rng), rand(path.rng), rand(path.rng));
     LightSample ls = sampleLight(pos, lu);
     if (ls.pdf > 0.0 && maxComponent(ls.radiance) > 0.0) {
@@ -733,6 +744,8 @@ void main() {
   path.scattering = vec4(0.0);
   path.outerAbsorption = vec3(0.0);
   path.outerScattering = vec4(0.0);
+  path.inGlass = false;
+  path.outerInGlass = false;
 #endif
   bool alive = false;
   Shadow shadow;

@@ -181,14 +181,16 @@ struct FrameUniforms {
   // 1 for Tungsten's tent, whose CDF the shader computes instead, and 0 for its Gaussian.
   vec4 filterWarp[9];
   // The medium the camera is in (render_scene.h mediaAround: inside glass or a boundary that holds
-  // one, else the world's): its absorption xyz, -; its scattering xyz and phase function's g. Then the
-  // same of the medium around that one.
+  // one, else the world's): its absorption xyz, 1 when it is glass's (else 0); its scattering xyz
+  // and phase function's g. Then the same of the medium around that one.
   vec4 cameraAbsorption;
   vec4 cameraScattering;
   vec4 cameraOuterAbsorption;
   vec4 cameraOuterScattering;
   // The world's medium (Environment::mediumAbsorption and on; zero where it has none), which a
-  // path goes back to when it leaves the outermost glass or boundary: as the camera's above.
+  // path goes back to when it leaves the outermost glass or boundary: as the camera's above, but
+  // worldAbsorption.w is 1 when no light is inside glass whose medium scatters
+  // (RenderSceneData::lightInScatteringGlass), else 0.
   vec4 worldAbsorption;
   vec4 worldScattering;
 };

@@ -742,6 +742,8 @@ TEST(RenderScene, TheCameraIsInTheMediumAroundIt) {
     EXPECT_EQ(inMilk.in.absorption, Vec3(0.0f));
     EXPECT_FLOAT_EQ(inMilk.in.anisotropy, 0.3f);
     EXPECT_EQ(inMilk.around.absorption, fogged) << "the milk is in the fog";
+    EXPECT_TRUE(inMilk.in.glass);
+    EXPECT_FALSE(inMilk.around.glass) << "the fog's is a boundary's";
     EXPECT_EQ(mediaAround(d, {-2, 0, 0}).in.absorption, Vec3(0.0f)) << "empty glass holds a vacuum";
     EXPECT_EQ(mediaAround(d, {-2, 0, 0}).around.absorption, fogged);
     EXPECT_EQ(mediaAround(d, {0, 0, 20}).in.absorption, Vec3(0.0f)) << "outside everything";
@@ -787,6 +789,47 @@ TEST(RenderScene, TheCameraIsInTheMediumAroundIt) {
   open.environment.mediumScattering = Vec3{0.5f, 0.5f, 0.0f};
   openBuilder.update(open, kUpdateEnvironment, nullptr);
   EXPECT_GT(openBuilder.data().lightPick[1], 0.0f) << "the third channel sees the sky";
+}
+
+// Glass whose medium scatters blocks every shadow ray from inside it to a light outside, so such
+// a scene's kernel samples no light there (trace.comp scatterInMedium) unless some light may be
+// inside: an emitter or a point light whose bounds meet the glass's, or the glass itself glowing.
+TEST(RenderScene, ALightInsideScatteringGlassKeepsItsLightSampling) {
+  Scene s = test::emptyScene(8, 8);
+  Material milk;
+  milk.type = MaterialType::Dielectric;
+  milk.interiorScattering = Vec3{6.0f};
+  const NodeId milkMaterial = test::addMaterial(s, milk);
+  const NodeId glass = test::addMeshObject(s, "milk", makeCube(), milkMaterial, Mat4::scale({2, 2, 2}));
+  Material lamp;
+  lamp.emission = Vec3{5.0f};
+  const NodeId quad = test::addMeshObject(s, "lamp", makeQuad(), test::addMaterial(s, lamp), Mat4::translate({0, 4, 0}));
+  RenderSceneBuilder builder;
+  auto inside = [&] {
+    builder.update(s, kUpdateAll, nullptr);
+    return builder.data().lightInScatteringGlass;
+  };
+  EXPECT_FALSE(inside()) << "the lamp is above the glass";
+  s.object(quad)->transform = Mat4::translate({0, 0.5f, 0});
+  EXPECT_TRUE(inside()) << "the lamp is in it";
+  s.object(quad)->transform = Mat4::translate({0, 4, 0});
+  Light bulb;
+  bulb.id = s.newId();
+  bulb.type = LightType::Point;
+  bulb.position = {0.2f, 0.1f, 0};
+  s.lights.push_back(bulb);
+  EXPECT_TRUE(inside()) << "a point light in it";
+  s.lights.back().position = {0, 0, 5};
+  EXPECT_FALSE(inside());
+  s.material(milkMaterial)->emission = Vec3{1.0f};
+  EXPECT_TRUE(inside()) << "glowing glass lights its own inside";
+  s.material(milkMaterial)->emission = Vec3{0.0f};
+  s.material(milkMaterial)->interiorScattering = Vec3{0.0f};
+  s.material(milkMaterial)->interiorAbsorption = Vec3{1.0f};
+  s.object(quad)->transform = Mat4::translate({0, 0.5f, 0});
+  EXPECT_FALSE(inside()) << "nothing scatters in it: no light is sampled from inside anyway";
+  s.object(glass)->visible = false;
+  EXPECT_FALSE(inside());
 }
 
 // The volumetric caustic's set-up: gas in a box of plain walls, closed by one boundary quad.

@@ -660,7 +660,9 @@ MediaAround mediaAround(const RenderSceneData& d, Vec3 point) {
     if (material < 0) return d.worldMedium;
     const std::size_t mbase = static_cast<std::size_t>(material) * gpu::kMaterialTexels;
     const vec4 &interior = d.materials[mbase + 8], &scattering = d.materials[mbase + 9];
-    return MediumAt{{interior.x, interior.y, interior.z}, {scattering.x, scattering.y, scattering.z}, scattering.w};
+    const int type = intOf(d.materials[mbase].w) & gpu::kMatTypeBits;
+    return MediumAt{{interior.x, interior.y, interior.z}, {scattering.x, scattering.y, scattering.z}, scattering.w,
+                    type == gpu::kMatDielectric || type == gpu::kMatRoughDielectric};
   };
   // The first two holders a ray from the point leaves by faces it did not come in by (-1: it
   // leaves the scene first). kUndecided where it meets an opaque surface before (a wall does not
@@ -1122,6 +1124,37 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   return renamed;
 }
 
+bool RenderSceneBuilder::lightInScatteringGlass(const Scene& scene) const {
+  // Glass blocks shadow rays, so from a scattering point inside it only a light inside it can be
+  // sampled. Bounds that meet are enough to keep sampling; an emissive glass meets itself.
+  auto scatteringGlass = [&](const Material* m) {
+    return m && (m->type == MaterialType::Dielectric || m->type == MaterialType::RoughDielectric) && m->filled() &&
+           maxComponent(m->interiorScattering) > 0;
+  };
+  std::vector<Bounds3> glass, lights;
+  for (std::size_t i = 0; i < data_.instanceObject.size(); ++i) {
+    const Object* o = scene.object(data_.instanceObject[i]);
+    const Material* mat = o && o->visible ? scene.material(o->material) : nullptr;
+    const MeshEntry* mesh = mat ? entryOf(*o) : nullptr;
+    if (!mesh) continue;
+    const bool inGlass = scatteringGlass(mat) || (mat->blendWith != kNoNode && scatteringGlass(scene.material(mat->blendWith)));
+    if (!inGlass && !mat->emissive()) continue;
+    const Bounds3 b = transformBounds(placement(o->transform, *mesh), mesh->bvh.bounds);
+    if (inGlass) glass.push_back(b);
+    if (mat->emissive()) lights.push_back(b);
+  }
+  if (glass.empty()) return false;
+  for (const Light& l : scene.lights)
+    if (l.visible && l.type != LightType::Directional) lights.push_back(Bounds3{l.position, l.position});
+  auto meet = [](const Bounds3& a, const Bounds3& b) {
+    return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y && a.lo.z <= b.hi.z && b.lo.z <= a.hi.z;
+  };
+  for (const Bounds3& g : glass)
+    for (const Bounds3& l : lights)
+      if (meet(g, l)) return true;
+  return false;
+}
+
 void RenderSceneBuilder::packEmitters(const Scene& scene) {
   data_.emitters.clear();
   std::vector<float> power;
@@ -1163,6 +1196,7 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
       power.push_back(area > 0 && std::isfinite(area) ? area * kPi * radianceLum : 0.0f);
     }
   }
+  data_.lightInScatteringGlass = lightInScatteringGlass(scene);
   double total = std::accumulate(power.begin(), power.end(), 0.0);
   for (std::size_t i = 0; i < power.size(); ++i)
     data_.emitters[i * gpu::kEmitterTexels + 3].w = total > 0 ? static_cast<float>(power[i] / total) : 0.0f;

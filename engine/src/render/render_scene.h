@@ -61,6 +61,7 @@ enum DirtyArrays : std::uint32_t {
 struct MediumAt {
   Vec3 absorption{0.0f}, scattering{0.0f};
   float anisotropy = 0;
+  bool glass = false;  // the interior of glass (which blocks shadow rays), not of a boundary
   // Nothing from infinitely far gets through it in any channel.
   bool dimsEveryChannel() const { return minComponent(absorption + scattering) > 0; }
 };
@@ -101,6 +102,9 @@ struct RenderSceneData {
   bool materialBump = false;           // some material has a bump map
   bool emissionTextures = false;       // some emissive material has an emission texture
   bool materialBlend = false;          // some material blends with another
+  // Some light or emitter may lie inside glass whose medium scatters (their bounds meet). Where
+  // none does, a scattering point in such glass samples no light (trace.comp scatterInMedium).
+  bool lightInScatteringGlass = true;
   bool instanceTransforms = false;     // some instance's transform is not the identity
   bool directReferences = false;       // the instance BVH is packed direct (layouts.h kFeatureDirectReferences)
 
@@ -180,6 +184,7 @@ class RenderSceneBuilder {
   void packMaterials(const Scene& scene);
   void packTextures(const Scene& scene, std::vector<std::string>* warnings);
   void packEmitters(const Scene& scene);
+  bool lightInScatteringGlass(const Scene& scene) const;  // RenderSceneData::lightInScatteringGlass
   void packEnvironment(const Scene& scene, std::vector<std::string>* warnings);
   void choosePickProbabilities(const Scene& scene);
   int textureIndex(NodeId id) const;

@@ -447,12 +447,12 @@ struct Renderer::Impl {
       mediaKnown = true;
     }
     const MediumAt &in = media.in, &around = media.around;
-    u.cameraAbsorption = {in.absorption.x, in.absorption.y, in.absorption.z, 0};
+    u.cameraAbsorption = {in.absorption.x, in.absorption.y, in.absorption.z, in.glass ? 1.0f : 0.0f};
     u.cameraScattering = {in.scattering.x, in.scattering.y, in.scattering.z, in.anisotropy};
-    u.cameraOuterAbsorption = {around.absorption.x, around.absorption.y, around.absorption.z, 0};
+    u.cameraOuterAbsorption = {around.absorption.x, around.absorption.y, around.absorption.z, around.glass ? 1.0f : 0.0f};
     u.cameraOuterScattering = {around.scattering.x, around.scattering.y, around.scattering.z, around.anisotropy};
     const MediumAt& world = d.worldMedium;
-    u.worldAbsorption = {world.absorption.x, world.absorption.y, world.absorption.z, 0};
+    u.worldAbsorption = {world.absorption.x, world.absorption.y, world.absorption.z, d.lightInScatteringGlass ? 0.0f : 1.0f};
     u.worldScattering = {world.scattering.x, world.scattering.y, world.scattering.z, world.anisotropy};
     std::uint32_t sel = countTile > 0 ? selectedInstance() : 0u;
     u.work = {itemCount, static_cast<std::uint32_t>(slots), sel, sel ? static_cast<std::uint32_t>(countTile) : 0u};
