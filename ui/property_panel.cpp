@@ -55,6 +55,25 @@ class PropertyPanel::Builder {
     return f;
   }
 
+  // A homogeneous medium's fields (a glass's or boundary's interior, the world's): absorption and
+  // scattering per channel, never negative, and the phase function's asymmetry; labelled and
+  // named by `prefix` and `key` ("Interior", "interior" gives "interiorAbsorption" and on), each
+  // edit made through `edit` on the member of T it shows.
+  template <class T>
+  void medium(const QString& prefix, const QString& key, const T& target, Vec3 T::*absorption, Vec3 T::*scattering,
+              float T::*anisotropy, const std::function<void(const QString&, int, const std::function<void(T&)>&)>& edit) {
+    for (Vec3 T::*field : {absorption, scattering}) {
+      const QString what = PropertyPanel::tr("%1 %2").arg(prefix, field == absorption ? PropertyPanel::tr("absorption") : PropertyPanel::tr("scattering"));
+      vec3(what, key + (field == absorption ? "Absorption" : "Scattering"), target.*field, 0.01, [edit, what, field](int channel, double v, int drag) {
+        edit(what, drag, [channel, v, field](T& x) { axisOf(x.*field, channel) = std::max(0.0f, static_cast<float>(v)); });
+      }, true);
+    }
+    const QString what = PropertyPanel::tr("%1 anisotropy").arg(prefix);
+    number(what, key + "Anisotropy", target.*anisotropy, -0.99, 0.99, 0.0, 3, [edit, what, anisotropy](double v, int drag) {
+      edit(what, drag, [v, anisotropy](T& x) { x.*anisotropy = static_cast<float>(v); });
+    });
+  }
+
   // Three fields labelled X, Y, Z, or R, G, B for a quantity per colour channel.
   void vec3(const QString& name, const QString& objectName, Vec3 value, double step, std::function<void(int, double, int)> apply,
             bool perChannel = false) {
@@ -337,20 +356,9 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       }, true);
     }
   }
-  if (holdsMedium(m.type)) {
-    b.vec3(tr("Interior absorption"), "interiorAbsorption", m.interiorAbsorption, 0.01, [edit](int channel, double v, int drag) {
-      edit(tr("Interior absorption"), drag,
-           [channel, v](Material& x) { axisOf(x.interiorAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
-    }, true);
-    b.vec3(tr("Interior scattering"), "interiorScattering", m.interiorScattering, 0.01, [edit](int channel, double v, int drag) {
-      edit(tr("Interior scattering"), drag,
-           [channel, v](Material& x) { axisOf(x.interiorScattering, channel) = std::max(0.0f, static_cast<float>(v)); });
-    }, true);
-    b.number(tr("Scattering anisotropy"), "interiorAnisotropy", m.interiorAnisotropy, -0.99, 0.99, defaults.interiorAnisotropy, 3,
-             [edit](double v, int drag) {
-               edit(tr("Scattering anisotropy"), drag, [v](Material& x) { x.interiorAnisotropy = static_cast<float>(v); });
-             });
-  }
+  if (holdsMedium(m.type))
+    b.medium<Material>(tr("Interior"), "interior", m, &Material::interiorAbsorption, &Material::interiorScattering,
+                       &Material::interiorAnisotropy, edit);
   if (m.type == MaterialType::Boundary) return;  // no surface: no texture, emission, alpha or blend applies
   if (m.type == MaterialType::Phong)
     b.number(tr("Diffuse ratio"), "diffuseRatio", m.diffuseRatio, 0.0, 1.0, defaults.diffuseRatio, 3, [edit](double v, int drag) {
@@ -576,18 +584,8 @@ void PropertyPanel::buildEnvironment(Builder& b) {
     });
   }
   // The medium filling the world (fog), as a glass's or boundary's interior.
-  b.vec3(tr("Medium absorption"), "mediumAbsorption", e.mediumAbsorption, 0.01, [edit](int channel, double v, int drag) {
-    edit(tr("Environment medium absorption"), drag,
-         [channel, v](Environment& x) { axisOf(x.mediumAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
-  }, true);
-  b.vec3(tr("Medium scattering"), "mediumScattering", e.mediumScattering, 0.01, [edit](int channel, double v, int drag) {
-    edit(tr("Environment medium scattering"), drag,
-         [channel, v](Environment& x) { axisOf(x.mediumScattering, channel) = std::max(0.0f, static_cast<float>(v)); });
-  }, true);
-  b.number(tr("Medium anisotropy"), "mediumAnisotropy", e.mediumAnisotropy, -0.99, 0.99, defaults.mediumAnisotropy, 3,
-           [edit](double v, int drag) {
-             edit(tr("Environment medium anisotropy"), drag, [v](Environment& x) { x.mediumAnisotropy = static_cast<float>(v); });
-           });
+  b.medium<Environment>(tr("Medium"), "medium", e, &Environment::mediumAbsorption, &Environment::mediumScattering,
+                        &Environment::mediumAnisotropy, edit);
 }
 
 void PropertyPanel::buildRender(Builder& b) {
