@@ -72,6 +72,14 @@ int runImport(const std::string& file, const std::string& saveAs) {
   std::printf("%s: %s scene: %zu objects, %zu meshes, %zu triangles, %zu materials, %zu textures, %zu lights\n",
               file.c_str(), scene->format.c_str(), s.objects.size(), s.meshes.size(), s.triangleCount(),
               s.materials.size(), s.textures.size(), s.lights.size());
+  const Environment& e = s.environment;
+  std::string environment = cat("environment: ", environmentTypeName(e.type));
+  if (e.filled()) {
+    const Vec3 a = e.mediumAbsorption, sc = e.mediumScattering;
+    environment += cat("; a medium fills the world: absorption (", a.x, ", ", a.y, ", ", a.z, "), scattering (", sc.x, ", ",
+                       sc.y, ", ", sc.z, "), anisotropy ", e.mediumAnisotropy);
+  }
+  std::printf("%s\n", environment.c_str());
   if (!saveAs.empty()) {
     auto saved = saveNativeScene(s, saveAs);
     if (!saved) {

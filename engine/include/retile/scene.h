@@ -286,6 +286,8 @@ struct Environment {
   friend bool operator==(const Environment&, const Environment&) = default;
 };
 
+const char* environmentTypeName(EnvironmentType t);  // "constant", "map", "sky"
+
 // World directions to the environment map's frame: `orientation`'s rotation, turned by `rotation`
 // about +y (the map's u grows with the angle from +x towards +z, its v downwards from +y).
 Mat4 environmentToMap(const Environment& e);

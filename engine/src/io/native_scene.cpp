@@ -54,14 +54,6 @@ const char* lightTypeName(LightType t) {
   }
   return "point";
 }
-const char* environmentTypeName(EnvironmentType t) {
-  switch (t) {
-    case EnvironmentType::Constant: return "constant";
-    case EnvironmentType::Map: return "map";
-    case EnvironmentType::Sky: return "sky";
-  }
-  return "constant";
-}
 
 // Reads fields of one JSON object, remembering the first problem with its location.
 class Reader {

@@ -7,6 +7,15 @@
 
 namespace retile {
 
+const char* environmentTypeName(EnvironmentType t) {
+  switch (t) {
+    case EnvironmentType::Constant: return "constant";
+    case EnvironmentType::Map: return "map";
+    case EnvironmentType::Sky: return "sky";
+  }
+  return "constant";
+}
+
 const char* pixelFilterName(PixelFilter f) {
   switch (f) {
     case PixelFilter::Box: return "box";
