@@ -828,6 +828,27 @@ TEST(RenderScene, ALightInsideScatteringGlassKeepsItsLightSampling) {
   s.material(milkMaterial)->interiorAbsorption = Vec3{1.0f};
   s.object(quad)->transform = Mat4::translate({0, 0.5f, 0});
   EXPECT_FALSE(inside()) << "nothing scatters in it: no light is sampled from inside anyway";
+  s.material(milkMaterial)->interiorScattering = Vec3{6.0f};
+  s.object(quad)->transform = Mat4::translate({0, 4, 0});
+  EXPECT_FALSE(inside());
+  // Where a path inside can get out other than through the glass, any light may be reached.
+  s.material(milkMaterial)->alpha = 0.5f;
+  EXPECT_TRUE(inside()) << "cut-out glass";
+  s.material(milkMaterial)->alpha = 1;
+  const NodeId sea = test::addMeshObject(s, "sea", makeQuad(), milkMaterial, Mat4::translate({0, -10, 0}) * Mat4::scale({100, 1, 100}));
+  EXPECT_TRUE(inside()) << "a water surface is open: a lamp above it is reached from below";
+  s.object(sea)->visible = false;
+  EXPECT_FALSE(inside());
+  Material paint, plaster;
+  paint.blendWith = test::addMaterial(s, plaster);
+  paint.blendRatio = 0.5f;
+  const NodeId painted = test::addMaterial(s, paint);
+  s.material(paint.blendWith)->blendWith = milkMaterial;
+  s.material(paint.blendWith)->blendRatio = 0.5f;
+  test::addMeshObject(s, "painted", makeCube(), painted, Mat4::translate({10, 0, 0}));
+  EXPECT_TRUE(inside()) << "milk two blends deep in a painted box, which a path leaves through the paint";
+  s.material(painted)->blendWith = kNoNode;
+  EXPECT_FALSE(inside());
   s.object(glass)->visible = false;
   EXPECT_FALSE(inside());
 }

@@ -1124,9 +1124,45 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   return renamed;
 }
 
+namespace {
+// Whether the triangles close a surface: after welding positions that agree to a millionth of the
+// mesh's size, every edge is met exactly once in each direction (closed and consistently wound).
+// A water surface, a window pane or a mesh with holes is not: a path inside can leave it.
+bool closedSurface(const MeshGeometry& g) {
+  if (g.indices.empty()) return false;
+  const Bounds3 b = g.bounds();
+  const float cell = std::max(maxComponent(b.extent()), 1e-30f) * 1e-6f;
+  using Cell = std::array<std::int64_t, 3>;
+  struct CellHash {
+    std::size_t operator()(const Cell& c) const {
+      return static_cast<std::size_t>(c[0] * 73856093 ^ c[1] * 19349663 ^ c[2] * 83492791);
+    }
+  };
+  std::unordered_map<Cell, std::uint32_t, CellHash> welded;
+  std::vector<std::uint32_t> id(g.positions.size());
+  for (std::size_t i = 0; i < g.positions.size(); ++i) {
+    const Vec3 q = (g.positions[i] - b.lo) / cell;
+    const Cell key{std::llround(q.x), std::llround(q.y), std::llround(q.z)};
+    id[i] = welded.emplace(key, static_cast<std::uint32_t>(welded.size())).first->second;
+  }
+  std::unordered_map<std::uint64_t, int> edges;  // directed edge -> times met
+  for (std::size_t t = 0; t + 2 < g.indices.size(); t += 3)
+    for (int e = 0; e < 3; ++e) {
+      const std::uint64_t from = id[g.indices[t + e]], to = id[g.indices[t + (e + 1) % 3]];
+      if (from == to) continue;  // a degenerate triangle's collapsed edge
+      if (++edges[from << 32 | to] > 1) return false;
+    }
+  for (const auto& [edge, n] : edges)
+    if (!edges.count((edge & 0xffffffffu) << 32 | edge >> 32)) return false;
+  return true;
+}
+}  // namespace
+
 bool RenderSceneBuilder::lightInScatteringGlass(const Scene& scene) const {
   // Glass blocks shadow rays, so from a scattering point inside it only a light inside it can be
-  // sampled. Bounds that meet are enough to keep sampling; an emissive glass meets itself.
+  // sampled: bounds that meet keep the sampling, and an emissive glass meets itself. That holds
+  // only where a path inside cannot get out but through the glass: so any scattering glass that
+  // is open (closedSurface), cut out, or blended with something other than uncut glass keeps it too.
   auto scatteringGlass = [&](const Material* m) {
     return m && (m->type == MaterialType::Dielectric || m->type == MaterialType::RoughDielectric) && m->filled() &&
            maxComponent(m->interiorScattering) > 0;
@@ -1137,10 +1173,23 @@ bool RenderSceneBuilder::lightInScatteringGlass(const Scene& scene) const {
     const Material* mat = o && o->visible ? scene.material(o->material) : nullptr;
     const MeshEntry* mesh = mat ? entryOf(*o) : nullptr;
     if (!mesh) continue;
-    const bool inGlass = scatteringGlass(mat) || (mat->blendWith != kNoNode && scatteringGlass(scene.material(mat->blendWith)));
-    if (!inGlass && !mat->emissive()) continue;
+    // Its blend chain, as the kernel follows it (fetchMaterial): glass throughout, or not.
+    bool scatters = false, allGlass = true;
+    const Material* part = mat;
+    for (int k = 0; part && k < kMaxBlendChain; ++k) {
+      scatters = scatters || scatteringGlass(part);
+      allGlass = allGlass && (part->type == MaterialType::Dielectric || part->type == MaterialType::RoughDielectric) &&
+                 part->alpha >= 1 && part->alphaTexture == kNoNode;
+      part = part->blendWith != kNoNode && part->blendWith != part->id ? scene.material(part->blendWith) : nullptr;
+    }
+    if (scatters) {
+      if (!allGlass) return true;
+      if (mesh->closed < 0) mesh->closed = mesh->geometry && closedSurface(*mesh->geometry) ? 1 : 0;
+      if (!mesh->closed) return true;
+    }
+    if (!scatters && !mat->emissive()) continue;
     const Bounds3 b = transformBounds(placement(o->transform, *mesh), mesh->bvh.bounds);
-    if (inGlass) glass.push_back(b);
+    if (scatters) glass.push_back(b);
     if (mat->emissive()) lights.push_back(b);
   }
   if (glass.empty()) return false;

@@ -167,6 +167,8 @@ class RenderSceneBuilder {
     // naming an instance again costs nothing when it is the same; kUnnamed when never written.
     static constexpr std::uint32_t kUnnamed = 0xffffffffu;
     mutable std::uint32_t named = kUnnamed;
+    // Whether its triangles close a surface, every edge met once each way (closedSurface); -1 until asked.
+    mutable int closed = -1;
   };
   // An object's transform from its mesh's packed space to world space.
   static Mat4 placement(const Mat4& objectTransform, const MeshEntry& mesh);
