@@ -636,11 +636,12 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
   for (const Material& m : scene.materials) pack(m);
   // The world's medium compiles the same kernel code in as a material's (trace.comp RETILE_MEDIUM).
   const Environment& env = scene.environment;
-  data_.worldMedium = env.filled() ? MediumAt{max(env.mediumAbsorption, Vec3{0.0f}), max(env.mediumScattering, Vec3{0.0f}),
-                                               std::clamp(env.mediumAnisotropy, -0.99f, 0.99f)}
-                                   : MediumAt{};
-  if (env.filled()) data_.materialTypes |= 1u << gpu::kMaskMedium;
-  if (env.filled() && maxComponent(env.mediumScattering) > 0) data_.materialTypes |= 1u << gpu::kMaskScattering;
+  const bool fog = env.filled();
+  data_.worldMedium = fog ? MediumAt{max(env.mediumAbsorption, Vec3{0.0f}), max(env.mediumScattering, Vec3{0.0f}),
+                                     std::clamp(env.mediumAnisotropy, -0.99f, 0.99f)}
+                          : MediumAt{};
+  if (fog) data_.materialTypes |= 1u << gpu::kMaskMedium;
+  if (fog && maxComponent(env.mediumScattering) > 0) data_.materialTypes |= 1u << gpu::kMaskScattering;
   defaultMaterial_ = static_cast<int>(data_.materials.size() / gpu::kMaterialTexels);
   Material fallback;
   fallback.albedo = Vec3{0.6f};
@@ -690,7 +691,7 @@ MediaAround mediaAround(const RenderSceneData& d, Vec3 point) {
       const int type = intOf(d.materials[mbase].w) & gpu::kMatTypeBits;
       const MediumAt medium = mediumOf(material);
       const bool filled = maxComponent(medium.absorption + medium.scattering) > 0;
-      const bool glass = type == gpu::kMatDielectric || type == gpu::kMatRoughDielectric;
+      const bool glass = medium.glass;
       if (!glass && type != gpu::kMatBoundary && !throughWalls) return left;
       if (glass || (type == gpu::kMatBoundary && filled)) {
         const vec4* t = d.meshTraversal.data() + static_cast<std::size_t>(hit.prim) * gpu::kTriTexels;
@@ -1163,10 +1164,11 @@ bool RenderSceneBuilder::lightInScatteringGlass(const Scene& scene) const {
   // sampled: bounds that meet keep the sampling, and an emissive glass meets itself. That holds
   // only where a path inside cannot get out but through the glass: so any scattering glass that
   // is open (closedSurface), cut out, or blended with something other than uncut glass keeps it too.
-  auto scatteringGlass = [&](const Material* m) {
-    return m && (m->type == MaterialType::Dielectric || m->type == MaterialType::RoughDielectric) && m->filled() &&
-           maxComponent(m->interiorScattering) > 0;
-  };
+  auto isGlass = [](const Material& m) { return m.type == MaterialType::Dielectric || m.type == MaterialType::RoughDielectric; };
+  auto scatteringGlass = [&](const Material* m) { return m && isGlass(*m) && m->filled() && maxComponent(m->interiorScattering) > 0; };
+  // Most scenes have none: then no instance needs looking at (this runs at every object move).
+  if (std::none_of(scene.materials.begin(), scene.materials.end(), [&](const Material& m) { return scatteringGlass(&m); }))
+    return false;
   std::vector<Bounds3> glass, lights;
   for (std::size_t i = 0; i < data_.instanceObject.size(); ++i) {
     const Object* o = scene.object(data_.instanceObject[i]);
@@ -1178,8 +1180,7 @@ bool RenderSceneBuilder::lightInScatteringGlass(const Scene& scene) const {
     const Material* part = mat;
     for (int k = 0; part && k < kMaxBlendChain; ++k) {
       scatters = scatters || scatteringGlass(part);
-      allGlass = allGlass && (part->type == MaterialType::Dielectric || part->type == MaterialType::RoughDielectric) &&
-                 part->alpha >= 1 && part->alphaTexture == kNoNode;
+      allGlass = allGlass && isGlass(*part) && part->alpha >= 1 && part->alphaTexture == kNoNode;
       part = part->blendWith != kNoNode && part->blendWith != part->id ? scene.material(part->blendWith) : nullptr;
     }
     if (scatters) {
