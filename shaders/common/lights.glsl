@@ -45,7 +45,7 @@ vec3 envRadiance(vec3 d) {
   // sky carry all of it.
   if (hasFeature(kFeatureEnvMap) && type == kEnvMap) {
     vec2 uv = directionToEnvUv(d);
-    return sampleTexture(frame.environment.y, vec2(uv.x, 1.0 - uv.y)).rgb * frame.environmentTint.rgb;
+    return max(sampleTexture(frame.environment.y, vec2(uv.x, 1.0 - uv.y)).rgb, vec3(0.0)) * frame.environmentTint.rgb;
   }
   return vec3(0.0);
 }
@@ -63,8 +63,8 @@ float envPdf(vec3 d) {
   if (norm <= 0.0 || sinActual <= 1e-6) return 0.0;
   float sinRow = sin(PI * (float(t.y) + 0.5) / float(frame.environment.w));
   vec4 info = texelFetch(uTexInfo, frame.environment.y * kTextureTexels);
-  vec3 c = texelFetch(uTexels, floatBitsToInt(info.x) + t.y * frame.environment.z + t.x).rgb;
-  return luminance(c) * sinRow / (norm * 2.0 * PI * PI * sinActual);
+  vec3 c = bitmapTexel(floatBitsToInt(info.x), t.y * frame.environment.z + t.x, floatBitsToInt(info.w)).rgb;
+  return max(luminance(c), 0.0) * sinRow / (norm * 2.0 * PI * PI * sinActual);
 }
 
 // Largest index i in [0, n) with cdf[base + i] <= u.

@@ -26,7 +26,9 @@ layout(set = 0, binding = 3) uniform samplerBuffer uTriShade;
 layout(set = 0, binding = 4) uniform samplerBuffer uInstances;
 layout(set = 0, binding = 5) uniform samplerBuffer uMaterials;
 layout(set = 0, binding = 6) uniform samplerBuffer uTexInfo;
-layout(set = 0, binding = 7) uniform samplerBuffer uTexels;
+// Every bitmap's texels, as pairs of words: 8-bit RGBA a word each, or RGBA16F two words each
+// (layouts.h kTexEightBit). A storage texel buffer, as uTraversal, for imageLoad.
+layout(set = 0, binding = 7, rg32ui) uniform readonly uimageBuffer uTexels;
 layout(set = 0, binding = 8) uniform samplerBuffer uEmitters;
 layout(set = 0, binding = 9) uniform samplerBuffer uEmitterAlias;
 layout(set = 0, binding = 10) uniform samplerBuffer uDeltaLights;
@@ -85,6 +87,34 @@ struct Hit {
   int instance;
 };
 
+// Texel i of a bitmap whose texels start at pair `offset`, linear RGBA. The sRGB curve is applied
+// to each texel before filtering, as when bitmaps were decoded to floats on the CPU. Only the
+// storages the scene has are compiled in (kFeatureByteTexels and on), by the preprocessor: lavapipe
+// inlines every call before it drops dead code, and a kernel that reads no texture took 12 MB
+// more to compile with this function's whole body in each of its seventeen calls.
+vec4 bitmapTexel(int offset, int i, int flags) {
+#if (RETILE_FEATURES & RT_FEATURE_BYTE_TEXELS) != 0
+  if (!hasFeature(kFeatureHalfTexels) || (flags & kTexEightBit) != 0) {
+    uvec2 pair = imageLoad(uTexels, offset + (i >> 1)).xy;
+    uint word = (i & 1) != 0 ? pair.y : pair.x;
+    vec4 c = vec4((uvec4(word) >> uvec4(0u, 8u, 16u, 24u)) & 255u) * (1.0 / 255.0);
+#if (RETILE_FEATURES & RT_FEATURE_SRGB_TEXELS) != 0
+    if ((flags & kTexSrgb) != 0)
+      c.rgb = mix(c.rgb / 12.92, pow((c.rgb + 0.055) / 1.055, vec3(2.4)), greaterThan(c.rgb, vec3(0.04045)));
+#endif
+    return c;
+  }
+#endif
+#if (RETILE_FEATURES & RT_FEATURE_HALF_TEXELS) != 0
+  uvec2 h = imageLoad(uTexels, offset + i).xy;
+  vec4 c = vec4(unpackHalf2x16(h.x), unpackHalf2x16(h.y));
+  c.rgb *= exp2(float((flags >> kTexScaleShift) & kTexScaleMax));
+  return c;
+#else
+  return vec4(0.0);
+#endif
+}
+
 // Texture lookup with repeat wrapping and bilinear filtering; checkers are analytic.
 vec4 sampleTexture(int index, vec2 uv) {
   vec4 info = texelFetch(uTexInfo, index * kTextureTexels);
@@ -109,10 +139,10 @@ vec4 sampleTexture(int index, vec2 uv) {
   i0 = clamp(i0, ivec2(0), size - 1);
   ivec2 i1 = i0 + 1;
   i1 -= ivec2(greaterThanEqual(i1, size)) * size;
-  vec4 a = texelFetch(uTexels, offset + i0.y * w + i0.x);
-  vec4 b = texelFetch(uTexels, offset + i0.y * w + i1.x);
-  vec4 c = texelFetch(uTexels, offset + i1.y * w + i0.x);
-  vec4 d = texelFetch(uTexels, offset + i1.y * w + i1.x);
+  vec4 a = bitmapTexel(offset, i0.y * w + i0.x, kind);
+  vec4 b = bitmapTexel(offset, i0.y * w + i1.x, kind);
+  vec4 c = bitmapTexel(offset, i1.y * w + i0.x, kind);
+  vec4 d = bitmapTexel(offset, i1.y * w + i1.x, kind);
   return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
 }
 
@@ -122,7 +152,8 @@ vec4 sampleTexture(int index, vec2 uv) {
 // the slope of a bump map depends on its resolution, as in Tungsten. Checkers are flat.
 vec2 textureSlope(int index, vec2 uv) {
   vec4 info = texelFetch(uTexInfo, index * kTextureTexels);
-  if ((floatBitsToInt(info.w) & 15) == kTexChecker) return vec2(0.0);
+  int flags = floatBitsToInt(info.w);
+  if ((flags & 15) == kTexChecker) return vec2(0.0);
   int offset = floatBitsToInt(info.x);
   int w = max(floatBitsToInt(info.y), 1), h = max(floatBitsToInt(info.z), 1);
   vec2 wrapped = vec2(uv.x, 1.0 - uv.y);
@@ -132,9 +163,9 @@ vec2 textureSlope(int index, vec2 uv) {
   ivec2 i = ivec2(floor(p));
   // Columns i - 1 .. i + 2 and rows likewise, wrapped.
   ivec4 xs = (ivec4(i.x) + ivec4(-1, 0, 1, 2) + 2 * w) % w;
-  ivec4 ys = ((ivec4(i.y) + ivec4(-1, 0, 1, 2) + 2 * h) % h) * w + offset;
+  ivec4 ys = ((ivec4(i.y) + ivec4(-1, 0, 1, 2) + 2 * h) % h) * w;
   const vec3 mean = vec3(1.0 / 3.0);
-#define RETILE_TEXEL(x, y) dot(texelFetch(uTexels, ys[y] + xs[x]).rgb, mean)
+#define RETILE_TEXEL(x, y) dot(bitmapTexel(offset, ys[y] + xs[x], flags).rgb, mean)
   float a01 = RETILE_TEXEL(1, 0), a02 = RETILE_TEXEL(2, 0);
   float a10 = RETILE_TEXEL(0, 1), a11 = RETILE_TEXEL(1, 1), a12 = RETILE_TEXEL(2, 1), a13 = RETILE_TEXEL(3, 1);
   float a20 = RETILE_TEXEL(0, 2), a21 = RETILE_TEXEL(1, 2), a22 = RETILE_TEXEL(2, 2), a23 = RETILE_TEXEL(3, 2);
@@ -150,7 +181,7 @@ vec2 textureSlope(int index, vec2 uv) {
 float sampleAlphaTexture(int index, vec2 uv) {
   vec4 info = texelFetch(uTexInfo, index * kTextureTexels);
   vec4 t = sampleTexture(index, uv);
-  return (floatBitsToInt(info.w) & 16) != 0 ? t.a : t.r;
+  return (floatBitsToInt(info.w) & kTexAlpha) != 0 ? t.a : t.r;
 }
 
 vec2 triangleUv(int prim, float u, float v) {

@@ -89,7 +89,18 @@ RT_CONST(int, kFeatureTungstenRoulette, 32768)  // Roulette::Tungsten (scene.h)
 // kTriAlphaTested). Only for scenes without instance transforms whose triangles each belong to
 // one instance (render_scene.cpp packInstances); ignored with kFeatureInstanceTransforms.
 RT_CONST(int, kFeatureDirectReferences, 65536)
-RT_CONST(int, kFeatureAll, 131071)
+// How bitmaps' texels are stored (kTexEightBit): some in 8 bits, some in halves (an environment
+// map is), some 8-bit ones sRGB-encoded. Each way of reading them costs speed wherever a texture
+// lookup is inlined (the traversal loop's cut-out test too), read or not: 45 % on the living room
+// with all three compiled in, where it has only the first. Also macros, for the preprocessor
+// (scene.glsl bitmapTexel).
+#define RT_FEATURE_BYTE_TEXELS 131072
+#define RT_FEATURE_HALF_TEXELS 262144
+#define RT_FEATURE_SRGB_TEXELS 524288
+RT_CONST(int, kFeatureByteTexels, RT_FEATURE_BYTE_TEXELS)
+RT_CONST(int, kFeatureHalfTexels, RT_FEATURE_HALF_TEXELS)
+RT_CONST(int, kFeatureSrgbTexels, RT_FEATURE_SRGB_TEXELS)
+RT_CONST(int, kFeatureAll, 1048575)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceEmissive, 4)
@@ -125,6 +136,19 @@ RT_CONST(int, kMatTypeBits, 255)
 
 RT_CONST(int, kTexBitmap, 0)
 RT_CONST(int, kTexChecker, 1)
+// A bitmap's flags, beside its kind (the low four bits): its file had alpha (else an alpha
+// texture reads red); its texels are 8-bit RGBA, a word each, instead of RGBA16F, two words
+// each; their colour is sRGB-encoded (else linear). The texel buffer is read in pairs of words
+// (R32G32_UINT), and a bitmap's offset counts pairs, so an 8-bit bitmap takes whole pairs.
+RT_CONST(int, kTexAlpha, 16)
+RT_CONST(int, kTexEightBit, 32)
+RT_CONST(int, kTexSrgb, 64)
+// And a half-float bitmap's colour is stored divided by 2^k, k in these bits, so that values
+// beyond a half's range (a sun in a sky map) keep their light.
+RT_CONST(int, kTexScaleShift, 8)
+RT_CONST(int, kTexScaleMax, 127)
+// Pairs of words the texel buffer may hold: lavapipe's texel-buffer limit (1 GiB).
+RT_CONST(int, kMaxTexelPairs, 134217728)
 
 RT_CONST(int, kLightPoint, 0)
 RT_CONST(int, kLightSpot, 1)

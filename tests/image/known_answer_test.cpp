@@ -4,11 +4,14 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <numbers>
 #include <random>
 #include <string>
 #include <tuple>
 #include <utility>
+#include <vector>
 
 #include "gpu_support.h"
 #include "retile/edit.h"
@@ -674,6 +677,98 @@ TEST(KnownAnswer, ATexturedBlendRatioVariesOverTheSurface) {
     }
   EXPECT_NEAR(left / nLeft, 0.8, 0.02);
   EXPECT_NEAR(right / nRight, 0.2, 0.015);
+}
+
+// An 8-bit grey texture of one row (PPM, so that the reader sees 8 bits), added to the scene.
+NodeId addByteRow(Scene& s, const std::filesystem::path& dir, const std::string& name, const std::vector<int>& row,
+                  TextureColorSpace space) {
+  const auto file = dir / (name + ".ppm");
+  std::vector<std::uint8_t> rgb;
+  for (int v : row) rgb.insert(rgb.end(), 3, static_cast<std::uint8_t>(v));
+  test::writePpm(file, static_cast<int>(row.size()), 1, rgb);
+  return test::addFileTexture(s, file, space);
+}
+
+// 8-bit textures keep their bytes on the device (a word a texel, two to a pair) and are decoded
+// there, as they were decoded on the CPU before: sRGB by its curve, Tungsten's gamma by its table
+// (applied to the bytes), linear as they are. Between them, textures of odd texel counts and
+// half-float textures, so that every one's offset is checked. Under a sky of 1 with one bounce, a
+// white lambert textured with a uniform texture reads the texture's value. A row of two texels,
+// 255 then 0, filtered and wrapped, rises from 0.5 at u = 0 to 1 at u = 1/4 and falls to 0 at 3/4:
+// over the left half of the frame (u from a to 1/2, the view 16 degrees wide from 3 above the
+// unit quad) it averages (3/8 - a/2 - a^2) / (1/2 - a), 0.782, and over the right half 1 minus
+// that; with the texels of a pair swapped, the other way round. Last, a sky map of 1 instead of
+// the constant sky.
+TEST(KnownAnswer, EightBitTexturesReadAsTheirDecodedValues) {
+  RETILE_RENDERER_OR_SKIP(r);
+  auto dir = test::tempDir();
+  Scene s = underUnitSky(32, 32, 16);  // the unit quad fills the frame
+  const double tungsten100 = std::floor(255.0 * std::pow(100.0 / 255.0, 2.2)) / 255.0;
+  const double srgb200 = std::pow((200.0 / 255.0 + 0.055) / 1.055, 2.4);
+  struct Case {
+    NodeId texture;
+    double expected;
+    const char* what;
+  };
+  const std::vector<Case> cases = {
+      {addColumnTexture(s, dir, "half-first", 3, 1, [](int) { return 0.5f; }), 0.5, "a half-float texture of 3 texels"},
+      {addByteRow(s, dir, "srgb", std::vector<int>(3, 200), TextureColorSpace::SRGB), srgb200, "8-bit sRGB, 3 texels"},
+      {addByteRow(s, dir, "tungsten", std::vector<int>(5, 100), TextureColorSpace::TungstenGamma), tungsten100,
+       "8-bit with Tungsten's gamma, 5 texels"},
+      {addColumnTexture(s, dir, "half-after", 3, 1, [](int) { return 0.25f; }), 0.25, "a half-float texture after 8-bit ones"},
+      {addByteRow(s, dir, "linear", std::vector<int>(1, 64), TextureColorSpace::Linear), 64.0 / 255.0, "8-bit linear, 1 texel"},
+  };
+  const NodeId pairTexture = addByteRow(s, dir, "pair", {255, 0}, TextureColorSpace::Linear);
+  Material white = grey(1.0f);
+  white.albedoTexture = cases[0].texture;
+  const NodeId material = test::addMaterial(s, white);
+  const NodeId plane = test::addMeshObject(s, "plane", makeQuad(), material, Mat4::identity());
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    s.material(material)->albedoTexture = c.texture;
+    EXPECT_NEAR(meanOver(renderScene(*r, s, 16), plane), c.expected, 0.004);
+  }
+  s.material(material)->albedoTexture = pairTexture;
+  const RenderImage img = renderScene(*r, s, 64);
+  double left = 0, right = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const double v = img.color[(static_cast<std::size_t>(y) * img.width + x) * 3 + 1];
+      (x < img.width / 2 ? left : right) += v;
+    }
+  const double half = img.width / 2.0 * img.height;
+  const double a = 0.5 - 3.0 * std::tan(8.0 * std::numbers::pi / 180.0);
+  const double expected = (0.375 - 0.5 * a - a * a) / (0.5 - a);
+  EXPECT_NEAR(left / half, expected, 0.006);
+  EXPECT_NEAR(right / half, 1.0 - expected, 0.006);
+  // A sky map of 1 (half floats) among 8-bit textures, the only half floats: both storages are
+  // read in one kernel.
+  std::erase_if(s.textures, [&](const Texture& t) { return t.id == cases[0].texture || t.id == cases[3].texture; });
+  s.environment.type = EnvironmentType::Map;
+  s.environment.map = addColumnTexture(s, dir, "sky", 4, 2, [](int) { return 1.0f; });
+  s.material(material)->albedoTexture = cases[2].texture;
+  EXPECT_NEAR(meanOver(renderScene(*r, s, 16), plane), tungsten100, 0.004) << "under a sky map";
+}
+
+// A sky map brighter than a half float's largest value (65504), as a sun in an HDR sky often is:
+// its texels are stored scaled down by a power of two and scaled back where they are read. A
+// uniform map of 2e6 (green) over a lambert plane of albedo 0.5 reads 1e6; clipped to halves, the
+// map read infinite and lit nothing.
+TEST(KnownAnswer, ASkyBrighterThanAHalfFloatKeepsItsLight) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = underUnitSky(16, 16, 20);
+  const auto file = test::tempDir() / "bright-sky.pfm";
+  {
+    // Portable float map: little-endian floats (the negative scale says so), bottom row first.
+    std::ofstream out(file, std::ios::binary);
+    out << "PF\n8 4\n-1.0\n";
+    const float texel[3] = {1e6f, 2e6f, 3e6f};
+    for (int i = 0; i < 8 * 4; ++i) out.write(reinterpret_cast<const char*>(texel), sizeof texel);
+  }
+  s.environment.type = EnvironmentType::Map;
+  s.environment.map = test::addFileTexture(s, file, TextureColorSpace::Linear);
+  NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, grey(0.5f)), Mat4::scale({1000, 1, 1000}));
+  EXPECT_NEAR(meanOver(renderScene(*r, s, 16), plane), 1e6, 1e4);
 }
 
 // The pixel filter (filter importance sampling): a light's straight edge on a pixel boundary.

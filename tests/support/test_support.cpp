@@ -4,6 +4,7 @@
 #include <clocale>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
@@ -29,6 +30,24 @@ fs::path tempDir() {
   fs::remove_all(p);
   fs::create_directories(p);
   return p;
+}
+
+NodeId addFileTexture(Scene& s, const fs::path& file, TextureColorSpace space) {
+  Texture t;
+  t.id = s.newId();
+  t.name = file.stem().string();
+  t.path = file;
+  t.colorSpace = space;
+  s.textures.push_back(t);
+  return t.id;
+}
+
+void writePpm(const fs::path& file, int width, int height, const std::vector<std::uint8_t>& rgb) {
+  ASSERT_EQ(rgb.size(), static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3) << file;
+  std::ofstream out(file, std::ios::binary);
+  out << "P6\n" << width << " " << height << "\n255\n";
+  out.write(reinterpret_cast<const char*>(rgb.data()), static_cast<std::streamsize>(rgb.size()));
+  ASSERT_TRUE(out.good()) << file;
 }
 
 fs::path commaLocaleDir(std::string* error) {

@@ -4,8 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "retile/image.h"
 #include "retile/scene.h"
@@ -21,6 +23,13 @@ std::filesystem::path sharedPath(const std::string& relative);
   if (var.empty()) GTEST_SKIP() << "skipped: ../shared/" << (relative) << " is not present";
 
 std::filesystem::path tempDir();  // a fresh directory per test
+
+// Adds a texture read from `file` (named after it) to the scene.
+NodeId addFileTexture(Scene& s, const std::filesystem::path& file, TextureColorSpace space);
+
+// Writes an 8-bit RGB image (binary PPM, which OpenImageIO reads as 8 bits a channel): rgb holds
+// width * height pixels of three bytes, row 0 at the top.
+void writePpm(const std::filesystem::path& file, int width, int height, const std::vector<std::uint8_t>& rgb);
 
 // A comma-decimal locale (de_DE.UTF-8), compiled once by localedef into a folder of its own, so
 // the tests need neither root nor a locale the machine happens to have. Point LOCPATH at the

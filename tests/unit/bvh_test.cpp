@@ -2,15 +2,20 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
+#include <filesystem>
 #include <limits>
 #include <random>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "render/bvh.h"
 #include "render/packed_trace.h"
 #include "render/render_scene.h"
 #include "scene/primitives.h"
+#include "retile/image.h"
 #include "retile/io.h"
 #include "test_support.h"
 
@@ -590,6 +595,97 @@ TEST(RenderScene, ATexturedEmitterIsPickedByItsTexturesMean) {
   }
   EXPECT_NEAR(pick[0] + pick[1], 1.0, 1e-5);
   EXPECT_NEAR(pick[1], 0.1 / 1.1, 1e-4) << "the textured emitter has a tenth of the power";
+}
+
+// Textures are packed in one array, 8-bit ones a word a texel and padded to whole pairs, half
+// floats two words a texel; an update copies unchanged ones from the last packing instead of
+// decoding their files again. With the first texture removed, the others hold the same texels at
+// their new offsets, although one's file is gone by then (it would be shown as a checker if it
+// were read again).
+TEST(RenderScene, TexturesKeepTheirTexelsWhenOthersComeAndGo) {
+  Scene s = test::emptyScene(8, 8);
+  const auto dir = test::tempDir();
+  auto bytes = [&](const std::string& name, const std::vector<int>& row) {
+    const auto file = dir / (name + ".ppm");
+    std::vector<std::uint8_t> rgb;
+    for (int v : row) rgb.insert(rgb.end(), {static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v / 2), static_cast<std::uint8_t>(255 - v)});
+    test::writePpm(file, static_cast<int>(row.size()), 1, rgb);
+    return file;
+  };
+  RenderImage halves;
+  halves.width = 2;
+  halves.height = 1;
+  halves.color = {0.25f, 0.5f, 2.0f, 4.0f, 0.125f, 0.0f};
+  const auto exr = dir / "halves.exr";
+  ASSERT_TRUE(writeRenderImage(halves, exr).ok());
+  for (const auto& file : {bytes("odd", {10, 20, 30}), exr, bytes("one", {200})}) test::addFileTexture(s, file, TextureColorSpace::Linear);
+  RenderSceneBuilder builder;
+  std::vector<std::string> warnings;
+  builder.update(s, kUpdateAll, &warnings);
+  EXPECT_TRUE(warnings.empty());
+  // Texture i's (flags, width, height) and its words.
+  auto texture = [&](int index) {
+    const RenderSceneData& d = builder.data();
+    const vec4* info = d.textureInfo.data() + static_cast<std::size_t>(index) * gpu::kTextureTexels;
+    const auto [offset, w, h, flags] = std::array{std::bit_cast<std::int32_t>(info->x), std::bit_cast<std::int32_t>(info->y),
+                                                  std::bit_cast<std::int32_t>(info->z), std::bit_cast<std::int32_t>(info->w)};
+    const std::size_t words = static_cast<std::size_t>(w * h) * ((flags & gpu::kTexEightBit) ? 1 : 2);
+    EXPECT_LE(static_cast<std::size_t>(offset) * 2 + words, d.texels.size());
+    return std::pair{std::array{flags, w, h},
+                     std::vector<std::uint32_t>(d.texels.begin() + offset * 2, d.texels.begin() + offset * 2 + static_cast<std::ptrdiff_t>(words))};
+  };
+  const auto odd = texture(0), half = texture(1), one = texture(2);
+  EXPECT_EQ(odd.first, (std::array{gpu::kTexBitmap | gpu::kTexEightBit, 3, 1}));
+  EXPECT_EQ(odd.second, (std::vector<std::uint32_t>{0xfff5050au, 0xffeb0a14u, 0xffe10f1eu}));
+  EXPECT_EQ(one.first, (std::array{gpu::kTexBitmap | gpu::kTexEightBit, 1, 1}));
+  EXPECT_EQ(half.first, (std::array{gpu::kTexBitmap, 2, 1}));
+  EXPECT_EQ(half.second[0], floatToHalf(0.25f) | std::uint32_t{floatToHalf(0.5f)} << 16);
+  EXPECT_EQ(half.second[1], floatToHalf(2.0f) | std::uint32_t{floatToHalf(1.0f)} << 16);
+  EXPECT_EQ(builder.data().texels.size(), 4u + 4u + 2u) << "3 bytes' words and a pad, 2 halves, 1 byte's word and a pad";
+  // The kernel reads both storages, and no sRGB.
+  const auto features = builder.data().features();
+  EXPECT_NE(features & static_cast<std::uint32_t>(gpu::kFeatureByteTexels), 0u);
+  EXPECT_NE(features & static_cast<std::uint32_t>(gpu::kFeatureHalfTexels), 0u);
+  EXPECT_EQ(features & static_cast<std::uint32_t>(gpu::kFeatureSrgbTexels), 0u);
+
+  std::filesystem::remove(exr);
+  s.textures.erase(s.textures.begin());
+  builder.update(s, kUpdateTextures, &warnings);
+  EXPECT_TRUE(warnings.empty()) << warnings.front();
+  EXPECT_EQ(texture(0), half) << "kept, not read again";
+  EXPECT_EQ(texture(1), one);
+  EXPECT_EQ(builder.data().texels.size(), 4u + 2u);
+  // Without the half-float texture and with an sRGB one, the kernel reads bytes alone, and sRGB.
+  s.textures.erase(s.textures.begin());
+  s.textures.back().colorSpace = TextureColorSpace::SRGB;
+  builder.update(s, kUpdateTextures, &warnings);
+  EXPECT_EQ(builder.data().features() & static_cast<std::uint32_t>(gpu::kFeatureByteTexels | gpu::kFeatureHalfTexels | gpu::kFeatureSrgbTexels),
+            static_cast<std::uint32_t>(gpu::kFeatureByteTexels | gpu::kFeatureSrgbTexels));
+}
+
+// The sky map is one of the scene's textures and is packed once, with them; the distribution
+// that light samples draw its texels by is built from the packed texels, so it follows the
+// brighter one.
+TEST(RenderScene, AnEnvironmentMapIsStoredOnceAmongTheTextures) {
+  Scene s = test::emptyScene(8, 8);
+  RenderImage sky;
+  sky.width = 2;
+  sky.height = 1;
+  sky.color = {1.0f, 1.0f, 1.0f, 3.0f, 3.0f, 3.0f};
+  const auto file = test::tempDir() / "two-texel-sky.exr";
+  ASSERT_TRUE(writeRenderImage(sky, file).ok());
+  s.environment.type = EnvironmentType::Map;
+  s.environment.map = test::addFileTexture(s, file, TextureColorSpace::Linear);
+  RenderSceneBuilder builder;
+  std::vector<std::string> warnings;
+  builder.update(s, kUpdateAll, &warnings);
+  EXPECT_TRUE(warnings.empty());
+  const RenderSceneData& d = builder.data();
+  EXPECT_EQ(d.environmentType, gpu::kEnvMap);
+  EXPECT_EQ(d.environmentMap, 0) << "the texture's own entry";
+  EXPECT_EQ(d.texels.size(), 4u) << "two texels of two words, once";
+  ASSERT_EQ(d.environmentCdf.size(), 1u + 2u + 3u);
+  EXPECT_NEAR(d.environmentCdf[1 + 2 + 1], 0.25, 1e-6) << "the first texel's share of its row";
 }
 
 // A mesh's packed triangles are kept in one place (the arrays of the last update) and copied

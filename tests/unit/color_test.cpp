@@ -55,6 +55,64 @@ TEST(Color, TungstenGammaTexturesDecodeWithTungstensTable) {
   EXPECT_NEAR(srgb->rgba[3 * 4] * 255.0f, 13.08f, 0.01f);
 }
 
+// 8-bit sources stay bytes (a quarter of the memory of halves), with the curve the shader decodes
+// them by; decoded, they are what the colour configuration made of them before. Every byte value
+// of an sRGB texture decodes to the config's value (within 2.5e-4 of it, less than a half float's
+// rounding: the config's linear segment is continuous with the power, a slope of 12.923 where
+// the standard's is 12.92); Tungsten's gamma is applied to the bytes (its
+// table is 8-bit); a 16-bit source becomes floats.
+TEST(Color, EightBitTexturesKeepTheirBytes) {
+  const auto file = test::tempDir() / "all-bytes.ppm";
+  std::vector<std::uint8_t> rgb;
+  for (int v = 0; v < 256; ++v) rgb.insert(rgb.end(), {static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(255 - v), static_cast<std::uint8_t>(v / 2)});
+  test::writePpm(file, 256, 1, rgb);
+  Texture t;
+  t.kind = TextureKind::File;
+  t.path = file;
+  t.colorSpace = TextureColorSpace::SRGB;  // OpenImageIO tags PPM files Rec709, which Auto takes as linear
+  auto img = loadTexture(t, file.parent_path());
+  ASSERT_TRUE(img.ok()) << img.error();
+  ASSERT_TRUE(img->eightBit());
+  EXPECT_EQ(img->curve, TextureImage::Curve::SRGB);
+  ASSERT_EQ(img->rgba8.size(), 256u * 4);
+  for (std::size_t v = 0; v < 256; ++v) {
+    EXPECT_EQ(img->rgba8[v * 4], v);
+    EXPECT_EQ(img->rgba8[v * 4 + 1], 255 - v);
+    EXPECT_EQ(img->rgba8[v * 4 + 3], 255) << "no alpha in the file";
+  }
+  std::vector<float> config(256 * 4);
+  for (std::size_t v = 0; v < 256; ++v)
+    for (std::size_t c = 0; c < 3; ++c) config[v * 4 + c] = static_cast<float>(img->rgba8[v * 4 + c]) / 255.0f;
+  ColorConfig::get()->srgbToLinear(config.data(), 256);
+  LinearImage linear = std::move(img.value()).toLinear();
+  ASSERT_EQ(linear.rgba.size(), config.size());
+  for (std::size_t i = 0; i < config.size(); ++i) {
+    if (i % 4 == 3) continue;
+    EXPECT_NEAR(linear.rgba[i], config[i], 2.5e-4f * config[i] + 1e-9f) << "texel " << i / 4 << ", channel " << i % 4;
+  }
+
+  t.colorSpace = TextureColorSpace::TungstenGamma;
+  auto tungsten = loadTexture(t, file.parent_path());
+  ASSERT_TRUE(tungsten.ok() && tungsten->eightBit());
+  EXPECT_EQ(tungsten->curve, TextureImage::Curve::Linear);
+  EXPECT_EQ(tungsten->rgba8[64 * 4], 12) << "floor(255 (64/255)^2.2)";
+  EXPECT_EQ(tungsten->rgba8[255 * 4], 255);
+
+  const auto deep = test::tempDir() / "sixteen.ppm";
+  {
+    std::ofstream out(deep, std::ios::binary);
+    out << "P6\n1 1\n65535\n";
+    for (int c = 0; c < 3; ++c) out << static_cast<char>(0x80) << static_cast<char>(0);
+  }
+  t.path = deep;
+  t.colorSpace = TextureColorSpace::Linear;
+  auto sixteen = loadTexture(t, deep.parent_path());
+  ASSERT_TRUE(sixteen.ok()) << sixteen.error();
+  EXPECT_FALSE(sixteen->eightBit());
+  ASSERT_EQ(sixteen->rgba.size(), 4u);
+  EXPECT_NEAR(sixteen->rgba[0], 32768.0f / 65535.0f, 1e-6f);
+}
+
 // A half EXR (Tungsten's references are) holds values below half's smallest normal, 6.1e-5, as
 // denormals; OpenImageIO converts them correctly only when the thread keeps denormals, and
 // the editor's threads flush them (flushDenormals). Read with them flushed, as the CLI reads.

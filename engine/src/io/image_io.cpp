@@ -20,27 +20,63 @@ namespace retile {
 namespace {
 
 struct Decoded {
-  LinearImage image;
+  TextureImage image;
   bool isFloat = false;
   std::string colorSpaceTag;
 };
 
 // Tungsten's LDR decoding (ImageIO::loadLdr with gamma correction): a 256-entry table of
 // floor(255 (v/255)^2.2), kept in 8 bits; colour only, alpha stays as stored.
-void tungstenGamma(LinearImage& image) {
-  static const std::array<float, 256> table = [] {
-    std::array<float, 256> t{};
-    for (int v = 0; v < 256; ++v) t[static_cast<std::size_t>(v)] = static_cast<float>(std::floor(255.0 * std::pow(v / 255.0, 2.2) + 1e-9) / 255.0);
+const std::array<std::uint8_t, 256>& tungstenGammaTable() {
+  static const std::array<std::uint8_t, 256> table = [] {
+    std::array<std::uint8_t, 256> t{};
+    for (int v = 0; v < 256; ++v)
+      t[static_cast<std::size_t>(v)] = static_cast<std::uint8_t>(std::floor(255.0 * std::pow(v / 255.0, 2.2) + 1e-9));
     return t;
   }();
+  return table;
+}
+
+void tungstenGamma(TextureImage& image) {
+  const auto& table = tungstenGammaTable();
+  if (image.eightBit()) {
+    for (std::size_t i = 0; i < image.rgba8.size(); ++i)
+      if (i % 4 != 3) image.rgba8[i] = table[image.rgba8[i]];
+    return;
+  }
   for (std::size_t i = 0; i < image.rgba.size(); ++i) {
     if (i % 4 == 3) continue;
     const long v = std::lround(std::clamp(image.rgba[i], 0.0f, 1.0f) * 255.0f);
-    image.rgba[i] = table[static_cast<std::size_t>(v)];
+    image.rgba[i] = static_cast<float>(table[static_cast<std::size_t>(v)]) / 255.0f;
   }
 }
 
-Result<Decoded> decode(const std::string& name, OIIO::Filesystem::IOProxy* proxy, const ImageLimits& limits) {
+// Whether the colour configuration decodes sRGB textures by the curve the shader applies to 8-bit
+// texels (it does with the shipped config; a $OCIO config may also change the primaries, and
+// then 8-bit textures are decoded here, to floats). Judged once, on every byte value of each
+// channel alone, to well within a half float's precision.
+bool configDecodesSrgbByTheCurve() {
+  static const bool same = [] {
+    std::vector<float> px(256 * 3 * 4, 0.0f);
+    for (std::size_t v = 0; v < 256; ++v)
+      for (std::size_t c = 0; c < 3; ++c) {
+        px[(v * 3 + c) * 4 + c] = static_cast<float>(v) / 255.0f;
+        px[(v * 3 + c) * 4 + 3] = 1.0f;
+      }
+    ColorConfig::get()->srgbToLinear(px.data(), 256 * 3);
+    for (std::size_t v = 0; v < 256; ++v)
+      for (std::size_t c = 0; c < 3; ++c)
+        for (std::size_t k = 0; k < 3; ++k) {
+          const float want = k == c ? srgbCurve(static_cast<float>(v) / 255.0f) : 0.0f;
+          if (!(std::abs(px[(v * 3 + c) * 4 + k] - want) <= 2e-4f * want + 1e-6f)) return false;
+        }
+    return true;
+  }();
+  return same;
+}
+
+// eightBit: keep an 8-bit source's bytes (TextureImage::rgba8) instead of converting to floats.
+Result<Decoded> decode(const std::string& name, OIIO::Filesystem::IOProxy* proxy, const ImageLimits& limits, bool eightBit) {
   using R = Result<Decoded>;
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);  // keep colour straight, not premultiplied
@@ -57,57 +93,91 @@ Result<Decoded> decode(const std::string& name, OIIO::Filesystem::IOProxy* proxy
   if (pixels > limits.maxPixels || spec.nchannels > 64)
     return R::failure(cat(name, ": image of ", spec.width, "x", spec.height, " with ", spec.nchannels,
                           " channels is larger than the limit of ", limits.maxPixels, " pixels"));
-  int nc = spec.nchannels;
-  std::vector<float> tmp(pixels * static_cast<std::uint64_t>(nc));
-  // Halves below 6.1e-5 convert correctly only with denormals kept (core/process.h), so the
-  // conversion runs here, in this thread, not in OpenImageIO's pool, whose threads may flush them.
-  KeepDenormals keep;
-  in->threads(1);
-  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, tmp.data()))
-    return R::failure(cat(name, ": cannot decode the image: ", in->geterror()));
+  const int nc = spec.nchannels;
+  const auto stride = static_cast<std::uint64_t>(nc);
+  eightBit = eightBit && spec.format == OIIO::TypeDesc::UINT8 && spec.channelformats.empty();
   Decoded d;
   d.isFloat = spec.format.basetype == OIIO::TypeDesc::FLOAT || spec.format.basetype == OIIO::TypeDesc::HALF ||
               spec.format.basetype == OIIO::TypeDesc::DOUBLE;
   d.colorSpaceTag = lowercase(std::string(spec.get_string_attribute("oiio:ColorSpace")));
-  LinearImage& img = d.image;
+  TextureImage& img = d.image;
   img.width = spec.width;
   img.height = spec.height;
   img.hasAlpha = spec.alpha_channel >= 0 && spec.alpha_channel < nc;
-  img.rgba.assign(pixels * 4, 1.0f);
-  for (std::uint64_t p = 0; p < pixels; ++p) {
-    const float* s = &tmp[p * static_cast<std::uint64_t>(nc)];
-    float* o = &img.rgba[p * 4];
-    if (nc < 3) {
-      o[0] = o[1] = o[2] = s[0];
-    } else {
+  const auto alpha = static_cast<std::uint64_t>(std::max(spec.alpha_channel, 0));
+  // Grey sources fill all three colour channels.
+  auto expand = [&](const auto* src, auto* out, auto one) {
+    for (std::uint64_t p = 0; p < pixels; ++p) {
+      const auto* s = &src[p * stride];
+      auto* o = &out[p * 4];
       o[0] = s[0];
-      o[1] = s[1];
-      o[2] = s[2];
+      o[1] = nc < 3 ? s[0] : s[1];
+      o[2] = nc < 3 ? s[0] : s[2];
+      o[3] = img.hasAlpha ? s[alpha] : one;
     }
-    if (img.hasAlpha) o[3] = s[spec.alpha_channel];
+  };
+  // Halves below 6.1e-5 convert correctly only with denormals kept (core/process.h), so the
+  // conversion runs here, in this thread, not in OpenImageIO's pool, whose threads may flush them.
+  KeepDenormals keep;
+  in->threads(1);
+  if (eightBit) {
+    std::vector<std::uint8_t> tmp(pixels * stride);
+    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, tmp.data()))
+      return R::failure(cat(name, ": cannot decode the image: ", in->geterror()));
+    img.rgba8.resize(pixels * 4);
+    expand(tmp.data(), img.rgba8.data(), std::uint8_t{255});
+  } else {
+    std::vector<float> tmp(pixels * stride);
+    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, tmp.data()))
+      return R::failure(cat(name, ": cannot decode the image: ", in->geterror()));
+    img.rgba.resize(pixels * 4);
+    expand(tmp.data(), img.rgba.data(), 1.0f);
   }
   return d;
 }
 
 }  // namespace
 
+float srgbCurve(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
+
+LinearImage TextureImage::toLinear() && {
+  LinearImage out;
+  out.width = width;
+  out.height = height;
+  out.hasAlpha = hasAlpha;
+  if (!eightBit()) {
+    out.rgba = std::move(rgba);
+    return out;
+  }
+  std::array<float, 256> colour{};
+  for (std::size_t v = 0; v < 256; ++v) {
+    const float f = static_cast<float>(v) / 255.0f;
+    colour[v] = curve == Curve::SRGB ? srgbCurve(f) : f;
+  }
+  out.rgba.resize(rgba8.size());
+  for (std::size_t i = 0; i < rgba8.size(); ++i)
+    out.rgba[i] = i % 4 == 3 ? static_cast<float>(rgba8[i]) / 255.0f : colour[rgba8[i]];
+  rgba8 = {};
+  return out;
+}
+
 Result<LinearImage> readImageRaw(const fs::path& file, const ImageLimits& limits) {
   std::error_code ec;
   if (!fs::exists(file, ec)) return Result<LinearImage>::failure(cat(file.string(), ": file not found"));
-  auto d = decode(file.string(), nullptr, limits);
+  auto d = decode(file.string(), nullptr, limits, false);
   if (!d) return Result<LinearImage>::failure(d.error());
-  return std::move(d->image);
+  return std::move(d->image).toLinear();
 }
 
-Result<LinearImage> loadTextureImage(const Texture& tex, const fs::path& base, const ImageLimits& limits) {
-  using R = Result<LinearImage>;
+Result<TextureImage> loadTexture(const Texture& tex, const fs::path& base, const ImageLimits& limits) {
+  using R = Result<TextureImage>;
   Result<Decoded> d = Result<Decoded>::failure("");
   if (tex.kind == TextureKind::Embedded) {
     if (tex.encoded.empty()) return R::failure(cat("texture '", tex.name, "': embedded image is empty"));
     OIIO::Filesystem::IOMemReader mem(const_cast<std::uint8_t*>(tex.encoded.data()), tex.encoded.size());
     std::string hint = tex.encodedFormat.empty() ? "png" : tex.encodedFormat;
     if (hint == "jpeg") hint = "jpg";
-    d = decode(cat("embedded.", hint), &mem, limits);
+    d = decode(cat("embedded.", hint), &mem, limits, true);
     if (!d) return R::failure(cat("texture '", tex.name, "': ", d.error()));
   } else if (tex.kind == TextureKind::File) {
     auto resolved = resolveScenePath(base, tex.path.string());
@@ -115,16 +185,17 @@ Result<LinearImage> loadTextureImage(const Texture& tex, const fs::path& base, c
       fs::path shown = tex.path.is_absolute() ? tex.path : base / tex.path;
       return R::failure(cat(shown.string(), ": texture file not found"));
     }
-    d = decode(resolved->string(), nullptr, limits);
+    d = decode(resolved->string(), nullptr, limits, true);
     if (!d) return R::failure(d.error());
   } else {
     return R::failure(cat("texture '", tex.name, "' is procedural and has no image"));
   }
   Decoded& dec = d.value();
+  TextureImage& img = dec.image;
   bool srgb = false;
   switch (tex.colorSpace) {
     case TextureColorSpace::TungstenGamma:
-      if (!dec.isFloat) tungstenGamma(dec.image);
+      if (!dec.isFloat) tungstenGamma(img);
       break;
     case TextureColorSpace::SRGB: srgb = true; break;
     case TextureColorSpace::Linear:
@@ -134,8 +205,24 @@ Result<LinearImage> loadTextureImage(const Texture& tex, const fs::path& base, c
              dec.colorSpaceTag.rfind("gamma", 0) == 0;
       break;
   }
-  if (srgb) ColorConfig::get()->srgbToLinear(dec.image.rgba.data(), dec.image.rgba.size() / 4);
-  return std::move(dec.image);
+  if (srgb && img.eightBit() && configDecodesSrgbByTheCurve()) {
+    img.curve = TextureImage::Curve::SRGB;
+  } else if (srgb) {
+    LinearImage linear = std::move(img).toLinear();  // the bytes as they are: the curve is linear so far
+    ColorConfig::get()->srgbToLinear(linear.rgba.data(), linear.rgba.size() / 4);
+    img = TextureImage{};
+    img.width = linear.width;
+    img.height = linear.height;
+    img.hasAlpha = linear.hasAlpha;
+    img.rgba = std::move(linear.rgba);
+  }
+  return std::move(img);
+}
+
+Result<LinearImage> loadTextureImage(const Texture& tex, const fs::path& base, const ImageLimits& limits) {
+  auto img = loadTexture(tex, base, limits);
+  if (!img) return Result<LinearImage>::failure(img.error());
+  return std::move(img.value()).toLinear();
 }
 
 Result<bool> writeRenderImage(const RenderImage& image, const fs::path& file, const DisplaySettings& display) {

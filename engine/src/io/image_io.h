@@ -23,10 +23,33 @@ struct ImageLimits {
   std::uint64_t maxPixels = std::uint64_t(1) << 28;  // 16k x 16k
 };
 
-// Decodes a texture node's image (file or embedded) to linear RGBA floats. Colour conversion
-// follows tex.colorSpace (Auto: 8/16-bit integer formats are sRGB, float formats linear).
+// A texture as the renderer stores it. An 8-bit source stays 8 bits a channel: a quarter of the
+// memory of linear halves and an eighth of floats, where textures are most of a scene's memory.
+// Its colour is then decoded per texel by `curve` where it is read (the shader); alpha is linear.
+// Other sources, and 8-bit ones whose decoding is not such a curve, are linear floats.
+struct TextureImage {
+  enum class Curve { Linear, SRGB };
+  int width = 0;
+  int height = 0;
+  bool hasAlpha = false;             // the file had an alpha channel (else alpha is 1 / 255)
+  std::vector<std::uint8_t> rgba8;   // when not empty: RGBA, row 0 at the top
+  Curve curve = Curve::Linear;       // of rgba8's colour
+  std::vector<float> rgba;           // otherwise: linear RGBA
+  bool eightBit() const { return !rgba8.empty(); }
+  // The linear values either way (rgba8 decoded by its curve, as the shader decodes it).
+  LinearImage toLinear() &&;
+};
+
+// Decodes a texture node's image (file or embedded). Colour conversion follows tex.colorSpace
+// (Auto: 8/16-bit integer formats are sRGB, float formats linear).
+Result<TextureImage> loadTexture(const Texture& tex, const std::filesystem::path& baseDirectory,
+                                 const ImageLimits& limits = {});
+// The same, as linear RGBA floats.
 Result<LinearImage> loadTextureImage(const Texture& tex, const std::filesystem::path& baseDirectory,
                                      const ImageLimits& limits = {});
+
+// The sRGB curve as the shader applies it to 8-bit texels (IEC 61966-2-1), for v in [0, 1].
+float srgbCurve(float v);
 
 // Reads any image OIIO knows as linear floats without conversion (for tests and references).
 Result<LinearImage> readImageRaw(const std::filesystem::path& file, const ImageLimits& limits = {});

@@ -317,6 +317,9 @@ std::uint32_t RenderSceneData::features() const {
   if (materialBlend) f |= gpu::kFeatureBlend;
   if (instanceTransforms) f |= gpu::kFeatureInstanceTransforms;
   if (directReferences) f |= gpu::kFeatureDirectReferences;
+  if (byteTexels) f |= gpu::kFeatureByteTexels;
+  if (halfTexels) f |= gpu::kFeatureHalfTexels;
+  if (srgbTexels) f |= gpu::kFeatureSrgbTexels;
   return f | static_cast<std::uint32_t>(filterFeature);
 }
 
@@ -1299,67 +1302,153 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
   }
 }
 
+namespace {
+
+constexpr std::uint64_t kMaxTexelBytes = static_cast<std::uint64_t>(gpu::kMaxTexelPairs) * 8;
+
+// Appends linear RGBA floats as RGBA16F, two words a texel (layouts.h); returns their mean
+// colour and sets *scaleExponent. Colour brighter than a half's largest value (65504; a sun in a
+// sky map often is) is stored divided by 2^*scaleExponent, the power of two that brings it in
+// range, and multiplied back where it is read: clipped, it would lose most of the sky's light.
+Vec3 appendHalves(std::vector<std::uint32_t>& out, const std::vector<float>& rgba, int* scaleExponent) {
+  double sum[3] = {0, 0, 0};
+  float brightest = 0;
+  for (std::size_t i = 0; i < rgba.size(); ++i)
+    if (i % 4 != 3 && std::isfinite(rgba[i])) brightest = std::max(brightest, std::abs(rgba[i]));
+  int e = 0;
+  while (e < gpu::kTexScaleMax && std::ldexp(65504.0f, e) < brightest) ++e;
+  *scaleExponent = e;
+  const float unscale = std::ldexp(1.0f, -e);
+  out.reserve(out.size() + rgba.size() / 2);
+  for (std::size_t i = 0; i + 3 < rgba.size(); i += 4) {
+    std::uint16_t c[4];
+    for (std::size_t k = 0; k < 4; ++k) {
+      const float v = std::isfinite(rgba[i + k]) ? rgba[i + k] : 0.0f;
+      if (k < 3) sum[k] += v;
+      c[k] = floatToHalf(k < 3 ? v * unscale : v);
+    }
+    out.push_back(static_cast<std::uint32_t>(c[0]) | static_cast<std::uint32_t>(c[1]) << 16);
+    out.push_back(static_cast<std::uint32_t>(c[2]) | static_cast<std::uint32_t>(c[3]) << 16);
+  }
+  const double n = std::max<double>(static_cast<double>(rgba.size() / 4), 1.0);
+  return Vec3{static_cast<float>(sum[0] / n), static_cast<float>(sum[1] / n), static_cast<float>(sum[2] / n)};
+}
+
+// Texel i of a packed bitmap, linear RGB, as the shader reads it (scene.glsl bitmapTexel).
+Vec3 packedTexel(const std::vector<std::uint32_t>& texels, std::size_t firstWord, std::size_t i, int flags) {
+  if (flags & gpu::kTexEightBit) {
+    const std::uint32_t w = texels[firstWord + i];
+    Vec3 c{static_cast<float>(w & 255u) / 255.0f, static_cast<float>((w >> 8) & 255u) / 255.0f, static_cast<float>((w >> 16) & 255u) / 255.0f};
+    if (flags & gpu::kTexSrgb) c = Vec3{srgbCurve(c.x), srgbCurve(c.y), srgbCurve(c.z)};
+    return c;
+  }
+  const std::uint32_t w0 = texels[firstWord + 2 * i], w1 = texels[firstWord + 2 * i + 1];
+  const float scale = std::ldexp(1.0f, (flags >> gpu::kTexScaleShift) & gpu::kTexScaleMax);
+  return Vec3{halfToFloat(static_cast<std::uint16_t>(w0 & 0xffffu)), halfToFloat(static_cast<std::uint16_t>(w0 >> 16)),
+              halfToFloat(static_cast<std::uint16_t>(w1 & 0xffffu))} *
+         scale;
+}
+
+// Appends 8-bit RGBA, a word a texel (red in the low byte, as the shader reads it), padded to
+// whole pairs of words; returns the mean colour as the shader decodes it.
+Vec3 appendBytes(std::vector<std::uint32_t>& out, const std::vector<std::uint8_t>& rgba, TextureImage::Curve curve) {
+  std::uint64_t count[3][256] = {};
+  out.reserve(out.size() + rgba.size() / 4 + 1);
+  for (std::size_t i = 0; i + 3 < rgba.size(); i += 4) {
+    for (std::size_t k = 0; k < 3; ++k) ++count[k][rgba[i + k]];
+    out.push_back(static_cast<std::uint32_t>(rgba[i]) | static_cast<std::uint32_t>(rgba[i + 1]) << 8 |
+                  static_cast<std::uint32_t>(rgba[i + 2]) << 16 | static_cast<std::uint32_t>(rgba[i + 3]) << 24);
+  }
+  if (out.size() % 2) out.push_back(0);
+  double sum[3] = {0, 0, 0};
+  for (int v = 0; v < 256; ++v) {
+    const float f = static_cast<float>(v) / 255.0f;
+    const double value = curve == TextureImage::Curve::SRGB ? srgbCurve(f) : f;
+    for (std::size_t k = 0; k < 3; ++k) sum[k] += value * static_cast<double>(count[k][v]);
+  }
+  const double n = std::max<double>(static_cast<double>(rgba.size() / 4), 1.0);
+  return Vec3{static_cast<float>(sum[0] / n), static_cast<float>(sum[1] / n), static_cast<float>(sum[2] / n)};
+}
+
+}  // namespace
+
 void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::string>* warnings) {
   auto& cache = decoded_;
+  // Unchanged textures are copied from the last packing, then it is freed.
+  std::vector<std::uint32_t> last = std::move(data_.texels);
+  data_.texels = {};
   data_.textureInfo.clear();
-  data_.texels.clear();
+  data_.byteTexels = data_.halfTexels = data_.srgbTexels = false;
   textureIndex_.clear();
   textureMean_.clear();
-  Vec3 mean{0.0f};  // of the texture appended last
-  auto appendBitmap = [&](const LinearImage& img, bool hasAlpha) {
-    auto offset = static_cast<std::int32_t>(data_.texels.size() / 4);
-    data_.textureInfo.push_back(ints(offset, img.width, img.height, gpu::kTexBitmap | (hasAlpha ? 16 : 0)));
-    data_.textureInfo.push_back({0, 0, 0, 0});
-    data_.textureInfo.push_back({0, 0, 0, 0});
-    data_.texels.reserve(data_.texels.size() + img.rgba.size());
-    double sum[4] = {0, 0, 0, 0};  // the mean's channels, in the one pass over the texels
-    for (std::size_t i = 0; i < img.rgba.size(); ++i) {
-      const float f = std::isfinite(img.rgba[i]) ? img.rgba[i] : 0.0f;
-      sum[i & 3] += f;
-      data_.texels.push_back(floatToHalf(f));
-    }
-    const double n = std::max<double>(static_cast<double>(img.rgba.size() / 4), 1.0);
-    mean = Vec3{static_cast<float>(sum[0] / n), static_cast<float>(sum[1] / n), static_cast<float>(sum[2] / n)};
-  };
   auto appendChecker = [&](Vec3 on, Vec3 off, int ru, int rv) {
-    mean = (on + off) * 0.5f;
     data_.textureInfo.push_back(ints(0, 0, 0, gpu::kTexChecker));
     data_.textureInfo.push_back(v4(on, static_cast<float>(std::max(ru, 1))));
     data_.textureInfo.push_back(v4(off, static_cast<float>(std::max(rv, 1))));
+    return (on + off) * 0.5f;
   };
   for (const Texture& t : scene.textures) {
     int index = static_cast<int>(data_.textureInfo.size() / gpu::kTextureTexels);
+    textureIndex_[t.id] = index;
     if (t.kind == TextureKind::Checker) {
-      appendChecker(t.checkerOn, t.checkerOff, t.checkerResU, t.checkerResV);
-      textureIndex_[t.id] = index;
-      textureMean_[t.id] = mean;
+      textureMean_[t.id] = appendChecker(t.checkerOn, t.checkerOff, t.checkerResU, t.checkerResV);
       continue;
     }
+    const std::size_t at = data_.texels.size();
     std::string sig = textureSignature(t, scene.baseDirectory);
     Decoded& d = cache[t.id];
-    if (d.signature != sig) {
+    if (d.signature == sig && d.ok && d.offset + d.words <= last.size()) {
+      data_.texels.insert(data_.texels.end(), last.begin() + static_cast<std::ptrdiff_t>(d.offset),
+                          last.begin() + static_cast<std::ptrdiff_t>(d.offset + d.words));
+    } else if (d.signature != sig || d.ok) {
+      d = Decoded{};
       d.signature = sig;
-      auto img = loadTextureImage(t, scene.baseDirectory);
+      auto img = loadTexture(t, scene.baseDirectory);
       d.ok = img.ok();
       if (img.ok()) {
-        d.image = std::move(img.value());
-      } else {
-        d.image = {};
-        if (warnings)
-          warnings->push_back(cat(img.error(), t.whenMissing == MissingTexture::Tungsten ? "; shown as Tungsten shows it (a black and white checker)"
-                                                                                      : "; shown as a magenta checker"));
+        const TextureImage& im = img.value();
+        d.width = im.width;
+        d.height = im.height;
+        d.flags = gpu::kTexBitmap | (im.hasAlpha ? gpu::kTexAlpha : 0);
+        if (im.eightBit()) {
+          d.flags |= gpu::kTexEightBit | (im.curve == TextureImage::Curve::SRGB ? gpu::kTexSrgb : 0);
+          d.mean = appendBytes(data_.texels, im.rgba8, im.curve);
+        } else {
+          int scale = 0;
+          d.mean = appendHalves(data_.texels, im.rgba, &scale);
+          d.flags |= scale << gpu::kTexScaleShift;
+        }
+      } else if (warnings) {
+        warnings->push_back(cat(img.error(), t.whenMissing == MissingTexture::Tungsten ? "; shown as Tungsten shows it (a black and white checker)"
+                                                                                    : "; shown as a magenta checker"));
       }
     }
+    d.offset = at;
+    d.words = data_.texels.size() - at;
+    if (d.ok && data_.texels.size() / 2 > static_cast<std::size_t>(gpu::kMaxTexelPairs)) {
+      data_.texels.resize(at);
+      d.ok = false;
+      d.signature.clear();  // tried again at the next update, when others may have left
+      if (warnings)
+        warnings->push_back(cat("texture '", t.name, "': the scene's textures need more than the renderer's ",
+                                kMaxTexelBytes >> 20, " MiB of texels; shown as a checker"));
+    }
     if (d.ok) {
-      appendBitmap(d.image, d.image.hasAlpha);
+      const bool eightBit = (d.flags & gpu::kTexEightBit) != 0;
+      data_.byteTexels |= eightBit;
+      data_.halfTexels |= !eightBit;
+      data_.srgbTexels |= (d.flags & gpu::kTexSrgb) != 0;
+      data_.textureInfo.push_back(ints(static_cast<std::int32_t>(at / 2), d.width, d.height, d.flags));
+      data_.textureInfo.push_back({0, 0, 0, 0});
+      data_.textureInfo.push_back({0, 0, 0, 0});
+      textureMean_[t.id] = d.mean;
     } else if (t.whenMissing == MissingTexture::Tungsten) {
-      appendChecker({1, 1, 1}, {0, 0, 0}, 2, 2);  // Tungsten's 2x2 stand-in, its texel (0, 0) white, at the top left
+      // Tungsten's 2x2 stand-in, its texel (0, 0) white, at the top left.
+      textureMean_[t.id] = appendChecker({1, 1, 1}, {0, 0, 0}, 2, 2);
     } else {
       // A visible substitute: nobody mistakes magenta and black squares for the real texture.
-      appendChecker({1, 0, 1}, {0.05f, 0.05f, 0.05f}, 8, 8);
+      textureMean_[t.id] = appendChecker({1, 0, 1}, {0.05f, 0.05f, 0.05f}, 8, 8);
     }
-    textureIndex_[t.id] = index;
-    textureMean_[t.id] = mean;
   }
   // Forget textures that left the scene.
   std::erase_if(cache, [&](const auto& kv) { return !scene.texture(kv.first); });
@@ -1373,21 +1462,36 @@ void RenderSceneBuilder::packEnvironment(const Scene& scene, std::vector<std::st
   data_.environmentWidth = data_.environmentHeight = 0;
   data_.environmentToMap = environmentToMap(e);
   environmentPower_ = 0;
-  LinearImage map;
   Vec3 tint = e.color * e.intensity;
+  int map = -1;  // the map's texture index
   if (e.type == EnvironmentType::Map) {
+    // The map is one of the scene's textures, packed with them (packTextures), so it is read
+    // like any bitmap and stored once.
     const Texture* t = scene.texture(e.map);
-    auto img = t ? loadTextureImage(*t, scene.baseDirectory) : Result<LinearImage>::failure("environment: no map texture set");
-    if (img.ok()) {
-      map = std::move(img.value());
-    } else {
-      if (warnings) warnings->push_back(cat(img.error(), "; lighting with a constant sky of radiance ", luminance(tint), " instead"));
-    }
+    map = t ? textureIndex(t->id) : -1;
+    if (map >= 0 && (std::bit_cast<std::int32_t>(data_.textureInfo[static_cast<std::size_t>(map) * gpu::kTextureTexels].w) & 15) != gpu::kTexBitmap)
+      map = -1;  // it could not be read (packTextures said why) and stands in as a checker
+    if (map < 0 && warnings)
+      warnings->push_back(cat("environment: ", t ? cat("the map '", t->name, "' could not be read") : std::string("no map texture is set"),
+                              "; lighting with a constant sky of radiance ", luminance(tint), " instead"));
   } else if (e.type == EnvironmentType::Sky) {
-    map = bakeSky(e);
+    LinearImage sky = bakeSky(e);
     tint = Vec3{e.intensity};
+    if ((data_.texels.size() + sky.rgba.size() / 2) / 2 <= static_cast<std::size_t>(gpu::kMaxTexelPairs)) {
+      map = static_cast<int>(data_.textureInfo.size() / gpu::kTextureTexels);
+      const std::size_t at = data_.texels.size();
+      int scale = 0;
+      appendHalves(data_.texels, sky.rgba, &scale);
+      data_.textureInfo.push_back(ints(static_cast<std::int32_t>(at / 2), sky.width, sky.height, gpu::kTexBitmap | scale << gpu::kTexScaleShift));
+      data_.textureInfo.push_back({0, 0, 0, 0});
+      data_.textureInfo.push_back({0, 0, 0, 0});
+      data_.halfTexels = true;
+    } else if (warnings) {
+      warnings->push_back(cat("environment: the sky and the scene's textures need more than the renderer's ", kMaxTexelBytes >> 20,
+                              " MiB of texels; lighting with a constant sky of radiance ", luminance(tint), " instead"));
+    }
   }
-  if (map.width == 0) {
+  if (map < 0) {
     if (maxComponent(tint) > 0) {
       data_.environmentType = gpu::kEnvConstant;
       data_.environmentTint = tint;
@@ -1395,22 +1499,18 @@ void RenderSceneBuilder::packEnvironment(const Scene& scene, std::vector<std::st
     }
     return;
   }
-  // The map joins the texture table so the shader reads it like any bitmap.
-  data_.environmentMap = static_cast<int>(data_.textureInfo.size() / gpu::kTextureTexels);
-  auto offset = static_cast<std::int32_t>(data_.texels.size() / 4);
-  data_.textureInfo.push_back(ints(offset, map.width, map.height, gpu::kTexBitmap));
-  data_.textureInfo.push_back({0, 0, 0, 0});
-  data_.textureInfo.push_back({0, 0, 0, 0});
-  for (float f : map.rgba) data_.texels.push_back(floatToHalf(std::isfinite(f) ? std::max(f, 0.0f) : 0.0f));
+  const vec4 info = data_.textureInfo[static_cast<std::size_t>(map) * gpu::kTextureTexels];
+  const std::size_t firstWord = static_cast<std::size_t>(std::bit_cast<std::int32_t>(info.x)) * 2;
+  const int w = std::bit_cast<std::int32_t>(info.y), h = std::bit_cast<std::int32_t>(info.z), flags = std::bit_cast<std::int32_t>(info.w);
+  data_.environmentMap = map;
   data_.environmentType = gpu::kEnvMap;
   data_.environmentTint = tint;
-  data_.environmentWidth = map.width;
-  data_.environmentHeight = map.height;
+  data_.environmentWidth = w;
+  data_.environmentHeight = h;
 
   // Piecewise-constant 2D distribution proportional to luminance * sin(theta) of the texel, so
   // directions are drawn in proportion to the radiance they carry. Values are read back from the
-  // half-float texels so the shader's pdf uses exactly what it samples.
-  int w = map.width, h = map.height;
+  // packed texels so the shader's pdf uses what it samples.
   std::vector<float>& cdf = data_.environmentCdf;
   cdf.assign(1 + static_cast<std::size_t>(h + 1) + static_cast<std::size_t>(h) * static_cast<std::size_t>(w + 1), 0.0f);
   float* marginal = &cdf[1];
@@ -1423,8 +1523,7 @@ void RenderSceneBuilder::packEnvironment(const Scene& scene, std::vector<std::st
     double acc = 0;
     row[0] = 0;
     for (int x = 0; x < w; ++x) {
-      const std::uint16_t* px = &data_.texels[static_cast<std::size_t>(offset) * 4 + static_cast<std::size_t>((y * w + x) * 4)];
-      float lum = luminance({halfToFloat(px[0]), halfToFloat(px[1]), halfToFloat(px[2])});
+      const float lum = luminance(packedTexel(data_.texels, firstWord, static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x), flags));
       acc += std::max(lum, 0.0f) * sinTheta;
       row[x + 1] = static_cast<float>(acc);
     }

@@ -77,7 +77,7 @@ struct RenderSceneData {
   std::vector<vec4> instances;         // kInstanceTexels per instance
   std::vector<vec4> materials;         // kMaterialTexels per material
   std::vector<vec4> textureInfo;       // kTextureTexels per texture
-  std::vector<std::uint16_t> texels;   // RGBA16F, all bitmaps
+  std::vector<std::uint32_t> texels;   // every bitmap: 8-bit RGBA or RGBA16F words (layouts.h kTexEightBit)
   std::vector<vec4> emitters;          // kEmitterTexels per emissive triangle
   std::vector<vec4> emitterAlias;      // one per emitter: (keep probability, alias index, -, -)
   std::vector<vec4> deltaLights;       // kDeltaLightTexels per light, suns first
@@ -101,6 +101,8 @@ struct RenderSceneData {
   bool materialTextures = false;       // some material reads an albedo or roughness texture
   bool materialBump = false;           // some material has a bump map
   bool emissionTextures = false;       // some emissive material has an emission texture
+  // How the packed bitmaps' texels are stored (layouts.h kFeatureByteTexels and on).
+  bool byteTexels = false, halfTexels = false, srgbTexels = false;
   bool materialBlend = false;          // some material blends with another
   // Some light or emitter may lie inside glass whose medium scatters (their bounds meet). Where
   // none does, a scattering point in such glass samples no light (trace.comp scatterInMedium).
@@ -172,11 +174,15 @@ class RenderSceneBuilder {
   };
   // An object's transform from its mesh's packed space to world space.
   static Mat4 placement(const Mat4& objectTransform, const MeshEntry& mesh);
-  // Decoding is the slow part of a texture update; bitmaps of unchanged textures are kept.
+  // Decoding is the slow part of a texture update, so unchanged textures are not decoded again:
+  // their texels are copied from where the last update packed them in data_.texels (a copy of
+  // their own would double the memory that textures take).
   struct Decoded {
     std::string signature;
-    LinearImage image;
     bool ok = false;
+    std::size_t offset = 0, words = 0;  // in data_.texels as last packed
+    int width = 0, height = 0, flags = 0;
+    Vec3 mean{0.0f};
   };
 
   void packGeometry(const Scene& scene);

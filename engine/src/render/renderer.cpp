@@ -157,9 +157,9 @@ struct Renderer::Impl {
 #endif
 
   template <class T>
-  void uploadArray(Buffer& b, const std::vector<T>& data, const char* what) {
+  void uploadArray(Buffer& b, const std::vector<T>& data, const char* what, VkBufferUsageFlags usage = kTexelUsage) {
     VkDeviceSize bytes = data.size() * sizeof(T);
-    if (!b.valid() || b.size() < bytes || (b.size() > 2 * bytes + 65536)) b = Buffer(ctx, bytes, kTexelUsage, false, what);
+    if (!b.valid() || b.size() < bytes || (b.size() > 2 * bytes + 65536)) b = Buffer(ctx, bytes, usage, false, what);
     b.upload(data.data(), bytes);
   }
 
@@ -194,7 +194,7 @@ struct Renderer::Impl {
     if (dirty & kDirtyMaterials) uploadArray(materials, d.materials, "materials");
     if (dirty & (kDirtyTextures | kDirtyEnvironment)) {
       uploadArray(texInfo, d.textureInfo, "texture table");
-      uploadArray(texels, d.texels, "texels");
+      uploadArray(texels, d.texels, "texels", kTexelUsage | VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT);
       uploadArray(envCdf, d.environmentCdf, "environment distribution");
     }
     if (dirty & kDirtyEmitters) {
@@ -220,7 +220,7 @@ struct Renderer::Impl {
           ctx, "trace.comp",
           std::vector<Binding>{Binding::Storage, Binding::Storage, Binding::StorageTexel, Binding::UniformTexel,
                                Binding::UniformTexel, Binding::UniformTexel,
-                               Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel,
+                               Binding::UniformTexel, Binding::StorageTexel, Binding::UniformTexel,
                                Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel, Binding::Storage,
                                Binding::Storage, Binding::Storage, Binding::Storage, Binding::UniformTexel},
           static_cast<std::uint32_t>(sizeof(gpu::TracePush)),
@@ -244,7 +244,7 @@ struct Renderer::Impl {
     t.bind(kBindInstances, instances, VK_FORMAT_R32G32B32A32_SFLOAT);
     t.bind(kBindMaterials, materials, VK_FORMAT_R32G32B32A32_SFLOAT);
     t.bind(kBindTexInfo, texInfo, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(kBindTexels, texels, VK_FORMAT_R16G16B16A16_SFLOAT);
+    t.bind(kBindTexels, texels, VK_FORMAT_R32G32_UINT);  // pairs of words (layouts.h kTexEightBit)
     t.bind(kBindEmitters, emitters, VK_FORMAT_R32G32B32A32_SFLOAT);
     t.bind(kBindAlias, alias, VK_FORMAT_R32G32B32A32_SFLOAT);
     t.bind(kBindDelta, delta, VK_FORMAT_R32G32B32A32_SFLOAT);
@@ -839,6 +839,9 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTungsten)) out.push_back("Tungsten's filter table");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTungstenTent)) out.push_back("Tungsten's tent");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureTungstenRoulette)) out.push_back("Tungsten's roulette");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureByteTexels)) out.push_back("8-bit texels");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureHalfTexels)) out.push_back("half-float texels");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureSrgbTexels)) out.push_back("sRGB texels");
   return out;
 }
 double Renderer::lastBlasSeconds() const { return impl_->builder.lastTiming().blas; }
