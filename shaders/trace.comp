@@ -830,6 +830,12 @@ void main() {
     // back with new rays; the others go on where they stopped. Lanes given nothing (Trace::idle)
     // do not count as waiting, so the last paths of an invocation run to the end. Some lane has a
     // ray here, so the loop has work when it starts.
+#if RETILE_ALPHA_TEST
+    // Rounds of the traversal loop: lanes paused on a candidate hit of an alpha-tested triangle
+    // (Trace::alphaPending) count as waiting, and between rounds they look its alpha up, outside
+    // the loop, where it costs once a round instead of at every step of every lane.
+    for (;;) {
+#endif
     while (!noGeometry) {
       loopIterations++;
       int below = stackBelow[clamp(tr.stackSize - 2, 0, kStackSize - 1)];  // the top after a pop
@@ -838,8 +844,21 @@ void main() {
       // One ballot a step: a subgroup operation is a loop over the lanes on lavapipe, which holds
       // about a tenth of this loop's time (subgroupAdd's loop as much; checking every second
       // step, with the step written twice in the loop, was slower).
+#if RETILE_ALPHA_TEST
+      if (subgroupBallotBitCount(subgroupBallot(!tr.done && !tr.alphaPending)) <= busyAtExit) break;
+#else
       if (subgroupBallotBitCount(subgroupBallot(!tr.done)) <= busyAtExit) break;
+#endif
     }
+#if RETILE_ALPHA_TEST
+      if (tr.alphaPending) {
+        tr.alphaDecision = alphaPasses(tr.pendingInstance, tr.pendingPrim, tr.pendingU, tr.pendingV, tr.rayRandom) ? 1 : -1;
+        tr.alphaPending = false;
+      }
+      loopIterations++;  // a round is a loop iteration too (the 65535 of them)
+      if (noGeometry || subgroupBallotBitCount(subgroupBallot(!tr.done)) <= busyAtExit) break;
+    }
+#endif
     if (noGeometry) tr.done = true;  // nothing to hit
     // Every lane ran every iteration of that loop (its exit is the same in all), so the counts,
     // equal before it, still are.

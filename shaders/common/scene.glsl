@@ -266,6 +266,17 @@ struct Trace {
   vec3 crossedSigma, crossedDepth;
   float crossedScale;
 #endif
+#if RETILE_ALPHA_TEST
+  // A candidate hit on an alpha-tested triangle pauses the lane's traversal on it (alphaPending)
+  // until trace.comp, past the traversal loop, looks its alpha up for every paused lane at once:
+  // lavapipe would pay for that lookup (fifteen fetches) at every step of every lane in the loop,
+  // taken or not. The answer, alphaDecision (1 passes, -1 does not, 0 none yet), is taken when
+  // the next step tests the same triangle again.
+  bool alphaPending;
+  int alphaDecision;
+  int pendingPrim, pendingInstance;
+  float pendingU, pendingV;
+#endif
 };
 
 // `root` is frame.scene.x, the instance BVH's root, which the caller reads once.
@@ -311,6 +322,10 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, i
   tr.instance = -1;
   tr.instFlags = 0;
   tr.instanceSp = -1;
+#if RETILE_ALPHA_TEST
+  tr.alphaPending = false;
+  tr.alphaDecision = 0;
+#endif
 }
 
 // One step of a lane's traversal. The caller (trace.comp's main) holds the stack below the top
@@ -324,6 +339,9 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, i
 // their record through the same three texel fetches of the one traversal buffer. Testing up to two leaves of four
 // triangles in the visiting iteration, as before, made every iteration pay for 24 fetches.
 void traceStep(inout Trace tr, int below, int root) {
+#if RETILE_ALPHA_TEST
+  if (tr.alphaPending) return;  // paused on a candidate whose alpha is not known yet
+#endif
   // Without instance transforms the ray in an instance's space is the world's, and the loop
   // carries nine values fewer (tr.o, d and invD are then never read, and compiled out).
   const bool transforms = hasFeature(kFeatureInstanceTransforms);
@@ -428,7 +446,17 @@ void traceStep(inout Trace tr, int below, int root) {
                  (p != tr.from.x || instance != tr.from.y);
 #if RETILE_ALPHA_TEST
     bool alphaTested = direct ? (floatBitsToInt(r2.w) & kTriAlphaTested) != 0 : (tr.instFlags & kInstanceAlphaTested) != 0;
-    if (found && alphaTested) found = alphaPasses(instance, p, uu, vv, tr.rayRandom);
+    if (found && alphaTested && tr.alphaDecision == 0) {
+      // Pause here, the item unchanged, so that the step is taken again with the answer.
+      tr.alphaPending = true;
+      tr.pendingPrim = p;
+      tr.pendingInstance = instance;
+      tr.pendingU = uu;
+      tr.pendingV = vv;
+      return;
+    }
+    if (found && alphaTested) found = tr.alphaDecision > 0;
+    tr.alphaDecision = 0;
 #endif
 #if RETILE_BOUNDARY
     if (found && tr.onShadow) {
