@@ -342,13 +342,17 @@ int benchEditScene(const std::string& path, int edits) {
   const double removeMs = timed(RemoveNode{o.id});
   const double addMs = timed(AddObject{o});
   const double firstMove = timed(moved());
-  double moveMs = 0, visibilityMs = 0, materialMs = 0;
+  double moveMs = 0, visibilityMs = 0, materialMs = 0, environmentMs = 0;
+  Environment environment = scene.environment;
   for (int i = 0; i < edits; ++i) {
     moveMs += timed(moved());
     o.visible = !o.visible;
     visibilityMs += timed(SetObject{o});
     mat.roughness = 0.1f + 0.01f * static_cast<float>(i % 50);
     materialMs += timed(SetMaterial{mat});
+    // A drag of the sky's intensity: its map (or baked sky) stays as it was.
+    environment.intensity *= i % 2 ? 1.0f / 1.01f : 1.01f;
+    environmentMs += timed(SetEnvironment{environment});
   }
   if (!refused.empty()) return std::fprintf(stderr, "error: %s: an edit was refused: %s\n", path.c_str(), refused.c_str()), 1;
   std::printf("scene            %s (%zu objects; edited: %s)\n", path.c_str(), scene.objects.size(), o.name.c_str());
@@ -357,6 +361,7 @@ int benchEditScene(const std::string& path, int edits) {
   std::printf("move             %.3f ms/edit\n", moveMs / edits);
   std::printf("show or hide     %.3f ms/edit\n", visibilityMs / edits);
   std::printf("material         %.3f ms/edit\n", materialMs / edits);
+  std::printf("sky intensity    %.3f ms/edit (%s)\n", environmentMs / edits, environmentTypeName(environment.type));
   std::printf("remove, add      %.3f ms, %.3f ms\n", removeMs, addMs);
   return 0;
 }

@@ -1102,6 +1102,41 @@ TEST(KnownAnswer, LightsAndSkyAddUpAsEditsBringThemInAndTakeThemOut) {
   s.lights.clear();
   r->updateScene(s, kUpdateLights);
   EXPECT_NEAR(meanOver(r->render(req), plane), 1.0, 0.02);
+
+  // A sky's intensity changes the frame's tint alone (its texels and distribution stay on the
+  // device): each step must still light the plane as it says, through the edit's own flags.
+  auto edit = [&](const Environment& e) {
+    auto flags = applyEdit(s, SetEnvironment{e});
+    ASSERT_TRUE(flags.ok());
+    r->updateScene(s, flags.value());
+  };
+  Environment e = s.environment;
+  e.type = EnvironmentType::Sky;
+  e.zenith = e.horizon = e.ground = Vec3{1.5f};
+  edit(e);
+  EXPECT_NEAR(meanOver(r->render(req), plane), 0.75, 0.02) << "a baked sky of 1.5";
+  e.intensity = 2;
+  edit(e);
+  EXPECT_NEAR(meanOver(r->render(req), plane), 1.5, 0.03) << "twice as bright";
+  RenderImage sky;
+  sky.width = 2;
+  sky.height = 1;
+  sky.color = {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f};
+  const auto file = test::tempDir() / "uniform-sky.exr";
+  ASSERT_TRUE(writeRenderImage(sky, file).ok());
+  e.map = test::addFileTexture(s, file, TextureColorSpace::Linear);
+  r->updateScene(s, kUpdateTextures | kUpdateMaterials | kUpdateEnvironment);
+  e.type = EnvironmentType::Map;
+  e.color = Vec3{1.0f};
+  e.intensity = 1;
+  edit(e);
+  EXPECT_NEAR(meanOver(r->render(req), plane), 0.5, 0.01) << "a map of 1 in place of the sky";
+  e.intensity = 3;
+  edit(e);
+  EXPECT_NEAR(meanOver(r->render(req), plane), 1.5, 0.03) << "three times as bright";
+  e.type = EnvironmentType::Sky;
+  edit(e);
+  EXPECT_NEAR(meanOver(r->render(req), plane), 2.25, 0.045) << "the sky again, at the map's intensity";
 }
 
 TEST(KnownAnswer, EveryMaterialGivesOnlyFiniteSamples) {

@@ -688,6 +688,90 @@ TEST(RenderScene, AnEnvironmentMapIsStoredOnceAmongTheTextures) {
   EXPECT_NEAR(d.environmentCdf[1 + 2 + 1], 0.25, 1e-6) << "the first texel's share of its row";
 }
 
+// Dragging the sky's intensity or colour changes the frame's tint, not the packed arrays: the
+// texels and the light-sampling distribution stay (nothing to copy or upload), the light pick
+// follows the new power. A baked sky is packed after the textures and replaced alone; whatever
+// the environment went through, the arrays end as a fresh packing of the same scene makes them.
+TEST(RenderScene, AnEnvironmentEditRepacksOnlyWhatItChanged) {
+  Scene s = test::emptyScene(8, 8);
+  RenderImage sky;
+  sky.width = 2;
+  sky.height = 1;
+  sky.color = {1.0f, 1.0f, 1.0f, 3.0f, 3.0f, 3.0f};
+  const auto file = test::tempDir() / "edited-sky.exr";
+  ASSERT_TRUE(writeRenderImage(sky, file).ok());
+  const auto otherFile = test::tempDir() / "edited-sky-other.ppm";
+  test::writePpm(otherFile, 3, 1, {10, 20, 30, 40, 50, 60, 70, 80, 90});
+  const NodeId other = test::addFileTexture(s, otherFile, TextureColorSpace::Linear);
+  ASSERT_NE(other, kNoNode);
+  s.environment.type = EnvironmentType::Map;
+  s.environment.map = test::addFileTexture(s, file, TextureColorSpace::Linear);
+  s.environment.color = Vec3{1.0f};
+  s.environment.intensity = 0.5f;
+  Material lit;
+  lit.emission = {1, 1, 1};
+  test::addMeshObject(s, "light", makeQuad(), test::addMaterial(s, lit), Mat4::identity());
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  const RenderSceneData& d = builder.data();
+  const std::vector<std::uint32_t> texels = d.texels;
+  const std::vector<float> cdf = d.environmentCdf;
+  const float pick = d.lightPick[1];
+  auto edit = [&](const Environment& e) {
+    auto flags = applyEdit(s, SetEnvironment{e});
+    EXPECT_TRUE(flags.ok());
+    return builder.update(s, flags.ok() ? flags.value() : 0u, nullptr);
+  };
+  Environment e = s.environment;
+  e.intensity = 4;
+  EXPECT_EQ(edit(e) & (kDirtyTextures | kDirtyEnvironment | kDirtyGeometry | kDirtyInstances | kDirtyMaterials), 0u)
+      << "an intensity drag repacks nothing";
+  EXPECT_EQ(d.texels, texels);
+  EXPECT_EQ(d.environmentCdf, cdf);
+  EXPECT_EQ(d.environmentType, gpu::kEnvMap);
+  EXPECT_FLOAT_EQ(d.environmentTint.x, 4 * s.environment.color.x);
+  EXPECT_GT(d.lightPick[1], pick) << "a brighter sky takes more of the light samples";
+
+  // To a baked sky: the sky's texels follow the textures', and the map's distribution goes.
+  e.type = EnvironmentType::Sky;
+  EXPECT_EQ(edit(e) & (kDirtyTextures | kDirtyEnvironment), kDirtyTextures | kDirtyEnvironment);
+  ASSERT_GT(d.texels.size(), texels.size());
+  EXPECT_TRUE(std::equal(texels.begin(), texels.end(), d.texels.begin())) << "the textures' texels kept in place";
+  EXPECT_EQ(d.environmentMap, 2) << "the sky's entry after the two textures";
+  const std::vector<std::uint32_t> withSky = d.texels;
+  const std::vector<float> skyCdf = d.environmentCdf;
+  e.intensity = 2;
+  EXPECT_EQ(edit(e) & (kDirtyTextures | kDirtyEnvironment), 0u) << "the same sky, brighter";
+  EXPECT_EQ(d.texels, withSky);
+  e.zenith = {0.1f, 0.2f, 0.9f};
+  EXPECT_EQ(edit(e) & kDirtyTextures, kDirtyTextures) << "another sky";
+  EXPECT_EQ(d.texels.size(), withSky.size());
+  EXPECT_NE(d.texels, withSky);
+  EXPECT_NE(d.environmentCdf, skyCdf);
+
+  // Back to the map: as a fresh packing makes the arrays.
+  e.type = EnvironmentType::Map;
+  EXPECT_EQ(edit(e) & (kDirtyTextures | kDirtyEnvironment), kDirtyTextures | kDirtyEnvironment);
+  RenderSceneBuilder fresh;
+  fresh.update(s, kUpdateAll, nullptr);
+  EXPECT_EQ(d.texels, fresh.data().texels);
+  EXPECT_EQ(d.textureInfo.size(), fresh.data().textureInfo.size());
+  EXPECT_EQ(d.environmentCdf, fresh.data().environmentCdf);
+  EXPECT_EQ(d.halfTexels, fresh.data().halfTexels);
+  EXPECT_EQ(d.lightPick[1], fresh.data().lightPick[1]);
+
+  // A texture edit under a baked sky: the sky comes back after the textures.
+  e.type = EnvironmentType::Sky;
+  edit(e);
+  ASSERT_TRUE(applyEdit(s, RemoveNode{other}).ok());
+  builder.update(s, kUpdateTextures | kUpdateMaterials | kUpdateEnvironment, nullptr);
+  RenderSceneBuilder again;
+  again.update(s, kUpdateAll, nullptr);
+  EXPECT_EQ(d.texels, again.data().texels);
+  EXPECT_EQ(d.environmentMap, again.data().environmentMap);
+  EXPECT_EQ(d.environmentCdf, again.data().environmentCdf);
+}
+
 // A mesh's packed triangles are kept in one place (the arrays of the last update) and copied
 // from there when meshes come and go: after adding a mesh and removing the first, every packed
 // triangle still holds its mesh's vertices and names its own global index.

@@ -343,11 +343,15 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
   std::uint32_t dirty = 0;
   if (flags & kUpdateTextures || flags & kUpdateEnvironment) {
     auto t = Clock::now();
-    packTextures(scene, warnings);
-    packEnvironment(scene, warnings);
+    // The world's medium is compiled into the kernel as a material's is, and hides the suns.
+    if (!(worldMediumOf(scene.environment) == data_.worldMedium)) flags |= kUpdateMaterials;
+    if (flags & kUpdateTextures) {
+      packTextures(scene, warnings);
+      dirty |= kDirtyTextures;
+      flags |= kUpdateMaterials;  // texture indices may have moved
+    }
+    dirty |= packEnvironment(scene, warnings);
     timing_.textures = secondsSince(t);
-    dirty |= kDirtyTextures | kDirtyEnvironment;
-    flags |= kUpdateMaterials;  // texture indices may have moved
   }
   if (flags & kUpdateGeometry) {
     auto t = Clock::now();
@@ -370,7 +374,7 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
     timing_.emitters = secondsSince(t);
     dirty |= kDirtyInstances | kDirtyEmitters;
   }
-  if (dirty & (kDirtyEmitters | kDirtyEnvironment | kDirtyInstances)) choosePickProbabilities(scene);
+  if (dirty & (kDirtyEmitters | kDirtyEnvironment | kDirtyInstances) || flags & kUpdateEnvironment) choosePickProbabilities(scene);
   return dirty;
 }
 
@@ -393,6 +397,11 @@ std::optional<Mat4> packedInverse(const Mat4& t) {
   return inv;
 }
 }  // namespace
+
+MediumAt worldMediumOf(const Environment& e) {
+  if (!e.filled()) return {};
+  return {max(e.mediumAbsorption, Vec3{0.0f}), max(e.mediumScattering, Vec3{0.0f}), std::clamp(e.mediumAnisotropy, -0.99f, 0.99f)};
+}
 
 Mat4 RenderSceneBuilder::placement(const Mat4& objectTransform, const MeshEntry& mesh) {
   if (mesh.placed == Mat4::identity()) return objectTransform;
@@ -640,9 +649,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
   // The world's medium compiles the same kernel code in as a material's (trace.comp RETILE_MEDIUM).
   const Environment& env = scene.environment;
   const bool fog = env.filled();
-  data_.worldMedium = fog ? MediumAt{max(env.mediumAbsorption, Vec3{0.0f}), max(env.mediumScattering, Vec3{0.0f}),
-                                     std::clamp(env.mediumAnisotropy, -0.99f, 0.99f)}
-                          : MediumAt{};
+  data_.worldMedium = worldMediumOf(env);
   if (fog) data_.materialTypes |= 1u << gpu::kMaskMedium;
   if (fog && maxComponent(env.mediumScattering) > 0) data_.materialTypes |= 1u << gpu::kMaskScattering;
   defaultMaterial_ = static_cast<int>(data_.materials.size() / gpu::kMaterialTexels);
@@ -1452,11 +1459,26 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
   }
   // Forget textures that left the scene.
   std::erase_if(cache, [&](const auto& kv) { return !scene.texture(kv.first); });
+  sceneTexelWords_ = data_.texels.size();
+  sceneTextureInfos_ = data_.textureInfo.size();
+  sceneHalfTexels_ = data_.halfTexels;
+  packedSky_.clear();
 }
 
-void RenderSceneBuilder::packEnvironment(const Scene& scene, std::vector<std::string>* warnings) {
+namespace {
+// What an environment's light-sampling distribution and baked sky are made from, as a key: its
+// map (the texture and what was decoded for it) or its sky's colours; empty for a constant.
+std::string environmentSource(const Environment& e, const Texture* map, const std::string& mapSignature) {
+  auto bits = [](Vec3 v) { return cat(std::bit_cast<std::uint32_t>(v.x), ",", std::bit_cast<std::uint32_t>(v.y), ",", std::bit_cast<std::uint32_t>(v.z)); };
+  if (e.type == EnvironmentType::Map && map) return cat("map|", map->id, "|", mapSignature);
+  if (e.type == EnvironmentType::Sky) return cat("sky|", bits(e.zenith), "|", bits(e.horizon), "|", bits(e.ground));
+  return {};
+}
+}  // namespace
+
+std::uint32_t RenderSceneBuilder::packEnvironment(const Scene& scene, std::vector<std::string>* warnings) {
   const Environment& e = scene.environment;
-  data_.environmentCdf.assign(1, 0.0f);
+  std::uint32_t dirty = 0;
   data_.environmentType = gpu::kEnvNone;
   data_.environmentMap = -1;
   data_.environmentWidth = data_.environmentHeight = 0;
@@ -1464,6 +1486,7 @@ void RenderSceneBuilder::packEnvironment(const Scene& scene, std::vector<std::st
   environmentPower_ = 0;
   Vec3 tint = e.color * e.intensity;
   int map = -1;  // the map's texture index
+  std::string source;
   if (e.type == EnvironmentType::Map) {
     // The map is one of the scene's textures, packed with them (packTextures), so it is read
     // like any bitmap and stored once.
@@ -1474,30 +1497,49 @@ void RenderSceneBuilder::packEnvironment(const Scene& scene, std::vector<std::st
     if (map < 0 && warnings)
       warnings->push_back(cat("environment: ", t ? cat("the map '", t->name, "' could not be read") : std::string("no map texture is set"),
                               "; lighting with a constant sky of radiance ", luminance(tint), " instead"));
-  } else if (e.type == EnvironmentType::Sky) {
-    LinearImage sky = bakeSky(e);
+    if (map >= 0) source = environmentSource(e, t, decoded_[t->id].signature);
+  }
+  // A sky packed after the scene's textures stays while it is the same sky.
+  const std::string sky = e.type == EnvironmentType::Sky ? environmentSource(e, nullptr, {}) : std::string();
+  if (packedSky_ != sky || sky.empty()) {
+    if (data_.texels.size() != sceneTexelWords_ || data_.textureInfo.size() != sceneTextureInfos_) dirty |= kDirtyTextures;
+    data_.texels.resize(sceneTexelWords_);
+    data_.textureInfo.resize(sceneTextureInfos_);
+    data_.halfTexels = sceneHalfTexels_;
+    packedSky_.clear();
+  }
+  if (!sky.empty()) {
     tint = Vec3{e.intensity};
-    if ((data_.texels.size() + sky.rgba.size() / 2) / 2 <= static_cast<std::size_t>(gpu::kMaxTexelPairs)) {
+    if (packedSky_ == sky) {
+      map = static_cast<int>(sceneTextureInfos_ / gpu::kTextureTexels);
+      source = sky;
+    } else if (LinearImage baked = bakeSky(e);
+               (data_.texels.size() + baked.rgba.size() / 2) / 2 <= static_cast<std::size_t>(gpu::kMaxTexelPairs)) {
       map = static_cast<int>(data_.textureInfo.size() / gpu::kTextureTexels);
       const std::size_t at = data_.texels.size();
       int scale = 0;
-      appendHalves(data_.texels, sky.rgba, &scale);
-      data_.textureInfo.push_back(ints(static_cast<std::int32_t>(at / 2), sky.width, sky.height, gpu::kTexBitmap | scale << gpu::kTexScaleShift));
+      appendHalves(data_.texels, baked.rgba, &scale);
+      data_.textureInfo.push_back(ints(static_cast<std::int32_t>(at / 2), baked.width, baked.height, gpu::kTexBitmap | scale << gpu::kTexScaleShift));
       data_.textureInfo.push_back({0, 0, 0, 0});
       data_.textureInfo.push_back({0, 0, 0, 0});
       data_.halfTexels = true;
+      packedSky_ = source = sky;
+      dirty |= kDirtyTextures;
     } else if (warnings) {
       warnings->push_back(cat("environment: the sky and the scene's textures need more than the renderer's ", kMaxTexelBytes >> 20,
                               " MiB of texels; lighting with a constant sky of radiance ", luminance(tint), " instead"));
     }
   }
   if (map < 0) {
+    if (environmentSource_ != "" || data_.environmentCdf.size() != 1) dirty |= kDirtyEnvironment;
+    data_.environmentCdf.assign(1, 0.0f);
+    environmentSource_.clear();
     if (maxComponent(tint) > 0) {
       data_.environmentType = gpu::kEnvConstant;
       data_.environmentTint = tint;
       environmentPower_ = kPi * luminance(tint);
     }
-    return;
+    return dirty;
   }
   const vec4 info = data_.textureInfo[static_cast<std::size_t>(map) * gpu::kTextureTexels];
   const std::size_t firstWord = static_cast<std::size_t>(std::bit_cast<std::int32_t>(info.x)) * 2;
@@ -1508,6 +1550,17 @@ void RenderSceneBuilder::packEnvironment(const Scene& scene, std::vector<std::st
   data_.environmentWidth = w;
   data_.environmentHeight = h;
 
+  if (source != environmentSource_ || data_.environmentCdf.size() == 1) {
+    environmentMean_ = environmentDistribution(firstWord, w, h, flags);
+    environmentSource_ = source;
+    dirty |= kDirtyEnvironment;
+  }
+  environmentPower_ = kPi * luminance(tint) * static_cast<float>(environmentMean_) * (kPi / 2);
+  if (environmentMean_ <= 0) data_.environmentType = gpu::kEnvNone;
+  return dirty;
+}
+
+double RenderSceneBuilder::environmentDistribution(std::size_t firstWord, int w, int h, int flags) {
   // Piecewise-constant 2D distribution proportional to luminance * sin(theta) of the texel, so
   // directions are drawn in proportion to the radiance they carry. Values are read back from the
   // packed texels so the shader's pdf uses what it samples.
@@ -1542,8 +1595,7 @@ void RenderSceneBuilder::packEnvironment(const Scene& scene, std::vector<std::st
   }
   // Normaliser: mean of luminance * sin(theta) over texels. pdf(direction) = lum / (norm * 2 pi^2).
   cdf[0] = total > 0 ? static_cast<float>(total / (static_cast<double>(w) * h)) : 0.0f;
-  environmentPower_ = kPi * luminance(tint) * static_cast<float>(total / (static_cast<double>(w) * h)) * (kPi / 2);
-  if (total <= 0) data_.environmentType = gpu::kEnvNone;
+  return total > 0 ? total / (static_cast<double>(w) * h) : 0.0;
 }
 
 void RenderSceneBuilder::choosePickProbabilities(const Scene&) {

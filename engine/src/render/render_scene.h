@@ -52,7 +52,7 @@ enum DirtyArrays : std::uint32_t {
   kDirtyMaterials = 1u << 2,
   kDirtyTextures = 1u << 3,   // textureInfo, texels
   kDirtyEmitters = 1u << 4,   // emitters, emitterAlias, deltaLights
-  kDirtyEnvironment = 1u << 5,
+  kDirtyEnvironment = 1u << 5,  // environmentCdf
   kDirtyTriangleNames = 1u << 6,  // meshTraversal only: the instances its triangles name (direct)
   kDirtyAllArrays = 0xffu,
 };
@@ -64,7 +64,11 @@ struct MediumAt {
   bool glass = false;  // the interior of glass (which blocks shadow rays), not of a boundary
   // Nothing from infinitely far gets through it in any channel.
   bool dimsEveryChannel() const { return minComponent(absorption + scattering) > 0; }
+  friend bool operator==(const MediumAt&, const MediumAt&) = default;
 };
+
+// The medium that fills the world (Environment::mediumAbsorption and on), as the kernel holds it.
+MediumAt worldMediumOf(const Environment& e);
 
 struct RenderSceneData {
   // The traversal buffer (layouts.h), in two parts so that moving an object re-uploads only the
@@ -193,7 +197,13 @@ class RenderSceneBuilder {
   void packTextures(const Scene& scene, std::vector<std::string>* warnings);
   void packEmitters(const Scene& scene);
   bool lightInScatteringGlass(const Scene& scene) const;  // RenderSceneData::lightInScatteringGlass
-  void packEnvironment(const Scene& scene, std::vector<std::string>* warnings);
+  // Returns the DirtyArrays it changed: kDirtyTextures when a baked sky came or went,
+  // kDirtyEnvironment when the light-sampling distribution changed. An intensity or colour edit
+  // changes neither, so dragging it copies no texels (packTextures runs only when textures change).
+  std::uint32_t packEnvironment(const Scene& scene, std::vector<std::string>* warnings);
+  // Fills data_.environmentCdf for the w x h map packed from texel word firstWord with `flags`
+  // (layouts.h kTex...); returns its mean of luminance * sin(theta).
+  double environmentDistribution(std::size_t firstWord, int w, int h, int flags);
   void choosePickProbabilities(const Scene& scene);
   int textureIndex(NodeId id) const;
   int materialIndex(NodeId id) const;
@@ -213,6 +223,16 @@ class RenderSceneBuilder {
   int defaultMaterial_ = 0;
   float emitterPower_ = 0;
   float environmentPower_ = 0;
+  // A baked sky is packed after the scene's textures, which end at these sizes of data_.texels
+  // and data_.textureInfo (halfTexels as they leave it), so that an environment edit replaces the
+  // sky alone. packedSky_ names the sky packed there (environmentSource), empty when none is.
+  std::size_t sceneTexelWords_ = 0, sceneTextureInfos_ = 0;
+  bool sceneHalfTexels_ = false;
+  std::string packedSky_;
+  // What data_.environmentCdf was made from (environmentSource; empty: no map or sky), and its
+  // mean of luminance * sin(theta), the environment's power before the tint.
+  std::string environmentSource_;
+  double environmentMean_ = 0;
   float deltaPower_ = 0;
   bool first_ = true;
   bool directReferences_ = true;

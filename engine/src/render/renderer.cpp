@@ -192,11 +192,11 @@ struct Renderer::Impl {
     }
     if (dirty & kDirtyInstances) uploadArray(instances, d.instances, "instances");
     if (dirty & kDirtyMaterials) uploadArray(materials, d.materials, "materials");
-    if (dirty & (kDirtyTextures | kDirtyEnvironment)) {
+    if (dirty & kDirtyTextures) {
       uploadArray(texInfo, d.textureInfo, "texture table");
       uploadArray(texels, d.texels, "texels", kTexelUsage | VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT);
-      uploadArray(envCdf, d.environmentCdf, "environment distribution");
     }
+    if (dirty & kDirtyEnvironment) uploadArray(envCdf, d.environmentCdf, "environment distribution");
     if (dirty & kDirtyEmitters) {
       uploadArray(emitters, d.emitters, "emitters");
       uploadArray(alias, d.emitterAlias, "emitter alias table");

@@ -182,7 +182,7 @@ Result<std::uint32_t> applyEdit(Scene& s, const Edit& edit) {
             sky.mediumAnisotropy = s.environment.mediumAnisotropy;
             const bool skyChanged = !(sky == s.environment);
             s.environment = v;
-            return (skyChanged ? kUpdateEnvironment : kUpdateMaterials) | kUpdateLights;
+            return skyChanged ? kUpdateEnvironment : kUpdateMaterials;
           },
           [&](const SetRenderSettings& e) -> Applied {
             if (auto why = checkSettings(e.settings); !why.empty()) return fail(why);
