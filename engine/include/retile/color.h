@@ -37,6 +37,10 @@ class ColorConfig {
   virtual void srgbToLinear(float* rgba, std::size_t pixels) const = 0;
 };
 
+// The sRGB curve (IEC 61966-2-1) from encoded to linear, for v in [0, 1]: what the shader decodes
+// 8-bit sRGB texels by, and the decoding when no configuration provides one.
+float srgbCurve(float v);
+
 // Where shipped resources live: $RETILE_RESOURCES, else <executable>/../share/retile when it
 // holds them (installed), else the source tree's resources/ (builds run in place).
 std::string resourceDirectory();

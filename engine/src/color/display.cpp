@@ -118,7 +118,7 @@ class OcioConfig final : public ColorConfig {
     for (std::size_t i = 0; i < pixels; ++i)
       for (int c = 0; c < 3; ++c) {
         float& v = rgba[i * 4 + static_cast<std::size_t>(c)];
-        v = v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+        v = srgbCurve(v);
       }
   }
 
@@ -183,5 +183,7 @@ std::shared_ptr<const ColorConfig> ColorConfig::get() {
   if (!instance) throw Error(failure);
   return instance;
 }
+
+float srgbCurve(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
 
 }  // namespace retile

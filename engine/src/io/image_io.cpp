@@ -138,7 +138,14 @@ Result<Decoded> decode(const std::string& name, OIIO::Filesystem::IOProxy* proxy
 
 }  // namespace
 
-float srgbCurve(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
+std::array<float, 256> TextureImage::byteValues() const {
+  std::array<float, 256> values{};
+  for (std::size_t v = 0; v < 256; ++v) {
+    const float f = static_cast<float>(v) / 255.0f;
+    values[v] = curve == Curve::SRGB ? srgbCurve(f) : f;
+  }
+  return values;
+}
 
 LinearImage TextureImage::toLinear() && {
   LinearImage out;
@@ -149,11 +156,7 @@ LinearImage TextureImage::toLinear() && {
     out.rgba = std::move(rgba);
     return out;
   }
-  std::array<float, 256> colour{};
-  for (std::size_t v = 0; v < 256; ++v) {
-    const float f = static_cast<float>(v) / 255.0f;
-    colour[v] = curve == Curve::SRGB ? srgbCurve(f) : f;
-  }
+  const std::array<float, 256> colour = byteValues();
   out.rgba.resize(rgba8.size());
   for (std::size_t i = 0; i < rgba8.size(); ++i)
     out.rgba[i] = i % 4 == 3 ? static_cast<float>(rgba8[i]) / 255.0f : colour[rgba8[i]];
@@ -217,12 +220,6 @@ Result<TextureImage> loadTexture(const Texture& tex, const fs::path& base, const
     img.rgba = std::move(linear.rgba);
   }
   return std::move(img);
-}
-
-Result<LinearImage> loadTextureImage(const Texture& tex, const fs::path& base, const ImageLimits& limits) {
-  auto img = loadTexture(tex, base, limits);
-  if (!img) return Result<LinearImage>::failure(img.error());
-  return std::move(img.value()).toLinear();
 }
 
 Result<bool> writeRenderImage(const RenderImage& image, const fs::path& file, const DisplaySettings& display) {

@@ -2,6 +2,7 @@
 // Any thread; no shared state besides OIIO's own thread-safe caches.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -36,6 +37,8 @@ struct TextureImage {
   Curve curve = Curve::Linear;       // of rgba8's colour
   std::vector<float> rgba;           // otherwise: linear RGBA
   bool eightBit() const { return !rgba8.empty(); }
+  // What each byte value of rgba8's colour decodes to by `curve` (alpha is value / 255).
+  std::array<float, 256> byteValues() const;
   // The linear values either way (rgba8 decoded by its curve, as the shader decodes it).
   LinearImage toLinear() &&;
 };
@@ -44,12 +47,6 @@ struct TextureImage {
 // (Auto: 8/16-bit integer formats are sRGB, float formats linear).
 Result<TextureImage> loadTexture(const Texture& tex, const std::filesystem::path& baseDirectory,
                                  const ImageLimits& limits = {});
-// The same, as linear RGBA floats.
-Result<LinearImage> loadTextureImage(const Texture& tex, const std::filesystem::path& baseDirectory,
-                                     const ImageLimits& limits = {});
-
-// The sRGB curve as the shader applies it to 8-bit texels (IEC 61966-2-1), for v in [0, 1].
-float srgbCurve(float v);
 
 // Reads any image OIIO knows as linear floats without conversion (for tests and references).
 Result<LinearImage> readImageRaw(const std::filesystem::path& file, const ImageLimits& limits = {});

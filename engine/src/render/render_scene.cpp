@@ -16,6 +16,7 @@
 #include "core/files.h"
 #include "render/packed_trace.h"
 #include "io/image_io.h"
+#include "retile/color.h"
 #include "retile/error.h"
 #include "retile/log.h"
 
@@ -1358,7 +1359,8 @@ Vec3 packedTexel(const std::vector<std::uint32_t>& texels, std::size_t firstWord
 
 // Appends 8-bit RGBA, a word a texel (red in the low byte, as the shader reads it), padded to
 // whole pairs of words; returns the mean colour as the shader decodes it.
-Vec3 appendBytes(std::vector<std::uint32_t>& out, const std::vector<std::uint8_t>& rgba, TextureImage::Curve curve) {
+Vec3 appendBytes(std::vector<std::uint32_t>& out, const TextureImage& image) {
+  const std::vector<std::uint8_t>& rgba = image.rgba8;
   std::uint64_t count[3][256] = {};
   out.reserve(out.size() + rgba.size() / 4 + 1);
   for (std::size_t i = 0; i + 3 < rgba.size(); i += 4) {
@@ -1368,11 +1370,9 @@ Vec3 appendBytes(std::vector<std::uint32_t>& out, const std::vector<std::uint8_t
   }
   if (out.size() % 2) out.push_back(0);
   double sum[3] = {0, 0, 0};
-  for (int v = 0; v < 256; ++v) {
-    const float f = static_cast<float>(v) / 255.0f;
-    const double value = curve == TextureImage::Curve::SRGB ? srgbCurve(f) : f;
-    for (std::size_t k = 0; k < 3; ++k) sum[k] += value * static_cast<double>(count[k][v]);
-  }
+  const std::array<float, 256> values = image.byteValues();
+  for (std::size_t v = 0; v < 256; ++v)
+    for (std::size_t k = 0; k < 3; ++k) sum[k] += static_cast<double>(values[v]) * static_cast<double>(count[k][v]);
   const double n = std::max<double>(static_cast<double>(rgba.size() / 4), 1.0);
   return Vec3{static_cast<float>(sum[0] / n), static_cast<float>(sum[1] / n), static_cast<float>(sum[2] / n)};
 }
@@ -1419,7 +1419,7 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
         d.flags = gpu::kTexBitmap | (im.hasAlpha ? gpu::kTexAlpha : 0);
         if (im.eightBit()) {
           d.flags |= gpu::kTexEightBit | (im.curve == TextureImage::Curve::SRGB ? gpu::kTexSrgb : 0);
-          d.mean = appendBytes(data_.texels, im.rgba8, im.curve);
+          d.mean = appendBytes(data_.texels, im);
         } else {
           int scale = 0;
           d.mean = appendHalves(data_.texels, im.rgba, &scale);
