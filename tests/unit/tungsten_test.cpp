@@ -649,6 +649,8 @@ TEST(Tungsten, ASkyCapTiedToASkydomeFollowsTheDome) {
   // The dome's +y turned a quarter about z points along -x; the sun's light travels along +x.
   EXPECT_NEAR(s.lights[0].direction.x, 1.0f, 1e-5f);
   EXPECT_NEAR(s.lights[0].direction.y, 0.0f, 1e-5f);
+  EXPECT_EQ(s.environment.type, EnvironmentType::Sky);
+  EXPECT_EQ(s.environment.ground, Vec3(0.0f)) << "Tungsten's dome is black below the horizon";
   // Naming no primitive, the cap keeps its own transform (here none: straight down), and says so.
   EXPECT_NEAR(s.lights[1].direction.y, -1.0f, 1e-5f);
   EXPECT_TRUE(std::any_of(r->warnings.begin(), r->warnings.end(),

@@ -992,7 +992,9 @@ class TungstenImporter {
       number(p, "intensity", &intensity, where);
       s.environment.type = EnvironmentType::Sky;
       s.environment.intensity = intensity * 0.5f;
-      warn(cat(where, ": the physical skydome is approximated by a gradient sky"));
+      // Tungsten's dome is the sky model's upper half; below the horizon it is black.
+      s.environment.ground = Vec3{0.0f};
+      warn(cat(where, ": the physical skydome is approximated by a gradient sky, black below the horizon as Tungsten's"));
       return;
     }
     if (type == "infinite_sphere_cap") {
