@@ -830,10 +830,11 @@ void main() {
     // back with new rays; the others go on where they stopped. Lanes given nothing (Trace::idle)
     // do not count as waiting, so the last paths of an invocation run to the end. Some lane has a
     // ray here, so the loop has work when it starts.
-#if RETILE_ALPHA_TEST
+#if RETILE_ALPHA_TEST || RETILE_BOUNDARY
     // Rounds of the traversal loop: lanes paused on a candidate hit of an alpha-tested triangle
-    // (Trace::alphaPending) count as waiting, and between rounds they look its alpha up, outside
-    // the loop, where it costs once a round instead of at every step of every lane.
+    // (Trace::alphaPending), or on a shadow ray's fifth boundary (crossingPending), count as
+    // waiting. Between rounds, outside the loop, where it costs once a round instead of at every
+    // step of every lane, they look the alpha up, and every lane counts the boundaries it crossed.
     for (;;) {
 #endif
     while (!noGeometry) {
@@ -844,17 +845,18 @@ void main() {
       // One ballot a step: a subgroup operation is a loop over the lanes on lavapipe, which holds
       // about a tenth of this loop's time (subgroupAdd's loop as much; checking every second
       // step, with the step written twice in the loop, was slower).
-#if RETILE_ALPHA_TEST
-      if (subgroupBallotBitCount(subgroupBallot(!tr.done && !tr.alphaPending)) <= busyAtExit) break;
-#else
-      if (subgroupBallotBitCount(subgroupBallot(!tr.done)) <= busyAtExit) break;
-#endif
+      if (subgroupBallotBitCount(subgroupBallot(!tr.done && !TRACE_PAUSED(tr))) <= busyAtExit) break;
     }
+#if RETILE_ALPHA_TEST || RETILE_BOUNDARY
 #if RETILE_ALPHA_TEST
       if (tr.alphaPending) {
         tr.alphaDecision = alphaPasses(tr.pendingInstance, tr.pendingPrim, tr.pendingU, tr.pendingV, tr.rayRandom) ? 1 : -1;
         tr.alphaPending = false;
       }
+#endif
+#if RETILE_BOUNDARY
+      countCrossings(tr);
+#endif
       loopIterations++;  // a round is a loop iteration too (the 65535 of them)
       if (noGeometry || subgroupBallotBitCount(subgroupBallot(!tr.done)) <= busyAtExit) break;
     }

@@ -265,6 +265,17 @@ struct Trace {
   // crossedScale sums the extinctions' sizes, to tell rounding from a medium still around.
   vec3 crossedSigma, crossedDepth;
   float crossedScale;
+  // The boundaries (kInstanceBoundary, kTriBoundary) a shadow ray crossed in this round of the
+  // traversal loop, up to four, whose media are not counted yet: trace.comp counts them past the
+  // loop for every lane at once (countCrossings), where in the loop lavapipe paid for the four
+  // fetches of a boundary's medium at every step of every lane. Each is its instance + 1, negated
+  // when the ray leaves across the back, and its distance. A fifth pauses the lane on it
+  // (crossingPending), as a cut-out's candidate does (alphaPending, below), until they are
+  // counted; the step is then taken again.
+  int crossings;
+  ivec4 crossingInstance;
+  vec4 crossingT;
+  bool crossingPending;
 #endif
 #if RETILE_ALPHA_TEST
   // A candidate hit on an alpha-tested triangle pauses the lane's traversal on it (alphaPending)
@@ -294,6 +305,8 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, i
   tr.crossedSigma = vec3(0.0);
   tr.crossedDepth = vec3(0.0);
   tr.crossedScale = 0.0;
+  tr.crossings = 0;
+  tr.crossingPending = false;
 #endif
   tr.idle = !(first || second);
   tr.done = tr.idle;
@@ -328,6 +341,39 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, i
 #endif
 }
 
+#if RETILE_BOUNDARY
+// Counts the boundaries the lane's shadow ray crossed (Trace::crossings) into its crossed media,
+// and lets a lane paused on a fifth go on. Outside the traversal loop (trace.comp).
+void countCrossings(inout Trace tr) {
+  for (int i = 0; i < tr.crossings; ++i) {
+    int code = tr.crossingInstance[i];
+    int material = floatBitsToInt(texelFetch(uInstances, (abs(code) - 1) * kInstanceTexels + 3).z) * kMaterialTexels;
+    vec3 sigma = texelFetch(uMaterials, material + 8).rgb + texelFetch(uMaterials, material + 9).rgb;
+    tr.crossedScale += maxComponent(sigma);
+    // The change of medium across it: from the world's (or to it) for one that holds a medium;
+    // none for an empty one, which leaves the ray's medium as it is.
+    if (maxComponent(sigma) > 0.0) sigma -= frame.worldAbsorption.xyz + frame.worldScattering.rgb;
+    sigma = code > 0 ? sigma : -sigma;
+    tr.crossedSigma += sigma;
+    tr.crossedDepth -= sigma * tr.crossingT[i];
+  }
+  tr.crossings = 0;
+  tr.crossingPending = false;
+}
+#endif
+
+// Whether a lane waits, paused on a candidate hit, for what is looked up between rounds of the
+// traversal loop (trace.comp).
+#if RETILE_ALPHA_TEST && RETILE_BOUNDARY
+#define TRACE_PAUSED(tr) ((tr).alphaPending || (tr).crossingPending)
+#elif RETILE_ALPHA_TEST
+#define TRACE_PAUSED(tr) ((tr).alphaPending)
+#elif RETILE_BOUNDARY
+#define TRACE_PAUSED(tr) ((tr).crossingPending)
+#else
+#define TRACE_PAUSED(tr) false
+#endif
+
 // One step of a lane's traversal. The caller (trace.comp's main) holds the stack below the top
 // entry: `below` is the entry a pop brings to the top, and tr.top is already in the slot a push
 // moves it to.
@@ -341,6 +387,9 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, i
 void traceStep(inout Trace tr, int below, int root) {
 #if RETILE_ALPHA_TEST
   if (tr.alphaPending) return;  // paused on a candidate whose alpha is not known yet
+#endif
+#if RETILE_BOUNDARY
+  if (tr.crossingPending) return;  // paused on a fifth boundary until the four are counted
 #endif
   // Without instance transforms the ray in an instance's space is the world's, and the loop
   // carries nine values fewer (tr.o, d and invD are then never read, and compiled out).
@@ -459,21 +508,20 @@ void traceStep(inout Trace tr, int below, int root) {
     tr.alphaDecision = 0;
 #endif
 #if RETILE_BOUNDARY
-    if (found && tr.onShadow) {
-      // A boundary is no surface: the shadow ray goes on, into the medium on its other side. det
-      // is -dot(d, the triangle's normal): positive across the front, into the boundary's medium.
-      int material = floatBitsToInt(texelFetch(uInstances, instance * kInstanceTexels + 3).z) * kMaterialTexels;
-      if ((floatBitsToInt(texelFetch(uMaterials, material).w) & kMatTypeBits) == kMatBoundary) {
-        vec3 sigma = texelFetch(uMaterials, material + 8).rgb + texelFetch(uMaterials, material + 9).rgb;
-        tr.crossedScale += maxComponent(sigma);
-        // The change of medium across it: from the world's (or to it) for one that holds a
-        // medium; none for an empty one, which leaves the ray's medium as it is.
-        if (maxComponent(sigma) > 0.0) sigma -= frame.worldAbsorption.xyz + frame.worldScattering.rgb;
-        sigma = det > 0.0 ? sigma : -sigma;
-        tr.crossedSigma += sigma;
-        tr.crossedDepth -= sigma * tt;
-        found = false;
+    // A boundary is no surface: the shadow ray goes on, into the medium on its other side, which
+    // countCrossings counts. (A boundary is never a cut-out: packInstances.)
+    bool boundary = direct ? (floatBitsToInt(r2.w) & kTriBoundary) != 0 : (tr.instFlags & kInstanceBoundary) != 0;
+    if (found && tr.onShadow && boundary) {
+      if (tr.crossings == 4) {
+        // Pause here, the item unchanged, so that the step is taken again once they are counted.
+        tr.crossingPending = true;
+        return;
       }
+      // det is -dot(d, the triangle's normal): positive across the front, into its medium.
+      tr.crossingInstance[tr.crossings] = det > 0.0 ? instance + 1 : -(instance + 1);
+      tr.crossingT[tr.crossings] = tt;
+      tr.crossings++;
+      found = false;
     }
 #endif
     if (found && tr.onShadow) {

@@ -39,8 +39,9 @@ RT_CONST(int, kItemNode, 0)
 RT_CONST(int, kItemTriangles, 1)
 RT_CONST(int, kItemInstance, 2)
 RT_CONST(int, kItemOffsetShift, 4)
-RT_CONST(int, kTriInstanceMask, 0x3fffffff)  // e2.w with kFeatureDirectReferences: the instance
-RT_CONST(int, kTriAlphaTested, 0x40000000)   // and its kInstanceAlphaTested flag
+RT_CONST(int, kTriInstanceMask, 0x1fffffff)  // e2.w with kFeatureDirectReferences: the instance
+RT_CONST(int, kTriBoundary, 0x20000000)      // and its kInstanceBoundary
+RT_CONST(int, kTriAlphaTested, 0x40000000)   // and kInstanceAlphaTested flags
 RT_CONST(int, kMaxLeafTriangles, 4)  // render/bvh.h maxLeafSize for mesh BVHs
 // A node names its children without items, to fit 48 bytes, so that a traversal step fetches three
 // texels instead of four (docs/MEASUREMENTS.md, fourteenth session). Its slots hold inner
@@ -103,6 +104,7 @@ RT_CONST(int, kFeatureSrgbTexels, RT_FEATURE_SRGB_TEXELS)
 RT_CONST(int, kFeatureAll, 1048575)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
+RT_CONST(int, kInstanceBoundary, 2)  // its material is a boundary (kMatBoundary), which shadow rays cross
 RT_CONST(int, kInstanceEmissive, 4)
 
 RT_CONST(int, kMatLambert, 0)

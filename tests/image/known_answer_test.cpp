@@ -388,6 +388,51 @@ TEST(KnownAnswer, ALightOutsideABoundaryLightsTheMediumInside) {
   expectOverAFloor(*r, boundaryOf(kOverAFloorAbsorption, kOverAFloorScattering, -0.3f), 3, 40);
 }
 
+// A sun straight above lights a plane through five stacked boundaries, each a slab one unit thick
+// of absorbing medium: ten crossings on every shadow ray, more than the four a lane records before
+// it must pause until they are counted (Trace::crossings), so the count goes on across rounds of
+// the traversal loop. The plane reads albedo / pi E exp(-5 sigma), in each channel. Packed direct
+// (triangles name their instance and its boundary flag) and with instance records.
+TEST(KnownAnswer, AShadowRayCountsEveryBoundaryItCrosses) {
+  RETILE_RENDERER_OR_SKIP(direct);
+  RendererOptions options;
+  options.directReferences = false;
+  std::string why;
+  auto records = test::makeRenderer(&why, options);
+  ASSERT_TRUE(records) << why;
+  const Vec3 sigma{0.1f, 0.25f, 0.0f};
+  Scene s = test::emptyScene(16, 16);
+  lookStraightDown(s, 1, 2);
+  s.settings.maxBounces = 1;
+  Material grey;
+  grey.albedo = Vec3{0.5f};
+  NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, grey), Mat4::scale({4, 1, 4}));
+  const NodeId fog = test::addMaterial(s, boundaryOf(sigma));
+  for (int i = 0; i < 5; ++i)
+    test::addMeshObject(s, "slab", makeCube(), fog, Mat4::translate({0, 2.5f + 2.0f * static_cast<float>(i), 0}) * Mat4::scale({40, 1, 40}));
+  Light sun;
+  sun.id = s.newId();
+  sun.type = LightType::Directional;
+  sun.direction = {0, -1, 0};
+  sun.intensity = 2.0f;
+  s.lights.push_back(sun);
+  for (Renderer* r : {direct.get(), records.get()}) {
+    RenderImage img = renderScene(*r, s, 4);
+    for (int c = 0; c < 3; ++c) {
+      double mean = 0;
+      int n = 0;
+      for (std::size_t i = 0; i < img.objectId.size(); ++i)
+        if (img.objectId[i] == plane) {
+          mean += img.color[3 * i + static_cast<std::size_t>(c)];
+          ++n;
+        }
+      ASSERT_GT(n, 0);
+      const double expected = 0.5 / kPi * 2.0 * std::exp(-5.0 * static_cast<double>(sigma[c]));
+      EXPECT_NEAR(mean / n, expected, 1e-3 * expected) << (r == direct.get() ? "direct" : "records") << ", channel " << c;
+    }
+  }
+}
+
 TEST(KnownAnswer, TheWorldsMediumDimsWhatTheCameraSeesAndHidesTheSky) {
   // The world filled with a medium that absorbs sigma (Environment::mediumAbsorption), before a
   // sky of 1: the sky is infinitely far, so it shows in the channel that does not absorb alone.

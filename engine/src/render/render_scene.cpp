@@ -943,7 +943,8 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
       shared = shared || !seen.insert(c.mesh).second;
     }
   }
-  const bool direct = directReferences_ && !transforms && !shared;
+  // A triangle names its instance in kTriInstanceMask's bits.
+  const bool direct = directReferences_ && !transforms && !shared && cands.size() <= static_cast<std::size_t>(gpu::kTriInstanceMask);
   BvhBuildOptions opt;
   opt.maxLeafSize = 1;  // a TLAS leaf is one reference: traversal enters its subtree directly
   auto build = [&](std::size_t factor, bool packDirect, std::vector<Ref>* refs) {
@@ -978,6 +979,7 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     if (mat && mat->type != MaterialType::Boundary && (mat->alpha < 1.0f || textureIndex(mat->alphaTexture) >= 0))
       flags |= gpu::kInstanceAlphaTested;
     if (mat && mat->emissive()) flags |= gpu::kInstanceEmissive;
+    if (mat && mat->type == MaterialType::Boundary) flags |= gpu::kInstanceBoundary;
     if (c.visible && (flags & gpu::kInstanceAlphaTested)) data_.alphaTested = true;
     flagsOf[i] = flags;
     inverseOf[i] = c.transform.inverse();
@@ -1000,7 +1002,8 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     for (std::size_t i = 0; i < cands.size(); ++i)
       if (!cands[i].visible) namer.try_emplace(cands[i].mesh, i);
     for (const auto& [mesh, i] : namer) {
-      const std::uint32_t name = static_cast<std::uint32_t>(i) | ((flagsOf[i] & gpu::kInstanceAlphaTested) ? gpu::kTriAlphaTested : 0u);
+      const std::uint32_t name = static_cast<std::uint32_t>(i) | ((flagsOf[i] & gpu::kInstanceAlphaTested) ? gpu::kTriAlphaTested : 0u) |
+                                 ((flagsOf[i] & gpu::kInstanceBoundary) ? gpu::kTriBoundary : 0u);
       if (mesh->named == name) continue;
       mesh->named = name;
       renamed = true;
