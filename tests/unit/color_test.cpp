@@ -124,6 +124,22 @@ TEST(Color, EightBitTexturesKeepTheirBytes) {
 // the editor's threads flush them (flushDenormals). Read with them flushed, as the CLI reads.
 // Four pixels are converted in this thread whatever the reader's thread count: this checks
 // KeepDenormals, not that the conversion stays off OpenImageIO's pool (threads(1)).
+// An 8-bit file is sRGB-encoded under Auto whatever else its reader calls it: OpenImageIO tags a
+// PPM "Rec709", a transfer curve, which was read as linear light.
+TEST(Color, AnEightBitFileIsEncodedUnlessItSaysLinear) {
+  const auto file = test::tempDir() / "grey.ppm";
+  test::writePpm(file, 1, 1, {128, 128, 128});
+  Texture t;
+  t.kind = TextureKind::File;
+  t.path = file;
+  t.colorSpace = TextureColorSpace::Auto;
+  auto img = loadTexture(t, file.parent_path());
+  ASSERT_TRUE(img.ok()) << img.error();
+  const LinearImage linear = std::move(img.value()).toLinear();
+  ASSERT_EQ(linear.rgba.size(), 4u);
+  EXPECT_NEAR(linear.rgba[0], srgbCurve(128.0f / 255.0f), 2.5e-4f) << "not " << 128.0f / 255.0f;
+}
+
 TEST(Color, HalfExrReadsValuesBelowHalfsSmallestNormal) {
   RenderImage im;
   im.width = 4;

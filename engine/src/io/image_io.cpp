@@ -204,8 +204,9 @@ Result<TextureImage> loadTexture(const Texture& tex, const fs::path& base, const
     case TextureColorSpace::Linear:
     case TextureColorSpace::Raw: srgb = false; break;
     case TextureColorSpace::Auto:
-      srgb = dec.colorSpaceTag == "srgb" || (dec.colorSpaceTag.empty() && !dec.isFloat) ||
-             dec.colorSpaceTag.rfind("gamma", 0) == 0;
+      // Integer data is encoded unless its file says linear: OpenImageIO tags a PPM "Rec709" (the
+      // transfer curve of its standard, not linear light), which the sRGB curve decodes closely.
+      srgb = dec.isFloat ? dec.colorSpaceTag == "srgb" || dec.colorSpaceTag.rfind("gamma", 0) == 0 : dec.colorSpaceTag != "linear";
       break;
   }
   if (srgb && img.eightBit() && configDecodesSrgbByTheCurve()) {
