@@ -663,19 +663,23 @@ TEST(RenderScene, TexturesKeepTheirTexelsWhenOthersComeAndGo) {
             static_cast<std::uint32_t>(gpu::kFeatureByteTexels | gpu::kFeatureSrgbTexels));
 }
 
+// Sets the scene's environment to a map of two texels, 1 then 3, written as EXR to `file`.
+void setTwoTexelSky(Scene& s, const std::filesystem::path& file) {
+  RenderImage sky;
+  sky.width = 2;
+  sky.height = 1;
+  sky.color = {1.0f, 1.0f, 1.0f, 3.0f, 3.0f, 3.0f};
+  ASSERT_TRUE(writeRenderImage(sky, file).ok());
+  s.environment.type = EnvironmentType::Map;
+  s.environment.map = test::addFileTexture(s, file, TextureColorSpace::Linear);
+}
+
 // The sky map is one of the scene's textures and is packed once, with them; the distribution
 // that light samples draw its texels by is built from the packed texels, so it follows the
 // brighter one.
 TEST(RenderScene, AnEnvironmentMapIsStoredOnceAmongTheTextures) {
   Scene s = test::emptyScene(8, 8);
-  RenderImage sky;
-  sky.width = 2;
-  sky.height = 1;
-  sky.color = {1.0f, 1.0f, 1.0f, 3.0f, 3.0f, 3.0f};
-  const auto file = test::tempDir() / "two-texel-sky.exr";
-  ASSERT_TRUE(writeRenderImage(sky, file).ok());
-  s.environment.type = EnvironmentType::Map;
-  s.environment.map = test::addFileTexture(s, file, TextureColorSpace::Linear);
+  setTwoTexelSky(s, test::tempDir() / "two-texel-sky.exr");
   RenderSceneBuilder builder;
   std::vector<std::string> warnings;
   builder.update(s, kUpdateAll, &warnings);
@@ -694,18 +698,11 @@ TEST(RenderScene, AnEnvironmentMapIsStoredOnceAmongTheTextures) {
 // the environment went through, the arrays end as a fresh packing of the same scene makes them.
 TEST(RenderScene, AnEnvironmentEditRepacksOnlyWhatItChanged) {
   Scene s = test::emptyScene(8, 8);
-  RenderImage sky;
-  sky.width = 2;
-  sky.height = 1;
-  sky.color = {1.0f, 1.0f, 1.0f, 3.0f, 3.0f, 3.0f};
-  const auto file = test::tempDir() / "edited-sky.exr";
-  ASSERT_TRUE(writeRenderImage(sky, file).ok());
   const auto otherFile = test::tempDir() / "edited-sky-other.ppm";
   test::writePpm(otherFile, 3, 1, {10, 20, 30, 40, 50, 60, 70, 80, 90});
   const NodeId other = test::addFileTexture(s, otherFile, TextureColorSpace::Linear);
   ASSERT_NE(other, kNoNode);
-  s.environment.type = EnvironmentType::Map;
-  s.environment.map = test::addFileTexture(s, file, TextureColorSpace::Linear);
+  setTwoTexelSky(s, test::tempDir() / "edited-sky.exr");
   s.environment.color = Vec3{1.0f};
   s.environment.intensity = 0.5f;
   Material lit;

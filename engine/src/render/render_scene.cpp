@@ -1504,7 +1504,7 @@ std::uint32_t RenderSceneBuilder::packEnvironment(const Scene& scene, std::vecto
   }
   // A sky packed after the scene's textures stays while it is the same sky.
   const std::string sky = e.type == EnvironmentType::Sky ? environmentSource(e, nullptr, {}) : std::string();
-  if (packedSky_ != sky || sky.empty()) {
+  if (packedSky_ != sky) {
     if (data_.texels.size() != sceneTexelWords_ || data_.textureInfo.size() != sceneTextureInfos_) dirty |= kDirtyTextures;
     data_.texels.resize(sceneTexelWords_);
     data_.textureInfo.resize(sceneTextureInfos_);
@@ -1534,7 +1534,7 @@ std::uint32_t RenderSceneBuilder::packEnvironment(const Scene& scene, std::vecto
     }
   }
   if (map < 0) {
-    if (environmentSource_ != "" || data_.environmentCdf.size() != 1) dirty |= kDirtyEnvironment;
+    if (!environmentSource_.empty() || data_.environmentCdf.size() != 1) dirty |= kDirtyEnvironment;
     data_.environmentCdf.assign(1, 0.0f);
     environmentSource_.clear();
     if (maxComponent(tint) > 0) {
