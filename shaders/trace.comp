@@ -167,6 +167,12 @@ vec3 offsetRay(vec3 p, vec3 n) {
               abs(p.z) < origin ? p.z + floatScale * n.z : pi.z);
 }
 
+// How far along a ray that leaves a surface it starts: Tungsten's rays skip what lies within its
+// epsilon (RayOffset::Tungsten), so light leaks through cracks narrower than that and contact
+// shadows closer than that vanish, in Tungsten and then here too. The skipped piece of a medium
+// is not counted on a path's own segment (at most 5e-4 of its optical depth per unit extinction).
+float surfaceSkip() { return hasFeature(kFeatureTungstenEpsilon) ? kTungstenEpsilon : 0.0; }
+
 // The work item that holds `slot`. Every lane runs it in every pass, for a slot of its own or
 // any, with the same number of iterations (enough for the longest search), so that the lanes'
 // loop counts stay equal without a synchronisation (a loop over the lanes on lavapipe; see
@@ -412,17 +418,18 @@ vec3 transmittance(vec3 sigmaT, float dist) {
 // Sets off the shadow ray of a next-event estimate from `origin` (on triangle `from`, or -1) in a
 // medium of extinction sigmaT to the light sample, adding L, dimmed by the media on its way, when
 // nothing blocks it; traced with the path's next segment.
-void castShadow(inout Shadow shadow, inout Path path, vec3 origin, ivec2 from, LightSample ls, vec3 L, vec3 sigmaT) {
+// `skip`: how far along the ray from the light sample's point the origin is (surfaceSkip).
+void castShadow(inout Shadow shadow, inout Path path, vec3 origin, float skip, ivec2 from, LightSample ls, vec3 L, vec3 sigmaT) {
 #if RETILE_BOUNDARY
   shadow.sigma = sigmaT;
   shadow.dist = ls.dist;
 #elif RETILE_MEDIUM
   L *= transmittance(sigmaT, ls.dist);
 #endif
-  shadow.origin = origin;
+  shadow.origin = origin + ls.dir * skip;
   shadow.from = from;
   shadow.dir = ls.dir;
-  shadow.tMax = ls.dist >= kInfinity ? kInfinity : ls.dist * (1.0 - 1e-4);
+  shadow.tMax = ls.dist >= kInfinity ? kInfinity : ls.dist * (1.0 - 1e-4) - skip;
   shadow.random = rand(path.rng);
   shadow.L = L;
   shadow.ended = false;
@@ -485,7 +492,7 @@ bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, float h
     if (ls.pdf > 0.0 && maxComponent(ls.radiance) > 0.0) {
       float phase = henyeyGreenstein(dot(path.rd, ls.dir), g);
       float w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, phase);
-      castShadow(shadow, path, pos, ivec2(-1), ls, path.beta * phase * ls.radiance * (w / ls.pdf), sigmaT);
+      castShadow(shadow, path, pos, 0.0, ivec2(-1), ls, path.beta * phase * ls.radiance * (w / ls.pdf), sigmaT);
     }
   }
   vec3 next = sampleHenyeyGreenstein(path.rd, g, vec2(rand(path.rng), rand(path.rng)));
@@ -622,7 +629,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
 #if RETILE_MEDIUM
     if (maxComponent(m.interior + m.scattering.rgb) > 0.0) crossMedium(path, m, frontFace);
 #endif
-    path.ro = offsetRay(pos, frontFace ? -ng : ng);
+    path.ro = offsetRay(pos, frontFace ? -ng : ng) + rd * surfaceSkip();
     path.from = ivec2(hit.prim, hit.instance);
     path.depth++;
     return true;
@@ -685,7 +692,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
           if ((isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric)) && sideL * dot(wo, ngs) < 0.0)
             sigmaT = frontFace ? m.interior + m.scattering.rgb : path.outerAbsorption + path.outerScattering.rgb;
 #endif
-          castShadow(shadow, path, offsetRay(pos, sideL > 0.0 ? ngs : -ngs), ivec2(hit.prim, hit.instance), ls, L, sigmaT);
+          castShadow(shadow, path, offsetRay(pos, sideL > 0.0 ? ngs : -ngs), surfaceSkip(), ivec2(hit.prim, hit.instance), ls, L, sigmaT);
         }
       }
     }
@@ -714,7 +721,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   path.specular = bs.delta;
   path.prevPdf = bs.pdf;
   path.prevPos = pos;
-  path.ro = offsetRay(pos, sideI > 0.0 ? ngs : -ngs);
+  path.ro = offsetRay(pos, sideI > 0.0 ? ngs : -ngs) + wi * surfaceSkip();
   path.from = ivec2(hit.prim, hit.instance);
   path.rd = wi;
   path.depth++;

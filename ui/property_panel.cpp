@@ -639,6 +639,12 @@ void PropertyPanel::buildRender(Builder& b) {
              if (i < 0 || i > 1) return;
              edit(tr("Russian roulette"), 0, [i](RenderSettings& x) { x.roulette = static_cast<Roulette>(i); });
            });
+  // And with where its rays leave a surface, which decides what leaks through cracks (see RayOffset).
+  b.choice(tr("Ray offset"), "rayOffset", {tr("Robust"), tr("As Tungsten's (skip 0.0005 units)")}, static_cast<int>(r.rayOffset),
+           [edit](int i) {
+             if (i < 0 || i > 1) return;
+             edit(tr("Ray offset"), 0, [i](RenderSettings& x) { x.rayOffset = static_cast<RayOffset>(i); });
+           });
   b.label(tr("Resolution"), tr("%1 x %2 (the viewport's size times the render scale)").arg(renderSize_.width()).arg(renderSize_.height()));
 }
 

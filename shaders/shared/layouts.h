@@ -101,7 +101,11 @@ RT_CONST(int, kFeatureDirectReferences, 65536)
 RT_CONST(int, kFeatureByteTexels, RT_FEATURE_BYTE_TEXELS)
 RT_CONST(int, kFeatureHalfTexels, RT_FEATURE_HALF_TEXELS)
 RT_CONST(int, kFeatureSrgbTexels, RT_FEATURE_SRGB_TEXELS)
-RT_CONST(int, kFeatureAll, 1048575)
+// RayOffset::Tungsten (scene.h): a ray leaving a surface skips what lies within kTungstenEpsilon
+// of it (scene units), as Tungsten's rays do (its DefaultEpsilon, the same for every primitive).
+RT_CONST(int, kFeatureTungstenEpsilon, 1048576)
+RT_CONST(float, kTungstenEpsilon, 5e-4)
+RT_CONST(int, kFeatureAll, 2097151)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceBoundary, 2)  // its material is a boundary (kMatBoundary), which shadow rays cross

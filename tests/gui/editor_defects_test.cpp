@@ -657,7 +657,7 @@ TEST(EditorDefects, CtrlClickSelectsSeveralObjectsAndADragMovesThemTogether) {
   EXPECT_EQ(w->selectedObjects(), std::vector<NodeId>{sphere});
 }
 
-// The pixel filter, how it is drawn and the shading-normal convention are render settings:
+// The pixel filter, how it is drawn and Tungsten's other conventions are render settings:
 // chosen in Properties, each reaches the engine as one undo step and restarts the accumulation.
 TEST(EditorDefects, ThePixelFilterIsARenderSettingWithUndo) {
   auto w = makeWindow();
@@ -684,27 +684,24 @@ TEST(EditorDefects, ThePixelFilterIsARenderSettingWithUndo) {
   EXPECT_EQ(w->scene().settings.filterSampling, FilterSampling::Tungsten);
   w->undoStack()->undo();
   EXPECT_EQ(w->scene().settings.filterSampling, FilterSampling::Exact);
-  // So is Tungsten's shading-normal convention; switching it must reach the renderer (another
-  // trace kernel) and be rendered.
-  auto* shading = w->findChild<QComboBox*>("shading");
-  ASSERT_TRUE(shading);
-  EXPECT_EQ(shading->currentIndex(), static_cast<int>(ShadingConvention::Consistent));
-  shading->setCurrentIndex(static_cast<int>(ShadingConvention::Tungsten));
-  EXPECT_EQ(w->scene().settings.shading, ShadingConvention::Tungsten);
-  const std::uint64_t shaded = w->documentVersion();
-  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == shaded; }));
-  w->undoStack()->undo();
-  EXPECT_EQ(w->scene().settings.shading, ShadingConvention::Consistent);
-  // And its Russian roulette, another trace kernel.
-  auto* roulette = w->findChild<QComboBox*>("roulette");
-  ASSERT_TRUE(roulette);
-  EXPECT_EQ(roulette->currentIndex(), static_cast<int>(Roulette::Standard));
-  roulette->setCurrentIndex(static_cast<int>(Roulette::Tungsten));
-  EXPECT_EQ(w->scene().settings.roulette, Roulette::Tungsten);
-  const std::uint64_t played = w->documentVersion();
-  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == played; }));
-  w->undoStack()->undo();
-  EXPECT_EQ(w->scene().settings.roulette, Roulette::Standard);
+  // So are the other conventions Tungsten files bring: its shading normals, its Russian roulette
+  // and where its rays leave a surface. Each is another trace kernel: switching it must reach the
+  // renderer and be rendered, and undo must bring ours back.
+  auto switchToTungsten = [&](const char* name, auto field) {
+    SCOPED_TRACE(name);
+    auto* box = w->findChild<QComboBox*>(name);
+    ASSERT_TRUE(box);
+    EXPECT_EQ(box->currentIndex(), 0) << "ours, in a new scene";
+    box->setCurrentIndex(1);
+    EXPECT_EQ(static_cast<int>(w->scene().settings.*field), 1);
+    const std::uint64_t switched = w->documentVersion();
+    ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == switched; }));
+    w->undoStack()->undo();
+    EXPECT_EQ(static_cast<int>(w->scene().settings.*field), 0);
+  };
+  switchToTungsten("shading", &RenderSettings::shading);
+  switchToTungsten("roulette", &RenderSettings::roulette);
+  switchToTungsten("rayOffset", &RenderSettings::rayOffset);
 }
 
 }  // namespace

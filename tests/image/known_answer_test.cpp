@@ -38,6 +38,12 @@ void lookStraightDown(Scene& s, float height, float fovDegrees) {
   s.camera.verticalFov = radians(fovDegrees);
 }
 
+Material grey(float albedo) {
+  Material m;
+  m.albedo = Vec3{albedo};
+  return m;
+}
+
 // Mean over the pixels whose first hit is `object`, of one channel (green by default: most tests
 // use grey).
 double meanOver(const RenderImage& img, NodeId object, int* count = nullptr, int channel = 1) {
@@ -542,6 +548,41 @@ TEST(KnownAnswer, DiffusePlaneUnderUniformSky) {
   EXPECT_NEAR(meanOver(img, plane), 1.0, 0.01);
 }
 
+// Where rays leave a surface (RayOffset). A floor of albedo 0.8 under a black lid h = 2.5e-4
+// above it, under a sky of 1, seen from between the two. Robust rays from the floor all meet the
+// lid: the floor reads 0. Tungsten's start 5e-4 along their direction, so those within 60 degrees
+// of the normal (cos > h / 5e-4) start past the lid and see the sky: 0.8 (1 - 0.5^2) = 0.6, by
+// light samples and BSDF samples alike. Away from the origin: there the robust offset is ulps of
+// the position (~1e-6 here), near it a fixed 1.5e-5, which would blur the answer.
+TEST(KnownAnswer, TungstensRaysSkipWhatLiesWithinItsEpsilon) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const float floorY = 0.04f, lidAbove = 2.5e-4f;
+  for (RayOffset offset : {RayOffset::Robust, RayOffset::Tungsten}) {
+    SCOPED_TRACE(offset == RayOffset::Tungsten ? "Tungsten's offset" : "robust offset");
+    Scene s = test::emptyScene(16, 16);
+    // Looking down at (2, 1), away from the quads' diagonals: rounding leaves a crack along a
+    // shared edge, wider the larger the triangles.
+    s.camera.position = {2, floorY + lidAbove / 2, 1};
+    s.camera.target = {2, floorY, 1};
+    s.camera.up = {0, 0, -1};
+    s.camera.verticalFov = radians(20.0f);
+    s.settings.maxBounces = 1;
+    s.settings.rayOffset = offset;
+    s.environment.color = Vec3{1.0f};
+    NodeId floor = test::addMeshObject(s, "floor", makeQuad(), test::addMaterial(s, grey(0.8f)),
+                                       Mat4::translate({0, floorY, 0}) * Mat4::scale({10, 1, 10}));
+    test::addMeshObject(s, "lid", makeQuad(), test::addMaterial(s, grey(0.0f)),
+                        Mat4::translate({0, floorY + lidAbove, 0}) * Mat4::scale({10, 1, 10}));
+    RenderImage img = renderScene(*r, s, 256);
+    int n;
+    const double mean = meanOver(img, floor, &n);
+    ASSERT_EQ(n, 16 * 16) << "the camera sees the floor alone";
+    // Robust: only the rare ray that grazes out past the lid's edge, 5 units away.
+    if (offset == RayOffset::Robust) EXPECT_LT(mean, 1e-6) << "no light gets under the lid";
+    else EXPECT_NEAR(mean, 0.6, 0.01);
+  }
+}
+
 // A sky map bright (2) above its horizon and black below, over a white-ish plane facing up: the
 // plane's radiance is albedo / pi times the irradiance from the bright half it sees. Upright: 1.
 // Turned upside down by its orientation: 0. Tilted a quarter turn about x (its up along world
@@ -651,12 +692,6 @@ Scene underUnitSky(int width, int height, float fovDegrees) {
   s.settings.maxBounces = 1;
   s.environment.color = Vec3{1.0f};
   return s;
-}
-
-Material grey(float albedo) {
-  Material m;
-  m.albedo = Vec3{albedo};
-  return m;
 }
 
 // A blend (Tungsten's mixed bsdf) shades as either part, chosen again at every hit: a white

@@ -91,6 +91,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   s.settings.filterSampling = FilterSampling::Tungsten;
   s.settings.shading = ShadingConvention::Tungsten;
   s.settings.roulette = Roulette::Tungsten;
+  s.settings.rayOffset = RayOffset::Tungsten;
   s.materials[0].separableShadowing = true;
   ASSERT_FALSE(s.textures.empty());
   s.materials[0].bumpTexture = s.textures[0].id;
@@ -132,6 +133,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.settings.filterSampling, FilterSampling::Tungsten);
   EXPECT_EQ(back->scene.settings.shading, ShadingConvention::Tungsten);
   EXPECT_EQ(back->scene.settings.roulette, Roulette::Tungsten);
+  EXPECT_EQ(back->scene.settings.rayOffset, RayOffset::Tungsten);
   EXPECT_TRUE(back->scene.materials[0].separableShadowing);
   EXPECT_EQ(back->scene.materials[0].bumpTexture, s.textures[0].id);
   EXPECT_EQ(back->scene.materials[0].bumpStrength, -2.5f);
@@ -290,6 +292,7 @@ TEST(Native, BrokenFilesGiveClearErrors) {
       {"{\"format\": \"retile-scene\", \"version\": 1, \"materials\": [{\"id\": 1, \"type\": \"glitter\"}]}", "unknown value 'glitter'"},
       {"{\"format\": \"retile-scene\", \"version\": 1, \"meshes\": [{\"id\": 1}, {\"id\": 1}]}", "not unique"},
       {"{\"format\": \"retile-scene\", \"version\": 1, \"settings\": {\"width\": 1e9}}", "outside 1..16384"},
+      {"{\"format\": \"retile-scene\", \"version\": 1, \"settings\": {\"ray_offset\": \"sideways\"}}", "settings.ray_offset: unknown ray_offset 'sideways' (robust, tungsten)"},
   };
   int i = 0;
   for (const Case& c : cases) {

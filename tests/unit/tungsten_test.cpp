@@ -40,6 +40,7 @@ TEST(Tungsten, CornellBoxMatchesTheObjVersion) {
   EXPECT_EQ(s.settings.filterSampling, FilterSampling::Tungsten) << "drawn as the scene's author saw it";
   EXPECT_EQ(s.settings.shading, ShadingConvention::Tungsten) << "Tungsten's defaults: two-sided, no consistency checks";
   EXPECT_EQ(s.settings.roulette, Roulette::Tungsten) << "a sample is the same work as in Tungsten";
+  EXPECT_EQ(s.settings.rayOffset, RayOffset::Tungsten) << "what leaks through cracks, as in Tungsten";
 
   // The light: a downward-facing quad 2 cm below the ceiling, corners as in cornell-box.obj.
   const Object* light = objectWithMaterial(s, "Light");

@@ -175,6 +175,7 @@ Value nativeSceneToJson(const Scene& s) {
   if (s.settings.filterSampling == FilterSampling::Tungsten) settings.set("filter_sampling", "tungsten");
   if (s.settings.shading == ShadingConvention::Tungsten) settings.set("shading", "tungsten");
   if (s.settings.roulette == Roulette::Tungsten) settings.set("roulette", "tungsten");
+  if (s.settings.rayOffset == RayOffset::Tungsten) settings.set("ray_offset", "tungsten");
   root.set("settings", settings);
 
   Value cam(json::Object{});
@@ -318,6 +319,16 @@ Value nativeSceneToJson(const Scene& s) {
   return root;
 }
 
+// A setting that is either Retile's own way (`ours`, the enum's first value, also when the file
+// says nothing) or Tungsten's ("tungsten", its second): the conventions Tungsten files bring.
+template <class E>
+void readConvention(Reader& r, const char* key, const char* ours, E* out) {
+  std::string name;
+  r.string(key, &name);
+  if (name == "tungsten") *out = E::Tungsten;
+  else if (!name.empty() && name != ours) r.problem(key, cat("unknown ", key, " '", name, "' (", ours, ", tungsten)"));
+}
+
 }  // namespace
 
 std::string nativeSceneToString(const Scene& s) { return json::write(nativeSceneToJson(s)); }
@@ -375,21 +386,10 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
     r.number("filter_width", &s.settings.filterWidth);
     if (!(s.settings.filterWidth > 0.0f && s.settings.filterWidth <= 16.0f))
       r.problem("filter_width", "expected a width in pixels within (0, 16]");
-    std::string sampling;
-    r.string("filter_sampling", &sampling);
-    if (sampling == "tungsten") s.settings.filterSampling = FilterSampling::Tungsten;
-    else if (!sampling.empty() && sampling != "exact")
-      r.problem("filter_sampling", cat("unknown filter sampling '", sampling, "' (exact, tungsten)"));
-    std::string shading;
-    r.string("shading", &shading);
-    if (shading == "tungsten") s.settings.shading = ShadingConvention::Tungsten;
-    else if (!shading.empty() && shading != "consistent")
-      r.problem("shading", cat("unknown shading '", shading, "' (consistent, tungsten)"));
-    std::string roulette;
-    r.string("roulette", &roulette);
-    if (roulette == "tungsten") s.settings.roulette = Roulette::Tungsten;
-    else if (!roulette.empty() && roulette != "standard")
-      r.problem("roulette", cat("unknown roulette '", roulette, "' (standard, tungsten)"));
+    readConvention(r, "filter_sampling", "exact", &s.settings.filterSampling);
+    readConvention(r, "shading", "consistent", &s.settings.shading);
+    readConvention(r, "roulette", "standard", &s.settings.roulette);
+    readConvention(r, "ray_offset", "robust", &s.settings.rayOffset);
   }
   if (const Value* v = root.find("camera")) {
     Reader r(&error, "camera", v);

@@ -80,6 +80,7 @@ class TungstenImporter {
     }
     s.settings.shading = !consistency && twoSided ? ShadingConvention::Tungsten : ShadingConvention::Consistent;
     s.settings.roulette = Roulette::Tungsten;
+    s.settings.rayOffset = RayOffset::Tungsten;
     if (!twoSided) warn("integrator: one-sided shading (enable_two_sided_shading: false) is rendered two-sided");
     if (const Value* r = root.find("renderer"); r && r->isObject()) {
       float spp;

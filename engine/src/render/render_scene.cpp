@@ -313,6 +313,7 @@ std::uint32_t RenderSceneData::features() const {
   if (suns > 0) f |= gpu::kFeatureSun;
   if (tungstenShading) f |= gpu::kFeatureTungstenShading;
   if (tungstenRoulette) f |= gpu::kFeatureTungstenRoulette;
+  if (tungstenEpsilon) f |= gpu::kFeatureTungstenEpsilon;
   if (materialBump) f |= gpu::kFeatureBump;
   if (emissionTextures) f |= gpu::kFeatureEmissionTextures;
   if (materialBlend) f |= gpu::kFeatureBlend;
@@ -339,6 +340,7 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
   first_ = false;
   data_.tungstenShading = scene.settings.shading == ShadingConvention::Tungsten;  // a kernel variant, no array
   data_.tungstenRoulette = scene.settings.roulette == Roulette::Tungsten;        // likewise
+  data_.tungstenEpsilon = scene.settings.rayOffset == RayOffset::Tungsten;       // likewise
   data_.filterFeature = filterFeature(scene.settings);                          // likewise
   timing_ = {};
   std::uint32_t dirty = 0;

@@ -116,6 +116,7 @@ struct RenderSceneData {
 
   bool tungstenShading = false;        // RenderSettings::shading is Tungsten's
   bool tungstenRoulette = false;       // RenderSettings::roulette is Tungsten's
+  bool tungstenEpsilon = false;        // RenderSettings::rayOffset is Tungsten's
   int filterFeature = gpu::kFeatureFilterTable;  // filterFeature(RenderSettings)
   std::uint32_t features() const;      // kFeature... (layouts.h) of what the arrays hold
 
