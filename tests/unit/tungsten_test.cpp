@@ -555,6 +555,95 @@ TEST(Tungsten, BumpMapsGoToACopyOfTheBsdf) {
   EXPECT_EQ(s.material(s.objects[5].material)->albedo, Vec3(0, 0, 1));
 }
 
+// Newer Tungsten files put the bump map in the bsdf (Bsdf::fromJson), at strength 1 times the
+// bitmap's scale. Either way it is read as data: Tungsten's gamma table is for colours only.
+TEST(Tungsten, ABumpMapInTheBsdfIsTheBsdfsAndReadAsData) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [
+        {"name": "a", "type": "rough_plastic", "bump": {"type": "bitmap", "file": "h.png", "scale": 0.5}},
+        {"name": "b", "type": "lambert", "bump": 0.5}],
+      "primitives": [{"type": "quad", "bsdf": "a"}, {"type": "quad", "bsdf": "b"},
+        {"type": "quad", "bsdf": "b", "bump": "g.png"}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  ASSERT_EQ(s.objects.size(), 3u);
+  const Material* a = s.material(s.objects[0].material);
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->name, "a") << "the bsdf's own, no copy";
+  ASSERT_NE(a->bumpTexture, kNoNode);
+  EXPECT_FLOAT_EQ(a->bumpStrength, 0.5f);
+  EXPECT_EQ(s.texture(a->bumpTexture)->colorSpace, TextureColorSpace::Raw);
+  EXPECT_EQ(s.material(s.objects[1].material)->bumpTexture, kNoNode) << "a constant has no slope";
+  const Material* onPrimitive = s.material(s.objects[2].material);
+  ASSERT_TRUE(onPrimitive && onPrimitive->bumpTexture != kNoNode);
+  EXPECT_EQ(s.texture(onPrimitive->bumpTexture)->colorSpace, TextureColorSpace::Raw);
+}
+
+// Tungsten's defaults and scalars where a file leaves them out or gives a colour: 64 path
+// segments; a transparency's base is a white lambert; one number from a colour is its channels'
+// mean (REQUEST_AVERAGE); a medium may name the exponential transmittance it has; a sun cap may
+// be given by its power, spread over its solid angle.
+TEST(Tungsten, DefaultsAndScalarsAreTungstens) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [
+        {"name": "leaf", "type": "transparency", "alpha": 0.5},
+        {"name": "metal", "type": "rough_conductor", "roughness": [0.1, 0.2, 0.6]}],
+      "media": [{"name": "fog", "type": "homogeneous", "sigma_s": 1, "transmittance": {"type": "exponential"}},
+                {"name": "odd", "type": "homogeneous", "sigma_s": 1, "transmittance": {"type": "linear"}}],
+      "primitives": [{"type": "quad", "bsdf": "leaf"}, {"type": "quad", "bsdf": "metal"},
+        {"type": "cube", "bsdf": {"type": "forward"}, "int_medium": "fog"},
+        {"type": "cube", "bsdf": {"type": "forward"}, "int_medium": "odd"},
+        {"type": "infinite_sphere_cap", "cap_angle": 5, "power": 30}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  EXPECT_EQ(s.settings.maxBounces, 63) << "no integrator: Tungsten's 64 segments";
+  const Material* leaf = s.material(s.objects[0].material);
+  ASSERT_TRUE(leaf);
+  EXPECT_EQ(leaf->type, MaterialType::Lambert);
+  EXPECT_EQ(leaf->albedo, Vec3{1.0f});
+  EXPECT_FLOAT_EQ(leaf->alpha, 0.5f);
+  EXPECT_NEAR(s.material(s.objects[1].material)->roughness, 0.3f, 1e-6f);
+  auto warned = [&](const std::string& what) {
+    return std::any_of(r->warnings.begin(), r->warnings.end(), [&](const std::string& w) { return w.find(what) != std::string::npos; });
+  };
+  EXPECT_FALSE(warned("'fog'")) << "an exponential transmittance is the homogeneous medium's own";
+  EXPECT_TRUE(warned("'odd'"));
+  ASSERT_EQ(s.lights.size(), 1u);
+  EXPECT_NEAR(s.lights[0].intensity, 30.0f, 1e-3f) << "radiance times the solid angle gives the power back";
+}
+
+// recompute_normals as Tungsten recomputes them: smoothed over every vertex at a position, not
+// across a crease of more than 27 degrees. A box keeps flat faces; a fold of 10 degrees, its
+// second face on vertices of its own (as a uv seam splits them), is smoothed across the fold.
+TEST(Tungsten, RecomputedNormalsMergeByPositionAndKeepCreases) {
+  auto dir = test::tempDir();
+  std::ofstream(dir / "box.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                                    "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
+  const float c = std::cos(radians(10.0f)), sn = std::sin(radians(10.0f));
+  std::ofstream(dir / "fold.obj") << "v 0 0 0\nv 0 0 1\nv -1 0 0\n"  // flat, facing +y
+                                  << "v 0 0 0\nv 0 0 1\nv " << c << " " << sn << " 0\n"  // tilted 10 degrees
+                                  << "f 1 3 2\nf 4 5 6\n";
+  std::ofstream(dir / "scene.json") << R"({"bsdfs": [{"name": "a", "type": "lambert"}], "primitives": [
+      {"type": "mesh", "file": "box.obj", "bsdf": "a", "smooth": true, "recompute_normals": true},
+      {"type": "mesh", "file": "fold.obj", "bsdf": "a", "smooth": true, "recompute_normals": true}]})";
+  auto r = importTungsten(dir / "scene.json");
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  ASSERT_EQ(s.objects.size(), 2u);
+  const MeshGeometry& box = *s.mesh(s.objects[0].mesh)->geometry;
+  ASSERT_EQ(box.normals.size(), box.positions.size());
+  for (std::size_t t = 0; t < box.indices.size(); t += 3) {
+    const Vec3 a = box.positions[box.indices[t]], b = box.positions[box.indices[t + 1]], d = box.positions[box.indices[t + 2]];
+    const Vec3 face = normalize(cross(b - a, d - a));
+    for (int k = 0; k < 3; ++k) EXPECT_GT(dot(box.normals[box.indices[t + static_cast<std::size_t>(k)]], face), 0.9999f) << "triangle " << t / 3;
+  }
+  const MeshGeometry& fold = *s.mesh(s.objects[1].mesh)->geometry;
+  ASSERT_EQ(fold.normals.size(), fold.positions.size());
+  const Vec3 across = normalize(Vec3{0, 1, 0} + Vec3{-sn, c, 0});  // equal areas
+  for (std::uint32_t v : fold.indices)
+    if (fold.positions[v].x == 0.0f) {
+      EXPECT_GT(dot(fold.normals[v], across), 0.9999f) << "vertex " << v;
+    }
+}
+
 TEST(Tungsten, PalikMetalNamesAreTheirMetals) {
   auto r = importTungsten(writeScene(R"({"bsdfs": [
         {"name": "a", "type": "conductor", "material": "Ni_palik"},

@@ -137,7 +137,7 @@ struct Material {
   // Mitsuba 0.5 have it, instead of the height-correlated form (Heitz 2014), which is the more
   // accurate and a little brighter at grazing angles. Tungsten files ask for the product.
   bool separableShadowing = false;
-  NodeId roughnessTexture = kNoNode;
+  NodeId roughnessTexture = kNoNode;  // scales roughness by the mean of its channels, as Tungsten's
   float ior = 1.5f;                // dielectric index (plastic coating, glass, thin sheet)
   // Plastics: the coating's absorption, its sigma_a times its thickness (Tungsten's plastic):
   // the diffuse base shows through dimmed by exp(-a (1 / cos wi + 1 / cos wo)).

@@ -2,6 +2,7 @@
 // order, Euler angles, shape extents, camera field of view, bounce counting) follow Tungsten so
 // scenes look as their authors rendered them; see docs/ARCHITECTURE.md for the mapping.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -23,6 +24,10 @@ namespace retile {
 namespace {
 
 using json::Value;
+
+// The scalar Tungsten reads from a colour where it wants one number (TexelConversion::
+// REQUEST_AVERAGE: roughness, blend ratios, alpha, bump): the mean of its channels.
+float channelMean(Vec3 c) { return (c.x + c.y + c.z) / 3.0f; }
 
 struct TextureRef {
   bool isTexture = false;
@@ -65,6 +70,7 @@ class TungstenImporter {
       }
     }
     if (const Value* c = root.find("camera"); c && ok()) camera(*c);
+    s.settings.maxBounces = 63;  // Tungsten's default of 64 path segments, where the file says none
     if (const Value* in = root.find("integrator"); in && in->isObject()) {
       float mb;
       if (const Value* v = in->find("max_bounces"); v && json::toFloat(*v, &mb) && mb >= 0)
@@ -338,7 +344,23 @@ class TungstenImporter {
   // `emitter`: the primitive carries emission, so an undefined name there stands for Tungsten's
   // null bsdf (published Bitterli-derived files name "null" or "NULL" for their lights without
   // defining it).
+  // A bsdf and, in the Tungsten of its newer files, its bump map (Bsdf::fromJson; older files put
+  // it on the primitive, which the primitive's copy of the bsdf then takes instead). Read as data,
+  // the channels averaged (REQUEST_AVERAGE: Tungsten's gamma table is for colours only), the
+  // slope times the bitmap's scale.
   Material bsdf(const Value& v, const std::string& where, int depth = 0, bool emitter = false) {
+    Material m = bsdfOwn(v, where, depth, emitter);
+    if (const Value* bump = v.isObject() ? v.find("bump") : nullptr; bump && ok()) {
+      TextureRef t = texture(*bump, where + ".bump", true);
+      if (t.isTexture) {
+        m.bumpTexture = t.texture;
+        m.bumpStrength = t.constant.x;
+      }
+    }
+    return m;
+  }
+
+  Material bsdfOwn(const Value& v, const std::string& where, int depth, bool emitter) {
     Material m;
     m.albedo = Vec3{1.0f};  // Tungsten's default albedo
     if (v.isString()) {
@@ -379,13 +401,15 @@ class TungstenImporter {
       return m;
     }
     if (type == "transparency") {
-      Material base = v.find("base") ? bsdf(*v.find("base"), where + ".base", depth + 1) : Material{};
+      Material base;  // Tungsten's default: lambert of albedo 1
+      base.albedo = Vec3{1.0f};
+      if (const Value* b = v.find("base")) base = bsdf(*b, where + ".base", depth + 1);
       std::string name = m.name;
       m = base;
       m.name = name;
       if (const Value* a = v.find("alpha")) {
         TextureRef t = texture(*a, where + ".alpha", true);
-        m.alpha = std::clamp(luminance(t.constant), 0.0f, 1.0f);
+        m.alpha = std::clamp(channelMean(t.constant), 0.0f, 1.0f);
         // A missing alpha map is Tungsten's stand-in checker too: half the squares transparent.
         if (t.isTexture) m.alphaTexture = t.texture;
       }
@@ -415,7 +439,7 @@ class TungstenImporter {
       if (rough) {
         if (const Value* r = v.find("roughness")) {
           TextureRef t = texture(*r, where + ".roughness", true);
-          coatRoughness = luminance(t.constant);
+          coatRoughness = channelMean(t.constant);
           if (t.isTexture) warn(cat(where, ": a rough coat's textured roughness is taken as ", coatRoughness, " everywhere"));
         }
         if (string(v, "distribution", "ggx") != "ggx") warn(cat(where, ": the rough coat's distribution is rendered as GGX"));
@@ -450,7 +474,7 @@ class TungstenImporter {
         // A bitmap ratio is read as data, its channels averaged (Tungsten's REQUEST_AVERAGE),
         // times the bitmap's scale.
         TextureRef t = texture(*r, where + ".ratio", true);
-        ratio = std::clamp(luminance(t.constant), 0.0f, 1.0f);
+        ratio = std::clamp(channelMean(t.constant), 0.0f, 1.0f);
         if (t.isTexture) ratioTexture = t.texture;
       }
       TextureRef albedo;  // Tungsten's default: 1
@@ -511,7 +535,7 @@ class TungstenImporter {
       m.roughness = fallback;
       if (const Value* r = v.find("roughness")) {
         TextureRef t = texture(*r, where + ".roughness", true);
-        m.roughness = luminance(t.constant);
+        m.roughness = channelMean(t.constant);
         m.roughnessTexture = t.texture;
       }
     };
@@ -794,6 +818,58 @@ class TungstenImporter {
     for (Vec3& n : g.normals) n = normalize(n);
   }
 
+  // Tungsten's recompute_normals (TriangleMesh::calcSmoothVertexNormals), rebuilt from what it
+  // does: vertices at one position are smoothed together, area-weighted, but not across a crease
+  // of more than 27 degrees (cos 0.15 pi). A corner whose face turns further from the first face
+  // that used its vertex gets a vertex of its own, which keeps that face's flat normal; a vertex
+  // takes the faces around its position within 27 degrees of its own first face. Smoothing by
+  // shared index alone rounded a box's edges and left seams where a file splits vertices.
+  static void creasedNormals(MeshGeometry& g) {
+    const float limit = std::cos(kPi * 0.15f);
+    const std::size_t original = g.positions.size(), triangles = g.indices.size() / 3;
+    const bool hasUvs = g.uvs.size() == original;
+    std::vector<Vec3> faceNormal(triangles), weighted(triangles);
+    for (std::size_t t = 0; t < triangles; ++t) {
+      const Vec3 a = g.positions[g.indices[t * 3]], b = g.positions[g.indices[t * 3 + 1]], c = g.positions[g.indices[t * 3 + 2]];
+      weighted[t] = cross(b - a, c - a);
+      const float len = length(weighted[t]);
+      faceNormal[t] = len > 0 && std::isfinite(len) ? weighted[t] / len : Vec3{0, 1, 0};
+    }
+    std::vector<Vec3> own(original, Vec3{0, 1, 0});  // each vertex's first face's normal
+    std::vector<char> used(original, 0);
+    for (std::size_t corner = 0; corner < triangles * 3; ++corner) {
+      const std::uint32_t v = g.indices[corner];
+      const Vec3 n = faceNormal[corner / 3];
+      if (!used[v]) {
+        used[v] = 1;
+        own[v] = n;
+      } else if (dot(own[v], n) < limit) {
+        g.indices[corner] = static_cast<std::uint32_t>(g.positions.size());
+        g.positions.push_back(g.positions[v]);
+        if (hasUvs) g.uvs.push_back(g.uvs[v]);
+        own.push_back(n);
+      }
+    }
+    // The original vertices at each position (+ 0.0f: -0 and 0 are one place).
+    auto key = [](Vec3 p) {
+      std::array<std::uint32_t, 3> k;
+      const float c[3] = {p.x + 0.0f, p.y + 0.0f, p.z + 0.0f};
+      std::memcpy(k.data(), c, sizeof c);
+      return k;
+    };
+    std::map<std::array<std::uint32_t, 3>, std::vector<std::uint32_t>> at;
+    for (std::uint32_t v = 0; v < original; ++v) at[key(g.positions[v])].push_back(v);
+    std::vector<Vec3> sum(original, Vec3{0.0f});
+    for (std::size_t corner = 0; corner < triangles * 3; ++corner) {
+      const std::size_t t = corner / 3;
+      for (std::uint32_t u : at[key(g.positions[g.indices[corner]])])
+        if (dot(own[u], faceNormal[t]) >= limit) sum[u] += weighted[t];
+    }
+    g.normals = own;  // a corner's own vertex keeps its face's normal
+    for (std::size_t v = 0; v < original; ++v)
+      if (const float len = length(sum[v]); len > 0 && std::isfinite(len)) g.normals[v] = sum[v] / len;
+  }
+
   // A mesh file's triangles that take the bsdf of one material index.
   struct MeshPart {
     std::int32_t material = 0;
@@ -834,7 +910,8 @@ class TungstenImporter {
     }
     MeshGeometry geom = std::move(g.value());
     if (!smooth) geom.normals.clear();  // flat shading
-    else if (recompute || geom.normals.empty()) smoothNormals(geom);  // across the parts' seams
+    else if (recompute) creasedNormals(geom);  // across the parts' seams
+    else if (geom.normals.empty()) smoothNormals(geom);
     const std::string name = fs::path(f).stem().string();
     std::vector<MeshPart> parts;
     if (!split || materials.size() * 3 != geom.indices.size() ||
@@ -1022,6 +1099,10 @@ class TungstenImporter {
       l.angularRadius = std::isfinite(cap) ? std::clamp(radians(cap), 0.0f, kPi / 2) : radians(10.0f);
       if (!(cap >= 0 && cap <= 90)) warn(cat(where, ": cap_angle ", cap, " is taken as ", degrees(l.angularRadius), " degrees"));
       float solidAngle = 2 * kPi * (1 - std::cos(l.angularRadius));
+      // Given as power, its radiance is the power over the cap's solid angle (Tungsten's
+      // InfiniteSphereCap::powerToRadianceFactor).
+      if (const Value* pw = p.find("power"); pw && !p.find("emission") && solidAngle > 0)
+        radiance = texture(*pw, where + ".power", false).constant / solidAngle;
       float power = maxComponent(radiance) * solidAngle;
       l.color = power > 0 ? radiance / maxComponent(radiance) : Vec3{1.0f};
       l.intensity = power;
@@ -1089,7 +1170,7 @@ class TungstenImporter {
     NodeId bumpTexture = kNoNode;
     float bumpStrength = 1;
     if (const Value* bump = p.find("bump")) {
-      TextureRef t = texture(*bump, where + ".bump", false);
+      TextureRef t = texture(*bump, where + ".bump", true);
       if (!ok()) return;
       number(p, "bump_strength", &bumpStrength, where);
       bumpTexture = t.texture;
@@ -1235,13 +1316,22 @@ class TungstenImporter {
   // Tungsten's homogeneous medium: sigma_a and sigma_s times density, and its phase function
   // (isotropic by default, as in Tungsten's Medium). Read leniently: nothing for a medium that is
   // not understood, with the reason in `why`; the caller names it in a warning and leaves it out.
+  // Tungsten's newer media name their transmittance, and write {"type": "exponential"}, the
+  // homogeneous medium's own, into every file they save; no key means the same.
+  static bool exponentialTransmittance(const Value* t) {
+    if (!t) return true;
+    if (t->isString()) return t->asString() == "exponential";
+    if (!t->isObject()) return false;
+    const Value* type = t->find("type");
+    return type && type->isString() && type->asString() == "exponential";
+  }
   std::optional<Filling> mediumFilling(const Value& medium, const std::string& name, std::string* why) {
     Vec3 sigmaA{0.0f}, sigmaS{0.0f};
     float density = 1;
     const Value *a = medium.find("sigma_a"), *sc = medium.find("sigma_s"), *d = medium.find("density");
     const std::string type = string(medium, "type");
     if (type != "homogeneous") *why = cat("a ", type.empty() ? "medium of no type" : cat(type, " medium"), "; only homogeneous ones are");
-    else if (medium.find("transmittance")) *why = "a non-exponential transmittance";
+    else if (!exponentialTransmittance(medium.find("transmittance"))) *why = "a non-exponential transmittance";
     else if (!((!a || json::toVec3(*a, &sigmaA)) && (!sc || json::toVec3(*sc, &sigmaS)) && (!d || json::toFloat(*d, &density))))
       *why = "sigma_a, sigma_s or density is not a number";
     if (!why->empty()) return std::nullopt;
