@@ -360,6 +360,7 @@ class TungstenImporter {
     return m;
   }
 
+  // The bsdf as its type reads it, without the bump map every type may carry (bsdf adds that).
   Material bsdfOwn(const Value& v, const std::string& where, int depth, bool emitter) {
     Material m;
     m.albedo = Vec3{1.0f};  // Tungsten's default albedo
