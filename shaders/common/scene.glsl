@@ -181,7 +181,9 @@ vec2 textureSlope(int index, vec2 uv) {
 float sampleAlphaTexture(int index, vec2 uv) {
   vec4 info = texelFetch(uTexInfo, index * kTextureTexels);
   vec4 t = sampleTexture(index, uv);
-  return (floatBitsToInt(info.w) & kTexAlpha) != 0 ? t.a : t.r;
+  // Without an alpha channel, the channels' mean, as Tungsten reads a transparency's alpha
+  // (REQUEST_AUTO); for a grey mask that is its value.
+  return (floatBitsToInt(info.w) & kTexAlpha) != 0 ? t.a : dot(t.rgb, vec3(1.0 / 3.0));
 }
 
 vec2 triangleUv(int prim, float u, float v) {

@@ -143,7 +143,7 @@ RT_CONST(int, kMatTypeBits, 255)
 RT_CONST(int, kTexBitmap, 0)
 RT_CONST(int, kTexChecker, 1)
 // A bitmap's flags, beside its kind (the low four bits): its file had alpha (else an alpha
-// texture reads red); its texels are 8-bit RGBA, a word each, instead of RGBA16F, two words
+// texture reads its channels' mean); its texels are 8-bit RGBA, a word each, instead of RGBA16F, two words
 // each; their colour is sRGB-encoded (else linear). The texel buffer is read in pairs of words
 // (R32G32_UINT), and a bitmap's offset counts pairs, so an 8-bit bitmap takes whole pairs.
 RT_CONST(int, kTexAlpha, 16)

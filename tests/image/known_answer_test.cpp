@@ -871,6 +871,12 @@ TEST(KnownAnswer, ACutOutLetsThroughWhatItsAlphaLeavesOut) {
   s.material(cutMaterial)->alphaTexture = addByteRow(s, test::tempDir(), "alpha", std::vector<int>(3, 77), TextureColorSpace::Raw);
   const double through = 1.0 - 77.0 / 255.0;
   EXPECT_NEAR(imageMean(renderScene(*r, s, 64)), through * through, 0.015) << "alpha from a texture";
+  // A texture without an alpha channel covers by its channels' mean (Tungsten's REQUEST_AUTO):
+  // red 231 alone is 77 too (read by its red, it would let 0.009 through).
+  const auto redFile = test::tempDir() / "red.ppm";
+  test::writePpm(redFile, 3, 1, {231, 0, 0, 231, 0, 0, 231, 0, 0});
+  s.material(cutMaterial)->alphaTexture = test::addFileTexture(s, redFile, TextureColorSpace::Raw);
+  EXPECT_NEAR(imageMean(renderScene(*r, s, 64)), through * through, 0.015) << "alpha from a colour texture";
   s.material(cutMaterial)->alphaTexture = kNoNode;
   s.material(cutMaterial)->alpha = 0.1f;
   for (int i = 1; i < 10; ++i)

@@ -178,7 +178,7 @@ struct Material {
   Vec3 emission{0.0f};             // radiance emitted from the front side
   NodeId emissionTexture = kNoNode;  // multiplies emission (glTF's emissiveTexture, Tungsten's textured emission)
   float alpha = 1.0f;              // coverage; < 1 or an alpha texture makes a cut-out
-  NodeId alphaTexture = kNoNode;
+  NodeId alphaTexture = kNoNode;   // its alpha channel, else the mean of its channels
   // Tilts the shading normal by the slope of this texture's value (the mean of its channels), as
   // Tungsten's bump maps do (BitmapTexture::derivatives: the difference across two texels); the
   // slope is scaled by bumpStrength.
