@@ -526,10 +526,8 @@ TEST(TracePass, InstancesEnteredAtSubtreesHitWhatBruteForceHits) {
 // (which leaves its instance unreached) are part of it.
 TEST(TracePass, DirectReferencesTraceWhatInstanceRecordsTrace) {
   RETILE_RENDERER_OR_SKIP(direct);
-  RendererOptions options;
-  options.directReferences = false;
   std::string why;
-  auto records = test::makeRenderer(&why, options);
+  auto records = test::makeRecordsRenderer(&why);
   ASSERT_TRUE(records) << why;
   Scene s = makeDefaultScene();
   ASSERT_GE(s.objects.size(), 3u);

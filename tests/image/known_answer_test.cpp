@@ -44,6 +44,15 @@ Material grey(float albedo) {
   return m;
 }
 
+// A directional light of irradiance `intensity` travelling straight down (-y): a sun overhead.
+void addSun(Scene& s, float intensity) {
+  Light sun;
+  sun.id = s.newId();
+  sun.type = LightType::Directional;
+  sun.intensity = intensity;
+  s.lights.push_back(sun);
+}
+
 // Mean over the pixels whose first hit is `object`, of one channel (green by default: most tests
 // use grey).
 double meanOver(const RenderImage& img, NodeId object, int* count = nullptr, int channel = 1) {
@@ -402,27 +411,18 @@ TEST(KnownAnswer, ALightOutsideABoundaryLightsTheMediumInside) {
 // (triangles name their instance and its boundary flag) and with instance records.
 TEST(KnownAnswer, AShadowRayCountsEveryBoundaryItCrosses) {
   RETILE_RENDERER_OR_SKIP(direct);
-  RendererOptions options;
-  options.directReferences = false;
   std::string why;
-  auto records = test::makeRenderer(&why, options);
+  auto records = test::makeRecordsRenderer(&why);
   ASSERT_TRUE(records) << why;
   const Vec3 sigma{0.1f, 0.25f, 0.0f};
   Scene s = test::emptyScene(16, 16);
   lookStraightDown(s, 1, 2);
   s.settings.maxBounces = 1;
-  Material grey;
-  grey.albedo = Vec3{0.5f};
-  NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, grey), Mat4::scale({4, 1, 4}));
+  NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, grey(0.5f)), Mat4::scale({4, 1, 4}));
   const NodeId fog = test::addMaterial(s, boundaryOf(sigma));
   for (int i = 0; i < 5; ++i)
     test::addMeshObject(s, "slab", makeCube(), fog, Mat4::translate({0, 2.5f + 2.0f * static_cast<float>(i), 0}) * Mat4::scale({40, 1, 40}));
-  Light sun;
-  sun.id = s.newId();
-  sun.type = LightType::Directional;
-  sun.direction = {0, -1, 0};
-  sun.intensity = 2.0f;
-  s.lights.push_back(sun);
+  addSun(s, 2.0f);
   for (Renderer* r : {direct.get(), records.get()}) {
     RenderImage img = renderScene(*r, s, 4);
     for (int c = 0; c < 3; ++c) {
@@ -989,11 +989,7 @@ TEST(KnownAnswer, ABumpMapTiltsTheNormalByItsSlope) {
   m.bumpStrength = 16.0f;
   NodeId material = test::addMaterial(s, m);
   NodeId plane = test::addMeshObject(s, "plane", makeQuad(), material, Mat4::scale({4, 1, 4}));
-  Light sun;
-  sun.id = s.newId();
-  sun.type = LightType::Directional;
-  sun.intensity = 1.0f;
-  s.lights.push_back(sun);
+  addSun(s, 1.0f);
 
   const double n = std::sqrt(1.25), l = std::sqrt(2.0);
   for (float side : {1.0f, -1.0f}) {
@@ -1015,15 +1011,8 @@ TEST(KnownAnswer, ASunsDiscLightsAndShowsAsItsRadiance) {
   Scene s = test::emptyScene(16, 16);
   lookStraightDown(s, 3, 2);
   s.settings.maxBounces = 1;
-  Material white;
-  white.albedo = Vec3{1.0f};
-  NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, white), Mat4::scale({4, 1, 4}));
-  Light sun;
-  sun.id = s.newId();
-  sun.type = LightType::Directional;
-  sun.direction = {0, -1, 0};
-  sun.intensity = 2.0f;
-  s.lights.push_back(sun);
+  NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, grey(1.0f)), Mat4::scale({4, 1, 4}));
+  addSun(s, 2.0f);
   for (float degreesWide : {0.0f, 0.5f, 30.0f, 60.0f}) {
     s.lights[0].angularRadius = radians(degreesWide);
     double expected = 2.0 * (1.0 + std::cos(radians(degreesWide))) / 2.0 / kPi;

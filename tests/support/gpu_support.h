@@ -12,6 +12,9 @@
 namespace retile::test {
 
 std::unique_ptr<Renderer> makeRenderer(std::string* whyNot, const RendererOptions& options = {});
+// The same renderer entering every instance through its record, never packed direct
+// (RendererOptions::directReferences off): the other traversal, for tests that run both.
+std::unique_ptr<Renderer> makeRecordsRenderer(std::string* whyNot);
 bool requireDevice();  // CI is set: no device is a failure
 
 #define RETILE_RENDERER_OR_SKIP(var)                                                  \

@@ -157,6 +157,12 @@ std::unique_ptr<Renderer> makeRenderer(std::string* whyNot, const RendererOption
   }
 }
 
+std::unique_ptr<Renderer> makeRecordsRenderer(std::string* whyNot) {
+  RendererOptions options;
+  options.directReferences = false;
+  return makeRenderer(whyNot, options);
+}
+
 Camera frontCamera(float fov) {
   Camera c;
   c.position = {0, 0, 0};
