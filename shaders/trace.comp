@@ -717,7 +717,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   if (bs.transmitted && (isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric))) crossMedium(path, m, frontFace);
 #endif
   // Roulette must not see the 1/eta^2 radiance scaling inside glass as lost energy.
-  if (bs.transmitted && !isMat(m.type, kMatThinSheet) && !isMat(m.type, kMatDiffuseTransmission)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
+  if (bs.transmitted && !m.tungstenGlass && !isMat(m.type, kMatThinSheet) && !isMat(m.type, kMatDiffuseTransmission)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
   path.specular = bs.delta;
   path.prevPdf = bs.pdf;
   path.prevPos = pos;

@@ -368,8 +368,11 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     b.number(tr("Transmittance"), "transmittance", m.transmittance, 0.0, 1.0, defaults.transmittance, 3, [edit](double v, int drag) {
       edit(tr("Transmittance"), drag, [v](Material& x) { x.transmittance = static_cast<float>(v); });
     });
-  if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic)
-    b.vec3(tr("Coating absorption"), "coatingAbsorption", m.coatingAbsorption, 0.01, [edit](int channel, double v, int drag) {
+  if (isGlassType(m.type))
+    b.choice(tr("Glass"), "glassConvention", {tr("Physical"), tr("Tungsten")}, m.tungstenGlass ? 1 : 0,
+             [edit](int i) { edit(tr("Glass"), 0, [i](Material& x) { x.tungstenGlass = i == 1; }); });
+  if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic || m.type == MaterialType::ThinSheet)
+    b.vec3(m.type == MaterialType::ThinSheet ? tr("Absorption") : tr("Coating absorption"), "coatingAbsorption", m.coatingAbsorption, 0.01, [edit](int channel, double v, int drag) {
       edit(tr("Coating absorption"), drag,
            [channel, v](Material& x) { axisOf(x.coatingAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
     }, true);

@@ -37,10 +37,11 @@ struct Material {
   float roughness;   // microfacet alpha, Oren-Nayar sigma, or Phong's a (exponent 2 / a^2 - 2)
   bool beckmann;     // rough types: Beckmann's distribution instead of GGX
   bool separable;    // rough types: G = G1(wo) G1(wi) instead of height-correlated
+  bool tungstenGlass;  // glass: albedo tints reflection too, no (n_t / n_i)^2 across (Material::tungstenGlass)
   float ior;
   float fdrInt;      // plastic: internal diffuse Fresnel reflectance of the coating; diffuse
                      // transmission: the transmittance; Phong: the diffuse ratio (packMaterial)
-  vec3 coating;      // plastic: the coating's absorption (sigma_a times thickness)
+  vec3 coating;      // plastic: the coating's absorption (sigma_a times thickness); thin sheet: the sheet's
   vec3 eta;
   vec3 k;
   vec3 emission;
@@ -59,6 +60,7 @@ Material unpackMaterial(vec4 t0, vec4 t1, vec4 t2, vec4 t3, vec4 t4, vec4 t6, ve
   m.type = type & kMatTypeBits;
   m.beckmann = kBeckmannUsed && (type & kMatBeckmann) != 0;
   m.separable = (type & kMatSeparable) != 0;
+  m.tungstenGlass = (type & kMatTungstenGlass) != 0;
   m.albedo = t0.rgb;
   m.roughness = t1.x;
   m.ior = t1.y;
@@ -110,23 +112,37 @@ bool isTransmissive(Material m) {
          isMat(m.type, kMatDiffuseTransmission);
 }
 
-// Unpolarised Fresnel reflectance at a dielectric boundary; eta = n_transmitted / n_incident,
-// cosI >= 0. Returns 1 for total internal reflection.
-float fresnelDielectric(float cosI, float eta, out float cosT) {
+// The reflectances of the two polarisations (s, p) at a dielectric boundary; eta = n_transmitted /
+// n_incident, cosI >= 0. Both 1 for total internal reflection.
+vec2 fresnelPolarised(float cosI, float eta, out float cosT) {
   float sin2T = (1.0 - cosI * cosI) / (eta * eta);
   if (sin2T >= 1.0) {
     cosT = 0.0;
-    return 1.0;
+    return vec2(1.0);
   }
   cosT = sqrt(1.0 - sin2T);
   float rs = (cosI - eta * cosT) / (cosI + eta * cosT);
   float rp = (eta * cosI - cosT) / (eta * cosI + cosT);
-  return 0.5 * (rs * rs + rp * rp);
+  return vec2(rs * rs, rp * rp);
+}
+
+// Unpolarised: the two's mean.
+float fresnelDielectric(float cosI, float eta, out float cosT) {
+  vec2 r = fresnelPolarised(cosI, eta, cosT);
+  return 0.5 * (r.x + r.y);
 }
 
 float fresnelDielectric(float cosI, float eta) {
   float cosT;
   return fresnelDielectric(cosI, eta, cosT);
+}
+
+// A thin sheet of index eta reflects at both faces, and light bounces between them: for each
+// polarisation R + T^2 R / (1 - R^2) = 2R / (1 + R) in all, the two then averaged (as Tungsten's
+// thin sheet, not the average's 2F / (1 + F), which is larger). cosT: the angle's inside the sheet.
+float thinSheetReflectance(float cosI, float eta, out float cosT) {
+  vec2 r = fresnelPolarised(cosI, eta, cosT);
+  return r.x / (1.0 + r.x) + r.y / (1.0 + r.y);
 }
 
 // Exact unpolarised reflectance of a conductor with complex index eta + i k.
@@ -332,12 +348,14 @@ vec3 baseEval(Material m, vec3 wo, vec3 wi, out float pdf) {
     float jac = eta * eta * abs(ih) / (denom * denom);
     pdf = (1.0 - F) * mf.normalPdf * jac;
     float f = abs(ih) * oh / (o.z * abs(i.z)) * (1.0 - F) * mf.D * mf.G2 / (denom * denom);
+    // Tungsten's form is the adjoint's: radiance not compressed by 1 / eta^2 (eta = n_i / n_o).
+    if (m.tungstenGlass) f *= eta * eta;
     return m.albedo * (f * abs(i.z));
   }
   float reflectionPdf = mf.normalPdf / (4.0 * max(oh, 1e-12));
   if (roughDielectric) {
     pdf = F * reflectionPdf;
-    return vec3(F * mf.D * mf.G2 / (4.0 * o.z));
+    return (m.tungstenGlass ? m.albedo : vec3(1.0)) * (F * mf.D * mf.G2 / (4.0 * o.z));
   }
   if (roughConductor) {
     pdf = reflectionPdf;
@@ -374,28 +392,29 @@ BsdfSample baseSample(Material m, vec3 wo, vec3 u) {
     float F = fresnelDielectric(cosO, eta, cosT);
     s.delta = true;
     if (isMat(t, kMatThinSheet)) {
-      // Both faces of a thin film: R + T^2 R / (1 - R^2) reflected in total, the rest passes.
-      float Fs = fresnelDielectric(cosO, m.ior);
-      float R = Fs < 1.0 ? 2.0 * Fs / (1.0 + Fs) : 1.0;
+      // What is not reflected passes straight through, dimmed by the sheet's absorption along
+      // its slanted way through (m.coating: the absorption straight across).
+      float cosIn;
+      float R = thinSheetReflectance(cosO, m.ior, cosIn);
       if (u.x < R) {
         s.wi = vec3(-wo.x, -wo.y, wo.z);
         s.weight = vec3(1.0);
         s.pdf = R;
       } else {
         s.wi = -wo;
-        s.weight = m.albedo;
+        s.weight = m.albedo * exp(-m.coating / max(cosIn, 1e-4));
         s.pdf = 1.0 - R;
         s.transmitted = true;
       }
     } else if (u.x < F) {
       s.wi = vec3(-wo.x, -wo.y, wo.z);
-      s.weight = vec3(1.0);
+      s.weight = m.tungstenGlass ? m.albedo : vec3(1.0);
       s.pdf = F;
     } else {
       float inv = 1.0 / eta;
       s.wi = normalize(vec3(-wo.x * inv, -wo.y * inv, entering ? -cosT : cosT));
-      // Radiance is compressed by 1/eta^2 on entering and expanded on leaving.
-      s.weight = m.albedo * (inv * inv);
+      // Radiance is compressed by 1/eta^2 on entering and expanded on leaving (not in Tungsten).
+      s.weight = m.tungstenGlass ? m.albedo : m.albedo * (inv * inv);
       s.pdf = 1.0 - F;
       s.transmitted = true;
     }

@@ -138,6 +138,8 @@ RT_CONST(int, kMaskScattering, 17)
 // Packed with a rough type: Smith's G as the product G1(wo) G1(wi) (Material::separableShadowing).
 // A multiply more per evaluation, so no kernel variant.
 RT_CONST(int, kMatSeparable, 512)
+// Packed with a glass type: Tungsten's glass (Material::tungstenGlass). A multiply more, no variant.
+RT_CONST(int, kMatTungstenGlass, 1024)
 RT_CONST(int, kMatTypeBits, 255)
 
 RT_CONST(int, kTexBitmap, 0)

@@ -40,6 +40,11 @@ Material separable(Material m) {
   return m;
 }
 
+Material tungstenGlass(Material m) {
+  m.tungstenGlass = true;
+  return m;
+}
+
 Material coated(Material m, float absorption) {
   m.coatingAbsorption = Vec3{absorption};
   return m;
@@ -95,6 +100,7 @@ std::vector<Case> smoothLobed() {
           {"rough_dielectric_beckmann", beckmann(material(MaterialType::RoughDielectric, 1.0f, 0.3f))},
           {"rough_conductor_separable", separable(material(MaterialType::RoughConductor, 1.0f, 0.3f))},
           {"rough_dielectric_separable", separable(material(MaterialType::RoughDielectric, 1.0f, 0.3f))},
+          {"rough_dielectric_tungsten", tungstenGlass(material(MaterialType::RoughDielectric, 0.8f, 0.3f))},
           {"rough_plastic_beckmann_separable", separable(beckmann(material(MaterialType::RoughPlastic, 0.8f, 0.4f)))},
           {"plastic_absorbing", coated(material(MaterialType::Plastic, 0.8f), 0.3f)},
           {"rough_plastic_absorbing", coated(material(MaterialType::RoughPlastic, 0.8f, 0.3f), 0.3f)},
@@ -328,6 +334,60 @@ TEST_F(Bsdfs, LosslessMaterialsKeepAllEnergy) {
     EXPECT_NEAR(sampledAlbedo(material(MaterialType::Plastic, 1.0f), wo).first, 1.0, 0.01) << "cos " << cosO;
     // Over a black base the coating reflects F alone: Tungsten's dielectric without refraction.
     EXPECT_NEAR(sampledAlbedo(material(MaterialType::Plastic, 0.0f), wo).first, F, 1e-3) << "cos " << cosO;
+  }
+}
+
+// Tungsten's glass (Material::tungstenGlass): its albedo tints both lobes, and radiance is not
+// scaled by eta^2 through the surface, so that white glass returns exactly everything from either
+// side, where the physical form returns F + (1 - F) / eta^2 from outside. The rough one's
+// transmission is the physical one's times eta^2 (eta = n_i / n_o: the index wi is in over
+// wo's), its reflection the physical one's times albedo; its pdf is the same.
+TEST_F(Bsdfs, TungstensGlassTintsBothLobesAndKeepsRadiance) {
+  const double eta = 1.5;
+  for (float cosO : {0.9f, 0.5f, 0.2f})
+    for (float side : {1.0f, -1.0f}) {
+      SCOPED_TRACE(testing::Message() << "cos " << cosO << (side > 0 ? " outside" : " inside"));
+      Vec3 wo = direction(side * cosO, 0.3f);
+      EXPECT_NEAR(sampledAlbedo(tungstenGlass(material(MaterialType::Dielectric, 1.0f)), wo).first, 1.0, 1e-5);
+      EXPECT_NEAR(sampledAlbedo(tungstenGlass(material(MaterialType::Dielectric, 0.6f)), wo).first, 0.6, 1e-5);
+      if (side > 0) {
+        EXPECT_NEAR(sampledAlbedo(material(MaterialType::Dielectric, 0.6f), wo).first,
+                    fresnel(cosO, eta) + 0.6 * (1 - fresnel(cosO, eta)) / (eta * eta), 0.003);
+      }
+    }
+  const Material physical = material(MaterialType::RoughDielectric, 0.6f, 0.3f), tungsten = tungstenGlass(physical);
+  struct Pair {
+    Vec3 wo, wi;
+    double ratio;
+  };
+  const Vec3 out = direction(0.7f, 0.2f), in = direction(-0.7f, 0.2f);
+  for (Pair p : {Pair{out, direction(-0.6f, 3.0f), eta * eta}, Pair{in, direction(0.6f, 3.0f), 1 / (eta * eta)},
+                 Pair{out, direction(0.6f, 3.0f), 0.6}, Pair{in, direction(-0.6f, 3.0f), 0.6}}) {
+    auto r = run({{physical, p.wo, p.wi, Vec3{0.5f}}, {tungsten, p.wo, p.wi, Vec3{0.5f}}});
+    ASSERT_GT(luminance(r[0].f), 0.0f);
+    EXPECT_NEAR(luminance(r[1].f) / luminance(r[0].f), p.ratio, 1e-4 * p.ratio) << p.wo.z << " -> " << p.wi.z;
+    EXPECT_NEAR(r[1].pdf, r[0].pdf, 1e-6 * r[0].pdf);
+  }
+}
+
+// A thin sheet reflects R, each polarisation's 2R / (1 + R) averaged (Tungsten's thin sheet), and
+// passes the rest dimmed by exp(-a / cos t), a its absorption (Material::coatingAbsorption) and
+// t the angle inside the sheet. Measured with a sheet that absorbs all it passes (R alone) and
+// one that absorbs a little.
+TEST_F(Bsdfs, AThinSheetReflectsEachPolarisationsShareAndAbsorbsAlongItsPath) {
+  const double eta = 1.5;
+  for (float cosO : {0.9f, 0.5f, 0.15f}) {
+    const double s2 = (1 - cosO * cosO) / (eta * eta), ct = std::sqrt(1 - s2);
+    const double rs = (cosO - eta * ct) / (cosO + eta * ct), rp = (eta * cosO - ct) / (eta * cosO + ct);
+    const double Rs = rs * rs, Rp = rp * rp, R = Rs / (1 + Rs) + Rp / (1 + Rp);
+    const double F = fresnel(cosO, eta);
+    Vec3 wo = direction(cosO, 0.3f);
+    Material opaque = coated(material(MaterialType::ThinSheet, 1.0f), 60.0f), thin = coated(material(MaterialType::ThinSheet, 1.0f), 0.3f);
+    EXPECT_NEAR(sampledAlbedo(opaque, wo).first, R, 5e-4) << "cos " << cosO;
+    EXPECT_NEAR(sampledAlbedo(thin, wo).first, R + (1 - R) * std::exp(-0.3 / ct), 5e-4) << "cos " << cosO;
+    if (cosO < 0.2f) {
+      EXPECT_GT(2 * F / (1 + F) - R, 0.01) << "the averaged form would differ measurably here";
+    }
   }
 }
 

@@ -425,6 +425,17 @@ TEST(Editor, GlassTakesAScatteringMediumFromItsPanel) {
   w->undoStack()->undo();
   EXPECT_EQ(w->scene().material(material)->interiorScattering, Vec3(0.0f));
   EXPECT_EQ(w->scene().material(material)->interiorAnisotropy, 0.0f);
+  // Glass takes Tungsten's convention, a thin sheet its absorption.
+  auto* glass = w->findChild<QComboBox*>("glassConvention");
+  ASSERT_TRUE(glass);
+  glass->setCurrentIndex(1);
+  EXPECT_TRUE(w->scene().material(material)->tungstenGlass);
+  type = w->findChild<QComboBox*>("materialType");
+  type->setCurrentIndex(static_cast<int>(MaterialType::ThinSheet));
+  ASSERT_TRUE(QTest::qWaitFor([&] { return w->findChild<ScrubField*>("coatingAbsorption2") != nullptr; }, 2000));
+  EXPECT_FALSE(w->findChild<QComboBox*>("glassConvention")) << "a thin sheet is not glass";
+  w->findChild<ScrubField*>("coatingAbsorption2")->setValue(0.25);
+  EXPECT_EQ(w->scene().material(material)->coatingAbsorption, Vec3(0.0f, 0.0f, 0.25f));
 }
 
 TEST(Editor, ABoundaryShowsItsMediumAndNoSurface) {

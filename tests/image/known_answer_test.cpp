@@ -183,6 +183,31 @@ TEST(KnownAnswer, GlassFilledWithAnAbsorbingMediumDimsByBeersLaw) {
   }
 }
 
+// An emitter of radiance 1 inside a slab of glass of index 1.5, seen head on through its face.
+// Radiance is 1.5^2 times as dense inside glass as outside, so the physical form shows it as
+// (1 - F) / 1.5^2 = 0.4267 (F = 0.04 head on); Tungsten's glass (Material::tungstenGlass) does
+// not scale radiance across the surface and shows 1 - F = 0.96, as Tungsten renders a lamp's
+// bulb. The sky is black and the emitter's albedo 0: nothing else reaches the camera.
+TEST(KnownAnswer, ALampInsideGlassShinesThroughAsItsConventionSays) {
+  RETILE_RENDERER_OR_SKIP(r);
+  for (bool tungsten : {false, true}) {
+    Material glass = filledGlass(Vec3{0.0f});
+    glass.ior = 1.5f;
+    glass.tungstenGlass = tungsten;
+    Scene s = slabBeforeTheSky(glass, 30, 8);
+    s.environment.color = Vec3{0.0f};
+    Material lamp = grey(0.0f);
+    lamp.emission = Vec3{1.0f};
+    // Facing the camera, halfway through the slab.
+    test::addMeshObject(s, "lamp", makeQuad(), test::addMaterial(s, lamp), Mat4::translate({0, 0, -5}) * Mat4::rotateX(kPi / 2) * Mat4::scale({8, 1, 8}));
+    RenderImage img = renderScene(*r, s, 64);
+    double sum = 0;
+    for (int y = 14; y < 18; ++y)
+      for (int x = 14; x < 18; ++x) sum += img.color[3 * (y * 32 + x) + 1];
+    EXPECT_NEAR(sum / 16, tungsten ? 0.96 : 0.96 / 2.25, 0.01) << (tungsten ? "Tungsten's glass" : "physical glass");
+  }
+}
+
 // A random walk, independent of the kernel's code, through a slab one unit thick of a medium of
 // extinction sigmaT and albedo omega, entered head on and endless sideways: the mean of
 // omega^(times scattered) with which walks leave it by either face, scattering by Henyey and

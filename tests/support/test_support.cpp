@@ -1,6 +1,9 @@
 #include "test_support.h"
 
 #include <atomic>
+#include <cstdio>
+#include <mutex>
+#include <vector>
 #include <clocale>
 #include <cmath>
 #include <cstdlib>
@@ -22,11 +25,35 @@ fs::path sharedPath(const std::string& relative) {
   return fs::exists(p, ec) ? p : fs::path();
 }
 
+namespace {
+std::mutex tempRootsMutex;
+std::vector<fs::path> tempRoots;
+
+// At exit: a run that passed leaves nothing behind in /tmp (thousands of directories gathered
+// there over a day's runs); a failed one keeps its files to look at, and says where.
+void removeTempRoots() {
+  std::lock_guard lock(tempRootsMutex);
+  if (::testing::UnitTest::GetInstance()->Failed()) {
+    const fs::path kept = fs::temp_directory_path() / ("retile-test-" + std::to_string(::getpid()) + "-*");
+    if (!tempRoots.empty()) std::fprintf(stderr, "retile tests: a test failed, so the files tests wrote stay in %s\n", kept.string().c_str());
+    return;
+  }
+  std::error_code ec;
+  for (const fs::path& root : tempRoots) fs::remove_all(root, ec);
+}
+}  // namespace
+
 fs::path tempDir() {
   static std::atomic<int> counter{0};
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "test";
-  fs::path p = fs::temp_directory_path() / ("retile-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++)) / name;
+  const fs::path root = fs::temp_directory_path() / ("retile-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+  {
+    std::lock_guard lock(tempRootsMutex);
+    if (tempRoots.empty()) std::atexit(removeTempRoots);
+    tempRoots.push_back(root);
+  }
+  fs::path p = root / name;
   fs::remove_all(p);
   fs::create_directories(p);
   return p;

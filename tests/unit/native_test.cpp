@@ -93,6 +93,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   s.settings.roulette = Roulette::Tungsten;
   s.settings.rayOffset = RayOffset::Tungsten;
   s.materials[0].separableShadowing = true;
+  s.materials[0].tungstenGlass = true;
   ASSERT_FALSE(s.textures.empty());
   s.materials[0].bumpTexture = s.textures[0].id;
   s.materials[0].bumpStrength = -2.5f;
@@ -135,6 +136,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.settings.roulette, Roulette::Tungsten);
   EXPECT_EQ(back->scene.settings.rayOffset, RayOffset::Tungsten);
   EXPECT_TRUE(back->scene.materials[0].separableShadowing);
+  EXPECT_TRUE(back->scene.materials[0].tungstenGlass);
   EXPECT_EQ(back->scene.materials[0].bumpTexture, s.textures[0].id);
   EXPECT_EQ(back->scene.materials[0].bumpStrength, -2.5f);
   EXPECT_EQ(back->scene.materials[0].emissionTexture, s.textures[0].id);

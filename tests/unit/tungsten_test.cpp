@@ -942,7 +942,40 @@ TEST(Tungsten, ADielectricWithoutRefractionIsAFresnelReflectorOnly) {
   EXPECT_EQ(frosted->type, MaterialType::RoughPlastic);
   EXPECT_EQ(frosted->roughness, 0.3f);
   EXPECT_EQ(s.material(s.objects[2].material)->type, MaterialType::Dielectric);
-  for (const auto& w : r->warnings) EXPECT_EQ(w.find("refraction"), std::string::npos) << w;
+  EXPECT_TRUE(s.material(s.objects[2].material)->tungstenGlass);
+  // Tungsten tints the coating's F by its albedo, which is not rendered: said for the one
+  // whose albedo is not white.
+  int albedoWarnings = 0;
+  for (const auto& w : r->warnings) albedoWarnings += w.find("bsdfs[0]") != std::string::npos && w.find("albedo") != std::string::npos;
+  EXPECT_EQ(albedoWarnings, 1);
+  EXPECT_EQ(r->warnings.size(), 1u);
+}
+
+// Tungsten's thin sheet has no albedo; its sigma_a absorbs along twice its thickness. Saved
+// natively, the absorption stays. Interference is not rendered, and said so.
+TEST(Tungsten, AThinSheetAbsorbsAlongTwiceItsThicknessAndHasNoAlbedo) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [
+      {"name": "film", "type": "thinsheet", "ior": 1.3, "albedo": 0.3, "sigma_a": [1, 2, 3], "thickness": 0.25},
+      {"name": "bubble", "type": "thinsheet", "enable_interference": true}],
+      "primitives": [{"type": "quad", "bsdf": "film"}, {"type": "quad", "bsdf": "bubble"}, {"type": "quad", "emission": 1}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  const Material* film = s.material(s.objects[0].material);
+  EXPECT_EQ(film->type, MaterialType::ThinSheet);
+  EXPECT_EQ(film->albedo, Vec3(1.0f));
+  EXPECT_EQ(film->ior, 1.3f);
+  EXPECT_EQ(film->coatingAbsorption, Vec3(0.5f, 1.0f, 1.5f));
+  EXPECT_EQ(s.material(s.objects[1].material)->coatingAbsorption, Vec3(0.0f)) << "sigma_a defaults to 0";
+  ASSERT_EQ(r->warnings.size(), 1u);
+  EXPECT_NE(r->warnings[0].find("interference"), std::string::npos) << r->warnings[0];
+  EXPECT_NE(r->warnings[0].find("bsdfs[1]"), std::string::npos) << r->warnings[0];
+
+  auto file = test::tempDir() / "scene.retile";
+  ASSERT_TRUE(saveNativeScene(s, file).ok());
+  auto back = loadNativeScene(file);
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_EQ(back->scene.material(back->scene.objects[0].material)->coatingAbsorption, Vec3(0.5f, 1.0f, 1.5f));
+  EXPECT_TRUE(back->scene.material(back->scene.objects[0].material)->albedo == Vec3(1.0f));
 }
 
 // The spaceship's leathers ask for Beckmann: rendered with it (no warning); a Phong distribution

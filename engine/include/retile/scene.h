@@ -139,8 +139,15 @@ struct Material {
   bool separableShadowing = false;
   NodeId roughnessTexture = kNoNode;  // scales roughness by the mean of its channels, as Tungsten's
   float ior = 1.5f;                // dielectric index (plastic coating, glass, thin sheet)
+  // Glass as Tungsten has it (its dielectric and rough_dielectric): albedo tints the reflection
+  // as well as the transmission, and radiance is not scaled by (n_t / n_i)^2 where it crosses
+  // the surface. The two agree on light that passes in and out again; they differ where a path
+  // ends inside, on an emitter within the glass (a lamp's bulb, say): 1 / ior^2 as bright here
+  // without this. Otherwise albedo tints the transmission alone, the physical form.
+  bool tungstenGlass = false;
   // Plastics: the coating's absorption, its sigma_a times its thickness (Tungsten's plastic):
-  // the diffuse base shows through dimmed by exp(-a (1 / cos wi + 1 / cos wo)).
+  // the diffuse base shows through dimmed by exp(-a (1 / cos wi + 1 / cos wo)). Thin sheets: the
+  // sheet's, light passing through it dimmed by exp(-a / cos t), t the angle inside the sheet.
   Vec3 coatingAbsorption{0.0f};
   float transmittance = 0.5f;      // diffuse transmission: the share of albedo passed through
   float diffuseRatio = 0.2f;       // Phong: the share of albedo reflected as Lambert (Tungsten's default)

@@ -259,6 +259,7 @@ Value nativeSceneToJson(const Scene& s) {
     if (m.separableShadowing) v.set("shadowing", "separable");
     v.set("roughness_texture", m.roughnessTexture);
     v.set("ior", m.ior);
+    if (m.tungstenGlass) v.set("glass", "tungsten");
     v.set("coating_absorption", json::fromVec3(m.coatingAbsorption));
     v.set("transmittance", m.transmittance);
     v.set("diffuse_ratio", m.diffuseRatio);
@@ -497,6 +498,11 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
         r.problem("shadowing", cat("unknown shadowing '", shadowing, "' (correlated, separable)"));
       r.id("roughness_texture", &m.roughnessTexture);
       r.number("ior", &m.ior);
+      std::string glass;
+      r.string("glass", &glass);
+      if (glass == "tungsten") m.tungstenGlass = true;
+      else if (!glass.empty() && glass != "physical")
+        r.problem("glass", cat("unknown glass convention '", glass, "' (physical, tungsten)"));
       r.vec3("coating_absorption", &m.coatingAbsorption);
       r.number("transmittance", &m.transmittance);
       r.number("diffuse_ratio", &m.diffuseRatio);

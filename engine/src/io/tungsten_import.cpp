@@ -589,16 +589,37 @@ class TungstenImporter {
     } else if (type == "dielectric" || type == "rough_dielectric") {
       const bool rough = type == "rough_dielectric";
       m.type = rough ? MaterialType::RoughDielectric : MaterialType::Dielectric;
+      m.tungstenGlass = true;
       if (rough) roughness(0.1f);
       if (const Value* e = v.find("enable_refraction"); e && e->isBool() && !e->asBool()) {
-        // Tungsten's dielectric without refraction reflects F (white) and transmits nothing:
-        // exactly a coating over a black base.
+        // Tungsten's dielectric without refraction reflects F and transmits nothing: a coating
+        // over a black base. (Tungsten tints that F by the albedo, which a coating cannot be:
+        // an albedo other than white is left out.)
+        if (m.albedoTexture != kNoNode || !(m.albedo == Vec3{1.0f}))
+          warn(cat(where, ": the albedo of a dielectric without refraction is not rendered; it reflects untinted"));
         m.type = rough ? MaterialType::RoughPlastic : MaterialType::Plastic;
         m.albedo = Vec3{0.0f};
         m.albedoTexture = kNoNode;
       }
     } else if (type == "thinsheet") {
       m.type = MaterialType::ThinSheet;
+      // Tungsten's thin sheet has no albedo: what passes is dimmed by its sigma_a along twice its
+      // thickness (Tungsten's factor), exp(-2 sigma_a thickness / cos t).
+      m.albedo = Vec3{1.0f};
+      m.albedoTexture = kNoNode;
+      Vec3 sigmaA{0.0f};
+      float thickness = 0.5f;  // Tungsten's default
+      vec3(v, "sigma_a", &sigmaA, where);
+      if (const Value* t = v.find("thickness")) {
+        TextureRef th = texture(*t, where, true);
+        if (th.isTexture)
+          warn(cat(where, ": a textured thin sheet thickness is not rendered; taken as 0.5"));
+        else
+          thickness = channelMean(th.constant);
+      }
+      m.coatingAbsorption = max(sigmaA * (2.0f * thickness), Vec3{0.0f});
+      if (const Value* e = v.find("enable_interference"); e && e->isBool() && e->asBool())
+        warn(cat(where, ": thin film interference is not rendered; the sheet reflects as without it"));
     } else if (type == "null") {
       m.type = MaterialType::Null;
     } else if (type == "phong") {

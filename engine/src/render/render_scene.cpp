@@ -578,7 +578,7 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
   const bool rough = isMicrofacet(m.type);
   int type = static_cast<int>(m.type) | (rough && m.beckmann ? gpu::kMatBeckmann : 0) |
-             (rough && m.separableShadowing ? gpu::kMatSeparable : 0);
+             (rough && m.separableShadowing ? gpu::kMatSeparable : 0) | (isGlassType(m.type) && m.tungstenGlass ? gpu::kMatTungstenGlass : 0);
   // Keep roughness away from zero, where GGX turns into a delta the rough code cannot sample.
   float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
   if (rough || m.type == MaterialType::Phong) roughness = std::max(roughness, 1e-3f);
