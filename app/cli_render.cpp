@@ -21,7 +21,7 @@ struct RenderOptions {
   std::optional<int> spp, maxBounces;
   int seed = 0;
   std::string out = "retile-render.png";
-  std::string view = "Standard";
+  std::optional<std::string> view;  // else the scene's (RenderSettings::view), else Standard
   double exposure = 0;
   bool denoise = false;
 };
@@ -34,7 +34,6 @@ int runRender(const RenderOptions& o) {
   if (o.maxBounces) req.maxBounces = *o.maxBounces;
   req.seed = static_cast<std::uint32_t>(o.seed);
   DisplaySettings display;
-  display.view = o.view;
   display.exposure = static_cast<float>(o.exposure);
   const std::filesystem::path out = o.out;
 
@@ -44,6 +43,7 @@ int runRender(const RenderOptions& o) {
     return 1;
   }
   for (const auto& w : loaded->warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  display.view = o.view ? *o.view : loaded->scene.settings.view.empty() ? "Standard" : loaded->scene.settings.view;
 
   Renderer renderer;
   std::fprintf(stderr, "device: %s\n", renderer.deviceName().c_str());
@@ -86,7 +86,8 @@ void addRender(CLI::App& app, int* status) {
           },
           ""));
   cmd->add_option("--view", o->view,
-                  "the PNG's OCIO view of the sRGB display: Standard, Filmic or Raw (default: " + o->view + ")")
+                  "the PNG's OCIO view of the sRGB display: Standard, Filmic or Raw (default: the scene's, as a Tungsten "
+                  "camera's tonemap says; else Standard)")
       ->type_name("NAME");
   addNumber(*cmd, "--exposure", &o->exposure, -64, 64, "stops, applied before the PNG's view transform")
       ->type_name("STOPS");

@@ -205,6 +205,7 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
     restoreState(settings.value("window/docks").toByteArray());
   }
   startEngine(doc_.scene());
+  applySceneView();
   rebuildOutliner();
   rebuildProperties();
   log(tr("viewport: %1").arg(view_->presentation()));
@@ -517,6 +518,7 @@ void MainWindow::buildDocks() {
   auto* displayBox = new QGroupBox(tr("Display (viewport only)"), settingsPanel);
   auto* df = new QFormLayout(displayBox);
   auto* viewBox = new QComboBox(displayBox);
+  displayView_ = viewBox;
   viewBox->setObjectName("displayView");
   try {
     for (const auto& v : ColorConfig::get()->views()) viewBox->addItem(QString::fromStdString(v));
@@ -1010,11 +1012,24 @@ void MainWindow::replaceDocument(Scene scene, const std::filesystem::path& file)
   updateTitle();
   loggedWarnings_.clear();
   startEngine(doc_.scene());
+  applySceneView();
   rebuildOutliner();
   panel_->setTarget({});
   rebuildProperties();
   graph_->setDocument(doc_.scene());
   graph_->resetLayout();
+}
+
+void MainWindow::applySceneView() {
+  const std::string& view = doc_.scene().settings.view;
+  if (view.empty() || !displayView_) return;
+  const int i = displayView_->findText(QString::fromStdString(view));
+  if (i < 0) {
+    log(tr("the scene asks for the view '%1', which the colour configuration does not have").arg(QString::fromStdString(view)));
+    return;
+  }
+  displayView_->setCurrentIndex(i);
+  log(tr("view: %1, as the scene asks").arg(displayView_->currentText()));
 }
 
 bool MainWindow::maybeSave() {

@@ -98,6 +98,8 @@ class MainWindow : public QMainWindow {
   void editSelected(const std::function<void(Object&)>& change, const QString& what);
   Vec3 pivot(const Object& o) const;  // where the gizmo sits and rotation/scale turn about
   void replaceDocument(Scene scene, const std::filesystem::path& file);
+  // Shows the document through the view its scene asks for (RenderSettings::view), if it names one.
+  void applySceneView();
   void buildDocks();
   QDockWidget* addDock(const QString& title, const char* name, QWidget* content, Qt::DockWidgetArea area);
   void startEngine(Scene scene);
@@ -144,6 +146,7 @@ class MainWindow : public QMainWindow {
   QElapsedTimer focusTimer_;
   QSpinBox* staleBox_ = nullptr;
   QComboBox* focusModeBox_ = nullptr;
+  QComboBox* displayView_ = nullptr;  // the viewport's OCIO view
   QPlainTextEdit* log_ = nullptr;
   QComboBox* methodBox_ = nullptr;
   QComboBox* tileBox_ = nullptr;

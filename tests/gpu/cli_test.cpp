@@ -68,6 +68,31 @@ TEST(Cli, ImportAndRenderUnderACommaDecimalLocale) {
   EXPECT_NE(comma.err.find("'0,5' is not a number"), std::string::npos) << comma.err;
 }
 
+// A PNG shows the scene through the view its file asks for (a Tungsten camera's tonemap), unless
+// --view says otherwise: the default render is byte for byte the one with that view named, and
+// not the Standard view's.
+TEST(Cli, APngIsShownThroughTheScenesViewUnlessToldOtherwise) {
+  Scene s = makeDefaultScene();
+  s.settings.view = "Raw";
+  const auto dir = test::tempDir();
+  ASSERT_TRUE(saveNativeScene(s, dir / "raw.retile").ok());
+  ChildLimits limits;
+  limits.timeout = std::chrono::minutes(5);
+  auto render = [&](const std::string& name, const std::vector<std::string>& view) {
+    std::vector<std::string> args = {"render", (dir / "raw.retile").string(), "--size", "16x16", "--spp", "2", "--out", (dir / name).string()};
+    args.insert(args.end(), view.begin(), view.end());
+    ChildResult r = runChild(RETILE_CLI_PATH, args, limits);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    auto bytes = readFile(dir / name);
+    return bytes.ok() ? bytes.value() : std::string();
+  };
+  const std::string byScene = render("scene.png", {}), raw = render("raw.png", {"--view", "Raw"}),
+                    standard = render("standard.png", {"--view", "Standard"});
+  ASSERT_FALSE(byScene.empty());
+  EXPECT_EQ(byScene, raw);
+  EXPECT_NE(byScene, standard);
+}
+
 // `retile compare` with a noise image lists the ratio by block size: noise averages away as blocks
 // grow, a bias does not. Three synthetic images: the reference flat; ours at two seeds, each with
 // its own noise and both 3 % brighter on the left half (the bias our renderer would have).

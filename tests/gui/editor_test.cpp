@@ -334,6 +334,27 @@ TEST(Editor, SaveOpenRoundTripAndABrokenFileKeepsTheScene) {
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 1; })) << "and keeps rendering";
 }
 
+// A scene that names the view its author saw it through (a Tungsten camera's tonemap) opens in
+// that view; one that names none leaves the viewport's as it was.
+TEST(Editor, AScenesViewIsTheViewportsWhenItOpens) {
+  auto w = makeWindow();
+  QTemporaryDir dir;
+  auto* view = w->findChild<QComboBox*>("displayView");
+  ASSERT_TRUE(view);
+  ASSERT_EQ(view->currentText(), "Standard");
+  Scene s = w->scene();
+  s.settings.view = "Filmic";
+  const std::filesystem::path filmic = (dir.path() + "/filmic.retile").toStdString();
+  ASSERT_TRUE(saveNativeScene(s, filmic).ok());
+  ASSERT_TRUE(w->openFile(filmic));
+  EXPECT_EQ(view->currentText(), "Filmic");
+  s.settings.view.clear();
+  const std::filesystem::path none = (dir.path() + "/none.retile").toStdString();
+  ASSERT_TRUE(saveNativeScene(s, none).ok());
+  ASSERT_TRUE(w->openFile(none));
+  EXPECT_EQ(view->currentText(), "Filmic") << "no view named: the viewport keeps its own";
+}
+
 TEST(Editor, UnderACommaDecimalLocaleOpensTheSharedSceneAndSavesWhatReadsBackUnderC) {
   RETILE_SHARED_OR_SKIP(box, "scenes/cornell-box/scene.json");
   QTemporaryDir dir;

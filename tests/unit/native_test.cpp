@@ -92,6 +92,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   s.settings.shading = ShadingConvention::Tungsten;
   s.settings.roulette = Roulette::Tungsten;
   s.settings.rayOffset = RayOffset::Tungsten;
+  s.settings.view = "Filmic";
   s.materials[0].separableShadowing = true;
   s.materials[0].tungstenGlass = true;
   ASSERT_FALSE(s.textures.empty());
@@ -135,6 +136,7 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.settings.shading, ShadingConvention::Tungsten);
   EXPECT_EQ(back->scene.settings.roulette, Roulette::Tungsten);
   EXPECT_EQ(back->scene.settings.rayOffset, RayOffset::Tungsten);
+  EXPECT_EQ(back->scene.settings.view, "Filmic");
   EXPECT_TRUE(back->scene.materials[0].separableShadowing);
   EXPECT_TRUE(back->scene.materials[0].tungstenGlass);
   EXPECT_EQ(back->scene.materials[0].bumpTexture, s.textures[0].id);

@@ -1010,6 +1010,20 @@ TEST(Tungsten, BeckmannIsKeptAndPhongWarns) {
 // origin of the primitive focus_pivot names; what is left out (cat's-eye vignetting, an aperture
 // texture, a pivot that names nothing) is said. Saved natively, the lens stays; a pinhole's file
 // does not mention one.
+// The camera's tonemap is the view the scene is shown through: filmic as Filmic, Tungsten's default
+// gamma as Standard, linear as Raw; Reinhard's, which we do not have, as Filmic with a warning.
+TEST(Tungsten, TheCamerasTonemapIsTheScenesView) {
+  const std::pair<const char*, const char*> cases[] = {
+      {R"("tonemap": "filmic",)", "Filmic"}, {"", "Standard"}, {R"("tonemap": "linear",)", "Raw"}, {R"("tonemap": "reinhard",)", "Filmic"}};
+  for (auto [tonemap, view] : cases) {
+    auto r = importTungsten(writeScene(std::string(R"({"camera": {)") + tonemap +
+                                       R"( "fov": 40}, "primitives": [{"type": "quad", "emission": 1}]})"));
+    ASSERT_TRUE(r.ok()) << r.error();
+    EXPECT_EQ(r->scene.settings.view, view) << tonemap;
+    EXPECT_EQ(r->warnings.size(), std::string(view) == "Filmic" && std::string(tonemap).find("reinhard") != std::string::npos ? 1u : 0u) << tonemap;
+  }
+}
+
 TEST(Tungsten, AThinLensCameraKeepsItsApertureAndFocus) {
   auto r = importTungsten(writeScene(R"({"camera": {"type": "thinlens", "fov": 40, "aperture_size": 0.02,
       "focus_distance": 3.5, "transform": {"position": [0, 1, 6], "look_at": [0, 1, 0], "up": [0, 1, 0]}},

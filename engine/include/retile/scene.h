@@ -362,6 +362,10 @@ struct RenderSettings {
   ShadingConvention shading = ShadingConvention::Consistent;  // Tungsten files: what their integrator asks
   Roulette roulette = Roulette::Standard;                     // Tungsten files: Tungsten's
   RayOffset rayOffset = RayOffset::Robust;                    // Tungsten files: Tungsten's
+  // The OCIO view the scene's author looked at it through (a Tungsten camera's tonemap), which
+  // the editor and `retile render` show it with until told otherwise; empty: the application's
+  // default, Standard. Display only: the render is the same whatever it says.
+  std::string view;
 };
 
 class Scene {

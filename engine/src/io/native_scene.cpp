@@ -176,6 +176,7 @@ Value nativeSceneToJson(const Scene& s) {
   if (s.settings.shading == ShadingConvention::Tungsten) settings.set("shading", "tungsten");
   if (s.settings.roulette == Roulette::Tungsten) settings.set("roulette", "tungsten");
   if (s.settings.rayOffset == RayOffset::Tungsten) settings.set("ray_offset", "tungsten");
+  if (!s.settings.view.empty()) settings.set("view", s.settings.view);
   root.set("settings", settings);
 
   Value cam(json::Object{});
@@ -391,6 +392,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
     readConvention(r, "shading", "consistent", &s.settings.shading);
     readConvention(r, "roulette", "standard", &s.settings.roulette);
     readConvention(r, "ray_offset", "robust", &s.settings.rayOffset);
+    r.string("view", &s.settings.view);
   }
   if (const Value* v = root.find("camera")) {
     Reader r(&error, "camera", v);

@@ -757,6 +757,20 @@ class TungstenImporter {
     } else if (type != "pinhole") {
       warn(cat("camera type '", type, "' is rendered as a pinhole camera"));
     }
+    // Its tonemap is how the author saw the scene: the nearest of our views shows it (the
+    // render itself is linear either way). Tungsten's default, gamma, is Standard's sRGB curve.
+    const std::string tonemap = string(c, "tonemap", "gamma");
+    if (tonemap == "filmic") {
+      s.settings.view = "Filmic";
+    } else if (tonemap == "linear") {
+      s.settings.view = "Raw";
+    } else if (tonemap == "reinhard" || tonemap == "pbrt") {
+      s.settings.view = "Filmic";
+      warn(cat("camera: tonemap '", tonemap, "' is shown through the Filmic view, the nearest there is"));
+    } else {
+      s.settings.view = "Standard";
+      if (tonemap != "gamma") warn(cat("camera: unknown tonemap '", tonemap, "'; shown through the Standard view"));
+    }
     // The renderer finds the medium around the camera itself (mediaAround): one that glass or a
     // boundary holds. Warned of once every primitive is read, if none does.
     cameraMedium_ = string(c, "medium");
