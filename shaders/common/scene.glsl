@@ -115,7 +115,8 @@ vec4 bitmapTexel(int offset, int i, int flags) {
 #endif
 }
 
-// Texture lookup with repeat wrapping and bilinear filtering; checkers are analytic.
+// Texture lookup, bilinear or nearest, repeated or held at the edges (kTexNearest, kTexClamp);
+// checkers are analytic.
 vec4 sampleTexture(int index, vec2 uv) {
   vec4 info = texelFetch(uTexInfo, index * kTextureTexels);
   int kind = floatBitsToInt(info.w);
@@ -129,16 +130,16 @@ vec4 sampleTexture(int index, vec2 uv) {
   int w = floatBitsToInt(info.y), h = floatBitsToInt(info.z);
   // v points up in every format we import; image rows go down. Wrap in floating point first:
   // GLSL leaves % of negative integers undefined, and far-away uvs overflow an int.
+  bool clampToEdge = (kind & kTexClamp) != 0, nearest = (kind & kTexNearest) != 0;
   vec2 wrapped = vec2(uv.x, 1.0 - uv.y);
-  wrapped = any(isnan(wrapped)) || any(isinf(wrapped)) ? vec2(0.0) : wrapped - floor(wrapped);
+  wrapped = any(isnan(wrapped)) || any(isinf(wrapped)) ? vec2(0.0) : clampToEdge ? clamp(wrapped, 0.0, 1.0) : wrapped - floor(wrapped);
   ivec2 size = ivec2(w, h);
-  vec2 p = wrapped * vec2(size) - 0.5;
-  vec2 f = fract(p);
-  ivec2 i0 = ivec2(floor(p));
-  i0 += ivec2(lessThan(i0, ivec2(0))) * size;
-  i0 = clamp(i0, ivec2(0), size - 1);
+  vec2 p = wrapped * vec2(size) - (nearest ? 0.0 : 0.5);
+  vec2 f = nearest ? vec2(0.0) : fract(p);
+  ivec2 base = ivec2(floor(p));
+  ivec2 i0 = clamp(base + ivec2(lessThan(base, ivec2(0))) * (clampToEdge ? ivec2(0) : size), ivec2(0), size - 1);
   ivec2 i1 = i0 + 1;
-  i1 -= ivec2(greaterThanEqual(i1, size)) * size;
+  i1 = clampToEdge ? clamp(base + 1, ivec2(0), size - 1) : i1 - ivec2(greaterThanEqual(i1, size)) * size;
   vec4 a = bitmapTexel(offset, i0.y * w + i0.x, kind);
   vec4 b = bitmapTexel(offset, i0.y * w + i1.x, kind);
   vec4 c = bitmapTexel(offset, i1.y * w + i0.x, kind);

@@ -151,6 +151,10 @@ RT_CONST(int, kTexChecker, 1)
 RT_CONST(int, kTexAlpha, 16)
 RT_CONST(int, kTexEightBit, 32)
 RT_CONST(int, kTexSrgb, 64)
+// Read at the nearest texel instead of bilinearly (Texture::interpolate), and with the edge
+// texels held beyond [0, 1] instead of repeating (Texture::clampToEdge).
+RT_CONST(int, kTexNearest, 128)
+RT_CONST(int, kTexClamp, 32768)
 // And a half-float bitmap's colour is stored divided by 2^k, k in these bits, so that values
 // beyond a half's range (a sun in a sky map) keep their light.
 RT_CONST(int, kTexScaleShift, 8)

@@ -851,6 +851,41 @@ TEST(KnownAnswer, EightBitTexturesReadAsTheirDecodedValues) {
   EXPECT_NEAR(meanOver(renderScene(*r, s, 16), plane), tungsten100, 0.004) << "under a sky map";
 }
 
+// A texture of two texels, 1 and 0, across the unit quad that fills the frame (the frame spans u
+// from a to 1 - a). Read at the nearest texel (Texture::interpolate off), the left half is 1 and
+// the right 0 but for the column the pixel filter straddles; held at its edges (clampToEdge), the
+// bilinear ramp runs from u = 0.25 to 0.75 only, so the left half's mean is (0.4375 - a) / (0.5 -
+// a) where repeating gives the EightBit test's (0.375 - a / 2 - a^2) / (0.5 - a).
+TEST(KnownAnswer, ABitmapIsReadAtItsNearestTexelOrHeldAtItsEdgesWhenAsked) {
+  RETILE_RENDERER_OR_SKIP(r);
+  auto dir = test::tempDir();
+  Scene s = underUnitSky(32, 32, 16);
+  const NodeId pair = addByteRow(s, dir, "pair", {255, 0}, TextureColorSpace::Linear);
+  Material white = grey(1.0f);
+  white.albedoTexture = pair;
+  test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, white), Mat4::identity());
+  auto halves = [&] {
+    const RenderImage img = renderScene(*r, s, 64);
+    double left = 0, right = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) (x < img.width / 2 ? left : right) += img.color[(static_cast<std::size_t>(y) * img.width + x) * 3 + 1];
+    const double half = img.width / 2.0 * img.height;
+    return std::pair{left / half, right / half};
+  };
+  const double a = 0.5 - 3.0 * std::tan(8.0 * std::numbers::pi / 180.0);
+  s.texture(pair)->interpolate = false;
+  auto [nearLeft, nearRight] = halves();
+  EXPECT_GT(nearLeft, 0.96);
+  EXPECT_LT(nearRight, 0.04);
+  EXPECT_NEAR(nearLeft + nearRight, 1.0, 0.006);
+  s.texture(pair)->interpolate = true;
+  s.texture(pair)->clampToEdge = true;
+  auto [heldLeft, heldRight] = halves();
+  EXPECT_NEAR(heldLeft, (0.4375 - a) / (0.5 - a), 0.006);
+  EXPECT_NEAR(heldRight, 1.0 - (0.4375 - a) / (0.5 - a), 0.006);
+  EXPECT_GT(heldLeft - (0.375 - 0.5 * a - a * a) / (0.5 - a), 0.05) << "repeating would read measurably less";
+}
+
 // A sky map brighter than a half float's largest value (65504), as a sun in an HDR sky often is:
 // its texels are stored scaled down by a power of two and scaled back where they are read. A
 // uniform map of 2e6 (green) over a lambert plane of albedo 0.5 reads 1e6; clipped to halves, the

@@ -96,6 +96,8 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   s.materials[0].separableShadowing = true;
   s.materials[0].tungstenGlass = true;
   ASSERT_FALSE(s.textures.empty());
+  s.textures[0].interpolate = false;
+  s.textures[0].clampToEdge = true;
   s.materials[0].bumpTexture = s.textures[0].id;
   s.materials[0].bumpStrength = -2.5f;
   s.materials[0].emissionTexture = s.textures[0].id;
@@ -137,6 +139,8 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.settings.roulette, Roulette::Tungsten);
   EXPECT_EQ(back->scene.settings.rayOffset, RayOffset::Tungsten);
   EXPECT_EQ(back->scene.settings.view, "Filmic");
+  EXPECT_FALSE(back->scene.textures[0].interpolate);
+  EXPECT_TRUE(back->scene.textures[0].clampToEdge);
   EXPECT_TRUE(back->scene.materials[0].separableShadowing);
   EXPECT_TRUE(back->scene.materials[0].tungstenGlass);
   EXPECT_EQ(back->scene.materials[0].bumpTexture, s.textures[0].id);

@@ -1024,6 +1024,42 @@ TEST(Tungsten, TheCamerasTonemapIsTheScenesView) {
   }
 }
 
+// A bitmap's interpolate and clamp are how its texture is read; the same file read otherwise is
+// another texture.
+TEST(Tungsten, ABitmapKeepsItsInterpolationAndClamp) {
+  auto r = importTungsten(writeScene(R"({"bsdfs": [
+      {"name": "pixel", "type": "lambert", "albedo": {"type": "bitmap", "file": "t.png", "interpolate": false, "clamp": true}},
+      {"name": "smooth", "type": "lambert", "albedo": "t.png"}],
+      "primitives": [{"type": "quad", "bsdf": "pixel"}, {"type": "quad", "bsdf": "smooth"}, {"type": "quad", "emission": 1}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  const Texture* pixel = s.texture(s.material(s.objects[0].material)->albedoTexture);
+  const Texture* smooth = s.texture(s.material(s.objects[1].material)->albedoTexture);
+  ASSERT_TRUE(pixel && smooth);
+  EXPECT_NE(pixel->id, smooth->id);
+  EXPECT_FALSE(pixel->interpolate);
+  EXPECT_TRUE(pixel->clampToEdge);
+  EXPECT_TRUE(smooth->interpolate);
+  EXPECT_FALSE(smooth->clampToEdge);
+}
+
+// An integrator block as Bitterli's files have it says nothing; settings that change the picture
+// and are not rendered are each said.
+TEST(Tungsten, IntegratorSettingsThatAreNotRenderedAreSaid) {
+  auto plain = importTungsten(writeScene(R"({"integrator": {"type": "path_tracer", "min_bounces": 0, "max_bounces": 64,
+      "enable_light_sampling": true, "enable_volume_light_sampling": true, "enable_consistency_checks": false,
+      "enable_two_sided_shading": true}, "primitives": [{"type": "quad", "emission": 1}]})"));
+  ASSERT_TRUE(plain.ok()) << plain.error();
+  EXPECT_TRUE(plain->warnings.empty()) << plain->warnings.front();
+  auto odd = importTungsten(writeScene(R"({"integrator": {"type": "bidirectional_path_tracer", "min_bounces": 2,
+      "enable_light_sampling": false}, "primitives": [{"type": "quad", "emission": 1}]})"));
+  ASSERT_TRUE(odd.ok()) << odd.error();
+  ASSERT_EQ(odd->warnings.size(), 3u);
+  EXPECT_NE(odd->warnings[0].find("min_bounces 2"), std::string::npos) << odd->warnings[0];
+  EXPECT_NE(odd->warnings[1].find("enable_light_sampling"), std::string::npos) << odd->warnings[1];
+  EXPECT_NE(odd->warnings[2].find("bidirectional_path_tracer"), std::string::npos) << odd->warnings[2];
+}
+
 TEST(Tungsten, AThinLensCameraKeepsItsApertureAndFocus) {
   auto r = importTungsten(writeScene(R"({"camera": {"type": "thinlens", "fov": 40, "aperture_size": 0.02,
       "focus_distance": 3.5, "transform": {"position": [0, 1, 6], "look_at": [0, 1, 0], "up": [0, 1, 0]}},

@@ -63,6 +63,10 @@ struct Texture {
   std::string encodedFormat;            // Embedded: a file extension hint such as "png"
   TextureColorSpace colorSpace = TextureColorSpace::Auto;
   MissingTexture whenMissing = MissingTexture::Checker;
+  // How a bitmap is read between and beyond its texels: bilinear, or the nearest texel (a Tungsten
+  // bitmap's "interpolate": false); repeated, or its edge texels held beyond [0, 1] (its "clamp").
+  bool interpolate = true;
+  bool clampToEdge = false;
   Vec3 checkerOn{0.8f}, checkerOff{0.2f};  // Checker: colours and squares per unit of uv
   int checkerResU = 8, checkerResV = 8;
 };

@@ -229,6 +229,8 @@ Value nativeSceneToJson(const Scene& s) {
     v.set("kind", textureKindName(t.kind));
     v.set("color_space", colorSpaceName(t.colorSpace));
     if (t.whenMissing == MissingTexture::Tungsten) v.set("when_missing", "tungsten");
+    if (!t.interpolate) v.set("interpolate", false);
+    if (t.clampToEdge) v.set("clamp", true);
     if (t.kind == TextureKind::File) {
       // Stored as written, plus the absolute location so a copy saved elsewhere still finds it.
       v.set("path", t.path.generic_string());
@@ -457,6 +459,8 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       if (whenMissing == "tungsten") t.whenMissing = MissingTexture::Tungsten;
       else if (!whenMissing.empty() && whenMissing != "checker")
         r.problem("when_missing", cat("unknown stand-in '", whenMissing, "' (checker, tungsten)"));
+      r.boolean("interpolate", &t.interpolate);
+      r.boolean("clamp", &t.clampToEdge);
       std::string path, absolute;
       r.string("path", &path);
       r.string("absolute_path", &absolute);

@@ -88,6 +88,17 @@ class TungstenImporter {
     s.settings.roulette = Roulette::Tungsten;
     s.settings.rayOffset = RayOffset::Tungsten;
     if (!twoSided) warn("integrator: one-sided shading (enable_two_sided_shading: false) is rendered two-sided");
+    if (const Value* in = root.find("integrator"); in && in->isObject()) {
+      // What else a path tracer's settings change in the picture, and is not rendered: said.
+      float minBounces = 0;
+      if (const Value* v = in->find("min_bounces"); v && json::toFloat(*v, &minBounces) && minBounces >= 1)
+        warn(cat("integrator: min_bounces ", minBounces, " is not rendered; light that arrives in fewer bounces is counted too"));
+      for (const char* key : {"enable_light_sampling", "enable_volume_light_sampling"})
+        if (const Value* v = in->find(key); v && v->isBool() && !v->asBool())
+          warn(cat("integrator: ", key, " false is not rendered; lights are sampled, which gives the same picture with less noise, except that point lights and suns, which Tungsten then never reaches, light it here"));
+      if (std::string type = string(*in, "type", "path_tracer"); type != "path_tracer")
+        warn(cat("integrator: '", type, "' is rendered by path tracing, which converges to the same picture"));
+    }
     if (const Value* r = root.find("renderer"); r && r->isObject()) {
       float spp;
       if (const Value* v = r->find("spp"); v && json::toFloat(*v, &spp) && spp >= 1)
@@ -266,8 +277,8 @@ class TungstenImporter {
     return v && v->isString() ? v->asString() : fallback;
   }
 
-  NodeId fileTexture(const std::string& ref, TextureColorSpace cs) {
-    std::string key = cat(ref, "|", static_cast<int>(cs));
+  NodeId fileTexture(const std::string& ref, TextureColorSpace cs, bool interpolate = true, bool clampToEdge = false) {
+    std::string key = cat(ref, "|", static_cast<int>(cs), "|", interpolate, "|", clampToEdge);
     if (auto it = textures_.find(key); it != textures_.end()) return it->second;
     Texture t;
     t.id = out_.scene.newId();
@@ -276,6 +287,8 @@ class TungstenImporter {
     t.name = fs::path(ref).filename().string();
     t.colorSpace = cs;
     t.whenMissing = MissingTexture::Tungsten;
+    t.interpolate = interpolate;
+    t.clampToEdge = clampToEdge;
     // One warning per missing file, however many materials use it; the environment says its own.
     if (!resolveScenePath(base_, ref) && !quietMissingTexture_ && missingWarned_.insert(ref).second)
       warn(cat("texture '", ref, "' not found; until the file is there it renders as Tungsten renders a missing texture, a black and white checker (as colour and as alpha)"));
@@ -313,9 +326,13 @@ class TungstenImporter {
       if (const Value* g = v.find("gamma_correct"); g && g->isBool()) gamma = g->asBool();
       float scale = 1;
       number(v, "scale", &scale, where);
+      bool interpolate = true, clampToEdge = false;  // Tungsten's defaults
+      if (const Value* i = v.find("interpolate"); i && i->isBool()) interpolate = i->asBool();
+      if (const Value* c = v.find("clamp"); c && c->isBool()) clampToEdge = c->asBool();
       r.isTexture = true;
       r.constant = Vec3{scale};
-      r.texture = fileTexture(f, data ? TextureColorSpace::Raw : gamma ? TextureColorSpace::TungstenGamma : TextureColorSpace::Linear);
+      r.texture = fileTexture(f, data ? TextureColorSpace::Raw : gamma ? TextureColorSpace::TungstenGamma : TextureColorSpace::Linear,
+                              interpolate, clampToEdge);
       return r;
     }
     if (type == "checker") {

@@ -1450,7 +1450,8 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
       data_.byteTexels |= eightBit;
       data_.halfTexels |= !eightBit;
       data_.srgbTexels |= (d.flags & gpu::kTexSrgb) != 0;
-      data_.textureInfo.push_back(ints(static_cast<std::int32_t>(at / 2), d.width, d.height, d.flags));
+      const int sampling = (t.interpolate ? 0 : gpu::kTexNearest) | (t.clampToEdge ? gpu::kTexClamp : 0);
+      data_.textureInfo.push_back(ints(static_cast<std::int32_t>(at / 2), d.width, d.height, d.flags | sampling));
       data_.textureInfo.push_back({0, 0, 0, 0});
       data_.textureInfo.push_back({0, 0, 0, 0});
       textureMean_[t.id] = d.mean;
