@@ -332,8 +332,14 @@ TEST_F(Bsdfs, LosslessMaterialsKeepAllEnergy) {
     EXPECT_NEAR(sampledAlbedo(material(MaterialType::ThinSheet, 1.0f), wo).first, 1.0, 1e-4);
     EXPECT_NEAR(sampledAlbedo(material(MaterialType::Dielectric, 1.0f), wo).first, F + (1 - F) / (eta * eta), 0.003);
     EXPECT_NEAR(sampledAlbedo(material(MaterialType::Plastic, 1.0f), wo).first, 1.0, 0.01) << "cos " << cosO;
-    // Over a black base the coating reflects F alone: Tungsten's dielectric without refraction.
+    // Over a black base the coating reflects F alone; so does a metal of index 1.5 + 0i, which
+    // is how Tungsten's dielectric without refraction is imported, tinted by its albedo.
     EXPECT_NEAR(sampledAlbedo(material(MaterialType::Plastic, 0.0f), wo).first, F, 1e-3) << "cos " << cosO;
+    Material reflector = material(MaterialType::Conductor, 0.7f);
+    reflector.metal = "custom";
+    reflector.eta = Vec3{1.5f};
+    reflector.k = Vec3{0.0f};
+    EXPECT_NEAR(sampledAlbedo(reflector, wo).first, 0.7 * F, 1e-5) << "cos " << cosO;
   }
 }
 

@@ -609,14 +609,15 @@ class TungstenImporter {
       m.tungstenGlass = true;
       if (rough) roughness(0.1f);
       if (const Value* e = v.find("enable_refraction"); e && e->isBool() && !e->asBool()) {
-        // Tungsten's dielectric without refraction reflects F and transmits nothing: a coating
-        // over a black base. (Tungsten tints that F by the albedo, which a coating cannot be:
-        // an albedo other than white is left out.)
-        if (m.albedoTexture != kNoNode || !(m.albedo == Vec3{1.0f}))
-          warn(cat(where, ": the albedo of a dielectric without refraction is not rendered; it reflects untinted"));
-        m.type = rough ? MaterialType::RoughPlastic : MaterialType::Plastic;
-        m.albedo = Vec3{0.0f};
-        m.albedoTexture = kNoNode;
+        // Tungsten's dielectric without refraction reflects F times its albedo and transmits
+        // nothing; being opaque, it is shaded from the viewer's side (two-sided), so F is always
+        // the outside's. That is exactly a metal of index ior + 0i: its Fresnel term is the
+        // dielectric's, tinted by the albedo, over the same lobe.
+        m.type = rough ? MaterialType::RoughConductor : MaterialType::Conductor;
+        m.metal = "custom";
+        m.eta = Vec3{std::clamp(m.ior, 1.0001f, 10.0f)};
+        m.k = Vec3{0.0f};
+        m.tungstenGlass = false;
       }
     } else if (type == "thinsheet") {
       m.type = MaterialType::ThinSheet;
