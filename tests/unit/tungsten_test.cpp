@@ -1023,6 +1023,29 @@ TEST(Tungsten, TheCamerasTonemapIsTheScenesView) {
   }
 }
 
+// Tungsten's sphere and disk are analytic; tessellated, ours keep their true areas (4 pi r^2 and
+// pi r^2), so that as emitters they give the light Tungsten's give.
+TEST(Tungsten, SpheresAndDisksKeepTheirTrueArea) {
+  auto r = importTungsten(writeScene(R"({"primitives": [
+      {"type": "sphere", "emission": 1, "transform": {"scale": 2}},
+      {"type": "disk", "emission": 1, "transform": {"scale": 3}}]})"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  ASSERT_EQ(s.objects.size(), 2u);
+  const double expected[] = {4 * kPi * 4, kPi * 9};
+  for (std::size_t k = 0; k < 2; ++k) {
+    const Object& o = s.objects[k];
+    const MeshGeometry& g = *s.mesh(o.mesh)->geometry;
+    double area = 0;
+    for (std::size_t i = 0; i + 2 < g.indices.size(); i += 3) {
+      const Vec3 a = o.transform.transformPoint(g.positions[g.indices[i]]), b = o.transform.transformPoint(g.positions[g.indices[i + 1]]),
+                 c = o.transform.transformPoint(g.positions[g.indices[i + 2]]);
+      area += 0.5 * static_cast<double>(length(cross(b - a, c - a)));
+    }
+    EXPECT_NEAR(area, expected[k], 2e-5 * expected[k]) << (k == 0 ? "sphere" : "disk");
+  }
+}
+
 // A bitmap's interpolate and clamp are how its texture is read; the same file read otherwise is
 // another texture.
 TEST(Tungsten, ABitmapKeepsItsInterpolationAndClamp) {
