@@ -1044,6 +1044,19 @@ TEST(Tungsten, SpheresAndDisksKeepTheirTrueArea) {
     }
     EXPECT_NEAR(area, expected[k], 2e-5 * expected[k]) << (k == 0 ? "sphere" : "disk");
   }
+  // And the sphere's uvs are Tungsten's: u = atan2(y, x) / 2 pi + 1/2, v = acos(z) / pi of the
+  // point on the unit sphere (poles and the seam, where u is either end, left out).
+  const MeshGeometry& sphere = *s.mesh(s.objects[0].mesh)->geometry;
+  int checked = 0;
+  for (std::size_t i = 0; i < sphere.positions.size(); ++i) {
+    const Vec3 n = normalize(sphere.positions[i]);
+    const Vec2 uv = sphere.uvs[i];
+    if (std::abs(n.z) > 0.999f || uv.x < 1e-3f || uv.x > 1 - 1e-3f) continue;
+    ASSERT_NEAR(uv.x, std::atan2(n.y, n.x) / (2 * kPi) + 0.5f, 1e-4) << i;
+    ASSERT_NEAR(uv.y, std::acos(n.z) / kPi, 1e-4) << i;
+    ++checked;
+  }
+  EXPECT_GT(checked, 4000);
 }
 
 // A bitmap's interpolate and clamp are how its texture is read; the same file read otherwise is

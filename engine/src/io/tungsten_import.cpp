@@ -853,13 +853,23 @@ class TungstenImporter {
     return scaled;
   }
 
+  // Tungsten's sphere has its poles on z and u = atan2(y, x) / 2 pi + 1/2, v = acos(z) / pi
+  // (Sphere::intersectionInfo); ours has them on y. The same mesh turned by (x, y, z) -> (-x, z, y),
+  // a rotation, carries uvs that are Tungsten's, so that a textured sphere looks as in Tungsten.
+  static std::shared_ptr<const MeshGeometry> tungstenSphere() {
+    auto g = std::make_shared<MeshGeometry>(*makeSphere());
+    for (Vec3& p : g->positions) p = Vec3{-p.x, p.z, p.y};
+    for (Vec3& n : g->normals) n = Vec3{-n.x, n.z, n.y};
+    return g;
+  }
+
   std::shared_ptr<const MeshGeometry> shape(const std::string& kind) {
     auto it = shapes_.find(kind);
     if (it != shapes_.end()) return it->second;
     std::shared_ptr<const MeshGeometry> g;
     if (kind == "quad") g = makeQuad();
     else if (kind == "cube") g = makeCube();
-    else if (kind == "sphere") g = withArea(makeSphere(), 4 * kPi);
+    else if (kind == "sphere") g = withArea(tungstenSphere(), 4 * kPi);
     else if (kind == "disk") g = withArea(makeLathe({{1.0f, 0.0f}, {0.0f, 0.0f}}, 64), kPi);
     else if (kind == "cylinder") g = makeCylinder(true);
     else if (kind == "open cylinder") g = makeCylinder(false);
