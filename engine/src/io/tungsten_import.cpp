@@ -71,7 +71,9 @@ class TungstenImporter {
     }
     if (const Value* c = root.find("camera"); c && ok()) camera(*c);
     s.settings.maxBounces = 63;  // Tungsten's default of 64 path segments, where the file says none
-    if (const Value* in = root.find("integrator"); in && in->isObject()) {
+    const Value* integrator = root.find("integrator");
+    if (integrator && !integrator->isObject()) integrator = nullptr;
+    if (const Value* in = integrator) {
       float mb;
       if (const Value* v = in->find("max_bounces"); v && json::toFloat(*v, &mb) && mb >= 0)
         s.settings.maxBounces = std::clamp(static_cast<int>(mb) - 1, 0, 1024);  // Tungsten counts segments
@@ -80,7 +82,7 @@ class TungstenImporter {
     // paths end about where ours do (ours also shade with the geometric normal where the viewer
     // is behind the shading normal); one-sided shading has no counterpart here.
     bool consistency = false, twoSided = true;
-    if (const Value* in = root.find("integrator"); in && in->isObject()) {
+    if (const Value* in = integrator) {
       if (const Value* v = in->find("enable_consistency_checks"); v && v->isBool()) consistency = v->asBool();
       if (const Value* v = in->find("enable_two_sided_shading"); v && v->isBool()) twoSided = v->asBool();
     }
@@ -88,7 +90,7 @@ class TungstenImporter {
     s.settings.roulette = Roulette::Tungsten;
     s.settings.rayOffset = RayOffset::Tungsten;
     if (!twoSided) warn("integrator: one-sided shading (enable_two_sided_shading: false) is rendered two-sided");
-    if (const Value* in = root.find("integrator"); in && in->isObject()) {
+    if (const Value* in = integrator) {
       // What else a path tracer's settings change in the picture, and is not rendered: said.
       float minBounces = 0;
       if (const Value* v = in->find("min_bounces"); v && json::toFloat(*v, &minBounces) && minBounces >= 1)
@@ -841,14 +843,10 @@ class TungstenImporter {
   // for the sphere's 48 x 96, 0.16 % for the disk's 64-gon), and as an emitter gives that much less
   // light, which is most of the 0.2 % a scene lit by them may differ by. Scaled out to the true area.
   static std::shared_ptr<const MeshGeometry> withArea(std::shared_ptr<const MeshGeometry> g, float area) {
-    double meshArea = 0;
-    for (std::size_t i = 0; i + 2 < g->indices.size(); i += 3) {
-      const Vec3 a = g->positions[g->indices[i]], b = g->positions[g->indices[i + 1]], c = g->positions[g->indices[i + 2]];
-      meshArea += 0.5 * static_cast<double>(length(cross(b - a, c - a)));
-    }
+    const float meshArea = worldArea(*g, Mat4::identity());
     if (!(meshArea > 0)) return g;
     auto scaled = std::make_shared<MeshGeometry>(*g);
-    const float s = static_cast<float>(std::sqrt(static_cast<double>(area) / meshArea));
+    const float s = std::sqrt(area / meshArea);
     for (Vec3& p : scaled->positions) p = p * s;
     return scaled;
   }
@@ -1069,7 +1067,7 @@ class TungstenImporter {
     return g;
   }
 
-  float worldArea(const MeshGeometry& g, const Mat4& m) {
+  static float worldArea(const MeshGeometry& g, const Mat4& m) {
     double a = 0;
     for (std::size_t i = 0; i + 2 < g.indices.size(); i += 3) {
       Vec3 p0 = m.transformPoint(g.positions[g.indices[i]]);
