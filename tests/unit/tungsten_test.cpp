@@ -1059,6 +1059,92 @@ TEST(Tungsten, SpheresAndDisksKeepTheirTrueArea) {
   EXPECT_GT(checked, 4000);
 }
 
+// The analytic shapes carry Tungsten's uvs, so that a texture on them lies as in Tungsten: the
+// quad's v runs against z, the cube's faces take their other two axes in turn, the cylinder's wall
+// takes the angle atan2(z, x), and the disk's u is the angle about its normal in Tungsten's frame
+// of it, v the distance from its centre over its radius. A disk is round whatever its scale. Each
+// triangle still faces the way its normals do.
+TEST(Tungsten, AnalyticShapesCarryTungstensUvs) {
+  // The disk's matrix: a turn about a slanted axis, scaled 2 in x, 1 in y, 0.5 in z, moved.
+  const Vec3 axis = normalize(Vec3{0.3f, 0.5f, 0.8f});
+  const float angle = 0.7f, c = std::cos(angle), sn = std::sin(angle), k = 1 - c;
+  const float rot[3][3] = {{c + axis.x * axis.x * k, axis.x * axis.y * k - axis.z * sn, axis.x * axis.z * k + axis.y * sn},
+                           {axis.y * axis.x * k + axis.z * sn, c + axis.y * axis.y * k, axis.y * axis.z * k - axis.x * sn},
+                           {axis.z * axis.x * k - axis.y * sn, axis.z * axis.y * k + axis.x * sn, c + axis.z * axis.z * k}};
+  const float scale[3] = {2, 1, 0.5f};
+  const Vec3 centre{1, -2, 3};
+  std::string matrix;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      const float v = i == 3 ? (j == 3 ? 1.0f : 0.0f) : j == 3 ? (i == 0 ? centre.x : i == 1 ? centre.y : centre.z) : rot[i][j] * scale[j];
+      matrix += (matrix.empty() ? "" : ", ") + std::to_string(v);
+    }
+  auto r = importTungsten(writeScene(R"({"primitives": [{"type": "quad"}, {"type": "cube"}, {"type": "cylinder"},
+      {"type": "disk", "transform": [)" + matrix + "]}]}"));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  ASSERT_EQ(s.objects.size(), 4u);
+  auto geometry = [&](std::size_t i) -> const MeshGeometry& { return *s.mesh(s.objects[i].mesh)->geometry; };
+  auto coord = [](Vec3 p, int d) { return d == 0 ? p.x : d == 1 ? p.y : p.z; };
+  const float eps = 1e-4f;
+  for (std::size_t o = 0; o < 4; ++o) {
+    const MeshGeometry& g = geometry(o);
+    for (std::size_t i = 0; i + 2 < g.indices.size(); i += 3) {
+      const Vec3 a = g.positions[g.indices[i]], b = g.positions[g.indices[i + 1]], cc = g.positions[g.indices[i + 2]];
+      if (length(cross(b - a, cc - a)) < 1e-9f) continue;  // a lathe's degenerate triangles at a cap's centre
+      ASSERT_GT(dot(cross(b - a, cc - a), g.normals[g.indices[i]] + g.normals[g.indices[i + 1]] + g.normals[g.indices[i + 2]]), 0) << o << " " << i;
+    }
+  }
+  for (std::size_t i = 0; i < geometry(0).positions.size(); ++i) {
+    const Vec3 p = geometry(0).positions[i];
+    EXPECT_NEAR(geometry(0).uvs[i].x, p.x + 0.5f, eps);
+    EXPECT_NEAR(geometry(0).uvs[i].y, 0.5f - p.z, eps);
+  }
+  for (std::size_t i = 0; i < geometry(1).positions.size(); ++i) {
+    const Vec3 p = geometry(1).positions[i], n = geometry(1).normals[i];
+    const int dim = std::abs(n.x) > 0.5f ? 0 : std::abs(n.y) > 0.5f ? 1 : 2;
+    EXPECT_NEAR(geometry(1).uvs[i].x, coord(p, (dim + 1) % 3) + 0.5f, eps) << i;
+    EXPECT_NEAR(geometry(1).uvs[i].y, coord(p, (dim + 2) % 3) + 0.5f, eps) << i;
+  }
+  int wall = 0, caps = 0;
+  for (std::size_t i = 0; i < geometry(2).positions.size(); ++i) {
+    const Vec3 p = geometry(2).positions[i], n = geometry(2).normals[i];
+    const Vec2 uv = geometry(2).uvs[i];
+    if (std::abs(n.y) > 0.5f) {
+      EXPECT_NEAR(uv.x, p.x + 0.5f, eps) << i;
+      EXPECT_NEAR(uv.y, p.z + 0.5f, eps) << i;
+      ++caps;
+    } else if (uv.x > 1e-3f && uv.x < 1 - 1e-3f) {
+      EXPECT_NEAR(uv.x, std::atan2(p.z, p.x) / (2 * kPi) + 0.5f, eps) << i;
+      EXPECT_NEAR(uv.y, p.y + 0.5f, eps) << i;
+      ++wall;
+    }
+  }
+  EXPECT_GT(wall, 100);
+  EXPECT_GT(caps, 100);
+  // Tungsten's disk, from its matrix: radius the larger of the x and z columns' lengths, normal
+  // the y column, u from TangentFrame(normal), which starts from y or x, whichever is further
+  // from the normal.
+  const Vec3 n = normalize(Vec3{rot[0][1], rot[1][1], rot[2][1]});
+  const float radius = 2;
+  const Vec3 t0 = std::abs(n.x) > std::abs(n.y) ? Vec3{0, 1, 0} : Vec3{1, 0, 0};
+  const Vec3 bt = normalize(cross(n, t0)), tg = cross(bt, n);
+  const Mat4& m = s.objects[3].transform;
+  const MeshGeometry& disk = geometry(3);
+  int checked = 0;
+  for (std::size_t i = 0; i < disk.positions.size(); ++i) {
+    const Vec3 d = m.transformPoint(disk.positions[i]) - centre;
+    EXPECT_NEAR(dot(d, n), 0, 1e-4f) << i;
+    EXPECT_LE(length(d), radius * 1.002f) << i;
+    EXPECT_NEAR(disk.uvs[i].y, length(d) / radius, 2e-3f) << i;  // the rim is pushed out to the true area
+    if (length(d) < 1e-3f || disk.uvs[i].x < 1e-3f || disk.uvs[i].x > 1 - 1e-3f) continue;
+    EXPECT_NEAR(disk.uvs[i].x, std::atan2(dot(d, tg), dot(d, bt)) / (2 * kPi) + 0.5f, eps) << i;
+    ++checked;
+  }
+  EXPECT_GT(checked, 60);
+  EXPECT_GT(dot(normalize(m.transformVector({0, 1, 0})), n), 0.9999f);
+}
+
 // A bitmap's interpolate and clamp are how its texture is read; the same file read otherwise is
 // another texture.
 TEST(Tungsten, ABitmapKeepsItsInterpolationAndClamp) {

@@ -861,16 +861,94 @@ class TungstenImporter {
     return g;
   }
 
+  // Tungsten's quad has v = 1/2 - z (Quad::intersect: v = 1 - l1); ours z + 1/2.
+  static std::shared_ptr<const MeshGeometry> tungstenQuad() {
+    auto g = std::make_shared<MeshGeometry>(*makeQuad());
+    for (Vec2& uv : g->uvs) uv.y = 1 - uv.y;
+    return g;
+  }
+
+  // Tungsten's cube maps a face across its other two axes in turn, (y, z) on the x faces, (z, x)
+  // on the y faces, (x, y) on the z faces, each from 0 to 1 and unmirrored on either side
+  // (Cube::intersectionInfo). Ours spans each face by its own corners.
+  static std::shared_ptr<const MeshGeometry> tungstenCube() {
+    auto g = std::make_shared<MeshGeometry>(*makeCube());
+    for (std::size_t i = 0; i < g->positions.size(); ++i) {
+      const Vec3 n = g->normals[i], p = g->positions[i];
+      const int dim = std::abs(n.x) > 0.5f ? 0 : std::abs(n.y) > 0.5f ? 1 : 2;
+      const float c[3] = {p.x, p.y, p.z};
+      g->uvs[i] = {c[(dim + 1) % 3] + 0.5f, c[(dim + 2) % 3] + 0.5f};
+    }
+    return g;
+  }
+
+  // Tungsten's cylinder has u = atan2(z, x) / 2 pi + 1/2 and v = y + 1/2 on its wall and
+  // (x + 1/2, z + 1/2) on its caps (Cylinder::intersectionInfo). Ours, turned half a turn about y
+  // (a rotation), has its seam where Tungsten's u wraps and u = 1 - Tungsten's along the wall.
+  static std::shared_ptr<const MeshGeometry> tungstenCylinder(bool capped) {
+    auto g = std::make_shared<MeshGeometry>(*makeCylinder(capped));
+    for (std::size_t i = 0; i < g->positions.size(); ++i) {
+      Vec3& p = g->positions[i];
+      Vec3& n = g->normals[i];
+      p = Vec3{-p.x, p.y, -p.z};
+      n = Vec3{-n.x, n.y, -n.z};
+      g->uvs[i] = std::abs(n.y) > 0.5f ? Vec2{p.x + 0.5f, p.z + 0.5f} : Vec2{1 - g->uvs[i].x, g->uvs[i].y};
+    }
+    return g;
+  }
+
+  // A disk of radius 1 facing +y whose u runs from 0 to 1 as -x turns towards -z, v from its
+  // centre out. Placed by tungstenDiskFrame, that is Tungsten's parametrisation.
+  static std::shared_ptr<const MeshGeometry> tungstenDisk(int segments) {
+    auto g = std::make_shared<MeshGeometry>();
+    for (int s = 0; s <= segments; ++s) {
+      const float u = static_cast<float>(s) / static_cast<float>(segments), phi = 2 * kPi * u;
+      // A centre vertex per segment, so that u does not blur across the disk towards its middle.
+      for (float r : {0.0f, 1.0f}) {
+        g->positions.push_back({-r * std::cos(phi), 0, -r * std::sin(phi)});
+        g->normals.push_back({0, 1, 0});
+        g->uvs.push_back({u, r});
+      }
+    }
+    for (int s = 0; s < segments; ++s) {
+      const auto c = static_cast<std::uint32_t>(2 * s);
+      g->indices.insert(g->indices.end(), {c, c + 3, c + 1});  // counter-clockwise seen from +y
+    }
+    return g;
+  }
+
+  // Tungsten's disk is round whatever its scale: its radius is the larger of the x and z scales,
+  // its normal the transformed y axis, and u the angle about it in a frame taken from the normal
+  // alone (Disk::prepareForRender, TangentFrame), so the same disk turned about its normal keeps
+  // its uvs where they were in the world. The frame's columns are that frame's bitangent, the
+  // normal and its tangent, each times the radius.
+  static Mat4 tungstenDiskFrame(const Mat4& xf, Vec3 scale) {
+    const float r = std::max(std::abs(scale.x), std::abs(scale.z));
+    const Vec3 n = normalize(xf.transformVector({0, 1, 0}));
+    const Vec3 t0 = std::abs(n.x) > std::abs(n.y) ? Vec3{0, 1, 0} : Vec3{1, 0, 0};
+    const Vec3 b = normalize(cross(n, t0));
+    const Vec3 t = cross(b, n);
+    const Vec3 c = xf.transformPoint({0, 0, 0});
+    Mat4 m;
+    const Vec3 cols[4] = {b * r, n * r, t * r, c};
+    for (int j = 0; j < 4; ++j) {
+      m.m[0][j] = cols[j].x;
+      m.m[1][j] = cols[j].y;
+      m.m[2][j] = cols[j].z;
+    }
+    return m;
+  }
+
   std::shared_ptr<const MeshGeometry> shape(const std::string& kind) {
     auto it = shapes_.find(kind);
     if (it != shapes_.end()) return it->second;
     std::shared_ptr<const MeshGeometry> g;
-    if (kind == "quad") g = makeQuad();
-    else if (kind == "cube") g = makeCube();
+    if (kind == "quad") g = tungstenQuad();
+    else if (kind == "cube") g = tungstenCube();
     else if (kind == "sphere") g = withArea(tungstenSphere(), 4 * kPi);
-    else if (kind == "disk") g = withArea(makeLathe({{1.0f, 0.0f}, {0.0f, 0.0f}}, 64), kPi);
-    else if (kind == "cylinder") g = makeCylinder(true);
-    else if (kind == "open cylinder") g = makeCylinder(false);
+    else if (kind == "disk") g = withArea(tungstenDisk(64), kPi);
+    else if (kind == "cylinder") g = tungstenCylinder(true);
+    else if (kind == "open cylinder") g = tungstenCylinder(false);
     shapes_[kind] = g;
     return g;
   }
@@ -1217,7 +1295,10 @@ class TungstenImporter {
     const bool byIndex = bsdfs && bsdfs->isArray() && !bsdfs->asArray().empty();
     if (type == "mesh") {
       parts = loadMesh(p, where, byIndex && bsdfs->asArray().size() > 1);
-    } else if (type == "quad" || type == "cube" || type == "disk") {
+    } else if (type == "quad" || type == "cube") {
+      parts.push_back({0, meshNode(type, type, shape(type))});
+    } else if (type == "disk") {
+      xf = tungstenDiskFrame(xf, scale);
       parts.push_back({0, meshNode(type, type, shape(type))});
     } else if (type == "sphere") {
       // Tungsten's sphere radius is the largest scale; the shape stays round.
