@@ -975,6 +975,17 @@ TEST(Tungsten, AThinSheetAbsorbsAlongTwiceItsThicknessAndHasNoAlbedo) {
   ASSERT_TRUE(back.ok()) << back.error();
   EXPECT_EQ(back->scene.material(back->scene.objects[0].material)->coatingAbsorption, Vec3(0.5f, 1.0f, 1.5f));
   EXPECT_TRUE(back->scene.material(back->scene.objects[0].material)->albedo == Vec3(1.0f));
+
+  // A textured albedo or thickness, which the sheet does not render, leaves no texture behind to
+  // be decoded and packed; a texture something uses stays.
+  auto textured = importTungsten(writeScene(R"({"bsdfs": [
+      {"name": "film", "type": "thinsheet", "albedo": {"type": "checker"}, "thickness": {"type": "checker", "res_u": 3}},
+      {"name": "floor", "type": "lambert", "albedo": {"type": "checker", "res_u": 5}}],
+      "primitives": [{"type": "quad", "bsdf": "film"}, {"type": "quad", "bsdf": "floor"}, {"type": "quad", "emission": 1}]})"));
+  ASSERT_TRUE(textured.ok()) << textured.error();
+  ASSERT_EQ(textured->scene.textures.size(), 1u);
+  EXPECT_EQ(textured->scene.textures[0].checkerResU, 5);
+  EXPECT_EQ(textured->scene.material(textured->scene.objects[1].material)->albedoTexture, textured->scene.textures[0].id);
 }
 
 // The spaceship's leathers ask for Beckmann: rendered with it (no warning); a Phong distribution

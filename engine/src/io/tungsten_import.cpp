@@ -166,6 +166,7 @@ class TungstenImporter {
     if (s.objects.empty() && s.environment.type == EnvironmentType::Constant && maxComponent(s.environment.color) <= 0)
       return fail("the scene has no geometry and no light");
     dropReplacedBsdfs();
+    dropUnusedTextures();
     return std::move(out_);
   }
 
@@ -243,6 +244,16 @@ class TungstenImporter {
     for (const Object& o : s.objects) used.insert(o.material);
     for (const Material& m : s.materials) used.insert(m.blendWith);
     std::erase_if(s.materials, [&](const Material& m) { return copied_.count(m.id) && !used.count(m.id); });
+  }
+
+  // Textures read for what is not rendered (a thin sheet's albedo or thickness) or for bsdfs
+  // that were replaced; otherwise they would be decoded and packed for nothing.
+  void dropUnusedTextures() {
+    Scene& s = out_.scene;
+    std::set<NodeId> used{s.environment.map};
+    for (const Material& m : s.materials)
+      for (NodeId t : m.textures()) used.insert(t);
+    std::erase_if(s.textures, [&](const Texture& t) { return !used.count(t.id); });
   }
 
   bool ok() const { return error_.empty(); }
