@@ -64,6 +64,7 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
     : QMainWindow(parent), options_(options), doc_(std::move(scene)), file_(std::move(file)) {
   view_ = new FrameView(this);
   setCentralWidget(view_);
+  if (options_.keepLayout) options_.cameraFraming = QSettings().value("viewport/cameraFraming", options_.cameraFraming).toBool();
   buildDocks();
   buildMenus();
   status_ = new QLabel(this);
@@ -322,6 +323,20 @@ void MainWindow::buildMenus() {
       options_.renderScale = k;
       options_.initialRenderSize = QSize();
       updateRenderSize();
+    });
+  }
+  QMenu* framing = render->addMenu(tr("&Framing"));
+  auto* framings = new QActionGroup(this);
+  for (bool camera : {false, true}) {
+    QAction* a = framing->addAction(camera ? tr("As the scene's &resolution (letterboxed)") : tr("&Fill the viewport"));
+    a->setObjectName(camera ? "framingCamera" : "framingViewport");
+    a->setCheckable(true);
+    a->setChecked(camera == options_.cameraFraming);
+    framings->addAction(a);
+    connect(a, &QAction::triggered, this, [this, camera] {
+      options_.cameraFraming = camera;
+      updateRenderSize();
+      rebuildProperties();  // the render settings say how the size was chosen
     });
   }
   render->addAction(tr("&Clear render region"), QKeySequence(Qt::CTRL | Qt::ALT | Qt::Key_R), this, [this] {
@@ -657,11 +672,23 @@ void MainWindow::sendMethod() {
 }
 
 QSize MainWindow::desiredRenderSize() const {
-  if (!options_.initialRenderSize.isEmpty()) return options_.initialRenderSize;
-  // The viewport's size (and so its aspect: the image fills it) at the render scale.
-  const QSize v = view_->size();
-  const int k = std::max(1, options_.renderScale);
-  return QSize(std::max(64, v.width() / k), std::max(36, v.height() / k));
+  QSize base = options_.initialRenderSize;
+  if (base.isEmpty()) {
+    // The viewport's size (and so its aspect: the image fills it) at the render scale.
+    const QSize v = view_->size();
+    const int k = std::max(1, options_.renderScale);
+    base = QSize(std::max(64, v.width() / k), std::max(36, v.height() / k));
+  }
+  const RenderSettings& r = doc_.scene().settings;
+  if (!options_.cameraFraming || r.width <= 0 || r.height <= 0) return base;
+  // The largest image of the scene's aspect within that; the view letterboxes it.
+  const double aspect = static_cast<double>(r.width) / r.height;
+  int w = base.width(), h = static_cast<int>(std::lround(w / aspect));
+  if (h > base.height()) {
+    h = base.height();
+    w = static_cast<int>(std::lround(h * aspect));
+  }
+  return QSize(std::max(16, w), std::max(16, h));
 }
 
 void MainWindow::updateRenderSize() {
@@ -669,6 +696,12 @@ void MainWindow::updateRenderSize() {
   if (size == renderSize_) return;
   renderSize_ = size;
   if (engine_) engine_->submit(ResizeCommand{size.width(), size.height()});
+  // The render settings show the viewport's size. Later: this may run inside a panel's edit.
+  for (PropertyPanel* p : {panel_, renderPanel_})
+    if (p) {
+      p->setRenderSize(renderSize_, options_.cameraFraming);
+      p->rebuildLater();
+    }
 }
 
 void MainWindow::startEngine(Scene scene) {
@@ -740,7 +773,17 @@ bool MainWindow::applyToDocument(const Edit& e) {
     showError(tr("Edit refused"), QString::fromStdString(r.error()));
     return false;
   }
-  engine_->submit(e, doc_.version());
+  // The engine renders at the viewport's size; the document keeps the scene's own resolution,
+  // which is saved and which `retile render` renders.
+  if (const auto* settings = std::get_if<SetRenderSettings>(&e)) {
+    updateRenderSize();  // framed as the scene, the viewport's image follows its resolution
+    SetRenderSettings atViewport = *settings;
+    atViewport.settings.width = renderSize_.width();
+    atViewport.settings.height = renderSize_.height();
+    engine_->submit(Edit{atViewport}, doc_.version());
+  } else {
+    engine_->submit(e, doc_.version());
+  }
   // Names, visibility, membership, materials shown beside objects. Deferred: the edit may come
   // from the outliner's own itemChanged, whose item a rebuild deletes.
   if (!outlinerRefreshQueued_) {
@@ -920,9 +963,9 @@ void MainWindow::rebuildOutliner() {
 }
 
 void MainWindow::rebuildProperties() {
-  panel_->setRenderSize(renderSize_);
+  panel_->setRenderSize(renderSize_, options_.cameraFraming);
   panel_->rebuild();
-  renderPanel_->setRenderSize(renderSize_);
+  renderPanel_->setRenderSize(renderSize_, options_.cameraFraming);
   renderPanel_->rebuild();
 }
 
@@ -1086,6 +1129,7 @@ void MainWindow::closeEvent(QCloseEvent* e) {
     QSettings settings;
     settings.setValue("window/geometry", saveGeometry());
     settings.setValue("window/docks", saveState());
+    settings.setValue("viewport/cameraFraming", options_.cameraFraming);
   }
   // A clean close: no recovery is offered next time.
   QDir dir(recoveryDirectory());

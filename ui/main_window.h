@@ -37,6 +37,9 @@ namespace retile::ui {
 struct EditorOptions {
   int renderScale = 4;        // render at 1/scale of the viewport (lavapipe traces well under 1 M samples/s)
   QSize initialRenderSize{};  // fixed render size (tests); empty: follow the viewport
+  // Frame the image as the scene's resolution frames it (its width : height, fitted into the
+  // viewport and letterboxed); else the image fills the viewport, widening or narrowing the view.
+  bool cameraFraming = false;
   // Restore the window's geometry and dock layout from QSettings and save them on close (the app;
   // tests leave it off so that one test's layout never reaches the next).
   bool keepLayout = false;

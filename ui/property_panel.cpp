@@ -595,11 +595,6 @@ void PropertyPanel::buildRender(Builder& b) {
   auto edit = [this](const QString& what, int drag, const std::function<void(RenderSettings&)>& change) {
     RenderSettings before = scene_().settings, after = before;
     change(after);
-    // The engine renders at the viewport's size; a settings edit must not resize it.
-    if (!renderSize_.isEmpty()) {
-      before.width = after.width = renderSize_.width();
-      before.height = after.height = renderSize_.height();
-    }
     send(SetRenderSettings{before}, SetRenderSettings{after}, what, drag);
   };
   const RenderSettings& r = scene_().settings;
@@ -648,7 +643,17 @@ void PropertyPanel::buildRender(Builder& b) {
              if (i < 0 || i > 1) return;
              edit(tr("Ray offset"), 0, [i](RenderSettings& x) { x.rayOffset = static_cast<RayOffset>(i); });
            });
-  b.label(tr("Resolution"), tr("%1 x %2 (the viewport's size times the render scale)").arg(renderSize_.width()).arg(renderSize_.height()));
+  // The scene's own image: what `retile render` renders and the framing the viewport can show.
+  b.number(tr("Width (px)"), "resolutionWidth", r.width, 1, kMaxImageSide, RenderSettings{}.width, 0, [edit](double v, int drag) {
+    edit(tr("Resolution"), drag, [v](RenderSettings& x) { x.width = static_cast<int>(v); });
+  });
+  b.number(tr("Height (px)"), "resolutionHeight", r.height, 1, kMaxImageSide, RenderSettings{}.height, 0, [edit](double v, int drag) {
+    edit(tr("Resolution"), drag, [v](RenderSettings& x) { x.height = static_cast<int>(v); });
+  });
+  b.label(tr("Viewport"), tr("%1 x %2 (%3, at the render scale)")
+                              .arg(renderSize_.width())
+                              .arg(renderSize_.height())
+                              .arg(cameraFraming_ ? tr("the scene's framing fitted into the viewport") : tr("the viewport's shape")));
 }
 
 }  // namespace retile::ui

@@ -41,7 +41,11 @@ class PropertyPanel : public QScrollArea {
   // Whether `e` changes something the panel shows (its target, or an object's material).
   bool shows(const Edit& e) const;
   // Render settings edits keep the engine's current resolution (the viewport owns it).
-  void setRenderSize(QSize s) { renderSize_ = s; }
+  // The engine's render size and how it was chosen, shown beside the scene's own resolution.
+  void setRenderSize(QSize s, bool cameraFraming = false) {
+    renderSize_ = s;
+    cameraFraming_ = cameraFraming;
+  }
 
  private:
   class Builder;
@@ -76,6 +80,7 @@ class PropertyPanel : public QScrollArea {
   std::optional<Edit> previewBefore_;  // the value before a colour dialog's first preview
   PropertyTarget target_;
   QSize renderSize_;
+  bool cameraFraming_ = false;
   QWidget* body_ = nullptr;
   QFormLayout* form_ = nullptr;
   int drag_ = 1000000;  // drag ids of this panel: far from the viewport's

@@ -642,11 +642,59 @@ TEST(Editor, CameraEnvironmentAndRenderSettingsHavePanels) {
   ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; })) << "the edit reached the engine";
   auto* bounces = w->findChild<ScrubField*>("maxBounces");
   ASSERT_TRUE(bounces);
+  const RenderSettings settings = w->scene().settings;
   bounces->setValue(3);
   EXPECT_EQ(w->scene().settings.maxBounces, 3);
   const std::uint64_t v2 = w->documentVersion();
   ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == v2; }));
   EXPECT_EQ(w->viewport()->frame()->width, 96) << "a settings edit keeps the viewport's render size";
+  EXPECT_EQ(w->scene().settings.width, settings.width) << "and the scene keeps its own resolution, which is saved";
+  EXPECT_EQ(w->scene().settings.height, settings.height);
+}
+
+// The scene's resolution is edited in the render settings; framed as the scene, the viewport shows
+// an image of that shape, letterboxed; filling the viewport, it takes the viewport's shape again.
+TEST(Editor, TheViewportCanFrameTheImageAsTheScenesResolution) {
+  auto w = makeWindow();  // the viewport renders at 96 x 54
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 1; }));
+  const RenderSettings before = w->scene().settings;
+  ASSERT_GT(before.height * 96, 300 * 54) << "the test wants the undone shape narrower than the viewport";
+  auto* width = w->findChild<ScrubField*>("resolutionWidth");
+  auto* height = w->findChild<ScrubField*>("resolutionHeight");
+  ASSERT_TRUE(width && height);
+  width->setValue(300);
+  height->setValue(400);
+  EXPECT_EQ(w->scene().settings.width, 300);
+  EXPECT_EQ(w->scene().settings.height, 400);
+  const std::uint64_t v = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == v; }));
+  EXPECT_EQ(w->viewport()->frame()->width, 96) << "filling the viewport, its shape stays";
+  EXPECT_EQ(w->viewport()->frame()->height, 54);
+
+  auto* camera = w->findChild<QAction*>("framingCamera");
+  ASSERT_TRUE(camera);
+  camera->trigger();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.width == 41 && f.height == 54; }))
+      << "3 : 4 within 96 x 54 is 41 x 54; got " << w->viewport()->frame()->width << " x " << w->viewport()->frame()->height;
+  const QRectF r = w->viewport()->imageRect();
+  EXPECT_NEAR(r.width() / r.height(), 41.0 / 54.0, 0.01) << "the view letterboxes the image, undistorted";
+  EXPECT_LE(r.width(), w->viewport()->width() + 0.5);
+  EXPECT_LE(r.height(), w->viewport()->height() + 0.5);
+  EXPECT_EQ(w->scene().settings.width, 300) << "framing changes nothing in the scene";
+  // Undo the height: the frame follows the scene's shape, 300 : 360 within 96 x 54.
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().settings.height, before.height);
+  const int expected = static_cast<int>(std::lround(54.0 * 300 / before.height));
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.width == expected && f.height == 54; }));
+
+  w->findChild<QAction*>("framingViewport")->trigger();
+  QTest::qWait(50);  // the panels rebuild: find the field again
+  width = w->findChild<ScrubField*>("resolutionWidth");
+  ASSERT_TRUE(width);
+  width->setValue(100);
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == w->documentVersion(); }));
+  EXPECT_EQ(w->viewport()->frame()->width, 96);
+  EXPECT_EQ(w->viewport()->frame()->height, 54);
 }
 
 TEST(Editor, DisplayExposureSnapshotsAndTheInspector) {
