@@ -650,10 +650,9 @@ void PropertyPanel::buildRender(Builder& b) {
   b.number(tr("Height (px)"), "resolutionHeight", r.height, 1, kMaxImageSide, RenderSettings{}.height, 0, [edit](double v, int drag) {
     edit(tr("Resolution"), drag, [v](RenderSettings& x) { x.height = static_cast<int>(v); });
   });
-  b.label(tr("Viewport"), tr("%1 x %2 (%3, at the render scale)")
-                              .arg(renderSize_.width())
-                              .arg(renderSize_.height())
-                              .arg(cameraFraming_ ? tr("the scene's framing fitted into the viewport") : tr("the viewport's shape")));
+  // How the viewport's image was sized (Render > Framing, Render > Render resolution).
+  b.label(tr("Viewport"), tr("%1 x %2, %3").arg(renderSize_.width()).arg(renderSize_.height())
+                              .arg(cameraFraming_ ? tr("framed as the scene") : tr("filling the view")));
 }
 
 }  // namespace retile::ui
