@@ -121,7 +121,7 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
     editCamera([this, d](Camera& c) {
       Vec3 fwd = normalize(c.target - c.position);
       Vec3 right = normalize(cross(fwd, c.up)), up = cross(right, fwd);
-      float k = 2.0f * length(c.target - c.position) * std::tan(c.verticalFov * 0.5f) / static_cast<float>(std::max(1, view_->height()));
+      float k = 2.0f * length(c.target - c.position) * std::tan(c.verticalFov * 0.5f) / static_cast<float>(std::max(1.0, view_->imageRect().height()));
       Vec3 move = right * static_cast<float>(-d.x() * k) + up * static_cast<float>(d.y() * k);
       c.position = c.position + move;
       c.target = c.target + move;
@@ -696,12 +696,9 @@ void MainWindow::updateRenderSize() {
   if (size == renderSize_) return;
   renderSize_ = size;
   if (engine_) engine_->submit(ResizeCommand{size.width(), size.height()});
-  // The render settings show the viewport's size. Later: this may run inside a panel's edit.
+  // The render settings show the viewport's size (in place: this may run inside a panel's drag).
   for (PropertyPanel* p : {panel_, renderPanel_})
-    if (p) {
-      p->setRenderSize(renderSize_, options_.cameraFraming);
-      p->rebuildLater();
-    }
+    if (p) p->setRenderSize(renderSize_, options_.cameraFraming);
 }
 
 void MainWindow::startEngine(Scene scene) {
@@ -780,6 +777,7 @@ bool MainWindow::applyToDocument(const Edit& e) {
     SetRenderSettings atViewport = *settings;
     atViewport.settings.width = renderSize_.width();
     atViewport.settings.height = renderSize_.height();
+    // A new resolution alone reaches the engine as the settings it has, which restart nothing.
     engine_->submit(Edit{atViewport}, doc_.version());
   } else {
     engine_->submit(e, doc_.version());
@@ -796,7 +794,8 @@ bool MainWindow::applyToDocument(const Edit& e) {
   refreshGraph();
   // Everything else that changes what the panel shows (a drag in the viewport, the node graph,
   // undo and redo) refreshes it.
-  if (!panelEdit_ && panel_->shows(e)) panel_->rebuildLater();
+  for (PropertyPanel* p : {panel_, renderPanel_})
+    if (!panelEdit_ && p->shows(e)) p->rebuildLater();
   return true;
 }
 

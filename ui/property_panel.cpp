@@ -44,7 +44,11 @@ class PropertyPanel::Builder {
     auto* l = new QLabel(QString("<b>%1</b>").arg(text.toHtmlEscaped()), p_->body_);
     form_->addRow(l);
   }
-  void label(const QString& name, const QString& text) { form_->addRow(name, new QLabel(text, p_->body_)); }
+  QLabel* label(const QString& name, const QString& text) {
+    auto* l = new QLabel(text, p_->body_);
+    form_->addRow(name, l);
+    return l;
+  }
 
   ScrubField* number(const QString& name, const QString& objectName, double value, double min, double max, double def,
                      int decimals, std::function<void(double, int)> apply) {
@@ -651,8 +655,18 @@ void PropertyPanel::buildRender(Builder& b) {
     edit(tr("Resolution"), drag, [v](RenderSettings& x) { x.height = static_cast<int>(v); });
   });
   // How the viewport's image was sized (Render > Framing, Render > Render resolution).
-  b.label(tr("Viewport"), tr("%1 x %2, %3").arg(renderSize_.width()).arg(renderSize_.height())
-                              .arg(cameraFraming_ ? tr("framed as the scene") : tr("filling the view")));
+  viewportLine_ = b.label(tr("Viewport"), viewportText());
+}
+
+QString PropertyPanel::viewportText() const {
+  return tr("%1 x %2, %3").arg(renderSize_.width()).arg(renderSize_.height())
+      .arg(cameraFraming_ ? tr("framed as the scene") : tr("filling the view"));
+}
+
+void PropertyPanel::setRenderSize(QSize s, bool cameraFraming) {
+  renderSize_ = s;
+  cameraFraming_ = cameraFraming;
+  if (viewportLine_) viewportLine_->setText(viewportText());
 }
 
 }  // namespace retile::ui

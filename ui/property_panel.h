@@ -5,6 +5,8 @@
 // it reads the owner's document whenever it builds or edits.
 #pragma once
 
+#include <QLabel>
+#include <QPointer>
 #include <QScrollArea>
 
 #include <functional>
@@ -40,12 +42,10 @@ class PropertyPanel : public QScrollArea {
   void rebuildLater();
   // Whether `e` changes something the panel shows (its target, or an object's material).
   bool shows(const Edit& e) const;
-  // Render settings edits keep the engine's current resolution (the viewport owns it).
   // The engine's render size and how it was chosen, shown beside the scene's own resolution.
-  void setRenderSize(QSize s, bool cameraFraming = false) {
-    renderSize_ = s;
-    cameraFraming_ = cameraFraming;
-  }
+  // Updates the line in place: a rebuild would drop a field being dragged (a drag of the scene's
+  // resolution, framed as the scene, resizes the render at every step).
+  void setRenderSize(QSize s, bool cameraFraming = false);
 
  private:
   class Builder;
@@ -73,6 +73,7 @@ class PropertyPanel : public QScrollArea {
   void buildCamera(Builder& b);
   void buildEnvironment(Builder& b);
   void buildRender(Builder& b);
+  QString viewportText() const;
 
   SceneRef scene_;
   Push push_;
@@ -81,6 +82,7 @@ class PropertyPanel : public QScrollArea {
   PropertyTarget target_;
   QSize renderSize_;
   bool cameraFraming_ = false;
+  QPointer<QLabel> viewportLine_;  // in the render settings, while they are shown
   QWidget* body_ = nullptr;
   QFormLayout* form_ = nullptr;
   int drag_ = 1000000;  // drag ids of this panel: far from the viewport's

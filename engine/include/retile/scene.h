@@ -370,6 +370,7 @@ struct RenderSettings {
   // the editor and `retile render` show it with until told otherwise; empty: the application's
   // default, Standard. Display only: the render is the same whatever it says.
   std::string view;
+  friend bool operator==(const RenderSettings&, const RenderSettings&) = default;
 };
 
 class Scene {

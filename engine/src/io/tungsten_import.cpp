@@ -914,11 +914,12 @@ class TungstenImporter {
     auto g = std::make_shared<MeshGeometry>();
     for (int s = 0; s <= segments; ++s) {
       const float u = static_cast<float>(s) / static_cast<float>(segments), phi = 2 * kPi * u;
-      // A centre vertex per segment, so that u does not blur across the disk towards its middle.
+      // A centre vertex per segment, at the segment's middle u, so that u does not blur across
+      // the disk towards its middle.
       for (float r : {0.0f, 1.0f}) {
         g->positions.push_back({-r * std::cos(phi), 0, -r * std::sin(phi)});
         g->normals.push_back({0, 1, 0});
-        g->uvs.push_back({u, r});
+        g->uvs.push_back({r > 0 ? u : (static_cast<float>(s) + 0.5f) / static_cast<float>(segments), r});
       }
     }
     for (int s = 0; s < segments; ++s) {

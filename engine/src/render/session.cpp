@@ -426,6 +426,12 @@ void RenderSession::setDocumentVersion(std::uint64_t version) { impl_->documentV
 Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t documentVersion) {
   completeGpu();  // the frame in flight's counters and probe belong to the state it was planned in
   Impl& d = *impl_;
+  // Settings the session already renders with (the editor sends them when only the scene's own
+  // resolution changed, which it does not render at): nothing to restart.
+  if (const auto* settings = std::get_if<SetRenderSettings>(&edit); settings && settings->settings == scene_.settings) {
+    d.documentVersion = std::max(d.documentVersion, documentVersion);
+    return 0u;
+  }
   // Where the edit's targets were, before: a pass prioritizes their old and new places.
   std::vector<NodeId> targets;
   NodeId target = editTarget(edit);
