@@ -654,6 +654,11 @@ void PropertyPanel::buildRender(Builder& b) {
   b.number(tr("Height (px)"), "resolutionHeight", r.height, 1, kMaxImageSide, RenderSettings{}.height, 0, [edit](double v, int drag) {
     edit(tr("Resolution"), drag, [v](RenderSettings& x) { x.height = static_cast<int>(v); });
   });
+  // The viewport converges for as long as it is left; `retile render` stops here.
+  b.number(tr("Samples per pixel"), "samplesPerPixel", r.samplesPerPixel, 1, 1048576, RenderSettings{}.samplesPerPixel, 0,
+           [edit](double v, int drag) {
+             edit(tr("Samples per pixel"), drag, [v](RenderSettings& x) { x.samplesPerPixel = static_cast<int>(v); });
+           });
   // How the viewport's image was sized (Render > Framing, Render > Render resolution).
   viewportLine_ = b.label(tr("Viewport"), viewportText());
 }

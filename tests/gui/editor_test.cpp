@@ -664,6 +664,10 @@ TEST(Editor, TheViewportCanFrameTheImageAsTheScenesResolution) {
   ASSERT_TRUE(width && height);
   width->setValue(300);
   height->setValue(400);
+  auto* spp = w->findChild<ScrubField*>("samplesPerPixel");
+  ASSERT_TRUE(spp);
+  spp->setValue(512);
+  EXPECT_EQ(w->scene().settings.samplesPerPixel, 512);
   EXPECT_EQ(w->scene().settings.width, 300);
   EXPECT_EQ(w->scene().settings.height, 400);
   const std::uint64_t v = w->documentVersion();
@@ -677,7 +681,9 @@ TEST(Editor, TheViewportCanFrameTheImageAsTheScenesResolution) {
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.width == 41 && f.height == 54; }))
       << "3 : 4 within 96 x 54 is 41 x 54; got " << w->viewport()->frame()->width << " x " << w->viewport()->frame()->height;
   EXPECT_EQ(w->scene().settings.width, 300) << "framing changes nothing in the scene";
-  // Undo the height: the frame follows the scene's shape, 300 : 360 within 96 x 54.
+  // Undo the samples and the height: the frame follows the scene's shape, 300 : 360 within 96 x 54.
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().settings.samplesPerPixel, before.samplesPerPixel);
   w->undoStack()->undo();
   EXPECT_EQ(w->scene().settings.height, before.height);
   const int expected = static_cast<int>(std::lround(54.0 * 300 / before.height));
@@ -686,18 +692,21 @@ TEST(Editor, TheViewportCanFrameTheImageAsTheScenesResolution) {
   w->findChild<QAction*>("framingViewport")->trigger();
   QTest::qWait(50);  // the panels rebuild: find the field again
   width = w->findChild<ScrubField*>("resolutionWidth");
-  ASSERT_TRUE(width);
+  spp = w->findChild<ScrubField*>("samplesPerPixel");
+  ASSERT_TRUE(width && spp);
   auto fewest = [](const FrameRecord& f) { return *std::min_element(f.tileSamples.begin(), f.tileSamples.end()); };
   ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.width == 96 && !f.tileSamples.empty() && fewest(f) >= 6; }));
   const std::uint64_t at = w->viewport()->frame()->frame;
   width->setValue(100);
+  spp->setValue(1000);
   EXPECT_EQ(w->scene().settings.width, 100);
+  EXPECT_EQ(w->scene().settings.samplesPerPixel, 1000);
   // A few frames on: a restart would have left at most about 4 samples in some tile.
   ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == w->documentVersion() && f.frame >= at + 4; }));
   const FrameRecord& f = *w->viewport()->frame();
   EXPECT_EQ(f.width, 96) << "filling the viewport, the scene's resolution does not change the image";
   EXPECT_EQ(f.height, 54);
-  EXPECT_GE(fewest(f), 6.0f) << "nor restart its accumulation";
+  EXPECT_GE(fewest(f), 6.0f) << "nor restart its accumulation, nor does what an offline render stops at";
 }
 
 TEST(Editor, DisplayExposureSnapshotsAndTheInspector) {
