@@ -123,7 +123,8 @@ vec4 sampleTexture(int index, vec2 uv) {
   if ((kind & 15) == kTexChecker) {
     vec4 on = texelFetch(uTexInfo, index * kTextureTexels + 1);
     vec4 off = texelFetch(uTexInfo, index * kTextureTexels + 2);
-    ivec2 cell = ivec2(floor(uv * vec2(on.w, off.w)));
+    vec2 at = uv * vec2(on.w, off.w);
+    ivec2 cell = (kind & kTexTruncate) != 0 ? ivec2(at) : ivec2(floor(at));
     return ((cell.x ^ cell.y) & 1) != 0 ? vec4(on.rgb, 1.0) : vec4(off.rgb, 1.0);
   }
   int offset = floatBitsToInt(info.x);

@@ -155,6 +155,9 @@ RT_CONST(int, kTexSrgb, 64)
 // texels held beyond [0, 1] instead of repeating (Texture::clampToEdge).
 RT_CONST(int, kTexNearest, 128)
 RT_CONST(int, kTexClamp, 32768)
+// A checker's cells as Tungsten counts them: uv times cells truncated toward zero, not floored
+// (Texture::tungstenCells).
+RT_CONST(int, kTexTruncate, 65536)
 // And a half-float bitmap's colour is stored divided by 2^k, k in these bits, so that values
 // beyond a half's range (a sun in a sky map) keep their light.
 RT_CONST(int, kTexScaleShift, 8)

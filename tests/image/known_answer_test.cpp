@@ -886,6 +886,45 @@ TEST(KnownAnswer, ABitmapIsReadAtItsNearestTexelOrHeldAtItsEdgesWhenAsked) {
   EXPECT_GT(heldLeft - (0.375 - 0.5 * a - a * a) / (0.5 - a), 0.05) << "repeating would read measurably less";
 }
 
+// A checker of two cells across u, on 1 and off 0, on the unit quad whose u runs from -1 to 1
+// (the frame spans x from -0.42 to 0.42). Floored, the cells left of the middle are u * 2 in
+// [-2, -1) off and [-1, 0) on; counted as Tungsten counts them (truncated toward zero), (-2, -1] is
+// on and (-1, 1) off, a cell twice as wide about u = 0. Right of the middle both agree.
+TEST(KnownAnswer, ATungstenCheckerCountsItsCellsTowardZero) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = underUnitSky(32, 32, 16);
+  Texture checker;
+  checker.id = s.newId();
+  checker.name = "checker";
+  checker.kind = TextureKind::Checker;
+  checker.checkerOn = Vec3{1.0f};
+  checker.checkerOff = Vec3{0.0f};
+  checker.checkerResU = 2;
+  checker.checkerResV = 1;
+  s.textures.push_back(checker);
+  Material white = grey(1.0f);
+  white.albedoTexture = checker.id;
+  auto quad = std::make_shared<MeshGeometry>(*makeQuad());
+  for (std::size_t i = 0; i < quad->positions.size(); ++i) quad->uvs[i] = {2 * quad->positions[i].x, 0.5f};
+  test::addMeshObject(s, "plane", quad, test::addMaterial(s, white), Mat4::identity());
+  // Columns well inside x in (-0.42, -0.25) and (-0.25, 0), then (0, 0.25) and (0.25, 0.42).
+  auto columns = [&](int from, int to) {
+    const RenderImage img = renderScene(*r, s, 32);
+    double sum = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = from; x <= to; ++x) sum += img.color[(static_cast<std::size_t>(y) * img.width + x) * 3 + 1];
+    return sum / ((to - from + 1) * img.height);
+  };
+  const int outerLeft[2] = {1, 4}, innerLeft[2] = {9, 13}, innerRight[2] = {18, 22}, outerRight[2] = {27, 30};
+  EXPECT_LT(columns(outerLeft[0], outerLeft[1]), 0.02) << "floored";
+  EXPECT_GT(columns(innerLeft[0], innerLeft[1]), 0.98);
+  s.texture(checker.id)->tungstenCells = true;
+  EXPECT_GT(columns(outerLeft[0], outerLeft[1]), 0.98) << "truncated";
+  EXPECT_LT(columns(innerLeft[0], innerLeft[1]), 0.02);
+  EXPECT_LT(columns(innerRight[0], innerRight[1]), 0.02) << "right of the middle both agree";
+  EXPECT_GT(columns(outerRight[0], outerRight[1]), 0.98);
+}
+
 // A sky map brighter than a half float's largest value (65504), as a sun in an HDR sky often is:
 // its texels are stored scaled down by a power of two and scaled back where they are read. A
 // uniform map of 2e6 (green) over a lambert plane of albedo 0.5 reads 1e6; clipped to halves, the

@@ -985,6 +985,12 @@ TEST(Tungsten, AThinSheetAbsorbsAlongTwiceItsThicknessAndHasNoAlbedo) {
   ASSERT_TRUE(textured.ok()) << textured.error();
   ASSERT_EQ(textured->scene.textures.size(), 1u);
   EXPECT_EQ(textured->scene.textures[0].checkerResU, 5);
+  EXPECT_TRUE(textured->scene.textures[0].tungstenCells) << "a Tungsten checker counts its cells as Tungsten does";
+  ASSERT_TRUE(saveNativeScene(textured->scene, file).ok());
+  auto checkerBack = loadNativeScene(file);
+  ASSERT_TRUE(checkerBack.ok()) << checkerBack.error();
+  ASSERT_EQ(checkerBack->scene.textures.size(), 1u);
+  EXPECT_TRUE(checkerBack->scene.textures[0].tungstenCells) << "and keeps counting so when saved natively";
   EXPECT_EQ(textured->scene.material(textured->scene.objects[1].material)->albedoTexture, textured->scene.textures[0].id);
 }
 

@@ -69,6 +69,10 @@ struct Texture {
   bool clampToEdge = false;
   Vec3 checkerOn{0.8f}, checkerOff{0.2f};  // Checker: colours and squares per unit of uv
   int checkerResU = 8, checkerResV = 8;
+  // Checker: its cells counted as Tungsten counts them (CheckerTexture: uv times cells truncated
+  // toward zero), so that where uvs go below 0 the cells about 0 are twice as wide and the pattern
+  // mirrors; else floored, a pattern that repeats everywhere.
+  bool tungstenCells = false;
 };
 
 // The materials the scenes we open use, and no more (see docs/ARCHITECTURE.md).

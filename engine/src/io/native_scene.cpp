@@ -244,6 +244,7 @@ Value nativeSceneToJson(const Scene& s) {
       v.set("off", json::fromVec3(t.checkerOff));
       v.set("res_u", t.checkerResU);
       v.set("res_v", t.checkerResV);
+      if (t.tungstenCells) v.set("cells", "tungsten");
     }
     textures.push_back(std::move(v));
   }
@@ -480,6 +481,10 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.vec3("off", &t.checkerOff);
       r.integer("res_u", &t.checkerResU);
       r.integer("res_v", &t.checkerResV);
+      std::string cells;
+      r.string("cells", &cells);
+      if (cells == "tungsten") t.tungstenCells = true;
+      else if (!cells.empty() && cells != "floor") r.problem("cells", cat("unknown cell count '", cells, "' (floor, tungsten)"));
       s.textures.push_back(std::move(t));
     }
   if (auto* a = list("materials"))

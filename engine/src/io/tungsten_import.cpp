@@ -362,6 +362,7 @@ class TungstenImporter {
       number(v, "res_v", &rv, where);
       t.checkerResU = std::clamp(static_cast<int>(ru), 1, 100000);
       t.checkerResV = std::clamp(static_cast<int>(rv), 1, 100000);
+      t.tungstenCells = true;
       out_.scene.textures.push_back(t);
       r.isTexture = true;
       r.texture = t.id;

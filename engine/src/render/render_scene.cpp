@@ -1393,8 +1393,8 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
   data_.byteTexels = data_.halfTexels = data_.srgbTexels = false;
   textureIndex_.clear();
   textureMean_.clear();
-  auto appendChecker = [&](Vec3 on, Vec3 off, int ru, int rv) {
-    data_.textureInfo.push_back(ints(0, 0, 0, gpu::kTexChecker));
+  auto appendChecker = [&](Vec3 on, Vec3 off, int ru, int rv, bool truncate = false) {
+    data_.textureInfo.push_back(ints(0, 0, 0, gpu::kTexChecker | (truncate ? gpu::kTexTruncate : 0)));
     data_.textureInfo.push_back(v4(on, static_cast<float>(std::max(ru, 1))));
     data_.textureInfo.push_back(v4(off, static_cast<float>(std::max(rv, 1))));
     return (on + off) * 0.5f;
@@ -1403,7 +1403,7 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
     int index = static_cast<int>(data_.textureInfo.size() / gpu::kTextureTexels);
     textureIndex_[t.id] = index;
     if (t.kind == TextureKind::Checker) {
-      textureMean_[t.id] = appendChecker(t.checkerOn, t.checkerOff, t.checkerResU, t.checkerResV);
+      textureMean_[t.id] = appendChecker(t.checkerOn, t.checkerOff, t.checkerResU, t.checkerResV, t.tungstenCells);
       continue;
     }
     const std::size_t at = data_.texels.size();
