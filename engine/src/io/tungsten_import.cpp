@@ -266,6 +266,7 @@ class TungstenImporter {
   }
   void warn(const std::string& what) { out_.warnings.push_back(cat(file_.filename().string(), ": ", what)); }
   std::set<std::string> undefinedWarned_;  // undefined bsdf names already reported
+  bool cullingWarned_ = false;              // backface_culling is said once per file
 
   bool number(const Value& obj, const char* key, float* out, const std::string& where) {
     const Value* v = obj.find(key);
@@ -1053,6 +1054,10 @@ class TungstenImporter {
     if (f.empty()) {
       problem(where, "mesh without a \"file\"");
       return {};
+    }
+    if (const Value* v = p.find("backface_culling"); v && v->isBool() && v->asBool() && !cullingWarned_) {
+      cullingWarned_ = true;
+      warn(cat(where, ": backface_culling is not rendered; the mesh is hit from behind too (said once for the file)"));
     }
     bool smooth = false, recompute = false;
     if (const Value* v = p.find("smooth"); v && v->isBool()) smooth = v->asBool();
