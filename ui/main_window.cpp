@@ -336,7 +336,6 @@ void MainWindow::buildMenus() {
     connect(a, &QAction::triggered, this, [this, camera] {
       options_.cameraFraming = camera;
       updateRenderSize();
-      rebuildProperties();  // the render settings say how the size was chosen
     });
   }
   render->addAction(tr("&Clear render region"), QKeySequence(Qt::CTRL | Qt::ALT | Qt::Key_R), this, [this] {
@@ -680,7 +679,7 @@ QSize MainWindow::desiredRenderSize() const {
     base = QSize(std::max(64, v.width() / k), std::max(36, v.height() / k));
   }
   const RenderSettings& r = doc_.scene().settings;
-  if (!options_.cameraFraming || r.width <= 0 || r.height <= 0) return base;
+  if (!options_.cameraFraming) return base;
   // The largest image of the scene's aspect within that; the view letterboxes it.
   const double aspect = static_cast<double>(r.width) / r.height;
   int w = base.width(), h = static_cast<int>(std::lround(w / aspect));
@@ -693,10 +692,12 @@ QSize MainWindow::desiredRenderSize() const {
 
 void MainWindow::updateRenderSize() {
   const QSize size = desiredRenderSize();
-  if (size == renderSize_) return;
-  renderSize_ = size;
-  if (engine_) engine_->submit(ResizeCommand{size.width(), size.height()});
-  // The render settings show the viewport's size (in place: this may run inside a panel's drag).
+  if (size != renderSize_) {
+    renderSize_ = size;
+    if (engine_) engine_->submit(ResizeCommand{size.width(), size.height()});
+  }
+  // The render settings show the viewport's size and framing (in place: this may run inside a
+  // panel's drag).
   for (PropertyPanel* p : {panel_, renderPanel_})
     if (p) p->setRenderSize(renderSize_, options_.cameraFraming);
 }

@@ -690,7 +690,7 @@ TEST(Editor, TheViewportCanFrameTheImageAsTheScenesResolution) {
   ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.width == expected && f.height == 54; }));
 
   w->findChild<QAction*>("framingViewport")->trigger();
-  QTest::qWait(50);  // the panels rebuild: find the field again
+  QTest::qWait(50);  // the undos rebuilt the render settings: find the fields again
   width = w->findChild<ScrubField*>("resolutionWidth");
   spp = w->findChild<ScrubField*>("samplesPerPixel");
   ASSERT_TRUE(width && spp);

@@ -908,21 +908,22 @@ TEST(KnownAnswer, ATungstenCheckerCountsItsCellsTowardZero) {
   for (std::size_t i = 0; i < quad->positions.size(); ++i) quad->uvs[i] = {2 * quad->positions[i].x, 0.5f};
   test::addMeshObject(s, "plane", quad, test::addMaterial(s, white), Mat4::identity());
   // Columns well inside x in (-0.42, -0.25) and (-0.25, 0), then (0, 0.25) and (0.25, 0.42).
-  auto columns = [&](int from, int to) {
-    const RenderImage img = renderScene(*r, s, 32);
+  auto columns = [](const RenderImage& img, int from, int to) {
     double sum = 0;
     for (int y = 0; y < img.height; ++y)
       for (int x = from; x <= to; ++x) sum += img.color[(static_cast<std::size_t>(y) * img.width + x) * 3 + 1];
     return sum / ((to - from + 1) * img.height);
   };
   const int outerLeft[2] = {1, 4}, innerLeft[2] = {9, 13}, innerRight[2] = {18, 22}, outerRight[2] = {27, 30};
-  EXPECT_LT(columns(outerLeft[0], outerLeft[1]), 0.02) << "floored";
-  EXPECT_GT(columns(innerLeft[0], innerLeft[1]), 0.98);
+  const RenderImage floored = renderScene(*r, s, 32);
+  EXPECT_LT(columns(floored, outerLeft[0], outerLeft[1]), 0.02) << "floored";
+  EXPECT_GT(columns(floored, innerLeft[0], innerLeft[1]), 0.98);
   s.texture(checker.id)->tungstenCells = true;
-  EXPECT_GT(columns(outerLeft[0], outerLeft[1]), 0.98) << "truncated";
-  EXPECT_LT(columns(innerLeft[0], innerLeft[1]), 0.02);
-  EXPECT_LT(columns(innerRight[0], innerRight[1]), 0.02) << "right of the middle both agree";
-  EXPECT_GT(columns(outerRight[0], outerRight[1]), 0.98);
+  const RenderImage truncated = renderScene(*r, s, 32);
+  EXPECT_GT(columns(truncated, outerLeft[0], outerLeft[1]), 0.98) << "truncated";
+  EXPECT_LT(columns(truncated, innerLeft[0], innerLeft[1]), 0.02);
+  EXPECT_LT(columns(truncated, innerRight[0], innerRight[1]), 0.02) << "right of the middle both agree";
+  EXPECT_GT(columns(truncated, outerRight[0], outerRight[1]), 0.98);
 }
 
 // A sky map brighter than a half float's largest value (65504), as a sun in an HDR sky often is:

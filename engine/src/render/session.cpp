@@ -426,19 +426,6 @@ void RenderSession::setDocumentVersion(std::uint64_t version) { impl_->documentV
 Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t documentVersion) {
   completeGpu();  // the frame in flight's counters and probe belong to the state it was planned in
   Impl& d = *impl_;
-  // Settings the session renders as it did: the editor sends them when only what an offline
-  // render stops at (the scene's own resolution, which it replaces by the viewport's, and its
-  // samples per pixel) or the display-only view changed. Kept, but nothing to restart.
-  if (const auto* settings = std::get_if<SetRenderSettings>(&edit)) {
-    RenderSettings same = settings->settings;
-    same.samplesPerPixel = scene_.settings.samplesPerPixel;
-    same.view = scene_.settings.view;
-    if (same == scene_.settings) {
-      scene_.settings = settings->settings;
-      d.documentVersion = std::max(d.documentVersion, documentVersion);
-      return 0u;
-    }
-  }
   // Where the edit's targets were, before: a pass prioritizes their old and new places.
   std::vector<NodeId> targets;
   NodeId target = editTarget(edit);
@@ -451,8 +438,21 @@ Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t d
   Bounds3 before;
   for (NodeId t : targets) before.grow(objectBounds(scene_, d.meshBounds, t));
 
+  const RenderSettings settingsBefore = scene_.settings;
   auto applied = retile::applyEdit(scene_, edit);
   if (!applied) return applied;
+  // Settings the session renders as it did: the editor sends them when only what an offline
+  // render stops at (the scene's own resolution, which it replaces by the viewport's, and its
+  // samples per pixel) or the display-only view changed. Kept, but nothing to restart.
+  if (std::holds_alternative<SetRenderSettings>(edit)) {
+    RenderSettings same = settingsBefore;
+    same.samplesPerPixel = scene_.settings.samplesPerPixel;
+    same.view = scene_.settings.view;
+    if (same == scene_.settings) {
+      d.documentVersion = std::max(d.documentVersion, documentVersion);
+      return 0u;
+    }
+  }
   std::uint32_t flags = applied.value();
   if (const auto* add = std::get_if<AddMesh>(&edit); add && add->mesh.geometry)
     d.meshBounds[add->mesh.id] = add->mesh.geometry->bounds();
