@@ -1,5 +1,6 @@
 #include "property_panel.h"
 
+#include <QCheckBox>
 #include <QComboBox>
 #include <QFormLayout>
 #include <QHBoxLayout>
@@ -146,6 +147,15 @@ class PropertyPanel::Builder {
     });
   }
 
+  QCheckBox* check(const QString& name, const QString& objectName, bool value, std::function<void(bool)> apply) {
+    auto* c = new QCheckBox(p_->body_);
+    c->setObjectName(objectName);
+    c->setChecked(value);
+    QObject::connect(c, &QCheckBox::toggled, c, [apply](bool on) { apply(on); });
+    form_->addRow(name, c);
+    return c;
+  }
+
   void row(const QString& name, QWidget* w) { form_->addRow(name, w); }
 
   void connectField(ScrubField* f, std::function<void(double, int)> apply) {
@@ -283,6 +293,11 @@ void PropertyPanel::buildObject(Builder& b, const Object& o) {
   });
   b.nodeChoice(tr("Material"), "materialAssignment", scene_().materials, o.material,
                [edit](NodeId m) { edit(tr("Assign material"), 0, [m](Object& x) { x.material = m; }); });
+  // A room's walls culled, the camera outside sees in through them (a Tungsten mesh's
+  // backface_culling).
+  b.check(tr("Front faces only"), "cullBackFaces", o.cullBackFaces, [edit](bool on) {
+    edit(on ? tr("Cull back faces") : tr("Show back faces"), 0, [on](Object& x) { x.cullBackFaces = on; });
+  })->setToolTip(tr("Rays pass through the object's back faces, shadow rays too: a wall seen from behind is not there"));
 }
 
 void PropertyPanel::buildMaterial(Builder& b, const Material& m) {

@@ -497,6 +497,14 @@ void traceStep(inout Trace tr, int below, int root) {
     int instance = direct ? floatBitsToInt(r2.w) & kTriInstanceMask : tr.instance;
     bool found = det != 0.0 && uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < tLimit &&
                  (p != tr.from.x || instance != tr.from.y);
+    if (hasFeature(kFeatureCullBack)) {
+      // det is -dot(d, the triangle's normal): negative where the ray meets its back, which an
+      // object hit from the front only lets every ray, shadow rays too, pass (as Tungsten's
+      // backface_culling does). In object space, so a mirroring transform keeps the side that
+      // the winding and the normal matrix call the front (trace.comp's frontFace).
+      bool culls = direct ? (floatBitsToInt(r2.w) & kTriCullBack) != 0 : (tr.instFlags & kInstanceCullBack) != 0;
+      found = found && !(culls && det < 0.0);
+    }
 #if RETILE_ALPHA_TEST
     bool alphaTested = direct ? (floatBitsToInt(r2.w) & kTriAlphaTested) != 0 : (tr.instFlags & kInstanceAlphaTested) != 0;
     if (found && alphaTested && tr.alphaDecision == 0) {

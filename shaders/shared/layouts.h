@@ -39,8 +39,9 @@ RT_CONST(int, kItemNode, 0)
 RT_CONST(int, kItemTriangles, 1)
 RT_CONST(int, kItemInstance, 2)
 RT_CONST(int, kItemOffsetShift, 4)
-RT_CONST(int, kTriInstanceMask, 0x1fffffff)  // e2.w with kFeatureDirectReferences: the instance
-RT_CONST(int, kTriBoundary, 0x20000000)      // and its kInstanceBoundary
+RT_CONST(int, kTriInstanceMask, 0x0fffffff)  // e2.w with kFeatureDirectReferences: the instance
+RT_CONST(int, kTriCullBack, 0x10000000)      // and its kInstanceCullBack,
+RT_CONST(int, kTriBoundary, 0x20000000)      // kInstanceBoundary
 RT_CONST(int, kTriAlphaTested, 0x40000000)   // and kInstanceAlphaTested flags
 RT_CONST(int, kMaxLeafTriangles, 4)  // render/bvh.h maxLeafSize for mesh BVHs
 // A node names its children without items, to fit 48 bytes, so that a traversal step fetches three
@@ -105,11 +106,14 @@ RT_CONST(int, kFeatureSrgbTexels, RT_FEATURE_SRGB_TEXELS)
 // of it (scene units), as Tungsten's rays do (its DefaultEpsilon, the same for every primitive).
 RT_CONST(int, kFeatureTungstenEpsilon, 1048576)
 RT_CONST(float, kTungstenEpsilon, 5e-4)
-RT_CONST(int, kFeatureAll, 2097151)
+// Some visible object is hit from the front only (Object::cullBackFaces, kInstanceCullBack).
+RT_CONST(int, kFeatureCullBack, 2097152)
+RT_CONST(int, kFeatureAll, 4194303)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceBoundary, 2)  // its material is a boundary (kMatBoundary), which shadow rays cross
 RT_CONST(int, kInstanceEmissive, 4)
+RT_CONST(int, kInstanceCullBack, 8)  // no ray hits its back faces (Object::cullBackFaces)
 
 RT_CONST(int, kMatLambert, 0)
 RT_CONST(int, kMatOrenNayar, 1)

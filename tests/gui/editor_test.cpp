@@ -425,6 +425,27 @@ TEST(Editor, AMaterialTakesABumpMapAndItsStrengthFromItsPanel) {
   EXPECT_FLOAT_EQ(w->scene().material(material)->bumpStrength, 1.0f);
 }
 
+// An object's "Front faces only" box: one undo step each way, and the engine renders with it.
+TEST(Editor, AnObjectIsHitFromTheFrontOnlyFromItsPanel) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  auto* cull = w->findChild<QCheckBox*>("cullBackFaces");
+  ASSERT_TRUE(cull) << "the object's panel has the box";
+  EXPECT_FALSE(cull->isChecked());
+  cull->setChecked(true);
+  EXPECT_TRUE(w->scene().object(sphere)->cullBackFaces);
+  EXPECT_EQ(w->undoStack()->undoText(), "Cull back faces");
+  const std::uint64_t version = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; })) << "the edit reached the engine";
+  w->undoStack()->undo();
+  EXPECT_FALSE(w->scene().object(sphere)->cullBackFaces);
+  QTest::qWait(50);  // the panel rebuilds on the next turn of the event loop
+  auto* again = w->findChild<QCheckBox*>("cullBackFaces");
+  ASSERT_TRUE(again);
+  EXPECT_FALSE(again->isChecked()) << "the box follows the undo";
+}
+
 TEST(Editor, GlassTakesAScatteringMediumFromItsPanel) {
   auto w = makeWindow();
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");

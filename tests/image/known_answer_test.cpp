@@ -608,6 +608,67 @@ TEST(KnownAnswer, TungstensRaysSkipWhatLiesWithinItsEpsilon) {
   }
 }
 
+// An object hit from the front only (Object::cullBackFaces, a Tungsten mesh's backface_culling).
+// A floor of albedo 0.8 under a sky of 1, and a black lid one unit above it, much wider than the
+// gap. Seen from between the two, the floor reads 0.8 where every ray up passes the lid (its
+// back faces the floor), by light samples and BSDF samples alike, and almost 0 where the lid
+// blocks them (its front faces the floor, or it is hit from both sides). Seen from above the
+// lid, the camera sees the lid when its front faces up and sees through it to the floor
+// otherwise. Packed direct (each triangle names its instance and flags) and through instance
+// records (the lid sharing the floor's mesh; a mirrored lid), and toggled on one renderer, as an
+// edit in the editor does.
+TEST(KnownAnswer, AnObjectHitFromTheFrontOnlyIsPassedFromBehind) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(16, 16);
+  s.settings.maxBounces = 1;
+  s.environment.color = Vec3{1.0f};
+  auto quad = makeQuad();  // facing +y
+  NodeId floor = test::addMeshObject(s, "floor", quad, test::addMaterial(s, grey(0.8f)), Mat4::scale({100, 1, 100}));
+  const Mat4 up = Mat4::translate({0, 1, 0}) * Mat4::scale({100, 1, 100});
+  NodeId lid = test::addMeshObject(s, "lid", makeQuad(), test::addMaterial(s, grey(0.0f)), up);
+  Object* lidObject = &s.objects.back();
+  const NodeId ownMesh = lidObject->mesh, floorMesh = s.objects.front().mesh;
+  struct Case {
+    const char* what;
+    Mat4 transform;
+    bool shared, culled, between;
+    NodeId seen;
+    double floorMean;
+  };
+  // Looking down at (2, 1), away from the quads' diagonals (see the epsilon test above).
+  const Case cases[] = {
+      {"culled, facing up, from between", up, false, true, true, floor, 0.8},
+      {"not culled, from between", up, false, false, true, floor, 0.0},
+      {"culled, facing up, from above", up, false, true, false, lid, 0.0},
+      {"culled, turned to face down, from above", up * Mat4::rotateX(kPi), false, true, false, floor, 0.0},
+      {"culled, mirrored to face down, from above", Mat4::translate({0, 1, 0}) * Mat4::scale({100, -1, 100}), false, true, false, floor, 0.0},
+      {"culled, mirrored, from between", Mat4::translate({0, 1, 0}) * Mat4::scale({100, -1, 100}), false, true, true, floor, 0.0},
+      {"culled, the floor's mesh, from between", up, true, true, true, floor, 0.8},
+      {"not culled, the floor's mesh, from between", up, true, false, true, floor, 0.0},
+      {"culled, the floor's mesh, from above", up, true, true, false, lid, 0.0},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    lidObject->transform = c.transform;
+    lidObject->mesh = c.shared ? floorMesh : ownMesh;
+    lidObject->cullBackFaces = c.culled;
+    s.camera.position = {2, c.between ? 0.5f : 3.0f, 1};
+    s.camera.target = {2, 0, 1};
+    s.camera.up = {0, 0, -1};
+    s.camera.verticalFov = radians(20.0f);
+    RenderImage img = renderScene(*r, s, 128);
+    int n;
+    const double mean = meanOver(img, c.seen, &n);
+    EXPECT_EQ(n, 16 * 16) << "the camera sees " << (c.seen == lid ? "the lid" : "the floor") << " alone";
+    if (c.seen == floor && n > 0) {
+      EXPECT_NEAR(mean, c.floorMean, 0.01);
+    }
+    const std::vector<std::string> kernel = r->kernelFeatures();
+    EXPECT_EQ(std::find(kernel.begin(), kernel.end(), "back faces culled") != kernel.end(), c.culled)
+        << "the kernel culls only when an object asks for it";
+  }
+}
+
 // A sky map bright (2) above its horizon and black below, over a white-ish plane facing up: the
 // plane's radiance is albedo / pi times the irradiance from the bright half it sees. Upright: 1.
 // Turned upside down by its orientation: 0. Tilted a quarter turn about x (its up along world

@@ -1197,24 +1197,35 @@ TEST(Tungsten, IntegratorSettingsThatAreNotRenderedAreSaid) {
   EXPECT_NE(odd->warnings[1].find("enable_light_sampling"), std::string::npos) << odd->warnings[1];
   EXPECT_NE(odd->warnings[2].find("bidirectional_path_tracer"), std::string::npos) << odd->warnings[2];
 
-  // A mesh's backface_culling, which Bitterli's files write on every mesh, false but for a few:
-  // said once however many meshes ask for it, and not at all when none does.
-  auto culled = [](bool a, bool b) {
-    auto file = writeScene(std::string(R"({"primitives": [
-        {"type": "mesh", "file": "tri.obj", "backface_culling": )") + (a ? "true" : "false") + R"(},
-        {"type": "mesh", "file": "tri.obj", "smooth": true, "backface_culling": )" + (b ? "true" : "false") + R"(},
-        {"type": "quad", "emission": 1}]})");
-    std::ofstream(file.parent_path() / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-    return importTungsten(file);
-  };
-  auto none = culled(false, false);
-  ASSERT_TRUE(none.ok()) << none.error();
-  EXPECT_TRUE(none->warnings.empty()) << none->warnings.front();
-  auto both = culled(true, true);
-  ASSERT_TRUE(both.ok()) << both.error();
-  ASSERT_EQ(both->warnings.size(), 1u);
-  EXPECT_NE(both->warnings[0].find("backface_culling is not rendered"), std::string::npos) << both->warnings[0];
-  EXPECT_NE(both->warnings[0].find("primitives[0]"), std::string::npos) << both->warnings[0];
+}
+
+// A mesh's backface_culling, which Bitterli's files write on every mesh (false but for a few),
+// is the object's: each mesh its own. Tungsten's analytic shapes do not read the key.
+TEST(Tungsten, AMeshsBackfaceCullingIsItsObjects) {
+  auto file = writeScene(R"({"primitives": [
+      {"type": "mesh", "file": "tri.obj", "backface_culling": true},
+      {"type": "mesh", "file": "tri.obj", "backface_culling": false},
+      {"type": "mesh", "file": "tri.obj"},
+      {"type": "quad", "emission": 1, "backface_culling": true}]})");
+  std::ofstream(file.parent_path() / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  auto r = importTungsten(file);
+  ASSERT_TRUE(r.ok()) << r.error();
+  EXPECT_TRUE(r->warnings.empty()) << r->warnings.front();
+  ASSERT_EQ(r->scene.objects.size(), 4u);
+  EXPECT_TRUE(r->scene.objects[0].cullBackFaces);
+  EXPECT_FALSE(r->scene.objects[1].cullBackFaces);
+  EXPECT_FALSE(r->scene.objects[2].cullBackFaces);
+  EXPECT_FALSE(r->scene.objects[3].cullBackFaces);
+  EXPECT_EQ(r->scene.objects[0].mesh, r->scene.objects[1].mesh) << "one mesh, culled by one object only";
+
+  // And it survives the native format.
+  const auto saved = file.parent_path() / "culled.retile";
+  ASSERT_TRUE(saveNativeScene(r->scene, saved).ok());
+  auto back = loadNativeScene(saved);
+  ASSERT_TRUE(back.ok()) << back.error();
+  ASSERT_EQ(back->scene.objects.size(), 4u);
+  EXPECT_TRUE(back->scene.objects[0].cullBackFaces);
+  EXPECT_FALSE(back->scene.objects[1].cullBackFaces);
 }
 
 TEST(Tungsten, AThinLensCameraKeepsItsApertureAndFocus) {

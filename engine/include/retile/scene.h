@@ -239,6 +239,10 @@ struct Object {
   NodeId material = kNoNode;
   Mat4 transform;  // object to world
   bool visible = true;
+  // Hit from the front only: rays, shadow rays too, pass through its back faces (a Tungsten
+  // mesh's backface_culling; a room's walls seen from outside it). The front is the side its
+  // winding's normal, carried by the transform's normal matrix, points to.
+  bool cullBackFaces = false;
 };
 
 enum class LightType { Point, Spot, Directional };

@@ -300,6 +300,7 @@ Value nativeSceneToJson(const Scene& s) {
     v.set("material", o.material);
     v.set("transform", mat4(o.transform));
     v.set("visible", o.visible);
+    if (o.cullBackFaces) v.set("backface_culling", true);
     objects.push_back(std::move(v));
   }
   root.set("objects", std::move(objects));
@@ -547,6 +548,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.id("material", &o.material);
       r.matrix("transform", &o.transform);
       r.boolean("visible", &o.visible);
+      r.boolean("backface_culling", &o.cullBackFaces);
       s.objects.push_back(std::move(o));
     }
   if (auto* a = list("lights"))

@@ -266,7 +266,6 @@ class TungstenImporter {
   }
   void warn(const std::string& what) { out_.warnings.push_back(cat(file_.filename().string(), ": ", what)); }
   std::set<std::string> undefinedWarned_;  // undefined bsdf names already reported
-  bool cullingWarned_ = false;              // backface_culling is said once per file
 
   bool number(const Value& obj, const char* key, float* out, const std::string& where) {
     const Value* v = obj.find(key);
@@ -1055,10 +1054,6 @@ class TungstenImporter {
       problem(where, "mesh without a \"file\"");
       return {};
     }
-    if (const Value* v = p.find("backface_culling"); v && v->isBool() && v->asBool() && !cullingWarned_) {
-      cullingWarned_ = true;
-      warn(cat(where, ": backface_culling is not rendered; the mesh is hit from behind too (said once for the file)"));
-    }
     bool smooth = false, recompute = false;
     if (const Value* v = p.find("smooth"); v && v->isBool()) smooth = v->asBool();
     if (const Value* v = p.find("recompute_normals"); v && v->isBool()) recompute = v->asBool();
@@ -1463,6 +1458,8 @@ class TungstenImporter {
       o.mesh = part.mesh;
       o.material = materialId;
       o.transform = xf;
+      // Only Tungsten's meshes read it (its TriangleMesh); its analytic shapes are hit from both sides.
+      if (const Value* v = p.find("backface_culling"); type == "mesh" && v && v->isBool()) o.cullBackFaces = v->asBool();
       s.objects.push_back(o);
     }
   }

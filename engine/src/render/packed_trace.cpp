@@ -41,7 +41,7 @@ PackedTrace tracePacked(std::span<const gpu::vec4> mesh, std::span<const gpu::ve
   Vec3 o = origin, d = direction, inv = worldInv;
   std::vector<std::int32_t> stack;
   stack.reserve(64);
-  std::int32_t item = root, instance = -1;
+  std::int32_t item = root, instance = -1, flags = 0;
   int instanceSp = -1;
   for (;;) {
     ++out.steps;
@@ -117,7 +117,9 @@ PackedTrace tracePacked(std::span<const gpu::vec4> mesh, std::span<const gpu::ve
       const Vec3 q = cross(s, e1);
       const float v = dot(d, q) * invDet;
       const float t = dot(e2, q) * invDet;
-      if (det != 0.0f && u >= 0.0f && v >= 0.0f && u + v <= 1.0f && t > 0.0f && t < out.t) {
+      // An object hit from the front only is passed from behind (det < 0), as in the kernel.
+      const bool culls = direct ? (intOf(r2.w) & gpu::kTriCullBack) != 0 : (flags & gpu::kInstanceCullBack) != 0;
+      if (det != 0.0f && u >= 0.0f && v >= 0.0f && u + v <= 1.0f && t > 0.0f && t < out.t && !(culls && det < 0.0f)) {
         out.t = t;
         out.prim = intOf(r0.w);
         out.instance = direct ? (intOf(r2.w) & gpu::kTriInstanceMask) : instance;
@@ -127,6 +129,7 @@ PackedTrace tracePacked(std::span<const gpu::vec4> mesh, std::span<const gpu::ve
       // Enter an instance: rows r1..r3 map world space to it (identity rows map exactly).
       const gpu::vec4 r3 = texel(at + 3);
       instance = intOf(r0.y);
+      flags = intOf(r0.z);
       auto row = [](const gpu::vec4& r, Vec3 p, float w) { return r.x * p.x + r.y * p.y + r.z * p.z + r.w * w; };
       o = {row(r1, origin, 1), row(r2, origin, 1), row(r3, origin, 1)};
       d = {row(r1, direction, 0), row(r2, direction, 0), row(r3, direction, 0)};
@@ -147,6 +150,7 @@ PackedTrace tracePacked(std::span<const gpu::vec4> mesh, std::span<const gpu::ve
       d = direction;
       inv = worldInv;
       instance = -1;
+      flags = 0;
       instanceSp = -1;
     }
     if (finished) return out;

@@ -15,7 +15,8 @@
 namespace retile {
 
 // A ray's closest hit and the traversal steps it took. No cut-out test: a cut-out counts as
-// solid, which changes a count only where a ray would have gone through one.
+// solid, which changes a count only where a ray would have gone through one. Back faces of an
+// object hit from the front only are passed, as in the kernel.
 struct PackedTrace {
   float t = 0;
   std::int32_t prim = -1;      // packed triangle index (its texel is 3 * prim), -1: a miss

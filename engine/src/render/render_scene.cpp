@@ -314,6 +314,7 @@ std::uint32_t RenderSceneData::features() const {
   if (tungstenShading) f |= gpu::kFeatureTungstenShading;
   if (tungstenRoulette) f |= gpu::kFeatureTungstenRoulette;
   if (tungstenEpsilon) f |= gpu::kFeatureTungstenEpsilon;
+  if (cullBack) f |= gpu::kFeatureCullBack;
   if (materialBump) f |= gpu::kFeatureBump;
   if (emissionTextures) f |= gpu::kFeatureEmissionTextures;
   if (materialBlend) f |= gpu::kFeatureBlend;
@@ -970,6 +971,7 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   data_.instanceObject.clear();
   data_.instancedTriangles = 0;
   data_.alphaTested = false;
+  data_.cullBack = false;
   data_.instanceTransforms = transforms;
   std::vector<int> flagsOf(cands.size(), 0);
   std::vector<Mat4> inverseOf(cands.size());
@@ -982,7 +984,9 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
       flags |= gpu::kInstanceAlphaTested;
     if (mat && mat->emissive()) flags |= gpu::kInstanceEmissive;
     if (mat && mat->type == MaterialType::Boundary) flags |= gpu::kInstanceBoundary;
+    if (c.object->cullBackFaces) flags |= gpu::kInstanceCullBack;
     if (c.visible && (flags & gpu::kInstanceAlphaTested)) data_.alphaTested = true;
+    if (c.visible && (flags & gpu::kInstanceCullBack)) data_.cullBack = true;
     flagsOf[i] = flags;
     inverseOf[i] = c.transform.inverse();
     const Mat4& inv = inverseOf[i];
@@ -994,8 +998,8 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   }
   // Direct, each triangle names its instance: a visible object's, or where none uses its mesh
   // a hidden one's, so that showing it later changes nothing. The names change when objects are
-  // added or removed (or a cut-out's flag changes), and then the meshes' part is uploaded again;
-  // a mesh whose triangles already name the right instance is not touched.
+  // added or removed (or a cut-out's or culling flag changes), and then the meshes' part is
+  // uploaded again; a mesh whose triangles already name the right instance is not touched.
   bool renamed = false;
   if (direct) {
     std::unordered_map<const MeshEntry*, std::size_t> namer;
@@ -1005,7 +1009,8 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
       if (!cands[i].visible) namer.try_emplace(cands[i].mesh, i);
     for (const auto& [mesh, i] : namer) {
       const std::uint32_t name = static_cast<std::uint32_t>(i) | ((flagsOf[i] & gpu::kInstanceAlphaTested) ? gpu::kTriAlphaTested : 0u) |
-                                 ((flagsOf[i] & gpu::kInstanceBoundary) ? gpu::kTriBoundary : 0u);
+                                 ((flagsOf[i] & gpu::kInstanceBoundary) ? gpu::kTriBoundary : 0u) |
+                                 ((flagsOf[i] & gpu::kInstanceCullBack) ? gpu::kTriCullBack : 0u);
       if (mesh->named == name) continue;
       mesh->named = name;
       renamed = true;

@@ -101,6 +101,7 @@ struct RenderSceneData {
   std::uint64_t triangleCount = 0;     // packed triangles: each mesh's once, and the copies of small shared ones
   std::uint64_t instancedTriangles = 0;
   bool alphaTested = false;            // some instance needs the cut-out test during traversal
+  bool cullBack = false;               // some visible instance is hit from the front only
   std::uint32_t materialTypes = 0;     // bit kMat... of each material type present
   bool materialTextures = false;       // some material reads an albedo or roughness texture
   bool materialBump = false;           // some material has a bump map
