@@ -1076,6 +1076,59 @@ TEST(Tungsten, SpheresAndDisksKeepTheirTrueArea) {
   EXPECT_GT(checked, 4000);
 }
 
+// Tungsten takes a mesh's and a quad's front from their winding in world space; ours is the
+// object's winding carried by the normal matrix. Under a mirroring transform the two differ
+// unless the importer winds the mirrored one the other way: for every triangle, our front
+// (normal matrix times the object-space winding normal) must point along Tungsten's (the winding
+// normal of the transformed vertices), mirrored or not (two negative scales are not).
+TEST(Tungsten, AMirroredMeshOrQuadFacesAsInTungsten) {
+  auto file = writeScene(R"({"primitives": [
+      {"type": "mesh", "file": "tri.obj"},
+      {"type": "mesh", "file": "tri.obj", "transform": {"scale": [-1, 1, 1]}},
+      {"type": "mesh", "file": "tri.obj", "transform": {"scale": [2, -1, -3], "rotation": [10, 20, 30]}},
+      {"type": "mesh", "file": "tri.obj", "transform": [1, 0, 0, 0, 0, 0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 1]},
+      {"type": "quad", "transform": {"scale": [1, -1, 1]}},
+      {"type": "quad", "transform": {"scale": [-2, 1, 1], "rotation": [0, 0, 90]}},
+      {"type": "quad", "emission": 1}]})");
+  std::ofstream(file.parent_path() / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\n";
+  auto r = importTungsten(file);
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  ASSERT_EQ(s.objects.size(), 7u);
+  // The file's triangles, as the unmirrored mesh keeps them.
+  const MeshGeometry& original = *s.mesh(s.objects[0].mesh)->geometry;
+  ASSERT_EQ(original.indices.size(), 6u);
+  int mirrored = 0;
+  for (std::size_t k = 0; k < s.objects.size(); ++k) {
+    const Object& o = s.objects[k];
+    SCOPED_TRACE(o.name);
+    const Mat4& m = o.transform;
+    const bool mirror = dot(cross(m.transformVector({1, 0, 0}), m.transformVector({0, 1, 0})), m.transformVector({0, 0, 1})) < 0;
+    mirrored += mirror ? 1 : 0;
+    const Mat4 normalMatrix = m.inverse().transposed();
+    const MeshGeometry& g = *s.mesh(o.mesh)->geometry;
+    ASSERT_FALSE(g.indices.empty());
+    for (std::size_t i = 0; i + 2 < g.indices.size(); i += 3) {
+      const Vec3 a = g.positions[g.indices[i]], b = g.positions[g.indices[i + 1]], c = g.positions[g.indices[i + 2]];
+      const Vec3 ours = normalMatrix.transformVector(cross(b - a, c - a));
+      // Tungsten's: a mesh's the file's triangle's, transformed; a quad's edge1 x edge0 (Quad.cpp).
+      Vec3 tungstens;
+      if (k < 4) {
+        const Vec3 fa = original.positions[original.indices[i]], fb = original.positions[original.indices[i + 1]],
+                   fc = original.positions[original.indices[i + 2]];
+        tungstens = cross(m.transformVector(fb - fa), m.transformVector(fc - fa));
+      } else {
+        tungstens = cross(m.transformVector({0, 0, 1}), m.transformVector({1, 0, 0}));
+      }
+      EXPECT_GT(dot(ours, tungstens), 0.0f) << "triangle " << i / 3;
+    }
+  }
+  EXPECT_EQ(mirrored, 4) << "the test covers mirrored and unmirrored shapes";
+  EXPECT_NE(s.objects[0].mesh, s.objects[1].mesh) << "a mirrored use takes a copy";
+  EXPECT_EQ(s.objects[1].mesh, s.objects[3].mesh) << "one copy for every mirrored use";
+  EXPECT_EQ(s.objects[0].mesh, s.objects[2].mesh) << "two negative scales do not mirror";
+}
+
 // The analytic shapes carry Tungsten's uvs, so that a texture on them lies as in Tungsten: the
 // quad's v runs against z, the cube's faces take their other two axes in turn, the cylinder's wall
 // takes the angle atan2(z, x), and the disk's u is the angle about its normal in Tungsten's frame

@@ -977,6 +977,21 @@ class TungstenImporter {
     return m.id;
   }
 
+  // A copy of `mesh` with every triangle wound the other way, its normals as they are.
+  NodeId mirroredMesh(NodeId mesh) {
+    if (auto it = mirroredOf_.find(mesh); it != mirroredOf_.end()) return it->second;
+    const Mesh* m = out_.scene.mesh(mesh);
+    if (!m || !m->geometry) return mesh;
+    auto g = std::make_shared<MeshGeometry>(*m->geometry);
+    for (std::size_t t = 0; t + 2 < g->indices.size(); t += 3) std::swap(g->indices[t + 1], g->indices[t + 2]);
+    Mesh copy;
+    copy.id = out_.scene.newId();
+    copy.name = cat(m->name, " (mirrored)");
+    copy.geometry = std::move(g);
+    out_.scene.meshes.push_back(std::move(copy));
+    return mirroredOf_[mesh] = out_.scene.meshes.back().id;
+  }
+
   static void smoothNormals(MeshGeometry& g) {
     g.normals.assign(g.positions.size(), Vec3{0.0f});
     for (std::size_t i = 0; i + 2 < g.indices.size(); i += 3) {
@@ -1336,6 +1351,15 @@ class TungstenImporter {
       warn(cat(where, ": transform is degenerate; the primitive is skipped"));
       return;
     }
+    // Tungsten takes a mesh's and a quad's front from their winding in world space (a mesh's
+    // vertices are transformed before Embree sees them, a quad's normal is the cross product of
+    // its transformed edges); ours is the object's winding carried by the normal matrix, which a
+    // mirroring transform turns the other way. So a mirrored one is wound the other way, and its
+    // light shines, its glass is entered and its back faces are culled on Tungsten's side.
+    // (Tungsten's other shapes face out, or along their transformed axis, as ours do.)
+    if ((type == "mesh" || type == "quad") && dot(cross(xf.transformVector({1, 0, 0}), xf.transformVector({0, 1, 0})),
+                                                  xf.transformVector({0, 0, 1})) < 0.0f)
+      for (MeshPart& part : parts) part.mesh = mirroredMesh(part.mesh);
 
     // A bump map belongs to the primitive in Tungsten and to the material here (as emission
     // does): the primitive gets its own copy of its bsdf. A constant has no slope.
@@ -1476,6 +1500,7 @@ class TungstenImporter {
   std::set<std::string> missingWarned_;
   bool quietMissingTexture_ = false;
   std::map<std::string, NodeId> meshIds_;
+  std::map<NodeId, NodeId> mirroredOf_;  // a mesh -> its copy wound the other way
   std::map<std::string, std::vector<MeshPart>> meshParts_;  // a mesh file's parts, by loadMesh's key
   std::map<std::string, std::shared_ptr<const MeshGeometry>> shapes_;
   int emitters_ = 0;
