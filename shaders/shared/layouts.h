@@ -87,9 +87,10 @@ RT_CONST(int, kFeatureFilterTungstenTent, 16384)
 RT_CONST(int, kFeatureTungstenRoulette, 32768)  // Roulette::Tungsten (scene.h)
 // The instance BVH's leaves are the instances' own top nodes and triangles, copied into its part
 // of the buffer, not instance records: a ray goes from the instance BVH into an instance without
-// a step of its own, and a triangle names its instance in e2.w (kTriInstanceMask, with
-// kTriAlphaTested). Only for scenes without instance transforms whose triangles each belong to
-// one instance (render_scene.cpp packInstances); ignored with kFeatureInstanceTransforms.
+// a step of its own, and a triangle names its instance in e2.w (kTriInstanceMask, with its
+// kTriCullBack, kTriBoundary and kTriAlphaTested flags). Only for scenes without instance
+// transforms whose triangles each belong to one instance (render_scene.cpp packInstances);
+// ignored with kFeatureInstanceTransforms.
 RT_CONST(int, kFeatureDirectReferences, 65536)
 // How bitmaps' texels are stored (kTexEightBit): some in 8 bits, some in halves (an environment
 // map is), some 8-bit ones sRGB-encoded. Each way of reading them costs speed wherever a texture

@@ -425,7 +425,9 @@ TEST(Editor, AMaterialTakesABumpMapAndItsStrengthFromItsPanel) {
   EXPECT_FLOAT_EQ(w->scene().material(material)->bumpStrength, 1.0f);
 }
 
-// An object's "Front faces only" box: one undo step each way, and the engine renders with it.
+// An object's "Front faces only" box: one undo step each way, and the edit reaches the engine
+// (what the engine makes of it, packed either way and toggled by updates, is
+// KnownAnswer.AnObjectHitFromTheFrontOnlyIsPassedFromBehind's).
 TEST(Editor, AnObjectIsHitFromTheFrontOnlyFromItsPanel) {
   auto w = makeWindow();
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");

@@ -377,8 +377,8 @@ TEST(RenderScene, OverlappingInstancesAreEnteredAtSubtrees) {
 
 // The kernel's traversal mirrored on the CPU (tracePacked) finds what brute force finds, over an
 // instance BVH packed direct and one entered through records, with instances opened at subtrees
-// (crossing rods), a shared mesh and, after a move, an instance transform; two objects (a rod
-// and a ball) are hit from the front only. Direct costs fewer steps on the same rays: no step
+// (crossing rods), a shared mesh and, after a move, instance transforms (one mirroring); two
+// objects (a rod and a ball) are hit from the front only. Direct costs fewer steps on the same rays: no step
 // enters an instance.
 TEST(RenderScene, PackedTraversalFindsWhatBruteForceFinds) {
   Scene s = test::emptyScene(8, 8);
@@ -391,7 +391,7 @@ TEST(RenderScene, PackedTraversalFindsWhatBruteForceFinds) {
   test::addMeshObject(s, "ball", sphere, mat, Mat4::translate({0.3f, 0.2f, -0.4f}) * Mat4::scale(Vec3{0.5f}));
   test::addMeshObject(s, "ball 2", sphere, mat, Mat4::translate({-0.6f, -0.3f, 0.5f}) * Mat4::scale(Vec3{0.4f}));
   s.object(b)->cullBackFaces = true;
-  s.objects[s.objects.size() - 2].cullBackFaces = true;
+  s.objects.back().cullBackFaces = true;
   std::mt19937 rng(4);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
   struct Ray {
@@ -420,7 +420,9 @@ TEST(RenderScene, PackedTraversalFindsWhatBruteForceFinds) {
           const Vec3 v1 = o.transform.transformPoint(g.positions[g.indices[3 * t + 1]]);
           const Vec3 v2 = o.transform.transformPoint(g.positions[g.indices[3 * t + 2]]);
           float tt, u, v;
-          if (o.cullBackFaces && dot(cross(v1 - v0, v2 - v0), r.d) > 0) continue;
+          const Vec3 front = o.transform.inverse().transposed().transformVector(
+              cross(g.positions[g.indices[3 * t + 1]] - g.positions[g.indices[3 * t]], g.positions[g.indices[3 * t + 2]] - g.positions[g.indices[3 * t]]));
+          if (o.cullBackFaces && dot(front, r.d) > 0) continue;
           if (intersectTriangle(r.o, r.d, v0, v1, v2, best, &tt, &u, &v) && tt > 0) {
             best = tt;
             bestObject = o.id;
@@ -457,6 +459,9 @@ TEST(RenderScene, PackedTraversalFindsWhatBruteForceFinds) {
   Object* moved = s.object(b);
   ASSERT_NE(moved, nullptr);
   moved->transform = Mat4::translate({0.2f, 0.1f, 0}) * Mat4::rotateY(0.3f);
+  // The culled ball mirrored: its front is where its winding's normal, carried by the normal
+  // matrix, points (outwards, as the brute force has it), not where its world-space winding does.
+  s.objects.back().transform = s.objects.back().transform * Mat4::scale({-1, 1, 1});
   direct.update(s, kUpdateInstances, nullptr);
   EXPECT_FALSE(direct.data().directReferences) << "a transform turns direct off";
   EXPECT_TRUE(direct.data().instanceTransforms);
@@ -1016,6 +1021,9 @@ TEST(RenderScene, ALightInsideScatteringGlassKeepsItsLightSampling) {
   s.material(milkMaterial)->alpha = 0.5f;
   EXPECT_TRUE(inside()) << "cut-out glass";
   s.material(milkMaterial)->alpha = 1;
+  s.object(glass)->cullBackFaces = true;
+  EXPECT_TRUE(inside()) << "culled glass: shadow rays leave it through its back faces";
+  s.object(glass)->cullBackFaces = false;
   const NodeId sea = test::addMeshObject(s, "sea", makeQuad(), milkMaterial, Mat4::translate({0, -10, 0}) * Mat4::scale({100, 1, 100}));
   EXPECT_TRUE(inside()) << "a water surface is open: a lamp above it is reached from below";
   s.object(sea)->visible = false;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "retile/io.h"
@@ -1119,6 +1120,9 @@ TEST(Tungsten, AMirroredMeshOrQuadFacesAsInTungsten) {
         tungstens = cross(m.transformVector(fb - fa), m.transformVector(fc - fa));
       } else {
         tungstens = cross(m.transformVector({0, 0, 1}), m.transformVector({1, 0, 0}));
+        // Its shading normal is that one too.
+        for (std::size_t v = i; v < i + 3 && !g.normals.empty(); ++v)
+          EXPECT_GT(dot(normalMatrix.transformVector(g.normals[g.indices[v]]), tungstens), 0.0f) << "a quad's shading normal";
       }
       EXPECT_GT(dot(ours, tungstens), 0.0f) << "triangle " << i / 3;
     }
@@ -1127,6 +1131,18 @@ TEST(Tungsten, AMirroredMeshOrQuadFacesAsInTungsten) {
   EXPECT_NE(s.objects[0].mesh, s.objects[1].mesh) << "a mirrored use takes a copy";
   EXPECT_EQ(s.objects[1].mesh, s.objects[3].mesh) << "one copy for every mirrored use";
   EXPECT_EQ(s.objects[0].mesh, s.objects[2].mesh) << "two negative scales do not mirror";
+  std::set<NodeId> used;
+  for (const Object& o : s.objects) used.insert(o.mesh);
+  EXPECT_EQ(used.size(), s.meshes.size()) << "no mesh left unused (the quad's unmirrored one is used by the last quad)";
+
+  // A file used only mirrored leaves no unmirrored mesh behind.
+  auto only = writeScene(R"({"primitives": [{"type": "mesh", "file": "tri.obj", "transform": {"scale": [-1, 1, 1]}},
+      {"type": "quad", "emission": 1, "transform": {"scale": [1, 1, -1]}}]})");
+  std::ofstream(only.parent_path() / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  auto o2 = importTungsten(only);
+  ASSERT_TRUE(o2.ok()) << o2.error();
+  EXPECT_EQ(o2->scene.meshes.size(), 2u);
+  EXPECT_EQ(o2->scene.objects[0].name, "tri") << "named after its file, as unmirrored";
 }
 
 // The analytic shapes carry Tungsten's uvs, so that a texture on them lies as in Tungsten: the

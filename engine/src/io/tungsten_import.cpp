@@ -167,6 +167,7 @@ class TungstenImporter {
       return fail("the scene has no geometry and no light");
     dropReplacedBsdfs();
     dropUnusedTextures();
+    dropUnusedMeshes();
     return std::move(out_);
   }
 
@@ -254,6 +255,15 @@ class TungstenImporter {
     for (const Material& m : s.materials)
       for (NodeId t : m.textures()) used.insert(t);
     std::erase_if(s.textures, [&](const Texture& t) { return !used.count(t.id); });
+  }
+
+  // Meshes no object uses (a file only ever used mirrored, whose copy replaced it; one whose
+  // primitive was skipped after it loaded), which would be packed and saved for nothing.
+  void dropUnusedMeshes() {
+    Scene& s = out_.scene;
+    std::set<NodeId> used;
+    for (const Object& o : s.objects) used.insert(o.mesh);
+    std::erase_if(s.meshes, [&](const Mesh& m) { return !used.count(m.id); });
   }
 
   bool ok() const { return error_.empty(); }
@@ -977,16 +987,20 @@ class TungstenImporter {
     return m.id;
   }
 
-  // A copy of `mesh` with every triangle wound the other way, its normals as they are.
-  NodeId mirroredMesh(NodeId mesh) {
+  // A copy of `mesh` with every triangle wound the other way. A mesh's normals stay as they are:
+  // Tungsten carries them by the normal matrix, as we do. A quad's turn with its winding: its
+  // shading normal is its winding's (Quad::intersectionInfo).
+  NodeId mirroredMesh(NodeId mesh, bool turnNormals) {
     if (auto it = mirroredOf_.find(mesh); it != mirroredOf_.end()) return it->second;
     const Mesh* m = out_.scene.mesh(mesh);
     if (!m || !m->geometry) return mesh;
     auto g = std::make_shared<MeshGeometry>(*m->geometry);
     for (std::size_t t = 0; t + 2 < g->indices.size(); t += 3) std::swap(g->indices[t + 1], g->indices[t + 2]);
+    if (turnNormals)
+      for (Vec3& n : g->normals) n = -n;
     Mesh copy;
     copy.id = out_.scene.newId();
-    copy.name = cat(m->name, " (mirrored)");
+    copy.name = m->name;  // what an object made from it is called
     copy.geometry = std::move(g);
     out_.scene.meshes.push_back(std::move(copy));
     return mirroredOf_[mesh] = out_.scene.meshes.back().id;
@@ -1359,7 +1373,7 @@ class TungstenImporter {
     // (Tungsten's other shapes face out, or along their transformed axis, as ours do.)
     if ((type == "mesh" || type == "quad") && dot(cross(xf.transformVector({1, 0, 0}), xf.transformVector({0, 1, 0})),
                                                   xf.transformVector({0, 0, 1})) < 0.0f)
-      for (MeshPart& part : parts) part.mesh = mirroredMesh(part.mesh);
+      for (MeshPart& part : parts) part.mesh = mirroredMesh(part.mesh, type == "quad");
 
     // A bump map belongs to the primitive in Tungsten and to the material here (as emission
     // does): the primitive gets its own copy of its bsdf. A constant has no slope.

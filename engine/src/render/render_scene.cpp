@@ -1184,7 +1184,8 @@ bool RenderSceneBuilder::lightInScatteringGlass(const Scene& scene) const {
   // Glass blocks shadow rays, so from a scattering point inside it only a light inside it can be
   // sampled: bounds that meet keep the sampling, and an emissive glass meets itself. That holds
   // only where a path inside cannot get out but through the glass: so any scattering glass that
-  // is open (closedSurface), cut out, or blended with something other than uncut glass keeps it too.
+  // is open (closedSurface), cut out, culled, or blended with something other than uncut glass
+  // keeps it too.
   auto isGlass = [](const Material& m) { return m.type == MaterialType::Dielectric || m.type == MaterialType::RoughDielectric; };
   auto scatteringGlass = [&](const Material* m) { return m && isGlass(*m) && m->filled() && maxComponent(m->interiorScattering) > 0; };
   // Most scenes have none: then no instance needs looking at (this runs at every object move).
@@ -1205,7 +1206,8 @@ bool RenderSceneBuilder::lightInScatteringGlass(const Scene& scene) const {
       part = part->blendWith != kNoNode && part->blendWith != part->id ? scene.material(part->blendWith) : nullptr;
     }
     if (scatters) {
-      if (!allGlass) return true;
+      // Culled, its back faces let shadow rays out, and paths.
+      if (!allGlass || o->cullBackFaces) return true;
       if (mesh->closed < 0) mesh->closed = mesh->geometry && closedSurface(*mesh->geometry) ? 1 : 0;
       if (!mesh->closed) return true;
     }
