@@ -422,18 +422,24 @@ void MainWindow::buildDocks() {
   });
   auto* outlinerDock = addDock(tr("Outliner"), "outliner", outliner_, Qt::LeftDockWidgetArea);
 
-  auto push = [this](const Edit& before, const Edit& after, const QString& text, int dragId) {
-    // The panel shows its own edits already; rebuilding it would drop the field being scrubbed.
-    QScopedValueRollback<bool> fromPanel(panelEdit_, true);
-    edit(before, after, text, dragId);
+  // Each panel's edits name it (`who`, the member that holds it): it shows them already, and
+  // rebuilding it would drop the field being scrubbed; the other panel, which may show the same
+  // thing (the render settings), rebuilds.
+  auto pushFrom = [this](PropertyPanel* const* who) {
+    return [this, who](const Edit& before, const Edit& after, const QString& text, int dragId) {
+      QScopedValueRollback<PropertyPanel*> fromPanel(panelEdit_, *who);
+      edit(before, after, text, dragId);
+    };
   };
   auto sceneRef = [this]() -> const Scene& { return doc_.scene(); };
   // A colour tried in the dialog: shown in the document and the render, not an undo step.
-  auto preview = [this](const Edit& e) {
-    QScopedValueRollback<bool> fromPanel(panelEdit_, true);
-    applyToDocument(e);
+  auto previewFrom = [this](PropertyPanel* const* who) {
+    return [this, who](const Edit& e) {
+      QScopedValueRollback<PropertyPanel*> fromPanel(panelEdit_, *who);
+      applyToDocument(e);
+    };
   };
-  panel_ = new PropertyPanel(sceneRef, push, preview, this);
+  panel_ = new PropertyPanel(sceneRef, pushFrom(&panel_), previewFrom(&panel_), this);
   panel_->setObjectName("propertyPanel");
   auto* propDock = addDock(tr("Properties"), "properties", panel_, Qt::RightDockWidgetArea);
 
@@ -560,7 +566,7 @@ void MainWindow::buildDocks() {
   connect(gamma, &ScrubField::edited, this, applyDisplay);
   sl->addWidget(displayBox);
 
-  renderPanel_ = new PropertyPanel([this]() -> const Scene& { return doc_.scene(); }, push, preview, settingsPanel);
+  renderPanel_ = new PropertyPanel(sceneRef, pushFrom(&renderPanel_), previewFrom(&renderPanel_), settingsPanel);
   renderPanel_->setTarget({PropertyTarget::Kind::Render, kNoNode});
   renderPanel_->setMinimumHeight(130);
   sl->addWidget(renderPanel_, 1);
@@ -796,7 +802,7 @@ bool MainWindow::applyToDocument(const Edit& e) {
   // Everything else that changes what the panel shows (a drag in the viewport, the node graph,
   // undo and redo) refreshes it.
   for (PropertyPanel* p : {panel_, renderPanel_})
-    if (!panelEdit_ && p->shows(e)) p->rebuildLater();
+    if (p != panelEdit_ && p->shows(e)) p->rebuildLater();
   return true;
 }
 

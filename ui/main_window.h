@@ -156,7 +156,7 @@ class MainWindow : public QMainWindow {
   QSpinBox* qualityBox_ = nullptr;
   QCheckBox* smoothBox_ = nullptr;
   QCheckBox* qualityAuto_ = nullptr;
-  bool panelEdit_ = false;  // the edit being applied comes from the properties panel itself
+  PropertyPanel* panelEdit_ = nullptr;  // the panel whose own edit is being applied (it shows it already)
   QSet<QString> loggedWarnings_;  // of the current document: each is logged once
   QCheckBox* denoiseBox_ = nullptr;
   QCheckBox* reuseBox_ = nullptr;

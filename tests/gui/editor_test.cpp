@@ -675,6 +675,39 @@ TEST(Editor, CameraEnvironmentAndRenderSettingsHavePanels) {
   EXPECT_EQ(w->scene().settings.height, settings.height);
 }
 
+// The render settings shown twice, in Properties and in the Render settings dock: an edit in
+// either shows in the other, which rebuilds (the one edited keeps its field, being scrubbed).
+TEST(Editor, RenderSettingsShownTwiceFollowEachOther) {
+  auto w = makeWindow();
+  bool picked = false;
+  for (QTreeWidgetItemIterator it(w->outliner()); *it; ++it)
+    if ((*it)->text(0) == "Render settings") {
+      w->outliner()->clearSelection();
+      (*it)->setSelected(true);
+      picked = true;
+    }
+  ASSERT_TRUE(picked);
+  // The dock's field: the one named so outside Properties.
+  auto docked = [&]() -> ScrubField* {
+    for (ScrubField* f : w->findChildren<ScrubField*>("maxBounces"))
+      if (!w->properties()->isAncestorOf(f)) return f;
+    return nullptr;
+  };
+  auto inProperties = [&] { return w->properties()->findChild<ScrubField*>("maxBounces"); };
+  ASSERT_TRUE(docked() && inProperties()) << "both show the settings";
+  ScrubField* edited = docked();
+  edited->setValue(5);
+  EXPECT_EQ(w->scene().settings.maxBounces, 5);
+  QTest::qWait(50);  // a panel rebuilds on the next turn of the event loop
+  ASSERT_TRUE(inProperties());
+  EXPECT_EQ(inProperties()->value(), 5) << "Properties follows the dock";
+  EXPECT_EQ(docked(), edited) << "the dock keeps the field being edited";
+  inProperties()->setValue(7);
+  QTest::qWait(50);
+  ASSERT_TRUE(docked());
+  EXPECT_EQ(docked()->value(), 7) << "the dock follows Properties";
+}
+
 // The scene's resolution is edited in the render settings; framed as the scene, the viewport shows
 // an image of that shape, letterboxed; filling the viewport, it takes the viewport's shape again.
 TEST(Editor, TheViewportCanFrameTheImageAsTheScenesResolution) {
