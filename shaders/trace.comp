@@ -136,8 +136,9 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
   }
   int base = shaded * kMaterialTexels;
   vec4 t2 = texelFetch(uMaterials, base + 2), t3 = texelFetch(uMaterials, base + 3);
-  // The coating's absorption is read only when the scene has plastics.
-  const bool plastics = (kMaterialMask & ((1 << kMatPlastic) | (1 << kMatRoughPlastic))) != 0;
+  // The coating's absorption (a plastic's, or a thin sheet's) is read only when the scene has
+  // either.
+  const bool plastics = (kMaterialMask & ((1 << kMatPlastic) | (1 << kMatRoughPlastic) | (1 << kMatThinSheet))) != 0;
   Material m = unpackMaterial(texelFetch(uMaterials, base), texelFetch(uMaterials, base + 1), t2, t3,
                               texelFetch(uMaterials, base + 4), plastics ? texelFetch(uMaterials, base + 6) : vec4(0.0),
                               kCoatUsed ? texelFetch(uMaterials, base + 7) : vec4(0.0),

@@ -142,6 +142,36 @@ TEST(KnownAnswer, WhiteFurnaceLosslessMaterials) {
   }
 }
 
+// A thin sheet absorbs along its path through it: seen head on before a sky of 1, it passes
+// (1 - R) exp(-a), R = 2r / (1 + r) its two faces' reflectance (r = 0.04 at index 1.5) and a its
+// absorption straight across, per channel. In a scene with no plastic in it: the absorption was
+// read only where a plastic compiled it in, and the sheet was clear.
+TEST(KnownAnswer, AThinSheetAbsorbsWithoutAPlasticInTheScene) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(16, 16);
+  s.camera = test::frontCamera(2);
+  s.settings.maxBounces = 1;
+  s.environment.color = Vec3{1.0f};
+  Material sheet;
+  sheet.type = MaterialType::ThinSheet;
+  sheet.albedo = Vec3{1.0f};
+  sheet.ior = 1.5f;
+  sheet.coatingAbsorption = Vec3{0.5f, 1.0f, 2.0f};
+  const NodeId quad = test::addMeshObject(s, "sheet", makeQuad(), test::addMaterial(s, sheet),
+                                          Mat4::translate({0, 0, -4}) * Mat4::rotateX(kPi / 2));
+  const RenderImage img = renderScene(*r, s, 16);
+  const double rf = 0.04, passes = 1 - 2 * rf / (1 + rf);
+  for (int c = 0; c < 3; ++c) {
+    int n;
+    const double mean = meanOver(img, quad, &n, c);
+    ASSERT_EQ(n, 16 * 16);
+    // What the sheet reflects sees the sky too, and adds R.
+    const double a = c == 0 ? sheet.coatingAbsorption.x : c == 1 ? sheet.coatingAbsorption.y : sheet.coatingAbsorption.z;
+    const double expected = passes * std::exp(-a) + 2 * rf / (1 + rf);
+    EXPECT_NEAR(mean, expected, 0.003) << "channel " << c;
+  }
+}
+
 // Glass of index 1.0001 (no Fresnel reflection, rays go straight) filled with a medium.
 Material filledGlass(Vec3 absorption, Vec3 scattering = Vec3{0.0f}, float anisotropy = 0) {
   Material glass;
