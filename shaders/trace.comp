@@ -155,6 +155,36 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
   return m;
 }
 
+#if RETILE_SHEET && RETILE_ALPHA_TEST
+// Whether the shadow ray paused on a candidate hit (trace's pendingPrim and on) passes it as a
+// thin sheet, as Tungsten's shadow rays pass its thin sheet (a forward lobe): then dimmed by what
+// the sheet lets through along the ray (thinSheetTransmittance, at the shading normal's angle,
+// as a path that passes it is). So a light behind a window is sampled through it, a point light
+// too, which no path could reach; and the path that passes a sheet keeps the light sample's MIS
+// (shadeSegment). Past the traversal loop, once a round.
+bool sheetPasses(inout Trace tr) {
+  int ibase = tr.pendingInstance * kInstanceTexels;
+  int prim = tr.pendingPrim;
+  int material = floatBitsToInt(texelFetch(uInstances, ibase + 3).z);
+  Material m = fetchMaterial(material, triangleUv(prim, tr.pendingU, tr.pendingV), tr.rayRandom);
+  if (!isMat(m.type, kMatThinSheet)) return false;
+  vec4 r0 = texelFetch(uInstances, ibase), r1 = texelFetch(uInstances, ibase + 1), r2 = texelFetch(uInstances, ibase + 2);
+  vec3 n = cross(imageLoad(uTraversal, prim * kTriTexels + 1).xyz, imageLoad(uTraversal, prim * kTriTexels + 2).xyz);
+  vec4 s3 = texelFetch(uTriShade, prim * kTriShadeTexels + 3);
+  if (s3.w > 0.5) {
+    float w = 1.0 - tr.pendingU - tr.pendingV;
+    vec3 ns = w * texelFetch(uTriShade, prim * kTriShadeTexels).xyz + tr.pendingU * texelFetch(uTriShade, prim * kTriShadeTexels + 1).xyz +
+              tr.pendingV * texelFetch(uTriShade, prim * kTriShadeTexels + 2).xyz;
+    if (dot(ns, ns) > 0.0) n = ns;
+  }
+  n = r0.xyz * n.x + r1.xyz * n.y + r2.xyz * n.z;  // to world space: the transposed world-to-object rows
+  float R;
+  tr.shadowWeight *= thinSheetTransmittance(m, abs(dot(normalize(n), tr.dir)), R);
+  tr.sheets++;
+  return true;
+}
+#endif
+
 // Offsets a ray origin off the surface by a few float ulps along n (Waechter and Binder,
 // Ray Tracing Gems ch. 6): robust at any distance from the origin, no scene-scale epsilon.
 vec3 offsetRay(vec3 p, vec3 n) {
@@ -248,6 +278,9 @@ struct Shadow {
   // traced (resolveShadow): the extinction of the medium it starts in, and the light's distance.
   vec3 sigma;
   float dist;
+#endif
+#if RETILE_SHEET
+  int depth;  // its path's bounces where it was cast: each thin sheet it passes counts one more
 #endif
 };
 
@@ -370,6 +403,12 @@ void resolveShadow(inout Path path, inout Shadow shadow, Trace tr) {
   if (shadow.selBase >= 0 && blocker >= 0 && blocker == selected) atomicAdd(selectionCounts[shadow.selBase + 2], 1u);
   bool visible = blocker < 0;
   vec3 L = shadow.L;
+#if RETILE_SHEET
+  // Dimmed by the thin sheets it passed, each a bounce, as a path that passes them counts it
+  // (shadeSegment): past the last bounce the path could not have reached the light either.
+  L *= tr.shadowWeight;
+  visible = visible && shadow.depth + tr.sheets < int(frame.image.w);
+#endif
 #if RETILE_BOUNDARY
   // Its optical depth through the media it ran in (Trace::crossedSigma). A negative one only
   // comes of boundaries that do not close, or of nested ones, whose media the path replaces and
@@ -436,6 +475,9 @@ void castShadow(inout Shadow shadow, inout Path path, vec3 origin, float skip, i
   shadow.ended = false;
   shadow.selBase = path.selBase;
   shadow.pending = true;
+#if RETILE_SHEET
+  shadow.depth = path.depth;
+#endif
 }
 
 #if RETILE_MEDIUM
@@ -711,6 +753,16 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   // Tungsten's convention has no such check (its enable_consistency_checks is off by default).
   if (!tungstenShading && (bs.transmitted ? sideI * sideO >= 0.0 : sideI * sideO <= 0.0)) return endPath(path, shadow);
   path.beta *= bs.weight;
+#if RETILE_SHEET
+  if (bs.transmitted && isMat(m.type, kMatThinSheet)) {
+    // Straight through, a bounce, as a boundary is crossed: the light sample of the vertex before
+    // saw through the sheet too (sheetPasses), so that vertex's pdf and lobe stay the MIS's.
+    path.ro = offsetRay(pos, sideI > 0.0 ? ngs : -ngs) + wi * surfaceSkip();
+    path.from = ivec2(hit.prim, hit.instance);
+    path.depth++;
+    return survivesRoulette(path, shadow);
+  }
+#endif
   // Through glass the path enters its medium or leaves it for the one around (crossMedium).
 #if RETILE_MEDIUM
   // Which side the path came from is the true surface's (as in Tungsten): a shading normal
@@ -858,7 +910,12 @@ void main() {
 #if RETILE_ALPHA_TEST || RETILE_BOUNDARY
 #if RETILE_ALPHA_TEST
       if (tr.alphaPending) {
-        tr.alphaDecision = alphaPasses(tr.pendingInstance, tr.pendingPrim, tr.pendingU, tr.pendingV, tr.rayRandom) ? 1 : -1;
+        bool solid = alphaPasses(tr.pendingInstance, tr.pendingPrim, tr.pendingU, tr.pendingV, tr.rayRandom);
+#if RETILE_SHEET
+        // (Sheets are flagged as cut-outs are: render_scene.cpp packInstances.)
+        if (solid && tr.onShadow) solid = !sheetPasses(tr);
+#endif
+        tr.alphaDecision = solid ? 1 : -1;
         tr.alphaPending = false;
       }
 #endif

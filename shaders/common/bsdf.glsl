@@ -30,6 +30,8 @@ const bool kScatteringUsed = (kMaterialMask & (1 << kMaskScattering)) != 0;
 // Likewise bit 13, kMatBoundary: only then do shadow rays pass surfaces (scene.glsl traceStep).
 #define RETILE_MEDIUM ((RETILE_MATERIALS & 65536) != 0)
 #define RETILE_BOUNDARY ((RETILE_MATERIALS & 8192) != 0)
+// And bit 9, kMatThinSheet: shadow rays pass thin sheets, dimmed (trace.comp sheetPasses).
+#define RETILE_SHEET ((RETILE_MATERIALS & 512) != 0)
 
 struct Material {
   int type;
@@ -143,6 +145,15 @@ float fresnelDielectric(float cosI, float eta) {
 float thinSheetReflectance(float cosI, float eta, out float cosT) {
   vec2 r = fresnelPolarised(cosI, eta, cosT);
   return r.x / (1.0 + r.x) + r.y / (1.0 + r.y);
+}
+
+// What a thin sheet lets straight through at |cos| cosO to its normal: what it does not reflect,
+// tinted by its albedo and dimmed by its absorption along its slanted way through (m.coating:
+// the absorption straight across). The same for a path that passes it and a shadow ray.
+vec3 thinSheetTransmittance(Material m, float cosO, out float R) {
+  float cosIn;
+  R = thinSheetReflectance(cosO, m.ior, cosIn);
+  return m.albedo * (1.0 - R) * exp(-m.coating / max(cosIn, 1e-4));
 }
 
 // Exact unpolarised reflectance of a conductor with complex index eta + i k.
@@ -392,17 +403,16 @@ BsdfSample baseSample(Material m, vec3 wo, vec3 u) {
     float F = fresnelDielectric(cosO, eta, cosT);
     s.delta = true;
     if (isMat(t, kMatThinSheet)) {
-      // What is not reflected passes straight through, dimmed by the sheet's absorption along
-      // its slanted way through (m.coating: the absorption straight across).
-      float cosIn;
-      float R = thinSheetReflectance(cosO, m.ior, cosIn);
+      // What is not reflected passes straight through (thinSheetTransmittance).
+      float R;
+      vec3 through = thinSheetTransmittance(m, cosO, R);
       if (u.x < R) {
         s.wi = vec3(-wo.x, -wo.y, wo.z);
         s.weight = vec3(1.0);
         s.pdf = R;
       } else {
         s.wi = -wo;
-        s.weight = m.albedo * exp(-m.coating / max(cosIn, 1e-4));
+        s.weight = through / max(1.0 - R, 1e-6);
         s.pdf = 1.0 - R;
         s.transmitted = true;
       }

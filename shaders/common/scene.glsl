@@ -281,6 +281,12 @@ struct Trace {
   vec4 crossingT;
   bool crossingPending;
 #endif
+#if RETILE_SHEET
+  // The thin sheets a shadow ray passed (they pause it as cut-outs do: alphaPending) and what
+  // they let through along it, taken past the loop (trace.comp sheetPasses).
+  vec3 shadowWeight;
+  int sheets;
+#endif
 #if RETILE_ALPHA_TEST
   // A candidate hit on an alpha-tested triangle pauses the lane's traversal on it (alphaPending)
   // until trace.comp, past the traversal loop, looks its alpha up for every paused lane at once:
@@ -342,6 +348,10 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, i
 #if RETILE_ALPHA_TEST
   tr.alphaPending = false;
   tr.alphaDecision = 0;
+#endif
+#if RETILE_SHEET
+  tr.shadowWeight = vec3(1.0);
+  tr.sheets = 0;
 #endif
 }
 

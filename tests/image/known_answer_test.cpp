@@ -172,6 +172,74 @@ TEST(KnownAnswer, AThinSheetAbsorbsWithoutAPlasticInTheScene) {
   }
 }
 
+// What a thin sheet of index 1.5 absorbing `a` straight across lets through at angle theta to its
+// normal: (1 - R) exp(-a / cos t), R each polarisation's 2r / (1 + r) averaged, t the angle inside.
+double sheetTransmittance(double theta, double a) {
+  const double ci = std::cos(theta), st = std::sin(theta) / 1.5, ct = std::sqrt(1 - st * st);
+  const double rs = (ci - 1.5 * ct) / (ci + 1.5 * ct), rp = (1.5 * ci - ct) / (1.5 * ci + ct);
+  const double r1 = rs * rs, r2 = rp * rp;
+  return (1 - (r1 / (1 + r1) + r2 / (1 + r2))) * std::exp(-a / ct);
+}
+
+// Shadow rays pass thin sheets, dimmed by what they let through, as Tungsten's do (its forward
+// lobe). A floor of albedo 0.5 one unit under a horizontal sheet absorbing 0.7, seen from between
+// the two (the camera's rays do not pass the sheet).
+//  - A point light above the sheet, which no path can reach: the floor under it reads the
+//    unshaded floor's times the sheet's transmittance head on; black at one bounce, where a path
+//    could not pass the sheet and reach the light either (the sheet is a bounce).
+//  - A sky of 1 above it, which paths reach through the sheet and light samples see through
+//    it, weighed against each other: the floor reads albedo times 2 int T(theta) cos sin, no
+//    more (a path that passed the sheet counted as a delta bounce would add the light twice).
+TEST(KnownAnswer, ShadowRaysPassAThinSheetDimmed) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const float a = 0.7f;
+  Scene s = test::emptyScene(16, 16);
+  s.camera.position = {0, 0.5f, 0};
+  s.camera.target = {0, 0, 0};
+  s.camera.up = {0, 0, -1};
+  s.camera.verticalFov = radians(10.0f);
+  s.settings.maxBounces = 2;
+  NodeId floor = test::addMeshObject(s, "floor", makeQuad(), test::addMaterial(s, grey(0.5f)), Mat4::scale({1000, 1, 1000}));
+  Material sheet;
+  sheet.type = MaterialType::ThinSheet;
+  sheet.albedo = Vec3{1.0f};
+  sheet.ior = 1.5f;
+  sheet.coatingAbsorption = Vec3{a};
+  test::addMeshObject(s, "sheet", makeQuad(), test::addMaterial(s, sheet), Mat4::translate({0, 1, 0}) * Mat4::scale({1000, 1, 1000}));
+  Light light;
+  light.id = s.newId();
+  light.type = LightType::Point;
+  light.intensity = 4;
+  light.position = {0, 2, 0};
+  s.lights.push_back(light);
+  auto floorMean = [&](int spp) {
+    int n;
+    const double mean = meanOver(renderScene(*r, s, spp), floor, &n);
+    EXPECT_EQ(n, 16 * 16);
+    return mean;
+  };
+  const double through = floorMean(16);
+  s.objects.back().visible = false;
+  const double open = floorMean(16);
+  EXPECT_GT(open, 0.1);
+  EXPECT_NEAR(through / open, sheetTransmittance(0, a), 0.003) << "the point light through the sheet";
+  s.objects.back().visible = true;
+  s.settings.maxBounces = 1;
+  EXPECT_LT(floorMean(16), 1e-6) << "one bounce: the sheet is a second";
+
+  s.settings.maxBounces = 2;
+  s.lights.clear();
+  s.environment.color = Vec3{1.0f};
+  double integral = 0;
+  const int steps = 2000;
+  for (int i = 0; i <= steps; ++i) {
+    const double theta = (kPi / 2) * i / steps, w = (i == 0 || i == steps) ? 1 : (i % 2 ? 4 : 2);
+    integral += w * sheetTransmittance(theta, a) * std::cos(theta) * std::sin(theta);
+  }
+  integral *= (kPi / 2) / steps / 3;
+  EXPECT_NEAR(floorMean(256), 0.5 * 2 * integral, 0.005) << "the sky through the sheet, once";
+}
+
 // Glass of index 1.0001 (no Fresnel reflection, rays go straight) filled with a medium.
 Material filledGlass(Vec3 absorption, Vec3 scattering = Vec3{0.0f}, float anisotropy = 0) {
   Material glass;

@@ -383,6 +383,17 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
 }
 
 namespace {
+// Whether `m`, or a material it blends with (as the kernel follows the chain: fetchMaterial), is a
+// thin sheet.
+bool sheetInBlend(const Scene& scene, const Material& m) {
+  const Material* part = &m;
+  for (int k = 0; part && k < kMaxBlendChain; ++k) {
+    if (part->type == MaterialType::ThinSheet) return true;
+    part = part->blendWith != kNoNode && part->blendWith != part->id ? scene.material(part->blendWith) : nullptr;
+  }
+  return false;
+}
+
 bool finite(const Mat4& t) {
   return std::all_of(&t.m[0][0], &t.m[0][0] + 16, [](float v) { return std::isfinite(v); });
 }
@@ -979,8 +990,9 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     const Candidate& c = cands[i];
     const Material* mat = scene.material(c.object->material);
     int flags = 0;
-    // A boundary is crossed whole (its medium must not be left at random).
-    if (mat && mat->type != MaterialType::Boundary && (mat->alpha < 1.0f || textureIndex(mat->alphaTexture) >= 0))
+    // A boundary is crossed whole (its medium must not be left at random). A thin sheet, which
+    // shadow rays pass dimmed, pauses them as a cut-out does (trace.comp sheetPasses).
+    if (mat && mat->type != MaterialType::Boundary && (mat->alpha < 1.0f || textureIndex(mat->alphaTexture) >= 0 || sheetInBlend(scene, *mat)))
       flags |= gpu::kInstanceAlphaTested;
     if (mat && mat->emissive()) flags |= gpu::kInstanceEmissive;
     if (mat && mat->type == MaterialType::Boundary) flags |= gpu::kInstanceBoundary;
