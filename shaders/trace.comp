@@ -155,36 +155,6 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
   return m;
 }
 
-#if RETILE_SHEET && RETILE_ALPHA_TEST
-// Whether the shadow ray paused on a candidate hit (trace's pendingPrim and on) passes it as a
-// thin sheet, as Tungsten's shadow rays pass its thin sheet (a forward lobe): then dimmed by what
-// the sheet lets through along the ray (thinSheetTransmittance, at the shading normal's angle,
-// as a path that passes it is). So a light behind a window is sampled through it, a point light
-// too, which no path could reach; and the path that passes a sheet keeps the light sample's MIS
-// (shadeSegment). Past the traversal loop, once a round.
-bool sheetPasses(inout Trace tr) {
-  int ibase = tr.pendingInstance * kInstanceTexels;
-  int prim = tr.pendingPrim;
-  int material = floatBitsToInt(texelFetch(uInstances, ibase + 3).z);
-  Material m = fetchMaterial(material, triangleUv(prim, tr.pendingU, tr.pendingV), tr.rayRandom);
-  if (!isMat(m.type, kMatThinSheet)) return false;
-  vec4 r0 = texelFetch(uInstances, ibase), r1 = texelFetch(uInstances, ibase + 1), r2 = texelFetch(uInstances, ibase + 2);
-  vec3 n = cross(imageLoad(uTraversal, prim * kTriTexels + 1).xyz, imageLoad(uTraversal, prim * kTriTexels + 2).xyz);
-  vec4 s3 = texelFetch(uTriShade, prim * kTriShadeTexels + 3);
-  if (s3.w > 0.5) {
-    float w = 1.0 - tr.pendingU - tr.pendingV;
-    vec3 ns = w * texelFetch(uTriShade, prim * kTriShadeTexels).xyz + tr.pendingU * texelFetch(uTriShade, prim * kTriShadeTexels + 1).xyz +
-              tr.pendingV * texelFetch(uTriShade, prim * kTriShadeTexels + 2).xyz;
-    if (dot(ns, ns) > 0.0) n = ns;
-  }
-  n = r0.xyz * n.x + r1.xyz * n.y + r2.xyz * n.z;  // to world space: the transposed world-to-object rows
-  float R;
-  tr.shadowWeight *= thinSheetTransmittance(m, abs(dot(normalize(n), tr.dir)), R);
-  tr.sheets++;
-  return true;
-}
-#endif
-
 // Offsets a ray origin off the surface by a few float ulps along n (Waechter and Binder,
 // Ray Tracing Gems ch. 6): robust at any distance from the origin, no scene-scale epsilon.
 vec3 offsetRay(vec3 p, vec3 n) {
@@ -279,8 +249,8 @@ struct Shadow {
   vec3 sigma;
   float dist;
 #endif
-#if RETILE_SHEET
-  int depth;  // its path's bounces where it was cast: each thin sheet it passes counts one more
+#if RETILE_SHEET || RETILE_BOUNDARY
+  int depth;  // its path's bounces where it was cast: each sheet or boundary it passes is one more
 #endif
 };
 
@@ -366,6 +336,62 @@ vec3 bumpNormal(vec3 ns, vec3 q1, vec3 q2, vec2 duv1, vec2 duv2, vec2 slope) {
   return dot(n, ns) < 0.0 ? -normalize(n) : normalize(n);
 }
 
+// The shading normal ns tilted by material `material`'s bump map, if it has one, at uv on the
+// triangle of object-space edges e1, e2 and shading texels s0..s3, in the instance whose
+// world-to-object rows are r0..r2.
+vec3 bumped(vec3 ns, int material, vec4 r0, vec4 r1, vec4 r2, vec3 e1, vec3 e2, vec4 s0, vec4 s1, vec4 s2, vec4 s3, vec2 uv) {
+  if (!hasFeature(kFeatureBump)) return ns;
+  vec4 bump = texelFetch(uMaterials, material * kMaterialTexels + 5);
+  int bumpTex = floatBitsToInt(bump.x);
+  if (bumpTex < 0) return ns;
+  // The triangle's edges in world space: the world-to-object rows' inverse, by cofactors.
+  vec3 c0 = cross(r1.xyz, r2.xyz), c1 = cross(r2.xyz, r0.xyz), c2 = cross(r0.xyz, r1.xyz);
+  float det = dot(r0.xyz, c0);
+  vec3 q1 = (c0 * e1.x + c1 * e1.y + c2 * e1.z) / det, q2 = (c0 * e2.x + c1 * e2.y + c2 * e2.z) / det;
+  vec2 duv1 = vec2(s2.w, s3.x) - vec2(s0.w, s1.w), duv2 = s3.yz - vec2(s0.w, s1.w);
+  return bumpNormal(ns, q1, q2, duv1, duv2, bump.y * textureSlope(bumpTex, uv));
+}
+
+#if RETILE_SHEET && RETILE_ALPHA_TEST
+// Whether the shadow ray paused on a candidate hit (trace's pendingPrim and on) passes it as a
+// thin sheet, as Tungsten's shadow rays pass its thin sheet (a forward lobe): then dimmed by what
+// the sheet lets through along the ray (thinSheetTransmittance, at the shading normal's angle,
+// as a path that passes it is). So a light behind a window is sampled through it, a point light
+// too, which no path could reach; and the path that passes a sheet keeps the light sample's MIS
+// (shadeSegment). Past the traversal loop, once a round.
+bool sheetPasses(inout Trace tr) {
+  int ibase = tr.pendingInstance * kInstanceTexels;
+  int prim = tr.pendingPrim;
+  float u = tr.pendingU, v = tr.pendingV, w = 1.0 - u - v;
+  int material = floatBitsToInt(texelFetch(uInstances, ibase + 3).z);
+  vec4 s0 = texelFetch(uTriShade, prim * kTriShadeTexels), s1 = texelFetch(uTriShade, prim * kTriShadeTexels + 1);
+  vec4 s2 = texelFetch(uTriShade, prim * kTriShadeTexels + 2), s3 = texelFetch(uTriShade, prim * kTriShadeTexels + 3);
+  vec2 uv = w * vec2(s0.w, s1.w) + u * vec2(s2.w, s3.x) + v * s3.yz;
+  // A number of each sheet's own for a blend's choice, as a path draws one at each hit: one for
+  // every sheet along the ray would make the same choice at each.
+  Material m = fetchMaterial(material, uv, hitRandom(tr.rayRandom, prim, 2246822519u));
+  if (!isMat(m.type, kMatThinSheet)) return false;
+  // The normal as shadeSegment shades with: interpolated, bumped.
+  vec4 r0 = texelFetch(uInstances, ibase), r1 = texelFetch(uInstances, ibase + 1), r2 = texelFetch(uInstances, ibase + 2);
+  vec3 e1 = imageLoad(uTraversal, prim * kTriTexels + 1).xyz, e2 = imageLoad(uTraversal, prim * kTriTexels + 2).xyz;
+  vec3 nObj = cross(e1, e2);
+  vec3 ng = normalize(r0.xyz * nObj.x + r1.xyz * nObj.y + r2.xyz * nObj.z), ns = ng;
+  if (s3.w > 0.5) {
+    nObj = w * s0.xyz + u * s1.xyz + v * s2.xyz;
+    vec3 n = r0.xyz * nObj.x + r1.xyz * nObj.y + r2.xyz * nObj.z;
+    if (dot(n, n) > 0.0) {
+      ns = normalize(n);
+      if (!hasFeature(kFeatureTungstenShading) && dot(ns, ng) < 0.0) ns = -ns;
+    }
+  }
+  ns = bumped(ns, material, r0, r1, r2, e1, e2, s0, s1, s2, s3, uv);
+  float R;
+  tr.shadowWeight *= thinSheetTransmittance(m, abs(dot(ns, tr.dir)), R);
+  tr.passed++;
+  return true;
+}
+#endif
+
 // Surfaces whose reflection or refraction shows other objects' edges: mirrors, smooth glass and
 // metal, and their nearly smooth rough kinds. The denoiser's guides look through them.
 bool guideLooksThrough(Material m) {
@@ -404,10 +430,13 @@ void resolveShadow(inout Path path, inout Shadow shadow, Trace tr) {
   bool visible = blocker < 0;
   vec3 L = shadow.L;
 #if RETILE_SHEET
-  // Dimmed by the thin sheets it passed, each a bounce, as a path that passes them counts it
-  // (shadeSegment): past the last bounce the path could not have reached the light either.
-  L *= tr.shadowWeight;
-  visible = visible && shadow.depth + tr.sheets < int(frame.image.w);
+  L *= tr.shadowWeight;  // dimmed by the thin sheets it passed
+#endif
+#if RETILE_SHEET || RETILE_BOUNDARY
+  // Each sheet or boundary it passed is a bounce, as for a path that passes it (shadeSegment):
+  // past the last bounce no path reaches the light that way, and neither does the light sample,
+  // whose MIS weight counts on that path.
+  visible = visible && shadow.depth + tr.passed < int(frame.image.w);
 #endif
 #if RETILE_BOUNDARY
   // Its optical depth through the media it ran in (Trace::crossedSigma). A negative one only
@@ -475,7 +504,7 @@ void castShadow(inout Shadow shadow, inout Path path, vec3 origin, float skip, i
   shadow.ended = false;
   shadow.selBase = path.selBase;
   shadow.pending = true;
-#if RETILE_SHEET
+#if RETILE_SHEET || RETILE_BOUNDARY
   shadow.depth = path.depth;
 #endif
 }
@@ -631,18 +660,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
       if (!hasFeature(kFeatureTungstenShading) && dot(ns, ng) < 0.0) ns = -ns;
     }
   }
-  if (hasFeature(kFeatureBump)) {
-    vec4 bump = texelFetch(uMaterials, floatBitsToInt(info.z) * kMaterialTexels + 5);
-    int bumpTex = floatBitsToInt(bump.x);
-    if (bumpTex >= 0) {
-      // The triangle's edges in world space: the world-to-object rows' inverse, by cofactors.
-      vec3 c0 = cross(r1.xyz, r2.xyz), c1 = cross(r2.xyz, r0.xyz), c2 = cross(r0.xyz, r1.xyz);
-      float det = dot(r0.xyz, c0);
-      vec3 q1 = (c0 * e1.x + c1 * e1.y + c2 * e1.z) / det, q2 = (c0 * e2.x + c1 * e2.y + c2 * e2.z) / det;
-      vec2 duv1 = vec2(s2.w, s3.x) - vec2(s0.w, s1.w), duv2 = s3.yz - vec2(s0.w, s1.w);
-      ns = bumpNormal(ns, q1, q2, duv1, duv2, bump.y * textureSlope(bumpTex, uv));
-    }
-  }
+  ns = bumped(ns, floatBitsToInt(info.z), r0, r1, r2, e1, e2, s0, s1, s2, s3, uv);
 
   Material m = fetchMaterial(floatBitsToInt(info.z), uv, hasFeature(kFeatureBlend) ? rand(path.rng) : 0.0);
   vec3 wo = -rd;
@@ -910,10 +928,13 @@ void main() {
 #if RETILE_ALPHA_TEST || RETILE_BOUNDARY
 #if RETILE_ALPHA_TEST
       if (tr.alphaPending) {
-        bool solid = alphaPasses(tr.pendingInstance, tr.pendingPrim, tr.pendingU, tr.pendingV, tr.rayRandom);
 #if RETILE_SHEET
-        // (Sheets are flagged as cut-outs are: render_scene.cpp packInstances.)
-        if (solid && tr.onShadow) solid = !sheetPasses(tr);
+        // Paused on a cut-out, or (a shadow ray) on a thin sheet, or both.
+        int flags = floatBitsToInt(texelFetch(uInstances, tr.pendingInstance * kInstanceTexels + 4).y);
+        bool solid = (flags & kInstanceAlphaTested) == 0 || alphaPasses(tr.pendingInstance, tr.pendingPrim, tr.pendingU, tr.pendingV, tr.rayRandom);
+        if (solid && tr.onShadow && (flags & kInstanceSheet) != 0) solid = !sheetPasses(tr);
+#else
+        bool solid = alphaPasses(tr.pendingInstance, tr.pendingPrim, tr.pendingU, tr.pendingV, tr.rayRandom);
 #endif
         tr.alphaDecision = solid ? 1 : -1;
         tr.alphaPending = false;

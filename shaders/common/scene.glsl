@@ -199,17 +199,21 @@ vec2 triangleUv(int prim, float u, float v) {
 
 // Stochastic cut-out: a candidate hit on an alpha-tested instance counts with probability alpha.
 // The random number comes from the ray and the triangle, so a shadow ray and the camera agree.
+// A number in [0, 1) of the ray's and a triangle's (hit by it), decorrelated by `salt` between uses.
+float hitRandom(float rayRandom, int prim, uint salt) {
+  uint h = floatBitsToUint(rayRandom) ^ (uint(prim) * salt);
+  h = h * 747796405u + 2891336453u;
+  h = ((h >> ((h >> 28u) + 4u)) ^ h) * 277803737u;
+  return float(((h >> 22u) ^ h) >> 8) * (1.0 / 16777216.0);
+}
+
 bool alphaPasses(int instance, int prim, float u, float v, float rayRandom) {
   int material = floatBitsToInt(texelFetch(uInstances, instance * kInstanceTexels + 3).z);
   vec4 m1 = texelFetch(uMaterials, material * kMaterialTexels + 1);
   int alphaTex = floatBitsToInt(texelFetch(uMaterials, material * kMaterialTexels + 4).w);
   float alpha = m1.z;
   if (alphaTex >= 0) alpha *= sampleAlphaTexture(alphaTex, triangleUv(prim, u, v));
-  uint h = floatBitsToUint(rayRandom) ^ (uint(prim) * 2654435761u);
-  h = h * 747796405u + 2891336453u;
-  h = ((h >> ((h >> 28u) + 4u)) ^ h) * 277803737u;
-  float r = float(((h >> 22u) ^ h) >> 8) * (1.0 / 16777216.0);
-  return r < alpha;
+  return hitRandom(rayRandom, prim, 2654435761u) < alpha;
 }
 
 // The item of a node's child in `slot` (layouts.h), from the node's layout.
@@ -282,10 +286,13 @@ struct Trace {
   bool crossingPending;
 #endif
 #if RETILE_SHEET
-  // The thin sheets a shadow ray passed (they pause it as cut-outs do: alphaPending) and what
-  // they let through along it, taken past the loop (trace.comp sheetPasses).
+  // What the thin sheets a shadow ray passed let through along it (they pause it as cut-outs do:
+  // alphaPending), taken past the loop (trace.comp sheetPasses).
   vec3 shadowWeight;
-  int sheets;
+#endif
+#if RETILE_SHEET || RETILE_BOUNDARY
+  // How many sheets and boundaries it passed: each a bounce, as for a path (trace.comp resolveShadow).
+  int passed;
 #endif
 #if RETILE_ALPHA_TEST
   // A candidate hit on an alpha-tested triangle pauses the lane's traversal on it (alphaPending)
@@ -351,7 +358,9 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, i
 #endif
 #if RETILE_SHEET
   tr.shadowWeight = vec3(1.0);
-  tr.sheets = 0;
+#endif
+#if RETILE_SHEET || RETILE_BOUNDARY
+  tr.passed = 0;
 #endif
 }
 
@@ -371,6 +380,7 @@ void countCrossings(inout Trace tr) {
     tr.crossedSigma += sigma;
     tr.crossedDepth -= sigma * tr.crossingT[i];
   }
+  tr.passed += tr.crossings;
   tr.crossings = 0;
   tr.crossingPending = false;
 }
@@ -517,6 +527,10 @@ void traceStep(inout Trace tr, int below, int root) {
     }
 #if RETILE_ALPHA_TEST
     bool alphaTested = direct ? (floatBitsToInt(r2.w) & kTriAlphaTested) != 0 : (tr.instFlags & kInstanceAlphaTested) != 0;
+#if RETILE_SHEET
+    // A thin sheet pauses shadow rays alone: an extension ray hits it.
+    alphaTested = alphaTested || (tr.onShadow && (direct ? (floatBitsToInt(r2.w) & kTriSheet) != 0 : (tr.instFlags & kInstanceSheet) != 0));
+#endif
     if (found && alphaTested && tr.alphaDecision == 0) {
       // Pause here, the item unchanged, so that the step is taken again with the answer.
       tr.alphaPending = true;

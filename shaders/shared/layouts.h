@@ -39,8 +39,9 @@ RT_CONST(int, kItemNode, 0)
 RT_CONST(int, kItemTriangles, 1)
 RT_CONST(int, kItemInstance, 2)
 RT_CONST(int, kItemOffsetShift, 4)
-RT_CONST(int, kTriInstanceMask, 0x0fffffff)  // e2.w with kFeatureDirectReferences: the instance
-RT_CONST(int, kTriCullBack, 0x10000000)      // and its kInstanceCullBack,
+RT_CONST(int, kTriInstanceMask, 0x07ffffff)  // e2.w with kFeatureDirectReferences: the instance
+RT_CONST(int, kTriSheet, 0x08000000)         // and its kInstanceSheet,
+RT_CONST(int, kTriCullBack, 0x10000000)      // kInstanceCullBack,
 RT_CONST(int, kTriBoundary, 0x20000000)      // kInstanceBoundary
 RT_CONST(int, kTriAlphaTested, 0x40000000)   // and kInstanceAlphaTested flags
 RT_CONST(int, kMaxLeafTriangles, 4)  // render/bvh.h maxLeafSize for mesh BVHs
@@ -88,7 +89,7 @@ RT_CONST(int, kFeatureTungstenRoulette, 32768)  // Roulette::Tungsten (scene.h)
 // The instance BVH's leaves are the instances' own top nodes and triangles, copied into its part
 // of the buffer, not instance records: a ray goes from the instance BVH into an instance without
 // a step of its own, and a triangle names its instance in e2.w (kTriInstanceMask, with its
-// kTriCullBack, kTriBoundary and kTriAlphaTested flags). Only for scenes without instance
+// kTriSheet, kTriCullBack, kTriBoundary and kTriAlphaTested flags). Only for scenes without instance
 // transforms whose triangles each belong to one instance (render_scene.cpp packInstances);
 // ignored with kFeatureInstanceTransforms.
 RT_CONST(int, kFeatureDirectReferences, 65536)
@@ -115,6 +116,9 @@ RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceBoundary, 2)  // its material is a boundary (kMatBoundary), which shadow rays cross
 RT_CONST(int, kInstanceEmissive, 4)
 RT_CONST(int, kInstanceCullBack, 8)  // no ray hits its back faces (Object::cullBackFaces)
+// Its material (or one it blends with) is a thin sheet, which shadow rays pass dimmed: it pauses
+// them as a cut-out pauses every ray (trace.comp sheetPasses).
+RT_CONST(int, kInstanceSheet, 16)
 
 RT_CONST(int, kMatLambert, 0)
 RT_CONST(int, kMatOrenNayar, 1)

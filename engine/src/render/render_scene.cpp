@@ -981,7 +981,7 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   data_.instances.clear();
   data_.instanceObject.clear();
   data_.instancedTriangles = 0;
-  data_.alphaTested = false;
+  data_.alphaTested = data_.cutOuts = data_.sheetShadows = false;
   data_.cullBack = false;
   data_.instanceTransforms = transforms;
   std::vector<int> flagsOf(cands.size(), 0);
@@ -990,14 +990,16 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     const Candidate& c = cands[i];
     const Material* mat = scene.material(c.object->material);
     int flags = 0;
-    // A boundary is crossed whole (its medium must not be left at random). A thin sheet, which
-    // shadow rays pass dimmed, pauses them as a cut-out does (trace.comp sheetPasses).
-    if (mat && mat->type != MaterialType::Boundary && (mat->alpha < 1.0f || textureIndex(mat->alphaTexture) >= 0 || sheetInBlend(scene, *mat)))
+    // A boundary is crossed whole (its medium must not be left at random).
+    if (mat && mat->type != MaterialType::Boundary && (mat->alpha < 1.0f || textureIndex(mat->alphaTexture) >= 0))
       flags |= gpu::kInstanceAlphaTested;
+    if (mat && sheetInBlend(scene, *mat)) flags |= gpu::kInstanceSheet;
     if (mat && mat->emissive()) flags |= gpu::kInstanceEmissive;
     if (mat && mat->type == MaterialType::Boundary) flags |= gpu::kInstanceBoundary;
     if (c.object->cullBackFaces) flags |= gpu::kInstanceCullBack;
-    if (c.visible && (flags & gpu::kInstanceAlphaTested)) data_.alphaTested = true;
+    if (c.visible && (flags & gpu::kInstanceAlphaTested)) data_.alphaTested = data_.cutOuts = true;
+    // A sheet's pause is the cut-outs' (RETILE_ALPHA_TEST).
+    if (c.visible && (flags & gpu::kInstanceSheet)) data_.alphaTested = data_.sheetShadows = true;
     if (c.visible && (flags & gpu::kInstanceCullBack)) data_.cullBack = true;
     flagsOf[i] = flags;
     inverseOf[i] = c.transform.inverse();
@@ -1022,7 +1024,8 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     for (const auto& [mesh, i] : namer) {
       const std::uint32_t name = static_cast<std::uint32_t>(i) | ((flagsOf[i] & gpu::kInstanceAlphaTested) ? gpu::kTriAlphaTested : 0u) |
                                  ((flagsOf[i] & gpu::kInstanceBoundary) ? gpu::kTriBoundary : 0u) |
-                                 ((flagsOf[i] & gpu::kInstanceCullBack) ? gpu::kTriCullBack : 0u);
+                                 ((flagsOf[i] & gpu::kInstanceCullBack) ? gpu::kTriCullBack : 0u) |
+                                 ((flagsOf[i] & gpu::kInstanceSheet) ? gpu::kTriSheet : 0u);
       if (mesh->named == name) continue;
       mesh->named = name;
       renamed = true;

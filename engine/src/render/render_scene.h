@@ -100,7 +100,9 @@ struct RenderSceneData {
   MediumAt worldMedium;                // Environment::medium..., none unless filled()
   std::uint64_t triangleCount = 0;     // packed triangles: each mesh's once, and the copies of small shared ones
   std::uint64_t instancedTriangles = 0;
-  bool alphaTested = false;            // some instance needs the cut-out test during traversal
+  // Some visible instance pauses traversal on its candidate hits (RETILE_ALPHA_TEST): a cut-out
+  // (cutOuts), every ray, or a thin sheet (sheetShadows), shadow rays.
+  bool alphaTested = false, cutOuts = false, sheetShadows = false;
   bool cullBack = false;               // some visible instance is hit from the front only
   std::uint32_t materialTypes = 0;     // bit kMat... of each material type present
   bool materialTextures = false;       // some material reads an albedo or roughness texture

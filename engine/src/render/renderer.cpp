@@ -821,7 +821,8 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   if (d.materialTypes & (1u << gpu::kMaskCoat)) out.push_back("coat");
   if (d.materialTypes & (1u << gpu::kMaskMedium)) out.push_back("medium");
   if (d.materialTypes & (1u << gpu::kMaskScattering)) out.push_back("scattering medium");
-  if (d.alphaTested) out.push_back("alpha test");
+  if (d.cutOuts) out.push_back("alpha test");
+  if (d.sheetShadows) out.push_back("shadow rays through thin sheets");
   const std::uint32_t f = d.features();
   if (f & static_cast<std::uint32_t>(gpu::kFeatureTextures)) out.push_back("textures");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureEnvConstant)) out.push_back("constant environment");
