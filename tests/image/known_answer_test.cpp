@@ -227,6 +227,18 @@ TEST(KnownAnswer, ShadowRaysPassAThinSheetDimmed) {
   s.settings.maxBounces = 1;
   EXPECT_LT(floorMean(16), 1e-6) << "one bounce: the sheet is a second";
 
+  // Two such sheets, each blended half and half with black paint: a shadow ray passes both with
+  // probability 1/4, each sheet its own draw (one draw for both would pass half the rays).
+  s.settings.maxBounces = 3;
+  const NodeId sheetMaterial = s.objects.back().material;
+  s.material(sheetMaterial)->blendWith = test::addMaterial(s, grey(0.0f));
+  s.material(sheetMaterial)->blendRatio = 0.5f;
+  test::addMeshObject(s, "sheet 2", makeQuad(), sheetMaterial, Mat4::translate({0, 1.2f, 0}) * Mat4::scale({1000, 1, 1000}));
+  const double t0 = sheetTransmittance(0, a);
+  EXPECT_NEAR(floorMean(64) / open, 0.25 * t0 * t0, 0.06 * 0.25 * t0 * t0) << "two blended sheets";
+  s.objects.pop_back();
+  s.material(sheetMaterial)->blendWith = kNoNode;
+
   s.settings.maxBounces = 2;
   s.lights.clear();
   s.environment.color = Vec3{1.0f};
