@@ -385,7 +385,7 @@ bool sheetPasses(inout Trace tr) {
     }
   }
   ns = bumped(ns, material, r0, r1, r2, e1, e2, s0, s1, s2, s3, uv);
-  float R;
+  vec3 R;
   tr.shadowWeight *= thinSheetTransmittance(m, abs(dot(ns, tr.dir)), R);
   tr.passed++;
   return true;

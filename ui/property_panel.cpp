@@ -395,6 +395,14 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       edit(tr("Coating absorption"), drag,
            [channel, v](Material& x) { axisOf(x.coatingAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
     }, true);
+  if (m.type == MaterialType::ThinSheet)
+    b.number(tr("Film thickness (nm)"), "filmThickness", m.filmThickness, 0.0, 5000.0, defaults.filmThickness, 1, [edit](double v, int drag) {
+      edit(tr("Film thickness"), drag, [v](Material& x) { x.filmThickness = static_cast<float>(v); });
+    })->setToolTip(tr("Thin-film interference over a film this thick: colours that change with the angle, as on a soap bubble; 0 for none"));
+  if (m.type == MaterialType::ThinSheet && m.filmThickness > 0)
+    b.choice(tr("Interference"), "interferenceConvention", {tr("Physical"), tr("Tungsten")}, m.tungstenGlass ? 1 : 0,
+             [edit](int i) { edit(tr("Interference"), 0, [i](Material& x) { x.tungstenGlass = i == 1; }); })
+        ->setToolTip(tr("Tungsten's form, for scenes made for it, shows a few per cent of the physical colours"));
   if (m.type == MaterialType::Conductor || m.type == MaterialType::RoughConductor) {
     QStringList metals;
     for (const auto& n : conductorNames()) metals << QString::fromStdString(n);

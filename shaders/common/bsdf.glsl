@@ -36,7 +36,8 @@ const bool kScatteringUsed = (kMaterialMask & (1 << kMaskScattering)) != 0;
 struct Material {
   int type;
   vec3 albedo;
-  float roughness;   // microfacet alpha, Oren-Nayar sigma, or Phong's a (exponent 2 / a^2 - 2)
+  float roughness;   // microfacet alpha, Oren-Nayar sigma, Phong's a (exponent 2 / a^2 - 2), or a thin
+                     // sheet's film thickness in nm (0: no interference; Material::filmThickness)
   bool beckmann;     // rough types: Beckmann's distribution instead of GGX
   bool separable;    // rough types: G = G1(wo) G1(wi) instead of height-correlated
   bool tungstenGlass;  // glass: albedo tints reflection too, no (n_t / n_i)^2 across (Material::tungstenGlass)
@@ -139,20 +140,36 @@ float fresnelDielectric(float cosI, float eta) {
   return fresnelDielectric(cosI, eta, cosT);
 }
 
-// A thin sheet of index eta reflects at both faces, and light bounces between them: for each
-// polarisation R + T^2 R / (1 - R^2) = 2R / (1 + R) in all, the two then averaged (as Tungsten's
-// thin sheet, not the average's 2F / (1 + F), which is larger). cosT: the angle's inside the sheet.
-float thinSheetReflectance(float cosI, float eta, out float cosT) {
-  vec2 r = fresnelPolarised(cosI, eta, cosT);
-  return r.x / (1.0 + r.x) + r.y / (1.0 + r.y);
+// A thin sheet's reflectance per channel. It reflects at both faces, and light bounces between
+// them: for each polarisation R + T^2 R / (1 - R^2) = 2R / (1 + R) in all, the two then averaged
+// (as Tungsten's thin sheet, not the average's 2F / (1 + F), which is larger). Over a film of
+// thickness m.roughness nm the waves interfere, phi the phase the film's two faces put between
+// them at 650, 510 and 475 nm: each polarisation passes (1 - R)^2 / (1 + R^2 - 2 R cos phi) of
+// what reaches it (Airy's, whose mean over the phase is the plain sheet's), or, as Tungsten draws
+// it (m.tungstenGlass; Fresnel::thinFilmReflectanceInterference),
+// (1 - R)^2 / sqrt(1 + R^4 - 2 R^2 cos phi), whose colours are a few per cent of Airy's.
+// cosT: the angle's inside the sheet.
+vec3 thinSheetReflectances(Material m, float cosI, out float cosT) {
+  vec2 r = fresnelPolarised(cosI, m.ior, cosT);
+  if (m.roughness <= 0.0) return vec3(r.x / (1.0 + r.x) + r.y / (1.0 + r.y));
+  vec3 cosPhi = cos(4.0 * PI * m.ior * m.roughness * cosT / vec3(650.0, 510.0, 475.0));
+  vec2 t2 = (1.0 - r) * (1.0 - r);
+  vec2 a = m.tungstenGlass ? r * r : r;  // Tungsten squares the reflectances once more
+  vec3 ds = 1.0 + a.x * a.x - 2.0 * a.x * cosPhi, dp = 1.0 + a.y * a.y - 2.0 * a.y * cosPhi;
+  if (m.tungstenGlass) {
+    ds = sqrt(max(ds, vec3(0.0)));
+    dp = sqrt(max(dp, vec3(0.0)));
+  }
+  return 1.0 - 0.5 * (t2.x / max(ds, vec3(1e-12)) + t2.y / max(dp, vec3(1e-12)));
 }
 
-// What a thin sheet lets straight through at |cos| cosO to its normal: what it does not reflect,
-// tinted by its albedo and dimmed by its absorption along its slanted way through (m.coating:
-// the absorption straight across). The same for a path that passes it and a shadow ray.
-vec3 thinSheetTransmittance(Material m, float cosO, out float R) {
+// What a thin sheet lets straight through at |cos| cosO to its normal: what it does not reflect
+// (R, per channel), tinted by its albedo and dimmed by its absorption along its slanted way
+// through (m.coating: the absorption straight across). The same for a path that passes it and a
+// shadow ray.
+vec3 thinSheetTransmittance(Material m, float cosO, out vec3 R) {
   float cosIn;
-  R = thinSheetReflectance(cosO, m.ior, cosIn);
+  R = thinSheetReflectances(m, cosO, cosIn);
   return m.albedo * (1.0 - R) * exp(-m.coating / max(cosIn, 1e-4));
 }
 
@@ -403,17 +420,19 @@ BsdfSample baseSample(Material m, vec3 wo, vec3 u) {
     float F = fresnelDielectric(cosO, eta, cosT);
     s.delta = true;
     if (isMat(t, kMatThinSheet)) {
-      // What is not reflected passes straight through (thinSheetTransmittance).
-      float R;
+      // What is not reflected passes straight through (thinSheetTransmittance); the two are
+      // chosen by the reflectance's mean over the channels.
+      vec3 R;
       vec3 through = thinSheetTransmittance(m, cosO, R);
-      if (u.x < R) {
+      float pR = (R.x + R.y + R.z) / 3.0;
+      if (u.x < pR) {
         s.wi = vec3(-wo.x, -wo.y, wo.z);
-        s.weight = vec3(1.0);
-        s.pdf = R;
+        s.weight = m.roughness > 0.0 ? R / pR : vec3(1.0);
+        s.pdf = pR;
       } else {
         s.wi = -wo;
-        s.weight = through / max(1.0 - R, 1e-6);
-        s.pdf = 1.0 - R;
+        s.weight = through / max(1.0 - pR, 1e-6);
+        s.pdf = 1.0 - pR;
         s.transmitted = true;
       }
     } else if (u.x < F) {

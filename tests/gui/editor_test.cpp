@@ -448,6 +448,26 @@ TEST(Editor, AnObjectIsHitFromTheFrontOnlyFromItsPanel) {
   EXPECT_FALSE(again->isChecked()) << "the box follows the undo";
 }
 
+// A thin sheet shows its film's thickness (thin-film interference), and the field edits it.
+TEST(Editor, AThinSheetTakesItsFilmThicknessFromItsPanel) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  const NodeId material = w->scene().object(sphere)->material;
+  EXPECT_FALSE(w->findChild<ScrubField*>("filmThickness")) << "only a thin sheet has a film";
+  auto* type = w->findChild<QComboBox*>("materialType");
+  ASSERT_TRUE(type);
+  type->setCurrentIndex(type->findText("thinsheet"));
+  ASSERT_EQ(w->scene().material(material)->type, MaterialType::ThinSheet);
+  QTest::qWait(50);  // the panel rebuilds on the next turn of the event loop
+  auto* film = w->findChild<ScrubField*>("filmThickness");
+  ASSERT_TRUE(film);
+  film->setValue(420);
+  EXPECT_FLOAT_EQ(w->scene().material(material)->filmThickness, 420.0f);
+  const std::uint64_t version = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; })) << "the edit reached the engine";
+}
+
 TEST(Editor, GlassTakesAScatteringMediumFromItsPanel) {
   auto w = makeWindow();
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");

@@ -151,12 +151,18 @@ struct Material {
   // as well as the transmission, and radiance is not scaled by (n_t / n_i)^2 where it crosses
   // the surface. The two agree on light that passes in and out again; they differ where a path
   // ends inside, on an emitter within the glass (a lamp's bulb, say): 1 / ior^2 as bright here
-  // without this. Otherwise albedo tints the transmission alone, the physical form.
+  // without this. Otherwise albedo tints the transmission alone, the physical form. For a thin
+  // sheet with a film (filmThickness): its interference as Tungsten draws it, much fainter than
+  // the physical (Airy) form's, which is otherwise drawn.
   bool tungstenGlass = false;
   // Plastics: the coating's absorption, its sigma_a times its thickness (Tungsten's plastic):
   // the diffuse base shows through dimmed by exp(-a (1 / cos wi + 1 / cos wo)). Thin sheets: the
   // sheet's, light passing through it dimmed by exp(-a / cos t), t the angle inside the sheet.
   Vec3 coatingAbsorption{0.0f};
+  // Thin sheets: thin-film interference over a film this many nanometres thick (Tungsten's
+  // enable_interference, over its thickness times 500): the sheet's reflectance then varies by
+  // channel (red, green and blue taken at 650, 510 and 475 nm) and with the angle. 0: none.
+  float filmThickness = 0.0f;
   float transmittance = 0.5f;      // diffuse transmission: the share of albedo passed through
   float diffuseRatio = 0.2f;       // Phong: the share of albedo reflected as Lambert (Tungsten's default)
   // A clear coat over this material (Tungsten's smooth_coat): a smooth dielectric layer of index

@@ -265,6 +265,7 @@ Value nativeSceneToJson(const Scene& s) {
     v.set("ior", m.ior);
     if (m.tungstenGlass) v.set("glass", "tungsten");
     v.set("coating_absorption", json::fromVec3(m.coatingAbsorption));
+    if (m.filmThickness != 0) v.set("film_thickness", m.filmThickness);
     v.set("transmittance", m.transmittance);
     v.set("diffuse_ratio", m.diffuseRatio);
     v.set("interior_absorption", json::fromVec3(m.interiorAbsorption));
@@ -516,6 +517,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       else if (!glass.empty() && glass != "physical")
         r.problem("glass", cat("unknown glass convention '", glass, "' (physical, tungsten)"));
       r.vec3("coating_absorption", &m.coatingAbsorption);
+      r.number("film_thickness", &m.filmThickness);
       r.number("transmittance", &m.transmittance);
       r.number("diffuse_ratio", &m.diffuseRatio);
       r.vec3("interior_absorption", &m.interiorAbsorption);

@@ -660,8 +660,10 @@ class TungstenImporter {
           thickness = channelMean(th.constant);
       }
       m.coatingAbsorption = max(sigmaA * (2.0f * thickness), Vec3{0.0f});
-      if (const Value* e = v.find("enable_interference"); e && e->isBool() && e->asBool())
-        warn(cat(where, ": thin film interference is not rendered; the sheet reflects as without it"));
+      // Tungsten's film is its thickness times 500 nm thick (ThinSheetBsdf), its interference
+      // drawn as Tungsten draws it.
+      if (const Value* e = v.find("enable_interference"); e && e->isBool() && e->asBool()) m.filmThickness = std::max(500.0f * thickness, 0.0f);
+      m.tungstenGlass = true;
     } else if (type == "null") {
       m.type = MaterialType::Null;
     } else if (type == "phong") {

@@ -590,11 +590,13 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
   const bool rough = isMicrofacet(m.type);
   int type = static_cast<int>(m.type) | (rough && m.beckmann ? gpu::kMatBeckmann : 0) |
-             (rough && m.separableShadowing ? gpu::kMatSeparable : 0) | (isGlassType(m.type) && m.tungstenGlass ? gpu::kMatTungstenGlass : 0);
+             (rough && m.separableShadowing ? gpu::kMatSeparable : 0) | ((isGlassType(m.type) || m.type == MaterialType::ThinSheet) && m.tungstenGlass ? gpu::kMatTungstenGlass : 0);
   // Keep roughness away from zero, where GGX turns into a delta the rough code cannot sample.
   float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
   if (rough || m.type == MaterialType::Phong) roughness = std::max(roughness, 1e-3f);
   if (m.type == MaterialType::OrenNayar) roughness = std::clamp(m.roughness, 0.0f, kPi / 2);
+  // A thin sheet has no roughness: the slot carries its film's thickness (Material::filmThickness).
+  if (m.type == MaterialType::ThinSheet) roughness = std::isfinite(m.filmThickness) ? std::clamp(m.filmThickness, 0.0f, 1e5f) : 0.0f;
   float ior = std::clamp(m.ior, 1.0001f, 10.0f);
   const bool coated = coatRendered(m);
   // Diffuse light inside a plastic coating reflects back this fraction at the boundary
