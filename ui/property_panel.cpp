@@ -396,8 +396,11 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
            [channel, v](Material& x) { axisOf(x.coatingAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
     }, true);
   if (m.type == MaterialType::ThinSheet)
-    b.number(tr("Film thickness (nm)"), "filmThickness", m.filmThickness, 0.0, 5000.0, defaults.filmThickness, 1, [edit](double v, int drag) {
+    b.number(tr("Film thickness (nm)"), "filmThickness", m.filmThickness, 0.0, 5000.0, defaults.filmThickness, 1, [this, id, edit](double v, int drag) {
+      const Material* cur = scene_().material(id);
+      const bool was = cur && cur->filmThickness > 0;
       edit(tr("Film thickness"), drag, [v](Material& x) { x.filmThickness = static_cast<float>(v); });
+      if (was != (v > 0)) rebuildLater();  // the interference's form shows only with a film
     })->setToolTip(tr("Thin-film interference over a film this thick: colours that change with the angle, as on a soap bubble; 0 for none"));
   if (m.type == MaterialType::ThinSheet && m.filmThickness > 0)
     b.choice(tr("Interference"), "interferenceConvention", {tr("Physical"), tr("Tungsten")}, m.tungstenGlass ? 1 : 0,

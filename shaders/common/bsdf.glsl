@@ -152,15 +152,18 @@ float fresnelDielectric(float cosI, float eta) {
 vec3 thinSheetReflectances(Material m, float cosI, out float cosT) {
   vec2 r = fresnelPolarised(cosI, m.ior, cosT);
   if (m.roughness <= 0.0) return vec3(r.x / (1.0 + r.x) + r.y / (1.0 + r.y));
-  vec3 cosPhi = cos(4.0 * PI * m.ior * m.roughness * cosT / vec3(650.0, 510.0, 475.0));
+  // 1 + a^2 - 2a cos phi as (1 - a)^2 + 4a sin^2(phi / 2): no cancellation near grazing angles,
+  // where a nears 1 and the difference of the first form rounded to 0.
+  vec3 half2 = sin(2.0 * PI * m.ior * m.roughness * cosT / vec3(650.0, 510.0, 475.0));
+  half2 *= half2;
   vec2 t2 = (1.0 - r) * (1.0 - r);
   vec2 a = m.tungstenGlass ? r * r : r;  // Tungsten squares the reflectances once more
-  vec3 ds = 1.0 + a.x * a.x - 2.0 * a.x * cosPhi, dp = 1.0 + a.y * a.y - 2.0 * a.y * cosPhi;
+  vec3 ds = (1.0 - a.x) * (1.0 - a.x) + 4.0 * a.x * half2, dp = (1.0 - a.y) * (1.0 - a.y) + 4.0 * a.y * half2;
   if (m.tungstenGlass) {
-    ds = sqrt(max(ds, vec3(0.0)));
-    dp = sqrt(max(dp, vec3(0.0)));
+    ds = sqrt(ds);
+    dp = sqrt(dp);
   }
-  return 1.0 - 0.5 * (t2.x / max(ds, vec3(1e-12)) + t2.y / max(dp, vec3(1e-12)));
+  return clamp(1.0 - 0.5 * (t2.x / max(ds, vec3(1e-30)) + t2.y / max(dp, vec3(1e-30))), 0.0, 1.0);
 }
 
 // What a thin sheet lets straight through at |cos| cosO to its normal: what it does not reflect

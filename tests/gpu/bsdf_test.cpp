@@ -432,6 +432,19 @@ TEST_F(Bsdfs, AThinFilmReflectsEachChannelByItsPhase) {
         // No film is the plain sheet.
         const double expected = film == 0.0f ? Rs / (1 + Rs) + Rp / (1 + Rp) : 1 - 0.5 * (passes(Rs) + passes(Rp));
         EXPECT_NEAR(sum[c], expected, 2e-3) << (tungsten ? "Tungsten's" : "Airy's") << ", film " << film << " nm, cos " << cosO << ", channel " << c;
+        // A film that absorbs nothing passes what it does not reflect, in every channel.
+        if (film > 0.0f) {
+          Material clear = m;
+          clear.coatingAbsorption = Vec3{0.0f};
+          std::vector<BsdfQuery> cq;
+          // Stratified in the choice between the two, finely: a channel's weight differs from its
+          // mean's by R / pR, so an imbalance of one sample in k shows as about 1 / k.
+          const int k = 65536;
+          for (int i = 0; i < k; ++i) cq.push_back({clear, wo, wo, {(i + 0.5f) / k, 0.5f, 0.5f}});
+          double both = 0;
+          for (const auto& ans : run(cq)) both += (c == 0 ? ans.weight.x : c == 1 ? ans.weight.y : ans.weight.z) / k;
+          EXPECT_NEAR(both, 1.0, 1e-4) << "reflected and passed, channel " << c;
+        }
         if (film > 0.0f && !tungsten) {
           // Airy's mean over the phase is the plain sheet's: numerically, over a period.
           double mean = 0;

@@ -462,8 +462,14 @@ TEST(Editor, AThinSheetTakesItsFilmThicknessFromItsPanel) {
   QTest::qWait(50);  // the panel rebuilds on the next turn of the event loop
   auto* film = w->findChild<ScrubField*>("filmThickness");
   ASSERT_TRUE(film);
+  EXPECT_FALSE(w->findChild<QComboBox*>("interferenceConvention")) << "no film, no interference";
   film->setValue(420);
   EXPECT_FLOAT_EQ(w->scene().material(material)->filmThickness, 420.0f);
+  QTest::qWait(50);
+  auto* form = w->findChild<QComboBox*>("interferenceConvention");
+  ASSERT_TRUE(form) << "a film shows its interference's form";
+  form->setCurrentIndex(1);
+  EXPECT_TRUE(w->scene().material(material)->tungstenGlass) << "Tungsten's";
   const std::uint64_t version = w->documentVersion();
   ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; })) << "the edit reached the engine";
 }

@@ -606,6 +606,32 @@ TEST(RenderScene, ATexturedEmitterIsPickedByItsTexturesMean) {
   EXPECT_NEAR(pick[1], 0.1 / 1.1, 1e-4) << "the textured emitter has a tenth of the power";
 }
 
+// A roughness texture on a type without roughness (left there by a change of type, or written in
+// a native file) is not packed: the kernel would scale what the slot holds for it (a thin sheet's
+// film thickness) by the texture's mean. On a rough type it is.
+TEST(RenderScene, OnlyARoughTypeReadsItsRoughnessTexture) {
+  Scene s = test::emptyScene(8, 8);
+  Texture grain;
+  grain.id = s.newId();
+  grain.kind = TextureKind::Checker;
+  s.textures.push_back(grain);
+  Material sheet;
+  sheet.type = MaterialType::ThinSheet;
+  sheet.filmThickness = 300;
+  sheet.roughnessTexture = grain.id;
+  Material rough = sheet;
+  rough.type = MaterialType::RoughPlastic;
+  test::addMeshObject(s, "sheet", makeQuad(), test::addMaterial(s, sheet), Mat4::identity());
+  test::addMeshObject(s, "plastic", makeQuad(), test::addMaterial(s, rough), Mat4::translate({3, 0, 0}));
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  const RenderSceneData& d = builder.data();
+  auto roughnessTexture = [&](std::size_t material) { return std::bit_cast<std::int32_t>(d.materials[material * gpu::kMaterialTexels + 3].w); };
+  EXPECT_EQ(roughnessTexture(0), -1) << "the sheet";
+  EXPECT_EQ(d.materials[0 * gpu::kMaterialTexels + 1].x, 300.0f) << "its film in the roughness slot";
+  EXPECT_GE(roughnessTexture(1), 0) << "the rough plastic";
+}
+
 // Textures are packed in one array, 8-bit ones a word a texel and padded to whole pairs, half
 // floats two words a texel; an update copies unchanged ones from the last packing instead of
 // decoding their files again. With the first texture removed, the others hold the same texels at

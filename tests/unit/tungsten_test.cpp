@@ -957,8 +957,10 @@ TEST(Tungsten, ADielectricWithoutRefractionIsAFresnelReflectorOnly) {
 TEST(Tungsten, AThinSheetAbsorbsAlongTwiceItsThicknessAndHasNoAlbedo) {
   auto r = importTungsten(writeScene(R"({"bsdfs": [
       {"name": "film", "type": "thinsheet", "ior": 1.3, "albedo": 0.3, "sigma_a": [1, 2, 3], "thickness": 0.25},
-      {"name": "bubble", "type": "thinsheet", "enable_interference": true}],
-      "primitives": [{"type": "quad", "bsdf": "film"}, {"type": "quad", "bsdf": "bubble"}, {"type": "quad", "emission": 1}]})"));
+      {"name": "bubble", "type": "thinsheet", "enable_interference": true},
+      {"name": "soap", "type": "thinsheet", "enable_interference": true, "thickness": 0.25}],
+      "primitives": [{"type": "quad", "bsdf": "film"}, {"type": "quad", "bsdf": "bubble"}, {"type": "quad", "bsdf": "soap"},
+      {"type": "quad", "emission": 1}]})"));
   ASSERT_TRUE(r.ok()) << r.error();
   const Scene& s = r->scene;
   const Material* film = s.material(s.objects[0].material);
@@ -970,6 +972,7 @@ TEST(Tungsten, AThinSheetAbsorbsAlongTwiceItsThicknessAndHasNoAlbedo) {
   EXPECT_EQ(film->filmThickness, 0.0f) << "no interference unless asked";
   EXPECT_EQ(s.material(s.objects[1].material)->filmThickness, 250.0f);
   EXPECT_TRUE(s.material(s.objects[1].material)->tungstenGlass) << "its interference drawn as Tungsten draws it";
+  EXPECT_EQ(s.material(s.objects[2].material)->filmThickness, 125.0f);
   EXPECT_TRUE(r->warnings.empty()) << r->warnings.front();
 
   auto file = test::tempDir() / "scene.retile";

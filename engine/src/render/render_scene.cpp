@@ -639,7 +639,10 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     if (coatRendered(m)) data_.materialTypes |= 1u << gpu::kMaskCoat;
     if (m.filled()) data_.materialTypes |= 1u << gpu::kMaskMedium;
     if (m.filled() && maxComponent(m.interiorScattering) > 0) data_.materialTypes |= 1u << gpu::kMaskScattering;
-    if (textureIndex(m.albedoTexture) >= 0 || textureIndex(m.roughnessTexture) >= 0) data_.materialTextures = true;
+    // A type without roughness reads no roughness texture: the kernel would scale what the slot
+    // holds for it (a thin sheet's film) by the texture's mean.
+    const int roughnessTexture = hasRoughness(m.type) ? textureIndex(m.roughnessTexture) : -1;
+    if (textureIndex(m.albedoTexture) >= 0 || roughnessTexture >= 0) data_.materialTextures = true;
     if (textureIndex(m.bumpTexture) >= 0 && m.bumpStrength != 0) data_.materialBump = true;
     if (textureIndex(m.emissionTexture) >= 0 && m.emissive()) data_.emissionTextures = true;
     int blendWith = -1, ratioTexture = -1;
@@ -658,7 +661,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
         data_.materialTextures = true;
       }
     }
-    auto texels = packMaterial(m, textureIndex(m.albedoTexture), textureIndex(m.roughnessTexture), textureIndex(m.alphaTexture),
+    auto texels = packMaterial(m, textureIndex(m.albedoTexture), roughnessTexture, textureIndex(m.alphaTexture),
                                textureIndex(m.bumpTexture), textureIndex(m.emissionTexture), blendWith, ratioTexture);
     data_.materials.insert(data_.materials.end(), texels.begin(), texels.end());
   };
