@@ -142,6 +142,16 @@ TEST(KnownAnswer, WhiteFurnaceLosslessMaterials) {
   }
 }
 
+// A clear thin sheet of index 1.5 absorbing `absorption` straight across.
+Material thinSheet(Vec3 absorption) {
+  Material m;
+  m.type = MaterialType::ThinSheet;
+  m.albedo = Vec3{1.0f};
+  m.ior = 1.5f;
+  m.coatingAbsorption = absorption;
+  return m;
+}
+
 // A thin sheet absorbs along its path through it: seen head on before a sky of 1, it passes
 // (1 - R) exp(-a), R = 2r / (1 + r) its two faces' reflectance (r = 0.04 at index 1.5) and a its
 // absorption straight across, per channel. In a scene with no plastic in it: the absorption was
@@ -152,11 +162,7 @@ TEST(KnownAnswer, AThinSheetAbsorbsWithoutAPlasticInTheScene) {
   s.camera = test::frontCamera(2);
   s.settings.maxBounces = 1;
   s.environment.color = Vec3{1.0f};
-  Material sheet;
-  sheet.type = MaterialType::ThinSheet;
-  sheet.albedo = Vec3{1.0f};
-  sheet.ior = 1.5f;
-  sheet.coatingAbsorption = Vec3{0.5f, 1.0f, 2.0f};
+  const Material sheet = thinSheet(Vec3{0.5f, 1.0f, 2.0f});
   const NodeId quad = test::addMeshObject(s, "sheet", makeQuad(), test::addMaterial(s, sheet),
                                           Mat4::translate({0, 0, -4}) * Mat4::rotateX(kPi / 2));
   const RenderImage img = renderScene(*r, s, 16);
@@ -200,11 +206,7 @@ TEST(KnownAnswer, ShadowRaysPassAThinSheetDimmed) {
   s.camera.verticalFov = radians(10.0f);
   s.settings.maxBounces = 2;
   NodeId floor = test::addMeshObject(s, "floor", makeQuad(), test::addMaterial(s, grey(0.5f)), Mat4::scale({1000, 1, 1000}));
-  Material sheet;
-  sheet.type = MaterialType::ThinSheet;
-  sheet.albedo = Vec3{1.0f};
-  sheet.ior = 1.5f;
-  sheet.coatingAbsorption = Vec3{a};
+  const Material sheet = thinSheet(Vec3{a});
   test::addMeshObject(s, "sheet", makeQuad(), test::addMaterial(s, sheet), Mat4::translate({0, 1, 0}) * Mat4::scale({1000, 1, 1000}));
   Light light;
   light.id = s.newId();
