@@ -51,6 +51,9 @@ TEST(Math, DecomposeAndComposeRoundTrip) {
     t.scale = {size(rng), size(rng), size(rng)};
     if (i % 7 == 0) t.scale.x = -t.scale.x;  // mirrored
     const Mat4 m = compose(t);
+    // The linear part's determinant is the scales' product: rotations keep volume and handedness.
+    const double volume = double(t.scale.x) * t.scale.y * t.scale.z;
+    EXPECT_NEAR(m.linearDeterminant(), volume, 1e-4 * std::abs(volume)) << i;
     const Trs back = decompose(m);
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(axis(back.translation, k), axis(t.translation, k), 1e-3f);

@@ -1084,6 +1084,18 @@ TEST(Tungsten, SpheresAndDisksKeepTheirTrueArea) {
   EXPECT_GT(checked, 4000);
 }
 
+// A disk's cone_angle narrows where Tungsten's disk emits; that is not rendered, so a narrower
+// cone than the hemisphere is said (and the default, or a wider one, changes nothing to say).
+TEST(Tungsten, ADisksNarrowConeIsSaid) {
+  for (const char* cone : {"", R"(, "cone_angle": 90)", R"(, "cone_angle": 120)", R"(, "cone_angle": 30)"}) {
+    auto r = importTungsten(writeScene(std::string(R"({"primitives": [{"type": "disk", "emission": 1)") + cone + "}]}"));
+    ASSERT_TRUE(r.ok()) << r.error();
+    EXPECT_EQ(r->scene.objects.size(), 1u);
+    const bool said = std::any_of(r->warnings.begin(), r->warnings.end(), [](const std::string& w) { return w.find("cone_angle 30") != std::string::npos; });
+    EXPECT_EQ(said, std::string(cone).find("30") != std::string::npos) << cone;
+  }
+}
+
 // Tungsten takes a mesh's and a quad's front from their winding in world space; ours is the
 // object's winding carried by the normal matrix. Under a mirroring transform the two differ
 // unless the importer winds the mirrored one the other way: for every triangle, our front

@@ -92,6 +92,9 @@ struct Mat4 {
   Vec3 translation() const { return {m[0][3], m[1][3], m[2][3]}; }
   Mat4 inverse() const;  // general inverse; a singular matrix yields all zeros
   Mat4 transposed() const;
+  // The determinant of the linear (upper 3x3) part, in double: negative where the transform
+  // mirrors (turns a winding and a handedness), zero where it flattens.
+  double linearDeterminant() const;
   // The rotation nearest in spirit to the linear part: its x, y and z columns made orthonormal
   // in that order (Gram-Schmidt), right-handed; identity when they are degenerate or not finite.
   Mat4 rotationPart() const;

@@ -161,13 +161,19 @@ Mat4 Mat4::inverse() const {
   return r;
 }
 
+double Mat4::linearDeterminant() const {
+  auto a = [&](int r, int c) { return static_cast<double>(m[r][c]); };
+  return a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) - a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0)) +
+         a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
+}
+
 Trs decompose(const Mat4& m) {
   Trs t;
   t.translation = m.translation();
   Vec3 col[3];
   for (int j = 0; j < 3; ++j) col[j] = Vec3{m.m[0][j], m.m[1][j], m.m[2][j]};
   t.scale = Vec3{length(col[0]), length(col[1]), length(col[2])};
-  if (dot(cross(col[0], col[1]), col[2]) < 0.0f) t.scale.x = -t.scale.x;  // mirrored
+  if (m.linearDeterminant() < 0) t.scale.x = -t.scale.x;  // mirrored
   float r[3][3];
   for (int j = 0; j < 3; ++j) {
     const float s = j == 0 ? t.scale.x : j == 1 ? t.scale.y : t.scale.z;

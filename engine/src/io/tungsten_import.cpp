@@ -1343,6 +1343,9 @@ class TungstenImporter {
       parts.push_back({0, meshNode(type, type, shape(type))});
     } else if (type == "disk") {
       xf = tungstenDiskFrame(xf, scale);
+      // Tungsten's disk then emits only within the cone about its normal (Disk::evalDirect).
+      if (float cone = 90; number(p, "cone_angle", &cone, where) && cone < 90)
+        warn(cat(where, ": cone_angle ", cone, " is not rendered; the disk emits into its whole hemisphere"));
       parts.push_back({0, meshNode(type, type, shape(type))});
     } else if (type == "sphere") {
       // Tungsten's sphere radius is the largest scale; the shape stays round.
@@ -1373,8 +1376,7 @@ class TungstenImporter {
     // mirroring transform turns the other way. So a mirrored one is wound the other way, and its
     // light shines, its glass is entered and its back faces are culled on Tungsten's side.
     // (Tungsten's other shapes face out, or along their transformed axis, as ours do.)
-    if ((type == "mesh" || type == "quad") && dot(cross(xf.transformVector({1, 0, 0}), xf.transformVector({0, 1, 0})),
-                                                  xf.transformVector({0, 0, 1})) < 0.0f)
+    if ((type == "mesh" || type == "quad") && xf.linearDeterminant() < 0)
       for (MeshPart& part : parts) part.mesh = mirroredMesh(part.mesh, type == "quad");
 
     // A bump map belongs to the primitive in Tungsten and to the material here (as emission

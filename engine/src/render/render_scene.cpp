@@ -383,15 +383,21 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
 }
 
 namespace {
-// Whether `m`, or a material it blends with (as the kernel follows the chain: fetchMaterial), is a
-// thin sheet.
-bool sheetInBlend(const Scene& scene, const Material& m) {
+// Calls `visit` on `m` and on each material it blends with, as the kernel follows the chain
+// (fetchMaterial): at most kMaxBlendChain, up to a missing one or one that blends with itself.
+template <class Visit>
+void forEachInBlend(const Scene& scene, const Material& m, Visit visit) {
   const Material* part = &m;
   for (int k = 0; part && k < kMaxBlendChain; ++k) {
-    if (part->type == MaterialType::ThinSheet) return true;
+    visit(*part);
     part = part->blendWith != kNoNode && part->blendWith != part->id ? scene.material(part->blendWith) : nullptr;
   }
-  return false;
+}
+
+bool sheetInBlend(const Scene& scene, const Material& m) {
+  bool sheet = false;
+  forEachInBlend(scene, m, [&](const Material& part) { sheet = sheet || part.type == MaterialType::ThinSheet; });
+  return sheet;
 }
 
 bool finite(const Mat4& t) {
@@ -403,10 +409,7 @@ bool finite(const Mat4& t) {
 // shines), with a finite affine inverse. Nothing for any other.
 std::optional<Mat4> packedInverse(const Mat4& t) {
   if (!finite(t) || t.m[3][0] != 0 || t.m[3][1] != 0 || t.m[3][2] != 0 || t.m[3][3] != 1) return std::nullopt;
-  auto m = [&](int r, int c) { return static_cast<double>(t.m[r][c]); };
-  const double det = m(0, 0) * (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1)) - m(0, 1) * (m(1, 0) * m(2, 2) - m(1, 2) * m(2, 0)) +
-                     m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0));
-  if (!(det > 0)) return std::nullopt;
+  if (!(t.linearDeterminant() > 0)) return std::nullopt;
   const Mat4 inv = t.inverse();
   if (!finite(inv) || inv.m[3][3] != 1) return std::nullopt;
   return inv;
@@ -986,7 +989,7 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   data_.instances.clear();
   data_.instanceObject.clear();
   data_.instancedTriangles = 0;
-  data_.alphaTested = data_.cutOuts = data_.sheetShadows = false;
+  data_.cutOuts = data_.sheetShadows = false;
   data_.cullBack = false;
   data_.instanceTransforms = transforms;
   std::vector<int> flagsOf(cands.size(), 0);
@@ -1002,9 +1005,9 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     if (mat && mat->emissive()) flags |= gpu::kInstanceEmissive;
     if (mat && mat->type == MaterialType::Boundary) flags |= gpu::kInstanceBoundary;
     if (c.object->cullBackFaces) flags |= gpu::kInstanceCullBack;
-    if (c.visible && (flags & gpu::kInstanceAlphaTested)) data_.alphaTested = data_.cutOuts = true;
+    if (c.visible && (flags & gpu::kInstanceAlphaTested)) data_.cutOuts = true;
     // A sheet's pause is the cut-outs' (RETILE_ALPHA_TEST).
-    if (c.visible && (flags & gpu::kInstanceSheet)) data_.alphaTested = data_.sheetShadows = true;
+    if (c.visible && (flags & gpu::kInstanceSheet)) data_.sheetShadows = true;
     if (c.visible && (flags & gpu::kInstanceCullBack)) data_.cullBack = true;
     flagsOf[i] = flags;
     inverseOf[i] = c.transform.inverse();
@@ -1219,12 +1222,10 @@ bool RenderSceneBuilder::lightInScatteringGlass(const Scene& scene) const {
     if (!mesh) continue;
     // Its blend chain, as the kernel follows it (fetchMaterial): glass throughout, or not.
     bool scatters = false, allGlass = true;
-    const Material* part = mat;
-    for (int k = 0; part && k < kMaxBlendChain; ++k) {
-      scatters = scatters || scatteringGlass(part);
-      allGlass = allGlass && isGlass(*part) && part->alpha >= 1 && part->alphaTexture == kNoNode;
-      part = part->blendWith != kNoNode && part->blendWith != part->id ? scene.material(part->blendWith) : nullptr;
-    }
+    forEachInBlend(scene, *mat, [&](const Material& part) {
+      scatters = scatters || scatteringGlass(&part);
+      allGlass = allGlass && isGlass(part) && part.alpha >= 1 && part.alphaTexture == kNoNode;
+    });
     if (scatters) {
       // Culled, its back faces let shadow rays out, and paths.
       if (!allGlass || o->cullBackFaces) return true;

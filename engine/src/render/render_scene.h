@@ -102,7 +102,8 @@ struct RenderSceneData {
   std::uint64_t instancedTriangles = 0;
   // Some visible instance pauses traversal on its candidate hits (RETILE_ALPHA_TEST): a cut-out
   // (cutOuts), every ray, or a thin sheet (sheetShadows), shadow rays.
-  bool alphaTested = false, cutOuts = false, sheetShadows = false;
+  bool cutOuts = false, sheetShadows = false;
+  bool alphaTested() const { return cutOuts || sheetShadows; }
   bool cullBack = false;               // some visible instance is hit from the front only
   std::uint32_t materialTypes = 0;     // bit kMat... of each material type present
   bool materialTextures = false;       // some material reads an albedo or roughness texture

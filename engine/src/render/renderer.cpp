@@ -202,7 +202,7 @@ struct Renderer::Impl {
       uploadArray(alias, d.emitterAlias, "emitter alias table");
       uploadArray(delta, d.deltaLights, "delta lights");
     }
-    selectTrace(d.alphaTested, d.materialTypes, d.features());
+    selectTrace(d.alphaTested(), d.materialTypes, d.features());
     bindAll();
   }
 
@@ -806,8 +806,8 @@ void Renderer::prepareMoves() {
   // A move gives an instance a transform, and then no reference is packed direct. An object
   // duplicated in place shares its mesh with the original: no transform, but not direct either.
   const auto direct = static_cast<std::uint32_t>(gpu::kFeatureDirectReferences);
-  impl_->traceVariant(d.alphaTested, d.materialTypes, (d.features() | static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms)) & ~direct);
-  if (d.features() & direct) impl_->traceVariant(d.alphaTested, d.materialTypes, d.features() & ~direct);
+  impl_->traceVariant(d.alphaTested(), d.materialTypes, (d.features() | static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms)) & ~direct);
+  if (d.features() & direct) impl_->traceVariant(d.alphaTested(), d.materialTypes, d.features() & ~direct);
 }
 
 std::size_t Renderer::kernelsCompiled() const { return impl_->traceVariants.size(); }
