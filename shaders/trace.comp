@@ -667,6 +667,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   bool frontFace = dot(ng, wo) > 0.0;
 
   bool emits = hasFeature(kFeatureEmitters) && (instFlags & kInstanceEmissive) != 0 && frontFace;
+  if (hasFeature(kFeatureEmissionCone) && emits) emits = dot(ng, wo) > emissionConeCos(floatBitsToInt(info.z));
   vec3 emitted = vec3(0.0);
   if (emits) {
     emitted = path.beta * m.emission;

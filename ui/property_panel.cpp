@@ -455,7 +455,12 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     float s = peak(cur->emission);
     Vec3 t = s > 0 ? cur->emission * (1.0f / s) : Vec3{1.0f};
     edit(tr("Emission"), drag, [t, v](Material& x) { x.emission = t * static_cast<float>(v); });
+    if ((s > 0) != (v > 0)) rebuildLater();  // the cone shows only while it emits
   });
+  if (m.emissive())
+    b.number(tr("Emission cone half angle"), "emissionCone", m.emissionCone, 0.0, 90.0, defaults.emissionCone, 1, [edit](double v, int drag) {
+      edit(tr("Emission cone"), drag, [v](Material& x) { x.emissionCone = static_cast<float>(v); });
+    })->setToolTip(tr("The half-angle about the normal within which the front emits: 90 lights the whole hemisphere, less makes a spot with a hard edge"));
   b.number(tr("Alpha"), "alpha", m.alpha, 0.0, 1.0, 1.0, 3, [edit](double v, int drag) {
     edit(tr("Alpha"), drag, [v](Material& x) { x.alpha = static_cast<float>(v); });
   });

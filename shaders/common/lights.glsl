@@ -140,6 +140,7 @@ LightSample sampleLight(vec3 p, vec3 u) {
     ls.dir = toL / d;
     float cosL = -dot(t4.xyz, ls.dir);
     if (cosL <= 0.0 || t0.w <= 0.0) return ls;  // emitters shine from their front only
+    if (hasFeature(kFeatureEmissionCone) && cosL <= emissionConeCos(instanceMaterial(floatBitsToInt(t1.w)))) return ls;
     ls.dist = d;
     ls.radiance = t3.rgb;
     if (hasFeature(kFeatureEmissionTextures) && floatBitsToInt(t4.w) >= 0)

@@ -207,8 +207,15 @@ float hitRandom(float rayRandom, int prim, uint salt) {
   return float(((h >> 22u) ^ h) >> 8) * (1.0 / 16777216.0);
 }
 
+// The index of an instance's material.
+int instanceMaterial(int instance) { return floatBitsToInt(texelFetch(uInstances, instance * kInstanceTexels + 3).z); }
+
+// The cosine of a material's emission cone (Material::emissionCone): its front emits toward
+// directions whose cosine with its normal is above it (0: the hemisphere).
+float emissionConeCos(int material) { return texelFetch(uMaterials, material * kMaterialTexels + 7).z; }
+
 bool alphaPasses(int instance, int prim, float u, float v, float rayRandom) {
-  int material = floatBitsToInt(texelFetch(uInstances, instance * kInstanceTexels + 3).z);
+  int material = instanceMaterial(instance);
   vec4 m1 = texelFetch(uMaterials, material * kMaterialTexels + 1);
   int alphaTex = floatBitsToInt(texelFetch(uMaterials, material * kMaterialTexels + 4).w);
   float alpha = m1.z;

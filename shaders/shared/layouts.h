@@ -110,7 +110,10 @@ RT_CONST(int, kFeatureTungstenEpsilon, 1048576)
 RT_CONST(float, kTungstenEpsilon, 5e-4)
 // Some visible object is hit from the front only (Object::cullBackFaces, kInstanceCullBack).
 RT_CONST(int, kFeatureCullBack, 2097152)
-RT_CONST(int, kFeatureAll, 4194303)
+// Some emitter emits into a cone narrower than its hemisphere (Material::emissionCone; the cosine
+// in its material's eighth texel, z).
+RT_CONST(int, kFeatureEmissionCone, 4194304)
+RT_CONST(int, kFeatureAll, 8388607)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceBoundary, 2)  // its material is a boundary (kMatBoundary), which shadow rays cross

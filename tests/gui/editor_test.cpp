@@ -474,6 +474,28 @@ TEST(Editor, AThinSheetTakesItsFilmThicknessFromItsPanel) {
   ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; })) << "the edit reached the engine";
 }
 
+// An emitter's panel shows its cone (and only an emitter's: the field comes and goes with its
+// emission); an edit reaches the material and the engine.
+TEST(Editor, AnEmittersConeIsEditedFromItsPanel) {
+  auto w = makeWindow();
+  NodeId lamp = objectNamed(w->scene(), "Area Light");
+  w->select(lamp);
+  const NodeId material = w->scene().object(lamp)->material;
+  auto* cone = w->findChild<ScrubField*>("emissionCone");
+  ASSERT_TRUE(cone);
+  cone->setValue(35);
+  EXPECT_FLOAT_EQ(w->scene().material(material)->emissionCone, 35.0f);
+  const std::uint64_t version = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; })) << "the edit reached the engine";
+  auto* emission = w->findChild<ScrubField*>("emission");
+  ASSERT_TRUE(emission);
+  emission->setValue(0);
+  ASSERT_TRUE(QTest::qWaitFor([&] { return w->findChild<ScrubField*>("emissionCone") == nullptr; }, 2000)) << "no emission, no cone";
+  w->findChild<ScrubField*>("emission")->setValue(5);
+  ASSERT_TRUE(QTest::qWaitFor([&] { return w->findChild<ScrubField*>("emissionCone") != nullptr; }, 2000));
+  EXPECT_FLOAT_EQ(w->scene().material(material)->emissionCone, 35.0f) << "the cone was kept meanwhile";
+}
+
 TEST(Editor, GlassTakesAScatteringMediumFromItsPanel) {
   auto w = makeWindow();
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");

@@ -1362,6 +1362,81 @@ TEST(KnownAnswer, ATexturedEmitterLightsAsItsLitPartAlone) {
   EXPECT_NEAR(textured, reference, 0.03 * reference);
 }
 
+// A 0.5 x 0.5 emitter 1 above a white floor, facing it, whose front emits into a cone of 30
+// degrees (Material::emissionCone), seen from just below it. Where every point of the emitter sees
+// the floor within the cone, the floor is lit as by the emitter with its whole hemisphere; where
+// none does, it is black, which holds only if both light samples and the rays that hit the
+// emitter keep to the cone (either alone leaves light there). Seen head on, the emitter shows its
+// radiance; from outside its cone, black. Edited to 90, it lights the far floor too.
+TEST(KnownAnswer, AnEmissionConeLightsOnlyWithinIt) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const int n = 32;
+  const float halfWidth = 1.5f, below = 0.9f;  // the floor seen from -1.5 to 1.5
+  Scene s = test::emptyScene(n, n);
+  s.settings.maxBounces = 1;
+  lookStraightDown(s, below, 2 * degrees(std::atan(halfWidth / below)));
+  NodeId floor = test::addMeshObject(s, "floor", makeQuad(), test::addMaterial(s, grey(1.0f)), Mat4::scale({100, 1, 100}));
+  Material lamp;
+  lamp.albedo = Vec3{0.0f};
+  lamp.emission = Vec3{4.0f};
+  lamp.emissionCone = 30;
+  const NodeId lampMaterial = test::addMaterial(s, lamp);
+  NodeId light = test::addMeshObject(s, "light", makeQuad(), lampMaterial, Mat4::translate({0, 1, 0}) * Mat4::rotateX(kPi) * Mat4::scale({0.5f, 1, 0.5f}));
+  RenderRequest req;
+  req.samplesPerPixel = 256;
+  req.seed = 3;
+  // The floor's mean over pixels nearer its centre than `inner`, and over those further than `outer`.
+  auto floorBy = [&](const RenderImage& img, float inner, float outer) {
+    double sums[2] = {0, 0};
+    int counts[2] = {0, 0};
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y * n + x);
+        if (img.objectId[i] != floor) continue;
+        const float fx = (2 * (x + 0.5f) / n - 1) * halfWidth, fz = (2 * (y + 0.5f) / n - 1) * halfWidth;
+        const float d = std::sqrt(fx * fx + fz * fz);
+        const int k = d < inner ? 0 : d > outer ? 1 : -1;
+        if (k < 0) continue;
+        sums[k] += img.color[i * 3 + 1];
+        ++counts[k];
+      }
+    EXPECT_GT(counts[0], 4);
+    EXPECT_GT(counts[1], 100);
+    return std::pair<double, double>{sums[0] / std::max(counts[0], 1), sums[1] / std::max(counts[1], 1)};
+  };
+  // Within 0.15 of the centre every point of the lamp is within 27 degrees; beyond 1.05, every
+  // one is beyond 32.
+  r->setScene(s);
+  const auto [coneNear, coneFar] = floorBy(r->render(req), 0.15f, 1.05f);
+  auto kernel = r->kernelFeatures();
+  EXPECT_NE(std::find(kernel.begin(), kernel.end(), "emission cones"), kernel.end());
+  s.material(lampMaterial)->emissionCone = 90;
+  r->updateScene(s, kUpdateMaterials);  // SetMaterial's, for a new cone
+  const auto [wideNear, wideFar] = floorBy(r->render(req), 0.15f, 1.05f);
+  kernel = r->kernelFeatures();
+  EXPECT_EQ(std::find(kernel.begin(), kernel.end(), "emission cones"), kernel.end()) << "compiled in only where a cone is narrower";
+  // About L A / (pi h^2) = 4 x 0.25 / pi under the lamp: 0.29 less its edges' cosines.
+  EXPECT_GT(wideNear, 0.25);
+  EXPECT_LT(wideNear, 0.32);
+  EXPECT_NEAR(coneNear, wideNear, 0.02 * wideNear);
+  EXPECT_GT(wideFar, 0.02);
+  EXPECT_EQ(coneFar, 0.0);
+
+  // The lamp itself, head on from below and from 66 degrees off its normal.
+  s.material(lampMaterial)->emissionCone = 30;
+  for (bool headOn : {true, false}) {
+    s.camera.position = headOn ? Vec3{0, 0.1f, 0} : Vec3{2, 0.1f, 0};
+    s.camera.target = {0, 1, 0};
+    s.camera.up = {0, 0, -1};
+    s.camera.verticalFov = radians(5.0f);
+    r->setScene(s);
+    int seen = 0;
+    const double mean = meanOver(r->render(req), light, &seen);
+    EXPECT_GT(seen, 10) << headOn;
+    EXPECT_NEAR(mean, headOn ? 4.0 : 0.0, 1e-3) << headOn;
+  }
+}
+
 TEST(KnownAnswer, InverseSquareFalloffOfASmallLight) {
   RETILE_RENDERER_OR_SKIP(r);
   NodeId plane;

@@ -1084,15 +1084,25 @@ TEST(Tungsten, SpheresAndDisksKeepTheirTrueArea) {
   EXPECT_GT(checked, 4000);
 }
 
-// A disk's cone_angle narrows where Tungsten's disk emits; that is not rendered, so a narrower
-// cone than the hemisphere is said (and the default, or a wider one, changes nothing to say).
-TEST(Tungsten, ADisksNarrowConeIsSaid) {
-  for (const char* cone : {"", R"(, "cone_angle": 90)", R"(, "cone_angle": 120)", R"(, "cone_angle": 30)"}) {
+// A disk's cone_angle narrows where Tungsten's disk emits (Disk::evalDirect): its emitter's
+// material takes it as its emission cone. Wider than the hemisphere is said and taken as 90.
+TEST(Tungsten, ADisksConeAngleIsItsEmissionCone) {
+  const std::pair<const char*, float> cases[] = {{"", 90}, {R"(, "cone_angle": 90)", 90}, {R"(, "cone_angle": 120)", 90}, {R"(, "cone_angle": 30)", 30}};
+  for (const auto& [cone, expected] : cases) {
     auto r = importTungsten(writeScene(std::string(R"({"primitives": [{"type": "disk", "emission": 1)") + cone + "}]}"));
     ASSERT_TRUE(r.ok()) << r.error();
-    EXPECT_EQ(r->scene.objects.size(), 1u);
-    const bool said = std::any_of(r->warnings.begin(), r->warnings.end(), [](const std::string& w) { return w.find("cone_angle 30") != std::string::npos; });
-    EXPECT_EQ(said, std::string(cone).find("30") != std::string::npos) << cone;
+    ASSERT_EQ(r->scene.objects.size(), 1u);
+    const Material* m = r->scene.material(r->scene.objects[0].material);
+    ASSERT_NE(m, nullptr);
+    EXPECT_EQ(m->emissionCone, expected) << cone;
+    const bool said = std::any_of(r->warnings.begin(), r->warnings.end(), [](const std::string& w) { return w.find("cone_angle 120") != std::string::npos; });
+    EXPECT_EQ(said, std::string(cone).find("120") != std::string::npos) << cone;
+    // The native format keeps it.
+    auto file = test::tempDir() / "cone.retile";
+    ASSERT_TRUE(saveNativeScene(r->scene, file).ok());
+    auto back = loadNativeScene(file);
+    ASSERT_TRUE(back.ok()) << back.error();
+    EXPECT_EQ(back->scene.material(back->scene.objects[0].material)->emissionCone, expected) << cone;
   }
 }
 

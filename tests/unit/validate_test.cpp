@@ -83,7 +83,10 @@ TEST(Validate, ValuesOutsideTheirRangesAreClampedOrReset) {
   m.ior = kNaN;
   m.alpha = 7;
   m.eta = {-1, 1, 1};
+  m.emissionCone = 200;
   addMeshObject(s, "Cube", makeCube(), m, Mat4{});
+  m.emissionCone = kNaN;
+  addMeshObject(s, "Cube 2", makeCube(), m, Mat4{});
   Light l;
   l.name = "Nowhere";
   l.position = {kNaN, 0, 0};
@@ -115,6 +118,9 @@ TEST(Validate, ValuesOutsideTheirRangesAreClampedOrReset) {
   EXPECT_EQ(r.ior, 1.5f);
   EXPECT_EQ(r.alpha, 1.0f);
   EXPECT_EQ(r.metal, "Cu");
+  EXPECT_EQ(r.emissionCone, 90.0f);
+  EXPECT_EQ(s.materials[1].emissionCone, 90.0f);
+  EXPECT_TRUE(mentions(warnings, "material 'Cube': emission cone was 200; now 90"));
   ASSERT_EQ(s.lights.size(), 2u);
   EXPECT_EQ(s.lights[0].name, "Spot");
   EXPECT_LE(s.lights[0].spotAngle, 1.5707964f);

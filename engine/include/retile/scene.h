@@ -198,6 +198,10 @@ struct Material {
   Vec3 k{3.9f, 2.45f, 2.14f};
   Vec3 emission{0.0f};             // radiance emitted from the front side
   NodeId emissionTexture = kNoNode;  // multiplies emission (glTF's emissiveTexture, Tungsten's textured emission)
+  // The half-angle, in degrees about the front's normal, of the cone the front emits into: 90 is
+  // the whole hemisphere; less, a spot with a hard edge (Tungsten's disk cone_angle). Seen from
+  // outside the cone the emitter is dark, and light samples from there find nothing.
+  float emissionCone = 90.0f;
   float alpha = 1.0f;              // coverage; < 1 or an alpha texture makes a cut-out
   NodeId alphaTexture = kNoNode;   // its alpha channel, else the mean of its channels
   // Tilts the shading normal by the slope of this texture's value (the mean of its channels), as

@@ -284,6 +284,7 @@ Value nativeSceneToJson(const Scene& s) {
     v.set("alpha_texture", m.alphaTexture);
     v.set("bump_texture", m.bumpTexture);
     v.set("emission_texture", m.emissionTexture);
+    if (m.emissionCone != 90) v.set("emission_cone", m.emissionCone);
     v.set("bump_strength", m.bumpStrength);
     v.set("blend_with", m.blendWith);
     v.set("blend_ratio", m.blendRatio);
@@ -534,6 +535,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.id("alpha_texture", &m.alphaTexture);
       r.id("bump_texture", &m.bumpTexture);
       r.id("emission_texture", &m.emissionTexture);
+      r.number("emission_cone", &m.emissionCone);
       r.number("bump_strength", &m.bumpStrength);
       r.id("blend_with", &m.blendWith);
       r.number("blend_ratio", &m.blendRatio);

@@ -1333,6 +1333,7 @@ class TungstenImporter {
     }
 
     std::vector<MeshPart> parts;  // one for every shape but a mesh with several material indices
+    float emissionCone = 90;      // Material::emissionCone, a disk's cone_angle
     Mat4 xf = transform(tv, where, &scale, type == "quad" || type == "disk");
     if (!ok()) return;
     const Value* bsdfs = p.find("bsdf");
@@ -1343,9 +1344,14 @@ class TungstenImporter {
       parts.push_back({0, meshNode(type, type, shape(type))});
     } else if (type == "disk") {
       xf = tungstenDiskFrame(xf, scale);
-      // Tungsten's disk then emits only within the cone about its normal (Disk::evalDirect).
-      if (float cone = 90; number(p, "cone_angle", &cone, where) && cone < 90)
-        warn(cat(where, ": cone_angle ", cone, " is not rendered; the disk emits into its whole hemisphere"));
+      // Tungsten's disk emits only within this cone about its normal (Disk::evalDirect), and its
+      // light samples outside it find nothing (Disk::sampleDirect). Wider than the hemisphere, its
+      // back would glow too, but only for paths that hit it: not rendered.
+      if (number(p, "cone_angle", &emissionCone, where) && emissionCone > 90) {
+        warn(cat(where, ": cone_angle ", emissionCone, " is wider than the hemisphere; only the front emits, as with 90"));
+        emissionCone = 90;
+      }
+      emissionCone = std::max(emissionCone, 0.0f);
       parts.push_back({0, meshNode(type, type, shape(type))});
     } else if (type == "sphere") {
       // Tungsten's sphere radius is the largest scale; the shape stays round.
@@ -1480,6 +1486,7 @@ class TungstenImporter {
         m.name = cat(mat.name.empty() ? std::string("emitter") : mat.name, " (", string(p, "name", cat("light ", ++emitters_)), ")");
         m.emission = max(emission, Vec3{0.0f});
         m.emissionTexture = emissionTexture;
+        m.emissionCone = emissionCone;
         s.materials.push_back(m);
         materialId = m.id;
       } else if (!mat.name.empty() && named_.count(mat.name) && named) {

@@ -33,13 +33,18 @@ using gpu::vec4;
 // A material as the shaders read it (kMaterialTexels texels: the first five, the seventh, the
 // eighth and the ninth unpacked by unpackMaterial in shaders/common/bsdf.glsl; the sixth, bump
 // map, emission texture and the material blended with, the seventh's w, the blend's ratio, the
-// eighth's x, the texture that scales it, and the tenth, the glass's scattering medium, read by
-// trace.comp; the eighth's y and the ninth hold the coat, or for glass its medium's absorption),
+// eighth's x, the texture that scales it, the eighth's z, the emission cone's cosine, and the
+// tenth, the glass's scattering medium, read by trace.comp; the eighth's y and the ninth hold the
+// coat, or for glass its medium's absorption),
 // with its textures' and blend partner's indices (-1: none). Roughness and IOR are clamped to
 // what the BSDF code can sample.
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture = -1, int roughnessTexture = -1,
                                                     int alphaTexture = -1, int bumpTexture = -1, int emissionTexture = -1,
                                                     int blendWith = -1, int blendRatioTexture = -1);
+
+// The cosine of Material::emissionCone, 0 for the hemisphere (or a cone that is not a number):
+// the front emits toward directions whose cosine with its normal is above it.
+float emissionConeCos(const Material& m);
 
 // How the trace kernel draws a sample's offset in its pixel for these settings: one of the
 // gpu::kFeatureFilter... bits (Tungsten draws its tent and Gaussian from a table of its own).
@@ -109,6 +114,7 @@ struct RenderSceneData {
   bool materialTextures = false;       // some material reads an albedo or roughness texture
   bool materialBump = false;           // some material has a bump map
   bool emissionTextures = false;       // some emissive material has an emission texture
+  bool emissionCones = false;          // some emissive material emits into a cone (Material::emissionCone)
   // How the packed bitmaps' texels are stored (layouts.h kFeatureByteTexels and on).
   bool byteTexels = false, halfTexels = false, srgbTexels = false;
   bool materialBlend = false;          // some material blends with another

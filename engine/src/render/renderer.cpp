@@ -842,6 +842,7 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   if (f & static_cast<std::uint32_t>(gpu::kFeatureTungstenRoulette)) out.push_back("Tungsten's roulette");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureTungstenEpsilon)) out.push_back("Tungsten's ray epsilon");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureCullBack)) out.push_back("back faces culled");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureEmissionCone)) out.push_back("emission cones");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureByteTexels)) out.push_back("8-bit texels");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureHalfTexels)) out.push_back("half-float texels");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureSrgbTexels)) out.push_back("sRGB texels");

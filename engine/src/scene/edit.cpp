@@ -32,7 +32,7 @@ std::string checkMaterial(const Scene& s, const Material& m) {
   if (!isFinite(m.albedo) || !isFinite(m.emission) || !isFinite(m.eta) || !isFinite(m.k) || !isFinite(m.coatingAbsorption) ||
       !isFinite(m.coatAbsorption) || !finite(m.coatIor) || !isFinite(m.interiorAbsorption) || !isFinite(m.interiorScattering) || !finite(m.interiorAnisotropy) || !finite(m.coatRoughness) ||
       !finite(m.roughness) || !finite(m.ior) || !finite(m.alpha) || !finite(m.bumpStrength) || !finite(m.blendRatio) ||
-      !finite(m.transmittance) || !finite(m.diffuseRatio) || !finite(m.filmThickness))
+      !finite(m.transmittance) || !finite(m.diffuseRatio) || !finite(m.filmThickness) || !finite(m.emissionCone))
     return cat("material '", m.name, "': a parameter is not a finite number");
   if (auto why = checkMedium(m.interiorAbsorption, m.interiorScattering, m.interiorAnisotropy); !why.empty())
     return cat("material '", m.name, "': ", why);
