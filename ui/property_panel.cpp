@@ -162,7 +162,13 @@ class PropertyPanel::Builder {
     // The builder lives only while the panel builds: the connections capture the panel.
     PropertyPanel* panel = p_;
     QObject::connect(f, &ScrubField::edited, f, [panel, apply](double v, bool scrubbing) { apply(v, scrubbing ? panel->drag_ : 0); });
-    QObject::connect(f, &ScrubField::scrubFinished, f, [panel] { ++panel->drag_; });
+    QObject::connect(f, &ScrubField::scrubFinished, f, [panel] {
+      ++panel->drag_;
+      if (panel->rebuildAfterScrub_) {
+        panel->rebuildAfterScrub_ = false;
+        panel->rebuildLater();
+      }
+    });
   }
 
  private:
@@ -200,7 +206,13 @@ void PropertyPanel::cancelPreview() {
   previewBefore_.reset();
 }
 
-void PropertyPanel::rebuildLater() {
+void PropertyPanel::rebuildLater(int drag) {
+  // Not while a field is scrubbed (drag > 0: its drag id), which the rebuild would delete under
+  // the mouse: when the scrub ends.
+  if (drag > 0) {
+    rebuildAfterScrub_ = true;
+    return;
+  }
   // Not from inside a field's signal: rebuilding deletes the field.
   if (rebuildQueued_) return;
   rebuildQueued_ = true;
@@ -363,7 +375,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       const Material* cur = scene_().material(id);
       const bool was = cur && cur->coated();
       edit(tr("Coat IOR"), drag, [v](Material& x) { x.coatIor = static_cast<float>(v); });
-      if (was != (v > 1.0)) rebuildLater();  // the coat's absorption shows only with a coat
+      if (was != (v > 1.0)) rebuildLater(drag);  // the coat's absorption shows only with a coat
     });
     if (m.coated()) {
       b.number(tr("Coat roughness"), "coatRoughness", m.coatRoughness, 0.0, 1.0, defaults.coatRoughness, 3, [edit](double v, int drag) {
@@ -400,7 +412,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       const Material* cur = scene_().material(id);
       const bool was = cur && cur->filmThickness > 0;
       edit(tr("Film thickness"), drag, [v](Material& x) { x.filmThickness = static_cast<float>(v); });
-      if (was != (v > 0)) rebuildLater();  // the interference's form shows only with a film
+      if (was != (v > 0)) rebuildLater(drag);  // the interference's form shows only with a film
     })->setToolTip(tr("Thin-film interference over a film this thick: colours that change with the angle, as on a soap bubble; 0 for none"));
   if (m.type == MaterialType::ThinSheet && m.filmThickness > 0)
     b.choice(tr("Interference"), "interferenceConvention", {tr("Physical"), tr("Tungsten")}, m.tungstenGlass ? 1 : 0,
@@ -448,6 +460,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     const Material* cur = scene_().material(id);
     float s = cur ? peak(cur->emission) : 0.0f;
     edit(tr("Emission colour"), drag, [c, s](Material& x) { x.emission = c * s; });
+    if (drag != kPreview && (s > 0) != (peak(c) * s > 0)) rebuildLater();  // black: no cone to show
   });
   b.number(tr("Emission"), "emission", strength, 0.0, 1e5, 0.0, 2, [this, id, edit](double v, int drag) {
     const Material* cur = scene_().material(id);
@@ -455,7 +468,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     float s = peak(cur->emission);
     Vec3 t = s > 0 ? cur->emission * (1.0f / s) : Vec3{1.0f};
     edit(tr("Emission"), drag, [t, v](Material& x) { x.emission = t * static_cast<float>(v); });
-    if ((s > 0) != (v > 0)) rebuildLater();  // the cone shows only while it emits
+    if ((s > 0) != (v > 0)) rebuildLater(drag);  // the cone shows only while it emits
   });
   if (m.emissive())
     b.number(tr("Emission cone half angle"), "emissionCone", m.emissionCone, 0.0, 90.0, defaults.emissionCone, 1, [edit](double v, int drag) {

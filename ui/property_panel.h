@@ -39,7 +39,9 @@ class PropertyPanel : public QScrollArea {
   // Rebuilds the editors from the document (after undo, redo or a structural change).
   void rebuild();
   // Once, after the current event: edits arriving in a burst (a drag) rebuild the panel once.
-  void rebuildLater();
+  // From a field's edit, pass its drag id: while the field is scrubbed, the rebuild waits for the
+  // scrub to end.
+  void rebuildLater(int drag = 0);
   // Whether `e` changes something the panel shows (its target, or an object's material).
   bool shows(const Edit& e) const;
   // The engine's render size and how it was chosen, shown beside the scene's own resolution.
@@ -87,6 +89,7 @@ class PropertyPanel : public QScrollArea {
   QFormLayout* form_ = nullptr;
   int drag_ = 1000000;  // drag ids of this panel: far from the viewport's
   bool rebuildQueued_ = false;
+  bool rebuildAfterScrub_ = false;  // a field asked for a rebuild while it was scrubbed
 };
 
 }  // namespace retile::ui

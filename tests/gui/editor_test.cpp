@@ -489,7 +489,13 @@ TEST(Editor, AnEmittersConeIsEditedFromItsPanel) {
   ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; })) << "the edit reached the engine";
   auto* emission = w->findChild<ScrubField*>("emission");
   ASSERT_TRUE(emission);
-  emission->setValue(0);
+  // Scrubbed down to 0: the panel is not rebuilt under the mouse (which would end the scrub),
+  // but once the scrub ends.
+  emit emission->edited(0.0, true);
+  QTest::qWait(50);
+  EXPECT_EQ(w->findChild<ScrubField*>("emission"), emission) << "still the field being scrubbed";
+  EXPECT_TRUE(w->findChild<ScrubField*>("emissionCone"));
+  emit emission->scrubFinished();
   ASSERT_TRUE(QTest::qWaitFor([&] { return w->findChild<ScrubField*>("emissionCone") == nullptr; }, 2000)) << "no emission, no cone";
   w->findChild<ScrubField*>("emission")->setValue(5);
   ASSERT_TRUE(QTest::qWaitFor([&] { return w->findChild<ScrubField*>("emissionCone") != nullptr; }, 2000));

@@ -606,6 +606,34 @@ TEST(RenderScene, ATexturedEmitterIsPickedByItsTexturesMean) {
   EXPECT_NEAR(pick[1], 0.1 / 1.1, 1e-4) << "the textured emitter has a tenth of the power";
 }
 
+// An emitter's cone is packed as its cosine where the kernel reads it (the material's eighth
+// texel, z), and compiles the cone in only while some emitter's cone is narrower than the
+// hemisphere: not for a cone on something that does not emit, nor once it is back at 90.
+TEST(RenderScene, AnEmissionConeIsPackedAsItsCosineAndCompiledInWhileNarrower) {
+  Scene s = test::emptyScene(8, 8);
+  Material lamp;
+  lamp.emission = Vec3{2.0f};
+  lamp.emissionCone = 60;
+  Material dark;
+  dark.emissionCone = 10;  // not an emitter: no cone to render
+  const NodeId lampId = test::addMaterial(s, lamp), darkId = test::addMaterial(s, dark);
+  test::addMeshObject(s, "lamp", makeQuad(), lampId, Mat4::identity());
+  test::addMeshObject(s, "dark", makeQuad(), darkId, Mat4::translate({3, 0, 0}));
+  const auto cone = static_cast<std::uint32_t>(gpu::kFeatureEmissionCone);
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  const auto cosineOf = [&](std::size_t material) { return builder.data().materials[material * gpu::kMaterialTexels + 7].z; };
+  EXPECT_NEAR(cosineOf(0), 0.5f, 1e-6f);
+  EXPECT_NE(builder.data().features() & cone, 0u);
+  s.material(lampId)->emissionCone = 90;
+  builder.update(s, kUpdateMaterials, nullptr);
+  EXPECT_EQ(cosineOf(0), 0.0f) << "the hemisphere";
+  EXPECT_EQ(builder.data().features() & cone, 0u) << "a narrow cone on a material that does not emit compiles nothing";
+  s.material(lampId)->emissionCone = std::numeric_limits<float>::quiet_NaN();
+  builder.update(s, kUpdateMaterials, nullptr);
+  EXPECT_EQ(cosineOf(0), 0.0f) << "not a number: the hemisphere";
+}
+
 // A roughness texture on a type without roughness (left there by a change of type, or written in
 // a native file) is not packed: the kernel would scale what the slot holds for it (a thin sheet's
 // film thickness) by the texture's mean. On a rough type it is.

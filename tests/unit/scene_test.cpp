@@ -152,6 +152,11 @@ TEST(Document, BadEditsAreRefusedAndChangeNothing) {
   EXPECT_FALSE(doc.apply(SetMaterial{blend}).ok()) << "not with itself";
   blend.blendWith = 424242;
   EXPECT_FALSE(doc.apply(SetMaterial{blend}).ok()) << "not with a material that does not exist";
+  for (float cone : {-10.0f, 91.0f, std::nanf("")}) {
+    Material m = doc.scene().materials[0];
+    m.emissionCone = cone;
+    EXPECT_FALSE(doc.apply(SetMaterial{m}).ok()) << cone;
+  }
   EXPECT_EQ(doc.version(), v0);
 }
 

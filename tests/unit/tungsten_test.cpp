@@ -1087,7 +1087,7 @@ TEST(Tungsten, SpheresAndDisksKeepTheirTrueArea) {
 // A disk's cone_angle narrows where Tungsten's disk emits (Disk::evalDirect): its emitter's
 // material takes it as its emission cone. Wider than the hemisphere is said and taken as 90.
 TEST(Tungsten, ADisksConeAngleIsItsEmissionCone) {
-  const std::pair<const char*, float> cases[] = {{"", 90}, {R"(, "cone_angle": 90)", 90}, {R"(, "cone_angle": 120)", 90}, {R"(, "cone_angle": 30)", 30}};
+  const std::pair<const char*, float> cases[] = {{"", 90}, {R"(, "cone_angle": 90)", 90}, {R"(, "cone_angle": 120)", 90}, {R"(, "cone_angle": 30)", 30}, {R"(, "cone_angle": -30)", 30}};
   for (const auto& [cone, expected] : cases) {
     auto r = importTungsten(writeScene(std::string(R"({"primitives": [{"type": "disk", "emission": 1)") + cone + "}]}"));
     ASSERT_TRUE(r.ok()) << r.error();

@@ -1347,11 +1347,11 @@ class TungstenImporter {
       // Tungsten's disk emits only within this cone about its normal (Disk::evalDirect), and its
       // light samples outside it find nothing (Disk::sampleDirect). Wider than the hemisphere, its
       // back would glow too, but only for paths that hit it: not rendered.
-      if (number(p, "cone_angle", &emissionCone, where) && emissionCone > 90) {
+      if (number(p, "cone_angle", &emissionCone, where) && std::abs(emissionCone) > 90) {
         warn(cat(where, ": cone_angle ", emissionCone, " is wider than the hemisphere; only the front emits, as with 90"));
         emissionCone = 90;
       }
-      emissionCone = std::max(emissionCone, 0.0f);
+      emissionCone = std::abs(emissionCone);  // Tungsten takes its cosine
       parts.push_back({0, meshNode(type, type, shape(type))});
     } else if (type == "sphere") {
       // Tungsten's sphere radius is the largest scale; the shape stays round.

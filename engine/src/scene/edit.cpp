@@ -36,6 +36,7 @@ std::string checkMaterial(const Scene& s, const Material& m) {
     return cat("material '", m.name, "': a parameter is not a finite number");
   if (auto why = checkMedium(m.interiorAbsorption, m.interiorScattering, m.interiorAnisotropy); !why.empty())
     return cat("material '", m.name, "': ", why);
+  if (m.emissionCone < 0 || m.emissionCone > 90) return cat("material '", m.name, "': its emission cone must be within 0..90 degrees");
   if (m.blendWith != kNoNode && (m.blendWith == m.id || !s.material(m.blendWith)))
     return cat("material '", m.name, "': it cannot blend with material ", m.blendWith);
   for (NodeId t : m.textures())
