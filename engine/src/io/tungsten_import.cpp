@@ -14,8 +14,10 @@
 
 #include "core/files.h"
 #include "core/json.h"
+#include "io/curve_reader.h"
 #include "retile/io.h"
 #include "retile/log.h"
+#include "scene/curves.h"
 #include "scene/primitives.h"
 
 namespace fs = std::filesystem;
@@ -65,6 +67,7 @@ class TungstenImporter {
         if (!ok()) break;
         m.id = s.newId();
         if (m.name.empty()) m.name = cat("bsdf ", i);
+        if (v.isObject() && string(v, "type") == "hair") hairBsdfs_.insert(m.name);
         named_[m.name] = m;
         s.materials.push_back(m);
       }
@@ -682,6 +685,8 @@ class TungstenImporter {
       m.transmittance = 0.5f;  // Tungsten's, which its files cannot change
     } else if (type == "forward") {
       m.type = MaterialType::Boundary;  // every ray passes; its primitive's int_medium fills it
+    } else if (type == "hair") {
+      hairFibre(v, where, m);
     } else {
       warn(cat(where, ": bsdf type '", type, "' is not supported; rendered as lambert with its albedo"));
       m.type = MaterialType::Lambert;
@@ -695,6 +700,32 @@ class TungstenImporter {
       m.coatingAbsorption = max(sigmaA * thickness, Vec3{0.0f});
     }
     return m;
+  }
+
+  // Tungsten's hair (HairBcsdf: d'Eon et al.'s far-field model of a rough dielectric fibre of
+  // index 1.55 with pigment inside, integrated over the fibre's width) is drawn as what that
+  // model describes: a rough glass fibre of the same index and roughness, filled with the
+  // pigment's absorption. Its sigma_a is per unit of the fibre's radius; interiorAbsorption holds
+  // it so until the curves that use it divide it by their radius (curvesHair). The scales' tilt
+  // (scale_angle) is left out.
+  void hairFibre(const Value& v, const std::string& where, Material& m) {
+    m.type = MaterialType::RoughDielectric;
+    m.ior = 1.55f;
+    m.albedo = Vec3{1.0f};
+    m.roughness = 0.1f;
+    number(v, "roughness", &m.roughness, where);
+    m.roughness = std::clamp(m.roughness, 0.0f, 1.0f);
+    float ratio = 0.5f, concentration = 0.25f;  // Tungsten's defaults
+    number(v, "melanin_ratio", &ratio, where);
+    number(v, "melanin_concentration", &concentration, where);
+    // Eumelanin's and pheomelanin's absorption (d'Eon et al. 2011, as Tungsten has them).
+    const Vec3 eumelanin{0.419f, 0.697f, 1.37f}, pheomelanin{0.187f, 0.4f, 1.05f};
+    Vec3 sigmaA = (eumelanin * (1 - ratio) + pheomelanin * ratio) * concentration;
+    vec3(v, "sigma_a", &sigmaA, where);
+    m.interiorAbsorption = isFinite(sigmaA) ? max(sigmaA, Vec3{0.0f}) : Vec3{0.0f};
+    if (hairWarned_.insert(where).second)
+      warn(cat(where, ": hair is drawn as a rough glass fibre (index 1.55, roughness ", m.roughness,
+               ") filled with its pigment, not by Tungsten's hair model; it converges more slowly and its scale tilt is left out"));
   }
 
   // Tungsten's rotYXZ: R = Ry(-ry) Rx(rx) Rz(rz), angles in degrees.
@@ -1070,6 +1101,88 @@ class TungstenImporter {
       if (const float len = length(sum[v]); len > 0 && std::isfinite(len)) g.normals[v] = sum[v] / len;
   }
 
+  // The tubes of a "curves" primitive's strands (scene/curves.h), as a mesh: its file (.hair or
+  // .fiber) with Tungsten's curve_thickness, curve_taper and subsample applied. `radius` gets the
+  // strands' mean radius in world units (Tungsten widens them by the transform's mean scale, as
+  // a uniform scale does here; under a scale that is not uniform the tubes are flattened where
+  // Tungsten's stay round). kNoNode when there is nothing to draw.
+  NodeId curves(const Value& p, const std::string& where, Vec3 scale, float* radius) {
+    const std::string f = string(p, "file");
+    if (f.empty()) {
+      warn(cat(where, ": curves without a \"file\"; skipped"));
+      return kNoNode;
+    }
+    auto path = resolveScenePath(base_, f);
+    if (!path) {
+      warn(cat(where, ": curve file '", f, "' not found; the primitive is skipped"));
+      return kNoNode;
+    }
+    float thickness = 0, subsample = 0;
+    const bool overridden = number(p, "curve_thickness", &thickness, where);
+    bool taper = false;
+    if (const Value* v = p.find("curve_taper"); v && v->isBool()) taper = v->asBool();
+    number(p, "subsample", &subsample, where);
+    if (const std::string mode = string(p, "mode", "half_cylinder"); mode == "ribbon")
+      warn(cat(where, ": ribbon curves are drawn as round tubes"));
+    std::vector<std::string> warnings;
+    Result<CurveSet> read = readCurves(*path, &warnings, options_);
+    for (auto& w : warnings) out_.warnings.push_back(w);
+    if (!read) {
+      warn(cat(where, ": ", read.error(), "; the primitive is skipped"));
+      return kNoNode;
+    }
+    CurveSet c = std::move(read.value());
+    if (overridden && !(thickness >= 0 && std::isfinite(thickness))) {
+      warn(cat(where, ": curve_thickness ", thickness, " is taken as 0.01"));
+      thickness = 0.01f;
+    }
+    applyCurveThickness(c, overridden ? &thickness : nullptr, taper);
+    if (subsample > 0) {
+      // Tungsten leaves each strand out with this probability (Curves::prepareForRender), drawn
+      // from its own random sequence: the same share is left out here, not the same strands.
+      CurveSet kept;
+      std::uint64_t state = 0x9e3779b97f4a7c15ull;
+      for (std::size_t i = 0; i < c.ends.size(); ++i) {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        if (static_cast<float>(state >> 40) / 16777216.0f < subsample) continue;
+        for (std::uint32_t n = i ? c.ends[i - 1] : 0; n < c.ends[i]; ++n) {
+          kept.positions.push_back(c.positions[n]);
+          kept.radii.push_back(c.radii[n]);
+        }
+        kept.ends.push_back(static_cast<std::uint32_t>(kept.positions.size()));
+      }
+      c = std::move(kept);
+    }
+    CurveTubeOptions tubeOptions;
+    tubeOptions.maxTriangles = std::min<std::uint64_t>(tubeOptions.maxTriangles, options_.maxTriangles);
+    CurveTubes tubes = makeCurveTubes(c, tubeOptions);
+    if (tubes.strandsKept == 0) {
+      warn(cat(where, ": '", f, "' has no strand of three nodes or more; the primitive is skipped"));
+      return kNoNode;
+    }
+    if (tubes.strandsKept < tubes.strandsUsable)
+      warn(cat(where, ": '", f, "' has ", c.pieceCount(), " spline pieces, more than ", tubeOptions.maxTriangles,
+               " triangles of tubes can draw; drawn with ", tubes.strandsKept, " of its ", tubes.strandsUsable, " strands"));
+    double sum = 0;
+    std::size_t nodes = 0;
+    for (std::size_t i = 0; i < c.ends.size(); ++i) {
+      const std::uint32_t start = i ? c.ends[i - 1] : 0;
+      if (c.ends[i] - start < 3) continue;
+      for (std::uint32_t n = start; n < c.ends[i]; ++n, ++nodes) sum += c.radii[n];
+    }
+    const float meanScale = (std::abs(scale.x) + std::abs(scale.y) + std::abs(scale.z)) / 3;
+    *radius = nodes ? static_cast<float>(sum / static_cast<double>(nodes)) * meanScale : 0.0f;
+    if (std::size_t dropped = sanitizeGeometry(tubes.geometry, nullptr); dropped)
+      warn(cat(where, ": ", dropped, " triangles of tubes with a position that is not finite were left out"));
+    if (tubes.geometry.indices.empty()) {
+      warn(cat(where, ": '", f, "' leaves no tube to draw; the primitive is skipped"));
+      return kNoNode;
+    }
+    // Each primitive its own mesh: the same file with other settings is other tubes.
+    return meshNode(cat("curves|", ++curvesMeshes_), fs::path(f).stem().string(),
+                    std::make_shared<MeshGeometry>(std::move(tubes.geometry)));
+  }
+
   // A mesh file's triangles that take the bsdf of one material index.
   struct MeshPart {
     std::int32_t material = 0;
@@ -1334,6 +1447,7 @@ class TungstenImporter {
 
     std::vector<MeshPart> parts;  // one for every shape but a mesh with several material indices
     float emissionCone = 90;      // Material::emissionCone, a disk's cone_angle
+    float fibreRadius = 0;        // curves: their mean radius in world units
     Mat4 xf = transform(tv, where, &scale, type == "quad" || type == "disk");
     if (!ok()) return;
     const Value* bsdfs = p.find("bsdf");
@@ -1367,6 +1481,10 @@ class TungstenImporter {
       if (const Value* c = p.find("capped"); c && c->isBool()) capped = c->asBool();
       std::string kind = capped ? "cylinder" : "open cylinder";
       parts.push_back({0, meshNode(kind, "cylinder", shape(kind))});
+    } else if (type == "curves") {
+      NodeId mesh = curves(p, where, scale, &fibreRadius);
+      if (mesh == kNoNode) return;
+      parts.push_back({0, mesh});
     } else {
       warn(cat(where, ": primitive type '", type, "' is not supported; skipped"));
       return;
@@ -1430,7 +1548,12 @@ class TungstenImporter {
       if (b) {
         mat = bsdf(*b, bsdfWhere, 0, emissive);
         if (!ok()) return;
+      } else if (type == "curves") {
+        hairFibre(json::Value(json::Object{}), bsdfWhere, mat);  // Tungsten's curves default to hair
       }
+      // A hair's absorption is per unit of its fibre's radius: each curves primitive gets its
+      // own copy, in world units.
+      const bool hair = type == "curves" && (!b || (b->isString() ? hairBsdfs_.count(b->asString()) > 0 : string(*b, "type") == "hair"));
       const bool named = b && b->isString();
       NodeId materialId = kNoNode;
       if (bumpTexture != kNoNode) {
@@ -1477,6 +1600,15 @@ class TungstenImporter {
           materialId = m.id;
           if (named) bumped_[key] = m.id;
         }
+      } else if (hair && !emissive) {
+        if (named) copied_.insert(mat.id);
+        Material m = mat;
+        m.id = s.newId();
+        const Mesh* tubes = s.mesh(part.mesh);
+        m.name = cat(mat.name.empty() ? std::string("hair") : mat.name, " (", string(p, "name", tubes ? tubes->name : where), ")");
+        m.interiorAbsorption = fibreRadius > 0 ? mat.interiorAbsorption / fibreRadius : Vec3{0.0f};
+        s.materials.push_back(m);
+        materialId = m.id;
       } else if (emissive) {
         // Emission belongs to the primitive in Tungsten and to the material here: give each
         // emitter its own copy of its bsdf.
@@ -1529,6 +1661,9 @@ class TungstenImporter {
   std::map<std::string, std::vector<MeshPart>> meshParts_;  // a mesh file's parts, by loadMesh's key
   std::map<std::string, std::shared_ptr<const MeshGeometry>> shapes_;
   int emitters_ = 0;
+  int curvesMeshes_ = 0;
+  std::set<std::string> hairBsdfs_;   // the names of the file's hair bsdfs
+  std::set<std::string> hairWarned_;  // where a hair bsdf was warned of
   std::set<NodeId> copied_;  // named bsdfs some primitive took a copy of (dropReplacedBsdfs)
   // (bsdf, bump texture, strength, medium) -> its copy
   std::map<std::tuple<std::string, NodeId, float, std::string>, NodeId> bumped_;
