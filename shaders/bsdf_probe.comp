@@ -8,7 +8,8 @@
 
 layout(local_size_x = 64) in;
 
-// Per query: the material's kMaterialTexels texels, then wo, wi and the sample's random numbers.
+// Per query: the material's kMaterialTexels texels, then wo (and in w a hair's h), wi and the
+// sample's random numbers.
 layout(set = 0, binding = 0, std430) readonly buffer Queries { vec4 queries[]; };
 // Per query: eval(wo, wi) (f * |cos wi|, pdf); the sample's wi and pdf; its weight and flags
 // (1: delta, 2: transmitted); eval at the sampled wi (f * |cos|, pdf).
@@ -26,6 +27,7 @@ void main() {
                               queries[base + 6u], queries[base + 7u], queries[base + 8u]);
   uint at = base + uint(kMaterialTexels);
   vec3 wo = queries[at].xyz, wi = queries[at + 1u].xyz, u = queries[at + 2u].xyz;
+  m.hairH = queries[at].w;  // the fibre runs along x (unpackMaterial)
   float pdf;
   vec3 f = bsdfEval(m, wo, wi, pdf);
   BsdfSample s = bsdfSample(m, wo, u);

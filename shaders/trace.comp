@@ -136,9 +136,9 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
   }
   int base = shaded * kMaterialTexels;
   vec4 t2 = texelFetch(uMaterials, base + 2), t3 = texelFetch(uMaterials, base + 3);
-  // The coating's absorption (a plastic's, or a thin sheet's) is read only when the scene has
-  // either.
-  const bool plastics = (kMaterialMask & ((1 << kMatPlastic) | (1 << kMatRoughPlastic) | (1 << kMatThinSheet))) != 0;
+  // The coating's absorption (a plastic's, a thin sheet's, a hair's pigment) is read only when
+  // the scene has one of them.
+  const bool plastics = (kMaterialMask & ((1 << kMatPlastic) | (1 << kMatRoughPlastic) | (1 << kMatThinSheet) | (1 << kMatHair))) != 0;
   Material m = unpackMaterial(texelFetch(uMaterials, base), texelFetch(uMaterials, base + 1), t2, t3,
                               texelFetch(uMaterials, base + 4), plastics ? texelFetch(uMaterials, base + 6) : vec4(0.0),
                               kCoatUsed ? texelFetch(uMaterials, base + 7) : vec4(0.0),
@@ -339,16 +339,26 @@ vec3 bumpNormal(vec3 ns, vec3 q1, vec3 q2, vec2 duv1, vec2 duv2, vec2 slope) {
 // The shading normal ns tilted by material `material`'s bump map, if it has one, at uv on the
 // triangle of object-space edges e1, e2 and shading texels s0..s3, in the instance whose
 // world-to-object rows are r0..r2.
+// The triangle's object-space edges e1, e2 in world space (q1, q2), through the inverse of the
+// instance's world-to-object rows r0..r2 (by cofactors), and theirs in uv (shading texels s0..s3).
+void worldEdges(vec4 r0, vec4 r1, vec4 r2, vec3 e1, vec3 e2, vec4 s0, vec4 s1, vec4 s2, vec4 s3, out vec3 q1, out vec3 q2,
+                out vec2 duv1, out vec2 duv2) {
+  vec3 c0 = cross(r1.xyz, r2.xyz), c1 = cross(r2.xyz, r0.xyz), c2 = cross(r0.xyz, r1.xyz);
+  float det = dot(r0.xyz, c0);
+  q1 = (c0 * e1.x + c1 * e1.y + c2 * e1.z) / det;
+  q2 = (c0 * e2.x + c1 * e2.y + c2 * e2.z) / det;
+  duv1 = vec2(s2.w, s3.x) - vec2(s0.w, s1.w);
+  duv2 = s3.yz - vec2(s0.w, s1.w);
+}
+
 vec3 bumped(vec3 ns, int material, vec4 r0, vec4 r1, vec4 r2, vec3 e1, vec3 e2, vec4 s0, vec4 s1, vec4 s2, vec4 s3, vec2 uv) {
   if (!hasFeature(kFeatureBump)) return ns;
   vec4 bump = texelFetch(uMaterials, material * kMaterialTexels + 5);
   int bumpTex = floatBitsToInt(bump.x);
   if (bumpTex < 0) return ns;
-  // The triangle's edges in world space: the world-to-object rows' inverse, by cofactors.
-  vec3 c0 = cross(r1.xyz, r2.xyz), c1 = cross(r2.xyz, r0.xyz), c2 = cross(r0.xyz, r1.xyz);
-  float det = dot(r0.xyz, c0);
-  vec3 q1 = (c0 * e1.x + c1 * e1.y + c2 * e1.z) / det, q2 = (c0 * e2.x + c1 * e2.y + c2 * e2.z) / det;
-  vec2 duv1 = vec2(s2.w, s3.x) - vec2(s0.w, s1.w), duv2 = s3.yz - vec2(s0.w, s1.w);
+  vec3 q1, q2;
+  vec2 duv1, duv2;
+  worldEdges(r0, r1, r2, e1, e2, s0, s1, s2, s3, q1, q2, duv1, duv2);
   return bumpNormal(ns, q1, q2, duv1, duv2, bump.y * textureSlope(bumpTex, uv));
 }
 
@@ -732,6 +742,19 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
     woL = toLocal(wo, t, b, nss);
   }
 
+  if (isMat(m.type, kMatHair)) {
+    // The fibre runs along the surface's u, as strands' tubes have it (scene/curves.h): dp/du,
+    // from the root towards the tip, which the scales' tilt leans by. Where light meets it
+    // across its width is drawn here, once for the light sample and the path's next direction.
+    vec3 q1, q2;
+    vec2 duv1, duv2;
+    worldEdges(r0, r1, r2, e1, e2, s0, s1, s2, s3, q1, q2, duv1, duv2);
+    float d = duv1.x * duv2.y - duv2.x * duv1.y;
+    vec3 along = toLocal((q1 * duv2.y - q2 * duv1.y) * (d < 0.0 ? -1.0 : 1.0), t, b, nss);
+    m.hairT = dot(along, along) > 0.0 ? normalize(along) : vec3(1.0, 0.0, 0.0);
+    m.hairH = 2.0 * rand(path.rng) - 1.0;
+  }
+
   // Next-event estimation with multiple importance sampling.
   if (!isDeltaMaterial(m) && (frame.lightPick.x + frame.lightPick.y + frame.lightPick.z) > 0.0) {
     vec3 lu = vec3(rand(path.rng), rand(path.rng), rand(path.rng));
@@ -770,7 +793,10 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   // viewer's side, not the normal's: inside glass it is the back (comparing with the normal
   // alone ended every path leaving glass, and every reflection inside it: black glass).
   // Tungsten's convention has no such check (its enable_consistency_checks is off by default).
-  if (!tungstenShading && (bs.transmitted ? sideI * sideO >= 0.0 : sideI * sideO <= 0.0)) return endPath(path, shadow);
+  // A fibre scatters to every side of its surface: the tube's far side, culled, lets the path
+  // through (Material::Hair).
+  if (!tungstenShading && !isMat(m.type, kMatHair) && (bs.transmitted ? sideI * sideO >= 0.0 : sideI * sideO <= 0.0))
+    return endPath(path, shadow);
   path.beta *= bs.weight;
 #if RETILE_SHEET
   if (bs.transmitted && isMat(m.type, kMatThinSheet)) {

@@ -80,8 +80,8 @@ class PropertyPanel::Builder {
   }
 
   // Three fields labelled X, Y, Z, or R, G, B for a quantity per colour channel.
-  void vec3(const QString& name, const QString& objectName, Vec3 value, double step, std::function<void(int, double, int)> apply,
-            bool perChannel = false) {
+  QWidget* vec3(const QString& name, const QString& objectName, Vec3 value, double step, std::function<void(int, double, int)> apply,
+                bool perChannel = false) {
     auto* row = new QWidget(p_->body_);
     auto* l = new QHBoxLayout(row);
     l->setContentsMargins(0, 0, 0, 0);
@@ -105,6 +105,7 @@ class PropertyPanel::Builder {
       l->addWidget(f, 1);
     }
     form_->addRow(name, row);
+    return row;
   }
 
   ColorField* color(const QString& name, const QString& objectName, Vec3 value, Vec3 def, std::function<void(Vec3, int)> apply) {
@@ -323,7 +324,8 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     edit(tr("Material type"), 0, [i](Material& x) { x.type = static_cast<MaterialType>(i); });
     rebuildLater();  // the type decides which fields apply
   });
-  if (m.type != MaterialType::Boundary)
+  // A boundary has no surface, and hair's colour is its pigment's absorption.
+  if (m.type != MaterialType::Boundary && m.type != MaterialType::Hair)
     b.color(tr("Albedo"), "albedo", m.albedo, defaults.albedo, [edit](Vec3 c, int drag) {
       edit(tr("Albedo"), drag, [c](Material& x) { x.albedo = c; });
     });
@@ -402,11 +404,22 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   if (isGlassType(m.type))
     b.choice(tr("Glass"), "glassConvention", {tr("Physical"), tr("Tungsten")}, m.tungstenGlass ? 1 : 0,
              [edit](int i) { edit(tr("Glass"), 0, [i](Material& x) { x.tungstenGlass = i == 1; }); });
-  if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic || m.type == MaterialType::ThinSheet)
-    b.vec3(m.type == MaterialType::ThinSheet ? tr("Absorption") : tr("Coating absorption"), "coatingAbsorption", m.coatingAbsorption, 0.01, [edit](int channel, double v, int drag) {
-      edit(tr("Coating absorption"), drag,
-           [channel, v](Material& x) { axisOf(x.coatingAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
+  if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic || m.type == MaterialType::ThinSheet ||
+      m.type == MaterialType::Hair) {
+    const QString label = m.type == MaterialType::ThinSheet ? tr("Absorption")
+                          : m.type == MaterialType::Hair     ? tr("Pigment absorption")
+                                                             : tr("Coating absorption");
+    QWidget* w = b.vec3(label, "coatingAbsorption", m.coatingAbsorption, 0.01, [edit, label](int channel, double v, int drag) {
+      edit(label, drag, [channel, v](Material& x) { axisOf(x.coatingAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
     }, true);
+    if (m.type == MaterialType::Hair)
+      w->setToolTip(tr("Per unit of the fibre's radius. Eumelanin (brown to black) absorbs about 0.42, 0.70, 1.37 per unit of "
+                       "concentration, pheomelanin (red to blond) 0.19, 0.40, 1.05"));
+  }
+  if (m.type == MaterialType::Hair)
+    b.number(tr("Scale tilt (degrees)"), "hairTilt", m.hairTilt, -45.0, 45.0, defaults.hairTilt, 1, [edit](double v, int drag) {
+      edit(tr("Scale tilt"), drag, [v](Material& x) { x.hairTilt = static_cast<float>(v); });
+    })->setToolTip(tr("How far the cuticle's scales lean the highlights along the fibre: the white one towards the tip, the coloured one back"));
   if (m.type == MaterialType::ThinSheet)
     b.number(tr("Film thickness (nm)"), "filmThickness", m.filmThickness, 0.0, 5000.0, defaults.filmThickness, 1, [this, id, edit](double v, int drag) {
       const Material* cur = scene_().material(id);
@@ -442,6 +455,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
                            Slot{"Bump texture", "bumpTexture", &Material::bumpTexture},
                            Slot{"Emission texture", "emissionTexture", &Material::emissionTexture}}) {
     if (slot.field == &Material::roughnessTexture && !rough) continue;
+    if (slot.field == &Material::albedoTexture && m.type == MaterialType::Hair) continue;
     auto field = slot.field;
     b.nodeChoice(tr(slot.label), slot.name, scene_().textures, m.*field, [this, edit, field](NodeId t) {
       edit(tr("Assign texture"), 0, [t, field](Material& x) { x.*field = t; });

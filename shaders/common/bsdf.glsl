@@ -12,7 +12,7 @@
 // alone: lavapipe runs every branch some lane of eight takes, and code for absent types still
 // costs registers and spills (removing the nine unused types speeds the Cornell box up by 9 %).
 #ifndef RETILE_MATERIALS
-#define RETILE_MATERIALS 0x3ffff
+#define RETILE_MATERIALS 0x7ffff
 #endif
 const int kMaterialMask = RETILE_MATERIALS;
 bool isMat(int t, int k) { return (kMaterialMask & (1 << k)) != 0 && t == k; }
@@ -24,11 +24,11 @@ const bool kBeckmannUsed = (kMaterialMask & (1 << kMaskBeckmann)) != 0;
 const bool kCoatUsed = (kMaterialMask & (1 << kMaskCoat)) != 0;
 const bool kMediumUsed = (kMaterialMask & (1 << kMaskMedium)) != 0;
 const bool kScatteringUsed = (kMaterialMask & (1 << kMaskScattering)) != 0;
-// The same for the preprocessor (bit 16 is kMaskMedium): the path's medium (trace.comp) is not
+// The same for the preprocessor (bit 17 is kMaskMedium): the path's medium (trace.comp) is not
 // even declared without one, so that a scene without filled glass carries no dead field. (What
 // the field cost was within the machine's noise: docs/MEASUREMENTS.md, twenty-second session.)
 // Likewise bit 13, kMatBoundary: only then do shadow rays pass surfaces (scene.glsl traceStep).
-#define RETILE_MEDIUM ((RETILE_MATERIALS & 65536) != 0)
+#define RETILE_MEDIUM ((RETILE_MATERIALS & 131072) != 0)
 #define RETILE_BOUNDARY ((RETILE_MATERIALS & 8192) != 0)
 // And bit 9, kMatThinSheet: shadow rays pass thin sheets, dimmed (trace.comp sheetPasses).
 #define RETILE_SHEET ((RETILE_MATERIALS & 512) != 0)
@@ -54,6 +54,10 @@ struct Material {
   vec3 interior;        // glass: its medium's absorption per unit of length
   vec4 scattering;      // glass: its medium's scattering per unit of length, and in w the phase
                         // function's asymmetry g (read by trace.comp, not by the BSDF)
+  // Hair: the fibre's direction in the shading frame, and where across its width the light
+  // meets it (h in -1..1, drawn afresh at each hit: see hairEval). Set by the caller.
+  vec3 hairT;
+  float hairH;
 };
 
 // The material's texels as render/render_scene.cpp packMaterial writes them, textures not applied.
@@ -77,6 +81,8 @@ Material unpackMaterial(vec4 t0, vec4 t1, vec4 t2, vec4 t3, vec4 t4, vec4 t6, ve
   m.coatRoughness = t8.w;
   m.interior = kMediumUsed ? t8.rgb : vec3(0.0);
   m.scattering = vec4(0.0);
+  m.hairT = vec3(1.0, 0.0, 0.0);
+  m.hairH = 0.0;
   return m;
 }
 
@@ -112,7 +118,7 @@ bool isDeltaMaterial(Material m) { return isDeltaBase(m) && !(kCoatUsed && m.coa
 
 bool isTransmissive(Material m) {
   return isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric) || isMat(m.type, kMatThinSheet) ||
-         isMat(m.type, kMatDiffuseTransmission);
+         isMat(m.type, kMatDiffuseTransmission) || isMat(m.type, kMatHair);
 }
 
 // The reflectances of the two polarisations (s, p) at a dielectric boundary; eta = n_transmitted /
@@ -317,6 +323,159 @@ MicrofacetTerms microfacetTerms(Material m, vec3 o, vec3 i, vec3 h, float a) {
 
 // f * |cos(wi)| and the pdf sample() would have for wi. Zero for delta lobes.
 //
+// Hair, as Tungsten's HairBcsdf has it (d'Eon et al. 2011, "An Energy-Conserving Hair
+// Reflectance Model", with the lobe shifts of Ou et al. 2012). Angles are about the fibre: theta
+// from the plane normal to it (sin theta = the direction's component along it), phi around it,
+// from wo. Lobe p (0: R, 1: TT, 2: TRT) is M_p(theta_i) A_p N_p(phi): M_p d'Eon's longitudinal
+// cone of variance v_p about the mirror of theta_o shifted by the scales' tilt, A_p what Fresnel
+// and the pigment leave of it, N_p a wrapped Gaussian of deviation beta_R about the azimuth
+// Phi_p that a ray meeting the fibre at h leaves by. Tungsten integrates A_p N_p over h into a
+// table; here h is the one drawn for the hit (m.hairH, uniform), which averages to the same, and
+// NEE and sampling at the hit share it, so their weights stay exact. As Tungsten's, eval is f
+// times the cosine (it integrates to the energy kept), and lobes past TRT are left out.
+const float kHairEta = 1.55;
+
+float hairI0(float x) {
+  float sum = 1.0, x2 = x * x, term = x2, denom = 4.0;
+  for (int i = 1; i <= 10; ++i) {
+    sum += term / denom;
+    term *= x2;
+    denom *= 4.0 * float((i + 1) * (i + 1));
+  }
+  return sum;
+}
+
+// d'Eon's longitudinal lobe of variance v for the angles a (theta_o shifted) and b (theta_i);
+// below v = 0.1 through logarithms, where I0 and sinh overflow.
+float hairM(float v, float sinA, float sinB, float cosA, float cosB) {
+  float a = cosA * cosB / v, b = sinA * sinB / v;
+  if (v < 0.1) {
+    float logI0 = a > 12.0 ? a + 0.5 * (log(1.0 / (2.0 * PI * a)) + 1.0 / (8.0 * a)) : log(hairI0(a));
+    return exp(-b + logI0 - 1.0 / v + 0.6931 + log(1.0 / (2.0 * v)));
+  }
+  return exp(-b) * hairI0(a) / (2.0 * v * sinh(1.0 / v));
+}
+
+// An angle taken into -pi..pi.
+float hairWrap(float phi) { return phi - 2.0 * PI * floor((phi + PI) / (2.0 * PI)); }
+
+// The wrapped Gaussian of deviation beta (Tungsten's "detector" D); beta is at most pi / 2, so
+// the neighbouring turns are all that count.
+float hairD(float beta, float phi) {
+  float x = hairWrap(phi), k = 1.0 / (sqrt(2.0 * PI) * beta), s = -0.5 / (beta * beta);
+  return k * (exp(s * x * x) + exp(s * (x - 2.0 * PI) * (x - 2.0 * PI)) + exp(s * (x + 2.0 * PI) * (x + 2.0 * PI)));
+}
+
+// Azimuths are drawn from a logistic trimmed to -pi..pi of the Gaussian's variance (its tails
+// are heavier, so the weights stay bounded); its density and its inverse.
+float hairLogisticScale(float beta) { return beta * (sqrt(3.0) / PI); }
+float hairLogisticCdf(float x, float s) { return 1.0 / (1.0 + exp(-x / s)); }
+float hairLogisticPdf(float x, float s) {
+  float e = exp(-abs(x) / s);
+  return e / (s * (1.0 + e) * (1.0 + e)) / (hairLogisticCdf(PI, s) - hairLogisticCdf(-PI, s));
+}
+float hairLogisticSample(float u, float s) {
+  float lo = hairLogisticCdf(-PI, s), hi = hairLogisticCdf(PI, s);
+  float c = clamp(lo + u * (hi - lo), 1e-7, 1.0 - 1e-7);
+  return clamp(-s * log(1.0 / c - 1.0), -PI, PI);
+}
+
+// The fibre's frame seen from wo: T along it, z wo's part across it, x = T x z.
+void hairFrame(Material m, vec3 wo, out vec3 T, out vec3 z, out vec3 x) {
+  T = m.hairT;
+  z = wo - T * dot(wo, T);
+  float len = length(z);
+  if (len < 1e-6) {
+    vec3 b;
+    makeFrame(T, z, b);
+  } else {
+    z /= len;
+  }
+  x = cross(T, z);
+}
+
+// What of lobes R, TT and TRT the fibre gives at h, for the half difference angle's cosine cosD.
+vec3 hairAttenuation(Material m, float cosD, float h, int p) {
+  float sin2D = 1.0 - cosD * cosD;
+  float cosT = sqrt(max(1.0 - sin2D / (kHairEta * kHairEta), 0.0));
+  float etaPrime = sqrt(max(kHairEta * kHairEta - sin2D, 0.0)) / max(cosD, 1e-4);
+  float gammaI = asin(clamp(h, -1.0, 1.0)), gammaT = asin(clamp(h / etaPrime, -1.0, 1.0));
+  float f = fresnelDielectric(cosD * cos(gammaI), kHairEta);
+  vec3 through = exp(-m.coating / max(cosT, 1e-4) * (2.0 * cos(gammaT)));
+  if (p == 0) return vec3(f);
+  vec3 a = (1.0 - f) * (1.0 - f) * through;
+  return p == 1 ? a : a * f * through;
+}
+
+// The azimuth lobe p leaves by, for a ray meeting the fibre at h.
+float hairPhi(float cosD, float h, int p) {
+  float sin2D = 1.0 - cosD * cosD;
+  float etaPrime = sqrt(max(kHairEta * kHairEta - sin2D, 0.0)) / max(cosD, 1e-4);
+  float gammaI = asin(clamp(h, -1.0, 1.0)), gammaT = asin(clamp(h / etaPrime, -1.0, 1.0));
+  return 2.0 * float(p) * gammaT - 2.0 * gammaI + float(p) * PI;
+}
+
+// The lobes' shares of the samples: their attenuations for theta_i the mirror of theta_o (as
+// Tungsten weighs them), whatever wi is drawn, so that the pdf can be evaluated for any wi.
+vec3 hairLobeWeights(Material m, float cosO, float h) {
+  vec3 w = vec3(luminance(hairAttenuation(m, cosO, h, 0)), luminance(hairAttenuation(m, cosO, h, 1)),
+                luminance(hairAttenuation(m, cosO, h, 2)));
+  float sum = w.x + w.y + w.z;
+  return sum > 0.0 ? w / sum : vec3(1.0, 0.0, 0.0);
+}
+
+vec3 hairEval(Material m, vec3 wo, vec3 wi, out float pdf) {
+  vec3 T, z, x;
+  hairFrame(m, wo, T, z, x);
+  float sinO = clamp(dot(wo, T), -1.0, 1.0), sinI = clamp(dot(wi, T), -1.0, 1.0);
+  float cosO = sqrt(1.0 - sinO * sinO), cosI = sqrt(1.0 - sinI * sinI);
+  float thetaO = asin(sinO), thetaI = asin(sinI);
+  float cosD = cos(0.5 * (thetaI - thetaO));
+  float phi = atan(dot(wi, x), dot(wi, z));
+  float tilt = m.eta.x;
+  float betaR = max(0.5 * PI * m.roughness, 0.04);
+  float v[3] = float[3](betaR * betaR, 0.25 * betaR * betaR, 4.0 * betaR * betaR);
+  float shift[3] = float[3](-2.0 * tilt, tilt, 4.0 * tilt);
+  vec3 weights = hairLobeWeights(m, cosO, m.hairH);
+  float s = hairLogisticScale(betaR);
+  vec3 f = vec3(0.0);
+  pdf = 0.0;
+  for (int p = 0; p < 3; ++p) {
+    float t = thetaO + shift[p];
+    float M = hairM(v[p], sin(t), sinI, cos(t), cosI);
+    float dphi = phi - hairPhi(cosD, m.hairH, p);
+    f += M * hairAttenuation(m, cosD, m.hairH, p) * hairD(betaR, dphi);
+    pdf += weights[p] * M * hairLogisticPdf(hairWrap(dphi), s);
+  }
+  return f;
+}
+
+// A direction drawn for hairEval's pdf: a lobe by hairLobeWeights, theta_i from its cone, phi
+// about its azimuth. (baseSample weighs it by hairEval.)
+vec3 hairSample(Material m, vec3 wo, vec3 u) {
+  vec3 T, z, x;
+  hairFrame(m, wo, T, z, x);
+  float sinO = clamp(dot(wo, T), -1.0, 1.0), cosO = sqrt(1.0 - sinO * sinO);
+  float thetaO = asin(sinO);
+  float tilt = m.eta.x;
+  float betaR = max(0.5 * PI * m.roughness, 0.04);
+  vec3 weights = hairLobeWeights(m, cosO, m.hairH);
+  int p = u.z < weights.x ? 0 : (u.z < weights.x + weights.y ? 1 : 2);
+  // What is left of u.z within the lobe's share is uniform again: the azimuth's.
+  float lo = p == 0 ? 0.0 : (p == 1 ? weights.x : weights.x + weights.y);
+  float uPhi = clamp((u.z - lo) / max(weights[p], 1e-7), 0.0, 1.0);
+  float v = p == 0 ? betaR * betaR : (p == 1 ? 0.25 * betaR * betaR : 4.0 * betaR * betaR);
+  float t = thetaO + (p == 0 ? -2.0 * tilt : (p == 1 ? tilt : 4.0 * tilt));
+  // theta_i about the cone (d'Eon's lobe, sampled in its numerically stable form).
+  float c = 1.0 + v * log(max(u.x, 1e-7) + (1.0 - u.x) * exp(-2.0 / v));
+  float sc = sqrt(max(1.0 - c * c, 0.0));
+  float sinI = clamp(-c * sin(t) + sc * cos(2.0 * PI * u.y) * cos(t), -1.0, 1.0);
+  float cosI = sqrt(1.0 - sinI * sinI);
+  float cosD = cos(0.5 * (asin(sinI) - thetaO));
+  float phi = hairPhi(cosD, m.hairH, p) + hairLogisticSample(uPhi, hairLogisticScale(betaR));
+  return T * sinI + cosI * (cos(phi) * z + sin(phi) * x);
+}
+
 // The three microfacet types share one evaluation of their half vector, D, G2 and pdf, and the
 // dielectric ones one Fresnel term: lavapipe runs the code of every type the kernel has for every
 // lane, and one copy of it per type made the spaceship's shading code (rough dielectric, rough
@@ -330,6 +489,7 @@ vec3 baseEval(Material m, vec3 wo, vec3 wi, out float pdf) {
   bool entering = wo.z > 0.0;
   bool flip = roughDielectric && !entering;
   vec3 o = flip ? -wo : wo, i = flip ? -wi : wi;
+  if (isMat(t, kMatHair)) return hairEval(m, wo, wi, pdf);
   if (isMat(t, kMatDiffuseTransmission)) {
     // Either side may face the viewer: reflection keeps the side, transmission changes it.
     float share = wo.z * wi.z < 0.0 ? m.fdrInt : 1.0 - m.fdrInt;
@@ -415,7 +575,10 @@ BsdfSample baseSample(Material m, vec3 wo, vec3 u) {
   if ((kMaterialMask & microfacetTypes) != 0) h = mfSample(m, wo.z > 0.0 ? wo : -wo, m.roughness, u.xy);
   const int plastics = (1 << kMatPlastic) | (1 << kMatRoughPlastic);
   float ps = (kMaterialMask & plastics) != 0 ? plasticSpecularProbability(m, wo.z) : 0.0;
-  if (isMat(t, kMatDielectric) || isMat(t, kMatThinSheet)) {
+  if (isMat(t, kMatHair)) {
+    s.wi = hairSample(m, wo, u);
+    evaluate = true;
+  } else if (isMat(t, kMatDielectric) || isMat(t, kMatThinSheet)) {
     bool entering = wo.z > 0.0;
     float cosO = abs(wo.z);
     float eta = entering ? m.ior : 1.0 / m.ior;

@@ -137,16 +137,17 @@ RT_CONST(int, kMatNull, 10)
 RT_CONST(int, kMatPhong, 11)
 RT_CONST(int, kMatDiffuseTransmission, 12)
 RT_CONST(int, kMatBoundary, 13)
+RT_CONST(int, kMatHair, 14)
 // Packed with a rough type (type | kMatBeckmann): Beckmann's distribution instead of GGX; and the
 // bit of the kernel's material mask that says some material has it.
 RT_CONST(int, kMatBeckmann, 256)
-RT_CONST(int, kMaskBeckmann, 14)
+RT_CONST(int, kMaskBeckmann, 15)
 // The bit of the kernel's material mask that says some material has a clear coat (Material::coatIor).
-RT_CONST(int, kMaskCoat, 15)
+RT_CONST(int, kMaskCoat, 16)
 // And the bit that says some glass or boundary is filled with a medium (Material::filled), and
 // the one that says some such medium scatters (Material::interiorScattering).
-RT_CONST(int, kMaskMedium, 16)
-RT_CONST(int, kMaskScattering, 17)
+RT_CONST(int, kMaskMedium, 17)
+RT_CONST(int, kMaskScattering, 18)
 // Packed with a rough type: Smith's G as the product G1(wo) G1(wi) (Material::separableShadowing).
 // A multiply more per evaluation, so no kernel variant.
 RT_CONST(int, kMatSeparable, 512)

@@ -30,6 +30,16 @@ Material material(MaterialType type, float albedo, float roughness = 0.3f, float
   return m;
 }
 
+// Tungsten's hair: the fibre runs along x in the probe's frame (its h is the query's).
+Material hair(float roughness, float absorption, float tilt = 2.0f) {
+  Material m;
+  m.type = MaterialType::Hair;
+  m.roughness = roughness;
+  m.coatingAbsorption = Vec3{absorption};
+  m.hairTilt = tilt;
+  return m;
+}
+
 Material beckmann(Material m) {
   m.beckmann = true;
   return m;
@@ -107,6 +117,8 @@ std::vector<Case> smoothLobed() {
           {"phong", phong(0.8f, 0.3f, 0.2f)},
           {"phong_narrow", phong(0.8f, 0.12f, 0.0f)},
           {"diffuse_transmission", transmitting(0.8f, 0.3f)},
+          {"hair", hair(0.3f, 0.4f)},
+          {"hair_dark", hair(0.5f, 3.0f, -5.0f)},
           {"coated_lambert", clearCoated(material(MaterialType::Lambert, 0.8f))},
           {"coated_rough_conductor", clearCoated(material(MaterialType::RoughConductor, 1.0f, 0.3f), 1.4f, 0.2f)},
           {"coated_rough_plastic", clearCoated(material(MaterialType::RoughPlastic, 0.6f, 0.4f), 1.3f)},
@@ -277,6 +289,9 @@ TEST_F(Bsdfs, ReflectionIsReciprocal) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> U(0.0f, 1.0f);
   for (const Case& c : smoothLobed()) {
+    // Tungsten's hair is not reciprocal: its lobes are shifted about wo's cone and its azimuths
+    // measured from wo, at the h where wo meets the fibre.
+    if (c.m.type == MaterialType::Hair) continue;
     std::vector<BsdfQuery> q;
     for (int i = 0; i < 2000; ++i) {
       Vec3 a = direction(0.05f + 0.95f * U(rng), 6.283f * U(rng)), b = direction(0.05f + 0.95f * U(rng), 6.283f * U(rng));
@@ -589,6 +604,70 @@ TEST_F(Bsdfs, ARoughCoatIsTungstensRoughCoat) {
   EXPECT_NEAR(sampledAlbedo(overMirror, Vec3{0, 0, 1}).first, integrated(glass, Vec3{0, 0, 1}, true).first + (1 - F0) * (1 - F0), 0.005);
   auto d = run({{overMirror, Vec3{0, 0, 1}, Vec3{0, 0, 1}, Vec3{0.5f, 0.5f, 0.99f}}});
   EXPECT_TRUE(d[0].delta) << "the mirror's own reflection stays a delta under the rough coat";
+}
+
+}  // namespace
+}  // namespace retile
+
+namespace retile {
+namespace {
+
+// Tungsten's hair (d'Eon et al. 2011). Seen straight across the fibre (wo perpendicular to it,
+// which runs along x) with its lobes narrow and untilted, every lobe's cone is about theta_i =
+// 0, where the half difference angle is 0: lobe R keeps F(cos gamma) of the light (gamma =
+// asin h, where across the fibre it is met), TT (1 - F)^2 exp(-2 a cos gamma_t) and TRT that
+// times F exp(-2 a cos gamma_t) again, gamma_t = asin(h / 1.55), a the absorption per unit of
+// radius. The directional albedo that sampling estimates must be their sum; and where the light
+// goes: R mirrored about the normal at gamma (phi = -2 gamma, phi about the fibre from wo
+// towards the fibre x wo, here -y), TT straight on at h = 0.
+TEST_F(Bsdfs, HairKeepsWhatItsLobesAttenuationsSay) {
+  const Vec3 wo{0, 0, 1};
+  for (float h : {0.0f, 0.5f, 0.9f})
+    for (float a : {0.0f, 0.3f, 1e4f}) {
+      const double gi = std::asin(h), gt = std::asin(h / 1.55);
+      const double f = fresnel(std::cos(gi), 1.55), t = std::exp(-2.0 * a * std::cos(gt));
+      const double expected = f + (1 - f) * (1 - f) * t * (1 + f * t);
+      std::vector<BsdfQuery> q;
+      for (int i = 0; i < 256; ++i)
+        for (int j = 0; j < 256; ++j) q.push_back({hair(0.02f, a, 0.0f), wo, wo, {(i + 0.5f) / 256, (j + 0.5f) / 256, ((i * 256 + j) * 0.618034f) - std::floor((i * 256 + j) * 0.618034f)}, h});
+      double sum = 0;
+      for (const auto& r : run(q)) sum += luminance(r.weight) / static_cast<double>(q.size());
+      EXPECT_NEAR(sum, expected, 0.01 * expected + 1e-4) << "h " << h << ", absorption " << a;
+    }
+  // Where each goes, by eval around the fibre (theta_i = 0): the black fibre's R peaks at -2
+  // gamma, the clear one's TT at pi.
+  for (float h : {0.0f, 0.5f}) {
+    std::vector<BsdfQuery> q;
+    for (int j = 0; j < 720; ++j) {
+      const float phi = -kPi + (j + 0.5f) * kPi / 360;
+      q.push_back({hair(0.1f, 1e4f, 0.0f), wo, {0, -std::sin(phi), std::cos(phi)}, Vec3{0.5f}, h});
+    }
+    const auto r = run(q);
+    int best = 0;
+    for (int j = 0; j < 720; ++j)
+      if (r[j].f.y > r[best].f.y) best = j;
+    EXPECT_NEAR(-kPi + (best + 0.5f) * kPi / 360, -2 * std::asin(h), 0.02) << "R at h " << h;
+  }
+  auto r = run({{hair(0.1f, 0.0f, 0.0f), wo, {0, 0, -1}}, {hair(0.1f, 0.0f, 0.0f), wo, {0, 1, 0}}});
+  EXPECT_GT(r[0].f.y, 50 * r[1].f.y) << "TT goes straight through";
+}
+
+// The scales' tilt leans the lobes along the fibre, as in Tungsten (its theta_I shifted by -2
+// tilt for R): seen straight across the fibre, a black one reflects most towards theta_i =
+// 2 tilt, towards its tip (the fibre runs from root to tip along +x).
+TEST_F(Bsdfs, HairScalesTiltItsLobes) {
+  const Vec3 wo{0, 0, 1};
+  const float tilt = 6.0f;
+  std::vector<BsdfQuery> q;
+  for (int j = 0; j < 400; ++j) {
+    const float theta = -0.5f + (j + 0.5f) / 400.0f;
+    q.push_back({hair(0.05f, 1e4f, tilt), wo, {std::sin(theta), 0, std::cos(theta)}});
+  }
+  const auto r = run(q);
+  int best = 0;
+  for (int j = 0; j < 400; ++j)
+    if (r[j].f.y > r[best].f.y) best = j;
+  EXPECT_NEAR(-0.5f + (best + 0.5f) / 400.0f, 2 * radians(tilt), 0.01) << "the black fibre's R";
 }
 
 }  // namespace

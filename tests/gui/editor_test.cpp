@@ -502,6 +502,30 @@ TEST(Editor, AnEmittersConeIsEditedFromItsPanel) {
   EXPECT_FLOAT_EQ(w->scene().material(material)->emissionCone, 35.0f) << "the cone was kept meanwhile";
 }
 
+TEST(Editor, HairShowsItsPigmentAndTiltInsteadOfAnAlbedo) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  const NodeId material = w->scene().object(sphere)->material;
+  EXPECT_TRUE(w->findChild<ColorField*>("albedo"));
+  EXPECT_FALSE(w->findChild<ScrubField*>("hairTilt"));
+  auto* type = w->findChild<QComboBox*>("materialType");
+  ASSERT_TRUE(type);
+  type->setCurrentIndex(static_cast<int>(MaterialType::Hair));
+  ASSERT_TRUE(QTest::qWaitFor([&] { return w->findChild<ScrubField*>("hairTilt") != nullptr; }, 2000));
+  EXPECT_FALSE(w->findChild<ColorField*>("albedo")) << "hair's colour is its pigment";
+  auto* pigment = w->findChild<ScrubField*>("coatingAbsorption2");
+  ASSERT_TRUE(pigment);
+  pigment->setValue(1.5);
+  w->findChild<ScrubField*>("hairTilt")->setValue(-3);
+  const Material* m = w->scene().material(material);
+  EXPECT_EQ(m->type, MaterialType::Hair);
+  EXPECT_FLOAT_EQ(m->coatingAbsorption.z, 1.5f);
+  EXPECT_FLOAT_EQ(m->hairTilt, -3.0f);
+  const std::uint64_t version = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; })) << "the edit reached the engine";
+}
+
 TEST(Editor, GlassTakesAScatteringMediumFromItsPanel) {
   auto w = makeWindow();
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");

@@ -1656,3 +1656,70 @@ TEST(KnownAnswer, ConvergedRenderEqualsMeanOfIndependentRenders) {
 
 }  // namespace
 }  // namespace retile
+
+namespace retile {
+namespace {
+
+double dielectricFresnel(double cosI, double eta) {
+  const double s2 = (1 - cosI * cosI) / (eta * eta);
+  if (s2 >= 1) return 1;
+  const double cosT = std::sqrt(1 - s2);
+  const double rs = (cosI - eta * cosT) / (cosI + eta * cosT), rp = (eta * cosI - cosT) / (eta * cosI + cosT);
+  return 0.5 * (rs * rs + rp * rp);
+}
+
+// Hair in the tracer (Material::Hair): a square of it seen head on, its fibres running along
+// the square's u (x), the light met at h drawn uniformly across each fibre.
+//  - Under a sky of 1 everything the fibre scatters sees 1: each pixel reads the directional
+//    albedo, which with the lobes narrow and seen straight across the fibre is the mean over h
+//    of R's F(cos gamma) (black) or of F + (1 - F)^2 (1 + F) (clear, no absorption): the pigment
+//    is read, and h is uniform.
+//  - Lit from above (a sun travelling -y, perpendicular to the fibres), the black fibre's R cone
+//    holds the light; turned so that its fibres run along y, towards the sun, it misses it: the
+//    fibre's direction is the surface's u.
+TEST(KnownAnswer, AFibreScattersAsItsLobesSayAboutItsDirection) {
+  RETILE_RENDERER_OR_SKIP(r);
+  auto fibre = [](float absorption, float roughness) {
+    Material m;
+    m.type = MaterialType::Hair;
+    m.roughness = roughness;
+    m.hairTilt = 0;
+    m.coatingAbsorption = Vec3{absorption};
+    return m;
+  };
+  double black = 0, clear = 0;
+  const int n = 2000;
+  for (int i = 0; i < n; ++i) {
+    const double h = (i + 0.5) / n, gi = std::asin(h);
+    const double f = dielectricFresnel(std::cos(gi), 1.55);
+    black += f / n;
+    clear += (f + (1 - f) * (1 - f) * (1 + f)) / n;
+  }
+  for (auto [absorption, expected] : {std::pair{1e4f, black}, std::pair{0.0f, clear}}) {
+    Scene s = test::emptyScene(16, 16);
+    s.camera = test::frontCamera(2);
+    s.settings.maxBounces = 1;
+    s.environment.color = Vec3{1.0f};
+    const NodeId quad = test::addMeshObject(s, "fibres", makeQuad(), test::addMaterial(s, fibre(absorption, 0.02f)),
+                                            Mat4::translate({0, 0, -4}) * Mat4::rotateX(kPi / 2));
+    const RenderImage img = renderScene(*r, s, 256);
+    int count;
+    EXPECT_NEAR(meanOver(img, quad, &count), expected, 0.02 * expected) << "absorption " << absorption;
+    EXPECT_EQ(count, 16 * 16);
+  }
+  double lit[2];
+  for (int turned = 0; turned < 2; ++turned) {
+    Scene s = test::emptyScene(16, 16);
+    s.camera = test::frontCamera(2);
+    s.settings.maxBounces = 1;
+    addSun(s, 1.0f);
+    const NodeId quad = test::addMeshObject(s, "fibres", makeQuad(), test::addMaterial(s, fibre(1e4f, 0.3f)),
+                                            Mat4::translate({0, 0, -4}) * Mat4::rotateZ(turned ? kPi / 2 : 0.0f) * Mat4::rotateX(kPi / 2));
+    lit[turned] = meanOver(renderScene(*r, s, 256), quad);
+  }
+  EXPECT_GT(lit[0], 0.005) << "the sun is in the black fibre's R cone";
+  EXPECT_GT(lit[0], 8 * lit[1]) << "fibres running towards the sun: " << lit[0] << " against " << lit[1];
+}
+
+}  // namespace
+}  // namespace retile

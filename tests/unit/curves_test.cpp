@@ -228,12 +228,12 @@ TEST(Curves, BrokenFilesFailWithTheFileAndTheProblem) {
   }
 }
 
-TEST(Curves, TungstenCurvesImportAsHairTubes) {
+TEST(Curves, TungstenCurvesImportAsTubesOfHair) {
   auto dir = test::tempDir();
   std::vector<Strand> list;
   for (int i = 0; i < 400; ++i) list.push_back({{float(i), 0, 0}, {float(i), 1, 0}, {float(i), 2, 0}, {float(i), 3, 0}});
   write(dir / "hair.hair", hairFile(list, nullptr, 0.02f));
-  std::ofstream(dir / "scene.json") << R"({"bsdfs": [{"name": "brown", "type": "hair", "melanin_ratio": 0.25, "melanin_concentration": 2, "roughness": 0.2}],
+  std::ofstream(dir / "scene.json") << R"({"bsdfs": [{"name": "brown", "type": "hair", "melanin_ratio": 0.25, "melanin_concentration": 2, "roughness": 0.2, "scale_angle": 3.5}],
       "primitives": [{"type": "curves", "name": "fur", "file": "hair.hair", "bsdf": "brown", "transform": {"scale": 2}},
                      {"type": "curves", "name": "half", "file": "hair.hair", "bsdf": "brown", "subsample": 0.5, "curve_thickness": 0.01},
                      {"type": "curves", "name": "plain", "file": "hair.hair"},
@@ -254,7 +254,6 @@ TEST(Curves, TungstenCurvesImportAsHairTubes) {
   std::string all;
   for (const std::string& w : r->warnings) all += w + "\n";
   EXPECT_NE(all.find("curve file 'missing.hair' not found"), std::string::npos) << all;
-  EXPECT_NE(all.find("hair is drawn as a rough glass fibre"), std::string::npos) << all;
 
   // Four sides, two subdivisions: 2 x 2 x 8 + 4 = 36 triangles a strand.
   EXPECT_EQ(s.mesh(fur->mesh)->geometry->triangleCount(), 400u * 36u);
@@ -262,22 +261,36 @@ TEST(Curves, TungstenCurvesImportAsHairTubes) {
   EXPECT_GT(kept, 150u) << "about half the strands";
   EXPECT_LT(kept, 250u);
 
-  // Glass of the hair's index and roughness, absorbing the melanin's sigma_a per unit of the
-  // fibre's radius: 0.02 scaled by 2 for the fur.
+  // Tungsten's hair: its roughness and tilt, the melanin's absorption per unit of radius (the
+  // same for every curves that names it: one material); the tubes cull their back faces, so
+  // that what a fibre scatters leaves it.
   const Material* m = s.material(fur->material);
   ASSERT_TRUE(m);
-  EXPECT_EQ(m->type, MaterialType::RoughDielectric);
-  EXPECT_FLOAT_EQ(m->ior, 1.55f);
+  EXPECT_EQ(m->type, MaterialType::Hair);
   EXPECT_FLOAT_EQ(m->roughness, 0.2f);
+  EXPECT_FLOAT_EQ(m->hairTilt, 3.5f);
   const Vec3 sigma = (Vec3{0.419f, 0.697f, 1.37f} * 0.75f + Vec3{0.187f, 0.4f, 1.05f} * 0.25f) * 2.0f;
-  EXPECT_NEAR(m->interiorAbsorption.x, sigma.x / 0.04f, 1e-3f);
-  EXPECT_NEAR(m->interiorAbsorption.z, sigma.z / 0.04f, 1e-3f);
-  EXPECT_NEAR(s.material(half->material)->interiorAbsorption.y, sigma.y / 0.01f, 1e-2f) << "curve_thickness overrides the file's";
-  // Without a bsdf, Tungsten's default hair: ratio 0.5, concentration 0.25.
+  EXPECT_NEAR(m->coatingAbsorption.x, sigma.x, 1e-5f);
+  EXPECT_NEAR(m->coatingAbsorption.z, sigma.z, 1e-5f);
+  EXPECT_EQ(half->material, fur->material);
+  EXPECT_TRUE(fur->cullBackFaces && half->cullBackFaces && plain->cullBackFaces);
+  // Without a bsdf, Tungsten's default hair: ratio 0.5, concentration 0.25, tilt 2.
   const Material* d = s.material(plain->material);
   ASSERT_TRUE(d);
-  EXPECT_EQ(d->type, MaterialType::RoughDielectric);
-  EXPECT_NEAR(d->interiorAbsorption.x, 0.25f * (0.419f + 0.187f) / 2 / 0.02f, 1e-3f);
+  EXPECT_EQ(d->type, MaterialType::Hair);
+  EXPECT_FLOAT_EQ(d->hairTilt, 2.0f);
+  EXPECT_NEAR(d->coatingAbsorption.x, 0.25f * (0.419f + 0.187f) / 2, 1e-5f);
+
+  // The native format keeps hair.
+  auto saved = test::tempDir() / "hair.retile";
+  ASSERT_TRUE(saveNativeScene(s, saved).ok());
+  auto back = loadNativeScene(saved);
+  ASSERT_TRUE(back.ok()) << back.error();
+  const Material* again = back->scene.material(fur->material);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->type, MaterialType::Hair);
+  EXPECT_FLOAT_EQ(again->hairTilt, 3.5f);
+  EXPECT_EQ(again->coatingAbsorption, m->coatingAbsorption);
 }
 
 }  // namespace

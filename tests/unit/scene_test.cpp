@@ -157,6 +157,11 @@ TEST(Document, BadEditsAreRefusedAndChangeNothing) {
     m.emissionCone = cone;
     EXPECT_FALSE(doc.apply(SetMaterial{m}).ok()) << cone;
   }
+  for (float tilt : {-46.0f, 50.0f, std::nanf("")}) {
+    Material m = doc.scene().materials[0];
+    m.hairTilt = tilt;
+    EXPECT_FALSE(doc.apply(SetMaterial{m}).ok()) << "hair tilt " << tilt;
+  }
   EXPECT_EQ(doc.version(), v0);
 }
 

@@ -84,6 +84,7 @@ TEST(Validate, ValuesOutsideTheirRangesAreClampedOrReset) {
   m.alpha = 7;
   m.eta = {-1, 1, 1};
   m.emissionCone = 200;
+  m.hairTilt = -60;
   addMeshObject(s, "Cube", makeCube(), m, Mat4{});
   m.emissionCone = kNaN;
   addMeshObject(s, "Cube 2", makeCube(), m, Mat4{});
@@ -121,6 +122,8 @@ TEST(Validate, ValuesOutsideTheirRangesAreClampedOrReset) {
   EXPECT_EQ(r.emissionCone, 90.0f);
   EXPECT_EQ(s.materials[1].emissionCone, 90.0f);
   EXPECT_TRUE(mentions(warnings, "material 'Cube': emission cone was 200; now 90"));
+  EXPECT_EQ(r.hairTilt, -45.0f);
+  EXPECT_TRUE(mentions(warnings, "material 'Cube': hair tilt was -60; now -45"));
   ASSERT_EQ(s.lights.size(), 2u);
   EXPECT_EQ(s.lights[0].name, "Spot");
   EXPECT_LE(s.lights[0].spotAngle, 1.5707964f);

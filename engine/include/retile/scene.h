@@ -100,8 +100,17 @@ enum class MaterialType {
   // straight through, entering the interior medium (interiorAbsorption and on) across the front
   // and leaving it across the back. Bounds fog and smoke, where glass would refract.
   Boundary,
+  // A hair or fur fibre seen from afar (Tungsten's hair: d'Eon et al. 2011's model with the
+  // lobes of Ou et al. 2012): light reflected off the cuticle (R), passed through the fibre
+  // (TT) and reflected once inside it (TRT), each in a cone about the fibre (longitudinal
+  // roughness, the cuticle's scales tilting the cones by hairTilt) and spread around it. The
+  // fibre has index 1.55; its pigment absorbs coatingAbsorption per unit of its radius. Made for
+  // the tubes strands are drawn as (scene/curves.h): the fibre's direction is the surface's u
+  // direction, and light scattered through it leaves from the same point, so its object should
+  // cull back faces.
+  Hair,
 };
-constexpr int kMaterialTypeCount = 14;
+constexpr int kMaterialTypeCount = 15;
 const char* materialTypeName(MaterialType t);
 bool materialTypeFromName(const std::string& name, MaterialType* out);
 // The types whose roughness is a microfacet alpha and which may use Beckmann's distribution.
@@ -112,7 +121,7 @@ constexpr bool isMicrofacet(MaterialType t) {
 // The types that pass light to the other side of a surface.
 constexpr bool isTransmissiveType(MaterialType t) {
   return t == MaterialType::Dielectric || t == MaterialType::RoughDielectric || t == MaterialType::ThinSheet ||
-         t == MaterialType::DiffuseTransmission || t == MaterialType::Boundary;
+         t == MaterialType::DiffuseTransmission || t == MaterialType::Boundary || t == MaterialType::Hair;
 }
 
 constexpr bool isGlassType(MaterialType t) { return t == MaterialType::Dielectric || t == MaterialType::RoughDielectric; }
@@ -122,7 +131,7 @@ constexpr bool holdsMedium(MaterialType t) { return isGlassType(t) || t == Mater
 
 // The types with a roughness field: microfacet alpha, Oren-Nayar sigma, or Phong's width.
 constexpr bool hasRoughness(MaterialType t) {
-  return isMicrofacet(t) || t == MaterialType::OrenNayar || t == MaterialType::Phong;
+  return isMicrofacet(t) || t == MaterialType::OrenNayar || t == MaterialType::Phong || t == MaterialType::Hair;
 }
 
 // Materials a hit follows through blends, the first included (Material::blendWith).
@@ -137,7 +146,8 @@ struct Material {
   MaterialType type = MaterialType::Lambert;
   Vec3 albedo{0.8f};
   NodeId albedoTexture = kNoNode;
-  float roughness = 0.1f;          // microfacet alpha for rough types; sigma for Oren-Nayar
+  float roughness = 0.1f;          // microfacet alpha for rough types; sigma for Oren-Nayar; hair: its cones' width
+  // (Tungsten's roughness: the R lobe's angular deviation is pi / 2 times it, at least 0.04)
   // Rough types: the microfacet distribution. GGX's long tails are the default; Beckmann for
   // files that ask for it (Tungsten's "distribution": "beckmann"), drawn as Tungsten draws it.
   bool beckmann = false;
@@ -158,7 +168,11 @@ struct Material {
   // Plastics: the coating's absorption, its sigma_a times its thickness (Tungsten's plastic):
   // the diffuse base shows through dimmed by exp(-a (1 / cos wi + 1 / cos wo)). Thin sheets: the
   // sheet's, light passing through it dimmed by exp(-a / cos t), t the angle inside the sheet.
+  // Hair: its pigment's, per unit of the fibre's radius.
   Vec3 coatingAbsorption{0.0f};
+  // Hair: the angle in degrees by which its cuticle's scales tilt the lobes (Tungsten's
+  // scale_angle): R by -2 of it, TT by 1 and TRT by 4.
+  float hairTilt = 2.0f;
   // Thin sheets: thin-film interference over a film this many nanometres thick (Tungsten's
   // enable_interference, over its thickness times 500): the sheet's reflectance then varies by
   // channel (red, green and blue taken at 650, 510 and 475 nm) and with the angle. 0: none.

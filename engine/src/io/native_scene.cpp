@@ -266,6 +266,7 @@ Value nativeSceneToJson(const Scene& s) {
     if (m.tungstenGlass) v.set("glass", "tungsten");
     v.set("coating_absorption", json::fromVec3(m.coatingAbsorption));
     if (m.filmThickness != 0) v.set("film_thickness", m.filmThickness);
+    if (m.type == MaterialType::Hair) v.set("hair_tilt", m.hairTilt);
     v.set("transmittance", m.transmittance);
     v.set("diffuse_ratio", m.diffuseRatio);
     v.set("interior_absorption", json::fromVec3(m.interiorAbsorption));
@@ -519,6 +520,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
         r.problem("glass", cat("unknown glass convention '", glass, "' (physical, tungsten)"));
       r.vec3("coating_absorption", &m.coatingAbsorption);
       r.number("film_thickness", &m.filmThickness);
+      r.number("hair_tilt", &m.hairTilt);
       r.number("transmittance", &m.transmittance);
       r.number("diffuse_ratio", &m.diffuseRatio);
       r.vec3("interior_absorption", &m.interiorAbsorption);

@@ -67,7 +67,6 @@ class TungstenImporter {
         if (!ok()) break;
         m.id = s.newId();
         if (m.name.empty()) m.name = cat("bsdf ", i);
-        if (v.isObject() && string(v, "type") == "hair") hairBsdfs_.insert(m.name);
         named_[m.name] = m;
         s.materials.push_back(m);
       }
@@ -702,30 +701,28 @@ class TungstenImporter {
     return m;
   }
 
-  // Tungsten's hair (HairBcsdf: d'Eon et al.'s far-field model of a rough dielectric fibre of
-  // index 1.55 with pigment inside, integrated over the fibre's width) is drawn as what that
-  // model describes: a rough glass fibre of the same index and roughness, filled with the
-  // pigment's absorption. Its sigma_a is per unit of the fibre's radius; interiorAbsorption holds
-  // it so until the curves that use it divide it by their radius (curvesHair). The scales' tilt
-  // (scale_angle) is left out.
+  // Tungsten's hair (HairBcsdf): its melanin gives the pigment's absorption per unit of the
+  // fibre's radius (d'Eon et al. 2011's eumelanin and pheomelanin, mixed by the ratio), unless
+  // sigma_a is given.
   void hairFibre(const Value& v, const std::string& where, Material& m) {
-    m.type = MaterialType::RoughDielectric;
-    m.ior = 1.55f;
+    m.type = MaterialType::Hair;
     m.albedo = Vec3{1.0f};
     m.roughness = 0.1f;
     number(v, "roughness", &m.roughness, where);
-    m.roughness = std::clamp(m.roughness, 0.0f, 1.0f);
+    m.roughness = std::clamp(std::isfinite(m.roughness) ? m.roughness : 0.1f, 0.0f, 1.0f);
+    m.hairTilt = 2.0f;
+    number(v, "scale_angle", &m.hairTilt, where);
+    if (!(std::abs(m.hairTilt) <= 45)) {
+      warn(cat(where, ": scale_angle ", m.hairTilt, " is taken as 2"));
+      m.hairTilt = 2.0f;
+    }
     float ratio = 0.5f, concentration = 0.25f;  // Tungsten's defaults
     number(v, "melanin_ratio", &ratio, where);
     number(v, "melanin_concentration", &concentration, where);
-    // Eumelanin's and pheomelanin's absorption (d'Eon et al. 2011, as Tungsten has them).
     const Vec3 eumelanin{0.419f, 0.697f, 1.37f}, pheomelanin{0.187f, 0.4f, 1.05f};
     Vec3 sigmaA = (eumelanin * (1 - ratio) + pheomelanin * ratio) * concentration;
     vec3(v, "sigma_a", &sigmaA, where);
-    m.interiorAbsorption = isFinite(sigmaA) ? max(sigmaA, Vec3{0.0f}) : Vec3{0.0f};
-    if (hairWarned_.insert(where).second)
-      warn(cat(where, ": hair is drawn as a rough glass fibre (index 1.55, roughness ", m.roughness,
-               ") filled with its pigment, not by Tungsten's hair model; it converges more slowly and its scale tilt is left out"));
+    m.coatingAbsorption = isFinite(sigmaA) ? max(sigmaA, Vec3{0.0f}) : Vec3{0.0f};
   }
 
   // Tungsten's rotYXZ: R = Ry(-ry) Rx(rx) Rz(rz), angles in degrees.
@@ -1102,11 +1099,11 @@ class TungstenImporter {
   }
 
   // The tubes of a "curves" primitive's strands (scene/curves.h), as a mesh: its file (.hair or
-  // .fiber) with Tungsten's curve_thickness, curve_taper and subsample applied. `radius` gets the
-  // strands' mean radius in world units (Tungsten widens them by the transform's mean scale, as
-  // a uniform scale does here; under a scale that is not uniform the tubes are flattened where
-  // Tungsten's stay round). kNoNode when there is nothing to draw.
-  NodeId curves(const Value& p, const std::string& where, Vec3 scale, float* radius) {
+  // .fiber) with Tungsten's curve_thickness, curve_taper and subsample applied. (Tungsten widens
+  // strands by the transform's mean scale, as a uniform scale does here; under a scale that is
+  // not uniform the tubes are flattened where Tungsten's stay round.) kNoNode when there is
+  // nothing to draw.
+  NodeId curves(const Value& p, const std::string& where) {
     const std::string f = string(p, "file");
     if (f.empty()) {
       warn(cat(where, ": curves without a \"file\"; skipped"));
@@ -1163,15 +1160,6 @@ class TungstenImporter {
     if (tubes.strandsKept < tubes.strandsUsable)
       warn(cat(where, ": '", f, "' has ", c.pieceCount(), " spline pieces, more than ", tubeOptions.maxTriangles,
                " triangles of tubes can draw; drawn with ", tubes.strandsKept, " of its ", tubes.strandsUsable, " strands"));
-    double sum = 0;
-    std::size_t nodes = 0;
-    for (std::size_t i = 0; i < c.ends.size(); ++i) {
-      const std::uint32_t start = i ? c.ends[i - 1] : 0;
-      if (c.ends[i] - start < 3) continue;
-      for (std::uint32_t n = start; n < c.ends[i]; ++n, ++nodes) sum += c.radii[n];
-    }
-    const float meanScale = (std::abs(scale.x) + std::abs(scale.y) + std::abs(scale.z)) / 3;
-    *radius = nodes ? static_cast<float>(sum / static_cast<double>(nodes)) * meanScale : 0.0f;
     if (std::size_t dropped = sanitizeGeometry(tubes.geometry, nullptr); dropped)
       warn(cat(where, ": ", dropped, " triangles of tubes with a position that is not finite were left out"));
     if (tubes.geometry.indices.empty()) {
@@ -1447,7 +1435,6 @@ class TungstenImporter {
 
     std::vector<MeshPart> parts;  // one for every shape but a mesh with several material indices
     float emissionCone = 90;      // Material::emissionCone, a disk's cone_angle
-    float fibreRadius = 0;        // curves: their mean radius in world units
     Mat4 xf = transform(tv, where, &scale, type == "quad" || type == "disk");
     if (!ok()) return;
     const Value* bsdfs = p.find("bsdf");
@@ -1482,7 +1469,7 @@ class TungstenImporter {
       std::string kind = capped ? "cylinder" : "open cylinder";
       parts.push_back({0, meshNode(kind, "cylinder", shape(kind))});
     } else if (type == "curves") {
-      NodeId mesh = curves(p, where, scale, &fibreRadius);
+      NodeId mesh = curves(p, where);
       if (mesh == kNoNode) return;
       parts.push_back({0, mesh});
     } else {
@@ -1551,9 +1538,6 @@ class TungstenImporter {
       } else if (type == "curves") {
         hairFibre(json::Value(json::Object{}), bsdfWhere, mat);  // Tungsten's curves default to hair
       }
-      // A hair's absorption is per unit of its fibre's radius: each curves primitive gets its
-      // own copy, in world units.
-      const bool hair = type == "curves" && (!b || (b->isString() ? hairBsdfs_.count(b->asString()) > 0 : string(*b, "type") == "hair"));
       const bool named = b && b->isString();
       NodeId materialId = kNoNode;
       if (bumpTexture != kNoNode) {
@@ -1600,15 +1584,6 @@ class TungstenImporter {
           materialId = m.id;
           if (named) bumped_[key] = m.id;
         }
-      } else if (hair && !emissive) {
-        if (named) copied_.insert(mat.id);
-        Material m = mat;
-        m.id = s.newId();
-        const Mesh* tubes = s.mesh(part.mesh);
-        m.name = cat(mat.name.empty() ? std::string("hair") : mat.name, " (", string(p, "name", tubes ? tubes->name : where), ")");
-        m.interiorAbsorption = fibreRadius > 0 ? mat.interiorAbsorption / fibreRadius : Vec3{0.0f};
-        s.materials.push_back(m);
-        materialId = m.id;
       } else if (emissive) {
         // Emission belongs to the primitive in Tungsten and to the material here: give each
         // emitter its own copy of its bsdf.
@@ -1641,6 +1616,9 @@ class TungstenImporter {
       o.transform = xf;
       // Only Tungsten's meshes read it (its TriangleMesh); its analytic shapes are hit from both sides.
       if (const Value* v = p.find("backface_culling"); type == "mesh" && v && v->isBool()) o.cullBackFaces = v->asBool();
+      // Tungsten's curves are the half of a tube that faces the ray: a tube's far side lets
+      // every ray through, so that light scattered through a fibre leaves it.
+      if (type == "curves") o.cullBackFaces = true;
       s.objects.push_back(o);
     }
   }
@@ -1662,8 +1640,6 @@ class TungstenImporter {
   std::map<std::string, std::shared_ptr<const MeshGeometry>> shapes_;
   int emitters_ = 0;
   int curvesMeshes_ = 0;
-  std::set<std::string> hairBsdfs_;   // the names of the file's hair bsdfs
-  std::set<std::string> hairWarned_;  // where a hair bsdf was warned of
   std::set<NodeId> copied_;  // named bsdfs some primitive took a copy of (dropReplacedBsdfs)
   // (bsdf, bump texture, strength, medium) -> its copy
   std::map<std::tuple<std::string, NodeId, float, std::string>, NodeId> bumped_;

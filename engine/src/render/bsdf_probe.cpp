@@ -24,7 +24,8 @@ std::vector<BsdfAnswer> BsdfProbe::run(const std::vector<BsdfQuery>& queries) {
   for (const BsdfQuery& q : queries) {
     auto m = packMaterial(q.material);
     in.insert(in.end(), m.begin(), m.end());
-    for (Vec3 v : {q.wo, q.wi, q.u}) in.push_back({v.x, v.y, v.z, 0.0f});
+    in.push_back({q.wo.x, q.wo.y, q.wo.z, q.hairH});
+    for (Vec3 v : {q.wi, q.u}) in.push_back({v.x, v.y, v.z, 0.0f});
   }
   const auto count = static_cast<std::uint32_t>(queries.size());
   vk::Buffer inBuf(ctx, in.size() * sizeof(vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "bsdf probe queries");

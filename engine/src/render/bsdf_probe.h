@@ -19,6 +19,7 @@ struct BsdfQuery {
   Material material;
   Vec3 wo{0, 0, 1}, wi{0, 0, 1};  // wi for eval; wo for eval and sample
   Vec3 u{0.5f};                   // the sample's random numbers in [0, 1)
+  float hairH = 0;                // hair: where across the fibre, which runs along x (Material::Hair)
 };
 
 struct BsdfAnswer {

@@ -582,6 +582,7 @@ static_assert(gpu::kMaxBlendChain == kMaxBlendChain, "the kernel follows as many
 // The kernel's material mask holds a bit per type, then Beckmann's, the coat's and the media's.
 static_assert(kMaterialTypeCount <= gpu::kMaskBeckmann && gpu::kMaskBeckmann < gpu::kMaskCoat &&
               gpu::kMaskCoat < gpu::kMaskMedium && gpu::kMaskMedium < gpu::kMaskScattering && gpu::kMaskScattering < 32);
+static_assert((1 << gpu::kMaskMedium) == 131072, "common/bsdf.glsl's RETILE_MEDIUM tests this bit");
 
 namespace {
 // Transmissive types take no coat (Material::coatIor).
@@ -596,6 +597,9 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
                                                     int bumpTexture, int emissionTexture, int blendWith, int blendRatioTexture) {
   Vec3 eta = m.eta, k = m.k;
   if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
+  // Hair has no complex index: the slot carries its scales' tilt in radians, and its index is
+  // the fibre's.
+  if (m.type == MaterialType::Hair) eta = Vec3{std::isfinite(m.hairTilt) ? std::clamp(m.hairTilt, -45.0f, 45.0f) * (kPi / 180) : 0.0f, 0.0f, 0.0f};
   const bool rough = isMicrofacet(m.type);
   int type = static_cast<int>(m.type) | (rough && m.beckmann ? gpu::kMatBeckmann : 0) |
              (rough && m.separableShadowing ? gpu::kMatSeparable : 0) | ((isGlassType(m.type) || m.type == MaterialType::ThinSheet) && m.tungstenGlass ? gpu::kMatTungstenGlass : 0);
@@ -605,7 +609,7 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   if (m.type == MaterialType::OrenNayar) roughness = std::clamp(m.roughness, 0.0f, kPi / 2);
   // A thin sheet has no roughness: the slot carries its film's thickness (Material::filmThickness).
   if (m.type == MaterialType::ThinSheet) roughness = std::isfinite(m.filmThickness) ? std::clamp(m.filmThickness, 0.0f, 1e5f) : 0.0f;
-  float ior = std::clamp(m.ior, 1.0001f, 10.0f);
+  float ior = m.type == MaterialType::Hair ? 1.55f : std::clamp(m.ior, 1.0001f, 10.0f);
   const bool coated = coatRendered(m);
   // Diffuse light inside a plastic coating reflects back this fraction at the boundary
   // (Jensen et al.'s polynomial fit of the internal diffuse Fresnel reflectance).

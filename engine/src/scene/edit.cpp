@@ -1,6 +1,7 @@
 #include "retile/edit.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "retile/log.h"
 
@@ -32,11 +33,12 @@ std::string checkMaterial(const Scene& s, const Material& m) {
   if (!isFinite(m.albedo) || !isFinite(m.emission) || !isFinite(m.eta) || !isFinite(m.k) || !isFinite(m.coatingAbsorption) ||
       !isFinite(m.coatAbsorption) || !finite(m.coatIor) || !isFinite(m.interiorAbsorption) || !isFinite(m.interiorScattering) || !finite(m.interiorAnisotropy) || !finite(m.coatRoughness) ||
       !finite(m.roughness) || !finite(m.ior) || !finite(m.alpha) || !finite(m.bumpStrength) || !finite(m.blendRatio) ||
-      !finite(m.transmittance) || !finite(m.diffuseRatio) || !finite(m.filmThickness) || !finite(m.emissionCone))
+      !finite(m.transmittance) || !finite(m.diffuseRatio) || !finite(m.filmThickness) || !finite(m.emissionCone) || !finite(m.hairTilt))
     return cat("material '", m.name, "': a parameter is not a finite number");
   if (auto why = checkMedium(m.interiorAbsorption, m.interiorScattering, m.interiorAnisotropy); !why.empty())
     return cat("material '", m.name, "': ", why);
   if (m.emissionCone < 0 || m.emissionCone > 90) return cat("material '", m.name, "': its emission cone must be within 0..90 degrees");
+  if (std::abs(m.hairTilt) > 45) return cat("material '", m.name, "': its hair tilt must be within -45..45 degrees");
   if (m.blendWith != kNoNode && (m.blendWith == m.id || !s.material(m.blendWith)))
     return cat("material '", m.name, "': it cannot blend with material ", m.blendWith);
   for (NodeId t : m.textures())

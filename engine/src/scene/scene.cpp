@@ -114,7 +114,7 @@ namespace {
 
 const char* const kMaterialNames[kMaterialTypeCount] = {
     "lambert", "oren_nayar", "plastic", "rough_plastic", "conductor", "rough_conductor",
-    "mirror",  "dielectric", "rough_dielectric", "thinsheet", "null", "phong", "diffuse_transmission", "boundary"};
+    "mirror",  "dielectric", "rough_dielectric", "thinsheet", "null", "phong", "diffuse_transmission", "boundary", "hair"};
 
 // RGB complex indices of refraction of common metals (the same RGB values Tungsten's scenes
 // name, from the RPI refractive index tables), so that scene files naming a metal look as

@@ -150,6 +150,7 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
     clampValue(m.diffuseRatio, 0.0f, 1.0f, 0.2f, what + ": diffuse ratio", warnings);
     clampValue(m.filmThickness, 0.0f, 1e5f, 0.0f, what + ": film thickness", warnings);
     clampValue(m.emissionCone, 0.0f, 90.0f, 90.0f, what + ": emission cone", warnings);
+    clampValue(m.hairTilt, -45.0f, 45.0f, 2.0f, what + ": hair tilt", warnings);
     clampValue(m.coatIor, 0.0f, 10.0f, 0.0f, what + ": coat index of refraction", warnings);
     checkColor(m.coatAbsorption, Vec3{0.0f}, what + ": coat absorption", warnings);
     clampValue(m.coatRoughness, 0.0f, 1.0f, 0.0f, what + ": coat roughness", warnings);
