@@ -129,6 +129,19 @@ TEST(Curves, ATubeFollowsItsSplineOutwardAndClosed) {
     const Vec3 p = g.positions[v];
     EXPECT_NEAR(std::sqrt(p.y * p.y + p.z * p.z), widened, 1e-5f);
   }
+  // u runs along the strand on every face, across the seam too, where v jumps back (Material::Hair
+  // takes the fibre's direction from it): dp/du of the straight strand's 60 side triangles points
+  // along +x.
+  for (std::size_t tri = 0; tri < 60; ++tri) {
+    const std::uint32_t* k = &g.indices[tri * 3];
+    const Vec3 e1 = g.positions[k[1]] - g.positions[k[0]], e2 = g.positions[k[2]] - g.positions[k[0]];
+    const Vec2 a = g.uvs[k[0]], b1 = g.uvs[k[1]], b2 = g.uvs[k[2]];
+    const float du1 = b1.x - a.x, dv1 = b1.y - a.y, du2 = b2.x - a.x, dv2 = b2.y - a.y;
+    const float det = du1 * dv2 - du2 * dv1;
+    ASSERT_NE(det, 0.0f) << "triangle " << tri;
+    const Vec3 dpdu = (e1 * dv2 - e2 * dv1) / det;
+    EXPECT_GT(dpdu.x, 0.99f * length(dpdu)) << "triangle " << tri;
+  }
   // A strand of two nodes is no spline piece: nothing.
   EXPECT_EQ(makeCurveTubes(strands({{{0, 0, 0}, {1, 0, 0}}}, r)).strandsKept, 0u);
 }
@@ -144,11 +157,16 @@ TEST(Curves, OverTheBudgetTheSubdivisionsGoThenStrands) {
   CurveTubes one = makeCurveTubes(c, options);
   EXPECT_EQ(one.subdivisions, 1);
   EXPECT_EQ(one.strandsKept, 10u);
-  options.maxTriangles = 100;  // every third strand: 4 of 10
+  options.maxTriangles = 250;  // three sides: 3 x 6 + 2 = 20 a strand, 200
+  CurveTubes three = makeCurveTubes(c, options);
+  EXPECT_EQ(three.sides, 3);
+  EXPECT_EQ(three.strandsKept, 10u);
+  EXPECT_EQ(three.geometry.triangleCount(), 200u);
+  options.maxTriangles = 100;  // every other strand: 5 of 10
   CurveTubes few = makeCurveTubes(c, options);
-  EXPECT_EQ(few.strandsKept, 4u);
+  EXPECT_EQ(few.strandsKept, 5u);
   EXPECT_EQ(few.strandsUsable, 10u);
-  EXPECT_LE(few.geometry.triangleCount(), 4u * 28u);
+  EXPECT_EQ(few.geometry.triangleCount(), 100u);
 }
 
 TEST(Curves, ThicknessAndTaperAsTungstenHasThem) {

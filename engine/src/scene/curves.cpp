@@ -56,7 +56,7 @@ void applyCurveThickness(CurveSet& curves, const float* thickness, bool taper) {
 
 CurveTubes makeCurveTubes(const CurveSet& curves, const CurveTubeOptions& options) {
   CurveTubes out;
-  const int sides = std::max(options.sides, 3);
+  int sides = std::max(options.sides, 3);
   std::size_t pieces = 0;
   for (std::size_t i = 0; i < curves.ends.size(); ++i) {
     const std::uint32_t nodes = curves.ends[i] - strandStart(curves, i);
@@ -70,13 +70,17 @@ CurveTubes makeCurveTubes(const CurveSet& curves, const CurveTubeOptions& option
     return std::uint64_t(pieceCount) * std::uint64_t(subdivisions) * std::uint64_t(2 * sides) +
            std::uint64_t(strands) * std::uint64_t(2 * (sides - 2));
   };
+  // Over the budget: one section a piece, then three sides (hair's shading looks only at the
+  // tube's direction, not its shape: the sides change only its outline), then fewer strands.
   int subdivisions = std::max(options.subdivisions, 1);
   if (triangles(subdivisions, out.strandsUsable, pieces) > options.maxTriangles) subdivisions = 1;
+  if (triangles(subdivisions, out.strandsUsable, pieces) > options.maxTriangles) sides = 3;
   std::size_t stride = 1;
   const std::uint64_t whole = triangles(subdivisions, out.strandsUsable, pieces);
   if (whole > options.maxTriangles)
     stride = static_cast<std::size_t>((whole + options.maxTriangles - 1) / std::max<std::uint64_t>(options.maxTriangles, 1));
   out.subdivisions = subdivisions;
+  out.sides = sides;
 
   // A regular polygon of circumradius R is, averaged over the directions it is seen from, as
   // wide as its perimeter over pi: 2 sides R sin(pi / sides) / pi, which this makes 2 r.

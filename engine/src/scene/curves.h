@@ -4,8 +4,8 @@
 // Tungsten intersects each strand's quadratic B-spline directly, as the front half of a round
 // tube seen along the ray. Retile's kernel traces triangles only, so a strand becomes a closed
 // tube of a few sides that follows the same spline with the same radius. A tube costs far more
-// memory than the spline (about 0.7 KB per spline piece against Tungsten's 16 bytes), which is
-// why makeCurveTubes works to a triangle budget.
+// memory than the spline (about 2 KB of device memory per spline piece at the defaults, against
+// Tungsten's 16 bytes a node), which is why makeCurveTubes works to a triangle budget.
 #pragma once
 
 #include <cstdint>
@@ -44,6 +44,7 @@ struct CurveTubes {
   std::size_t strandsKept = 0;  // strands with a tube (of those with three nodes or more)
   std::size_t strandsUsable = 0;
   int subdivisions = 0;          // what the budget allowed
+  int sides = 0;
 };
 
 // One closed tube per strand of three nodes or more: `sides` faces around, outward facing, with
@@ -51,7 +52,8 @@ struct CurveTubes {
 // a path that refracts into it leave through an end without crossing a surface). The polygon is
 // scaled so that its width, averaged over the directions it is seen from, is the strand's
 // diameter (its perimeter over pi). u runs along the strand from 0 to 1, v around it.
-// Over the budget, the subdivisions drop to one, then every k-th strand is kept.
+// Over the budget, the subdivisions drop to one, then the sides to three, then every k-th strand
+// is kept.
 CurveTubes makeCurveTubes(const CurveSet& curves, const CurveTubeOptions& options = {});
 
 }  // namespace retile
