@@ -447,6 +447,8 @@ void resolveShadow(inout Path path, inout Shadow shadow, Trace tr) {
   // past the last bounce no path reaches the light that way, and neither does the light sample,
   // whose MIS weight counts on that path.
   visible = visible && shadow.depth + tr.passed < int(frame.image.w);
+  // Its light arrives in one bounce more than its path's vertex has, and one for each of those.
+  if (hasFeature(kFeatureMinBounces)) visible = visible && shadow.depth + 1 + tr.passed >= frame.bounces.x;
 #endif
 #if RETILE_BOUNDARY
   // Its optical depth through the media it ran in (Trace::crossedSigma). A negative one only
@@ -499,6 +501,11 @@ vec3 transmittance(vec3 sigmaT, float dist) {
 // nothing blocks it; traced with the path's next segment.
 // `skip`: how far along the ray from the light sample's point the origin is (surfaceSkip).
 void castShadow(inout Shadow shadow, inout Path path, vec3 origin, float skip, ivec2 from, LightSample ls, vec3 L, vec3 sigmaT) {
+#if !(RETILE_SHEET || RETILE_BOUNDARY)
+  // Its light arrives in one bounce more than the path has taken: too few, and it is not traced.
+  // (Past sheets and boundaries, each one more: resolveShadow decides.)
+  if (hasFeature(kFeatureMinBounces) && path.depth + 1 < frame.bounces.x) return;
+#endif
 #if RETILE_BOUNDARY
   shadow.sigma = sigmaT;
   shadow.dist = ls.dist;
@@ -624,7 +631,11 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
     else atomicAdd(selectionCounts[path.selBase + 1], uint(max(maxBounces + 1, 1) / path.depth));
   }
 
+  // Light that reaches the camera in fewer bounces than frame.bounces.x is left out (Tungsten's
+  // min_bounces): the sky and the emitters this segment finds, the light samples of vertices before.
+  bool counts = !hasFeature(kFeatureMinBounces) || path.depth >= frame.bounces.x;
   if (hit.prim < 0) {
+    if (!counts) return false;
     vec3 Le = envRadiance(rd);
     vec3 added = path.beta * Le;
     if (!path.specular) added *= powerHeuristic(path.prevPdf, frame.lightPick.y * envPdf(rd));
@@ -676,7 +687,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   vec3 wo = -rd;
   bool frontFace = dot(ng, wo) > 0.0;
 
-  bool emits = hasFeature(kFeatureEmitters) && (instFlags & kInstanceEmissive) != 0 && frontFace;
+  bool emits = hasFeature(kFeatureEmitters) && (instFlags & kInstanceEmissive) != 0 && frontFace && counts;
   if (hasFeature(kFeatureEmissionCone) && emits) emits = dot(ng, wo) > emissionConeCos(floatBitsToInt(info.z));
   vec3 emitted = vec3(0.0);
   if (emits) {

@@ -664,6 +664,15 @@ void PropertyPanel::buildRender(Builder& b) {
   b.number(tr("Max bounces"), "maxBounces", r.maxBounces, 0, 1024, RenderSettings{}.maxBounces, 0, [edit](double v, int drag) {
     edit(tr("Max bounces"), drag, [v](RenderSettings& x) { x.maxBounces = static_cast<int>(v); });
   });
+  // Light that arrives in fewer bounces is left out: 1 hides the lights seen directly.
+  b.number(tr("Min bounces"), "minBounces", r.minBounces, 0, 1024, RenderSettings{}.minBounces, 0, [edit](double v, int drag) {
+    edit(tr("Min bounces"), drag, [v](RenderSettings& x) { x.minBounces = static_cast<int>(v); });
+  });
+  // Off, only paths that hit a light see it (Tungsten's enable_light_sampling false): noisier, and
+  // point, spot and sun lights without a disc go dark.
+  b.check(tr("Light sampling"), "lightSampling", r.lightSampling, [edit](bool on) {
+    edit(on ? tr("Light sampling on") : tr("Light sampling off"), 0, [on](RenderSettings& x) { x.lightSampling = on; });
+  });
   b.number(tr("Seed"), "seed", r.seed, 0, 1e9, 0, 0, [edit](double v, int drag) {
     edit(tr("Seed"), drag, [v](RenderSettings& x) { x.seed = static_cast<std::uint32_t>(v); });
   });

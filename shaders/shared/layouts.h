@@ -113,7 +113,9 @@ RT_CONST(int, kFeatureCullBack, 2097152)
 // Some emitter emits into a cone narrower than its hemisphere (Material::emissionCone; the cosine
 // in its material's eighth texel, z).
 RT_CONST(int, kFeatureEmissionCone, 4194304)
-RT_CONST(int, kFeatureAll, 8388607)
+// Light that arrives in fewer than FrameUniforms::bounces.x bounces is left out (RenderSettings::minBounces).
+RT_CONST(int, kFeatureMinBounces, 8388608)
+RT_CONST(int, kFeatureAll, 16777215)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceBoundary, 2)  // its material is a boundary (kMatBoundary), which shadow rays cross
@@ -245,6 +247,7 @@ struct FrameUniforms {
   // (RenderSceneData::lightInScatteringGlass), else 0.
   vec4 worldAbsorption;
   vec4 worldScattering;
+  ivec4 bounces;        // the fewest a path's light counts at (RenderSettings::minBounces), -, -, -
 };
 
 // A rectangle of pixels that receives q samples each this frame. Slot s of the frame belongs to
@@ -314,7 +317,7 @@ struct DenoisePush {
 
 #ifdef __cplusplus
 static_assert(sizeof(DenoisePush) == 48);
-static_assert(sizeof(FrameUniforms) == 29 * 16);
+static_assert(sizeof(FrameUniforms) == 30 * 16);
 static_assert(sizeof(WorkItem) == 48);
 static_assert(sizeof(TracePush) == 16);
 }  // namespace retile::gpu

@@ -786,6 +786,36 @@ TEST(Editor, RenderSettingsShownTwiceFollowEachOther) {
   EXPECT_EQ(docked()->value(), 7) << "the dock follows Properties";
 }
 
+// Min bounces and light sampling are render settings: edited from the panel, each one undo step
+// that reaches the engine.
+TEST(Editor, MinBouncesAndLightSamplingAreEditedFromTheRenderSettings) {
+  auto w = makeWindow();
+  auto* minBounces = w->findChild<ScrubField*>("minBounces");
+  auto* lights = w->findChild<QCheckBox*>("lightSampling");
+  ASSERT_TRUE(minBounces && lights) << "the render settings show both";
+  EXPECT_EQ(minBounces->value(), 0);
+  EXPECT_TRUE(lights->isChecked());
+  minBounces->setValue(2);
+  EXPECT_EQ(w->scene().settings.minBounces, 2);
+  EXPECT_EQ(w->undoStack()->undoText(), "Min bounces");
+  QTest::qWait(50);  // a panel rebuilds on the next turn of the event loop
+  lights = w->findChild<QCheckBox*>("lightSampling");
+  ASSERT_TRUE(lights);
+  lights->setChecked(false);
+  EXPECT_FALSE(w->scene().settings.lightSampling);
+  EXPECT_EQ(w->undoStack()->undoText(), "Light sampling off");
+  const std::uint64_t version = w->documentVersion();
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; })) << "the edits reached the engine";
+  w->undoStack()->undo();
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().settings.minBounces, 0);
+  EXPECT_TRUE(w->scene().settings.lightSampling);
+  QTest::qWait(50);
+  ASSERT_TRUE(w->findChild<QCheckBox*>("lightSampling"));
+  EXPECT_TRUE(w->findChild<QCheckBox*>("lightSampling")->isChecked()) << "the box follows the undo";
+  EXPECT_EQ(w->findChild<ScrubField*>("minBounces")->value(), 0);
+}
+
 // The scene's resolution is edited in the render settings; framed as the scene, the viewport shows
 // an image of that shape, letterboxed; filling the viewport, it takes the viewport's shape again.
 TEST(Editor, TheViewportCanFrameTheImageAsTheScenesResolution) {

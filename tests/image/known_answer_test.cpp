@@ -648,33 +648,113 @@ TEST(KnownAnswer, ABoundaryInTheWorldsMediumTradesOneMediumForTheOther) {
   expectOverAFloor(*r, boundaryOf(kOverAFloorAbsorption, kOverAFloorScattering, -0.3f), 3, 40, false, 0.15f);
 }
 
+// A closed furnace: the camera inside a sphere that emits le and reflects rho, at most `bounces`.
+// Reversed winding and normals turn the sphere's front side, and so its emission, inwards. (A
+// negative scale would not: transformed normals keep pointing out of the surface.)
+Scene closedFurnace(float rho, float le, int bounces) {
+  Scene s = test::emptyScene(16, 16);
+  s.camera = test::frontCamera(60);
+  s.settings.maxBounces = bounces;
+  Material m;
+  m.albedo = Vec3{rho};
+  m.emission = Vec3{le};
+  auto inside = std::make_shared<MeshGeometry>(*makeSphere(24, 48));
+  for (std::size_t t = 0; t < inside->indices.size(); t += 3) std::swap(inside->indices[t + 1], inside->indices[t + 2]);
+  for (Vec3& n : inside->normals) n = -n;
+  test::addMeshObject(s, "inside", inside, test::addMaterial(s, m), Mat4::scale(Vec3{3.0f}));
+  return s;
+}
+
+// Min bounces (Tungsten's min_bounces): in the closed furnace, a path's light of k bounces is
+// Le rho^k, so leaving out fewer than m leaves Le (rho^m - rho^(B+1)) / (1 - rho), and past B
+// nothing. Light samples and emitters hit are both cut (either alone left in is caught: at m = 1
+// the emitter seen directly adds 1, the light samples of the first vertex rho). Also where a thin
+// sheet (outside the furnace, never reached) compiles in the shadow rays that count the sheets
+// they pass, which decide at the end of the ray instead of at its start.
 TEST(KnownAnswer, ClosedFurnaceWithBounceLimit) {
   // Inside a sphere that emits Le and reflects rho, a path of at most B bounces sees
   // Le * (1 + rho + ... + rho^B). Exercises emitter sampling, MIS, roulette (either rule: with
   // rho 0.5, Tungsten's plays from the fourth bounce on) and the bounce limit.
   RETILE_RENDERER_OR_SKIP(r);
+  const float rho = 0.5f, le = 1.0f;
+  const int bounces = 6;
   for (Roulette roulette : {Roulette::Standard, Roulette::Tungsten}) {
     SCOPED_TRACE(roulette == Roulette::Tungsten ? "Tungsten's roulette" : "standard roulette");
-    Scene s = test::emptyScene(16, 16);
-    s.camera = test::frontCamera(60);
+    Scene s = closedFurnace(rho, le, bounces);
     s.settings.roulette = roulette;
-    const float rho = 0.5f, le = 1.0f;
-    const int bounces = 6;
-    s.settings.maxBounces = bounces;
-    Material m;
-    m.albedo = Vec3{rho};
-    m.emission = Vec3{le};
-    // Reversed winding and normals turn the sphere's front side, and so its emission, inwards.
-    // (A negative scale would not: transformed normals keep pointing out of the surface.)
-    auto inside = std::make_shared<MeshGeometry>(*makeSphere(24, 48));
-    for (std::size_t t = 0; t < inside->indices.size(); t += 3) std::swap(inside->indices[t + 1], inside->indices[t + 2]);
-    for (Vec3& n : inside->normals) n = -n;
-    test::addMeshObject(s, "inside", inside, test::addMaterial(s, m), Mat4::scale(Vec3{3.0f}));
     RenderImage img = renderScene(*r, s, 256);
     double expected = le * (1 - std::pow(rho, bounces + 1)) / (1 - rho);
     double mean = test::meanLuminance(img, 0, 0, 16, 16);
     EXPECT_NEAR(mean, expected, expected * 0.01) << "expected " << expected;
   }
+}
+
+TEST(KnownAnswer, MinBouncesLeaveOutTheLightOfShorterPaths) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const float rho = 0.5f, le = 1.0f;
+  const int bounces = 6;
+  for (bool sheet : {false, true}) {
+    SCOPED_TRACE(sheet ? "with a thin sheet in the scene" : "without a sheet");
+    Scene s = closedFurnace(rho, le, bounces);
+    if (sheet) {
+      Material glass;
+      glass.type = MaterialType::ThinSheet;
+      glass.ior = 1.5f;
+      test::addMeshObject(s, "pane", makeQuad(), test::addMaterial(s, glass), Mat4::translate({0, 10, 0}));
+    }
+    for (int minBounces : {1, 3, 7}) {
+      SCOPED_TRACE(minBounces);
+      s.settings.minBounces = minBounces;
+      // Light of three bounces or more is what roulette plays with: 1024 spp keep it within 1.5 %.
+      RenderImage img = renderScene(*r, s, 1024);
+      double expected = minBounces > bounces ? 0.0 : le * (std::pow(rho, minBounces) - std::pow(rho, bounces + 1)) / (1 - rho);
+      double mean = test::meanLuminance(img, 0, 0, 16, 16);
+      if (expected == 0) EXPECT_EQ(mean, 0.0);
+      else EXPECT_NEAR(mean, expected, expected * 0.015) << "expected " << expected;
+    }
+  }
+}
+
+// Without light sampling (Tungsten's enable_light_sampling false) lights are found by the paths
+// that hit them, at their full weight: the furnace and a floor under the sky read what they read
+// with it; a point light, which no path can hit, lights nothing, and with it the floor under it
+// reads I rho / (pi h^2).
+TEST(KnownAnswer, WithoutLightSamplingOnlyPathsFindLights) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const float rho = 0.5f;
+  Scene furnace = closedFurnace(rho, 1.0f, 6);
+  furnace.settings.lightSampling = false;
+  double expected = (1 - std::pow(rho, 7)) / (1 - rho);
+  EXPECT_NEAR(test::meanLuminance(renderScene(*r, furnace, 256), 0, 0, 16, 16), expected, expected * 0.01);
+
+  Scene sky = test::emptyScene(32, 32);
+  lookStraightDown(sky, 3, 20);
+  sky.settings.maxBounces = 3;
+  sky.settings.lightSampling = false;
+  sky.environment.color = Vec3{2.0f};
+  NodeId plane = test::addMeshObject(sky, "plane", makeQuad(), test::addMaterial(sky, grey(0.5f)), Mat4::scale({1000, 1, 1000}));
+  EXPECT_NEAR(meanOver(renderScene(*r, sky, 128), plane), 1.0, 0.01);
+
+  Scene lamp = test::emptyScene(16, 16);
+  lookStraightDown(lamp, 0.5f, 2);
+  lamp.settings.maxBounces = 1;
+  NodeId floor = test::addMeshObject(lamp, "floor", makeQuad(), test::addMaterial(lamp, grey(0.8f)), Mat4::scale({100, 1, 100}));
+  Light point;
+  point.id = lamp.newId();
+  point.position = {0, 1, 0};
+  point.intensity = 2.0f;
+  lamp.lights.push_back(point);
+  const double lit = 2.0 * 0.8 / kPi;
+  EXPECT_NEAR(meanOver(renderScene(*r, lamp, 16), floor), lit, lit * 0.01);
+  lamp.settings.lightSampling = false;
+  EXPECT_EQ(meanOver(renderScene(*r, lamp, 16), floor), 0.0);
+  // Back on, through an update as the editor sends it: the light samples come back.
+  lamp.settings.lightSampling = true;
+  r->updateScene(lamp, kUpdateSettings);
+  RenderRequest req;
+  req.samplesPerPixel = 16;
+  req.seed = 1;
+  EXPECT_NEAR(meanOver(r->render(req), floor), lit, lit * 0.01);
 }
 
 TEST(KnownAnswer, DiffusePlaneUnderUniformSky) {

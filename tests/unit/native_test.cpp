@@ -92,6 +92,8 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   s.settings.shading = ShadingConvention::Tungsten;
   s.settings.roulette = Roulette::Tungsten;
   s.settings.rayOffset = RayOffset::Tungsten;
+  s.settings.minBounces = 2;
+  s.settings.lightSampling = false;
   s.settings.view = "Filmic";
   s.materials[0].separableShadowing = true;
   s.materials[0].tungstenGlass = true;
@@ -138,6 +140,8 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.settings.shading, ShadingConvention::Tungsten);
   EXPECT_EQ(back->scene.settings.roulette, Roulette::Tungsten);
   EXPECT_EQ(back->scene.settings.rayOffset, RayOffset::Tungsten);
+  EXPECT_EQ(back->scene.settings.minBounces, 2);
+  EXPECT_FALSE(back->scene.settings.lightSampling);
   EXPECT_EQ(back->scene.settings.view, "Filmic");
   EXPECT_FALSE(back->scene.textures[0].interpolate);
   EXPECT_TRUE(back->scene.textures[0].clampToEdge);

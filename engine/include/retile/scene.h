@@ -389,6 +389,13 @@ struct RenderSettings {
   int width = 640;
   int height = 360;
   int maxBounces = 16;  // paths past it carry ~albedo^17 of the light: < 0.5 % in a Cornell box
+  // Light that reaches the camera in fewer bounces (scattering events) is left out: 1 hides the
+  // lights seen directly, 2 keeps only indirect light (Tungsten's min_bounces); past maxBounces, nothing.
+  int minBounces = 0;
+  // Next-event estimation. Off, lights are found only by the paths that hit them (Tungsten's
+  // enable_light_sampling false): the same picture with more noise, except that point, spot and
+  // delta directional lights, which no path can hit, light nothing.
+  bool lightSampling = true;
   int samplesPerPixel = 64;
   std::uint32_t seed = 0;
   // New scenes (the built-in one, glTF/OBJ/FBX imports): Blackman-Harris 1.5 px, as Blender.

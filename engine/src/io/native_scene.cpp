@@ -167,6 +167,9 @@ Value nativeSceneToJson(const Scene& s) {
   settings.set("width", s.settings.width);
   settings.set("height", s.settings.height);
   settings.set("max_bounces", s.settings.maxBounces);
+  // Written only where they are not the defaults, as files from before them have neither.
+  if (s.settings.minBounces != 0) settings.set("min_bounces", s.settings.minBounces);
+  if (!s.settings.lightSampling) settings.set("light_sampling", false);
   settings.set("spp", s.settings.samplesPerPixel);
   settings.set("seed", s.settings.seed);
   settings.set("pixel_filter", pixelFilterName(s.settings.pixelFilter));
@@ -381,6 +384,8 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
     r.integer("width", &s.settings.width);
     r.integer("height", &s.settings.height);
     r.integer("max_bounces", &s.settings.maxBounces);
+    r.integer("min_bounces", &s.settings.minBounces);
+    r.boolean("light_sampling", &s.settings.lightSampling);
     r.integer("spp", &s.settings.samplesPerPixel);
     int seed = 0;
     r.integer("seed", &seed);

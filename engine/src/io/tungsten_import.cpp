@@ -93,13 +93,15 @@ class TungstenImporter {
     s.settings.rayOffset = RayOffset::Tungsten;
     if (!twoSided) warn("integrator: one-sided shading (enable_two_sided_shading: false) is rendered two-sided");
     if (const Value* in = integrator) {
-      // What else a path tracer's settings change in the picture, and is not rendered: said.
+      // Tungsten counts bounces as scattering events, as RenderSettings::minBounces does (unlike
+      // max_bounces, which counts path segments).
       float minBounces = 0;
       if (const Value* v = in->find("min_bounces"); v && json::toFloat(*v, &minBounces) && minBounces >= 1)
-        warn(cat("integrator: min_bounces ", minBounces, " is not rendered; light that arrives in fewer bounces is counted too"));
-      for (const char* key : {"enable_light_sampling", "enable_volume_light_sampling"})
-        if (const Value* v = in->find(key); v && v->isBool() && !v->asBool())
-          warn(cat("integrator: ", key, " false is not rendered; lights are sampled, which gives the same picture with less noise, except that point lights and suns, which Tungsten then never reaches, light it here"));
+        s.settings.minBounces = std::clamp(static_cast<int>(minBounces), 0, 1024);
+      if (const Value* v = in->find("enable_light_sampling"); v && v->isBool()) s.settings.lightSampling = v->asBool();
+      // Tungsten can turn it off in media alone; here it is one setting for surfaces and media.
+      if (const Value* v = in->find("enable_volume_light_sampling"); v && v->isBool() && !v->asBool() && s.settings.lightSampling)
+        warn("integrator: enable_volume_light_sampling false is not rendered; lights are sampled from media too, which gives the same picture with less noise, except that point lights and suns, which Tungsten's media then never see, light them here");
       if (std::string type = string(*in, "type", "path_tracer"); type != "path_tracer")
         warn(cat("integrator: '", type, "' is rendered by path tracing, which converges to the same picture"));
     }

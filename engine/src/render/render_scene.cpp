@@ -315,6 +315,7 @@ std::uint32_t RenderSceneData::features() const {
   if (tungstenRoulette) f |= gpu::kFeatureTungstenRoulette;
   if (tungstenEpsilon) f |= gpu::kFeatureTungstenEpsilon;
   if (cullBack) f |= gpu::kFeatureCullBack;
+  if (minBounces > 0) f |= gpu::kFeatureMinBounces;
   if (materialBump) f |= gpu::kFeatureBump;
   if (emissionTextures) f |= gpu::kFeatureEmissionTextures;
   if (emissionCones) f |= gpu::kFeatureEmissionCone;
@@ -344,6 +345,9 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
   data_.tungstenRoulette = scene.settings.roulette == Roulette::Tungsten;        // likewise
   data_.tungstenEpsilon = scene.settings.rayOffset == RayOffset::Tungsten;       // likewise
   data_.filterFeature = filterFeature(scene.settings);                          // likewise
+  data_.minBounces = std::clamp(scene.settings.minBounces, 0, std::max(scene.settings.maxBounces, 0) + 1);  // likewise
+  const bool lightSamplingChanged = data_.lightSampling != scene.settings.lightSampling;
+  data_.lightSampling = scene.settings.lightSampling;
   timing_ = {};
   std::uint32_t dirty = 0;
   if (flags & kUpdateTextures || flags & kUpdateEnvironment) {
@@ -379,7 +383,8 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
     timing_.emitters = secondsSince(t);
     dirty |= kDirtyInstances | kDirtyEmitters;
   }
-  if (dirty & (kDirtyEmitters | kDirtyEnvironment | kDirtyInstances) || flags & kUpdateEnvironment) choosePickProbabilities(scene);
+  if (dirty & (kDirtyEmitters | kDirtyEnvironment | kDirtyInstances) || flags & kUpdateEnvironment || lightSamplingChanged)
+    choosePickProbabilities(scene);
   return dirty;
 }
 
@@ -1676,7 +1681,7 @@ void RenderSceneBuilder::choosePickProbabilities(const Scene&) {
         if (v > floor && big > 0) v -= extra * (v - floor) / big;
     }
   }
-  for (int i = 0; i < 3; ++i) data_.lightPick[i] = p[i];
+  for (int i = 0; i < 3; ++i) data_.lightPick[i] = data_.lightSampling ? p[i] : 0.0f;
 }
 
 }  // namespace retile

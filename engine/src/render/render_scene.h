@@ -96,7 +96,11 @@ struct RenderSceneData {
   std::vector<NodeId> instanceObject;  // instance index -> object id (hidden objects too, never reached)
   std::size_t instanceReferences = 0;  // leaves of the instance BVH: instances or their subtrees
   Bounds3 bounds;
-  float lightPick[3] = {0, 0, 0};      // emitters, environment, delta lights
+  // emitters, environment, delta lights; all 0 without light sampling (RenderSettings::lightSampling),
+  // which turns off next-event estimation and leaves every hit's emission its full weight.
+  float lightPick[3] = {0, 0, 0};
+  bool lightSampling = true;           // RenderSettings::lightSampling
+  int minBounces = 0;                  // RenderSettings::minBounces (kFeatureMinBounces when > 0)
   int environmentType = 0;             // kEnvNone / kEnvConstant / kEnvMap
   int environmentMap = -1;             // texture index of the map
   int environmentWidth = 0, environmentHeight = 0;

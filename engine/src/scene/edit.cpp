@@ -79,6 +79,7 @@ std::string checkSettings(const RenderSettings& r) {
   if (r.width < 1 || r.height < 1 || r.width > kMaxImageSide || r.height > kMaxImageSide)
     return cat("render settings: size ", r.width, "x", r.height, " is outside 1..", kMaxImageSide);
   if (r.maxBounces < 0 || r.maxBounces > 1024) return "render settings: max bounces must be within 0..1024";
+  if (r.minBounces < 0 || r.minBounces > 1024) return "render settings: min bounces must be within 0..1024";
   if (r.samplesPerPixel < 1) return "render settings: samples per pixel must be at least 1";
   return {};
 }

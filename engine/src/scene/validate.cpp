@@ -201,6 +201,7 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
   clampInt(s.width, 1, kMaxImageSide, "image width", warnings);
   clampInt(s.height, 1, kMaxImageSide, "image height", warnings);
   clampInt(s.maxBounces, 0, 1024, "max bounces", warnings);
+  clampInt(s.minBounces, 0, 1024, "min bounces", warnings);
   clampInt(s.samplesPerPixel, 1, 1 << 20, "samples per pixel", warnings);
   clampValue(s.filterWidth, 0.25f, 16.0f, defaultFilterWidth(s.pixelFilter), "pixel filter width", warnings);
 
