@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (fuzz/, the fuzz preset: clang with ASan and UBSan), seeds each from
+# Builds the libFuzzer targets (fuzz/, in the asan preset's tree: clang with ASan and UBSan, the
+# same build scripts/asan.sh runs the suites in, so CI compiles the engine once for both), seeds each from
 # ../shared (scenes, corpus), resources/scripts and scenes the command line converts to native
 # files, and fuzzes each for SECONDS (default 30). Usage: scripts/fuzz.sh [SECONDS] [TARGET...]
-# Inputs found to add coverage stay in build-fuzz/corpus/TARGET (runs build on them); an input
+# Inputs found to add coverage stay in build-asan/fuzz/corpus/TARGET (runs build on them); an input
 # that crashes, breaks an invariant, leaks, times out or runs out of memory is written to
-# build-fuzz/artifacts/TARGET/ and the script fails. Prints how many executions each target ran.
+# build-asan/fuzz/artifacts/TARGET/ and the script fails. Prints how many executions each target ran.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-30}
@@ -13,12 +14,12 @@ targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(fuzz_json fuzz_obj fuzz_scenario fuzz_native fuzz_tungsten fuzz_assimp)
 shared=${RETILE_SHARED_DIR:-../shared}
 
-cmake --preset fuzz >/dev/null
-cmake --build --preset fuzz
+cmake --preset asan >/dev/null
+cmake --build --preset asan --target fuzzers
 # The native seeds are scenes saved by the command line (the ci build's, built if missing).
 [ -x build-ci/bin/retile ] || { cmake --preset ci >/dev/null && cmake --build --preset ci --target retile retile-import-worker; }
 
-seeds=build-fuzz/seeds
+seeds=build-asan/fuzz/seeds
 rm -rf "$seeds"
 mkdir -p "$seeds"/{fuzz_json,fuzz_obj,fuzz_scenario,fuzz_native,fuzz_tungsten,fuzz_assimp}
 small() { find "$@" -type f -size -64k 2>/dev/null; }
@@ -44,10 +45,10 @@ done
 export LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 status=0
 for t in "${targets[@]}"; do
-  corpus=build-fuzz/corpus/$t
-  artifacts=build-fuzz/artifacts/$t
+  corpus=build-asan/fuzz/corpus/$t
+  artifacts=build-asan/fuzz/artifacts/$t
   mkdir -p "$corpus" "$artifacts"
-  log=build-fuzz/$t.log
+  log=build-asan/fuzz/$t.log
   extra=()
   # Assimp is not instrumented and crashes on hostile files inside its own parsers, which is why
   # the editor runs it in a child process: keep fuzzing past such crashes (in forked jobs) and sort
@@ -56,7 +57,7 @@ for t in "${targets[@]}"; do
   # Readers print a warning per problem they repair: stderr goes to the log, of which the end
   # (the sanitizer's or libFuzzer's report) is shown when the run fails.
   set +e
-  "build-fuzz/bin/$t" "$corpus" "$seeds/$t" -max_total_time="$seconds" -max_len=65536 -timeout=20 \
+  "build-asan/bin/$t" "$corpus" "$seeds/$t" -max_total_time="$seconds" -max_len=65536 -timeout=20 \
     -rss_limit_mb=3072 -print_final_stats=1 -artifact_prefix="$artifacts/" "${extra[@]}" >"$log" 2>&1
   rc=$?
   set -e
@@ -72,7 +73,7 @@ for t in "${targets[@]}"; do
     mkdir -p "$artifacts/in-assimp"
     for a in "$artifacts"/crash-* "$artifacts"/leak-* "$artifacts"/oom-* "$artifacts"/timeout-*; do
       [ -e "$a" ] || continue
-      report=$(timeout 300 "build-fuzz/bin/$t" -rss_limit_mb=3072 -timeout=20 "$a" 2>&1 || true)
+      report=$(timeout 300 "build-asan/bin/$t" -rss_limit_mb=3072 -timeout=20 "$a" 2>&1 || true)
       first=$(grep -a -m1 -o ' in retile::[^ ]*' <<<"$report" || true)
       if [ -z "$first" ] || [[ "$first" == *convertWithAssimp* ]]; then
         theirs=$((theirs + 1)); mv "$a" "$artifacts/in-assimp/"

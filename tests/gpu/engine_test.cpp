@@ -56,7 +56,7 @@ long residentBytes() {
 TEST(Session, MemoryStaysFlatFrameAfterFrame) {
   RETILE_RENDERER_OR_SKIP(probe);
   probe.reset();
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(RETILE_ASAN)
   GTEST_SKIP() << "AddressSanitizer keeps freed memory in quarantine: the resident size says nothing here";
 #endif
   for (bool denoise : {false, true}) {

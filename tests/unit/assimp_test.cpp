@@ -156,7 +156,7 @@ TEST(Assimp, GarbageFileFailsCleanly) {
 }
 
 TEST(Assimp, MemoryLimitStopsABlowUp) {
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(RETILE_ASAN)
   GTEST_SKIP() << "an AddressSanitizer build sets no address-space limit on the worker (core/process.cpp)";
 #endif
   RETILE_SHARED_OR_SKIP(file, "scenes/bunny/bunny.obj");

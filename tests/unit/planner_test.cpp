@@ -259,13 +259,13 @@ TEST(Planner, FollowingFocusPointsMoveWithTheObjectNotThePointOfChange) {
   p.planBatch({camera});
   p.planBatch({moveFacts(kCup, {250, 140}, {260, 135})});
   ASSERT_EQ(p.focus().size(), 2u);
-  EXPECT_EQ(p.focus()[0].pixel, Vec2(60, 45)) << "moved by the cup's own motion (+10, -5)";
-  EXPECT_EQ(p.focus()[1].pixel, Vec2(300, 20)) << "a static point stays";
+  EXPECT_EQ(p.focus()[0].pixel, (Vec2{60, 45})) << "moved by the cup's own motion (+10, -5)";
+  EXPECT_EQ(p.focus()[1].pixel, (Vec2{300, 20})) << "a static point stays";
   // A material edit moves nothing.
   EditFacts material = moveFacts(kCup, {260, 135}, {260, 135});
   material.moved = false;
   p.planBatch({material});
-  EXPECT_EQ(p.focus()[0].pixel, Vec2(60, 45));
+  EXPECT_EQ(p.focus()[0].pixel, (Vec2{60, 45}));
 }
 
 TEST(Planner, ChangeTracesTheSpiralDuringADragAndProbesOnceItStops) {

@@ -20,7 +20,7 @@
 // An AddressSanitizer build (the asan preset) reserves terabytes of address space for its shadow
 // memory at start: under an address-space limit every worker would abort before reading a byte.
 // The limit is left out there; the wall-clock limit stays.
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(RETILE_ASAN)
 constexpr bool kAddressSanitizer = true;
 #else
 constexpr bool kAddressSanitizer = false;
