@@ -146,7 +146,18 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
   if (kScatteringUsed) m.scattering = texelFetch(uMaterials, base + 9);
   int albedoTex = floatBitsToInt(t2.w), roughTex = floatBitsToInt(t3.w);
   if (hasFeature(kFeatureTextures) && albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
-  if (hasFeature(kFeatureTextures) && roughTex >= 0) m.roughness = max(m.roughness * dot(sampleTexture(roughTex, uv).rgb, vec3(1.0 / 3.0)), 1e-3);
+  if (hasFeature(kFeatureTextures) && roughTex >= 0) {
+    float scale = dot(sampleTexture(roughTex, uv).rgb, vec3(1.0 / 3.0));
+    if (isMat(m.type, kMatThinSheet)) {
+      // A thin sheet's texture is its thickness (Material::roughnessTexture): its absorption
+      // straight across and its film (in the roughness slot; 0, none) grow with it.
+      scale = max(scale, 0.0);
+      m.roughness *= scale;
+      m.coating *= scale;
+    } else {
+      m.roughness = max(m.roughness * scale, 1e-3);
+    }
+  }
   if (hasFeature(kFeatureBlend)) m.emission = texelFetch(uMaterials, index * kMaterialTexels + 4).rgb;
   if (hasFeature(kFeatureEmissionTextures)) {
     int emissionTex = floatBitsToInt(texelFetch(uMaterials, index * kMaterialTexels + 5).z);

@@ -454,10 +454,13 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
                            Slot{"Alpha texture", "alphaTexture", &Material::alphaTexture},
                            Slot{"Bump texture", "bumpTexture", &Material::bumpTexture},
                            Slot{"Emission texture", "emissionTexture", &Material::emissionTexture}}) {
-    if (slot.field == &Material::roughnessTexture && !rough) continue;
+    const bool sheet = m.type == MaterialType::ThinSheet;
+    if (slot.field == &Material::roughnessTexture && !rough && !sheet) continue;
     if (slot.field == &Material::albedoTexture && m.type == MaterialType::Hair) continue;
     auto field = slot.field;
-    b.nodeChoice(tr(slot.label), slot.name, scene_().textures, m.*field, [this, edit, field](NodeId t) {
+    // A thin sheet has no roughness: its texture is its thickness's (Material::roughnessTexture).
+    const char* label = sheet && field == &Material::roughnessTexture ? "Thickness texture" : slot.label;
+    b.nodeChoice(tr(label), slot.name, scene_().textures, m.*field, [this, edit, field](NodeId t) {
       edit(tr("Assign texture"), 0, [t, field](Material& x) { x.*field = t; });
       rebuildLater();
     });

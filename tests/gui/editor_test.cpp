@@ -463,6 +463,12 @@ TEST(Editor, AThinSheetTakesItsFilmThicknessFromItsPanel) {
   auto* film = w->findChild<ScrubField*>("filmThickness");
   ASSERT_TRUE(film);
   EXPECT_FALSE(w->findChild<QComboBox*>("interferenceConvention")) << "no film, no interference";
+  // Its roughness texture slot is its thickness's, and says so.
+  auto* thickness = w->findChild<QComboBox*>("roughnessTexture");
+  ASSERT_TRUE(thickness) << "a sheet has a thickness texture";
+  bool labelled = false;
+  for (QLabel* l : w->properties()->findChildren<QLabel*>()) labelled = labelled || l->text() == "Thickness texture";
+  EXPECT_TRUE(labelled);
   film->setValue(420);
   EXPECT_FLOAT_EQ(w->scene().material(material)->filmThickness, 420.0f);
   QTest::qWait(50);

@@ -178,6 +178,59 @@ TEST(KnownAnswer, AThinSheetAbsorbsWithoutAPlasticInTheScene) {
   }
 }
 
+// A thin sheet's texture is its thickness (Material::roughnessTexture): a checker of one value v
+// across the sheet of the test above scales its absorption by v, and its film: a film of 500 nm
+// at thickness 0 is none, so the sheet reflects as a plain one (the sky of 1 seen through it and in
+// it adds up to 1 where it absorbs nothing; a film of 500 nm reflects a colour instead).
+TEST(KnownAnswer, AThinSheetsThicknessTextureScalesItsAbsorptionAndFilm) {
+  RETILE_RENDERER_OR_SKIP(r);
+  for (float thickness : {0.0f, 0.4f, 1.0f}) {
+    SCOPED_TRACE(thickness);
+    Scene s = test::emptyScene(16, 16);
+    s.camera = test::frontCamera(2);
+    s.settings.maxBounces = 1;
+    s.environment.color = Vec3{1.0f};
+    Texture t;
+    t.id = s.newId();
+    t.name = "thickness";
+    t.kind = TextureKind::Checker;
+    t.checkerOn = t.checkerOff = Vec3{thickness};
+    s.textures.push_back(t);
+    Material sheet = thinSheet(Vec3{0.5f, 1.0f, 2.0f});
+    sheet.roughnessTexture = t.id;
+    const NodeId quad = test::addMeshObject(s, "sheet", makeQuad(), test::addMaterial(s, sheet),
+                                            Mat4::translate({0, 0, -4}) * Mat4::rotateX(kPi / 2));
+    const RenderImage img = renderScene(*r, s, 16);
+    const double rf = 0.04, passes = 1 - 2 * rf / (1 + rf);
+    for (int c = 0; c < 3; ++c) {
+      const double a = c == 0 ? 0.5 : c == 1 ? 1.0 : 2.0;
+      EXPECT_NEAR(meanOver(img, quad, nullptr, c), passes * std::exp(-a * thickness) + 2 * rf / (1 + rf), 0.003) << "channel " << c;
+    }
+    // The same sheet clear, over a film of 500 nm at that thickness, before a lamp of 1 with
+    // nothing behind the camera: what it lets through, 1 - R, R the plain sheet's or the film's.
+    s.environment.color = Vec3{0.0f};
+    s.materials.back().coatingAbsorption = Vec3{0.0f};
+    s.materials.back().filmThickness = 500.0f;
+    Material lamp = grey(0.0f);
+    lamp.emission = Vec3{1.0f};
+    test::addMeshObject(s, "lamp", makeQuad(), test::addMaterial(s, lamp),
+                        Mat4::translate({0, 0, -6}) * Mat4::rotateX(kPi / 2) * Mat4::scale(Vec3{10.0f}));
+    const RenderImage film = renderScene(*r, s, 16);
+    double lo = 1, hi = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double through = meanOver(film, quad, nullptr, c);
+      lo = std::min(lo, through);
+      hi = std::max(hi, through);
+    }
+    if (thickness == 0) {
+      EXPECT_NEAR(lo, passes, 0.003) << "no film: a plain sheet";
+      EXPECT_NEAR(hi, passes, 0.003) << "no film: a plain sheet";
+    } else {
+      EXPECT_GT(hi - lo, 0.01) << "a film lets some colours through more than others";
+    }
+  }
+}
+
 // What a thin sheet of index 1.5 absorbing `a` straight across lets through at angle theta to its
 // normal: (1 - R) exp(-a / cos t), R each polarisation's 2r / (1 + r) averaged, t the angle inside.
 double sheetTransmittance(double theta, double a) {

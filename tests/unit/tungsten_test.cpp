@@ -984,22 +984,31 @@ TEST(Tungsten, AThinSheetAbsorbsAlongTwiceItsThicknessAndHasNoAlbedo) {
   EXPECT_EQ(back->scene.material(back->scene.objects[1].material)->filmThickness, 250.0f);
   EXPECT_TRUE(back->scene.material(back->scene.objects[1].material)->tungstenGlass);
 
-  // A textured albedo or thickness, which the sheet does not render, leaves no texture behind to
-  // be decoded and packed; a texture something uses stays.
+  // A textured albedo, which the sheet does not render, leaves no texture behind to be decoded
+  // and packed; a texture something uses stays. A textured thickness is the sheet's roughness
+  // texture, scaling what a thickness of 1 gives: sigma_a along twice it, a film of 500 nm.
   auto textured = importTungsten(writeScene(R"({"bsdfs": [
-      {"name": "film", "type": "thinsheet", "albedo": {"type": "checker"}, "thickness": {"type": "checker", "res_u": 3}},
+      {"name": "film", "type": "thinsheet", "albedo": {"type": "checker"}, "sigma_a": 0.5, "enable_interference": true,
+       "thickness": {"type": "checker", "res_u": 3}},
       {"name": "floor", "type": "lambert", "albedo": {"type": "checker", "res_u": 5}}],
-      "primitives": [{"type": "quad", "bsdf": "film"}, {"type": "quad", "bsdf": "floor"}, {"type": "quad", "emission": 1}]})"));
+      "primitives": [{"type": "quad", "bsdf": "floor"}, {"type": "quad", "bsdf": "film"}, {"type": "quad", "emission": 1}]})"));
   ASSERT_TRUE(textured.ok()) << textured.error();
-  ASSERT_EQ(textured->scene.textures.size(), 1u);
-  EXPECT_EQ(textured->scene.textures[0].checkerResU, 5);
+  EXPECT_TRUE(textured->warnings.empty()) << textured->warnings.front();
+  ASSERT_EQ(textured->scene.textures.size(), 2u);
+  const Material& floor = *textured->scene.material(textured->scene.objects[0].material);
+  ASSERT_TRUE(textured->scene.texture(floor.albedoTexture));
+  EXPECT_EQ(textured->scene.texture(floor.albedoTexture)->checkerResU, 5);
+  const Material& sheet = *textured->scene.material(textured->scene.objects[1].material);
+  ASSERT_NE(sheet.roughnessTexture, kNoNode);
+  EXPECT_EQ(textured->scene.texture(sheet.roughnessTexture)->checkerResU, 3);
+  EXPECT_EQ(sheet.coatingAbsorption, Vec3{1.0f});
+  EXPECT_EQ(sheet.filmThickness, 500.0f);
   EXPECT_TRUE(textured->scene.textures[0].tungstenCells) << "a Tungsten checker counts its cells as Tungsten does";
   ASSERT_TRUE(saveNativeScene(textured->scene, file).ok());
   auto checkerBack = loadNativeScene(file);
   ASSERT_TRUE(checkerBack.ok()) << checkerBack.error();
-  ASSERT_EQ(checkerBack->scene.textures.size(), 1u);
+  ASSERT_EQ(checkerBack->scene.textures.size(), 2u);
   EXPECT_TRUE(checkerBack->scene.textures[0].tungstenCells) << "and keeps counting so when saved natively";
-  EXPECT_EQ(textured->scene.material(textured->scene.objects[1].material)->albedoTexture, textured->scene.textures[0].id);
 }
 
 // The spaceship's leathers ask for Beckmann: rendered with it (no warning); a Phong distribution

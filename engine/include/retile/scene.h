@@ -155,7 +155,10 @@ struct Material {
   // Mitsuba 0.5 have it, instead of the height-correlated form (Heitz 2014), which is the more
   // accurate and a little brighter at grazing angles. Tungsten files ask for the product.
   bool separableShadowing = false;
-  NodeId roughnessTexture = kNoNode;  // scales roughness by the mean of its channels, as Tungsten's
+  // Scales roughness by the mean of its channels, as Tungsten's. A thin sheet has no roughness:
+  // there it is its thickness (Tungsten's textured thickness), which scales both its absorption
+  // (coatingAbsorption) and its film (filmThickness) point by point.
+  NodeId roughnessTexture = kNoNode;
   float ior = 1.5f;                // dielectric index (plastic coating, glass, thin sheet)
   // Glass as Tungsten has it (its dielectric and rough_dielectric): albedo tints the reflection
   // as well as the transmission, and radiance is not scaled by (n_t / n_i)^2 where it crosses

@@ -251,7 +251,7 @@ class TungstenImporter {
     std::erase_if(s.materials, [&](const Material& m) { return copied_.count(m.id) && !used.count(m.id); });
   }
 
-  // Textures read for what is not rendered (a thin sheet's albedo or thickness) or for bsdfs
+  // Textures read for what is not rendered (a thin sheet's albedo) or for bsdfs
   // that were replaced; otherwise they would be decoded and packed for nothing.
   void dropUnusedTextures() {
     Scene& s = out_.scene;
@@ -657,11 +657,14 @@ class TungstenImporter {
       float thickness = 0.5f;  // Tungsten's default
       vec3(v, "sigma_a", &sigmaA, where);
       if (const Value* t = v.find("thickness")) {
+        // Textured, the thickness is the sheet's roughness texture (Material::roughnessTexture),
+        // which scales the absorption and the film below, as given for a thickness of 1.
         TextureRef th = texture(*t, where, true);
-        if (th.isTexture)
-          warn(cat(where, ": a textured thin sheet thickness is not rendered; taken as 0.5"));
-        else
-          thickness = channelMean(th.constant);
+        thickness = channelMean(th.constant);
+        if (th.isTexture) {
+          m.roughnessTexture = th.texture;
+          thickness = 1.0f;
+        }
       }
       m.coatingAbsorption = max(sigmaA * (2.0f * thickness), Vec3{0.0f});
       // Tungsten's film is its thickness times 500 nm thick (ThinSheetBsdf), its interference

@@ -658,8 +658,8 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     if (m.filled()) data_.materialTypes |= 1u << gpu::kMaskMedium;
     if (m.filled() && maxComponent(m.interiorScattering) > 0) data_.materialTypes |= 1u << gpu::kMaskScattering;
     // A type without roughness reads no roughness texture: the kernel would scale what the slot
-    // holds for it (a thin sheet's film) by the texture's mean.
-    const int roughnessTexture = hasRoughness(m.type) ? textureIndex(m.roughnessTexture) : -1;
+    // holds for it (hair's tilt) by the texture's mean. A thin sheet's is its thickness.
+    const int roughnessTexture = hasRoughness(m.type) || m.type == MaterialType::ThinSheet ? textureIndex(m.roughnessTexture) : -1;
     if (textureIndex(m.albedoTexture) >= 0 || roughnessTexture >= 0) data_.materialTextures = true;
     if (textureIndex(m.bumpTexture) >= 0 && m.bumpStrength != 0) data_.materialBump = true;
     if (textureIndex(m.emissionTexture) >= 0 && m.emissive()) data_.emissionTextures = true;
