@@ -635,9 +635,10 @@ TEST(RenderScene, AnEmissionConeIsPackedAsItsCosineAndCompiledInWhileNarrower) {
 }
 
 // A roughness texture on a type without roughness (left there by a change of type, or written in
-// a native file) is not packed: the kernel would scale what the slot holds for it (a thin sheet's
-// film thickness) by the texture's mean. On a rough type it is.
-TEST(RenderScene, OnlyARoughTypeReadsItsRoughnessTexture) {
+// a native file) is not packed: the kernel would read it for nothing. On a rough type it is, and
+// on a thin sheet, which has no roughness, as its thickness (the kernel scales its film, in the
+// roughness slot, and its absorption by it).
+TEST(RenderScene, OnlyARoughTypeOrASheetReadsItsRoughnessTexture) {
   Scene s = test::emptyScene(8, 8);
   Texture grain;
   grain.id = s.newId();
@@ -649,15 +650,19 @@ TEST(RenderScene, OnlyARoughTypeReadsItsRoughnessTexture) {
   sheet.roughnessTexture = grain.id;
   Material rough = sheet;
   rough.type = MaterialType::RoughPlastic;
+  Material matte = sheet;
+  matte.type = MaterialType::Lambert;
   test::addMeshObject(s, "sheet", makeQuad(), test::addMaterial(s, sheet), Mat4::identity());
   test::addMeshObject(s, "plastic", makeQuad(), test::addMaterial(s, rough), Mat4::translate({3, 0, 0}));
+  test::addMeshObject(s, "matte", makeQuad(), test::addMaterial(s, matte), Mat4::translate({6, 0, 0}));
   RenderSceneBuilder builder;
   builder.update(s, kUpdateAll, nullptr);
   const RenderSceneData& d = builder.data();
   auto roughnessTexture = [&](std::size_t material) { return std::bit_cast<std::int32_t>(d.materials[material * gpu::kMaterialTexels + 3].w); };
-  EXPECT_EQ(roughnessTexture(0), -1) << "the sheet";
+  EXPECT_GE(roughnessTexture(0), 0) << "the sheet: its thickness";
   EXPECT_EQ(d.materials[0 * gpu::kMaterialTexels + 1].x, 300.0f) << "its film in the roughness slot";
   EXPECT_GE(roughnessTexture(1), 0) << "the rough plastic";
+  EXPECT_EQ(roughnessTexture(2), -1) << "lambert has no roughness";
 }
 
 // Textures are packed in one array, 8-bit ones a word a texel and padded to whole pairs, half
