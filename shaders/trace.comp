@@ -217,6 +217,7 @@ struct Path {
   bool specular;  // the last bounce was a delta lobe (the camera ray counts as one)
   float prevPdf;
   vec3 prevPos;
+  float prevGroupTotal;  // lightGroupTotal (lights.glsl) at prevPos, -1 if not known
   int depth;
   int selBase;
   // Denoiser guides from the first hit that is not a mirror or glass (guideLooksThrough: so
@@ -319,6 +320,7 @@ Path startPath(uint slot, int found) {
   path.specular = true;
   path.prevPdf = 0.0;
   path.prevPos = path.ro;
+  path.prevGroupTotal = -1.0;
   path.depth = 0;
   path.selBase = selectionBase(px, py);
   path.auxAlbedo = vec3(0.0);
@@ -586,6 +588,7 @@ bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, float h
   // which blocks it, so none is cast; and the next direction meets no light before the glass, so
   // no hit needs the weight the sample would have shared.
   bool blockedByGlass = path.inGlass && frame.worldAbsorption.w > 0.0;
+  lightGroupTotal = -1.0;
   if ((frame.lightPick.x + frame.lightPick.y + frame.lightPick.z) > 0.0 && !blockedByGlass) {
     vec3 lu = vec3(rand(path.rng), rand(path.rng), rand(path.rng));
     LightSample ls = sampleLight(pos, lu);
@@ -602,6 +605,7 @@ bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, float h
   path.from = ivec2(-1);
   path.specular = false;
   path.prevPos = pos;
+  path.prevGroupTotal = lightGroupTotal;
   path.depth++;
   return survivesRoulette(path, shadow);
 }
@@ -705,7 +709,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
     emitted = path.beta * m.emission;
     if (!path.specular) {
       int emitter = floatBitsToInt(info.w) + (hit.prim - floatBitsToInt(info.y));
-      emitted *= powerHeuristic(path.prevPdf, emitterPdf(emitter, path.prevPos, pos, dot(ng, wo)));
+      emitted *= powerHeuristic(path.prevPdf, emitterPdf(emitter, path.prevPos, pos, dot(ng, wo), path.prevGroupTotal));
     }
     path.L += emitted;
   }
@@ -778,6 +782,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   }
 
   // Next-event estimation with multiple importance sampling.
+  lightGroupTotal = -1.0;
   if (!isDeltaMaterial(m) && (frame.lightPick.x + frame.lightPick.y + frame.lightPick.z) > 0.0) {
     vec3 lu = vec3(rand(path.rng), rand(path.rng), rand(path.rng));
     LightSample ls = sampleLight(pos, lu);
@@ -841,6 +846,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   path.specular = bs.delta;
   path.prevPdf = bs.pdf;
   path.prevPos = pos;
+  path.prevGroupTotal = lightGroupTotal;
   path.ro = offsetRay(pos, sideI > 0.0 ? ngs : -ngs) + wi * surfaceSkip();
   path.from = ivec2(hit.prim, hit.instance);
   path.rd = wi;
@@ -930,6 +936,9 @@ void main() {
     // iterations in every lane.
     if (hasFeature(kFeatureEnvMap)) syncLoopIterations();
     if (hasFeature(kFeatureSun)) loopIterations += uint(frame.lightPick.w);
+    // Likewise the light groups' loops, a group an iteration, in the lanes that shaded: at most
+    // one light sample's choice and one emitter's pdf without its total.
+    if (hasFeature(kFeatureLightGroups)) loopIterations += 2u * uint(frame.bounces.y);
     // A path's sample is written once, when it ends. (Written by every lane every iteration, as
     // it was to keep lavapipe's per-lane store branches predictable, the four stores, each a loop
     // over the lanes and over the components, took a tenth of the time.)

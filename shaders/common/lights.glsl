@@ -1,4 +1,5 @@
-// Light sources for next-event estimation and MIS: emissive triangles (alias table by power),
+// Light sources for next-event estimation and MIS: emissive triangles (alias table by power,
+// within the light group chosen for the shading point where there are several),
 // the environment (constant, or an equirectangular map importance-sampled by luminance) and
 // delta lights (point, spot, directional) and suns (directional lights with a disc).
 #ifndef RETILE_LIGHTS_GLSL
@@ -110,6 +111,62 @@ struct LightSample {
   bool delta;
 };
 
+// About what light group g gives a point at p (render_scene.cpp packEmitters, FrameUniforms::lightGroups): its weight scale
+// over the squared distance to its centre, at most the weight at its radius, and for a plane the
+// cosine it is seen at from p; nothing from behind a plane, where every triangle faces away. Any
+// weight above 0 wherever the group could light p keeps the estimate unbiased.
+float lightGroupWeight(int g, vec3 p) {
+  vec4 centre = frame.lightGroups[2 * g];
+  vec4 plane = frame.lightGroups[2 * g + 1];
+  vec3 toCentre = centre.xyz - p;
+  float d2 = dot(toCentre, toCentre);
+  float w = min(centre.w / max(d2, 1e-30), plane.w);
+  if (all(equal(plane.xyz, vec3(0.0)))) return w;
+  float h = -dot(plane.xyz, toCentre);
+  return h > 0.0 ? w * min(h * inversesqrt(max(d2, 1e-30)), 1.0) : 0.0;
+}
+
+// The total of the light groups' weights at the point of the last light sample that chose a
+// group, -1 after one that did not (trace.comp keeps it with the path for the emitter it may
+// hit next, whose pdf needs it).
+float lightGroupTotal = -1.0;
+
+// Chooses a light group for a light sample at p, with u in [0, 1), in one pass: each group with
+// weight w replaces the choice so far with probability w over the total so far, and u, rescaled
+// to what is left of it, decides the next. -1 when none can light p. Its iterations, and
+// lightGroupTotalAt's, are counted in trace.comp's main, in every lane.
+int chooseLightGroup(vec3 p, float u, out float probability) {
+  float total = 0.0, chosenWeight = 0.0;
+  int chosen = -1;
+  for (int g = 0; g < frame.bounces.y; ++g) {
+    float w = lightGroupWeight(g, p);
+    if (!(w > 0.0)) continue;
+    total += w;
+    float keep = w / total;
+    if (u < keep) {
+      chosen = g;
+      chosenWeight = w;
+      u = u / keep;
+    } else {
+      u = (u - keep) / (1.0 - keep);
+    }
+    u = clamp(u, 0.0, 0.99999994);
+  }
+  lightGroupTotal = total;
+  probability = chosen >= 0 ? chosenWeight / total : 0.0;
+  return chosen;
+}
+
+// The total chooseLightGroup at p adds up, in the same order.
+float lightGroupTotalAt(vec3 p) {
+  float total = 0.0;
+  for (int g = 0; g < frame.bounces.y; ++g) {
+    float w = lightGroupWeight(g, p);
+    if (w > 0.0) total += w;
+  }
+  return total;
+}
+
 // Picks one light in proportion to frame.lightPick and samples it as seen from p.
 LightSample sampleLight(vec3 p, vec3 u) {
   LightSample ls;
@@ -120,12 +177,21 @@ LightSample sampleLight(vec3 p, vec3 u) {
   ls.delta = false;
   float pe = frame.lightPick.x, pv = frame.lightPick.y;
   if (hasFeature(kFeatureEmitters) && u.z < pe) {
-    int n = frame.scene.z;
+    int first = 0, n = frame.scene.z;
+    float groupProbability = 1.0;
+    if (hasFeature(kFeatureLightGroups)) {
+      // What is left of u.z below pe is again uniform.
+      int g = chooseLightGroup(p, u.z / pe, groupProbability);
+      if (g < 0) return ls;
+      vec4 r = texelFetch(uEmitterAlias, frame.scene.z + g * kLightGroupTexels);
+      first = floatBitsToInt(r.x);
+      n = floatBitsToInt(r.y);
+    }
     float scaled = u.x * float(n);
     int i = min(int(scaled), n - 1);
     float frac = scaled - float(i);
-    vec4 alias = texelFetch(uEmitterAlias, i);
-    int e = frac < alias.x ? i : floatBitsToInt(alias.y);
+    vec4 alias = texelFetch(uEmitterAlias, first + i);
+    int e = frac < alias.x ? first + i : floatBitsToInt(alias.y);
     int base = e * kEmitterTexels;
     vec4 t0 = texelFetch(uEmitters, base), t1 = texelFetch(uEmitters, base + 1), t2 = texelFetch(uEmitters, base + 2);
     vec4 t3 = texelFetch(uEmitters, base + 3), t4 = texelFetch(uEmitters, base + 4);
@@ -145,7 +211,7 @@ LightSample sampleLight(vec3 p, vec3 u) {
     ls.radiance = t3.rgb;
     if (hasFeature(kFeatureEmissionTextures) && floatBitsToInt(t4.w) >= 0)
       ls.radiance *= sampleTexture(floatBitsToInt(t4.w), triangleUv(floatBitsToInt(t2.w), b.x, b.y)).rgb;
-    ls.pdf = pe * t3.w * d2 / (cosL * t0.w);
+    ls.pdf = pe * groupProbability * t3.w * d2 / (cosL * t0.w);
     return ls;
   }
   if (hasFeature(kFeatureEnvConstant | kFeatureEnvMap) && u.z < pe + pv) {
@@ -211,13 +277,19 @@ vec3 sunsSeen(vec3 d, bool specular, float bsdfPdf) {
   return seen;
 }
 
-// pdf with which sampleLight would have chosen the emitter point hit by a BSDF ray.
-float emitterPdf(int emitter, vec3 from, vec3 hitPos, float cosL) {
+// pdf with which sampleLight would have chosen the emitter point hit by a BSDF ray; groupTotal
+// is lightGroupTotal of the light sample at `from` (below 0: not known).
+float emitterPdf(int emitter, vec3 from, vec3 hitPos, float cosL, float groupTotal) {
   vec4 t0 = texelFetch(uEmitters, emitter * kEmitterTexels);
   vec4 t3 = texelFetch(uEmitters, emitter * kEmitterTexels + 3);
   vec3 d = hitPos - from;
   if (cosL <= 0.0 || t0.w <= 0.0) return 0.0;
-  return frame.lightPick.x * t3.w * dot(d, d) / (cosL * t0.w);
+  float pick = frame.lightPick.x * t3.w;
+  if (hasFeature(kFeatureLightGroups)) {
+    float total = groupTotal >= 0.0 ? groupTotal : lightGroupTotalAt(from);
+    pick *= total > 0.0 ? lightGroupWeight(floatBitsToInt(texelFetch(uEmitterAlias, emitter).z), from) / total : 0.0;
+  }
+  return pick * dot(d, d) / (cosL * t0.w);
 }
 
 #endif

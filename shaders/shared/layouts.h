@@ -28,6 +28,11 @@ RT_CONST(int, kEmitterTexels, 5)    // v0.xyz area | e1.xyz instance | e2.xyz tr
 // position.xyz type | direction.xyz cosOuter | intensity.rgb cosInner | -; a sun (kLightSun):
 // - type | direction.xyz 1 - cos(angular radius) | radiance.rgb solid angle | -
 RT_CONST(int, kDeltaLightTexels, 4)
+// With kFeatureLightGroups, the emitter alias table (one texel per emitter: keep probability,
+// alias index, light group) is followed by kLightGroupTexels per group: its first emitter and
+// emitter count. What the choice of group weighs is in FrameUniforms::lightGroups.
+RT_CONST(int, kLightGroupTexels, 1)
+RT_CONST(int, kMaxLightGroups, 16)
 
 // The traversal buffer holds every triangle (packed triangle p at texel p * kTriTexels), then the
 // mesh BVHs, the instance BVH and one record per reference to an instance (or, with
@@ -115,7 +120,12 @@ RT_CONST(int, kFeatureCullBack, 2097152)
 RT_CONST(int, kFeatureEmissionCone, 4194304)
 // Light that arrives in fewer than FrameUniforms::bounces.x bounces is left out (RenderSettings::minBounces).
 RT_CONST(int, kFeatureMinBounces, 8388608)
-RT_CONST(int, kFeatureAll, 16777215)
+// Light samples choose among the emissive instances (light groups) by what each would give the
+// shading point (lights.glsl lightGroupWeight), then a triangle of the chosen one by power;
+// without it, a triangle of all of them by power. For 2 to kMaxLightGroups groups
+// (FrameUniforms::bounces.y).
+RT_CONST(int, kFeatureLightGroups, 16777216)
+RT_CONST(int, kFeatureAll, 33554431)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceBoundary, 2)  // its material is a boundary (kMatBoundary), which shadow rays cross
@@ -247,7 +257,13 @@ struct FrameUniforms {
   // (RenderSceneData::lightInScatteringGlass), else 0.
   vec4 worldAbsorption;
   vec4 worldScattering;
-  ivec4 bounces;        // the fewest a path's light counts at (RenderSettings::minBounces), -, -, -
+  ivec4 bounces;        // the fewest a path's light counts at (RenderSettings::minBounces), light groups (0 without kFeatureLightGroups), -, -
+  // Two per light group (kFeatureLightGroups; lights.glsl lightGroupWeight), here because every
+  // lane reads every group's at every light sample, where a texel fetch is a call per read on
+  // lavapipe: a centre.xyz (on its plane, if it is one) and its weight scale (its power over pi
+  // for a plane, over 4 pi otherwise); the plane's normal.xyz, 0 when the group is not one plane
+  // facing one way, and the most weight it is given (the scale over its bounding radius squared).
+  vec4 lightGroups[2 * kMaxLightGroups];
 };
 
 // A rectangle of pixels that receives q samples each this frame. Slot s of the frame belongs to
@@ -317,7 +333,7 @@ struct DenoisePush {
 
 #ifdef __cplusplus
 static_assert(sizeof(DenoisePush) == 48);
-static_assert(sizeof(FrameUniforms) == 30 * 16);
+static_assert(sizeof(FrameUniforms) == (30 + 2 * kMaxLightGroups) * 16);
 static_assert(sizeof(WorkItem) == 48);
 static_assert(sizeof(TracePush) == 16);
 }  // namespace retile::gpu

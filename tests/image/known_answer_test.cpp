@@ -1570,6 +1570,73 @@ TEST(KnownAnswer, AnEmissionConeLightsOnlyWithinIt) {
   }
 }
 
+// Two 1 x 1 lamps 0.5 above a white floor, facing it, and a 3 x 3 one above the camera facing
+// away from everything (a ceiling lamp seen from its ceiling), with 9/11 of the power. As three
+// objects, three light groups: light samples at the floor go to the two that can light it. As one
+// mesh, one group: picked by power among all triangles, most go to the one facing away. The
+// floor's mean is the same either way (with the emitters' pdfs for the rays that hit them right
+// too); with groups, its noise is lower.
+TEST(KnownAnswer, LightGroupsSpendLightSamplesOnLampsThatCanLightThePoint) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const int n = 32;
+  struct Lamp {
+    Vec3 at;
+    float size;
+    bool down;
+  };
+  const Lamp lamps[3] = {{{-0.8f, 0.5f, 0}, 1, true}, {{0.8f, 0.5f, 0.3f}, 1, true}, {{0, 4, 0}, 3, false}};
+  auto placed = [](const Lamp& l) {
+    return Mat4::translate(l.at) * (l.down ? Mat4::rotateX(kPi) : Mat4::identity()) * Mat4::scale({l.size, 1, l.size});
+  };
+  struct Result {
+    double mean, noise;
+  };
+  auto floorLit = [&](bool grouped) {
+    Scene s = test::emptyScene(n, n);
+    s.settings.maxBounces = 1;
+    lookStraightDown(s, 3, 80);
+    NodeId floor = test::addMeshObject(s, "floor", makeQuad(), test::addMaterial(s, grey(1.0f)), Mat4::scale({8, 1, 8}));
+    Material lamp;
+    lamp.albedo = Vec3{0.0f};
+    lamp.emission = Vec3{4.0f};
+    const NodeId lampId = test::addMaterial(s, lamp);
+    if (grouped) {
+      for (const Lamp& l : lamps) test::addMeshObject(s, "lamp", makeQuad(), lampId, placed(l));
+    } else {
+      auto all = std::make_shared<MeshGeometry>();
+      const auto quad = makeQuad();
+      for (const Lamp& l : lamps) {
+        const auto base = static_cast<std::uint32_t>(all->positions.size());
+        const Mat4 m = placed(l);
+        for (std::size_t v = 0; v < quad->positions.size(); ++v) {
+          all->positions.push_back(m.transformPoint(quad->positions[v]));
+          all->normals.push_back(normalize(m.transformVector(quad->normals[v])));
+          all->uvs.push_back(quad->uvs[v]);
+        }
+        for (std::uint32_t i : quad->indices) all->indices.push_back(base + i);
+      }
+      test::addMeshObject(s, "lamps", all, lampId, Mat4::identity());
+    }
+    const RenderImage a = renderScene(*r, s, 256, 1), b = renderScene(*r, s, 256, 2);
+    const auto kernel = r->kernelFeatures();
+    EXPECT_EQ(std::find(kernel.begin(), kernel.end(), "light groups") != kernel.end(), grouped);
+    int seen = 0;
+    const double mean = 0.5 * (meanOver(a, floor, &seen) + meanOver(b, floor));
+    EXPECT_GT(seen, 600);
+    double squares = 0;
+    for (std::size_t i = 0; i < a.objectId.size(); ++i)
+      if (a.objectId[i] == floor) {
+        const double d = a.color[i * 3 + 1] - b.color[i * 3 + 1];
+        squares += d * d;
+      }
+    return Result{mean, std::sqrt(squares / (2.0 * seen)) / mean};
+  };
+  const Result groups = floorLit(true), one = floorLit(false);
+  EXPECT_GT(groups.mean, 0.1);
+  EXPECT_NEAR(groups.mean, one.mean, 0.01 * one.mean);
+  EXPECT_GT(one.noise, 1.5 * groups.noise) << "with groups " << groups.noise << ", as one " << one.noise;
+}
+
 TEST(KnownAnswer, InverseSquareFalloffOfASmallLight) {
   RETILE_RENDERER_OR_SKIP(r);
   NodeId plane;

@@ -573,7 +573,8 @@ TEST(RenderScene, InstancesApartKeepOneReferenceEach) {
 }
 
 // Light samples pick emitter triangles by power: a textured emitter's is scaled by its texture's
-// mean, and its records name its triangle and texture for the uv lookup at a sample.
+// mean, and its records name its triangle and texture for the uv lookup at a sample. (Two lamps
+// side by side facing the same way gain little from a choice per point: no light groups.)
 TEST(RenderScene, ATexturedEmitterIsPickedByItsTexturesMean) {
   Scene s = test::emptyScene(8, 8);
   Texture dim;
@@ -593,6 +594,8 @@ TEST(RenderScene, ATexturedEmitterIsPickedByItsTexturesMean) {
   const RenderSceneData& d = builder.data();
   ASSERT_EQ(d.emitters.size(), 4u * gpu::kEmitterTexels);
   EXPECT_NE(d.features() & static_cast<std::uint32_t>(gpu::kFeatureEmissionTextures), 0u);
+  EXPECT_EQ(d.lightGroups, 0) << "gain " << d.lightGroupGain;
+  EXPECT_LT(d.lightGroupGain, kLightGroupMinGain);
   double pick[2] = {0, 0};
   for (std::size_t e = 0; e < 4; ++e) {
     const vec4* r = d.emitters.data() + e * gpu::kEmitterTexels;
@@ -604,6 +607,139 @@ TEST(RenderScene, ATexturedEmitterIsPickedByItsTexturesMean) {
   }
   EXPECT_NEAR(pick[0] + pick[1], 1.0, 1e-5);
   EXPECT_NEAR(pick[1], 0.1 / 1.1, 1e-4) << "the textured emitter has a tenth of the power";
+}
+
+// The gain of choosing a light group per point: with one group's weight everywhere it has, as
+// much as by power (1); with two equal lamps, each seen from the far side of the other's plane
+// where only it can light, the share of power each gets by power is a half (2).
+TEST(RenderScene, ALightGroupsGainIsWhatChoosingPerPointSaves) {
+  const Bounds3 box{{-1, -1, -1}, {1, 1, 1}};
+  auto lamp = [](Vec3 centre, Vec3 normal, float scale) {
+    return std::array<vec4, 2>{vec4{centre.x, centre.y, centre.z, scale}, vec4{normal.x, normal.y, normal.z, 1e30f}};
+  };
+  std::vector<vec4> shapes;
+  auto add = [&](const std::array<vec4, 2>& l) { shapes.insert(shapes.end(), l.begin(), l.end()); };
+  // The same weights at every point in proportion to the power: as good as by power.
+  add(lamp({0, 0, 0}, {0, 0, 0}, 1));
+  add(lamp({0, 0, 0}, {0, 0, 0}, 3));
+  EXPECT_NEAR(lightGroupGain(shapes, {1, 3}, box), 1.0, 1e-6);
+  // Two lamps at the centre facing opposite ways: every point sees one.
+  shapes.clear();
+  add(lamp({0, 0, 0}, {0, 1, 0}, 1));
+  add(lamp({0, 0, 0}, {0, -1, 0}, 1));
+  EXPECT_NEAR(lightGroupGain(shapes, {1, 1}, box), 2.0, 1e-6);
+  // The same with a tenth of the power in the first: where only it lights, by power it gets a
+  // tenth of the samples (second moment 11 w^2 against w^2), where the other does 11/10.
+  EXPECT_GT(lightGroupGain(shapes, {1, 10}, box), 2.0);
+  EXPECT_EQ(lightGroupGain(shapes, {1, 1}, Bounds3{}), 1.0) << "no points";
+}
+
+// Each emissive instance is a light group: its run of emitters, an alias table within the run,
+// its bounding sphere, its plane where all its triangles lie in one facing one way (a quad, not a
+// ball nor two quads back to back), and a scale from its power. One group, or more than
+// kMaxLightGroups, compiles no groups in, and picks among all emitters by power.
+TEST(RenderScene, EmissiveInstancesAreLightGroupsWithTheirPlanes) {
+  Scene s = test::emptyScene(8, 8);
+  Material lamp;
+  lamp.emission = Vec3{2.0f};
+  const NodeId lampId = test::addMaterial(s, lamp);
+  // Facing down, 2 x 2, its centre at (5, 3, 0).
+  test::addMeshObject(s, "quad", makeQuad(), lampId, Mat4::translate({5, 3, 0}) * Mat4::rotateX(kPi) * Mat4::scale({2, 1, 2}));
+  test::addMeshObject(s, "ball", makeSphere(8, 16), lampId, Mat4::translate({-4, 0, 0}));
+  auto twoFaced = std::make_shared<MeshGeometry>(*makeQuad());
+  for (std::uint32_t i : {0u, 2u, 1u, 0u, 3u, 2u}) twoFaced->indices.push_back(i);
+  std::swap(twoFaced->indices[7], twoFaced->indices[8]);
+  std::swap(twoFaced->indices[10], twoFaced->indices[11]);
+  test::addMeshObject(s, "two faced", twoFaced, lampId, Mat4::translate({0, 0, 6}));
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  const RenderSceneData& d = builder.data();
+  const std::size_t n = d.emitters.size() / gpu::kEmitterTexels;
+  ASSERT_EQ(d.lightGroups, 3) << "gain " << d.lightGroupGain;
+  EXPECT_GE(d.lightGroupGain, kLightGroupMinGain);
+  EXPECT_NE(d.features() & static_cast<std::uint32_t>(gpu::kFeatureLightGroups), 0u);
+  ASSERT_EQ(d.emitterAlias.size(), n + 3u * gpu::kLightGroupTexels);
+  ASSERT_EQ(d.lightGroupShapes.size(), 6u);
+  std::size_t covered = 0;
+  int planes = 0;
+  for (int g = 0; g < 3; ++g) {
+    const vec4 run = d.emitterAlias[n + static_cast<std::size_t>(g) * gpu::kLightGroupTexels];
+    const vec4* rec = d.lightGroupShapes.data() + 2 * static_cast<std::size_t>(g);
+    const auto first = static_cast<std::size_t>(std::bit_cast<std::int32_t>(run.x));
+    const auto count = static_cast<std::size_t>(std::bit_cast<std::int32_t>(run.y));
+    EXPECT_EQ(first, covered) << "the groups are consecutive runs";
+    covered += count;
+    double picks = 0, area = 0;
+    for (std::size_t e = first; e < first + count; ++e) {
+      EXPECT_EQ(std::bit_cast<std::int32_t>(d.emitterAlias[e].z), g);
+      const auto alias = static_cast<std::size_t>(std::bit_cast<std::int32_t>(d.emitterAlias[e].y));
+      EXPECT_TRUE(alias >= first && alias < first + count) << "an alias within the group";
+      picks += d.emitters[e * gpu::kEmitterTexels + 3].w;
+      area += d.emitters[e * gpu::kEmitterTexels].w;
+    }
+    EXPECT_NEAR(picks, 1.0, 1e-5) << g;
+    const Vec3 normal{rec[1].x, rec[1].y, rec[1].z};
+    if (count == 2) {
+      // The quad facing down: its centre on its plane y = 3, its scale area x 2, its most weight
+      // that over its bounding radius (sqrt 2) squared.
+      ++planes;
+      EXPECT_NEAR(normal.y, -1.0f, 1e-5f);
+      EXPECT_NEAR(rec[0].x, 5.0f, 1e-5f);
+      EXPECT_NEAR(rec[0].y, 3.0f, 1e-5f);
+      EXPECT_NEAR(rec[0].w, 8.0f, 1e-3f);
+      EXPECT_NEAR(rec[1].w, 4.0f, 1e-3f);
+    } else {
+      EXPECT_EQ(length(normal), 0.0f) << "no one plane facing one way: group " << g;
+      EXPECT_NEAR(rec[0].w, area * 2.0 / 4.0, 1e-3 * area) << "a quarter of its area times its radiance";
+    }
+  }
+  EXPECT_EQ(planes, 1);
+  EXPECT_EQ(covered, n);
+
+  // A tilted triangle, whose bounding box's centre is off its plane: the centre is put on it.
+  Scene tilted = test::emptyScene(8, 8);
+  auto triangle = std::make_shared<MeshGeometry>();
+  triangle->positions = {{0, 0, 0}, {1, 0, 0}, {0, 0, 2}};
+  triangle->normals.assign(3, {0, 1, 0});
+  triangle->uvs.assign(3, {0, 0});
+  triangle->indices = {0, 2, 1};
+  const NodeId tiltedLamp = test::addMaterial(tilted, lamp);
+  test::addMeshObject(tilted, "triangle", triangle, tiltedLamp, Mat4::translate({1, 2, 3}) * Mat4::rotateZ(0.5f) * Mat4::rotateX(0.7f));
+  test::addMeshObject(tilted, "quad", makeQuad(), tiltedLamp, Mat4::translate({0, -5, 0}));
+  builder.update(tilted, kUpdateAll, nullptr);
+  {
+    const RenderSceneData& t = builder.data();
+    ASSERT_EQ(t.lightGroups, 2);
+    const vec4* rec = t.lightGroupShapes.data();  // the triangle's group, the first
+    const Vec3 normal{rec[1].x, rec[1].y, rec[1].z}, centre{rec[0].x, rec[0].y, rec[0].z};
+    const Vec3 corner{t.emitters[0].x, t.emitters[0].y, t.emitters[0].z};
+    EXPECT_NEAR(length(normal), 1.0f, 1e-5f) << "a plane";
+    EXPECT_NEAR(dot(normal, centre - corner), 0.0f, 1e-5f) << "the centre on the plane";
+    const Mat4 place = Mat4::translate({1, 2, 3}) * Mat4::rotateZ(0.5f) * Mat4::rotateX(0.7f);
+    Bounds3 placed;
+    for (Vec3 v : triangle->positions) placed.grow(place.transformPoint(v));
+    EXPECT_GT(std::abs(dot(normal, placed.center() - corner)), 0.01f) << "the box's centre is off the plane";
+  }
+
+  // One emitter: no groups, and the picks are among all emitters.
+  Scene one = test::emptyScene(8, 8);
+  test::addMeshObject(one, "ball", makeSphere(8, 16), test::addMaterial(one, lamp), Mat4::identity());
+  builder.update(one, kUpdateAll, nullptr);
+  EXPECT_EQ(builder.data().lightGroups, 0);
+  EXPECT_EQ(builder.data().features() & static_cast<std::uint32_t>(gpu::kFeatureLightGroups), 0u);
+  EXPECT_EQ(builder.data().emitterAlias.size(), builder.data().emitters.size() / gpu::kEmitterTexels);
+  EXPECT_TRUE(builder.data().lightGroupShapes.empty());
+  // More than kMaxLightGroups: the same.
+  Scene many = test::emptyScene(8, 8);
+  const NodeId manyLamp = test::addMaterial(many, lamp);
+  for (int i = 0; i <= gpu::kMaxLightGroups; ++i)
+    test::addMeshObject(many, "quad", makeQuad(), manyLamp, Mat4::translate({2.0f * static_cast<float>(i), 0, 0}));
+  builder.update(many, kUpdateAll, nullptr);
+  const RenderSceneData& m = builder.data();
+  EXPECT_EQ(m.lightGroups, 0);
+  double picks = 0;
+  for (std::size_t e = 0; e < m.emitters.size() / gpu::kEmitterTexels; ++e) picks += m.emitters[e * gpu::kEmitterTexels + 3].w;
+  EXPECT_NEAR(picks, 1.0, 1e-5);
 }
 
 // An emitter's cone is packed as its cosine where the kernel reads it (the material's eighth

@@ -59,6 +59,46 @@ std::vector<vec4> aliasTable(const std::vector<float>& weights) {
   return table;
 }
 
+// What lightGroupWeight (lights.glsl) gives the light group of `shape` (two texels,
+// FrameUniforms::lightGroups) at p; the kernel's twin, for lightGroupGain.
+double lightGroupWeight(const vec4* shape, Vec3 p) {
+  const Vec3 toCentre = Vec3{shape[0].x, shape[0].y, shape[0].z} - p;
+  const double d2 = std::max<double>(dot(toCentre, toCentre), 1e-30);
+  const double w = std::min<double>(shape[0].w / d2, shape[1].w);
+  const Vec3 normal{shape[1].x, shape[1].y, shape[1].z};
+  if (normal.x == 0 && normal.y == 0 && normal.z == 0) return w;
+  const double h = -dot(normal, toCentre);
+  return h > 0 ? w * std::min(h / std::sqrt(d2), 1.0) : 0.0;
+}
+
+}  // namespace
+
+// Taking the groups' weights as what they give, a light sample's second moment where it picks by
+// power among all emitters (the sum over groups of w^2 over the group's share of the power)
+// against where it picks a group by weight (W^2, the square of their sum), summed over a grid of
+// points through the scene. Points near lights weigh most, as they do in an image.
+double lightGroupGain(const std::vector<vec4>& shapes, const std::vector<double>& power, const Bounds3& bounds) {
+  const double total = std::accumulate(power.begin(), power.end(), 0.0);
+  if (bounds.empty() || !(total > 0)) return 1.0;
+  const int n = 12;
+  double byPower = 0, byWeight = 0;
+  for (int i = 0; i < n * n * n; ++i) {
+    const Vec3 f{(static_cast<float>(i % n) + 0.5f) / n, (static_cast<float>(i / n % n) + 0.5f) / n, (static_cast<float>(i / (n * n)) + 0.5f) / n};
+    const Vec3 p = bounds.lo + Vec3{f.x * bounds.extent().x, f.y * bounds.extent().y, f.z * bounds.extent().z};
+    double sum = 0, moment = 0;
+    for (std::size_t g = 0; g < power.size(); ++g) {
+      const double w = lightGroupWeight(shapes.data() + 2 * g, p);
+      sum += w;
+      if (w > 0 && power[g] > 0) moment += w * w * total / power[g];
+    }
+    byPower += moment;
+    byWeight += sum * sum;
+  }
+  return byWeight > 0 ? byPower / byWeight : 1.0;
+}
+
+namespace {
+
 // The item naming the record of `kind` at texel `offset` of the traversal buffer (layouts.h).
 std::int32_t traversalItem(std::int64_t offset, int kind) {
   if (offset + 4 > gpu::kMaxTraversalTexels)
@@ -316,6 +356,7 @@ std::uint32_t RenderSceneData::features() const {
   if (tungstenEpsilon) f |= gpu::kFeatureTungstenEpsilon;
   if (cullBack) f |= gpu::kFeatureCullBack;
   if (minBounces > 0) f |= gpu::kFeatureMinBounces;
+  if (lightGroups > 0) f |= gpu::kFeatureLightGroups;
   if (materialBump) f |= gpu::kFeatureBump;
   if (emissionTextures) f |= gpu::kFeatureEmissionTextures;
   if (emissionCones) f |= gpu::kFeatureEmissionCone;
@@ -1268,6 +1309,11 @@ bool RenderSceneBuilder::lightInScatteringGlass(const Scene& scene) const {
 void RenderSceneBuilder::packEmitters(const Scene& scene) {
   data_.emitters.clear();
   std::vector<float> power;
+  // Each emissive instance is a light group, its emitters a run of the table.
+  struct Group {
+    std::size_t first = 0, count = 0;
+  };
+  std::vector<Group> groups;
   std::size_t count = data_.instanceObject.size();
   for (std::size_t i = 0; i < count; ++i) {
     const Object* o = scene.object(data_.instanceObject[i]);
@@ -1287,6 +1333,7 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
     // it would get a tenth of the samples at 20 degrees, a grainy spot.
     float radianceLum = std::max(luminance(radiance), 1e-6f);
     std::size_t n = mesh->bvh.primOrder.size();
+    groups.push_back({power.size(), n});
     for (std::size_t p = 0; p < n; ++p) {
       const vec4* t = data_.meshTraversal.data() + (std::size_t{mesh->triOffset} + p) * gpu::kTriTexels;
       Vec3 v0{t[0].x, t[0].y, t[0].z};
@@ -1306,15 +1353,82 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
       data_.emitters.push_back(v4(w2 - w0, bitsOf(static_cast<std::int32_t>(mesh->triOffset + p))));
       data_.emitters.push_back(v4(mat->emission, 0));
       data_.emitters.push_back(v4(nrm, bitsOf(textureIndex(mat->emissionTexture))));
-      power.push_back(area > 0 && std::isfinite(area) ? area * kPi * radianceLum : 0.0f);
+      power.push_back(area > 0 && std::isfinite(area) && std::isfinite(radianceLum) ? area * kPi * radianceLum : 0.0f);
     }
   }
   data_.lightInScatteringGlass = lightInScatteringGlass(scene);
-  double total = std::accumulate(power.begin(), power.end(), 0.0);
-  for (std::size_t i = 0; i < power.size(); ++i)
-    data_.emitters[i * gpu::kEmitterTexels + 3].w = total > 0 ? static_cast<float>(power[i] / total) : 0.0f;
-  data_.emitterAlias = aliasTable(power);
-  emitterPower_ = static_cast<float>(total);
+  emitterPower_ = static_cast<float>(std::accumulate(power.begin(), power.end(), 0.0));
+  // Each group's shape, as lightGroupWeight (lights.glsl) reads it: one plane facing one way,
+  // seen from behind, gives nothing, which is what Tungsten's quads say of a light facing away.
+  data_.lightGroupShapes.clear();
+  std::vector<double> groupPower;
+  if (groups.size() >= 2 && groups.size() <= static_cast<std::size_t>(gpu::kMaxLightGroups)) {
+    for (const Group& grp : groups) {
+      const double total = std::accumulate(power.begin() + static_cast<std::ptrdiff_t>(grp.first),
+                                           power.begin() + static_cast<std::ptrdiff_t>(grp.first + grp.count), 0.0);
+      groupPower.push_back(total);
+      Bounds3 bounds;
+      const vec4* e = data_.emitters.data() + grp.first * gpu::kEmitterTexels;
+      Vec3 normal{0.0f}, onPlane{0.0f};
+      bool planar = true;
+      for (std::size_t k = 0; k < grp.count; ++k, e += gpu::kEmitterTexels) {
+        const Vec3 w0{e[0].x, e[0].y, e[0].z};
+        bounds.grow(w0);
+        bounds.grow(w0 + Vec3{e[1].x, e[1].y, e[1].z});
+        bounds.grow(w0 + Vec3{e[2].x, e[2].y, e[2].z});
+        if (!(power[grp.first + k] > 0)) continue;
+        const Vec3 nrm{e[4].x, e[4].y, e[4].z};
+        if (length(normal) == 0) normal = nrm, onPlane = w0;
+        else if (!(dot(normal, nrm) > 1 - 1e-5f)) planar = false;
+      }
+      const float radius = bounds.empty() ? 0.0f : 0.5f * length(bounds.extent());
+      Vec3 centre = bounds.empty() ? Vec3{0.0f} : bounds.center();
+      const float offset = dot(normal, onPlane);
+      // Rounding of the placed vertices grows with their distance from the origin.
+      const float slack = 1e-4f * radius + 1e-6f * (std::abs(offset) + length(centre));
+      e = data_.emitters.data() + grp.first * gpu::kEmitterTexels;
+      for (std::size_t k = 0; planar && k < grp.count; ++k, e += gpu::kEmitterTexels) {
+        const Vec3 w0{e[0].x, e[0].y, e[0].z};
+        for (Vec3 v : {w0, w0 + Vec3{e[1].x, e[1].y, e[1].z}, w0 + Vec3{e[2].x, e[2].y, e[2].z}})
+          if (!(std::abs(dot(normal, v) - offset) <= slack)) planar = false;
+      }
+      planar = planar && length(normal) > 0;
+      if (planar) centre = centre - normal * (dot(normal, centre) - offset);  // onto the plane, which the kernel measures from it
+      else normal = Vec3{0.0f};
+      // What it gives a point at distance d is about its radiance times the solid angle of its
+      // area (a plane's seen at the plane's cosine, a solid's a quarter of its area, a convex
+      // body's mean projection), over d^2.
+      const float scale = static_cast<float>(total / (planar ? kPi : 4 * kPi));
+      data_.lightGroupShapes.push_back(v4(centre, scale));
+      data_.lightGroupShapes.push_back(v4(normal, scale / std::max(radius * radius, 1e-30f)));
+    }
+  }
+  // The choice per point costs every light sample a pass over the groups (a tenth of the
+  // spaceship's samples/s, whose lamps it helps little): it is compiled in only where it gains.
+  data_.lightGroupGain = groupPower.empty() ? 1.0 : lightGroupGain(data_.lightGroupShapes, groupPower, data_.bounds);
+  data_.lightGroups = data_.lightGroupGain >= kLightGroupMinGain ? static_cast<int>(groups.size()) : 0;
+  if (data_.lightGroups == 0) {
+    groups.assign(1, Group{0, power.size()});
+    data_.lightGroupShapes.clear();
+  }
+  data_.emitterAlias.clear();
+  std::vector<vec4> runs;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const Group& grp = groups[g];
+    const std::vector<float> part(power.begin() + static_cast<std::ptrdiff_t>(grp.first),
+                                  power.begin() + static_cast<std::ptrdiff_t>(grp.first + grp.count));
+    const double total = std::accumulate(part.begin(), part.end(), 0.0);
+    for (std::size_t k = 0; k < part.size(); ++k)
+      data_.emitters[(grp.first + k) * gpu::kEmitterTexels + 3].w = total > 0 ? static_cast<float>(part[k] / total) : 0.0f;
+    for (vec4 a : aliasTable(part)) {
+      a.y = bitsOf(std::bit_cast<std::int32_t>(a.y) + static_cast<std::int32_t>(grp.first));
+      a.z = bitsOf(static_cast<std::int32_t>(g));
+      data_.emitterAlias.push_back(a);
+    }
+    if (data_.lightGroups > 0)
+      runs.push_back({bitsOf(static_cast<std::int32_t>(grp.first)), bitsOf(static_cast<std::int32_t>(grp.count)), 0, 0});
+  }
+  data_.emitterAlias.insert(data_.emitterAlias.end(), runs.begin(), runs.end());
 
   data_.deltaLights.clear();
   deltaPower_ = 0;

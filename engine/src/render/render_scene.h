@@ -50,6 +50,13 @@ float emissionConeCos(const Material& m);
 // gpu::kFeatureFilter... bits (Tungsten draws its tent and Gaussian from a table of its own).
 int filterFeature(const RenderSettings& s);
 
+// How much lower, about, a light sample's second moment is where it chooses one of the light
+// groups of `shapes` (two texels each, FrameUniforms::lightGroups) by what it gives the point than
+// where it picks among all emitters by power, over points through `bounds`; `power` is each
+// group's. Light groups are compiled in from kLightGroupMinGain on.
+double lightGroupGain(const std::vector<vec4>& shapes, const std::vector<double>& power, const Bounds3& bounds);
+inline constexpr double kLightGroupMinGain = 1.5;
+
 // Which arrays changed in the last update, so the uploader copies only those.
 enum DirtyArrays : std::uint32_t {
   kDirtyGeometry = 1u << 0,   // meshTraversal, triangleShading
@@ -88,7 +95,15 @@ struct RenderSceneData {
   std::vector<vec4> textureInfo;       // kTextureTexels per texture
   std::vector<std::uint32_t> texels;   // every bitmap: 8-bit RGBA or RGBA16F words (layouts.h kTexEightBit)
   std::vector<vec4> emitters;          // kEmitterTexels per emissive triangle
-  std::vector<vec4> emitterAlias;      // one per emitter: (keep probability, alias index, -, -)
+  // One per emitter (keep probability, alias index, light group), then the light groups' records
+  // (layouts.h kLightGroupTexels). An emitter's alias and its pick probability (emitters' radiance.w)
+  // are within its group, or, with no light groups, among all emitters.
+  std::vector<vec4> emitterAlias;
+  // Emissive instances chosen per shading point (kFeatureLightGroups), or 0: 2 to
+  // kMaxLightGroups of them where lightGroupGain is at least kLightGroupMinGain.
+  int lightGroups = 0;
+  std::vector<vec4> lightGroupShapes;  // two per light group, for FrameUniforms::lightGroups
+  double lightGroupGain = 1;           // lightGroupGain of the emissive instances (1: fewer than 2, or more than kMaxLightGroups)
   std::vector<vec4> deltaLights;       // kDeltaLightTexels per light, suns first
   int suns = 0;                        // directional lights with a disc (kLightSun)
   std::vector<float> environmentCdf;   // marginal (h+1) then conditional rows (w+1 each)

@@ -454,7 +454,8 @@ struct Renderer::Impl {
     const MediumAt& world = d.worldMedium;
     u.worldAbsorption = {world.absorption.x, world.absorption.y, world.absorption.z, d.lightInScatteringGlass ? 0.0f : 1.0f};
     u.worldScattering = {world.scattering.x, world.scattering.y, world.scattering.z, world.anisotropy};
-    u.bounces = {d.minBounces, 0, 0, 0};
+    u.bounces = {d.minBounces, d.lightGroups, 0, 0};
+    std::copy_n(d.lightGroupShapes.begin(), std::min<std::size_t>(d.lightGroupShapes.size(), std::size(u.lightGroups)), u.lightGroups);
     std::uint32_t sel = countTile > 0 ? selectedInstance() : 0u;
     u.work = {itemCount, static_cast<std::uint32_t>(slots), sel, sel ? static_cast<std::uint32_t>(countTile) : 0u};
     // Tungsten draws its box exactly, and has no other filter the table could stand for.
@@ -845,6 +846,7 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   if (f & static_cast<std::uint32_t>(gpu::kFeatureCullBack)) out.push_back("back faces culled");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureEmissionCone)) out.push_back("emission cones");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureMinBounces)) out.push_back("min bounces");
+  if (f & static_cast<std::uint32_t>(gpu::kFeatureLightGroups)) out.push_back("light groups");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureByteTexels)) out.push_back("8-bit texels");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureHalfTexels)) out.push_back("half-float texels");
   if (f & static_cast<std::uint32_t>(gpu::kFeatureSrgbTexels)) out.push_back("sRGB texels");
