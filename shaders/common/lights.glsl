@@ -111,10 +111,11 @@ struct LightSample {
   bool delta;
 };
 
-// About what light group g gives a point at p (render_scene.cpp packEmitters, FrameUniforms::lightGroups): its weight scale
-// over the squared distance to its centre, at most the weight at its radius, and for a plane the
-// cosine it is seen at from p; nothing from behind a plane, where every triangle faces away. Any
-// weight above 0 wherever the group could light p keeps the estimate unbiased.
+// About what light group g gives a point at p (render_scene.cpp packEmitters,
+// FrameUniforms::lightGroups): its weight scale over the squared distance to its centre, at most
+// the weight at its radius, and for a plane the cosine it is seen at from p; nothing from behind a
+// plane, where every triangle faces away. Any weight above 0 wherever the group could light p
+// keeps the estimate unbiased. render_scene.cpp has its twin, for lightGroupGain.
 float lightGroupWeight(int g, vec3 p) {
   vec4 centre = frame.lightGroups[2 * g];
   vec4 plane = frame.lightGroups[2 * g + 1];
