@@ -351,7 +351,7 @@ class GraphNodeItem : public QGraphicsItem {
       const QPointF c = inputPos(i);
       socket(c, inputs[i]);
       p->setPen(QColor(222, 222, 228));
-      p->drawText(QRectF(12, c.y() - kRowH / 2, kNodeWidth / 2, kRowH), Qt::AlignVCenter | Qt::AlignLeft, inputs[i]);
+      p->drawText(QRectF(12, c.y() - kRowH / 2, kNodeWidth / 2, kRowH), Qt::AlignVCenter | Qt::AlignLeft, label(i));
     }
     if (!output.isEmpty()) {
       const QPointF c = outputPos();
@@ -362,10 +362,14 @@ class GraphNodeItem : public QGraphicsItem {
     }
   }
 
+  // What input i is called on this node: its socket's name unless `labels` renames it.
+  QString label(qsizetype i) const { return i < labels.size() && !labels[i].isEmpty() ? labels[i] : inputs[i]; }
+
   NodeId id;
   NodeKind kind;
   QString title, subtitle;
   QStringList inputs;
+  QStringList labels;  // shown instead of inputs' names where not empty (the sockets keep them)
   QString output;
   QColor swatch;  // invalid: none
 };
@@ -550,6 +554,12 @@ void NodeGraphView::rebuild() {
     if (m.type != MaterialType::Boundary) {
       n->inputs = textureInputs();
       n->inputs << kBlendInput;
+      // A sheet has no roughness: the kernel reads that texture as its thickness (Tungsten's
+      // textured thinsheet), as the material panel says too.
+      if (m.type == MaterialType::ThinSheet) {
+        n->labels.resize(n->inputs.size());
+        n->labels[n->inputs.indexOf(QLatin1String("roughness"))] = QStringLiteral("thickness");
+      }
     }
     n->output = QStringLiteral("material");
     // An emitter shows its light's hue; its albedo is usually black.
@@ -731,6 +741,13 @@ QPointF NodeGraphView::socketScenePos(NodeId id, const QString& socket, bool out
   if (output) return n->output == socket ? n->mapToScene(n->outputPos()) : n->pos();
   const auto i = n->inputs.indexOf(socket);
   return i < 0 ? n->pos() : n->mapToScene(n->inputPos(i));
+}
+
+QString NodeGraphView::socketLabel(NodeId id, const QString& input) const {
+  auto it = nodes_.find(id);
+  if (it == nodes_.end()) return {};
+  const auto i = it->second->inputs.indexOf(input);
+  return i < 0 ? QString() : it->second->label(i);
 }
 
 GraphNodeItem* NodeGraphView::nodeAt(QPointF scenePos) const {

@@ -90,6 +90,8 @@ class NodeGraphView : public QGraphicsView {
 
   QPointF nodePosition(NodeId id) const;  // scene coordinates of the node's top-left; (0, 0) if absent
   QPointF socketScenePos(NodeId id, const QString& socket, bool output) const;
+  // The name drawn beside an input ("thickness" for a sheet's "roughness"); empty if it has none.
+  QString socketLabel(NodeId id, const QString& input) const;
 
   void openNodeSearch(QPointF scenePos);  // the Tab / right-click menu
   void startRename(NodeId id);            // the F2 inline editor; nothing while one is open

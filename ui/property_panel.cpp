@@ -321,7 +321,13 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   QStringList types;
   for (int t = 0; t < kMaterialTypeCount; ++t) types << materialTypeName(static_cast<MaterialType>(t));
   b.choice(tr("Type"), "materialType", types, static_cast<int>(m.type), [this, edit](int i) {
-    edit(tr("Material type"), 0, [i](Material& x) { x.type = static_cast<MaterialType>(i); });
+    edit(tr("Material type"), 0, [i](Material& x) {
+      const auto type = static_cast<MaterialType>(i);
+      // A sheet reads that texture as its thickness, other types as their roughness: one meaning
+      // does not carry over to the other (undo brings the texture back with the type).
+      if ((type == MaterialType::ThinSheet) != (x.type == MaterialType::ThinSheet)) x.roughnessTexture = kNoNode;
+      x.type = type;
+    });
     rebuildLater();  // the type decides which fields apply
   });
   // A boundary has no surface, and hair's colour is its pigment's absorption.

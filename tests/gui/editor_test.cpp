@@ -448,6 +448,44 @@ TEST(Editor, AnObjectIsHitFromTheFrontOnlyFromItsPanel) {
   EXPECT_FALSE(again->isChecked()) << "the box follows the undo";
 }
 
+// A roughness texture does not become a sheet's thickness (nor a thickness a roughness) when
+// the type changes; undo gives it back with the type.
+TEST(Editor, SwitchingToOrFromASheetDropsItsRoughnessOrThicknessTexture) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  const NodeId material = w->scene().object(sphere)->material;
+  auto* rough = w->findChild<QComboBox*>("roughnessTexture");
+  ASSERT_TRUE(rough) << materialTypeName(w->scene().material(material)->type);
+  ASSERT_GT(rough->count(), 1) << "a texture to choose";
+  rough->setCurrentIndex(1);
+  const NodeId texture = w->scene().material(material)->roughnessTexture;
+  ASSERT_NE(texture, kNoNode);
+  const MaterialType before = w->scene().material(material)->type;
+  QTest::qWait(50);
+  auto* type = w->findChild<QComboBox*>("materialType");
+  ASSERT_TRUE(type);
+  type->setCurrentIndex(type->findText("thinsheet"));
+  ASSERT_EQ(w->scene().material(material)->type, MaterialType::ThinSheet);
+  EXPECT_EQ(w->scene().material(material)->roughnessTexture, kNoNode);
+  w->undoStack()->undo();
+  EXPECT_EQ(w->scene().material(material)->type, before);
+  EXPECT_EQ(w->scene().material(material)->roughnessTexture, texture);
+  // And a sheet's thickness texture does not become a roughness.
+  w->undoStack()->redo();
+  ASSERT_EQ(w->scene().material(material)->type, MaterialType::ThinSheet);
+  QTest::qWait(50);
+  auto* thickness = w->findChild<QComboBox*>("roughnessTexture");
+  ASSERT_TRUE(thickness);
+  thickness->setCurrentIndex(1);
+  ASSERT_NE(w->scene().material(material)->roughnessTexture, kNoNode);
+  QTest::qWait(50);
+  type = w->findChild<QComboBox*>("materialType");
+  type->setCurrentIndex(static_cast<int>(before));
+  EXPECT_EQ(w->scene().material(material)->type, before);
+  EXPECT_EQ(w->scene().material(material)->roughnessTexture, kNoNode);
+}
+
 // A thin sheet shows its film's thickness (thin-film interference), and the field edits it.
 TEST(Editor, AThinSheetTakesItsFilmThicknessFromItsPanel) {
   auto w = makeWindow();

@@ -250,6 +250,21 @@ TEST_F(NodeGraph, ABoundaryHasNoInputs) {
   EXPECT_TRUE(edits.empty());
 }
 
+// A sheet has no roughness; its "roughness" texture is read as its thickness, and the node says
+// so, while the socket keeps its name (links, the API).
+TEST_F(NodeGraph, ASheetsRoughnessInputIsShownAsItsThickness) {
+  const NodeId ground = named(scene().materials, "Ground");
+  const NodeId checker = named(scene().textures, "Checker");
+  EXPECT_EQ(view.socketLabel(ground, "roughness"), "roughness");
+  Material sheet = *scene().material(ground);
+  sheet.type = MaterialType::ThinSheet;
+  ASSERT_TRUE(doc.apply(SetMaterial{sheet}).ok());
+  view.setDocument(doc.scene());
+  EXPECT_EQ(view.socketLabel(ground, "roughness"), "thickness");
+  EXPECT_EQ(view.socketLabel(ground, "albedo"), "albedo");
+  EXPECT_TRUE(view.link(checker, ground, "roughness"));
+}
+
 TEST_F(NodeGraph, DeleteRemovesTheSelectionAndTheBeforesRestoreEveryReference) {
   const Scene original = scene();
   const NodeId lacquer = named(scene().materials, "Red Lacquer");

@@ -634,6 +634,61 @@ TEST(RenderScene, ALightGroupsGainIsWhatChoosingPerPointSaves) {
   EXPECT_EQ(lightGroupGain(shapes, {1, 1}, Bounds3{}), 1.0) << "no points";
 }
 
+// Light groups switch on at kLightGroupMinGain but, once on, stay on down to kLightGroupKeepGain,
+// so a lamp turned to and fro across one threshold does not swap kernel variants at each
+// crossing. Two lamps inside a ball of white, the second turned from facing away from the first
+// (each lights its own half: a high gain) to facing the same way (a low gain), and back.
+TEST(RenderScene, LightGroupsTurnedOnStayOnUntilTheirGainFallsFarther) {
+  Scene s = test::emptyScene(8, 8);
+  Material lamp;
+  lamp.emission = Vec3{2.0f};
+  const NodeId lampId = test::addMaterial(s, lamp);
+  test::addMeshObject(s, "room", makeSphere(8, 16), test::addMaterial(s, Material{}), Mat4::scale(Vec3{20.0f}));
+  test::addMeshObject(s, "up", makeQuad(), lampId, Mat4::identity());
+  const NodeId turned = test::addMeshObject(s, "turned", makeQuad(), lampId, Mat4::translate({1.5f, 0, 0}));
+  constexpr int kSteps = 24;
+  auto turn = [&](int step) {
+    s.object(turned)->transform = Mat4::translate({1.5f, 0, 0}) * Mat4::rotateZ(kPi * static_cast<float>(step) / kSteps);
+  };
+  // The gain at each angle, as a scene opened there has it.
+  std::vector<double> gain(kSteps + 1);
+  bool between = false;
+  for (int k = 0; k <= kSteps; ++k) {
+    turn(k);
+    RenderSceneBuilder fresh;
+    fresh.update(s, kUpdateAll, nullptr);
+    gain[static_cast<std::size_t>(k)] = fresh.data().lightGroupGain;
+    EXPECT_EQ(fresh.data().lightGroups > 0, fresh.data().lightGroupGain >= kLightGroupMinGain) << k;
+    between = between || (gain[static_cast<std::size_t>(k)] >= kLightGroupKeepGain && gain[static_cast<std::size_t>(k)] < kLightGroupMinGain);
+  }
+  ASSERT_LT(gain[0], kLightGroupKeepGain) << "facing the same way";
+  ASSERT_GE(gain[kSteps], kLightGroupMinGain) << "facing apart";
+  ASSERT_TRUE(between) << "some angle between the thresholds";
+  RenderSceneBuilder builder;
+  turn(kSteps);
+  builder.update(s, kUpdateAll, nullptr);
+  int keptOn = 0, keptOff = 0;
+  auto sweep = [&](int from, int to) {
+    const int step = from < to ? 1 : -1;
+    for (int k = from;; k += step) {
+      const bool wasOn = builder.data().lightGroups > 0;
+      turn(k);
+      builder.update(s, kUpdateInstances | kUpdateLights, nullptr);
+      const double g = gain[static_cast<std::size_t>(k)];
+      EXPECT_NEAR(builder.data().lightGroupGain, g, 1e-6 * g) << k;
+      const bool on = builder.data().lightGroups > 0;
+      EXPECT_EQ(on, g >= (wasOn ? kLightGroupKeepGain : kLightGroupMinGain)) << k << ", gain " << g;
+      if (on && g < kLightGroupMinGain) ++keptOn;
+      if (!on && g >= kLightGroupKeepGain) ++keptOff;
+      if (k == to) break;
+    }
+  };
+  sweep(kSteps, 0);
+  sweep(0, kSteps);
+  EXPECT_GT(keptOn, 0) << "on below the gain that turns them on";
+  EXPECT_GT(keptOff, 0) << "off above the gain that keeps them on";
+}
+
 // Each emissive instance is a light group: its run of emitters, an alias table within the run,
 // its bounding sphere, its plane where all its triangles lie in one facing one way (a quad, not a
 // ball nor two quads back to back), and a scale from its power. One group, or more than

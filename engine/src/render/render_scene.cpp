@@ -71,6 +71,47 @@ double lightGroupWeight(const vec4* shape, Vec3 p) {
   return h > 0 ? w * std::min(h / std::sqrt(d2), 1.0) : 0.0;
 }
 
+// Appends the two texels of FrameUniforms::lightGroups that lightGroupWeight (lights.glsl) reads
+// for the `count` emitters (kEmitterTexels each) from `e`, of `power` and `total` power. One
+// plane facing one way, seen from behind, gives nothing, which is what Tungsten's quads say of a
+// light facing away; any other shape gives to every side.
+void pushLightGroupShape(std::vector<vec4>& out, const vec4* e, const float* power, std::size_t count, double total) {
+  Bounds3 bounds;
+  Vec3 normal{0.0f}, onPlane{0.0f};
+  bool planar = true;
+  for (std::size_t k = 0; k < count; ++k) {
+    const vec4* t = e + k * gpu::kEmitterTexels;
+    const Vec3 w0{t[0].x, t[0].y, t[0].z};
+    bounds.grow(w0);
+    bounds.grow(w0 + Vec3{t[1].x, t[1].y, t[1].z});
+    bounds.grow(w0 + Vec3{t[2].x, t[2].y, t[2].z});
+    if (!(power[k] > 0)) continue;
+    const Vec3 nrm{t[4].x, t[4].y, t[4].z};
+    if (length(normal) == 0) normal = nrm, onPlane = w0;
+    else if (!(dot(normal, nrm) > 1 - 1e-5f)) planar = false;
+  }
+  const float radius = bounds.empty() ? 0.0f : 0.5f * length(bounds.extent());
+  Vec3 centre = bounds.empty() ? Vec3{0.0f} : bounds.center();
+  const float offset = dot(normal, onPlane);
+  // Rounding of the placed vertices grows with their distance from the origin.
+  const float slack = 1e-4f * radius + 1e-6f * (std::abs(offset) + length(centre));
+  for (std::size_t k = 0; planar && k < count; ++k) {
+    const vec4* t = e + k * gpu::kEmitterTexels;
+    const Vec3 w0{t[0].x, t[0].y, t[0].z};
+    for (Vec3 v : {w0, w0 + Vec3{t[1].x, t[1].y, t[1].z}, w0 + Vec3{t[2].x, t[2].y, t[2].z}})
+      if (!(std::abs(dot(normal, v) - offset) <= slack)) planar = false;
+  }
+  planar = planar && length(normal) > 0;
+  if (planar) centre = centre - normal * (dot(normal, centre) - offset);  // onto the plane, which the kernel measures from it
+  else normal = Vec3{0.0f};
+  // What it gives a point at distance d is about its radiance times the solid angle of its area
+  // (a plane's seen at the plane's cosine, a solid's a quarter of its area, a convex body's mean
+  // projection), over d^2.
+  const float scale = static_cast<float>(total / (planar ? kPi : 4 * kPi));
+  out.push_back(v4(centre, scale));
+  out.push_back(v4(normal, scale / std::max(radius * radius, 1e-30f)));
+}
+
 }  // namespace
 
 // Taking the groups' weights as what they give, a light sample's second moment where it picks by
@@ -81,10 +122,11 @@ double lightGroupGain(const std::vector<vec4>& shapes, const std::vector<double>
   const double total = std::accumulate(power.begin(), power.end(), 0.0);
   if (bounds.empty() || !(total > 0)) return 1.0;
   const int n = 12;
+  const Vec3 extent = bounds.extent();
   double byPower = 0, byWeight = 0;
   for (int i = 0; i < n * n * n; ++i) {
     const Vec3 f{(static_cast<float>(i % n) + 0.5f) / n, (static_cast<float>(i / n % n) + 0.5f) / n, (static_cast<float>(i / (n * n)) + 0.5f) / n};
-    const Vec3 p = bounds.lo + Vec3{f.x * bounds.extent().x, f.y * bounds.extent().y, f.z * bounds.extent().z};
+    const Vec3 p = bounds.lo + Vec3{f.x * extent.x, f.y * extent.y, f.z * extent.z};
     double sum = 0, moment = 0;
     for (std::size_t g = 0; g < power.size(); ++g) {
       const double w = lightGroupWeight(shapes.data() + 2 * g, p);
@@ -1367,46 +1409,18 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
       const double total = std::accumulate(power.begin() + static_cast<std::ptrdiff_t>(grp.first),
                                            power.begin() + static_cast<std::ptrdiff_t>(grp.first + grp.count), 0.0);
       groupPower.push_back(total);
-      Bounds3 bounds;
-      const vec4* e = data_.emitters.data() + grp.first * gpu::kEmitterTexels;
-      Vec3 normal{0.0f}, onPlane{0.0f};
-      bool planar = true;
-      for (std::size_t k = 0; k < grp.count; ++k, e += gpu::kEmitterTexels) {
-        const Vec3 w0{e[0].x, e[0].y, e[0].z};
-        bounds.grow(w0);
-        bounds.grow(w0 + Vec3{e[1].x, e[1].y, e[1].z});
-        bounds.grow(w0 + Vec3{e[2].x, e[2].y, e[2].z});
-        if (!(power[grp.first + k] > 0)) continue;
-        const Vec3 nrm{e[4].x, e[4].y, e[4].z};
-        if (length(normal) == 0) normal = nrm, onPlane = w0;
-        else if (!(dot(normal, nrm) > 1 - 1e-5f)) planar = false;
-      }
-      const float radius = bounds.empty() ? 0.0f : 0.5f * length(bounds.extent());
-      Vec3 centre = bounds.empty() ? Vec3{0.0f} : bounds.center();
-      const float offset = dot(normal, onPlane);
-      // Rounding of the placed vertices grows with their distance from the origin.
-      const float slack = 1e-4f * radius + 1e-6f * (std::abs(offset) + length(centre));
-      e = data_.emitters.data() + grp.first * gpu::kEmitterTexels;
-      for (std::size_t k = 0; planar && k < grp.count; ++k, e += gpu::kEmitterTexels) {
-        const Vec3 w0{e[0].x, e[0].y, e[0].z};
-        for (Vec3 v : {w0, w0 + Vec3{e[1].x, e[1].y, e[1].z}, w0 + Vec3{e[2].x, e[2].y, e[2].z}})
-          if (!(std::abs(dot(normal, v) - offset) <= slack)) planar = false;
-      }
-      planar = planar && length(normal) > 0;
-      if (planar) centre = centre - normal * (dot(normal, centre) - offset);  // onto the plane, which the kernel measures from it
-      else normal = Vec3{0.0f};
-      // What it gives a point at distance d is about its radiance times the solid angle of its
-      // area (a plane's seen at the plane's cosine, a solid's a quarter of its area, a convex
-      // body's mean projection), over d^2.
-      const float scale = static_cast<float>(total / (planar ? kPi : 4 * kPi));
-      data_.lightGroupShapes.push_back(v4(centre, scale));
-      data_.lightGroupShapes.push_back(v4(normal, scale / std::max(radius * radius, 1e-30f)));
+      pushLightGroupShape(data_.lightGroupShapes, data_.emitters.data() + grp.first * gpu::kEmitterTexels,
+                          power.data() + grp.first, grp.count, total);
     }
   }
   // The choice per point costs every light sample a pass over the groups (a tenth of the
   // spaceship's samples/s, whose lamps it helps little): it is compiled in only where it gains.
   data_.lightGroupGain = groupPower.empty() ? 1.0 : lightGroupGain(data_.lightGroupShapes, groupPower, data_.bounds);
-  data_.lightGroups = data_.lightGroupGain >= kLightGroupMinGain ? static_cast<int>(groups.size()) : 0;
+  // Once on, they stay on down to kLightGroupKeepGain: a lamp dragged to and fro across one
+  // threshold would otherwise swap kernel variants at each crossing (each a pause on lavapipe the
+  // first time). Either variant renders the same image in expectation.
+  const double needed = data_.lightGroups > 0 ? kLightGroupKeepGain : kLightGroupMinGain;
+  data_.lightGroups = data_.lightGroupGain >= needed ? static_cast<int>(groups.size()) : 0;
   if (data_.lightGroups == 0) {
     groups.assign(1, Group{0, power.size()});
     data_.lightGroupShapes.clear();

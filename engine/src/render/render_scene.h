@@ -56,6 +56,8 @@ int filterFeature(const RenderSettings& s);
 // group's. Light groups are compiled in from kLightGroupMinGain on.
 double lightGroupGain(const std::vector<vec4>& shapes, const std::vector<double>& power, const Bounds3& bounds);
 inline constexpr double kLightGroupMinGain = 1.5;
+// Where they are on already, they stay on from this gain on (packEmitters).
+inline constexpr double kLightGroupKeepGain = 1.3;
 
 // Which arrays changed in the last update, so the uploader copies only those.
 enum DirtyArrays : std::uint32_t {
