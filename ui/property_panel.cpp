@@ -247,6 +247,9 @@ void PropertyPanel::rebuild() {
   body_ = new QWidget;
   form_ = new QFormLayout(body_);
   form_->setFieldGrowthPolicy(QFormLayout::AllNonFixedFieldsGrow);
+  // A row too wide for the dock (a long label beside three channels) puts its label above its
+  // field, rather than the panel cutting the last channel off (it scrolls only vertically).
+  form_->setRowWrapPolicy(QFormLayout::WrapLongRows);
   Builder b(this, form_);
   const Scene& s = scene_();
   switch (target_.kind) {

@@ -604,6 +604,26 @@ TEST(Editor, GlassTakesAScatteringMediumFromItsPanel) {
   EXPECT_EQ(w->scene().material(material)->coatingAbsorption, Vec3(0.0f, 0.0f, 0.25f));
 }
 
+// The panel scrolls only vertically, so a row wider than the dock was cut off: a long label
+// beside three channels lost its last one at the default layout. Such a row now puts its label
+// above its fields, and the panel fits a narrow dock.
+TEST(Editor, TheMaterialPanelFitsANarrowDock) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  auto* type = w->findChild<QComboBox*>("materialType");
+  ASSERT_TRUE(type);
+  type->setCurrentIndex(static_cast<int>(MaterialType::Dielectric));
+  ASSERT_TRUE(QTest::qWaitFor([&] { return w->findChild<ScrubField*>("interiorAbsorption2") != nullptr; }, 2000));
+  QWidget* body = w->properties()->widget();
+  ASSERT_TRUE(body);
+  const int needed = body->minimumSizeHint().width();
+  const int labelAndChannels = w->properties()->fontMetrics().horizontalAdvance("Interior absorption") +
+                               3 * w->findChild<ScrubField*>("interiorAbsorption2")->minimumWidth();
+  EXPECT_LT(needed, labelAndChannels) << "the label beside the three channels would not fit";
+  EXPECT_LE(needed, 320) << "a dock of 320 pixels holds every row";
+}
+
 TEST(Editor, ABoundaryShowsItsMediumAndNoSurface) {
   auto w = makeWindow();
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
