@@ -36,7 +36,7 @@ int runEditor(int argc, char** argv, const std::string& file) {
   ui::EditorOptions options;
   // The window and its docks as the user left them (a screenshot shows the default layout).
   options.keepLayout = !qEnvironmentVariableIsSet("RETILE_SCREENSHOT");
-  options.cameraFraming = qEnvironmentVariable("RETILE_SCREENSHOT_FRAMING") == "camera";
+  if (qEnvironmentVariable("RETILE_SCREENSHOT_FRAMING") == "viewport") options.cameraFraming = false;
   ui::MainWindow window(std::move(scene), path, options);
   window.show();
   // The last session did not close cleanly: offer its newest autosave.

@@ -39,7 +39,9 @@ struct EditorOptions {
   QSize initialRenderSize{};  // fixed render size (tests); empty: follow the viewport
   // Frame the image as the scene's resolution frames it (its width : height, fitted into the
   // viewport and letterboxed); else the image fills the viewport, widening or narrowing the view.
-  bool cameraFraming = false;
+  // On by default: filling a viewport narrower than a 16:9 scene cuts off its sides, and a file
+  // should open showing what its camera frames, what `retile render` renders.
+  bool cameraFraming = true;
   // Restore the window's geometry and dock layout from QSettings and save them on close (the app;
   // tests leave it off so that one test's layout never reaches the next).
   bool keepLayout = false;

@@ -554,9 +554,7 @@ void NodeGraphView::rebuild() {
     if (m.type != MaterialType::Boundary) {
       n->inputs = textureInputs();
       n->inputs << kBlendInput;
-      // A sheet has no roughness: the kernel reads that texture as its thickness (Tungsten's
-      // textured thinsheet), as the material panel says too.
-      if (m.type == MaterialType::ThinSheet) {
+      if (roughnessSlotIsThickness(m.type)) {
         n->labels.resize(n->inputs.size());
         n->labels[n->inputs.indexOf(QLatin1String("roughness"))] = QStringLiteral("thickness");
       }

@@ -328,7 +328,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       const auto type = static_cast<MaterialType>(i);
       // A sheet reads that texture as its thickness, other types as their roughness: one meaning
       // does not carry over to the other (undo brings the texture back with the type).
-      if ((type == MaterialType::ThinSheet) != (x.type == MaterialType::ThinSheet)) x.roughnessTexture = kNoNode;
+      if (roughnessSlotIsThickness(type) != roughnessSlotIsThickness(x.type)) x.roughnessTexture = kNoNode;
       x.type = type;
     });
     rebuildLater();  // the type decides which fields apply
@@ -463,12 +463,11 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
                            Slot{"Alpha texture", "alphaTexture", &Material::alphaTexture},
                            Slot{"Bump texture", "bumpTexture", &Material::bumpTexture},
                            Slot{"Emission texture", "emissionTexture", &Material::emissionTexture}}) {
-    const bool sheet = m.type == MaterialType::ThinSheet;
-    if (slot.field == &Material::roughnessTexture && !rough && !sheet) continue;
+    if (slot.field == &Material::roughnessTexture && !readsRoughnessSlot(m.type)) continue;
     if (slot.field == &Material::albedoTexture && m.type == MaterialType::Hair) continue;
     auto field = slot.field;
-    // A thin sheet has no roughness: its texture is its thickness's (Material::roughnessTexture).
-    const char* label = sheet && field == &Material::roughnessTexture ? "Thickness texture" : slot.label;
+    const char* label =
+        field == &Material::roughnessTexture && roughnessSlotIsThickness(m.type) ? "Thickness texture" : slot.label;
     b.nodeChoice(tr(label), slot.name, scene_().textures, m.*field, [this, edit, field](NodeId t) {
       edit(tr("Assign texture"), 0, [t, field](Material& x) { x.*field = t; });
       rebuildLater();

@@ -696,7 +696,7 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   if (rough || m.type == MaterialType::Phong) roughness = std::max(roughness, 1e-3f);
   if (m.type == MaterialType::OrenNayar) roughness = std::clamp(m.roughness, 0.0f, kPi / 2);
   // A thin sheet has no roughness: the slot carries its film's thickness (Material::filmThickness).
-  if (m.type == MaterialType::ThinSheet) roughness = std::isfinite(m.filmThickness) ? std::clamp(m.filmThickness, 0.0f, 1e5f) : 0.0f;
+  if (roughnessSlotIsThickness(m.type)) roughness = std::isfinite(m.filmThickness) ? std::clamp(m.filmThickness, 0.0f, 1e5f) : 0.0f;
   float ior = m.type == MaterialType::Hair ? 1.55f : std::clamp(m.ior, 1.0001f, 10.0f);
   const bool coated = coatRendered(m);
   // Diffuse light inside a plastic coating reflects back this fraction at the boundary
@@ -741,8 +741,8 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     if (m.filled()) data_.materialTypes |= 1u << gpu::kMaskMedium;
     if (m.filled() && maxComponent(m.interiorScattering) > 0) data_.materialTypes |= 1u << gpu::kMaskScattering;
     // A type without roughness reads no roughness texture: the kernel would scale what the slot
-    // holds for it (hair's tilt) by the texture's mean. A thin sheet's is its thickness.
-    const int roughnessTexture = hasRoughness(m.type) || m.type == MaterialType::ThinSheet ? textureIndex(m.roughnessTexture) : -1;
+    // holds for it (hair's tilt) by the texture's mean.
+    const int roughnessTexture = readsRoughnessSlot(m.type) ? textureIndex(m.roughnessTexture) : -1;
     if (textureIndex(m.albedoTexture) >= 0 || roughnessTexture >= 0) data_.materialTextures = true;
     if (textureIndex(m.bumpTexture) >= 0 && m.bumpStrength != 0) data_.materialBump = true;
     if (textureIndex(m.emissionTexture) >= 0 && m.emissive()) data_.emissionTextures = true;
