@@ -288,9 +288,9 @@ void addEdit(CLI::App& app, int* status) {
             "with --reference: relative RMSE below which a frame counts as settled")
       ->type_name("REL");
   CLI::Option* denoise = cmd->add_flag("--denoise", o->method.denoise, "denoise what the method shows");
-  addInt(*cmd, "--denoise-threshold", &o->method.denoiseThreshold, 0, 16384,
-         "pixels a pass's region grows before it is denoised again at its new size")
-      ->type_name("PX")
+  addNumber(*cmd, "--denoise-threshold", &o->method.denoiseThreshold, 0, 1,
+            "share of the image's width (height) a pass's region grows by before it is denoised again at its new size")
+      ->type_name("SHARE")
       ->needs(denoise);
   cmd->add_flag("--no-soft-borders", o->noSoftBorders, "no blending at seams between tiles showing different things")
       ->needs(denoise);

@@ -21,11 +21,13 @@ int runEditor(int argc, char** argv, const std::string& file) {
   QApplication::setOrganizationName("Retile");
   Scene scene = makeDefaultScene();
   std::filesystem::path path;
+  std::vector<std::string> warnings;
   QString openError;
   if (!file.empty() && file != "default") {
     auto loaded = importScene(file);
     if (loaded) {
       scene = std::move(loaded->scene);
+      warnings = std::move(loaded->warnings);
       path = file;
     } else {
       // The editor still opens, on the built-in scene, and says why.
@@ -39,6 +41,7 @@ int runEditor(int argc, char** argv, const std::string& file) {
   if (qEnvironmentVariable("RETILE_SCREENSHOT_FRAMING") == "viewport") options.cameraFraming = false;
   ui::MainWindow window(std::move(scene), path, options);
   window.show();
+  if (!path.empty()) window.opened(path, warnings);
   // The last session did not close cleanly: offer its newest autosave.
   if (!recovery.isEmpty() && !qEnvironmentVariableIsSet("RETILE_NO_PROMPTS") &&
       QMessageBox::question(&window, QObject::tr("Recover"),

@@ -52,8 +52,14 @@ void main() {
   float depth = 1e30;
   float instance = intBitsToFloat(0);
   bool haveInstance = false;
+  // A coarse item's pixels share their block's samples (trace.comp).
+  uint block = max(item.pixels.z, 1u), cell = p;
+  if (block > 1u) {
+    uint cols = (uint(item.rect.z) + block - 1u) / block;
+    cell = (uint(py - item.rect.y) / block) * cols + uint(px - item.rect.x) / block;
+  }
   for (uint r = 0u; r < item.info.x; ++r) {
-    uint slot = item.info.y + p * item.info.x + r;
+    uint slot = item.info.y + cell * item.info.x + r;
     vec4 s = samples[slot];
     precise vec3 y = s.rgb - lost;
     precise vec3 t = sum + y;

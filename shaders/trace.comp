@@ -29,7 +29,8 @@ layout(set = 0, binding = 14, std430) buffer Stats { uint rayCounts[kStatsCount]
 // `retile bench throughput` prints it); should a scene's segments be longer, the paths stop
 // earlier, when twice the longest segment so far would pass kLoopLimit.
 
-// What the tracer sees of the selected object, per tile (the indirection-aware policy).
+// What the tracer sees of the selected object and of its group, per tile (the indirection-aware
+// policy): the instances' set words, then the counters (layouts.h, kSelectionCounters).
 layout(set = 0, binding = 15, std430) buffer Selection { uint selectionCounts[]; };
 
 layout(push_constant) uniform Push { TracePush push; };
@@ -109,7 +110,15 @@ int selectionBase(int px, int py) {
   uint t = frame.work.w;
   if (t == 0u || frame.work.z == 0u) return -1;
   uint cols = (frame.image.x + t - 1u) / t;
-  return int(((uint(py) / t) * cols + uint(px) / t) * uint(kSelectionCounters));
+  return int(frame.work.z - 1u + ((uint(py) / t) * cols + uint(px) / t) * uint(kSelectionCounters));
+}
+
+// The counted sets an instance belongs to (bit 0: the selected object, bit 1: its group). Read only
+// while counting: a storage buffer read costs lavapipe far more than a texel fetch.
+uint countedSets(int instance) {
+  if (instance < 0) return 0u;
+  uint word = selectionCounts[uint(instance) / uint(kInstancesPerSetWord)];
+  return (word >> ((uint(instance) % uint(kInstancesPerSetWord)) * 2u)) & 3u;
 }
 
 // The material a hit on material `index` shades with: itself or, for a blend (Material::blendWith),
@@ -276,10 +285,12 @@ uint primaryRays = 0u, bounceRays = 0u, shadowRays = 0u;
 Path startPath(uint slot, int found) {
   WorkItem item = items[found];
   uint inItem = slot - item.info.y;
-  uint p = inItem / item.info.x;  // a pixel's q samples are neighbours (layouts.h WorkItem)
+  uint p = inItem / item.info.x;  // a pixel's (a block's) q samples are neighbours (layouts.h WorkItem)
   uint rep = inItem - p * item.info.x;
-  int px = item.rect.x + int(p % uint(item.rect.z));
-  int py = item.rect.y + int(p / uint(item.rect.z));
+  uint block = max(item.pixels.z, 1u);
+  uint cols = (uint(item.rect.z) + block - 1u) / block;
+  int px = item.rect.x + int((p % cols) * block);
+  int py = item.rect.y + int((p / cols) * block);
   uint width = frame.image.x, height = frame.image.y;
   Path path;
   path.slot = slot;
@@ -287,10 +298,16 @@ Path startPath(uint slot, int found) {
 
   // Every sample jitters its own primary ray, evenly over the pixel's samples, then is placed by
   // the scene's pixel filter (its inverse CDF per axis): filter importance sampling, so the
-  // accumulation stays a plain mean per pixel.
+  // accumulation stays a plain mean per pixel. A coarse item's sample lands anywhere in its block
+  // (the part of it inside the item), which all the block's pixels then share.
   vec2 jitter = pixelJitter(uint(py) * width + uint(px), item.info.z + rep, frame.image.z);
   vec2 offset = vec2(filterOffset(jitter.x), filterOffset(jitter.y));
-  vec2 ndc = vec2((float(px) + 0.5 + offset.x) / float(width), (float(py) + 0.5 + offset.y) / float(height)) * 2.0 - 1.0;
+  vec2 at = vec2(0.5);
+  if (block > 1u) {
+    vec2 extent = vec2(min(int(block), item.rect.x + item.rect.z - px), min(int(block), item.rect.y + item.rect.w - py));
+    at = vec2(rand(path.rng), rand(path.rng)) * extent;
+  }
+  vec2 ndc = vec2((float(px) + at.x + offset.x) / float(width), (float(py) + at.y + offset.y) / float(height)) * 2.0 - 1.0;
   float tanHalf = frame.cameraPosition.w;
   path.rd = normalize(frame.cameraForward.xyz + ndc.x * tanHalf * frame.cameraRight.w * frame.cameraRight.xyz -
                       ndc.y * tanHalf * frame.cameraUp.xyz);
@@ -448,8 +465,11 @@ void resolveShadow(inout Path path, inout Shadow shadow, Trace tr) {
   int blocker = tr.blocker;
   if (!shadow.pending) return;
   shadowRays++;
-  int selected = int(frame.work.z) - 1;
-  if (shadow.selBase >= 0 && blocker >= 0 && blocker == selected) atomicAdd(selectionCounts[shadow.selBase + 2], 1u);
+  if (shadow.selBase >= 0 && blocker >= 0) {
+    uint sets = countedSets(blocker);
+    for (int k = 0; k < kCountedSets; ++k)
+      if ((sets & (1u << k)) != 0u) atomicAdd(selectionCounts[shadow.selBase + 3 * k + 2], 1u);
+  }
   bool visible = blocker < 0;
   vec3 L = shadow.L;
 #if RETILE_SHEET
@@ -615,7 +635,6 @@ bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, float h
 // next-event estimation (its shadow ray is traced with the next segment) and the next direction.
 // Returns false when the path has ended.
 bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
-  int selected = int(frame.work.z) - 1;
   int maxBounces = int(frame.image.w);
   vec3 ro = path.ro, rd = path.rd;
   if (path.depth == 0) primaryRays++; else bounceRays++;
@@ -639,11 +658,15 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
     path.beta *= transmittance(path.absorption, hit.t);
   }
 #endif
-  if (path.selBase >= 0 && hit.prim >= 0 && hit.instance == selected) {
+  if (path.selBase >= 0 && hit.prim >= 0) {
     // Direct hits (through boundaries too: nothing is picked yet), then reflections weighted
     // (maxBounces + 1) / depth: 4, 2, 1 at 3 bounces.
-    if (path.auxInstance <= 0) atomicAdd(selectionCounts[path.selBase], 1u);
-    else atomicAdd(selectionCounts[path.selBase + 1], uint(max(maxBounces + 1, 1) / path.depth));
+    uint sets = countedSets(hit.instance);
+    for (int k = 0; k < kCountedSets; ++k) {
+      if ((sets & (1u << k)) == 0u) continue;
+      if (path.auxInstance <= 0) atomicAdd(selectionCounts[path.selBase + 3 * k], 1u);
+      else atomicAdd(selectionCounts[path.selBase + 3 * k + 1], uint(max(maxBounces + 1, 1) / path.depth));
+    }
   }
 
   // Light that reaches the camera in fewer bounces than frame.bounces.x is left out (Tungsten's

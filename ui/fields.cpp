@@ -4,12 +4,16 @@
 #include <QContextMenuEvent>
 #include <QKeyEvent>
 #include <QLineEdit>
+#include <QLocale>
 #include <QMenu>
 #include <QMouseEvent>
 #include <QStyle>
 #include <QStyleOptionSpinBox>
+#include <QToolTip>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace retile::ui {
 
@@ -76,25 +80,89 @@ void ScrubField::mouseReleaseEvent(QMouseEvent* e) {
 }
 
 bool ScrubField::event(QEvent* e) {
-  // Outside typing, shortcuts (Ctrl+Z, B, A, W...) win over the spin box's own key handling.
-  if (e->type() == QEvent::ShortcutOverride && !typing_) {
-    e->ignore();
-    return true;
+  if (e->type() == QEvent::ShortcutOverride) {
+    // Outside typing, shortcuts (Ctrl+Z, B, A, W...) win over the spin box's own key handling.
+    if (!typing_) {
+      e->ignore();
+      return true;
+    }
+    // While typing, Esc cancels the typing and Enter commits it: neither may reach the window's
+    // shortcuts (Esc pauses the render there).
+    const int key = static_cast<QKeyEvent*>(e)->key();
+    if (key == Qt::Key_Escape || key == Qt::Key_Return || key == Qt::Key_Enter) {
+      e->accept();
+      return true;
+    }
   }
   return QDoubleSpinBox::event(e);
+}
+
+std::optional<double> ScrubField::parse(const QString& text) {
+  const QString t = text.trimmed();
+  bool ok = false;
+  double v = QLocale().toDouble(t, &ok);
+  if (!ok) v = QLocale::c().toDouble(t, &ok);
+  if (!ok) {
+    // Qt's readers give no NaN or infinity back: name them, so the refusal says what they are.
+    const QString lower = t.toLower();
+    if (lower == "nan" || lower == "-nan") return std::numeric_limits<double>::quiet_NaN();
+    if (lower == "inf" || lower == "+inf" || lower == "infinity") return std::numeric_limits<double>::infinity();
+    if (lower == "-inf" || lower == "-infinity") return -std::numeric_limits<double>::infinity();
+    return std::nullopt;
+  }
+  return v;
+}
+
+QValidator::State ScrubField::validate(QString& text, int&) const {
+  // Anything may be typed; it is judged once committed, with a word when it is refused.
+  const QString typed = text.mid(prefix().size(), text.size() - prefix().size() - suffix().size());
+  const auto v = parse(typed);
+  return v && std::isfinite(*v) && *v >= minimum() && *v <= maximum() ? QValidator::Acceptable : QValidator::Intermediate;
+}
+
+double ScrubField::valueFromText(const QString& text) const {
+  const auto v = parse(text);
+  return v && std::isfinite(*v) ? std::clamp(*v, minimum(), maximum()) : value();
+}
+
+void ScrubField::refuse(const QString& why) {
+  lastRefusal_ = why;
+  QToolTip::showText(mapToGlobal(QPoint(0, height())), why, this, {}, 5000);
+  emit refused(why);
+}
+
+void ScrubField::commitTyped() {
+  const QString typed = cleanText();
+  const auto v = parse(typed);
+  const QString shown = textFromValue(committed_);
+  if (!v || !std::isfinite(*v)) {
+    refuse(v ? tr("%1 is not a finite number: kept %2").arg(typed, shown) : tr("\"%1\" is not a number: kept %2").arg(typed, shown));
+    silent_ = true;
+    setValue(committed_);
+    lineEdit()->setText(prefix() + shown + suffix());  // setValue rewrites nothing when the value is the same
+    silent_ = false;
+    return;
+  }
+  lastRefusal_.clear();
+  const double clamped = std::clamp(*v, minimum(), maximum());
+  if (clamped != *v)
+    refuse(tr("%1 is outside %2 to %3: set to %4").arg(typed, textFromValue(minimum()), textFromValue(maximum()), textFromValue(clamped)));
+  if (clamped == value()) lineEdit()->setText(prefix() + textFromValue(clamped) + suffix());
+  else setValue(clamped);
 }
 
 void ScrubField::keyPressEvent(QKeyEvent* e) {
   if (e->key() == Qt::Key_Escape) {
     silent_ = true;
     setValue(committed_);  // drops the typed text
+    lineEdit()->setText(prefix() + textFromValue(committed_) + suffix());
     silent_ = false;
     typing_ = false;
     clearFocus();
     return;
   }
   if (e->key() == Qt::Key_Return || e->key() == Qt::Key_Enter) {
-    QDoubleSpinBox::keyPressEvent(e);
+    if (typing_) commitTyped();
     typing_ = false;
     return;
   }
@@ -109,6 +177,8 @@ void ScrubField::focusInEvent(QFocusEvent* e) {
 }
 
 void ScrubField::focusOutEvent(QFocusEvent* e) {
+  // Leaving the field takes what was typed, as Enter does.
+  if (typing_) commitTyped();
   typing_ = false;
   QDoubleSpinBox::focusOutEvent(e);
 }

@@ -1,6 +1,9 @@
 // Parameter editors with the conventions artists bring from Blender, Houdini and Katana: drag a
 // number field to scrub (Shift: ten times finer), click to type, Enter commits, Esc cancels,
 // "Reset to default" on the context menu; a colour swatch whose whole dialog session is one edit.
+// A typed value is read as a number in the user's locale or in C's (1e3, -2.5, 0,5 under de_DE);
+// one outside the field's range is clamped and one that is no finite number is refused, each
+// said in a tooltip at the field and by refused().
 // A field keeps the keyboard only while a value is typed into it: after a scrub, Ctrl+Z, B and
 // the other shortcuts go to the window.
 // GUI thread only. Each field owns nothing but its widgets; the caller turns its signals into
@@ -11,6 +14,8 @@
 #include <QDoubleSpinBox>
 #include <QPushButton>
 
+#include <optional>
+
 namespace retile::ui {
 
 class ScrubField : public QDoubleSpinBox {
@@ -19,11 +24,17 @@ class ScrubField : public QDoubleSpinBox {
   ScrubField(double value, double min, double max, double defaultValue, int decimals, QWidget* parent = nullptr);
   double defaultValue() const { return default_; }
   bool scrubbing() const { return scrubbing_; }
+  // What the last typed value was refused or clamped for; empty when it was taken as typed.
+  QString lastRefusal() const { return lastRefusal_; }
+  // A typed text as a number (the locale's form, else C's), or nullopt; NaN and infinities parse.
+  static std::optional<double> parse(const QString& text);
 
  signals:
   // A committed value: typed and entered, stepped, reset, or one step of a scrub.
   void edited(double value, bool scrubbing);
   void scrubFinished();
+  // A typed value was refused (not a finite number) or clamped to the range: why, in words.
+  void refused(const QString& why);
 
  protected:
   void mousePressEvent(QMouseEvent* e) override;
@@ -34,9 +45,14 @@ class ScrubField : public QDoubleSpinBox {
   void focusOutEvent(QFocusEvent* e) override;
   bool event(QEvent* e) override;
   void contextMenuEvent(QContextMenuEvent* e) override;
+  QValidator::State validate(QString& text, int& pos) const override;
+  double valueFromText(const QString& text) const override;
 
  private:
   void commit(double v);
+  // Takes what was typed (Enter, or the focus leaving while typing): clamped or refused with a word.
+  void commitTyped();
+  void refuse(const QString& why);
 
   double default_;
   double committed_;  // the value Esc returns to
@@ -45,6 +61,7 @@ class ScrubField : public QDoubleSpinBox {
   int lastX_ = 0;
   bool silent_ = false;
   bool typing_ = false;  // a value is being typed: the field keeps Ctrl+Z, letters and the like
+  QString lastRefusal_;
 };
 
 class ColorField : public QPushButton {

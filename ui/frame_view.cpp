@@ -21,6 +21,15 @@ QColor priorityColor(float priority) {
   return QColor::fromHsvF(std::fmod(0.8f + 0.35f * t, 1.0f), 0.9f, 1.0f, 0.3f);
 }
 
+const QColor FrameView::kServedColor(80, 220, 255);
+const QColor FrameView::kChangeColor(255, 60, 60);
+const QColor FrameView::kFocusColor(80, 255, 120);
+const QColor FrameView::kDenoisedColor = QColor::fromHsvF(0.08, 1.0, 1.0);
+const QColor FrameView::kReusedColor(90, 230, 120);
+const QColor FrameView::kRejectedColor(255, 70, 70);
+// Red, yellow and blue: apart from each other and from the heat map's ramp they lie over.
+const QColor FrameView::kClassColor[3] = {QColor(255, 40, 40), QColor(255, 200, 0), QColor(60, 140, 255)};
+
 FrameView::FrameView(QWidget* parent) : QWidget(parent) {
   setMinimumSize(160, 90);
   setAttribute(Qt::WA_OpaquePaintEvent);
@@ -54,7 +63,14 @@ void FrameView::fallBackToWidget(const QString& why) {
 }
 
 void FrameView::setOverlays(const OverlaySettings& o) {
+  const QRectF area = imageArea();
   overlays_ = o;
+  refresh();
+  if (imageArea() != area) emit resized();  // the legend's strip took or gave back room
+}
+
+void FrameView::clearInspection() {
+  region_ = {};
   refresh();
 }
 
@@ -162,11 +178,17 @@ void FrameView::drawGizmo(QPainter& p) const {
   p.drawEllipse(o, 3.5, 3.5);
 }
 
+QRectF FrameView::imageArea() const {
+  const QRectF legend = legendRect();
+  return QRectF(0, 0, width(), legend.isEmpty() ? height() : legend.top());
+}
+
 QRectF FrameView::imageRect() const {
-  if (image_.isNull()) return rect();
-  double s = std::min(width() / static_cast<double>(image_.width()), height() / static_cast<double>(image_.height()));
+  const QRectF area = imageArea();
+  if (image_.isNull()) return area;
+  double s = std::min(area.width() / image_.width(), area.height() / image_.height());
   double w = image_.width() * s, h = image_.height() * s;
-  return {(width() - w) / 2, (height() - h) / 2, w, h};
+  return {area.x() + (area.width() - w) / 2, area.y() + (area.height() - h) / 2, w, h};
 }
 
 QImage FrameView::composed() const {
@@ -218,14 +240,20 @@ void FrameView::compose(QPainter& p, const QRect& area) const {
     p.drawImage(r, image_);
   }
   drawOverlays(p, r);
+  if (overlays_.legend) drawLegend(p);
   drawGizmo(p);
   if (!notice_.isEmpty() && QDateTime::currentMSecsSinceEpoch() < noticeUntil_) {
     // A short confirmation where the artist is looking (Ctrl+B has no other visible effect).
-    p.setFont(QFont(font().family(), 10, QFont::Bold));
-    const QRectF box(r.center().x() - 180, r.y() + 12, 360, 26);
+    // As wide as its text, up to the image's width, where it wraps.
+    const QFont noticeFont(font().family(), 10, QFont::Bold);
+    p.setFont(noticeFont);
+    const QFontMetricsF fm(noticeFont);
+    const double maxWidth = std::max(120.0, r.width() - 24);
+    const QRectF text = fm.boundingRect(QRectF(0, 0, maxWidth, 1000), Qt::AlignCenter | Qt::TextWordWrap, notice_);
+    const QRectF box(r.center().x() - text.width() / 2 - 12, r.y() + 12, text.width() + 24, text.height() + 10);
     p.fillRect(box, QColor(0, 0, 0, 190));
     p.setPen(Qt::white);
-    p.drawText(box, Qt::AlignCenter, notice_);
+    p.drawText(box, Qt::AlignCenter | Qt::TextWordWrap, notice_);
   }
   if (compare_ != Compare::Off && snapshotUsable) {
     p.setFont(QFont(font().family(), 11, QFont::Bold));
@@ -304,21 +332,17 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
   };
   const int tiles = f.cols * f.rows;
   if (heatMapShown() && static_cast<int>(f.tilePriority.size()) == tiles) {
-    for (int t = 0; t < tiles; ++t) {
-      float pr = f.tilePriority[static_cast<std::size_t>(t)];
-      if (pr < 0) continue;
-      p.fillRect(tileRect(t), priorityColor(pr));
-    }
+    for (int t = 0; t < tiles; ++t)
+      if (heatMapOn(t)) p.fillRect(tileRect(t), priorityColor(f.tilePriority[static_cast<std::size_t>(t)]));
   }
   if (overlays_.classes && static_cast<int>(f.tileClass.size()) == tiles) {
     // Hatched, so they read on top of the heat map: what the selected object touches directly
     // (high), through reflections or shadows (middle), and barely (low).
-    static const QColor classColor[3] = {QColor(255, 40, 40), QColor(255, 200, 0), QColor(60, 140, 255)};
     for (int t = 0; t < tiles; ++t) {
       int c = f.tileClass[static_cast<std::size_t>(t)];
       if (c > 2) continue;
-      p.fillRect(tileRect(t), QBrush(classColor[c], Qt::BDiagPattern));
-      p.setPen(QPen(classColor[c], 1.5));
+      p.fillRect(tileRect(t), QBrush(kClassColor[c], Qt::BDiagPattern));
+      p.setPen(QPen(kClassColor[c], 1.5));
       p.drawRect(tileRect(t).adjusted(1, 1, -1, -1));
     }
   }
@@ -345,7 +369,7 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
             QString::number(static_cast<int>(f.tileSamples[static_cast<std::size_t>(t)])));
   }
   if (overlays_.served && static_cast<int>(f.servedTiles.size()) < tiles) {
-    p.setPen(QPen(QColor(80, 220, 255), 1.5));
+    p.setPen(QPen(kServedColor, 1.5));
     p.setBrush(Qt::NoBrush);
     for (int t : f.servedTiles) p.drawRect(tileRect(t).adjusted(0.5, 0.5, -0.5, -0.5));
   }
@@ -354,7 +378,7 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
     const auto n = static_cast<int>(f.denoised.size());
     for (int i = 0; i < n; ++i) {
       const DenoisedRegion& d = f.denoised[static_cast<std::size_t>(i)];
-      QColor c = QColor::fromHsvF(0.08, 0.25 + 0.75 * (i + 1) / n, 1.0);
+      QColor c = QColor::fromHsvF(kDenoisedColor.hsvHueF(), 0.25 + 0.75 * (i + 1) / n, 1.0);
       QRectF rr(r.x() + d.rect.x * sx, r.y() + d.rect.y * sy, d.rect.width * sx, d.rect.height * sy);
       p.setPen(QPen(c, 2.0, Qt::DashLine));
       p.setBrush(Qt::NoBrush);
@@ -368,7 +392,7 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
   if (overlays_.reuse && static_cast<int>(f.tileReuse.size()) == tiles) {
     // Reusing: a green corner mark, so the picture stays readable; rejected: red hatching with
     // the frames since the rejection.
-    const QColor keep(90, 230, 120), drop(255, 70, 70);
+    const QColor keep = kReusedColor, drop = kRejectedColor;
     for (int t = 0; t < tiles; ++t) {
       const QRectF box = tileRect(t);
       const auto state = f.tileReuse[static_cast<std::size_t>(t)];
@@ -379,7 +403,7 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
         p.setBrush(keep);
         p.drawPolygon(corner);
       } else if (state == 2) {
-        p.fillRect(box, QBrush(drop, Qt::FDiagPattern));
+        p.fillRect(box, QBrush(drop, Qt::DiagCrossPattern));
         p.setPen(QPen(drop, 1.0));
         p.setBrush(Qt::NoBrush);
         p.drawRect(box.adjusted(1, 1, -1, -1));
@@ -390,13 +414,12 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
   }
   if (overlays_.markers) {
     QPointF poc(r.x() + f.pointOfChange.x * sx, r.y() + f.pointOfChange.y * sy);
-    p.setPen(QPen(QColor(255, 60, 60), 2.5));
+    p.setPen(QPen(kChangeColor, 2.5));
     p.drawLine(poc + QPointF(-10, 0), poc + QPointF(10, 0));
     p.drawLine(poc + QPointF(0, -10), poc + QPointF(0, 10));
-    p.setPen(QPen(QColor(80, 255, 120), 2.5));
+    p.setPen(QPen(kFocusColor, 2.5));
     for (const Vec2& fp : f.focus) p.drawEllipse(QPointF(r.x() + fp.x * sx, r.y() + fp.y * sy), 9, 9);
   }
-  if (overlays_.legend) drawLegend(p, r);
 }
 
 FrameView::TileLabels FrameView::tileLabels(const QRectF& tile) const {
@@ -414,35 +437,80 @@ FrameView::TileLabels FrameView::tileLabels(const QRectF& tile) const {
   return l;
 }
 
-// One row per overlay that is on, so nothing is explained that is not drawn and the box grows
-// with its rows instead of other boxes stacking over it.
-std::vector<FrameView::LegendRow> FrameView::legendRows() const {
-  std::vector<LegendRow> rows;
-  if (!frame_) return rows;
-  const FrameRecord& f = *frame_;
-  if (heatMapShown()) rows.push_back({Qt::white, tr("served first  ...  last (tile priority)"), true});
-  if (overlays_.served) rows.push_back({QColor(80, 220, 255), tr("outlined: tiles traced this frame")});
-  if (overlays_.markers) rows.push_back({QColor(255, 90, 90), tr("+ point of change    o focus point")});
-  if (overlays_.classes && !f.tileClass.empty())
-    rows.push_back({QColor(255, 200, 0), tr("hatched: indirection classes high / middle / low")});
-  if (overlays_.denoised && !f.denoised.empty())
-    rows.push_back({QColor::fromHsvF(0.08, 1.0, 1.0),
-                    tr("dashed: %n denoised region(s), labelled frames since", nullptr, static_cast<int>(f.denoised.size()))});
-  if (overlays_.reuse && !f.tileReuse.empty()) {
-    rows.push_back({QColor(90, 230, 120), tr("corner: %n tile(s) reusing their history", nullptr, f.reusedTiles)});
-    rows.push_back({QColor(255, 70, 70), tr("hatched: %n history(ies) rejected, frames since", nullptr, f.rejectedTiles)});
+std::vector<FrameView::LegendItem> FrameView::legendItems(bool everything) const {
+  using K = LegendItem::Key;
+  std::vector<LegendItem> items;
+  if (!frame_ && !everything) return items;
+  static const FrameRecord none;
+  const FrameRecord& f = frame_ ? *frame_ : none;
+  const int tiles = f.cols * f.rows;
+  if (everything ? overlays_.priority : heatMapShown()) items.push_back({K::Ramp, Qt::white, tr("tiles still to come: next ... last")});
+  if (overlays_.served && (everything || (!f.servedTiles.empty() && static_cast<int>(f.servedTiles.size()) < tiles)))
+    items.push_back({K::Outline, kServedColor, tr("traced this frame")});
+  if (overlays_.markers) {
+    items.push_back({K::Cross, kChangeColor, tr("point of change")});
+    if (everything || !f.focus.empty()) items.push_back({K::Circle, kFocusColor, tr("focus point")});
   }
-  rows.push_back({Qt::lightGray, tr("%1, %2: %3/%4 tiles").arg(QString::fromStdString(f.method), QString::fromStdString(f.mode))
-                                     .arg(f.queueServed).arg(f.queueLength)});
-  return rows;
+  if (overlays_.classes && (everything || !f.tileClass.empty())) {
+    const QString what[3] = {tr("high: the selection seen, or reflected strongly"), tr("middle: its reflections and shadows"),
+                             tr("low: faint traces of it")};
+    for (int c = 0; c < 3; ++c)
+      if (everything || std::find(f.tileClass.begin(), f.tileClass.end(), c) != f.tileClass.end())
+        items.push_back({K::Hatch, kClassColor[c], what[c]});
+  }
+  if (overlays_.order && (everything || f.queueLength > 1)) items.push_back({K::None, Qt::white, tr("numbers: place in the queue")});
+  if (overlays_.samples) items.push_back({K::None, QColor(180, 255, 180), tr("numbers: samples per pixel")});
+  if (overlays_.denoised && (everything || !f.denoised.empty()))
+    items.push_back({K::Dashed, kDenoisedColor, tr("denoised region, labelled frames since (newest brightest)")});
+  if (overlays_.reuse && (everything || f.reusedTiles > 0))
+    items.push_back({K::Corner, kReusedColor, tr("%n tile(s) reusing their history", nullptr, everything ? 9999 : f.reusedTiles)});
+  if (overlays_.reuse && (everything || f.rejectedTiles > 0))
+    items.push_back({K::CrossHatch, kRejectedColor, tr("%n history(ies) rejected, frames since", nullptr, everything ? 9999 : f.rejectedTiles)});
+  // The strip's height must not follow the method (a new one would resize the render): the
+  // longest label stands in for it.
+  const QString method = everything ? QStringLiteral("indirection+focus+smooth+denoise+reuse") : QString::fromStdString(f.method);
+  const QString mode = everything ? QStringLiteral("global-update") : QString::fromStdString(f.mode);
+  items.push_back({K::None, QColor(200, 200, 200), tr("%1, %2: %3 of %4 tiles")
+                                                      .arg(method, mode)
+                                                      .arg(everything ? 99999 : static_cast<qulonglong>(f.queueServed))
+                                                      .arg(everything ? 99999 : static_cast<qulonglong>(f.queueLength))});
+  return items;
 }
 
-QRectF FrameView::legendRect(const QRectF& r) const {
-  double height = 8;
-  for (const LegendRow& row : legendRows()) height += row.gradient ? kLegendLine + 12 : kLegendLine;
-  // Narrower in a narrow viewport (the rows are elided), never outside the image.
-  const double width = std::max(120.0, std::min(kLegendWidth, r.width() - 16));
-  return QRectF(r.x() + 8, std::max(r.y() + 8, r.bottom() - height - 8), width, height);
+QFont FrameView::legendFont() const { return QFont(font().family(), 9); }
+
+FrameView::LegendLayout FrameView::layOutLegend(const std::vector<LegendItem>& items, double width) const {
+  // Items flow left to right and wrap; an item wider than the strip wraps its own words.
+  const QFontMetricsF fm(legendFont());
+  const double line = std::max(fm.height(), kLegendKey) + 4;
+  const double inner = std::max(40.0, width - 2 * kLegendPad);
+  LegendLayout l;
+  double x = 0, y = kLegendPad, rowHeight = line;
+  for (const LegendItem& item : items) {
+    const double key = item.key == LegendItem::Key::None ? 0 : kLegendKey + 5;
+    double w = key + fm.horizontalAdvance(item.text), h = line;
+    if (w > inner) {
+      w = inner;
+      h = std::max(line, fm.boundingRect(QRectF(0, 0, inner - key, 1e4), Qt::TextWordWrap, item.text).height() + 4);
+    }
+    if (x > 0 && x + w > inner) {
+      x = 0;
+      y += rowHeight;
+      rowHeight = line;
+    }
+    l.items.emplace_back(kLegendPad + x, y, w, h);
+    rowHeight = std::max(rowHeight, h);
+    x += w + kLegendGap;
+  }
+  l.height = items.empty() ? 0 : y + rowHeight + kLegendPad;
+  return l;
+}
+
+QRectF FrameView::legendRect() const {
+  if (!overlays_.legend) return {};
+  // Never more than half the widget: a tiny viewport keeps its picture.
+  const double h = std::min(layOutLegend(legendItems(true), width()).height, height() / 2.0);
+  return QRectF(0, height() - h, width(), h);
 }
 
 bool FrameView::heatMapShown() const {
@@ -450,31 +518,76 @@ bool FrameView::heatMapShown() const {
   return overlays_.priority && frame_ && frame_->mode != "refinement";
 }
 
-void FrameView::drawLegend(QPainter& p, const QRectF& r) const {
-  const std::vector<LegendRow> rows = legendRows();
-  QFont lf(font().family(), 9);
-  p.setFont(lf);
-  const QRectF box = legendRect(r);
-  const double lineH = kLegendLine, width = box.width();
-  p.fillRect(box, QColor(0, 0, 0, 170));
-  double y = box.y() + 5;
-  for (const LegendRow& row : rows) {
-    if (row.gradient) {
-      const double ramp = std::min(140.0, width - 20);
-      QLinearGradient g(box.x() + 10, 0, box.x() + 10 + ramp, 0);
-      for (int i = 0; i <= 10; ++i) {
-        QColor c = priorityColor(1.0f - i / 10.0f);
-        c.setAlphaF(1.0);
-        g.setColorAt(i / 10.0, c);
+bool FrameView::heatMapOn(int tile) const {
+  if (!heatMapShown()) return false;
+  const FrameRecord& f = *frame_;
+  const auto t = static_cast<std::size_t>(tile);
+  if (t >= f.tilePriority.size() || f.tilePriority[t] < 0 || f.queueLength == 0) return false;
+  // Its place in the queue, from its priority (1 at the head falling to 0 at the end).
+  const auto rank = static_cast<std::size_t>(std::lround((1.0f - f.tilePriority[t]) * static_cast<float>(f.queueLength - 1)));
+  return rank >= f.queueServed && std::find(f.servedTiles.begin(), f.servedTiles.end(), tile) == f.servedTiles.end();
+}
+
+void FrameView::drawLegend(QPainter& p) const {
+  using K = LegendItem::Key;
+  const QRectF strip = legendRect();
+  if (strip.isEmpty()) return;
+  p.save();
+  p.setClipRect(strip);
+  p.fillRect(strip, QColor(20, 20, 24));
+  p.setFont(legendFont());
+  const std::vector<LegendItem> items = legendItems();
+  const LegendLayout layout = layOutLegend(items, strip.width());
+  p.setRenderHint(QPainter::Antialiasing, true);
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const LegendItem& item = items[i];
+    const QRectF at = layout.items[i].translated(strip.topLeft());
+    const QRectF key(at.x(), at.y() + 2, kLegendKey, kLegendKey - 4);
+    const QPointF c = key.center();
+    p.setBrush(Qt::NoBrush);
+    p.setPen(QPen(item.color, 2.0));
+    switch (item.key) {
+      case K::None: break;
+      case K::Ramp: {
+        QLinearGradient g(key.topLeft(), key.topRight());
+        for (int s = 0; s <= 4; ++s) {
+          QColor rc = priorityColor(1.0f - s / 4.0f);
+          rc.setAlphaF(1.0);
+          g.setColorAt(s / 4.0, rc);
+        }
+        p.fillRect(key, g);
+        break;
       }
-      p.fillRect(QRectF(box.x() + 10, y + 2, ramp, 9), g);
-      y += 12;
+      case K::Outline: p.drawRect(key.adjusted(1, 1, -1, -1)); break;
+      case K::Cross:
+        p.drawLine(c - QPointF(6, 0), c + QPointF(6, 0));
+        p.drawLine(c - QPointF(0, 6), c + QPointF(0, 6));
+        break;
+      case K::Circle: p.drawEllipse(c, 5.5, 5.5); break;
+      case K::Hatch:
+      case K::CrossHatch:
+        p.fillRect(key, QBrush(item.color, item.key == K::Hatch ? Qt::BDiagPattern : Qt::DiagCrossPattern));
+        p.setPen(QPen(item.color, 1.5));
+        p.drawRect(key.adjusted(1, 1, -1, -1));
+        break;
+      case K::Dashed:
+        p.setPen(QPen(item.color, 2.0, Qt::DashLine));
+        p.drawRect(key.adjusted(1, 1, -1, -1));
+        break;
+      case K::Corner:
+        p.setPen(Qt::NoPen);
+        p.setBrush(item.color);
+        p.drawPolygon(QPolygonF({key.topRight(), key.topRight() + QPointF(-8, 0), key.topRight() + QPointF(0, 8)}));
+        p.setPen(QPen(QColor(160, 160, 160), 1.0));
+        p.setBrush(Qt::NoBrush);
+        p.drawRect(key.adjusted(0.5, 0.5, -0.5, -0.5));
+        break;
     }
-    p.setPen(row.color);
-    p.drawText(QRectF(box.x() + 10, y, width - 14, lineH),
-               p.fontMetrics().elidedText(row.text, Qt::ElideRight, static_cast<int>(width - 14)));
-    y += lineH;
+    const double keyWidth = item.key == K::None ? 0 : kLegendKey + 5;
+    p.setPen(item.key == K::Ramp ? QColor(230, 230, 230) : item.color);
+    p.drawText(at.adjusted(keyWidth, 0, 0, 0), Qt::AlignLeft | Qt::AlignTop | Qt::TextWordWrap, item.text);
   }
+  p.restore();
 }
 
 QPoint FrameView::imagePixel(QPointF pos) const {

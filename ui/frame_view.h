@@ -44,6 +44,9 @@ class FrameView : public QWidget {
   // What the pixel inspector reads: the image as shown (denoised, when it is) or the accumulation.
   enum class Inspect { Shown, Raw };
   void setInspect(Inspect what) { inspect_ = what; }
+  // Forgets the inspected region (it belonged to another scene).
+  void clearInspection();
+  QRect inspectedRegion() const { return region_; }
   Inspect inspect() const { return inspect_; }
   // Display-only: exposure, gamma and OCIO view; the accumulated samples are untouched.
   void setDisplay(const DisplaySettings& d);
@@ -90,18 +93,36 @@ class FrameView : public QWidget {
   // The picture exactly as presented: image, overlays and banners at the widget's size.
   QImage composed() const;
 
-  // The overlays' layout, for drawing and for tests: the legend's rows (one per overlay that is
-  // on) and its box inside the image rectangle `r`; where a tile's order number and sample count go.
-  struct LegendRow {
-    QColor color;
+  // The legend: one item per kind of mark on screen, each led by its key (the mark as drawn, in
+  // its colour), laid out in a strip below the image that the image never shares, so that it
+  // covers nothing however small the image, and wrapped, never cut, to the viewport's width.
+  struct LegendItem {
+    enum class Key { None, Ramp, Outline, Cross, Circle, Hatch, CrossHatch, Dashed, Corner };
+    Key key = Key::None;
+    QColor color;  // of the mark and of its words
     QString text;
-    bool gradient = false;  // the heat map's colour ramp above the text
   };
-  std::vector<LegendRow> legendRows() const;
-  static constexpr double kLegendLine = 15, kLegendWidth = 300;  // widget pixels
-  // The priority heat map is drawn: it is on and the frame belongs to a pass.
+  // What is drawn now (the frame and the overlays that are on): nothing explained that is not drawn.
+  std::vector<LegendItem> legendItems() const { return legendItems(false); }
+  // Where each item goes in a strip `width` wide (from its top left), and the strip's height.
+  struct LegendLayout {
+    std::vector<QRectF> items;
+    double height = 0;
+  };
+  LegendLayout layOutLegend(const std::vector<LegendItem>& items, double width) const;
+  // The strip in widget pixels (empty with the legend off). Its height is what every item the
+  // overlays can draw would need, so the image does not jump as marks come and go.
+  QRectF legendRect() const;
+  // Where the image may go: the widget above the legend strip.
+  QRectF imageArea() const;
+  // The marks' colours, shared by the drawing and its legend.
+  static const QColor kServedColor, kChangeColor, kFocusColor, kDenoisedColor, kReusedColor, kRejectedColor;
+  static const QColor kClassColor[3];  // high, middle, low
+  // The priority heat map is drawn: it is on and the frame belongs to a pass. It tints only the
+  // tiles the pass has yet to reach, so the re-rendered ones can be judged as they come.
   bool heatMapShown() const;
-  QRectF legendRect(const QRectF& r) const;
+  bool heatMapOn(int tile) const;
+  static constexpr double kLegendPad = 6, kLegendKey = 16, kLegendGap = 16;  // widget pixels
   struct TileLabels {
     QFont font;
     QRectF order, samples;
@@ -144,7 +165,11 @@ class FrameView : public QWidget {
   void refresh();
   void compose(QPainter& p, const QRect& area) const;
   void drawOverlays(QPainter& p, const QRectF& r) const;
-  void drawLegend(QPainter& p, const QRectF& r) const;
+  void drawLegend(QPainter& p) const;
+  // `everything`: every item the overlays that are on can draw, whatever the frame shows (the
+  // strip's height is made for them).
+  std::vector<LegendItem> legendItems(bool everything) const;
+  QFont legendFont() const;
   QImage toDisplay(const RenderImage& img) const;
   const std::vector<float>& inspected(const RenderImage& img) const { return inspect_ == Inspect::Raw ? img.color : img.shown(); }
   QPoint imagePixel(QPointF widgetPos) const;

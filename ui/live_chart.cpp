@@ -114,6 +114,17 @@ LiveChart::~LiveChart() {
   if (worker_.joinable()) worker_.join();
 }
 
+void LiveChart::reset() {
+  if (cancel_) *cancel_ = true;
+  if (worker_.joinable()) worker_.join();  // cancelled: it stops at its next frame
+  reference_.clear();
+  refVersion_ = 0;
+  lastError_ = -1;
+  error_->clear();
+  referenceButton_->setEnabled(true);
+  status_->setText(tr("No reference yet."));
+}
+
 int LiveChart::errorPoints() const { return static_cast<int>(error_->count()); }
 int LiveChart::throughputPoints() const { return static_cast<int>(samplesPerSecond_->count()); }
 
@@ -175,7 +186,8 @@ void LiveChart::renderReference(const Scene& scene, std::uint64_t documentVersio
       failure = QString::fromUtf8(e.what());
     }
     if (*cancel) return;
-    QMetaObject::invokeMethod(this, [this, color = std::move(color), failure, w, h, documentVersion]() mutable {
+    QMetaObject::invokeMethod(this, [this, color = std::move(color), failure, w, h, documentVersion, cancel]() mutable {
+      if (*cancel) return;  // reset() or a newer request came after the render ended
       referenceButton_->setEnabled(true);
       if (!failure.isEmpty()) {
         status_->setText(tr("Reference failed: %1").arg(failure));

@@ -37,6 +37,8 @@ class LiveChart : public QWidget {
   // Renders a reference of `scene` (at its settings' size) with `spp` samples per pixel.
   void renderReference(const Scene& scene, std::uint64_t documentVersion, int spp);
   bool hasReference() const { return !reference_.empty(); }
+  // Forgets the reference and its error (another scene was opened); a render under way is cancelled.
+  void reset();
   double lastError() const { return lastError_; }
   int errorPoints() const;
   int throughputPoints() const;

@@ -41,6 +41,7 @@
 
 #include <cmath>
 #include <numeric>
+#include <optional>
 
 #include "edit_command.h"
 #include "fields.h"
@@ -58,6 +59,8 @@ namespace {
 constexpr int kIdRole = Qt::UserRole + 1;
 constexpr int kKindRole = Qt::UserRole + 2;  // a PropertyTarget::Kind
 
+QString inspectorHint() { return MainWindow::tr("Hover the image for linear values; Ctrl+drag a region for its mean, min and max."); }
+
 }  // namespace
 
 MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions options, QWidget* parent)
@@ -67,8 +70,15 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
   if (options_.keepLayout) options_.cameraFraming = QSettings().value("viewport/cameraFraming", options_.cameraFraming).toBool();
   buildDocks();
   buildMenus();
+  // Left: the active tool (it carries over between selections), replaced for a while by a
+  // message; right: the render's figures.
+  toolLabel_ = new QLabel(this);
+  toolLabel_->setObjectName("toolStatus");
+  statusBar()->addWidget(toolLabel_);
   status_ = new QLabel(this);
-  statusBar()->addPermanentWidget(status_, 1);
+  statusBar()->addPermanentWidget(status_);
+  showTool();
+  for (PropertyPanel* p : {panel_, renderPanel_}) connect(p, &PropertyPanel::message, this, &MainWindow::notify);
   connect(view_, &FrameView::objectPicked, this, [this](quint64 id) { select(static_cast<NodeId>(id)); });
   connect(view_, &FrameView::objectToggled, this, [this](quint64 id) { toggleSelected(static_cast<NodeId>(id)); });
   connect(view_, &FrameView::focusPlaced, this, [this](QPointF p) {
@@ -247,7 +257,11 @@ void MainWindow::buildMenus() {
   QAction* undo = undo_.createUndoAction(this, tr("&Undo"));
   undo->setShortcut(QKeySequence::Undo);
   QAction* redo = undo_.createRedoAction(this, tr("&Redo"));
-  redo->setShortcut(QKeySequence::Redo);
+  // Ctrl+Y as well as the platform's redo (Ctrl+Shift+Z here): artists bring either habit.
+  QList<QKeySequence> redoKeys = QKeySequence::keyBindings(QKeySequence::Redo);
+  for (const QKeySequence& k : {QKeySequence(Qt::CTRL | Qt::Key_Y), QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_Z)})
+    if (!redoKeys.contains(k)) redoKeys << k;
+  redo->setShortcuts(redoKeys);
   editMenu->addAction(undo);
   editMenu->addAction(redo);
 
@@ -275,7 +289,10 @@ void MainWindow::buildMenus() {
   QMenu* tools = menuBar()->addMenu(tr("&Tools"));
   auto* toolGroup = new QActionGroup(this);
   auto tool = [&](const QString& name, FrameView::Tool t, Qt::Key key) {
-    QAction* a = tools->addAction(name, QKeySequence(key), this, [this, t] { view_->setTool(t); });
+    QAction* a = tools->addAction(name, QKeySequence(key), this, [this, t] {
+      view_->setTool(t);
+      showTool();
+    });
     a->setCheckable(true);
     a->setChecked(t == view_->tool());
     toolGroup->addAction(a);
@@ -343,6 +360,7 @@ void MainWindow::buildMenus() {
     log(tr("render region cleared: the whole image renders"));
   });
   QAction* pause = render->addAction(tr("&Pause / resume"));
+  pause->setObjectName("pauseAction");
   pause->setShortcut(Qt::Key_Escape);
   connect(pause, &QAction::triggered, this, [this] {
     paused_ = !paused_;
@@ -350,6 +368,11 @@ void MainWindow::buildMenus() {
     view_->setPaused(paused_);
     log(paused_ ? tr("paused: the accumulated samples are kept") : tr("resumed"));
   });
+
+  // Every panel, so that a closed one comes back (the docks exist by now).
+  QMenu* windows = menuBar()->addMenu(tr("&Window"));
+  windows->setObjectName("windowMenu");
+  for (QDockWidget* d : findChildren<QDockWidget*>()) windows->addAction(d->toggleViewAction());
 }
 
 QDockWidget* MainWindow::addDock(const QString& title, const char* name, QWidget* content, Qt::DockWidgetArea area) {
@@ -477,6 +500,7 @@ void MainWindow::buildDocks() {
   staleBox_->setObjectName("staleCap");
   staleBox_->setRange(1, 4096);
   staleBox_->setValue(method_.staleCap);
+  staleBox_->setKeyboardTracking(false);
   staleBox_->setToolTip(tr("Stale samples kept per pixel by the smooth transition: the old image weighs C/(C+n) after n fresh samples"));
   focusModeBox_ = new QComboBox(methodBox);
   focusModeBox_->setObjectName("focusMode");
@@ -497,10 +521,12 @@ void MainWindow::buildDocks() {
                              "The samples themselves are untouched (the pixel inspector can read either)."));
   denoiseThresholdBox_ = new QSpinBox(methodBox);
   denoiseThresholdBox_->setObjectName("denoiseThreshold");
-  denoiseThresholdBox_->setRange(0, 16384);
-  denoiseThresholdBox_->setSuffix(tr(" px"));
-  denoiseThresholdBox_->setValue(method_.denoiseThreshold);
-  denoiseThresholdBox_->setToolTip(tr("The denoised region is re-sized when its width or height has grown by more than this"));
+  denoiseThresholdBox_->setRange(0, 100);
+  denoiseThresholdBox_->setSuffix(tr(" % of the image"));
+  denoiseThresholdBox_->setValue(static_cast<int>(std::lround(method_.denoiseThreshold * 100)));
+  denoiseThresholdBox_->setKeyboardTracking(false);  // a typed value applies on Enter, not at every digit
+  denoiseThresholdBox_->setToolTip(tr("The denoised region is re-sized when its width (height) has grown by more than this "
+                                      "share of the image's width (height)"));
   softBordersBox_ = new QCheckBox(tr("soft borders"), methodBox);
   softBordersBox_->setObjectName("softBorders");
   softBordersBox_->setChecked(method_.softBorders);
@@ -588,7 +614,7 @@ void MainWindow::buildDocks() {
   connect(inspectSource, &QComboBox::currentIndexChanged, this, [this](int i) {
     view_->setInspect(i == 1 ? FrameView::Inspect::Raw : FrameView::Inspect::Shown);
   });
-  inspector_ = new QLabel(tr("Hover the image for linear values; Ctrl+drag a region for its mean, min and max."), inspectorPanel);
+  inspector_ = new QLabel(inspectorHint(), inspectorPanel);
   inspector_->setObjectName("inspector");
   inspector_->setWordWrap(true);
   inspector_->setTextInteractionFlags(Qt::TextSelectableByMouse);
@@ -660,7 +686,7 @@ void MainWindow::sendMethod() {
   m.denoise = denoiseBox_->isChecked();
   m.reuse = reuseBox_->isChecked() && m.kind != MethodKind::Global;
   reuseBox_->setEnabled(m.kind != MethodKind::Global);
-  m.denoiseThreshold = denoiseThresholdBox_->value();
+  m.denoiseThreshold = denoiseThresholdBox_->value() / 100.0;
   m.softBorders = softBordersBox_->isChecked();
   staleBox_->setEnabled(m.smooth);
   denoiseThresholdBox_->setEnabled(m.denoise);
@@ -673,14 +699,14 @@ void MainWindow::sendMethod() {
   engine_->submit(MethodCommand{method_});
   log(tr("method %1, T=%2, Q=%3%4").arg(QString::fromStdString(methodLabel(m))).arg(m.tileSize)
           .arg(m.quality ? QString::number(m.quality) : tr("auto"),
-               m.denoise ? tr(", denoise threshold %1 px").arg(m.denoiseThreshold) : QString()));
+               m.denoise ? tr(", denoise threshold %1 % of the image").arg(denoiseThresholdBox_->value()) : QString()));
 }
 
 QSize MainWindow::desiredRenderSize() const {
   QSize base = options_.initialRenderSize;
   if (base.isEmpty()) {
     // The viewport's size (and so its aspect: the image fills it) at the render scale.
-    const QSize v = view_->size();
+    const QSize v = view_->imageArea().size().toSize();
     const int k = std::max(1, options_.renderScale);
     base = QSize(std::max(64, v.width() / k), std::max(36, v.height() / k));
   }
@@ -716,6 +742,7 @@ void MainWindow::startEngine(Scene scene) {
   scene.settings.height = size.height();
   EngineOptions engineOptions;
   engineOptions.documentVersion = doc_.version();
+  engineOptions.previewBlock = options_.previewBlock;
   engine_ = std::make_unique<Engine>(std::move(scene), method_, engineOptions);
   engine_->setFrameCallback([this] { QMetaObject::invokeMethod(this, [this] { onFrame(); }, Qt::QueuedConnection); });
   engine_->start();
@@ -741,12 +768,13 @@ void MainWindow::onFrame() {
   double spp = frame->tileSamples.empty() ? 0.0
                                           : std::accumulate(frame->tileSamples.begin(), frame->tileSamples.end(), 0.0) /
                                                 static_cast<double>(frame->tileSamples.size());
+  const QString mode = QString::fromStdString(frame->mode) + (frame->block > 1 ? tr(", preview 1/%1").arg(frame->block) : QString());
   status_->setText(tr("%1 fps | %2 spp | queue %3/%4 | %5 (%6) | %7x%8 | %9")
                        .arg(fps_, 0, 'f', 1)
                        .arg(spp, 0, 'f', 0)
                        .arg(frame->queueServed)
                        .arg(frame->queueLength)
-                       .arg(QString::fromStdString(frame->method), QString::fromStdString(frame->mode))
+                       .arg(QString::fromStdString(frame->method), mode)
                        .arg(frame->width)
                        .arg(frame->height)
                        .arg(QString::fromStdString(engine_->deviceName())));
@@ -806,16 +834,7 @@ bool MainWindow::applyToDocument(const Edit& e) {
   return true;
 }
 
-Vec3 MainWindow::pivot(const Object& o) const {
-  // Imported meshes often sit in world space under an identity transform: the centre of the
-  // object's bounds is where an artist expects the gizmo and the pivot.
-  const Mesh* m = doc_.scene().mesh(o.mesh);
-  if (m && m->geometry) {
-    Bounds3 b = transformBounds(o.transform, m->geometry->bounds());
-    if (!b.empty()) return b.center();
-  }
-  return o.transform.transformPoint(Vec3{0.0f});
-}
+Vec3 MainWindow::pivot(const Object& o) const { return objectPivot(doc_.scene(), o); }
 
 void MainWindow::updateGizmo() {
   FrameView::Gizmo g;
@@ -923,49 +942,71 @@ void MainWindow::editSelected(const std::function<void(Object&)>& change, const 
 }
 
 void MainWindow::rebuildOutliner() {
+  // A rebuild follows every edit: it must not undo what the user did to the list (groups folded,
+  // where it was scrolled, the environment or a material picked in it).
+  using Key = QPair<int, qulonglong>;  // kind, id
+  auto keyOf = [](const QTreeWidgetItem* it) { return Key(it->data(0, kKindRole).toInt(), it->data(0, kIdRole).toULongLong()); };
+  QSet<QString> folded;
+  for (int i = 0; i < outliner_->topLevelItemCount(); ++i)
+    if (!outliner_->topLevelItem(i)->isExpanded()) folded << outliner_->topLevelItem(i)->text(0);
+  QSet<Key> picked;
+  for (const QTreeWidgetItem* it : outliner_->selectedItems()) picked << keyOf(it);
+  const bool hasCurrent = outliner_->currentItem() != nullptr;
+  const Key current = hasCurrent ? keyOf(outliner_->currentItem()) : Key(-1, 0);
+  const int scrolled = outliner_->verticalScrollBar()->value();
+
   QSignalBlocker block(outliner_);
   outliner_->clear();
   const Scene& s = doc_.scene();
   auto group = [&](const QString& name) {
     auto* g = new QTreeWidgetItem(outliner_, {name, QString()});
-    g->setExpanded(true);
+    g->setExpanded(!folded.contains(name));
     g->setFlags(Qt::ItemIsEnabled);
     return g;
+  };
+  std::vector<QTreeWidgetItem*> items;
+  auto item = [&](QTreeWidgetItem* parent, const QString& name, const QString& kind, PropertyTarget::Kind k, NodeId id) {
+    auto* it = new QTreeWidgetItem(parent, {name, kind});
+    if (id != kNoNode) it->setData(0, kIdRole, static_cast<qulonglong>(id));
+    it->setData(0, kKindRole, static_cast<int>(k));
+    items.push_back(it);
+    return it;
   };
   QTreeWidgetItem* objects = group(tr("Objects"));
   for (const Object& o : s.objects) {
     // Imported objects are often named after their mesh files: the material says what they are.
     const Material* m = s.material(o.material);
-    auto* it = new QTreeWidgetItem(objects, {QString::fromStdString(o.name), m ? QString::fromStdString(m->name) : tr("object")});
-    it->setData(0, kIdRole, static_cast<qulonglong>(o.id));
-    it->setData(0, kKindRole, static_cast<int>(PropertyTarget::Kind::Object));
+    auto* it = item(objects, QString::fromStdString(o.name), m ? QString::fromStdString(m->name) : tr("object"),
+                    PropertyTarget::Kind::Object, o.id);
     it->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsEditable | Qt::ItemIsUserCheckable);
     it->setCheckState(0, o.visible ? Qt::Checked : Qt::Unchecked);
-    if (std::find(selected_.begin(), selected_.end(), o.id) != selected_.end()) it->setSelected(true);
   }
   QTreeWidgetItem* materials = group(tr("Materials"));
-  for (const Material& m : s.materials) {
-    auto* it = new QTreeWidgetItem(materials, {QString::fromStdString(m.name), materialTypeName(m.type)});
-    it->setData(0, kIdRole, static_cast<qulonglong>(m.id));
-    it->setData(0, kKindRole, static_cast<int>(PropertyTarget::Kind::Material));
-    it->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsEditable);
-  }
+  for (const Material& m : s.materials)
+    item(materials, QString::fromStdString(m.name), materialTypeName(m.type), PropertyTarget::Kind::Material, m.id)
+        ->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsEditable);
   QTreeWidgetItem* lights = group(tr("Lights"));
   for (const Light& l : s.lights) {
-    auto* it = new QTreeWidgetItem(lights, {QString::fromStdString(l.name), tr("light")});
-    it->setData(0, kIdRole, static_cast<qulonglong>(l.id));
-    it->setData(0, kKindRole, static_cast<int>(PropertyTarget::Kind::Light));
+    auto* it = item(lights, QString::fromStdString(l.name), tr("light"), PropertyTarget::Kind::Light, l.id);
     it->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsEditable | Qt::ItemIsUserCheckable);
     it->setCheckState(0, l.visible ? Qt::Checked : Qt::Unchecked);
   }
   QTreeWidgetItem* scene = group(tr("Scene"));
-  auto single = [&](const QString& name, PropertyTarget::Kind kind) {
-    auto* it = new QTreeWidgetItem(scene, {name, QString()});
-    it->setData(0, kKindRole, static_cast<int>(kind));
-  };
-  single(tr("Camera"), PropertyTarget::Kind::Camera);
-  single(tr("Environment"), PropertyTarget::Kind::Environment);
-  single(tr("Render settings"), PropertyTarget::Kind::Render);
+  item(scene, tr("Camera"), QString(), PropertyTarget::Kind::Camera, kNoNode);
+  item(scene, tr("Environment"), QString(), PropertyTarget::Kind::Environment, kNoNode);
+  item(scene, tr("Render settings"), QString(), PropertyTarget::Kind::Render, kNoNode);
+
+  // Selected objects are the window's selection; anything else stays picked as it was.
+  for (QTreeWidgetItem* it : items) {
+    const Key k = keyOf(it);
+    const bool object = k.first == static_cast<int>(PropertyTarget::Kind::Object);
+    const bool selected = object ? std::find(selected_.begin(), selected_.end(), static_cast<NodeId>(k.second)) != selected_.end()
+                                 : picked.contains(k);
+    if (selected) it->setSelected(true);
+    if (hasCurrent && current == k) outliner_->setCurrentItem(it, 0, QItemSelectionModel::NoUpdate);
+  }
+  outliner_->doItemsLayout();  // the scroll bar's range, before its old value is put back
+  outliner_->verticalScrollBar()->setValue(scrolled);
 }
 
 void MainWindow::rebuildProperties() {
@@ -1044,11 +1085,40 @@ bool MainWindow::openFile(const std::filesystem::path& file) {
     showError(tr("Cannot open scene"), QString::fromStdString(r.error()));
     return false;
   }
-  for (const auto& w : r->warnings) log(tr("warning: %1").arg(QString::fromStdString(w)));
   replaceDocument(std::move(r->scene), file);
+  opened(file, r->warnings);
+  return true;
+}
+
+void MainWindow::opened(const std::filesystem::path& file, const std::vector<std::string>& warnings) {
   log(tr("opened %1").arg(QString::fromStdString(file.string())));
   rememberRecent(file);
-  return true;
+  for (const auto& w : warnings) log(tr("warning: %1").arg(QString::fromStdString(w)));
+  if (warnings.empty()) return;
+  const QString text = tr("%n warning(s) opening %1: see the Log", nullptr, static_cast<int>(warnings.size()))
+                           .arg(QString::fromStdString(file.filename().string()));
+  view_->showNotice(text, 8000);
+  statusBar()->showMessage(text, 15000);
+  if (auto* logDock = findChild<QDockWidget*>("log")) {
+    logDock->show();
+    logDock->raise();
+  }
+}
+
+void MainWindow::notify(const QString& text) {
+  statusBar()->showMessage(text, 8000);
+  log(text);
+}
+
+void MainWindow::showTool() {
+  QString name;
+  switch (view_->tool()) {
+    case FrameView::Tool::Select: name = tr("Select (Q): click picks"); break;
+    case FrameView::Tool::Move: name = tr("Move (W): drag the selection or an arrow"); break;
+    case FrameView::Tool::Rotate: name = tr("Rotate (E): drag turns about the selection's centre"); break;
+    case FrameView::Tool::Scale: name = tr("Scale (R): drag scales about the selection's centre"); break;
+  }
+  toolLabel_->setText(tr("Tool: %1").arg(name));
 }
 
 void MainWindow::replaceDocument(Scene scene, const std::filesystem::path& file) {
@@ -1067,6 +1137,12 @@ void MainWindow::replaceDocument(Scene scene, const std::filesystem::path& file)
   rebuildProperties();
   graph_->setDocument(doc_.scene());
   graph_->resetLayout();
+  // The inspector's region and readout and the chart's reference described the old scene.
+  view_->clearInspection();
+  pixelText_.clear();
+  regionText_.clear();
+  inspector_->setText(inspectorHint());
+  chart_->reset();
 }
 
 void MainWindow::applySceneView() {

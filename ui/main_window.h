@@ -35,7 +35,11 @@ class QDockWidget;
 namespace retile::ui {
 
 struct EditorOptions {
-  int renderScale = 4;        // render at 1/scale of the viewport (lavapipe traces well under 1 M samples/s)
+  // Render at 1/scale of the viewport at rest, and while edits come at 1/(scale x previewBlock)
+  // (RenderSession::setPreview): lavapipe traces well under a million samples a second, so the
+  // frames of a drag stay quick and the picture at rest is sharp enough to judge a material.
+  int renderScale = 2;
+  int previewBlock = 2;
   QSize initialRenderSize{};  // fixed render size (tests); empty: follow the viewport
   // Frame the image as the scene's resolution frames it (its width : height, fitted into the
   // viewport and letterboxed); else the image fills the viewport, widening or narrowing the view.
@@ -55,6 +59,12 @@ class MainWindow : public QMainWindow {
 
   // Opens a scene file; on failure shows the error and keeps the current scene. Returns success.
   bool openFile(const std::filesystem::path& file);
+  // A file has been opened (here or by the command line before the window existed): it goes to
+  // Open Recent, and what its import warned about is logged and announced where it is seen (the
+  // viewport's notice, the status bar, the Log raised).
+  void opened(const std::filesystem::path& file, const std::vector<std::string>& warnings);
+  // A line the user should read now: the status bar for a while, and the log.
+  void notify(const QString& text);
   bool saveTo(const std::filesystem::path& file);
   // Appends a line to the Log dock (a warning is logged once per document).
   void log(const QString& line);
@@ -79,6 +89,7 @@ class MainWindow : public QMainWindow {
   // Applies an edit through the undo stack (dragId > 0 merges a drag into one step).
   void edit(const Edit& before, const Edit& after, const QString& text, int dragId = 0);
   QString lastError() const { return lastError_; }
+  bool paused() const { return paused_; }
   // Autosave: writes the document to the newest of three rotating recovery files when it changed.
   bool autosave();
   // Recovery files left by a session that did not close cleanly (newest first).
@@ -121,6 +132,7 @@ class MainWindow : public QMainWindow {
   void rebuildRecentMenu();
   void editCamera(const std::function<void(Camera&)>& change, const QString& what);
   void frameSelected();
+  void showTool();  // the active tool in the status bar
 
   EditorOptions options_;
   Document doc_;
@@ -129,7 +141,13 @@ class MainWindow : public QMainWindow {
   QUndoStack undo_;
   NodeId selection_ = kNoNode;
   std::vector<NodeId> selected_;  // includes selection_
-  MethodSettings method_;
+  MethodSettings method_ = editorMethod();
+  // The editor's method at start: the library's, denoised, so that a pass shows its growing regions.
+  static MethodSettings editorMethod() {
+    MethodSettings m;
+    m.denoise = true;
+    return m;
+  }
   bool paused_ = false;
   int dragCounter_ = 0;
   QString lastError_;
@@ -165,6 +183,7 @@ class MainWindow : public QMainWindow {
   QSpinBox* denoiseThresholdBox_ = nullptr;
   QCheckBox* softBordersBox_ = nullptr;
   QLabel* status_ = nullptr;
+  QLabel* toolLabel_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   int autosaveSlot_ = 0;
   int autosavedIndex_ = -1;  // undo index at the last autosave

@@ -163,6 +163,7 @@ class PropertyPanel::Builder {
     // The builder lives only while the panel builds: the connections capture the panel.
     PropertyPanel* panel = p_;
     QObject::connect(f, &ScrubField::edited, f, [panel, apply](double v, bool scrubbing) { apply(v, scrubbing ? panel->drag_ : 0); });
+    QObject::connect(f, &ScrubField::refused, panel, &PropertyPanel::message);
     QObject::connect(f, &ScrubField::scrubFinished, f, [panel] {
       ++panel->drag_;
       if (panel->rebuildAfterScrub_) {
@@ -279,32 +280,34 @@ void PropertyPanel::buildObject(Builder& b, const Object& o) {
   const NodeId id = o.id;
   auto edit = nodeEdit<Object, SetObject>(id, [](const Scene& sc, NodeId i) { return sc.object(i); });
   b.header(tr("Object: %1").arg(QString::fromStdString(o.name)));
-  // Position moves the object and keeps its rotation and scale.
-  b.vec3(tr("Position"), "position", o.transform.transformPoint(Vec3{0.0f}), 0.01, [edit](int axis, double v, int drag) {
+  // Position is the object's pivot (objectPivot: where the gizmo sits); moving keeps its rotation
+  // and scale, and a turn or scale, here or with the gizmo, keeps its position.
+  const Scene& scene = scene_();
+  b.vec3(tr("Position"), "position", objectPivot(scene, o), 0.01, [this, edit](int axis, double v, int drag) {
     edit(tr("Move"), drag, [&](Object& x) {
-      Vec3 p = x.transform.transformPoint(Vec3{0.0f});
       Vec3 d{0.0f};
-      axisOf(d, axis) = static_cast<float>(v) - axisOf(p, axis);
+      Vec3 at = objectPivot(scene_(), x);
+      axisOf(d, axis) = static_cast<float>(v) - axisOf(at, axis);
       x.transform = Mat4::translate(d) * x.transform;
     });
   });
-  // Rotation and scale about the object's origin, as the gizmo turns and scales it. A sheared
-  // transform (rare in imported files) loses its shear when one of them is edited.
+  // A sheared transform (rare in imported files) loses its shear when one of these is edited.
+  auto aboutPivot = [this](Object& x, const std::function<void(Trs&)>& change) {
+    const Vec3 at = objectPivot(scene_(), x);
+    Trs t = decompose(x.transform);
+    change(t);
+    x.transform = compose(t);
+    x.transform = Mat4::translate(at - objectPivot(scene_(), x)) * x.transform;
+  };
   const Trs trs = decompose(o.transform);
-  b.vec3(tr("Rotation"), "rotation", trs.rotationDegrees, 1.0, [edit](int axis, double v, int drag) {
-    edit(tr("Rotate"), drag, [&](Object& x) {
-      Trs t = decompose(x.transform);
-      axisOf(t.rotationDegrees, axis) = static_cast<float>(v);
-      x.transform = compose(t);
-    });
+  b.vec3(tr("Rotation"), "rotation", trs.rotationDegrees, 1.0, [edit, aboutPivot](int axis, double v, int drag) {
+    edit(tr("Rotate"), drag, [&](Object& x) { aboutPivot(x, [&](Trs& t) { axisOf(t.rotationDegrees, axis) = static_cast<float>(v); }); });
   });
-  b.vec3(tr("Scale"), "scale", trs.scale, 0.01, [edit](int axis, double v, int drag) {
+  b.vec3(tr("Scale"), "scale", trs.scale, 0.01, [edit, aboutPivot](int axis, double v, int drag) {
     edit(tr("Scale"), drag, [&](Object& x) {
-      Trs t = decompose(x.transform);
       // Never zero: a flat object cannot be scaled back up.
       const double magnitude = std::max(std::abs(v), 1e-4);
-      axisOf(t.scale, axis) = static_cast<float>(v < 0 ? -magnitude : magnitude);
-      x.transform = compose(t);
+      aboutPivot(x, [&](Trs& t) { axisOf(t.scale, axis) = static_cast<float>(v < 0 ? -magnitude : magnitude); });
     });
   });
   b.nodeChoice(tr("Material"), "materialAssignment", scene_().materials, o.material,
@@ -479,21 +482,32 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
                [edit](double v, int drag) { edit(tr("Bump strength"), drag, [v](Material& x) { x.bumpStrength = static_cast<float>(v); }); });
   }
 
-  const float strength = peak(m.emission);
-  const Vec3 tint = strength > 0 ? m.emission * (1.0f / strength) : Vec3{1.0f};
-  b.color(tr("Emission colour"), "emissionColor", tint, Vec3{1.0f}, [this, id, edit](Vec3 c, int drag) {
-    const Material* cur = scene_().material(id);
-    float s = cur ? peak(cur->emission) : 0.0f;
-    edit(tr("Emission colour"), drag, [c, s](Material& x) { x.emission = c * s; });
-    if (drag != kPreview && (s > 0) != (peak(c) * s > 0)) rebuildLater();  // black: no cone to show
-  });
-  b.number(tr("Emission"), "emission", strength, 0.0, 1e5, 0.0, 2, [this, id, edit](double v, int drag) {
+  // Shown as a swatch (the colour, normalised: files give radiance above 1) and a strength, the
+  // peak of the radiance; each edit keeps the other, a strength of 0 included.
+  auto tintOf = [](const Material& x) { return peak(x.emission) > 0 ? x.emission * (1.0f / peak(x.emission)) : Vec3{1.0f}; };
+  auto strengthOf = [](const Material& x) { return peak(x.emission) * x.emissionStrength; };
+  b.color(tr("Emission colour"), "emissionColor", tintOf(m), Vec3{1.0f}, [this, id, edit, strengthOf](Vec3 c, int drag) {
     const Material* cur = scene_().material(id);
     if (!cur) return;
-    float s = peak(cur->emission);
-    Vec3 t = s > 0 ? cur->emission * (1.0f / s) : Vec3{1.0f};
-    edit(tr("Emission"), drag, [t, v](Material& x) { x.emission = t * static_cast<float>(v); });
-    if ((s > 0) != (v > 0)) rebuildLater(drag);  // the cone shows only while it emits
+    const bool was = cur->emissive();
+    const float s = strengthOf(*cur);
+    edit(tr("Emission colour"), drag, [c, s](Material& x) {
+      x.emission = c;
+      x.emissionStrength = s;
+    });
+    const Material* now = scene_().material(id);
+    if (drag != kPreview && now && now->emissive() != was) rebuildLater();  // black: no cone to show
+  });
+  b.number(tr("Emission"), "emission", strengthOf(m), 0.0, 1e5, 0.0, 2, [this, id, edit, tintOf](double v, int drag) {
+    const Material* cur = scene_().material(id);
+    if (!cur) return;
+    const bool was = cur->emissive();
+    const Vec3 t = tintOf(*cur);
+    edit(tr("Emission"), drag, [t, v](Material& x) {
+      x.emission = t;
+      x.emissionStrength = static_cast<float>(v);
+    });
+    if (was != (v > 0)) rebuildLater(drag);  // the cone shows only while it emits
   });
   if (m.emissive())
     b.number(tr("Emission cone half angle"), "emissionCone", m.emissionCone, 0.0, 90.0, defaults.emissionCone, 1, [edit](double v, int drag) {

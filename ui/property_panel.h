@@ -49,6 +49,10 @@ class PropertyPanel : public QScrollArea {
   // resolution, framed as the scene, resizes the render at every step).
   void setRenderSize(QSize s, bool cameraFraming = false);
 
+ signals:
+  // Something the user should read: a typed value refused or clamped (the owner shows it).
+  void message(const QString& text);
+
  private:
   class Builder;
   // An editor of node `id`: reads the node from the document when called (never a stale copy),

@@ -235,8 +235,8 @@ struct FrameUniforms {
   vec4 environmentTint; // rgb multiplier (constant: the radiance), -
   vec4 environmentToMap[3]; // rows of the rotation from world directions to the map's frame (xyz)
   vec4 sceneSphere;     // bounding sphere: centre xyz, radius
-  uvec4 work;           // work item count, total sample slots, selected instance + 1 (0: none),
-                        // tile size of the selection counters (0: not counting)
+  uvec4 work;           // work item count, total sample slots, where the selection buffer's
+                        // counters start + 1 (0: not counting), tile size of the counters
   // A sample's offset from the pixel centre along each axis, in pixels, for u = i / 32: the
   // inverse CDF of the scene's pixel filter (filter importance sampling), 33 values, packed; the
   // last slot (filterWarp[8].w): a tent's radius, inverted exactly instead (0: use the table);
@@ -274,11 +274,19 @@ struct FrameUniforms {
 struct WorkItem {
   ivec4 rect;   // x0, y0, width, height
   uvec4 info;   // q, slotStart, sampleBase, flags (kWorkRestart: replace the pixel's sums)
-  uvec4 pixels; // pixelStart (prefix of width * height over items), stale cap (kWorkCapStale), -, -
+  uvec4 pixels; // pixelStart (prefix of width * height over items), stale cap (kWorkCapStale),
+                // block (> 1: a coarse item, each of its samples standing for a block x block
+                // square of pixels, its slots per block instead of per pixel), -
 };
 RT_CONST(uint, kWorkRestart, 1u)
 RT_CONST(uint, kWorkCapStale, 2u)   // scale the pixel's sums down to at most pixels.y samples first
-RT_CONST(int, kSelectionCounters, 3) // per tile: direct hits, weighted reflections, blocked shadow rays
+// Per tile: direct hits, weighted reflections and blocked shadow rays of the selected object,
+// then the same of its group (every object of its material), kCountedSets sets of three.
+RT_CONST(int, kCountedSets, 2)
+RT_CONST(int, kSelectionCounters, 6)
+// The selection buffer starts with a word per 16 instances: two bits each, the sets the instance
+// belongs to (bit 0: the selected object, bit 1: its group); the counters follow.
+RT_CONST(int, kInstancesPerSetWord, 16)
 
 struct TracePush {
   uint slotOffset;   // first slot of this dispatch (dispatches are split by size)

@@ -75,6 +75,46 @@ TEST(AccumulatePass, RestartReplacesAndUnservedPixelsKeepTheirSums) {
   EXPECT_EQ(img.sampleCount[15], 4.0f);
 }
 
+// A preview's coarse item traces a sample per block and every pixel of the block takes it: the
+// same value and count across the block, a block cut by the item's edge included, nothing outside.
+TEST(AccumulatePass, ACoarseItemGivesEachBlockOneEstimateForAllItsPixels) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const int w = 16, h = 12;
+  Scene s = test::emptyScene(w, h);
+  s.camera = test::frontCamera(40);
+  s.settings.maxBounces = 2;
+  s.environment.color = Vec3{1.0f};  // a lit grey wall: every sample differs
+  Material grey;
+  grey.albedo = Vec3{0.6f};
+  NodeId mat = test::addMaterial(s, grey);
+  test::addMeshObject(s, "wall", makeQuad(), mat, Mat4::translate({0, 0, -5}) * Mat4::rotateX(kPi / 2) * Mat4::scale({100, 1, 100}));
+  r->setScene(s);
+  r->resize(w, h);
+  TileWork coarse{1, 2, 13, 7, 2, 0, true};
+  coarse.block = 4;  // blocks of 4, 4, 4 and 1 pixels across, 4 and 3 down
+  FrameStats fs = r->renderFrame({coarse});
+  EXPECT_EQ(fs.samples, 4u * 2u * 2u) << "a sample per block and quality";
+  RenderImage img = r->readback();
+  std::set<float> values;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y * w + x);
+      const bool inside = x >= 1 && x < 14 && y >= 2 && y < 9;
+      ASSERT_EQ(img.sampleCount[i], inside ? 2.0f : 0.0f) << x << "," << y;
+      if (!inside) continue;
+      const int cornerX = 1 + (x - 1) / 4 * 4, cornerY = 2 + (y - 2) / 4 * 4;
+      const std::size_t c = static_cast<std::size_t>(cornerY * w + cornerX);
+      for (int ch = 0; ch < 3; ++ch) ASSERT_EQ(img.color[i * 3 + ch], img.color[c * 3 + ch]) << x << "," << y << " takes its block's";
+      values.insert(img.color[i * 3]);
+    }
+  EXPECT_EQ(values.size(), 8u) << "eight blocks, eight estimates";
+  // A full-resolution restart of the same pixels gives each its own.
+  r->renderFrame({{1, 2, 13, 7, 2, 2, true}});
+  RenderImage fine = r->readback();
+  const std::size_t a = static_cast<std::size_t>(2 * w + 1), b = static_cast<std::size_t>(2 * w + 2);
+  EXPECT_NE(fine.color[a * 3], fine.color[b * 3]);
+}
+
 TEST(AccumulatePass, ThousandsOfSamplesDoNotDrift) {
   RETILE_RENDERER_OR_SKIP(r);
   // 0.1 is not representable; a naive float sum over 8192 samples drifts by ~1e-4 relative.
@@ -236,6 +276,8 @@ TEST(TracePass, SelectionCountersSeeDirectHitsReflectionsAndShadows) {
   NodeId mg = test::addMaterial(s, grey);
   test::addMeshObject(s, "floor", makeQuad(), mg, Mat4::scale({40, 1, 40}));
   NodeId box = test::addMeshObject(s, "box", makeCube(), mg, Mat4::translate({-1.5f, 0.25f, 0}) * Mat4::scale(Vec3{0.5f}));
+  // A second box on the right, counted only as one of the group (a material's other user).
+  NodeId other = test::addMeshObject(s, "other", makeCube(), mg, Mat4::translate({1.5f, 0.25f, 0}) * Mat4::scale(Vec3{0.5f}));
   Light sun;
   sun.id = s.newId();
   sun.type = LightType::Point;
@@ -244,31 +286,36 @@ TEST(TracePass, SelectionCountersSeeDirectHitsReflectionsAndShadows) {
   s.lights.push_back(sun);
   r->setScene(s);
   r->resize(w, h);
-  r->setSelection(box);
+  r->setSelection(box, {box, other});
   FrameOptions count;
   count.selectionTileSize = tile;
   for (int f = 0; f < 4; ++f) r->renderFrame({{0, 0, w, h, 4, static_cast<std::uint32_t>(f * 4), f == 0}}, count);
   SelectionCounts c = r->takeSelectionCounts();
   ASSERT_EQ(c.tileSize, tile);
-  ASSERT_EQ(c.direct.size(), 8u);  // 4 x 2 tiles
+  ASSERT_EQ(c.object.direct.size(), 8u);  // 4 x 2 tiles
+  ASSERT_EQ(c.group.direct.size(), 8u);
   std::uint64_t direct = 0, reflection = 0, shadow = 0;
-  for (std::size_t t = 0; t < c.direct.size(); ++t) {
-    direct += c.direct[t];
-    reflection += c.reflection[t];
-    shadow += c.shadow[t];
+  for (std::size_t t = 0; t < c.object.direct.size(); ++t) {
+    direct += c.object.direct[t];
+    reflection += c.object.reflection[t];
+    shadow += c.object.shadow[t];
   }
   EXPECT_GT(direct, 0u);
   EXPECT_GT(reflection, 0u) << "floor paths bounce onto the box";
   EXPECT_GT(shadow, 0u) << "the box blocks shadow rays from the floor";
-  // The box is left of centre: its direct hits are all in the left half of the tiles.
-  EXPECT_EQ(c.direct[3] + c.direct[7], 0u);
+  // The box is left of centre: its direct hits are all in the left half of the tiles; the group's
+  // are on both sides, the left ones the box's own.
+  EXPECT_EQ(c.object.direct[3] + c.object.direct[7], 0u);
+  EXPECT_GT(c.group.direct[2] + c.group.direct[3] + c.group.direct[6] + c.group.direct[7], 0u) << "the other box";
+  for (std::size_t t : {0u, 1u, 4u, 5u}) EXPECT_EQ(c.group.direct[t], c.object.direct[t]) << "tile " << t;
   SelectionCounts again = r->takeSelectionCounts();
-  EXPECT_EQ(again.direct[1] + again.direct[5], 0u) << "taking the counts clears them";
+  EXPECT_EQ(again.object.direct[1] + again.object.direct[5], 0u) << "taking the counts clears them";
   // Nothing selected: nothing counted.
   r->setSelection(kNoNode);
   r->renderFrame({{0, 0, w, h, 1, 100, false}}, count);
   SelectionCounts none = r->takeSelectionCounts();
-  for (auto v : none.direct) EXPECT_EQ(v, 0u);
+  for (auto v : none.object.direct) EXPECT_EQ(v, 0u);
+  for (auto v : none.group.direct) EXPECT_EQ(v, 0u);
 }
 
 TEST(TracePass, AuxiliaryOutputsDescribeTheFirstHit) {

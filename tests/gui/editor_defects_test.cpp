@@ -238,16 +238,21 @@ TEST(EditorDefects, TheLegendExplainsWhatIsDrawnAndNothingElse) {
   o.legend = true;
   v->setOverlays(o);
   v->showFrame(inPass);
-  QRectF box = v->legendRect(v->imageRect());
+  using Key = FrameView::LegendItem::Key;
+  auto keyed = [&](Key k) {
+    const auto items = v->legendItems();
+    return std::any_of(items.begin(), items.end(), [k](const FrameView::LegendItem& i) { return i.key == k; });
+  };
+  QRectF box = v->legendRect();
   EXPECT_EQ(saturatedPixels(v->composed(), box), 0) << "no colour ramp without the heat map";
-  for (const auto& row : v->legendRows()) EXPECT_FALSE(row.gradient);
+  EXPECT_FALSE(keyed(Key::Ramp));
   o.priority = true;
   v->setOverlays(o);
-  box = v->legendRect(v->imageRect());
+  box = v->legendRect();
   EXPECT_GT(saturatedPixels(v->composed(), box), 50) << "the ramp with it";
   v->showFrame(refining);
   EXPECT_FALSE(v->heatMapShown()) << "no heat map outside a pass";
-  EXPECT_EQ(saturatedPixels(v->composed(), v->legendRect(v->imageRect())), 0);
+  EXPECT_EQ(saturatedPixels(v->composed(), v->legendRect()), 0);
 
   // Indirection with counters: the classes' row is in the legend's one box, inside the image.
   MethodSettings m;
@@ -260,17 +265,11 @@ TEST(EditorDefects, TheLegendExplainsWhatIsDrawnAndNothingElse) {
   v->showFrame(v->frame());
   o.classes = true;
   v->setOverlays(o);
-  bool listed = false;
-  for (const auto& row : v->legendRows()) listed = listed || row.text.contains("indirection classes");
-  EXPECT_TRUE(listed);
-  box = v->legendRect(v->imageRect());
-  EXPECT_TRUE(v->imageRect().contains(box)) << "the whole legend is inside the image: " << box.x() << "," << box.y() << " "
-                                             << box.width() << "x" << box.height() << " in " << v->imageRect().x() << ","
-                                             << v->imageRect().y() << " " << v->imageRect().width() << "x"
-                                             << v->imageRect().height();
-  double needed = 8;
-  for (const auto& row : v->legendRows()) needed += FrameView::kLegendLine + (row.gradient ? 12 : 0);
-  EXPECT_GE(box.height(), needed) << "and tall enough for its rows";
+  EXPECT_TRUE(keyed(Key::Hatch)) << "the classes are keyed";
+  box = v->legendRect();
+  EXPECT_TRUE(QRectF(v->rect()).contains(box)) << "the whole legend is in the viewport";
+  EXPECT_FALSE(box.intersects(v->imageRect())) << "beside the image, not over it";
+  EXPECT_GE(box.height(), v->layOutLegend(v->legendItems(), box.width()).height) << "and tall enough for its items";
 }
 
 // 9. Tile order numbers and samples per tile printed on top of each other.

@@ -265,7 +265,7 @@ TEST(Editor, TheDenoiseSettingsReachTheEngineAndTheRegionBoundariesDraw) {
   moved.transform = Mat4::translate({0, 0.05f, 0}) * o.transform;
   w->edit(SetObject{o}, SetObject{moved}, "move");
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.mode == "incremental" && f.denoised.size() >= 2; }))
-      << "a pass stacks growing regions (16 px threshold)";
+      << "a pass stacks growing regions (a threshold of 16 % of the image)";
   const FrameRecord f = *w->viewport()->frame();
   const RegionRect inner = f.denoised.front().rect, outer = f.denoised.back().rect;
   EXPECT_GT(outer.width * outer.height, inner.width * inner.height);

@@ -10,7 +10,7 @@ namespace retile {
 namespace {
 
 // Plays a spiral pass from `centre`, `perFrame` tiles a frame, and returns every frame's decision.
-std::vector<DenoiseFrame> playSpiral(DenoiseRegions& r, const TileGrid& g, int centre, int perFrame, int threshold) {
+std::vector<DenoiseFrame> playSpiral(DenoiseRegions& r, const TileGrid& g, int centre, int perFrame, double threshold) {
   std::vector<int> order = spiralOrder(g, centre);
   std::vector<char> started(static_cast<std::size_t>(g.count()), 0), grows(static_cast<std::size_t>(g.count()), 1);
   std::vector<DenoiseFrame> frames;
@@ -27,13 +27,13 @@ TEST(DenoiseRegions, GrowsOnlyPastTheThresholdOnEitherAxisAndCoversTheFrameAtThe
   TileGrid g(320, 96, 16);  // 20 x 6 tiles: the height reaches the frame long before the width
   DenoiseRegions r;
   r.reset(g);
-  auto frames = playSpiral(r, g, g.index(10, 3), 3, 40);
+  auto frames = playSpiral(r, g, g.index(10, 3), 3, 0.125);  // 40 px of the width, 12 of the height
   std::vector<TileRect> pushed;
   for (const DenoiseFrame& f : frames)
     if (f.filter) pushed.push_back(f.domain);
   ASSERT_GE(pushed.size(), 3u) << "the region grew several times";
   for (std::size_t i = 1; i < pushed.size(); ++i) {
-    bool grewW = pushed[i].width - pushed[i - 1].width > 40, grewH = pushed[i].height - pushed[i - 1].height > 40;
+    bool grewW = pushed[i].width - pushed[i - 1].width > 40, grewH = pushed[i].height - pushed[i - 1].height > 12;
     bool last = i + 1 == pushed.size();  // when the pass re-rendered its last tile
     EXPECT_TRUE(grewW || grewH || last) << "resize " << i << ": " << pushed[i - 1].width << "x" << pushed[i - 1].height
                                          << " -> " << pushed[i].width << "x" << pushed[i].height;
@@ -47,7 +47,7 @@ TEST(DenoiseRegions, OlderResultsStayOnTopAndOnlyTheNewRingTakesTheNewResult) {
   TileGrid g(160, 160, 16);
   DenoiseRegions r;
   r.reset(g);
-  auto frames = playSpiral(r, g, g.index(5, 5), 4, 16);
+  auto frames = playSpiral(r, g, g.index(5, 5), 4, 0.1);
   std::vector<int> firstRegion(static_cast<std::size_t>(g.count()), -1);
   for (const DenoiseFrame& f : frames) {
     for (int t = 0; t < g.count(); ++t) {
@@ -79,7 +79,7 @@ TEST(DenoiseRegions, TilesNotYetReRenderedTakeNoPartAndShowTheirPreviousResult) 
   std::vector<char> started(16, 0), grows(16, 1);
   started[static_cast<std::size_t>(g.index(0, 0))] = 1;
   started[static_cast<std::size_t>(g.index(2, 0))] = 1;  // a second seed two tiles away
-  DenoiseFrame f = r.incremental(started, grows, 200, false, 2);
+  DenoiseFrame f = r.incremental(started, grows, 1.0, false, 2);
   ASSERT_TRUE(f.filter);
   EXPECT_EQ(f.domain.width, 48) << "one rectangle spans both seeds";
   int between = g.index(1, 0);
@@ -89,7 +89,7 @@ TEST(DenoiseRegions, TilesNotYetReRenderedTakeNoPartAndShowTheirPreviousResult) 
   EXPECT_EQ(f.source[static_cast<std::size_t>(g.index(0, 1))], TileSource::Previous);
   // Once re-rendered outside any region, it shows its fresh samples.
   started[static_cast<std::size_t>(g.index(3, 3))] = 1;
-  DenoiseFrame next = r.incremental(started, grows, 200, false, 3);
+  DenoiseFrame next = r.incremental(started, grows, 1.0, false, 3);
   EXPECT_EQ(next.source[static_cast<std::size_t>(g.index(3, 3))], TileSource::Fresh);
 }
 
@@ -97,9 +97,9 @@ TEST(DenoiseRegions, ANewPointOfChangeRestartsTheStack) {
   TileGrid g(128, 128, 16);
   DenoiseRegions r;
   r.reset(g);
-  auto a = playSpiral(r, g, g.index(1, 1), 6, 16);
+  auto a = playSpiral(r, g, g.index(1, 1), 6, 0.125);
   ASSERT_GT(a.back().regions.size(), 1u);
-  auto b = playSpiral(r, g, g.index(6, 6), 1, 16);
+  auto b = playSpiral(r, g, g.index(6, 6), 1, 0.125);
   EXPECT_EQ(b.front().regions.size(), 1u) << "restart: one region, around the new point";
   EXPECT_EQ(b.front().domain.x, 96);
   EXPECT_EQ(b.front().domain.width, 16);
@@ -129,7 +129,7 @@ TEST(DenoiseRegions, ThresholdZeroGrowsEveryFrameAndAFullFrameThresholdOnlyAtThe
     }
   }
   EXPECT_EQ(got, expected);
-  auto full = playSpiral(r, g, g.index(4, 4), 2, 128);
+  auto full = playSpiral(r, g, g.index(4, 4), 2, 1.0);
   int pushes = 0;
   for (const DenoiseFrame& f : full) pushes += f.filter;
   EXPECT_EQ(pushes, 2) << "the first region, then the whole frame when the pass ends";
@@ -142,7 +142,7 @@ TEST(DenoiseRegions, RegionsAtTheBorderAndTinyAndHugeFrames) {
     TileGrid g(w, h, 32);
     DenoiseRegions r;
     r.reset(g);
-    auto frames = playSpiral(r, g, g.count() - 1, std::max(1, g.count() / 7), 200);  // from the corner
+    auto frames = playSpiral(r, g, g.count() - 1, std::max(1, g.count() / 7), 0.1);  // from the corner
     const DenoiseFrame& last = frames.back();
     ASSERT_FALSE(last.regions.empty());
     const TileRect& outer = last.regions.back().rect;
@@ -169,7 +169,7 @@ TEST(DenoiseRegions, GrowsOnlyOverTheTilesItIsToldTo) {
   r.restart();
   std::vector<char> started(static_cast<std::size_t>(g.count()), 1), grows(static_cast<std::size_t>(g.count()), 0);
   grows[static_cast<std::size_t>(g.index(2, 1))] = grows[static_cast<std::size_t>(g.index(3, 2))] = 1;
-  DenoiseFrame f = r.incremental(started, grows, 200, false, 1);
+  DenoiseFrame f = r.incremental(started, grows, 1.0, false, 1);
   EXPECT_EQ(f.domain.x, 32);
   EXPECT_EQ(f.domain.y, 16);
   EXPECT_EQ(f.domain.width, 32);

@@ -73,6 +73,48 @@ std::int64_t pixelsOf(const TileGrid& g, const std::vector<int>& tiles) {
 
 bool contains(const std::vector<int>& v, int t) { return std::find(v.begin(), v.end(), t) != v.end(); }
 
+// Issue 60: a material edit was planned as a spiral around the centre of all its objects, its
+// counters unused. Its objects' direct, reflected and shadow tiles now come first, as for a move.
+TEST(Planner, AMaterialEditServesEveryObjectOfTheMaterialByItsClasses) {
+  TileGrid g(320, 180, 16);  // 20 x 12 tiles
+  constexpr NodeId kWood = 20;
+  Planner p(g, methodOf(MethodKind::Indirection, 0));
+  p.select(kTable);
+  // The table at the left, a chair of the same wood at the right; the chair shadows the floor.
+  const std::vector<int> table = {g.index(2, 8), g.index(3, 8)}, chair = {g.index(17, 3)};
+  const std::vector<int> shadow = {g.index(17, 5)}, reflection = {g.index(10, 1)};
+  IndirectionCounts group = countsOf(g, {table[0], table[1], chair[0]}, shadow, reflection);
+  ASSERT_EQ(p.countTarget(), kTable);
+  while (p.countThisFrame(AccumMode::Refinement) && !p.frameCounted()) {
+  }
+  p.setCounts(kTable, countsOf(g, table, {}, {}), Vec2{56, 136}, kWood, group);
+  ASSERT_TRUE(p.haveCounts());
+
+  // The session's facts of a material edit: one per object of the material on screen.
+  auto each = [&](Vec2 centre) {
+    EditFacts f;
+    f.material = kWood;
+    f.pointOfChange = centre;
+    f.screen = {{static_cast<int>(centre.x) - 8, static_cast<int>(centre.y) - 8, 16, 16}};
+    return f;
+  };
+  Plan plan = p.planBatch({each({56, 136}), each({280, 56})});
+  ASSERT_EQ(plan.kind, PlanKind::Pass);
+  const std::vector<int> first(plan.order.begin(), plan.order.begin() + plan.leading);
+  for (int t : table) EXPECT_TRUE(contains(first, t)) << "the table's tiles are prioritized";
+  for (int t : chair) EXPECT_TRUE(contains(first, t)) << "so are the chair's";
+  for (int t : shadow) EXPECT_TRUE(contains(first, t)) << "and the shadow of the material's objects";
+  for (int t : reflection) EXPECT_TRUE(contains(first, t)) << "and their reflections";
+  EXPECT_LT(plan.leading, g.count() / 4) << "the rest of the image waits";
+  ASSERT_FALSE(p.classes().empty()) << "the classes stay shown during the pass";
+  EXPECT_EQ(p.classes()[static_cast<std::size_t>(shadow[0])], TileClass::High);
+  // A material the counters do not describe: a spiral, as before.
+  EditFacts other = each({56, 136});
+  other.material = kWood + 1;
+  Plan spiral = p.planBatch({other});
+  EXPECT_EQ(spiral.order, spiralOrder(g, g.tileAt({56, 136})));
+}
+
 TEST(Planner, SpiralStartsAtThePointOfChangeAndRestartsEveryTile) {
   TileGrid g(320, 180, 16);
   Planner p(g, methodOf(MethodKind::Spiral, 32));

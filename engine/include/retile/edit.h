@@ -55,6 +55,12 @@ NodeId editTarget(const Edit& edit);
 std::uint64_t editCoalesceKey(const Edit& edit);
 const char* editName(const Edit& edit);
 
+// Whether applying `edit` to `before` can change a rendered pixel. False for what no render
+// reads: a new name; a node nothing visible uses (a texture or material no shown object reaches,
+// a mesh no shown object has); an object or light hidden before and after; a node just added
+// that nothing references yet. True when in doubt (camera, environment, settings).
+bool changesImage(const Scene& before, const Edit& edit);
+
 // Applies an edit to a scene. Fails (leaving the scene untouched) when the target does not exist,
 // an added id is taken, or a value is unusable (NaN transform, reference to a missing node).
 Result<std::uint32_t> applyEdit(Scene& scene, const Edit& edit);

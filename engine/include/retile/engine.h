@@ -94,6 +94,8 @@ struct EngineOptions {
   int maxSamplesPerPixel = 4096;
   // The document version the initial scene corresponds to: frames carry it until the first edit.
   std::uint64_t documentVersion = 0;
+  // RenderSession::setPreview: coarse frames while edits come (the editor); 1: none.
+  int previewBlock = 1;
   // Fault injection for tests: the Nth frame (from 1) fails as a frame on a lost device does, so
   // that the recovery can be tested on a device that never fails. 0: never.
   int failFrame = 0;

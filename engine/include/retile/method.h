@@ -38,10 +38,12 @@ struct MethodSettings {
   std::vector<FocusPoint> focus;  // up to 3
   int indirectionFrames = 4;      // frames over which the indirection counters are gathered
   // Denoising (schedule/denoise_regions.h): the global method and continuous refinement denoise
-  // the whole frame each frame; a pass denoises a growing region, re-sized when its width or
-  // height grew by more than the threshold (pixels) since the last re-size.
+  // the whole frame each frame; a pass denoises a growing region, re-sized when its width grew
+  // by more than this share of the image's width, or its height by more than this share of its
+  // height, since the last re-size: the same steps at every render size (the paper's 200 px at
+  // 1920 wide is about a tenth).
   bool denoise = false;
-  int denoiseThreshold = 200;
+  double denoiseThreshold = 0.1;
   bool softBorders = true;  // with denoise: seams between tiles showing different things blend
   static constexpr int kFeatherPixels = 4;  // over this many pixels each side
   // Verified reuse (schedule/reuse.h): a restarted tile keeps its samples beside the fresh ones

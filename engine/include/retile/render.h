@@ -34,6 +34,9 @@ struct TileWork {
   std::uint32_t sampleBase = 0;
   bool restart = false;
   int capStale = 0;  // > 0 (and not restart): first scale the sums down to at most this many samples
+  // > 1: coarse, a preview: each sample stands for a block x block square of pixels, which all
+  // take it (a tile costs 1 / block^2 of its pixels' samples); quality is per block.
+  int block = 1;
 };
 
 // What a tile of the displayed image shows (DenoiseWork::tileCodes): the raw accumulation, either
@@ -87,11 +90,16 @@ struct FrameOptions {
   std::vector<Reuse> reuse;
 };
 
-// Per tile of the counting tile size, summed over frames until read: primary hits on the selected
-// object, later path vertices on it weighted (maxBounces + 1) / depth, and shadow rays it blocked.
+// Per tile of the counting tile size, summed over frames until read: primary hits on the counted
+// objects, later path vertices on them weighted (maxBounces + 1) / depth, and shadow rays they
+// blocked; for the selected object and, beside it, for its group (every object of its material,
+// which a material edit changes).
 struct SelectionCounts {
+  struct Set {
+    std::vector<std::uint32_t> direct, reflection, shadow;
+  };
   int tileSize = 0;
-  std::vector<std::uint32_t> direct, reflection, shadow;
+  Set object, group;
 };
 
 // The trace pass stops its paths once its loop-iteration count passes this (trace.comp; the
@@ -173,8 +181,9 @@ class Renderer {
   // Per pixel (row-major), the mean luminance of the last frame's samples; NaN where it traced
   // nothing. For the change-aware policy's probe frame.
   std::vector<float> readbackFrameLuminance();
-  // The object whose hits are counted (kNoNode: none). Takes effect with the next frame.
-  void setSelection(NodeId object);
+  // The object whose hits are counted (kNoNode: none), and the group counted beside it. Takes
+  // effect with the next frame, and clears the counts when it changes what is counted.
+  void setSelection(NodeId object, std::vector<NodeId> group = {});
   // Returns the counts gathered since the last call (or since the tile size changed) and clears them.
   SelectionCounts takeSelectionCounts();
   // Reads back the accumulated image (mean per pixel) and auxiliary outputs.

@@ -73,6 +73,7 @@ struct Texture {
   // toward zero), so that where uvs go below 0 the cells about 0 are twice as wide and the pattern
   // mirrors; else floored, a pattern that repeats everywhere.
   bool tungstenCells = false;
+  friend bool operator==(const Texture&, const Texture&) = default;
 };
 
 // The materials the scenes we open use, and no more (see docs/ARCHITECTURE.md).
@@ -220,7 +221,11 @@ struct Material {
   std::string metal = "Cu";        // conductors: a named metal (see conductorNames) or "custom"
   Vec3 eta{0.2f, 0.92f, 1.1f};     // conductors with metal == "custom"
   Vec3 k{3.9f, 2.45f, 2.14f};
-  Vec3 emission{0.0f};             // radiance emitted from the front side
+  // The front's emitted radiance is emission times emissionStrength: the colour, and a strength
+  // that at 0 turns the light off and keeps its colour (importers leave the strength at 1).
+  Vec3 emission{0.0f};
+  float emissionStrength = 1.0f;
+  Vec3 radiance() const { return emission * emissionStrength; }
   NodeId emissionTexture = kNoNode;  // multiplies emission (glTF's emissiveTexture, Tungsten's textured emission)
   // The half-angle, in degrees about the front's normal, of the cone the front emits into: 90 is
   // the whole hemisphere; less, a spot with a hard edge (Tungsten's disk cone_angle). Seen from
@@ -259,7 +264,8 @@ struct Material {
   }
 
   // A boundary is no surface, so nothing on it shines.
-  bool emissive() const { return type != MaterialType::Boundary && (emission.x > 0 || emission.y > 0 || emission.z > 0); }
+  bool emissive() const { return type != MaterialType::Boundary && emissionStrength > 0 && maxComponent(emission) > 0; }
+  friend bool operator==(const Material&, const Material&) = default;
 };
 
 // Named metals with RGB complex indices of refraction (linear sRGB primaries).
@@ -277,6 +283,7 @@ struct Object {
   // mesh's backface_culling; a room's walls seen from outside it). The front is the side its
   // winding's normal, carried by the transform's normal matrix, points to.
   bool cullBackFaces = false;
+  friend bool operator==(const Object&, const Object&) = default;
 };
 
 enum class LightType { Point, Spot, Directional };
@@ -297,6 +304,7 @@ struct Light {
   // no ray); wider, the disc casts soft shadows and shows in mirrors and glass, with the same
   // irradiance (intensity) facing it.
   float angularRadius = 0.0f;
+  friend bool operator==(const Light&, const Light&) = default;
 };
 
 struct Camera {
@@ -458,6 +466,12 @@ class Scene {
  private:
   NodeId nextId_ = 1;
 };
+
+// Where an object sits for an artist: the centre of its mesh's bounds, carried by its transform
+// (imported meshes often lie in world space under a transform whose origin is far from them); its
+// transform's origin when it has no geometry. The gizmo sits there, turns and scales keep it in
+// place, and Properties shows it as the object's position. Walks the mesh's vertices.
+Vec3 objectPivot(const Scene& s, const Object& o);
 
 // The built-in look-dev scene: ground, glossy sphere, a cup by a mirror-like panel, a textured
 // box, an area light and a sky. Generated in code, so it needs no files.

@@ -64,7 +64,8 @@ struct FrameRecord {
   int reusedTiles = 0, rejectedTiles = 0;
   std::size_t queueLength = 0;        // tiles in the current pass
   std::size_t queueServed = 0;        // tiles of the pass finished
-  std::uint64_t samples = 0;          // samples traced this frame: always width x height
+  std::uint64_t samples = 0;          // samples traced this frame: width x height, a preview's fewer
+  int block = 1;                      // > 1: a preview while edits come, a sample per block x block pixels
   double scheduleMs = 0, traceMs = 0, readbackMs = 0, frameMs = 0;
   std::shared_ptr<const RenderImage> image;  // the accumulated image after this frame (may be null)
 };
@@ -97,7 +98,8 @@ class RenderSession {
   void select(NodeId object);
   // Focus points for the focus policies (at most 3 are used).
   void setFocus(std::vector<FocusPoint> focus);
-  // A new method or new settings; returns what is wrong, or an empty string. Resets globally.
+  // A new method or new settings; returns what is wrong, or an empty string. The accumulated
+  // samples stay (no setting of the method changes what a sample is).
   std::string setMethod(const MethodSettings& method);
   void resize(int width, int height);
   void setMaxBounces(int maxBounces);
@@ -106,6 +108,14 @@ class RenderSession {
   void setRegion(RegionRect region);
   // The document version of the scene the session was made from (frames report it until an edit).
   void setDocumentVersion(std::uint64_t version);
+  // Previews (the editor): while edits come, and for kPreviewLingerMs after the last, frames
+  // trace a sample per `block` x `block` pixels (W x H / block^2 samples, so they come block^2
+  // times as often) over the edit's global update or its pass's prioritized tiles, which they
+  // restart; then the edit's plan runs again at full resolution, the prioritized tiles first and
+  // the converged rest kept as the method keeps it. 1: off (the command line, the evaluation).
+  // Not with verified reuse, whose test needs every sample at its pixel.
+  void setPreview(int block);
+  static constexpr double kPreviewLingerMs = 250;
 
   // Plans, traces and accumulates one frame, and waits for it. `readImage`: read the accumulated
   // image back into the record (the command line and the viewport need it; benchmarks may not).

@@ -284,6 +284,7 @@ Value nativeSceneToJson(const Scene& s) {
     v.set("eta", json::fromVec3(m.eta));
     v.set("k", json::fromVec3(m.k));
     v.set("emission", json::fromVec3(m.emission));
+    if (m.emissionStrength != 1) v.set("emission_strength", m.emissionStrength);
     v.set("alpha", m.alpha);
     v.set("alpha_texture", m.alphaTexture);
     v.set("bump_texture", m.bumpTexture);
@@ -538,6 +539,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
       r.vec3("eta", &m.eta);
       r.vec3("k", &m.k);
       r.vec3("emission", &m.emission);
+      r.number("emission_strength", &m.emissionStrength);
       r.number("alpha", &m.alpha);
       r.id("alpha_texture", &m.alphaTexture);
       r.id("bump_texture", &m.bumpTexture);

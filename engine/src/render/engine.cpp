@@ -139,6 +139,7 @@ void Engine::run() {
   try {
     session = std::make_unique<RenderSession>(std::move(initialScene_), initialMethod_, options_.renderer);
     session->setDocumentVersion(options_.documentVersion);
+    session->setPreview(options_.previewBlock);
     std::lock_guard lock(mutex_);
     device_ = session->deviceName();
     for (const auto& w : session->sceneWarnings()) errors_.push_back("warning: " + w);
@@ -237,6 +238,7 @@ void Engine::run() {
         session.reset();  // destroys the old device first: lavapipe and small GPUs hold one well
         session = std::make_unique<RenderSession>(std::move(scene), std::move(method), options_.renderer);
         session->setDocumentVersion(version);
+        session->setPreview(options_.previewBlock);
         session->select(selection);
         if (!region.empty()) session->setRegion(region);
         last.reset();

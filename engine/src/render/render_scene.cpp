@@ -709,7 +709,7 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   return {v4(max(m.albedo, Vec3{0.0f}), bitsOf(type)),
           vec4{roughness, ior, std::clamp(m.alpha, 0.0f, 1.0f), std::clamp(fdrInt, 0.0f, 1.0f)},
           v4(eta, bitsOf(albedoTexture)), v4(k, bitsOf(roughnessTexture)),
-          v4(max(m.emission, Vec3{0.0f}), bitsOf(alphaTexture)),
+          v4(max(m.radiance(), Vec3{0.0f}), bitsOf(alphaTexture)),
           vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, bitsOf(emissionTexture), bitsOf(blendWith)},
           v4(max(m.coatingAbsorption, Vec3{0.0f}), std::isfinite(m.blendRatio) ? std::clamp(m.blendRatio, 0.0f, 1.0f) : 1.0f),
           vec4{bitsOf(blendRatioTexture), coated ? std::min(m.coatIor, 10.0f) : 0.0f, emissionConeCos(m), 0},
@@ -1368,7 +1368,7 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
     data_.instances[i * gpu::kInstanceTexels + 3].w = bitsOf(first);
     // Light samples pick triangles by power: a textured emitter's is its texture's mean times its
     // emission (light samples read the texture where they land, so any choice stays unbiased).
-    Vec3 radiance = mat->emission;
+    Vec3 radiance = mat->radiance();
     if (auto it = textureMean_.find(mat->emissionTexture); it != textureMean_.end()) radiance = radiance * it->second;
     // Not scaled down by an emission cone's share of the hemisphere (sin^2 of its half angle):
     // a spot is aimed at what it lights, where it is as bright as without its cone, and scaled
@@ -1393,7 +1393,7 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
       data_.emitters.push_back(v4(w1 - w0, bitsOf(static_cast<std::int32_t>(i))));
       // The triangle's packed index and the emission texture's, for its uvs at a light sample.
       data_.emitters.push_back(v4(w2 - w0, bitsOf(static_cast<std::int32_t>(mesh->triOffset + p))));
-      data_.emitters.push_back(v4(mat->emission, 0));
+      data_.emitters.push_back(v4(mat->radiance(), 0));
       data_.emitters.push_back(v4(nrm, bitsOf(textureIndex(mat->emissionTexture))));
       power.push_back(area > 0 && std::isfinite(area) && std::isfinite(radianceLum) ? area * kPi * radianceLum : 0.0f);
     }

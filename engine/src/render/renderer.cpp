@@ -112,7 +112,10 @@ struct Renderer::Impl {
   bool warpTungsten = false;
   bool hasScene = false;
   NodeId selectedObject = kNoNode;
+  std::vector<NodeId> countedGroup;  // counted beside the selection: every object of its material
   int countTileSize = 0;            // tile size the selection buffer is laid out for
+  std::size_t countTiles = 0;        // tiles it holds counters for
+  std::vector<std::uint32_t> setWords;  // the sets' words on the device (layouts.h)
   std::vector<gpu::WorkItem> lastItems;  // the last frame's work, for readbackFrameLuminance
 
   // Pipelined frames: the submitted frame's results land in one of two slots, so that the frame
@@ -346,49 +349,78 @@ struct Renderer::Impl {
     displayCurrent = false;
   }
 
-  std::uint32_t selectedInstance() const {
-    if (selectedObject == kNoNode) return 0;
+  // Per instance, two bits: the selected object (bit 0) and its group (bit 1); a removed or hidden
+  // object is in no instance the tracer reaches.
+  std::vector<std::uint32_t> countedSetWords() const {
     const auto& objects = builder.data().instanceObject;
-    for (std::size_t i = 0; i < objects.size(); ++i)
-      if (objects[i] == selectedObject) return static_cast<std::uint32_t>(i + 1);
-    return 0;  // removed: nothing to count (a hidden object's instance is never reached)
+    std::vector<std::uint32_t> words((objects.size() + gpu::kInstancesPerSetWord - 1) / gpu::kInstancesPerSetWord + 1, 0u);
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      const bool selected = objects[i] == selectedObject && selectedObject != kNoNode;
+      const bool grouped = std::find(countedGroup.begin(), countedGroup.end(), objects[i]) != countedGroup.end();
+      const std::uint32_t bits = (selected ? 1u : 0u) | (grouped ? 2u : 0u);
+      words[i / gpu::kInstancesPerSetWord] |= bits << ((i % gpu::kInstancesPerSetWord) * 2);
+    }
+    return words;
   }
 
-  // Lays the counters out for `tileSize` (clearing them when it changes).
-  void prepareSelection(int tileSize) {
-    if (tileSize <= 0) return;
-    std::size_t tiles = static_cast<std::size_t>((width + tileSize - 1) / tileSize) *
-                        static_cast<std::size_t>((height + tileSize - 1) / tileSize);
-    VkDeviceSize bytes = tiles * gpu::kSelectionCounters * sizeof(std::uint32_t);
-    if (tileSize != countTileSize || selection.size() < bytes) {
+  // Lays the counters out for `tileSize` after the sets' words (clearing them when either
+  // changes). Returns where the counters start, in words.
+  std::uint32_t prepareSelection(int tileSize) {
+    if (tileSize <= 0) return 0;
+    const std::size_t tiles = static_cast<std::size_t>((width + tileSize - 1) / tileSize) *
+                              static_cast<std::size_t>((height + tileSize - 1) / tileSize);
+    std::vector<std::uint32_t> words = countedSetWords();
+    const VkDeviceSize bytes = (words.size() + tiles * gpu::kSelectionCounters) * sizeof(std::uint32_t);
+    if (tileSize != countTileSize || tiles != countTiles || words.size() != setWords.size() || selection.size() < bytes) {
       selection = Buffer(ctx, std::max<VkDeviceSize>(bytes, 16), kStorageUsage, true, "selection counters");
       std::vector<std::uint32_t> zero(selection.size() / sizeof(std::uint32_t), 0);
+      std::copy(words.begin(), words.end(), zero.begin());
       selection.upload(zero.data(), zero.size() * sizeof(std::uint32_t));
       countTileSize = tileSize;
+      countTiles = tiles;
+      setWords = std::move(words);
       bindAll();
+    } else if (words != setWords) {
+      selection.upload(words.data(), words.size() * sizeof(std::uint32_t));  // a new selection: the counts start again
+      std::vector<std::uint32_t> zero(tiles * gpu::kSelectionCounters, 0);
+      selection.upload(zero.data(), zero.size() * sizeof(std::uint32_t), words.size() * sizeof(std::uint32_t));
+      setWords = std::move(words);
     }
+    return static_cast<std::uint32_t>(setWords.size());
   }
 
   SelectionCounts takeSelectionCounts() {
     completeInFlight();  // the frame in flight uses what this touches
     SelectionCounts c;
     c.tileSize = countTileSize;
-    if (countTileSize <= 0 || width <= 0) return c;
-    std::size_t tiles = static_cast<std::size_t>((width + countTileSize - 1) / countTileSize) *
-                        static_cast<std::size_t>((height + countTileSize - 1) / countTileSize);
+    if (countTileSize <= 0 || width <= 0 || countTiles == 0) return c;
+    const std::size_t tiles = countTiles;
+    const VkDeviceSize offset = setWords.size() * sizeof(std::uint32_t);
     std::vector<std::uint32_t> raw(tiles * gpu::kSelectionCounters);
-    selection.download(raw.data(), raw.size() * sizeof(std::uint32_t));
+    selection.download(raw.data(), raw.size() * sizeof(std::uint32_t), offset);
     std::vector<std::uint32_t> zero(raw.size(), 0);
-    selection.upload(zero.data(), zero.size() * sizeof(std::uint32_t));
-    c.direct.resize(tiles);
-    c.reflection.resize(tiles);
-    c.shadow.resize(tiles);
+    selection.upload(zero.data(), zero.size() * sizeof(std::uint32_t), offset);
+    for (auto* set : {&c.object, &c.group}) {
+      set->direct.resize(tiles);
+      set->reflection.resize(tiles);
+      set->shadow.resize(tiles);
+    }
     for (std::size_t t = 0; t < tiles; ++t) {
-      c.direct[t] = raw[t * 3];
-      c.reflection[t] = raw[t * 3 + 1];
-      c.shadow[t] = raw[t * 3 + 2];
+      const std::uint32_t* r = &raw[t * gpu::kSelectionCounters];
+      c.object.direct[t] = r[0];
+      c.object.reflection[t] = r[1];
+      c.object.shadow[t] = r[2];
+      c.group.direct[t] = r[3];
+      c.group.reflection[t] = r[4];
+      c.group.shadow[t] = r[5];
     }
     return c;
+  }
+
+  // The sample slots a work item takes: one per pixel, or per block of a coarse item, q each.
+  static std::uint64_t itemSlots(const gpu::WorkItem& w) {
+    const std::uint64_t b = std::max(w.pixels.z, 1u);
+    return ((static_cast<std::uint64_t>(w.rect.z) + b - 1) / b) * ((static_cast<std::uint64_t>(w.rect.w) + b - 1) / b) * w.info.x;
   }
 
   std::vector<float> readbackFrameLuminance() {
@@ -396,11 +428,12 @@ struct Renderer::Impl {
     std::vector<float> lum(static_cast<std::size_t>(width) * static_cast<std::size_t>(height),
                            std::numeric_limits<float>::quiet_NaN());
     std::uint64_t slots = 0;
-    for (const auto& w : lastItems) slots += static_cast<std::uint64_t>(w.rect.z) * static_cast<std::uint64_t>(w.rect.w) * w.info.x;
+    for (const auto& w : lastItems) slots = std::max(slots, w.info.y + itemSlots(w));
     if (slots == 0) return lum;
     std::vector<gpu::vec4> s(slots);
     samples.download(s.data(), slots * sizeof(gpu::vec4));
     for (const auto& w : lastItems) {
+      if (w.pixels.z > 1) continue;  // a preview's block: no pixel of its own (probes are never coarse)
       std::uint64_t pixels = static_cast<std::uint64_t>(w.rect.z) * static_cast<std::uint64_t>(w.rect.w);
       for (std::uint64_t p = 0; p < pixels; ++p) {
         double sum = 0, n = 0;
@@ -417,7 +450,8 @@ struct Renderer::Impl {
     return lum;
   }
 
-  void writeFrameUniforms(std::uint32_t itemCount, std::uint64_t slots, int countTile) {
+  // `counters`: where the selection buffer's counters start (0: not counting).
+  void writeFrameUniforms(std::uint32_t itemCount, std::uint64_t slots, int countTile, std::uint32_t counters) {
     const RenderSceneData& d = builder.data();
     gpu::FrameUniforms u{};
     Vec3 forward = normalize(camera.target - camera.position);
@@ -456,8 +490,8 @@ struct Renderer::Impl {
     u.worldScattering = {world.scattering.x, world.scattering.y, world.scattering.z, world.anisotropy};
     u.bounces = {d.minBounces, d.lightGroups, 0, 0};
     std::copy_n(d.lightGroupShapes.begin(), std::min<std::size_t>(d.lightGroupShapes.size(), std::size(u.lightGroups)), u.lightGroups);
-    std::uint32_t sel = countTile > 0 ? selectedInstance() : 0u;
-    u.work = {itemCount, static_cast<std::uint32_t>(slots), sel, sel ? static_cast<std::uint32_t>(countTile) : 0u};
+    const bool counting = countTile > 0 && counters > 0;
+    u.work = {itemCount, static_cast<std::uint32_t>(slots), counting ? counters + 1 : 0u, counting ? static_cast<std::uint32_t>(countTile) : 0u};
     // Tungsten draws its box exactly, and has no other filter the table could stand for.
     const int drawn = d.filterFeature;  // the compiled kernel's
     const bool tungsten = drawn == gpu::kFeatureFilterTungsten || drawn == gpu::kFeatureFilterTungstenTent;
@@ -498,10 +532,10 @@ struct Renderer::Impl {
       w.rect = {x0, y0, x1 - x0, y1 - y0};
       std::uint32_t flags = t.restart ? gpu::kWorkRestart : (t.capStale > 0 ? gpu::kWorkCapStale : 0u);
       w.info = {static_cast<std::uint32_t>(t.quality), static_cast<std::uint32_t>(slots), t.sampleBase, flags};
-      w.pixels = {static_cast<std::uint32_t>(pixels), static_cast<std::uint32_t>(std::max(t.capStale, 0)), 0, 0};
-      std::uint64_t n = static_cast<std::uint64_t>(x1 - x0) * static_cast<std::uint64_t>(y1 - y0);
-      slots += n * static_cast<std::uint64_t>(t.quality);
-      pixels += n;
+      w.pixels = {static_cast<std::uint32_t>(pixels), static_cast<std::uint32_t>(std::max(t.capStale, 0)),
+                  static_cast<std::uint32_t>(std::clamp(t.block, 1, 64)), 0};
+      slots += itemSlots(w);
+      pixels += static_cast<std::uint64_t>(x1 - x0) * static_cast<std::uint64_t>(y1 - y0);
       items.push_back(w);
     }
     RETILE_ASSERT(slots < (1ull << 32), cat("a frame of ", slots, " samples"));
@@ -514,8 +548,8 @@ struct Renderer::Impl {
         bindAll();
       }
       work.upload(items.data(), workBytes);
-      prepareSelection(options.selectionTileSize);
-      writeFrameUniforms(static_cast<std::uint32_t>(items.size()), slots, options.selectionTileSize);
+      const std::uint32_t counters = prepareSelection(options.selectionTileSize);
+      writeFrameUniforms(static_cast<std::uint32_t>(items.size()), slots, options.selectionTileSize, counters);
       std::uint32_t zero[gpu::kStatsCount] = {};
       stats.upload(zero, sizeof zero);
       invocations = traceInvocations(slots, iterationsPerPath, options.pathsPerInvocation);
@@ -768,7 +802,10 @@ FrameTicket Renderer::submitFrame(const std::vector<TileWork>& tiles, const Fram
 FrameStats Renderer::completeFrame(FrameTicket frame) { return impl_->completedSlot(frame.id).stats; }
 RenderImage Renderer::frameImage(FrameTicket frame) { return impl_->frameImage(frame.id); }
 std::vector<float> Renderer::readbackFrameLuminance() { return impl_->readbackFrameLuminance(); }
-void Renderer::setSelection(NodeId object) { impl_->selectedObject = object; }
+void Renderer::setSelection(NodeId object, std::vector<NodeId> group) {
+  impl_->selectedObject = object;
+  impl_->countedGroup = std::move(group);
+}
 SelectionCounts Renderer::takeSelectionCounts() { return impl_->takeSelectionCounts(); }
 RenderImage Renderer::readback() { return impl_->readback(); }
 std::uint64_t Renderer::sceneDeviceBytes() const { return impl_->builder.data().deviceBytes(); }

@@ -63,6 +63,7 @@ struct RenderSession::Impl {
   bool newPass = false;                  // a plan started a pass (or a global update) since the last frame
   std::vector<char> leading;             // per tile: ranked first by the pass's policy
   NodeId counting = kNoNode;             // the object the renderer's counters describe
+  NodeId countingMaterial = kNoNode;     // its material when counting began: the group's
   // Frames submitted and not yet finished, oldest first (at most two: one read back while the
   // next traces). Their records are filled at submission and completed when they finish.
   struct Pending {
@@ -88,6 +89,24 @@ struct RenderSession::Impl {
   std::uint64_t pass = 0;               // counts the passes started (execute)
   std::vector<std::uint64_t> reusePass; // per tile: the pass that last started its history
   std::vector<double> reuseCredit;      // per tile: spp of history it keeps (the scheduler's credit)
+  int previewBlock = 1;                 // setPreview
+  bool previewed = false;               // the last frame was a preview: the next full one plans the edit again
+  Clock::time_point lastEdit{};
+
+  // The block size of the next frame: the preview's while edits come (or came a moment ago) and
+  // it has something to show; else 1, and the first full frame after a preview plans the last
+  // edit again (a probe pending is the change policy's next step instead).
+  int frameBlock(bool edited, bool reusing) {
+    if (previewBlock <= 1 || reusing) return 1;
+    if (edited) lastEdit = Clock::now();
+    if ((edited || msSince(lastEdit) < kPreviewLingerMs) && !scheduler.previewDone()) {
+      previewed = true;
+      return previewBlock;
+    }
+    if (previewed && scheduler.mode() != AccumMode::Probe) execute(planner.lastEditPlan());
+    previewed = false;
+    return 1;
+  }
 
   void resetReuse() {
     const auto n = static_cast<std::size_t>(scheduler.grid().count());
@@ -296,11 +315,18 @@ struct RenderSession::Impl {
   }
   std::vector<DenoiseRegion> lastRegions;  // the stack as of the last planned frame
 
-  // The renderer counts what the planner wants counted; a new target starts from zero.
-  void syncCounting() {
+  // The renderer counts what the planner wants counted, and beside it the objects that share its
+  // material (what a material edit changes); a new target starts from zero.
+  void syncCounting(const Scene& scene) {
     if (planner.countTarget() == counting) return;
     counting = planner.countTarget();
-    renderer.setSelection(counting);
+    const Object* o = scene.object(counting);
+    countingMaterial = o ? o->material : kNoNode;
+    std::vector<NodeId> group;
+    if (countingMaterial != kNoNode)
+      for (const Object& x : scene.objects)
+        if (x.material == countingMaterial) group.push_back(x.id);
+    renderer.setSelection(counting, std::move(group));
     renderer.takeSelectionCounts();
   }
 };
@@ -360,15 +386,19 @@ void RenderSession::setMaxBounces(int maxBounces) {
 std::string RenderSession::setMethod(const MethodSettings& method) {
   completeGpu();  // the frame in flight's counters and probe belong to the state it was planned in
   if (std::string bad = validateMethodSettings(method); !bad.empty()) return bad;
-  bool newGrid = method.tileSize != this->method().tileSize;
+  // No setting of the method changes what a sample is: the accumulation stays, and the next edit
+  // is planned the new way. A pass under way goes on, but for a new T, whose tiles take over the
+  // samples their pixels hold (TileScheduler::regrid).
+  const bool newGrid = method.tileSize != this->method().tileSize;
   impl_->planner.setMethod(method);
   if (newGrid) {
-    // The accumulation stays valid; only the tiles change. Restart cleanly all the same, so
-    // per-tile records describe the new grid.
-    impl_->newGrid(method.tileSize);
+    const TileGrid grid(impl_->width, impl_->height, method.tileSize);
+    impl_->scheduler.regrid(grid);
+    impl_->planner.setGrid(grid);
+    impl_->denoise.reset(grid);
+    impl_->batch.clear();
+    impl_->resetReuse();
     impl_->applyRegion();
-  } else {
-    impl_->scheduler.globalUpdate();
   }
   return {};
 }
@@ -423,6 +453,11 @@ std::optional<Vec2> projectedCentre(const Camera& cam, int w, int h, const Bound
 
 void RenderSession::setDocumentVersion(std::uint64_t version) { impl_->documentVersion = version; }
 
+void RenderSession::setPreview(int block) {
+  completeGpu();
+  impl_->previewBlock = std::clamp(block, 1, 16);
+}
+
 Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t documentVersion) {
   completeGpu();  // the frame in flight's counters and probe belong to the state it was planned in
   Impl& d = *impl_;
@@ -439,6 +474,9 @@ Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t d
   for (NodeId t : targets) before.grow(objectBounds(scene_, d.meshBounds, t));
 
   const RenderSettings settingsBefore = scene_.settings;
+  // An edit no pixel shows (a name, a node nothing visible uses) is applied and uploaded, but the
+  // samples stay: nothing restarts.
+  const bool visible = changesImage(scene_, edit);
   auto applied = retile::applyEdit(scene_, edit);
   if (!applied) return applied;
   // Settings the session renders as it did: the editor sends them when only what an offline
@@ -462,6 +500,7 @@ Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t d
   d.documentVersion = std::max(d.documentVersion, documentVersion);
   if (selection_ != kNoNode && !scene_.object(selection_)) select(kNoNode);
   if (d.planner.countTarget() != kNoNode && !scene_.object(d.planner.countTarget())) d.planner.select(selection_);
+  if (!visible) return flags;
 
   EditFacts facts;
   if (flags & kUpdateSettings) {
@@ -474,10 +513,29 @@ Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t d
   }
   // Camera moves and settings discard everything (the global-update mode).
   facts.global = (flags & (kUpdateCamera | kUpdateSettings)) != 0;
+  const Camera& cam = scene_.camera;
+  const auto* material = std::get_if<SetMaterial>(&edit);
+  if (material) facts.material = material->material.id;
+  if (material && targets.size() > 1 && !facts.global) {
+    // A material shared by several objects changes each where it is seen: a point of change and a
+    // rectangle per object on screen, planned as a batch of edits is (the box around them all
+    // would put the spiral's head between them, and every tile in the box first).
+    const std::size_t planned = d.batch.size();
+    for (NodeId t : targets) {
+      const Bounds3 b = objectBounds(scene_, d.meshBounds, t);
+      const TileRect r = screenRect(cam, d.width, d.height, b);
+      if (r.pixels() <= 0) continue;
+      EditFacts each = facts;
+      each.pointOfChange = projectedCentre(cam, d.width, d.height, b)
+                               .value_or(Vec2{r.x + r.width * 0.5f, r.y + r.height * 0.5f});
+      each.screen = {r};
+      d.batch.push_back(std::move(each));
+    }
+    if (d.batch.size() > planned) return flags;
+  }
 
   // The point of change: the centre of the edited objects' bounds, a light's position, or
   // (environment, textures) the image centre.
-  const Camera& cam = scene_.camera;
   Bounds3 after;
   for (NodeId t : targets) after.grow(objectBounds(scene_, d.meshBounds, t));
   std::optional<Vec2> poc = projectedCentre(cam, d.width, d.height, after);
@@ -512,7 +570,8 @@ void RenderSession::completeGpu() {
       // The object's own centre now is where its later motion is measured from.
       std::optional<Vec2> centre = projectedCentre(scene_.camera, d.width, d.height,
                                                    objectBounds(scene_, d.meshBounds, d.counting));
-      d.planner.setCounts(d.counting, IndirectionCounts{c.direct, c.reflection, c.shadow}, centre);
+      auto counts = [](const SelectionCounts::Set& s) { return IndirectionCounts{s.direct, s.reflection, s.shadow}; };
+      d.planner.setCounts(d.counting, counts(c.object), centre, d.countingMaterial, counts(c.group));
     }
   }
 
@@ -549,17 +608,19 @@ void RenderSession::submitFrame(bool readImage) {
   auto start = Clock::now();
   const TileGrid& grid = d.scheduler.grid();
   // One plan for every edit since the last frame; without edits, whatever quiet brings.
-  d.execute(d.batch.empty() ? d.planner.planQuiet(d.scheduler.passActive()) : d.planner.planBatch(d.batch));
+  const bool edited = !d.batch.empty();
+  d.execute(edited ? d.planner.planBatch(d.batch) : d.planner.planQuiet(d.scheduler.passActive() || d.previewed));
   d.batch.clear();
-  d.syncCounting();
+  const int block = d.frameBlock(edited, method().reuse);
+  d.syncCounting(scene_);
   std::vector<double> samplesBefore;
   if (method().reuse) samplesBefore = d.scheduler.tileSamples();
   else d.scheduler.setCredit({});
-  FramePlan plan = d.scheduler.nextFrame();
+  FramePlan plan = d.scheduler.nextFrame(block);
   std::vector<TileWork> work;
   work.reserve(plan.chunks.size());
   for (const TileChunk& c : plan.chunks)
-    work.push_back({c.rect.x, c.rect.y, c.rect.width, c.rect.height, c.quality, c.sampleBase, c.restart, c.capStale});
+    work.push_back({c.rect.x, c.rect.y, c.rect.width, c.rect.height, c.quality, c.sampleBase, c.restart, c.capStale, c.block});
   FrameOptions options;
   options.accumulate = plan.mode != AccumMode::Probe;
   if (method().denoise) options.denoise = d.denoiseWork(plan.mode, d.frame + 1, method());
@@ -577,6 +638,7 @@ void RenderSession::submitFrame(bool readImage) {
   rec.documentVersion = d.documentVersion;
   rec.method = methodLabel(method());
   rec.mode = accumModeName(plan.mode);
+  rec.block = block;
   rec.smooth = method().smooth;
   rec.staleCap = method().staleCap;
   rec.width = d.width;

@@ -30,13 +30,14 @@ std::string checkMedium(Vec3 absorption, Vec3 scattering, float anisotropy) {
 }
 
 std::string checkMaterial(const Scene& s, const Material& m) {
-  if (!isFinite(m.albedo) || !isFinite(m.emission) || !isFinite(m.eta) || !isFinite(m.k) || !isFinite(m.coatingAbsorption) ||
+  if (!isFinite(m.albedo) || !isFinite(m.emission) || !finite(m.emissionStrength) || !isFinite(m.eta) || !isFinite(m.k) || !isFinite(m.coatingAbsorption) ||
       !isFinite(m.coatAbsorption) || !finite(m.coatIor) || !isFinite(m.interiorAbsorption) || !isFinite(m.interiorScattering) || !finite(m.interiorAnisotropy) || !finite(m.coatRoughness) ||
       !finite(m.roughness) || !finite(m.ior) || !finite(m.alpha) || !finite(m.bumpStrength) || !finite(m.blendRatio) ||
       !finite(m.transmittance) || !finite(m.diffuseRatio) || !finite(m.filmThickness) || !finite(m.emissionCone) || !finite(m.hairTilt))
     return cat("material '", m.name, "': a parameter is not a finite number");
   if (auto why = checkMedium(m.interiorAbsorption, m.interiorScattering, m.interiorAnisotropy); !why.empty())
     return cat("material '", m.name, "': ", why);
+  if (m.emissionStrength < 0) return cat("material '", m.name, "': its emission strength must not be negative");
   if (m.emissionCone < 0 || m.emissionCone > 90) return cat("material '", m.name, "': its emission cone must be within 0..90 degrees");
   if (std::abs(m.hairTilt) > 45) return cat("material '", m.name, "': its hair tilt must be within -45..45 degrees");
   if (m.blendWith != kNoNode && (m.blendWith == m.id || !s.material(m.blendWith)))
@@ -141,6 +142,82 @@ const char* editName(const Edit& edit) {
   return names[edit.index()];
 }
 
+namespace {
+
+// What the render reads of a scene: the materials of shown objects (through their blends), their
+// textures and meshes, and the sky's map.
+struct InUse {
+  std::vector<NodeId> materials, textures, meshes;
+  bool has(const std::vector<NodeId>& v, NodeId id) const { return std::find(v.begin(), v.end(), id) != v.end(); }
+};
+
+InUse inUse(const Scene& s) {
+  InUse u;
+  for (const Object& o : s.objects) {
+    if (!o.visible) continue;
+    u.meshes.push_back(o.mesh);
+    // A blend's partners, each once (a cycle would be refused by the importers, but stop anyway).
+    for (NodeId m = o.material; m != kNoNode && !u.has(u.materials, m);) {
+      u.materials.push_back(m);
+      const Material* mat = s.material(m);
+      m = mat ? mat->blendWith : kNoNode;
+    }
+  }
+  for (NodeId m : u.materials)
+    if (const Material* mat = s.material(m))
+      for (NodeId t : mat->textures())
+        if (t != kNoNode) u.textures.push_back(t);
+  if (s.environment.map != kNoNode) u.textures.push_back(s.environment.map);
+  return u;
+}
+
+// Equal but for the name.
+template <class Node>
+bool sameButName(Node a, const Node& b) {
+  a.name = b.name;
+  return a == b;
+}
+
+}  // namespace
+
+bool changesImage(const Scene& s, const Edit& edit) {
+  const InUse u = inUse(s);
+  return std::visit(
+      Overloaded{
+          [&](const SetMaterial& e) {
+            const Material* old = s.material(e.material.id);
+            return !old || (u.has(u.materials, old->id) && !sameButName(*old, e.material));
+          },
+          [&](const SetObject& e) {
+            const Object* old = s.object(e.object.id);
+            return !old || ((old->visible || e.object.visible) && !sameButName(*old, e.object));
+          },
+          [&](const SetLight& e) {
+            const Light* old = s.light(e.light.id);
+            return !old || ((old->visible || e.light.visible) && !sameButName(*old, e.light));
+          },
+          [&](const SetTexture& e) {
+            const Texture* old = s.texture(e.texture.id);
+            return !old || (u.has(u.textures, old->id) && !sameButName(*old, e.texture));
+          },
+          [&](const AddMesh&) { return false; },
+          [&](const AddMaterial&) { return false; },
+          [&](const AddTexture&) { return false; },
+          [&](const AddObject& e) { return e.object.visible; },
+          [&](const AddLight& e) { return e.light.visible; },
+          [&](const RemoveNode& e) {
+            if (const Object* o = s.object(e.id)) return o->visible;
+            if (const Light* l = s.light(e.id)) return l->visible;
+            if (s.material(e.id)) return u.has(u.materials, e.id);
+            if (s.texture(e.id)) return u.has(u.textures, e.id);
+            if (s.mesh(e.id)) return u.has(u.meshes, e.id);
+            return true;
+          },
+          [&](const auto&) { return true; },
+      },
+      edit);
+}
+
 Result<std::uint32_t> applyEdit(Scene& s, const Edit& edit) {
   return std::visit(
       Overloaded{
@@ -150,7 +227,7 @@ Result<std::uint32_t> applyEdit(Scene& s, const Edit& edit) {
             if (!old) return fail(cat("material ", e.material.id, " does not exist"));
             // Emission decides which triangles are lights.
             std::uint32_t flags = kUpdateMaterials;
-            if (old->emission != e.material.emission) flags |= kUpdateLights;
+            if (old->radiance() != e.material.radiance()) flags |= kUpdateLights;
             return replaceNode(s.materials, e.material, "material", flags);
           },
           [&](const SetObject& e) -> Applied {

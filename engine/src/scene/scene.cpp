@@ -110,6 +110,14 @@ Bounds3 MeshGeometry::bounds() const {
   return b;
 }
 
+Vec3 objectPivot(const Scene& s, const Object& o) {
+  // The transformed centre of the local bounds, which a turn or scale about it leaves in place
+  // (the centre of the transformed bounds is the same point for any affine transform).
+  const Mesh* m = s.mesh(o.mesh);
+  const Bounds3 b = m && m->geometry ? m->geometry->bounds() : Bounds3{};
+  return o.transform.transformPoint(b.empty() ? Vec3{0.0f} : b.center());
+}
+
 namespace {
 
 const char* const kMaterialNames[kMaterialTypeCount] = {

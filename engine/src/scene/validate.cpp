@@ -139,6 +139,7 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
     const std::string what = cat("material '", m.name, "'");
     checkColor(m.albedo, Vec3{0.8f}, what + ": albedo", warnings);
     checkColor(m.emission, Vec3{0.0f}, what + ": emission", warnings);
+    clampValue(m.emissionStrength, 0.0f, 1e6f, 1.0f, what + ": emission strength", warnings);
     checkColor(m.coatingAbsorption, Vec3{0.0f}, what + ": coating absorption", warnings);
     clampValue(m.roughness, 0.0f, m.type == MaterialType::OrenNayar ? 1.6f : 1.0f, 0.5f, what + ": roughness", warnings);
     // Below 1 is an interface seen from the denser side (water to air), which scenes do use.

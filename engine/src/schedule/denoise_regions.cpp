@@ -49,7 +49,7 @@ DenoiseFrame DenoiseRegions::wholeFrame(std::uint64_t frame) {
   return describe(true, stack_.front().rect, started_);
 }
 
-DenoiseFrame DenoiseRegions::incremental(const std::vector<char>& started, const std::vector<char>& grows, int threshold,
+DenoiseFrame DenoiseRegions::incremental(const std::vector<char>& started, const std::vector<char>& grows, double threshold,
                                          bool passComplete, std::uint64_t frame) {
   const auto n = static_cast<std::size_t>(grid_.count());
   if (whole_) restart();  // the first incremental frame after refinement: a pass began
@@ -78,8 +78,8 @@ DenoiseFrame DenoiseRegions::incremental(const std::vector<char>& started, const
   bool push = stack_.empty();
   if (!push) {
     const TileRect& top = stack_.back().rect;
-    threshold = std::max(threshold, 0);
-    bool grew = box.width - top.width > threshold || box.height - top.height > threshold;
+    const double share = std::max(threshold, 0.0);
+    bool grew = box.width - top.width > share * grid_.width() || box.height - top.height > share * grid_.height();
     push = grew || (passComplete && uncovered);
   }
   if (!push) return describe(false, {}, started_);

@@ -56,9 +56,10 @@ class DenoiseRegions {
   // Global update or continuous refinement: the whole frame, denoised this frame.
   DenoiseFrame wholeFrame(std::uint64_t frame);
   // An incremental frame. `started`: per tile, re-rendered by the pass so far; `grows`: per tile,
-  // counts for the region's rectangle (all tiles, or the prioritized ones). `threshold` in pixels.
+  // counts for the region's rectangle (all tiles, or the prioritized ones). `threshold`: a share
+  // of the image's width (for the region's width) and height (for its height).
   // `passComplete`: the pass has started every tile it will re-render.
-  DenoiseFrame incremental(const std::vector<char>& started, const std::vector<char>& grows, int threshold,
+  DenoiseFrame incremental(const std::vector<char>& started, const std::vector<char>& grows, double threshold,
                            bool passComplete, std::uint64_t frame);
   // A frame that accumulates nothing (the change probe): the display stays as it was.
   DenoiseFrame unchanged() const;

@@ -45,7 +45,8 @@ std::string validateMethodSettings(const MethodSettings& s) {
   if (s.reuse && s.kind == MethodKind::Global) return "reuse keeps what an edit did not change: it needs an incremental method, not global";
   if (!(s.reuseFalseReject > 0.0 && s.reuseFalseReject < 0.5))
     return cat("the reuse false-reject rate must be in (0, 0.5), not ", s.reuseFalseReject);
-  if (s.denoiseThreshold < 0 || s.denoiseThreshold > 16384) return cat("denoise threshold must be 0..16384 pixels, not ", s.denoiseThreshold);
+  if (!(s.denoiseThreshold >= 0 && s.denoiseThreshold <= 1))
+    return cat("the denoise threshold is a share of the image, 0..1, not ", s.denoiseThreshold);
   return {};
 }
 

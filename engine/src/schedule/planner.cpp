@@ -18,6 +18,8 @@ bool Planner::focusPolicy() const {
 void Planner::dropCounts(bool gatherAgain) {
   counts_ = {};
   countsFor_ = kNoNode;
+  groupCounts_ = {};
+  groupMaterial_ = kNoNode;
   countedCentre_.reset();
   classes_.clear();
   countFramesLeft_ = gatherAgain && countTarget_ != kNoNode ? method_.indirectionFrames : 0;
@@ -25,6 +27,7 @@ void Planner::dropCounts(bool gatherAgain) {
 
 void Planner::setGrid(const TileGrid& grid) {
   grid_ = grid;
+  lastEditPlan_ = {};
   pointsOfChange_.clear();
   lastTouched_.clear();
   passFromEdit_ = false;
@@ -34,6 +37,7 @@ void Planner::setGrid(const TileGrid& grid) {
 
 void Planner::setMethod(const MethodSettings& method) {
   method_ = method;
+  lastEditPlan_ = {};
   passFromEdit_ = false;
   probePending_ = false;
   dropCounts(true);
@@ -56,10 +60,13 @@ bool Planner::countThisFrame(AccumMode mode) const {
 
 bool Planner::frameCounted() { return countFramesLeft_ > 0 && --countFramesLeft_ == 0; }
 
-void Planner::setCounts(NodeId object, const IndirectionCounts& counts, std::optional<Vec2> centre) {
+void Planner::setCounts(NodeId object, const IndirectionCounts& counts, std::optional<Vec2> centre,
+                        NodeId groupMaterial, const IndirectionCounts& group) {
   if (object != countTarget_) return;  // gathered for an object no longer of interest
   counts_ = counts;
   countsFor_ = object;
+  groupMaterial_ = group.empty() ? kNoNode : groupMaterial;
+  groupCounts_ = group;
   countedCentre_ = centre;
   classes_ = indirectionPlan(grid_, counts_, grid_.tileAt(centre.value_or(this->centre())), {}).classes;
 }
@@ -125,18 +132,18 @@ Plan Planner::spiralPass(const std::vector<char>& touched) const {
 // they stay. First the moved direct tiles and every tile the edit touched, then the other high,
 // middle and low tiles (all prioritized), then the rest. Automatic Q fits all high and touched
 // tiles into one frame, so the object's old and new places are refreshed together (no ghosting).
-Plan Planner::indirectionPass(const std::vector<char>& touched, Vec2 motion) {
+Plan Planner::indirectionPass(const std::vector<char>& touched, Vec2 motion, const IndirectionCounts& counts) {
   const auto n = static_cast<std::size_t>(grid_.count());
   std::vector<int> spiral = interleavedSpirals(grid_, centres());
-  IndirectionPlan classes = indirectionPlan(grid_, counts_, spiral.front(), spiral);
+  IndirectionPlan classes = indirectionPlan(grid_, counts, spiral.front(), spiral);
   std::vector<int> direct;
-  for (std::size_t t = 0; t < n && t < counts_.direct.size(); ++t)
-    if (counts_.direct[t] > 0) direct.push_back(static_cast<int>(t));
+  for (std::size_t t = 0; t < n && t < counts.direct.size(); ++t)
+    if (counts.direct[t] > 0) direct.push_back(static_cast<int>(t));
   std::vector<int> moved = followMotion(grid_, direct, motion);
 
   std::vector<TileClass> cls(n, TileClass::Rest);
   for (std::size_t t = 0; t < n; ++t)
-    if (!(counts_.direct.size() > t && counts_.direct[t] > 0)) cls[t] = classes.classes[t];
+    if (!(counts.direct.size() > t && counts.direct[t] > 0)) cls[t] = classes.classes[t];
   std::vector<char> first(n, 0);
   for (int t : moved) first[static_cast<std::size_t>(t)] = 1;
   for (std::size_t t = 0; t < n; ++t)
@@ -179,7 +186,8 @@ Plan Planner::planBatch(const std::vector<EditFacts>& batch) {
     probePending_ = false;
     bool cameraLike = std::any_of(batch.begin(), batch.end(), [](const EditFacts& f) { return f.global; });
     if (cameraLike) dropCounts(true);
-    return Plan{PlanKind::GlobalUpdate};
+    lastEditPlan_ = Plan{PlanKind::GlobalUpdate};
+    return lastEditPlan_;
   }
 
   // The edited object: the last one the batch changed alone. Its motion within the batch moves
@@ -209,17 +217,26 @@ Plan Planner::planBatch(const std::vector<EditFacts>& batch) {
   std::vector<char> touched = touchedTiles(batch);
   lastTouched_ = touched;
   passFromEdit_ = true;
+  // A material edit: the material, when the batch changed one.
+  NodeId material = kNoNode;
+  for (const EditFacts& f : batch)
+    if (f.material != kNoNode) material = f.material;
   Plan plan;
   if (indirection() && haveCounts() && object == countsFor_ && object != kNoNode) {
     Vec2 motion{0.0f};
     if (centreNow && countedCentre_) motion = Vec2{centreNow->x - countedCentre_->x, centreNow->y - countedCentre_->y};
-    plan = indirectionPass(touched, motion);
+    plan = indirectionPass(touched, motion, counts_);
+  } else if (indirection() && material != kNoNode && material == groupMaterial_ && !groupCounts_.empty()) {
+    // Every object of the material changed where it stands: its direct, reflected and shadow
+    // tiles first, as for a move.
+    plan = indirectionPass(touched, Vec2{0.0f}, groupCounts_);
   } else {
     if (indirection() && haveCounts() && object != countsFor_) classes_.clear();  // they do not apply
     plan = spiralPass(touched);
   }
   // Change: the spiral (or indirection) order while edits keep coming; one probe when they stop.
   probePending_ = method_.kind == MethodKind::Change;
+  lastEditPlan_ = plan;
   return plan;
 }
 
@@ -257,7 +274,8 @@ Plan Planner::planFromProbe(const std::vector<float>& tileDifference) {
   for (int t : byChange)
     if (!first[static_cast<std::size_t>(t)]) order.push_back(t);
   passFromEdit_ = true;
-  return pass(std::move(order), prioritized, method_.quality > 0 ? method_.quality : kDefaultAutomaticQuality);
+  lastEditPlan_ = pass(std::move(order), prioritized, method_.quality > 0 ? method_.quality : kDefaultAutomaticQuality);
+  return lastEditPlan_;
 }
 
 }  // namespace retile

@@ -26,6 +26,7 @@ struct EditFacts {
   Vec2 pointOfChange{0.0f};       // projected centre of the targets' bounds (light position; else centre)
   std::vector<TileRect> screen;   // image rectangles the targets cover, before and after the edit
   NodeId object = kNoNode;        // the one object the edit changed (a move; a material only it uses)
+  NodeId material = kNoNode;      // a material edit: the material (the batch holds a fact per object using it)
   bool moved = false;             // that object's transform changed
   std::optional<Vec2> centreBefore, centreAfter;  // its projected bounds centre
 };
@@ -73,7 +74,10 @@ class Planner {
   bool countThisFrame(AccumMode mode) const;
   bool frameCounted();
   // `centre`: the object's projected centre now, from which its later motion is measured.
-  void setCounts(NodeId object, const IndirectionCounts& counts, std::optional<Vec2> centre);
+  // `group`: the counts of every object using `groupMaterial` (the object's material), which a
+  // material edit of it plans by as a move plans by the object's.
+  void setCounts(NodeId object, const IndirectionCounts& counts, std::optional<Vec2> centre,
+                 NodeId groupMaterial = kNoNode, const IndirectionCounts& group = {});
   bool haveCounts() const { return !counts_.empty() && countsFor_ != kNoNode; }
 
   // One plan for all edits applied since the last frame (a batch), with all their points of change.
@@ -84,6 +88,9 @@ class Planner {
   // The change policy's pass from the probe: per tile, how much the probe's estimate differs from
   // the image before it (relative; NaN: unknown).
   Plan planFromProbe(const std::vector<float>& tileDifference);
+  // The plan of the last edit (planBatch or planFromProbe), to run again at full resolution after
+  // a preview of it (RenderSession); None when the grid or method changed since.
+  const Plan& lastEditPlan() const { return lastEditPlan_; }
 
   const MethodSettings& method() const { return method_; }
   const TileGrid& grid() const { return grid_; }
@@ -106,7 +113,7 @@ class Planner {
   std::vector<int> centres() const;  // tiles of the points of change, then (focus policies) of the focus points
   std::vector<char> touchedTiles(const std::vector<EditFacts>& batch) const;
   Plan spiralPass(const std::vector<char>& touched) const;
-  Plan indirectionPass(const std::vector<char>& touched, Vec2 motion);
+  Plan indirectionPass(const std::vector<char>& touched, Vec2 motion, const IndirectionCounts& counts);
   Plan pass(std::vector<int> order, int leading, int quality) const;
   void dropCounts(bool gatherAgain);
 
@@ -119,9 +126,12 @@ class Planner {
   int countFramesLeft_ = 0;
   NodeId countsFor_ = kNoNode;
   IndirectionCounts counts_;
+  NodeId groupMaterial_ = kNoNode;  // what groupCounts_ describe: the objects of this material
+  IndirectionCounts groupCounts_;
   std::optional<Vec2> countedCentre_;
   std::vector<TileClass> classes_;
 
+  Plan lastEditPlan_;
   bool passFromEdit_ = false;  // a pass runs because of an edit: gather counters when it drains
   bool probePending_ = false;  // change policy: probe on the first frame without an edit
 };

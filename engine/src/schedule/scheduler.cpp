@@ -30,6 +30,38 @@ void TileScheduler::reset(const TileGrid& grid) {
   pendingProbe_ = false;
 }
 
+void TileScheduler::regrid(const TileGrid& grid) {
+  const TileGrid old = grid_;
+  const std::vector<double> oldSamples = samples_;
+  const std::vector<std::uint32_t> oldNext = nextIndex_;
+  const bool global = pendingGlobal_;
+  reset(grid);
+  pendingGlobal_ = global;
+  if (old.width() != grid.width() || old.height() != grid.height() || old.count() == 0) {
+    pendingGlobal_ = true;  // other pixels: nothing carries over
+    return;
+  }
+  // A new tile holds the mean of the samples its pixels hold (area-weighted over the old tiles it
+  // overlaps), and its sample indices continue past the largest any of its pixels has seen.
+  const int t0 = old.tileSize();
+  for (int t = 0; t < grid_.count(); ++t) {
+    const TileRect r = grid_.rect(t);
+    double sum = 0;
+    std::uint32_t next = 0;
+    for (int row = r.y / t0; row <= (r.y + r.height - 1) / t0; ++row)
+      for (int col = r.x / t0; col <= (r.x + r.width - 1) / t0; ++col) {
+        const int o = old.index(col, row);
+        const TileRect q = old.rect(o);
+        const int w = std::min(r.x + r.width, q.x + q.width) - std::max(r.x, q.x);
+        const int h = std::min(r.y + r.height, q.y + q.height) - std::max(r.y, q.y);
+        sum += oldSamples[static_cast<std::size_t>(o)] * w * h;
+        next = std::max(next, oldNext[static_cast<std::size_t>(o)]);
+      }
+    samples_[static_cast<std::size_t>(t)] = sum / static_cast<double>(r.pixels());
+    nextIndex_[static_cast<std::size_t>(t)] = next;
+  }
+}
+
 void TileScheduler::globalUpdate() {
   pendingGlobal_ = true;
   pendingProbe_ = false;
@@ -188,7 +220,62 @@ std::int64_t TileScheduler::waterFill(FramePlan& plan, std::vector<int> order, s
   return spent;
 }
 
-FramePlan TileScheduler::nextFrame() {
+bool TileScheduler::previewDone() const {
+  if (pendingGlobal_) return false;
+  return pendingProbe_ || pos_ >= queue_.size() || (smooth_ && static_cast<int>(pos_) >= prioritized_);
+}
+
+FramePlan TileScheduler::previewFrame(int block) {
+  FramePlan plan;
+  const std::int64_t area = static_cast<std::int64_t>(block) * block;
+  auto blocks = [&](int t) {
+    const TileRect r = grid_.rect(t);
+    return static_cast<std::int64_t>((r.width + block - 1) / block) * ((r.height + block - 1) / block);
+  };
+  auto serve = [&](int t, int q) {
+    const auto i = static_cast<std::size_t>(t);
+    TileChunk c;
+    c.tile = t;
+    c.rect = grid_.rect(t);
+    c.quality = q;
+    c.sampleBase = nextIndex_[i];
+    c.restart = true;
+    c.block = block;
+    nextIndex_[i] += static_cast<std::uint32_t>(q);
+    samples_[i] = q;
+    plan.servedTiles.push_back(t);
+    plan.chunks.push_back(c);
+    plan.samples += blocks(t) * q;
+  };
+  if (pendingGlobal_) {
+    plan.mode = AccumMode::GlobalUpdate;
+    for (int t = 0; t < grid_.count(); ++t)
+      if (inRegion(t)) serve(t, 1);
+    queue_.clear();
+    pass_.clear();
+    pos_ = 0;
+    refineCursor_ = 0;
+    pendingGlobal_ = false;
+    return plan;
+  }
+  plan.mode = passActive() ? AccumMode::Incremental : AccumMode::Refinement;
+  std::int64_t remaining = (grid_.pixels() + area - 1) / area;
+  const int q = std::max<int>(1, static_cast<int>(quality_ / area));
+  while (pos_ < queue_.size() && !(smooth_ && static_cast<int>(pos_) >= prioritized_)) {
+    const int t = queue_[pos_];
+    if (blocks(t) * q > remaining && !plan.chunks.empty()) break;
+    remaining -= blocks(t) * q;
+    serve(t, q);
+    pass_[pos_].started = true;
+    pass_[pos_].need = 0;
+    finished_.push_back(t);
+    ++pos_;
+  }
+  return plan;
+}
+
+FramePlan TileScheduler::nextFrame(int block) {
+  if (block > 1) return previewFrame(block);
   FramePlan plan;
   const std::int64_t budget = grid_.pixels();
   const int n = grid_.count();

@@ -26,6 +26,7 @@ struct TileChunk {
   std::uint32_t sampleBase = 0;  // sample indices sampleBase .. sampleBase + quality - 1
   bool restart = false;          // replace the pixels' sums
   int capStale = 0;              // > 0: first scale the sums down to at most this many samples
+  int block = 1;                 // > 1: a preview's chunk, a sample per block x block pixels (TileWork::block)
 };
 
 struct FramePlan {
@@ -44,6 +45,10 @@ class TileScheduler {
 
   // A new grid (resize, new T): everything restarts with a global update.
   void reset(const TileGrid& grid);
+  // The same pixels cut into other tiles (a new T): the accumulation stays, each new tile taking
+  // the samples its pixels hold and sample indices none of them has seen. A pass under way ends
+  // (its order named the old tiles): refinement follows. Other pixels reset as reset() does.
+  void regrid(const TileGrid& grid);
   // The next frame restarts every tile at 1 spp; refinement follows.
   void globalUpdate();
   // The next frame is a probe (traced, not accumulated); the caller then starts a pass.
@@ -54,7 +59,11 @@ class TileScheduler {
   // sums capped at `staleCap` samples per pixel and add fresh ones, else they restart too.
   void startPass(std::vector<int> order, int quality, int prioritized, bool smooth, int staleCap);
 
-  FramePlan nextFrame();
+  // `block` > 1: a preview while edits come (previewFrame); else a frame of the method.
+  FramePlan nextFrame(int block = 1);
+  // Whether a preview has anything left to show: a global update, or prioritized tiles of the pass
+  // (previews restart tiles only: coarse samples added to a sum would blur it for good).
+  bool previewDone() const;
   // A render region: only the marked tiles are traced (empty: every tile). Frames then spend the
   // budget on the region (about W x H / region pixels spp per tile, each tile once per frame,
   // so a frame traces at most W x H samples); passes skip tiles outside it.
@@ -87,6 +96,10 @@ class TileScheduler {
     bool started = false;
   };
   void emit(FramePlan& plan, int tile, TileRect rect, int quality, bool restart, int cap, bool wholeTile);
+  // A frame of W x H / block^2 samples, each standing for a block of pixels: the global update at
+  // 1 sample per block, or the pass's prioritized tiles restarted at Q / block^2 per block. The
+  // caller plans the same edit again at full resolution once the preview ends.
+  FramePlan previewFrame(int block);
   std::int64_t waterFill(FramePlan& plan, std::vector<int> order, std::int64_t budget, std::vector<char>& served);
   // Samples per pixel tile t holds, its kept history's credit counted.
   double held(int t) const {
