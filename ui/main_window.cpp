@@ -904,6 +904,7 @@ void MainWindow::applySelection() {
   // The engine's indirection counters and the gizmo follow the last picked object.
   engine_->submit(SelectCommand{selection_});
   if (graph_) {
+    graph_->followSelection(selected_);
     if (selected_.size() > 1) graph_->selectNodes(selected_);
     else graph_->setSelectedObject(selection_);
   }

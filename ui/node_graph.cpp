@@ -1,252 +1,34 @@
 #include "node_graph.h"
 
 #include <QApplication>
+#include <QButtonGroup>
 #include <QCursor>
-#include <QFrame>
 #include <QGraphicsPathItem>
 #include <QGraphicsRectItem>
 #include <QGraphicsScene>
+#include <QHBoxLayout>
 #include <QKeyEvent>
+#include <QLabel>
 #include <QLineEdit>
-#include <QListWidget>
 #include <QMouseEvent>
 #include <QPainter>
 #include <QPainterPathStroker>
-#include <QRegularExpression>
 #include <QScrollBar>
-#include <QVBoxLayout>
+#include <QToolButton>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
 #include <map>
-#include <set>
+#include <memory>
+
+#include "graph_items.h"
+#include "graph_layout.h"
+#include "node_search.h"
 
 namespace retile::ui {
 namespace {
-
-constexpr qreal kNodeWidth = 190;
-constexpr qreal kHeaderH = 24;
-constexpr qreal kSubtitleH = 18;
-constexpr qreal kRowH = 20;
-constexpr qreal kBottomPad = 8;
-constexpr qreal kSocketR = 5.5;
-constexpr qreal kColumnStep = kNodeWidth + 90;
-constexpr qreal kRowGap = 24;
-
-enum class NodeKind { Texture, Material, Object, Light, Camera, Settings };
-
-int columnOf(NodeKind k) {
-  switch (k) {
-    case NodeKind::Texture: return 0;
-    case NodeKind::Material: return 1;
-    case NodeKind::Object: return 2;
-    default: return 3;
-  }
-}
-
-QColor headerColor(NodeKind k) {
-  switch (k) {
-    case NodeKind::Texture: return {176, 112, 40};
-    case NodeKind::Material: return {52, 132, 82};
-    case NodeKind::Object: return {52, 96, 168};
-    case NodeKind::Light: return {168, 148, 36};
-    case NodeKind::Camera: return {118, 80, 160};
-    case NodeKind::Settings: return {92, 92, 104};
-  }
-  return Qt::gray;
-}
-
-// Sockets are coloured by what flows through them, so a compatible pair is recognisable at a glance.
-QColor socketColor(const QString& socket) {
-  return socket == QLatin1String("material") || socket == QLatin1String("blend") ? QColor(96, 210, 128) : QColor(236, 196, 72);
-}
-
-// A material's input that takes the material it blends with (Material::blendWith), below its
-// texture inputs.
-const QString kBlendInput = QStringLiteral("blend");
-
-// A material node's texture inputs, top to bottom, and the fields they set.
-struct TextureInput {
-  const char* name;
-  NodeId Material::*field;
-};
-constexpr TextureInput kTextureInputs[] = {{"albedo", &Material::albedoTexture},
-                                           {"roughness", &Material::roughnessTexture},
-                                           {"alpha", &Material::alphaTexture},
-                                           {"bump", &Material::bumpTexture},
-                                           {"emission", &Material::emissionTexture},
-                                           {"blend ratio", &Material::blendRatioTexture}};
-
-const QStringList& textureInputs() {
-  static const QStringList inputs = [] {
-    QStringList l;
-    for (const TextureInput& t : kTextureInputs) l << QLatin1String(t.name);
-    return l;
-  }();
-  return inputs;
-}
-
-bool isTextureInput(const QString& s) { return textureInputs().contains(s); }
-
-NodeId Material::*textureSlot(const QString& input) {
-  for (const TextureInput& t : kTextureInputs)
-    if (input == QLatin1String(t.name)) return t.field;
-  return nullptr;
-}
-
-// A link about to take a dropped node stands out from the others: thicker and brighter.
-QPen linkPen(const QString& input, bool highlighted) {
-  return highlighted ? QPen(socketColor(input).lighter(145), 5) : QPen(socketColor(input), 2.5);
-}
-
-QPainterPath linkPath(QPointF a, QPointF b) {
-  QPainterPath p(a);
-  const qreal dx = std::max<qreal>(40, std::abs(b.x() - a.x()) * 0.5);
-  p.cubicTo(a + QPointF(dx, 0), b - QPointF(dx, 0), b);
-  return p;
-}
-
-QColor displayColor(const Vec3& linear) {
-  auto c = [](float v) { return static_cast<int>(std::lround(255 * std::pow(std::clamp(v, 0.0f, 1.0f), 1 / 2.2f))); };
-  return {c(linear.x), c(linear.y), c(linear.z)};
-}
-
-// "Name", "Name.001", ...: Blender's convention, which artists already read as "a copy of Name".
-template <class Node>
-std::string uniqueName(const std::vector<Node>& nodes, std::string base) {
-  static const QRegularExpression suffix(QStringLiteral("\\.\\d{3}$"));
-  QString b = QString::fromStdString(base);
-  b.remove(suffix);
-  if (b.isEmpty()) b = QStringLiteral("Node");
-  auto taken = [&](const std::string& n) {
-    return std::any_of(nodes.begin(), nodes.end(), [&](const Node& x) { return x.name == n; });
-  };
-  if (!taken(b.toStdString())) return b.toStdString();
-  for (int i = 1;; ++i) {
-    std::string n = QStringLiteral("%1.%2").arg(b).arg(i, 3, 10, QLatin1Char('0')).toStdString();
-    if (!taken(n)) return n;
-  }
-}
-
-// Builds a GraphEdit against a working copy of the scene: every `after` is applied to the copy as it
-// is added, so later steps see the earlier ones (their `before` values are right for undo, new ids
-// do not collide) and a step the document would refuse aborts the whole edit here.
-class EditBuilder {
- public:
-  explicit EditBuilder(const Scene& s) : scene_(s) {}
-
-  const Scene& scene() const { return scene_; }
-  bool ok() const { return ok_; }
-  bool empty() const { return edit_.steps.empty(); }
-
-  bool step(Edit before, Edit after) {
-    if (!ok_) return false;
-    if (!applyEdit(scene_, after).ok()) {
-      ok_ = false;
-      return false;
-    }
-    edit_.steps.emplace_back(std::move(before), std::move(after));
-    return true;
-  }
-
-  bool set(const Material& m) {
-    const Material* old = scene_.material(m.id);
-    return old && step(SetMaterial{*old}, SetMaterial{m});
-  }
-  bool set(const Object& o) {
-    const Object* old = scene_.object(o.id);
-    return old && step(SetObject{*old}, SetObject{o});
-  }
-  bool set(const Light& l) {
-    const Light* old = scene_.light(l.id);
-    return old && step(SetLight{*old}, SetLight{l});
-  }
-  bool set(const Texture& t) {
-    const Texture* old = scene_.texture(t.id);
-    return old && step(SetTexture{*old}, SetTexture{t});
-  }
-
-  NodeId newId() const {
-    NodeId id = scene_.peekNextId();
-    while (scene_.mesh(id) || scene_.material(id) || scene_.object(id) || scene_.light(id) || scene_.texture(id)) ++id;
-    return id;
-  }
-
-  // Points `to`'s input at `from` (kNoNode clears it). False when nothing changes or it is not allowed.
-  bool assign(NodeId to, const QString& input, NodeId from) {
-    if (input == QLatin1String("material")) {
-      const Object* o = scene_.object(to);
-      if (!o || (from != kNoNode && !scene_.material(from)) || o->material == from) return false;
-      Object c = *o;
-      c.material = from;
-      return set(c);
-    }
-    if (input == kBlendInput) {
-      const Material* m = scene_.material(to);
-      if (!m || from == to || (from != kNoNode && !scene_.material(from)) || m->blendWith == from) return false;
-      Material c = *m;
-      c.setBlendWith(from);
-      return set(c);
-    }
-    NodeId Material::*slot = textureSlot(input);
-    const Material* m = scene_.material(to);
-    if (!slot || !m || (from != kNoNode && !scene_.texture(from)) || m->*slot == from) return false;
-    Material c = *m;
-    c.*slot = from;
-    return set(c);
-  }
-
-  // Clears the references to the node first, so that undoing (befores in reverse) adds it back and
-  // then restores them.
-  bool remove(NodeId id) {
-    if (const Object* o = scene_.object(id)) return step(AddObject{*o}, RemoveNode{id});
-    if (const Light* l = scene_.light(id)) return step(AddLight{*l}, RemoveNode{id});
-    if (const Material* m = scene_.material(id)) {
-      Material copy = *m;
-      std::vector<NodeId> users;
-      for (const Object& o : scene_.objects)
-        if (o.material == id) users.push_back(o.id);
-      for (NodeId u : users)
-        if (!assign(u, QStringLiteral("material"), kNoNode)) return false;
-      std::vector<NodeId> blends;
-      for (const Material& b : scene_.materials)
-        if (b.blendWith == id) blends.push_back(b.id);
-      for (NodeId b : blends)
-        if (!assign(b, kBlendInput, kNoNode)) return false;
-      return step(AddMaterial{copy}, RemoveNode{id});
-    }
-    if (const Texture* t = scene_.texture(id)) {
-      Texture copy = *t;
-      std::vector<std::pair<NodeId, QString>> users;
-      for (const Material& m : scene_.materials)
-        for (const QString& slot : textureInputs())
-          if (m.*textureSlot(slot) == id) users.emplace_back(m.id, slot);
-      for (const auto& [m, slot] : users)
-        if (!assign(m, slot, kNoNode)) return false;
-      if (scene_.environment.map == id) {
-        Environment env = scene_.environment;
-        env.map = kNoNode;
-        env.type = EnvironmentType::Constant;  // what RemoveNode does; stated so undo restores the type
-        if (!step(SetEnvironment{scene_.environment}, SetEnvironment{env})) return false;
-      }
-      return step(AddTexture{copy}, RemoveNode{id});
-    }
-    return false;
-  }
-
-  GraphEdit finish(const QString& text) {
-    edit_.text = text;
-    return std::move(edit_);
-  }
-
- private:
-  Scene scene_;
-  GraphEdit edit_;
-  bool ok_ = true;
-};
 
 // An inline editor that can be cancelled with Escape (QLineEdit alone only knows "finished").
 // Every key typed into it is its own: QLineEdit lets Escape, Return and keys it has no use for
@@ -280,180 +62,6 @@ class RenameEdit : public QLineEdit {
 
 }  // namespace
 
-// One node: a rounded box with a coloured header, a subtitle line and one row per socket (inputs on
-// the left, the output on the right of the first row). Plain data; the view lays it out and rebuilds it.
-class GraphNodeItem : public QGraphicsItem {
- public:
-  enum { Type = UserType + 1 };
-
-  GraphNodeItem(NodeId nodeId, NodeKind nodeKind) : id(nodeId), kind(nodeKind) {
-    setFlag(ItemIsSelectable);
-    setZValue(1);
-  }
-  int type() const override { return Type; }
-
-  qreal height() const {
-    const auto rows = std::max<qsizetype>(inputs.size(), output.isEmpty() ? 0 : 1);
-    return kHeaderH + kSubtitleH + static_cast<qreal>(rows) * kRowH + kBottomPad;
-  }
-  QRectF boundingRect() const override {
-    return {-kSocketR - 2, -2, kNodeWidth + 2 * kSocketR + 4, height() + 4};
-  }
-  QPointF inputPos(qsizetype i) const { return {0, kHeaderH + kSubtitleH + (static_cast<qreal>(i) + 0.5) * kRowH}; }
-  QPointF outputPos() const { return {kNodeWidth, kHeaderH + kSubtitleH + 0.5 * kRowH}; }
-  bool deletable() const { return kind != NodeKind::Camera && kind != NodeKind::Settings; }
-
-  void paint(QPainter* p, const QStyleOptionGraphicsItem*, QWidget*) override {
-    p->setRenderHint(QPainter::Antialiasing, true);
-    const QRectF body(0, 0, kNodeWidth, height());
-    QPainterPath shape;
-    shape.addRoundedRect(body, 7, 7);
-    p->fillPath(shape, QColor(50, 50, 56, 240));
-    p->save();
-    p->setClipRect(QRectF(0, 0, kNodeWidth, kHeaderH));
-    p->fillPath(shape, headerColor(kind));
-    p->restore();
-    p->setBrush(Qt::NoBrush);
-    p->setPen(isSelected() ? QPen(QColor(255, 168, 40), 2.4) : QPen(QColor(18, 18, 20), 1));
-    p->drawPath(shape);
-
-    QFont titleFont = p->font();
-    titleFont.setBold(true);
-    p->setFont(titleFont);
-    p->setPen(Qt::white);
-    const qreal swatchSpace = swatch.isValid() ? 22 : 0;
-    const QRectF titleRect(8, 0, kNodeWidth - 16 - swatchSpace, kHeaderH);
-    p->drawText(titleRect, Qt::AlignVCenter | Qt::AlignLeft,
-                QFontMetricsF(titleFont).elidedText(title, Qt::ElideRight, titleRect.width()));
-    if (swatch.isValid()) {
-      p->setPen(QPen(QColor(20, 20, 20), 1));
-      p->setBrush(swatch);
-      p->drawRoundedRect(QRectF(kNodeWidth - 22, 5, 14, 14), 3, 3);
-      p->setBrush(Qt::NoBrush);
-    }
-
-    QFont small = p->font();
-    small.setBold(false);
-    small.setPointSizeF(std::max(6.0, small.pointSizeF() * 0.88));
-    p->setFont(small);
-    p->setPen(QColor(178, 178, 186));
-    const QRectF subRect(8, kHeaderH, kNodeWidth - 16, kSubtitleH);
-    p->drawText(subRect, Qt::AlignVCenter | Qt::AlignLeft,
-                QFontMetricsF(small).elidedText(subtitle, Qt::ElideRight, subRect.width()));
-
-    auto socket = [&](QPointF c, const QString& name) {
-      p->setPen(QPen(QColor(18, 18, 20), 1.2));
-      p->setBrush(socketColor(name));
-      p->drawEllipse(c, kSocketR, kSocketR);
-      p->setBrush(Qt::NoBrush);
-    };
-    for (qsizetype i = 0; i < inputs.size(); ++i) {
-      const QPointF c = inputPos(i);
-      socket(c, inputs[i]);
-      p->setPen(QColor(222, 222, 228));
-      p->drawText(QRectF(12, c.y() - kRowH / 2, kNodeWidth / 2, kRowH), Qt::AlignVCenter | Qt::AlignLeft, label(i));
-    }
-    if (!output.isEmpty()) {
-      const QPointF c = outputPos();
-      socket(c, output);
-      p->setPen(QColor(222, 222, 228));
-      p->drawText(QRectF(kNodeWidth / 2, c.y() - kRowH / 2, kNodeWidth / 2 - 12, kRowH),
-                  Qt::AlignVCenter | Qt::AlignRight, output);
-    }
-  }
-
-  // What input i is called on this node: its socket's name unless `labels` renames it.
-  QString label(qsizetype i) const { return i < labels.size() && !labels[i].isEmpty() ? labels[i] : inputs[i]; }
-
-  NodeId id;
-  NodeKind kind;
-  QString title, subtitle;
-  QStringList inputs;
-  QStringList labels;  // shown instead of inputs' names where not empty (the sockets keep them)
-  QString output;
-  QColor swatch;  // invalid: none
-};
-
-// The Tab / right-click menu: a filter line over the creatable types. Up/Down move, Enter creates,
-// Escape (or a click elsewhere: it is a popup) closes.
-class NodeSearchPopup : public QFrame {
- public:
-  NodeSearchPopup(QWidget* parent, std::function<void(const QString&)> chosen)
-      : QFrame(parent, Qt::Popup), chosen_(std::move(chosen)) {
-    setFrameShape(QFrame::StyledPanel);
-    auto* layout = new QVBoxLayout(this);
-    layout->setContentsMargins(4, 4, 4, 4);
-    layout->setSpacing(4);
-    filter_ = new QLineEdit(this);
-    filter_->setObjectName(QStringLiteral("nodeSearch"));
-    filter_->setPlaceholderText(NodeGraphView::tr("Add node..."));
-    list_ = new QListWidget(this);
-    list_->setObjectName(QStringLiteral("nodeSearchList"));
-    list_->addItems(NodeGraphView::creatableTypes());
-    layout->addWidget(filter_);
-    layout->addWidget(list_);
-    resize(220, 170);
-    filter_->installEventFilter(this);
-    QObject::connect(filter_, &QLineEdit::textChanged, this, [this](const QString& t) { refilter(t); });
-    QObject::connect(filter_, &QLineEdit::returnPressed, this, [this] { activate(list_->currentItem()); });
-    QObject::connect(list_, &QListWidget::itemClicked, this, [this](QListWidgetItem* i) { activate(i); });
-  }
-
-  void popupAt(QPoint global) {
-    filter_->clear();
-    refilter(QString());
-    move(global);
-    show();
-    filter_->setFocus();
-  }
-
- protected:
-  bool eventFilter(QObject* o, QEvent* e) override {
-    if (o == filter_ && e->type() == QEvent::KeyPress) {
-      const int key = static_cast<QKeyEvent*>(e)->key();
-      if (key == Qt::Key_Escape) {
-        hide();
-        return true;
-      }
-      if (key == Qt::Key_Down || key == Qt::Key_Up) {
-        step(key == Qt::Key_Down ? 1 : -1);
-        return true;
-      }
-    }
-    return QFrame::eventFilter(o, e);
-  }
-
- private:
-  void refilter(const QString& text) {
-    QListWidgetItem* first = nullptr;
-    for (int i = 0; i < list_->count(); ++i) {
-      QListWidgetItem* item = list_->item(i);
-      const bool match = item->text().contains(text.trimmed(), Qt::CaseInsensitive);
-      item->setHidden(!match);
-      if (match && !first) first = item;
-    }
-    list_->setCurrentItem(first);
-  }
-  void step(int d) {
-    const int n = list_->count();
-    for (int i = list_->currentRow() + d; i >= 0 && i < n; i += d)
-      if (!list_->item(i)->isHidden()) {
-        list_->setCurrentRow(i);
-        return;
-      }
-  }
-  void activate(QListWidgetItem* item) {
-    if (!item || item->isHidden()) return;
-    const QString type = item->text();
-    hide();
-    chosen_(type);
-  }
-
-  std::function<void(const QString&)> chosen_;
-  QLineEdit* filter_ = nullptr;
-  QListWidget* list_ = nullptr;
-};
-
 NodeGraphView::NodeGraphView(QWidget* parent) : QGraphicsView(parent) {
   auto* s = new QGraphicsScene(this);
   // A large fixed scene rect: panning is not bounded by where the nodes happen to be.
@@ -470,18 +78,70 @@ NodeGraphView::NodeGraphView(QWidget* parent) : QGraphicsView(parent) {
 
   // The two transient items outlive rebuilds; everything else is recreated by setDocument.
   dragLink_ = s->addPath(QPainterPath(), QPen(QColor(240, 240, 240), 2.5, Qt::DashLine));
-  dragLink_->setZValue(3);
+  dragLink_->setZValue(kDragLinkZ);
   dragLink_->hide();
   marquee_ = s->addRect(QRectF(), QPen(QColor(255, 168, 40), 1, Qt::DashLine), QColor(255, 168, 40, 36));
-  marquee_->setZValue(4);
+  marquee_->setZValue(kMarqueeZ);
   marquee_->hide();
+  buildScopeBar();
+}
+
+void NodeGraphView::buildScopeBar() {
+  // In the corner of the graph itself, so that it comes wherever the graph is docked.
+  scopeBar_ = new QWidget(this);
+  scopeBar_->setObjectName(QStringLiteral("graphScopeBar"));
+  scopeBar_->setAutoFillBackground(true);
+  auto* row = new QHBoxLayout(scopeBar_);
+  row->setContentsMargins(6, 3, 6, 3);
+  row->setSpacing(4);
+  row->addWidget(new QLabel(tr("Show:"), scopeBar_));
+  auto* group = new QButtonGroup(scopeBar_);
+  auto button = [&](const QString& text, const char* name, Scope scope, const QString& tip) {
+    auto* b = new QToolButton(scopeBar_);
+    b->setText(text);
+    b->setObjectName(QLatin1String(name));
+    b->setCheckable(true);
+    b->setToolTip(tip);
+    b->setFocusPolicy(Qt::NoFocus);  // the keys stay with the graph
+    group->addButton(b);
+    row->addWidget(b);
+    connect(b, &QToolButton::clicked, this, [this, scope] { setScope(scope); });
+    return b;
+  };
+  showSelection_ = button(tr("Selection"), "graphShowSelection", Scope::Selection,
+                          tr("The selected objects, their materials and those materials' textures"));
+  showAll_ = button(tr("All"), "graphShowAll", Scope::All,
+                    tr("Every node of the scene (A frames as much as is legible)"));
+  scopeNote_ = new QLabel(scopeBar_);
+  scopeNote_->setObjectName(QStringLiteral("graphScopeNote"));
+  row->addWidget(scopeNote_);
+  updateScopeBar();
+}
+
+void NodeGraphView::updateScopeBar() {
+  showSelection_->setChecked(scope_ == Scope::Selection);
+  showAll_->setChecked(scope_ == Scope::All);
+  QString note;
+  if (scope_ == Scope::Selection && roots_.empty()) note = tr("nothing selected: every node");
+  else if (focused() && roots_.size() == 1) note = tr("%1 and its material").arg(nameOf(scene_, roots_.front()));
+  else if (focused()) note = tr("%n objects and their materials", nullptr, static_cast<int>(roots_.size()));
+  scopeNote_->setText(note);
+  scopeNote_->setVisible(!note.isEmpty());
+  scopeBar_->adjustSize();
+  scopeBar_->move(viewport()->geometry().topLeft());
+}
+
+void NodeGraphView::resizeEvent(QResizeEvent* e) {
+  QGraphicsView::resizeEvent(e);
+  if (scopeBar_) scopeBar_->move(viewport()->geometry().topLeft());
 }
 
 NodeGraphView::~NodeGraphView() = default;
 
 QStringList NodeGraphView::creatableTypes() {
-  return {QStringLiteral("Material"), QStringLiteral("Texture"), QStringLiteral("Light"), QStringLiteral("Spot Light"),
-          QStringLiteral("Directional Light")};
+  QStringList names;
+  for (const CreatableType& t : creatableTypeTable()) names << t.name;
+  return names;
 }
 
 void NodeGraphView::setDocument(const Scene& scene) {
@@ -509,15 +169,34 @@ void NodeGraphView::resetLayout() {
   }
   pasteCount_ = 0;
   positions_.clear();
+  roots_.clear();
+  pendingRoots_.clear();
+  rootsPending_ = false;
+  shown_.clear();
+  focusPositions_.clear();
   rebuild();
   frameAll();
+}
+
+bool NodeGraphView::exists(NodeId id) const {
+  return scene_.material(id) || scene_.object(id) || scene_.light(id) || scene_.texture(id);
 }
 
 void NodeGraphView::rebuild() {
   std::vector<NodeId> selection;
   for (NodeId id : pendingSelection_)
-    if (scene_.material(id) || scene_.object(id) || scene_.light(id) || scene_.texture(id)) selection.push_back(id);
+    if (exists(id)) selection.push_back(id);
   if (selection.empty()) selection = selectedNodes();
+  if (focused()) {
+    // What was shown stays (a texture unlinked a moment ago is still there to link again), nodes
+    // just made join it, and whatever any of them is made of comes along.
+    std::vector<NodeId> seeds;
+    for (NodeId id : roots_) seeds.push_back(id);
+    for (NodeId id : shown_) seeds.push_back(id);
+    for (NodeId id : pendingSelection_) seeds.push_back(id);
+    std::erase_if(seeds, [this](NodeId id) { return !exists(id); });
+    shown_ = neighbourhood(scene_, seeds);
+  }
   pendingSelection_.clear();
 
   for (Link& l : links_) delete l.item;
@@ -525,7 +204,17 @@ void NodeGraphView::rebuild() {
   for (auto& [id, n] : nodes_) delete n;
   nodes_.clear();
 
+  const std::vector<GraphNodeItem*> order = addNodes();
+  placeNodes(order);
+  addLinks(order);
+  setSelection(selection);
+  updateLinkPaths();
+  updateScopeBar();
+}
+
+std::vector<GraphNodeItem*> NodeGraphView::addNodes() {
   std::vector<GraphNodeItem*> order;
+  const bool all = !focused();
   auto add = [&](NodeId id, NodeKind kind, const std::string& title, const QString& subtitle) {
     auto* n = new GraphNodeItem(id, kind);
     n->title = QString::fromStdString(title);
@@ -536,6 +225,7 @@ void NodeGraphView::rebuild() {
     return n;
   };
   for (const Texture& t : scene_.textures) {
+    if (!all && !shown_.count(t.id)) continue;
     QString sub;
     switch (t.kind) {
       case TextureKind::File: sub = tr("File: %1").arg(QString::fromStdString(t.path.filename().string())); break;
@@ -547,6 +237,7 @@ void NodeGraphView::rebuild() {
     if (t.kind == TextureKind::Checker) n->swatch = displayColor(t.checkerOn);
   }
   for (const Material& m : scene_.materials) {
+    if (!all && !shown_.count(m.id)) continue;
     QString sub = QString::fromLatin1(materialTypeName(m.type));
     if (m.emissive()) sub += tr(", emissive");
     GraphNodeItem* n = add(m.id, NodeKind::Material, m.name, sub);
@@ -565,12 +256,13 @@ void NodeGraphView::rebuild() {
     n->swatch = displayColor(m.emissive() ? m.emission / peak : m.albedo);
   }
   for (const Object& o : scene_.objects) {
+    if (!all && !shown_.count(o.id)) continue;
     const Mesh* mesh = scene_.mesh(o.mesh);
     QString sub = mesh ? tr("Mesh: %1").arg(QString::fromStdString(mesh->name)) : tr("No mesh");
     if (!o.visible) sub += tr(" (hidden)");
     add(o.id, NodeKind::Object, o.name, sub)->inputs = {QStringLiteral("material")};
   }
-  {
+  if (all) {
     const Camera& c = scene_.camera;
     const double fov = static_cast<double>(c.verticalFov) * 180.0 / kPi;
     // With a lens, the distance in focus (the subtitle has room for little more).
@@ -583,112 +275,52 @@ void NodeGraphView::rebuild() {
         tr("%1x%2, %3 spp, %4 bounces").arg(r.width).arg(r.height).arg(r.samplesPerPixel).arg(r.maxBounces));
   }
   for (const Light& l : scene_.lights) {
+    if (!all && !shown_.count(l.id)) continue;
     static const char* const types[] = {"Point", "Spot", "Directional"};
     const QLatin1String type(types[static_cast<int>(l.type)]);
     const QString sub = tr("%1 light, intensity %2").arg(type).arg(l.intensity);
     GraphNodeItem* n = add(l.id, NodeKind::Light, l.name, sub);
     n->swatch = displayColor(l.color);
   }
-
-  if (positions_.empty()) layOut(order);
-  // Nodes seen before keep their place; new ones go below the lowest node of their kind's last column.
-  std::map<int, QPointF> below;  // per column kind: where the next node goes
-  for (GraphNodeItem* n : order) {
-    auto it = positions_.find(n->id);
-    if (it == positions_.end()) continue;
-    n->setPos(it->second);
-    const int c = columnOf(n->kind);
-    const QPointF bottom(it->second.x(), it->second.y() + n->height() + kRowGap);
-    auto b = below.find(c);
-    if (b == below.end() || bottom.x() > b->second.x() + kNodeWidth ||
-        (std::abs(bottom.x() - b->second.x()) < kNodeWidth && bottom.y() > b->second.y()))
-      below[c] = bottom;
-  }
-  for (GraphNodeItem* n : order) {
-    if (positions_.count(n->id)) continue;
-    const int c = columnOf(n->kind);
-    auto b = below.find(c);
-    const QPointF p = b != below.end() ? b->second : QPointF(c * kColumnStep, 0);
-    below[c] = QPointF(p.x(), p.y() + n->height() + kRowGap);
-    positions_[n->id] = p;
-    n->setPos(p);
-  }
-
-  auto addLink = [&](NodeId from, NodeId to, const QString& input) {
-    if (!nodes_.count(from) || !nodes_.count(to)) return;
-    auto* item = scene()->addPath(QPainterPath(), linkPen(input, false));
-    item->setZValue(0);
-    links_.push_back({from, to, input, item});
-  };
-  for (const Object& o : scene_.objects)
-    if (o.material != kNoNode) addLink(o.material, o.id, QStringLiteral("material"));
-  for (const Material& m : scene_.materials) {
-    if (m.type == MaterialType::Boundary) continue;  // no inputs to draw its links to
-    for (const QString& slot : textureInputs())
-      if (m.*textureSlot(slot) != kNoNode) addLink(m.*textureSlot(slot), m.id, slot);
-    if (m.blendWith != kNoNode) addLink(m.blendWith, m.id, kBlendInput);
-  }
-
-  setSelection(selection);
-  updateLinkPaths();
+  return order;
 }
 
-void NodeGraphView::layOut(const std::vector<GraphNodeItem*>& nodes) {
-  // Columns by kind (textures, materials, objects, the rest), each in the order of what it feeds,
-  // so that links run mostly level: materials as the scene lists them, objects by their material,
-  // textures by the first material that uses them. A kind too tall for the panel's shape wraps
-  // into more columns; a big scene (the living room has about 90 nodes) fills the panel instead of
-  // making one thin column.
-  std::unordered_map<NodeId, std::size_t> materialRank, textureRank;
-  for (std::size_t i = 0; i < scene_.materials.size(); ++i) {
-    const Material& m = scene_.materials[i];
-    materialRank[m.id] = i;
-    for (NodeId t : m.textures())
-      if (t != kNoNode && !textureRank.count(t)) textureRank[t] = i;
+void NodeGraphView::placeNodes(const std::vector<GraphNodeItem*>& order) {
+  std::unordered_map<NodeId, QPointF>& at = positions();
+  if (at.empty()) {
+    // The panel's shape (a wide strip below the viewport, unless the artist made it otherwise).
+    const double aspect = height() > 50 ? static_cast<double>(width()) / height() : 4.0;
+    at = focused() ? layOutNeighbourhood(scene_, order, roots_) : layOutIslands(scene_, order, aspect);
   }
-  auto rank = [&](const GraphNodeItem* n) -> std::size_t {
-    constexpr std::size_t kLast = std::numeric_limits<std::size_t>::max();
-    switch (n->kind) {
-      case NodeKind::Texture: {
-        auto it = textureRank.find(n->id);
-        return it == textureRank.end() ? kLast : it->second;
-      }
-      case NodeKind::Object: {
-        const Object* o = scene_.object(n->id);
-        auto it = o ? materialRank.find(o->material) : materialRank.end();
-        return it == materialRank.end() ? kLast : it->second;
-      }
-      default: return 0;
+  // Nodes seen before keep their place; new ones go in a row below all of them, in columns by
+  // kind, where they cover nothing.
+  qreal bottom = 0;
+  for (GraphNodeItem* n : order)
+    if (auto it = at.find(n->id); it != at.end()) {
+      n->setPos(it->second);
+      bottom = std::max(bottom, it->second.y() + n->height());
     }
-  };
-  std::array<std::vector<GraphNodeItem*>, 4> columns;
-  for (GraphNodeItem* n : nodes) columns[static_cast<std::size_t>(columnOf(n->kind))].push_back(n);
-  double area = 0, tallest = 0;
-  for (auto& column : columns) {
-    std::stable_sort(column.begin(), column.end(),
-                     [&](const GraphNodeItem* a, const GraphNodeItem* b) { return rank(a) < rank(b); });
-    for (const GraphNodeItem* n : column) {
-      area += (n->height() + kRowGap) * kColumnStep;
-      tallest = std::max<double>(tallest, n->height() + kRowGap);
-    }
+  std::map<int, qreal> next;  // per column kind: the top of its next new node
+  for (GraphNodeItem* n : order) {
+    if (at.count(n->id)) continue;
+    const int c = columnOf(n->kind);
+    auto y = next.try_emplace(c, bottom + 2 * kRowGap).first;
+    const QPointF p(c * kColumnStep, y->second);
+    y->second += n->height() + kRowGap;
+    at[n->id] = p;
+    n->setPos(p);
   }
-  // The panel's shape (a wide strip below the viewport, unless the artist made it otherwise).
-  const double aspect = std::clamp(height() > 50 ? static_cast<double>(width()) / height() : 4.0, 1.0, 8.0);
-  const double maxHeight = std::max({std::sqrt(area / aspect), 4.0 * tallest, 400.0});
-  qreal x = 0;
-  for (const auto& column : columns) {
-    if (column.empty()) continue;
-    qreal y = 0;
-    for (GraphNodeItem* n : column) {
-      if (y > 0 && y + n->height() > maxHeight) {
-        x += kColumnStep;
-        y = 0;
-      }
-      positions_[n->id] = QPointF(x, y);
-      y += n->height() + kRowGap;
+}
+
+void NodeGraphView::addLinks(const std::vector<GraphNodeItem*>& order) {
+  for (const GraphNodeItem* n : order)
+    for (const auto& [from, input] : linksInto(scene_, n->id)) {
+      if (!nodes_.count(from)) continue;
+      auto* item = new GraphLinkItem;
+      item->setPen(linkPen(input, LinkLook::Normal));
+      scene()->addItem(item);
+      links_.push_back({from, n->id, input, item});
     }
-    x += kColumnStep + kRowGap;  // a little more room between kinds than between a kind's columns
-  }
 }
 
 void NodeGraphView::updateLinkPaths() {
@@ -703,8 +335,9 @@ void NodeGraphView::setSelection(const std::vector<NodeId>& ids) {
   const std::set<NodeId> want(ids.begin(), ids.end());
   for (auto& [id, n] : nodes_) {
     n->setSelected(want.count(id) > 0);
-    n->setZValue(n->isSelected() ? 2 : 1);
+    n->setZValue(n->isSelected() ? kSelectedNodeZ : kNodeZ);
   }
+  highlightLink(nullptr);
 }
 
 void NodeGraphView::setSelectedObject(NodeId id) {
@@ -716,6 +349,41 @@ void NodeGraphView::setSelectedObject(NodeId id) {
 }
 
 void NodeGraphView::selectNodes(const std::vector<NodeId>& ids) { setSelection(ids); }
+
+void NodeGraphView::followSelection(const std::vector<NodeId>& objects) {
+  std::vector<NodeId> roots;
+  for (NodeId id : objects)
+    if (scene_.object(id) && std::find(roots.begin(), roots.end(), id) == roots.end()) roots.push_back(id);
+  // Rebuilding under a gesture would pull its nodes away: a click here that selected an object
+  // shows that object's graph when the button comes up.
+  if (mouseDown_ && QGuiApplication::mouseButtons() != Qt::NoButton) {
+    pendingRoots_ = roots;
+    rootsPending_ = true;
+    return;
+  }
+  rootsPending_ = false;
+  if (roots == roots_) return;
+  roots_ = roots;
+  shown_.clear();
+  focusPositions_.clear();
+  if (scope_ == Scope::Selection) {
+    rebuild();
+    frameAll();
+  } else {
+    updateScopeBar();
+  }
+}
+
+void NodeGraphView::setScope(Scope scope) {
+  scope_ = scope;
+  rebuild();
+  frameAll();
+}
+
+qreal NodeGraphView::legibleZoom() const {
+  constexpr qreal kLegiblePixels = 9;
+  return kLegiblePixels / std::max(1, QFontInfo(font()).pixelSize());
+}
 
 std::vector<NodeId> NodeGraphView::selectedNodes() const {
   std::vector<NodeId> ids;
@@ -824,21 +492,20 @@ const NodeGraphView::Link* NodeGraphView::insertTarget() const {
 }
 
 void NodeGraphView::highlightLink(const Link* target) {
+  // In the whole graph, the selection's links stand out of the bundle: the others fade.
+  std::set<NodeId> selected;
+  if (!focused())
+    for (const auto& [id, n] : nodes_)
+      if (n->isSelected()) selected.insert(id);
   // Every link, not just the previous target: a refresh in the middle of a drag rebuilds the items.
-  for (const Link& l : links_) l.item->setPen(linkPen(l.input, &l == target));
+  for (const Link& l : links_) {
+    const bool faded = !selected.empty() && !selected.count(l.from) && !selected.count(l.to);
+    const LinkLook look = &l == target ? LinkLook::Highlighted : faded ? LinkLook::Faded : LinkLook::Normal;
+    l.item->setPen(linkPen(l.input, look));
+    l.item->setZValue(kLinkZ + (look == LinkLook::Faded ? 0 : 1));
+  }
 }
 
-namespace {
-
-QString nameOf(const Scene& s, NodeId id) {
-  if (const auto* n = s.material(id)) return QString::fromStdString(n->name);
-  if (const auto* n = s.object(id)) return QString::fromStdString(n->name);
-  if (const auto* n = s.light(id)) return QString::fromStdString(n->name);
-  if (const auto* n = s.texture(id)) return QString::fromStdString(n->name);
-  return QString::number(id);
-}
-
-}  // namespace
 
 bool NodeGraphView::request(GraphEdit edit, const Scene& result) {
   if (edit.steps.empty()) return false;
@@ -887,7 +554,7 @@ bool NodeGraphView::createNode(const QString& type, QPointF scenePos) {
     m.id = id;
     m.name = uniqueName(scene_.materials, "Material");
     b.step(RemoveNode{id}, AddMaterial{m});
-  } else if (type == QLatin1String("Texture")) {
+  } else if (type == QLatin1String("Checker Texture")) {
     // A checker: a file texture needs a path, and a checker shows the uv layout right away.
     Texture t;
     t.id = id;
@@ -899,8 +566,8 @@ bool NodeGraphView::createNode(const QString& type, QPointF scenePos) {
     l.id = id;
     if (type == QLatin1String("Spot Light")) l.type = LightType::Spot;
     else if (type == QLatin1String("Directional Light")) l.type = LightType::Directional;
-    else if (type != QLatin1String("Light")) return false;
-    l.name = uniqueName(scene_.lights, l.type == LightType::Point ? "Light" : type.toStdString());
+    else if (type != QLatin1String("Point Light")) return false;
+    l.name = uniqueName(scene_.lights, type.toStdString());
     // Above the middle of the scene, where a new light is visible in the default view.
     const Bounds3 bounds = scene_.worldBounds();
     l.position = bounds.empty() ? Vec3{0.0f, 2.0f, 0.0f}
@@ -911,7 +578,7 @@ bool NodeGraphView::createNode(const QString& type, QPointF scenePos) {
     return false;
   }
   if (!b.ok()) return false;
-  positions_[id] = scenePos;
+  positions()[id] = scenePos;
   pendingSelection_ = {id};
   return request(b.finish(tr("Add %1").arg(type)), b.scene());
 }
@@ -960,7 +627,7 @@ bool NodeGraphView::duplicateSelected() {
     } else {
       continue;
     }
-    positions_[copyId] = nodePosition(id) + offset;
+    positions()[copyId] = nodePosition(id) + offset;
     made.push_back(copyId);
   }
   if (made.empty()) return false;
@@ -1002,14 +669,14 @@ bool NodeGraphView::paste() {
       if (*t != kNoNode && !scene_.texture(*t)) *t = kNoNode;
     if (m.blendWith != kNoNode && !scene_.material(m.blendWith)) m.blendWith = kNoNode;  // likewise its partner
     if (!b.step(RemoveNode{m.id}, AddMaterial{m})) return false;
-    positions_[m.id] = copiedPositions_[k++] + offset;
+    positions()[m.id] = copiedPositions_[k++] + offset;
     made.push_back(m.id);
   }
   for (Light l : copiedLights_) {
     l.id = b.newId();
     l.name = uniqueName(b.scene().lights, l.name);
     if (!b.step(RemoveNode{l.id}, AddLight{l})) return false;
-    positions_[l.id] = copiedPositions_[k++] + offset;
+    positions()[l.id] = copiedPositions_[k++] + offset;
     made.push_back(l.id);
   }
   ++pasteCount_;
@@ -1079,15 +746,17 @@ void NodeGraphView::openNodeSearch(QPointF scenePos) {
   search_->popupAt(viewport()->mapToGlobal(mapFromScene(scenePos)));
 }
 
-void NodeGraphView::frameRect(QRectF r) {
+void NodeGraphView::frameRect(QRectF r, const QRectF& focus) {
   if (r.isEmpty() || viewport()->width() < 2) return;
   r.adjust(-40, -40, 40, 40);
-  fitInView(r, Qt::KeepAspectRatio);
-  // Framing a single small node should not blow it up past a readable size.
-  if (transform().m11() > 1.5) {
-    setTransform(QTransform::fromScale(1.5, 1.5));
-    centerOn(r.center());
-  }
+  // The buttons in the corner cover the top of the viewport: frame below them.
+  const qreal top = scopeBar_->height();
+  const QSizeF view(viewport()->width(), std::max(1.0, viewport()->height() - top));
+  // Framing a single small node should not blow it up past a readable size, nor framing a big
+  // graph shrink it past one.
+  const qreal zoom = std::clamp(std::min(view.width() / r.width(), view.height() / r.height()), legibleZoom(), 1.5);
+  setTransform(QTransform::fromScale(zoom, zoom));
+  centerOn(framingCentre(r, focus.adjusted(-40, -40, 40, 40), view / zoom) - QPointF(0, top / 2 / zoom));
 }
 
 void NodeGraphView::frameSelected() {
@@ -1095,13 +764,24 @@ void NodeGraphView::frameSelected() {
   for (const auto& [id, n] : nodes_)
     if (n->isSelected()) r |= n->sceneBoundingRect();
   if (r.isEmpty()) frameAll();
-  else frameRect(r);
+  else frameRect(r, r);
 }
 
 void NodeGraphView::frameAll() {
-  QRectF r;
+  QRectF r, focus;
   for (const auto& [id, n] : nodes_) r |= n->sceneBoundingRect();
-  frameRect(r);
+  // What stays in view when not everything fits: the selection's objects and their materials,
+  // else the graph's selected nodes, else its top-left corner, where the first column starts.
+  for (NodeId id : roots_) {
+    const Object* o = scene_.object(id);
+    for (NodeId n : {id, o ? o->material : kNoNode})
+      if (nodes_.count(n)) focus |= nodes_.at(n)->sceneBoundingRect();
+  }
+  if (focus.isEmpty())
+    for (const auto& [id, n] : nodes_)
+      if (n->isSelected()) focus |= n->sceneBoundingRect();
+  if (focus.isEmpty()) focus = QRectF(r.topLeft(), QSizeF(1, 1));
+  frameRect(r, focus);
 }
 
 void NodeGraphView::showEvent(QShowEvent* e) {
@@ -1230,6 +910,7 @@ void NodeGraphView::mousePressEvent(QMouseEvent* e) {
     return;
   }
   if (e->button() != Qt::LeftButton) return;
+  mouseDown_ = true;  // until this button's release: see followSelection
 
   // Sockets first: they stick out of the node boxes, and a press on one never selects.
   const SocketHit s = socketAt(pressScene_);
@@ -1317,7 +998,7 @@ void NodeGraphView::mouseMoveEvent(QMouseEvent* e) {
         auto it = nodes_.find(id);
         if (it == nodes_.end()) continue;
         it->second->setPos(start + d);
-        positions_[id] = start + d;
+        positions()[id] = start + d;
       }
       updateLinkPaths();
       highlightLink(insertTarget());  // what a release here would do
@@ -1341,6 +1022,7 @@ void NodeGraphView::mouseReleaseEvent(QMouseEvent* e) {
   if (e->button() != dragButton_) return;  // another button than the one dragging: see mousePressEvent
   const Drag d = drag_;
   drag_ = Drag::None;
+  mouseDown_ = false;
   switch (d) {
     case Drag::None:
     case Drag::Pan: break;
@@ -1356,6 +1038,7 @@ void NodeGraphView::mouseReleaseEvent(QMouseEvent* e) {
     }
     case Drag::Marquee: marquee_->hide(); break;
   }
+  if (rootsPending_) followSelection(pendingRoots_);
 }
 
 void NodeGraphView::finishLinkDrag(QPointF scenePos) {

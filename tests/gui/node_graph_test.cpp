@@ -2,22 +2,29 @@
 // link and unlink, keys delete, duplicate, rename, copy and paste, Tab searches and creates. Each
 // requested GraphEdit is applied to a Document (its afters in order) and the graph refreshed, as
 // the main window does; undo is the befores in reverse order.
+#include <QAbstractButton>
 #include <QAction>
+#include <QFontInfo>
 #include <QApplication>
 #include <QGraphicsPathItem>
 #include <QGraphicsRectItem>
 #include <QGraphicsScene>
 #include <QLineEdit>
 #include <QListWidget>
+#include <QPainterPathStroker>
 #include <QSignalSpy>
 #include <QTest>
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <sstream>
 
+#include "editor_support.h"
 #include "node_graph.h"
+#include "retile/io.h"
+#include "test_support.h"
 
 namespace retile::ui {
 namespace {
@@ -135,7 +142,7 @@ class NodeGraph : public ::testing::Test {
   std::vector<GraphEdit> edits;
 };
 
-TEST_F(NodeGraph, LaysOutColumnsShowsAssignmentsAndKeepsMovedNodesWhereTheyAre) {
+TEST_F(NodeGraph, LaysOutWhatFeedsWhatLeftToRightAndKeepsMovedNodesWhereTheyAre) {
   const NodeId checker = named(scene().textures, "Checker");
   const NodeId ground = named(scene().materials, "Ground");
   const NodeId sphere = named(scene().objects, "Glossy Sphere");
@@ -143,11 +150,13 @@ TEST_F(NodeGraph, LaysOutColumnsShowsAssignmentsAndKeepsMovedNodesWhereTheyAre) 
   for (const Object& o : scene().objects) EXPECT_TRUE(view.hasNode(o.id)) << o.name;
   EXPECT_TRUE(view.hasNode(NodeGraphView::kCameraNode));
   EXPECT_TRUE(view.hasNode(NodeGraphView::kSettingsNode));
-  EXPECT_LT(view.nodePosition(checker).x(), view.nodePosition(ground).x()) << "textures | materials";
-  EXPECT_LT(view.nodePosition(ground).x(), view.nodePosition(sphere).x()) << "materials | objects";
-  EXPECT_EQ(view.linkSource(sphere, "material"), scene().object(sphere)->material);
   const NodeId checkered = named(scene().materials, "Checkered");
+  const NodeId lacquer = scene().object(sphere)->material;
+  EXPECT_LT(view.nodePosition(checker).x(), view.nodePosition(checkered).x()) << "a texture left of its material";
+  EXPECT_LT(view.nodePosition(lacquer).x(), view.nodePosition(sphere).x()) << "a material left of its object";
+  EXPECT_EQ(view.linkSource(sphere, "material"), lacquer);
   EXPECT_EQ(view.linkSource(checkered, "albedo"), checker);
+  EXPECT_TRUE(view.hasNode(ground));
 
   // Drag the sphere's node by its header; the link follows and a refresh keeps the place.
   const QPointF before = view.nodePosition(sphere);
@@ -661,7 +670,8 @@ TEST_F(NodeGraph, DroppingANodeOnALinkItFitsInsertsIt) {
   const NodeId checker = named(scene().textures, "Checker");
   const NodeId checkered = named(scene().materials, "Checkered");
   ASSERT_EQ(view.linkSource(checkered, "albedo"), checker);
-  ASSERT_TRUE(view.createNode("Texture", view.nodePosition(checker) + QPointF(0, 200)));  // below it, in the clear
+  // Below it, in the clear.
+  ASSERT_TRUE(view.createNode("Checker Texture", view.nodePosition(checker) + QPointF(0, 200)));
   const NodeId made = scene().textures.back().id;
   drag(body(made), at(linkMiddle(checkered, "albedo")));
   ASSERT_EQ(edits.size(), 3u);
@@ -706,6 +716,258 @@ TEST_F(NodeGraph, DraggingASelectionOverALinkOnlyMovesIt) {
   EXPECT_EQ(describe(scene()), describe(original));
   EXPECT_LT(QLineF(view.mapToScene(body(steel)), view.mapToScene(to)).length(), 4.0);
   EXPECT_NE(view.nodePosition(cup), cupAt) << "the whole selection moved";
+}
+
+// The living room as a new user met it (issue 60, point 12): a window of 1600 x 1000 with the
+// graph in its dock along the bottom, about 230 pixels high.
+class NodeGraphArtist : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    window.resize(1600, 1000);
+    view = new NodeGraphView(&window);
+    view->setGeometry(0, 1000 - 230, 1600, 230);
+  }
+  // False (the test then skips) when ../shared is absent.
+  bool openLivingRoom() {
+    const auto file = retile::test::sharedPath("scenes/living-room/scene.json");
+    if (file.empty()) return false;
+    auto imported = importScene(file);
+    EXPECT_TRUE(imported.ok());
+    if (!imported.ok()) return false;
+    room = imported.value().scene;
+    view->setDocument(room);
+    window.show();
+    EXPECT_TRUE(QTest::qWaitForWindowExposed(&window));
+    return true;
+  }
+  // How tall the nodes' titles are on screen, in pixels (the painter draws them in the view's font).
+  double titlePixels() const { return QFontInfo(view->font()).pixelSize() * view->transform().m11(); }
+  QRectF visible() const { return view->mapToScene(view->viewport()->rect()).boundingRect(); }
+  // Every link's curve keeps off the boxes of the nodes it does not join.
+  void expectNoLinkCrossesANode(const char* where) {
+    QPainterPathStroker stroker;
+    stroker.setWidth(1);
+    int links = 0;
+    for (QGraphicsItem* i : view->scene()->items()) {
+      auto* link = qgraphicsitem_cast<QGraphicsPathItem*>(i);
+      if (!link || !link->isVisible() || link->pen().style() != Qt::SolidLine) continue;
+      ++links;
+      const QPainterPath stroke = stroker.createStroke(link->path());
+      const QPointF ends[] = {link->path().pointAtPercent(0), link->path().pointAtPercent(1)};
+      for (QGraphicsItem* n : view->scene()->items()) {
+        if (n->type() != QGraphicsItem::UserType + 1) continue;
+        const QRectF box = n->mapRectToScene(QRectF(0, 0, 190, n->boundingRect().height() - 4));
+        const QRectF near = box.adjusted(-8, -8, 8, 8);
+        if (near.contains(ends[0]) || near.contains(ends[1])) continue;  // a node the link joins
+        EXPECT_FALSE(stroke.intersects(box)) << where << ": a link from " << ends[0].x() << ", " << ends[0].y()
+                                             << " to " << ends[1].x() << ", " << ends[1].y() << " crosses the node at "
+                                             << box.x() << ", " << box.y();
+      }
+    }
+    EXPECT_GT(links, 0) << where;
+  }
+  // With RETILE_GRAPH_SHOTS=DIR, what the graph shows is saved there for a person to look at.
+  void shoot(const char* name) {
+    if (const char* dir = std::getenv("RETILE_GRAPH_SHOTS"))
+      view->grab().save(QString::fromLocal8Bit(dir) + "/" + name + ".png");
+  }
+
+  QWidget window;
+  NodeGraphView* view = nullptr;
+  Scene room;
+};
+
+// 1. Framing all ~90 nodes shrank their text to 5 pixels: framing stops at a legible zoom.
+TEST_F(NodeGraphArtist, TheLivingRoomsGraphIsLegibleByDefault) {
+  if (!openLivingRoom()) GTEST_SKIP() << "skipped: ../shared/scenes/living-room is not present";
+  shoot("living-room-default");
+  EXPECT_GE(titlePixels(), 9.0) << "as opened";
+  view->frameAll();
+  EXPECT_GE(titlePixels(), 9.0) << "after A";
+  view->setScope(NodeGraphView::Scope::All);
+  EXPECT_GE(titlePixels(), 9.0) << "showing everything";
+  shoot("living-room-all");
+}
+
+// 2. The graph shows what the artist works on: the selection's object, its material and that
+// material's textures and blend partner, legibly, and nothing else to tangle with.
+TEST_F(NodeGraphArtist, TheGraphShowsTheSelectionsMaterialGraph) {
+  if (!openLivingRoom()) GTEST_SKIP() << "skipped: ../shared/scenes/living-room is not present";
+  // An object whose material has a texture and blends with another, if the room has one.
+  const Object* chosen = nullptr;
+  int best = -1;
+  for (const Object& o : room.objects) {
+    const Material* m = room.material(o.material);
+    if (!m) continue;
+    int score = 0;
+    for (NodeId t : m->textures()) score += t != kNoNode ? 1 : 0;
+    score += m->blendWith != kNoNode ? 2 : 0;
+    if (score > best) best = score, chosen = &o;
+  }
+  ASSERT_TRUE(chosen);
+  const Material& material = *room.material(chosen->material);
+  view->followSelection({chosen->id});
+  view->setSelectedObject(chosen->id);
+  shoot("living-room-selection");
+  EXPECT_GE(titlePixels(), 9.0);
+  std::vector<NodeId> expected{chosen->id, material.id};
+  for (NodeId t : material.textures())
+    if (t != kNoNode) expected.push_back(t);
+  if (material.blendWith != kNoNode) expected.push_back(material.blendWith);
+  for (NodeId id : expected) {
+    EXPECT_TRUE(view->hasNode(id)) << id;
+    EXPECT_TRUE(visible().contains(view->nodePosition(id) + QPointF(20, 10))) << id << " is in view";
+  }
+  std::size_t shown = 0;
+  for (QGraphicsItem* i : view->scene()->items()) shown += i->type() == QGraphicsItem::UserType + 1 ? 1 : 0;
+  EXPECT_LE(shown, 12u) << "the neighbourhood, not the room's " << room.objects.size() << " objects";
+  EXPECT_FALSE(view->hasNode(NodeGraphView::kCameraNode));
+
+  expectNoLinkCrossesANode("the selection's graph");
+  // Everything is a click away, and nothing selected shows everything.
+  auto* showAll = view->findChild<QAbstractButton*>("graphShowAll");
+  ASSERT_TRUE(showAll);
+  QTest::mouseClick(showAll, Qt::LeftButton);
+  EXPECT_EQ(view->scope(), NodeGraphView::Scope::All);
+  EXPECT_TRUE(view->hasNode(NodeGraphView::kCameraNode));
+  expectNoLinkCrossesANode("the whole graph");
+  EXPECT_TRUE(visible().contains(view->nodePosition(chosen->id) + QPointF(20, 10))) << "the selection stays in view";
+  view->setScope(NodeGraphView::Scope::Selection);
+  view->followSelection({});
+  for (const Object& o : room.objects) EXPECT_TRUE(view->hasNode(o.id)) << o.name;
+  EXPECT_GE(titlePixels(), 9.0);
+}
+
+// 2. In the editor: picking an object shows its material graph, legibly.
+TEST(NodeGraphInEditor, PickingAnObjectShowsItsMaterialGraph) {
+  auto w = test::makeWindow();
+  w->resize(1600, 1000);
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(w.get()));
+  NodeGraphView* graph = w->graph();
+  const NodeId cup = test::objectNamed(w->scene(), "Cup");
+  const NodeId material = w->scene().object(cup)->material;
+  w->select(cup);
+  const QRectF shown = graph->mapToScene(graph->viewport()->rect()).boundingRect();
+  EXPECT_TRUE(shown.contains(graph->nodePosition(material) + QPointF(20, 10))) << "the cup's material is in view";
+  EXPECT_GE(QFontInfo(graph->font()).pixelSize() * graph->transform().m11(), 9.0);
+  EXPECT_FALSE(graph->hasNode(test::objectNamed(w->scene(), "Glossy Sphere"))) << "another object's node";
+}
+
+// 3. Links ran behind nodes and seemed plugged into whatever socket sat at their height: they
+// are drawn above every node and end at their own sockets.
+TEST_F(NodeGraphArtist, LinksAreDrawnAboveNodesAndEndAtTheirSockets) {
+  if (!openLivingRoom()) GTEST_SKIP() << "skipped: ../shared/scenes/living-room is not present";
+  view->setScope(NodeGraphView::Scope::All);
+  view->selectNodes({room.objects.front().id, room.materials.front().id});  // selected nodes are raised
+  double topNode = -1e9;
+  std::vector<const QGraphicsPathItem*> links;
+  for (QGraphicsItem* i : view->scene()->items()) {
+    if (i->type() == QGraphicsItem::UserType + 1) topNode = std::max(topNode, i->zValue());
+    auto* p = qgraphicsitem_cast<QGraphicsPathItem*>(i);
+    if (p && p->isVisible() && p->pen().style() == Qt::SolidLine) links.push_back(p);
+  }
+  auto drawn = [&](NodeId from, const QString& output, NodeId to, const QString& input) {
+    const QPointF a = view->socketScenePos(from, output, true), b = view->socketScenePos(to, input, false);
+    for (const QGraphicsPathItem* p : links)
+      if (QLineF(p->path().pointAtPercent(0), a).length() < 0.5 &&
+          QLineF(p->path().pointAtPercent(1), b).length() < 0.5)
+        return p;
+    return static_cast<const QGraphicsPathItem*>(nullptr);
+  };
+  int checked = 0;
+  for (const Object& o : room.objects) {
+    if (o.material == kNoNode) continue;
+    const QGraphicsPathItem* p = drawn(o.material, "material", o.id, "material");
+    ASSERT_TRUE(p) << o.name << "'s material link ends at its socket";
+    EXPECT_GT(p->zValue(), topNode) << o.name << "'s material link is drawn above the nodes";
+    ++checked;
+  }
+  for (const Material& m : room.materials)
+    if (m.albedoTexture != kNoNode && m.type != MaterialType::Boundary) {
+      const QGraphicsPathItem* p = drawn(m.albedoTexture, "texture", m.id, "albedo");
+      ASSERT_TRUE(p) << m.name << "'s albedo link";
+      EXPECT_GT(p->zValue(), topNode);
+      ++checked;
+    }
+  EXPECT_GT(checked, 20);
+}
+
+// 4. The Tab list was cut off at the window's bottom: it opens within the window.
+TEST_F(NodeGraphArtist, TheNodeSearchStaysInsideTheWindow) {
+  Document doc{makeDefaultScene()};
+  view->setDocument(doc.scene());
+  window.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&window));
+  const QRect inside = window.frameGeometry();
+  const QRect vp = view->viewport()->rect();
+  for (QPoint corner : {vp.bottomLeft() + QPoint(4, -4), vp.bottomRight() + QPoint(-4, -4), vp.center()}) {
+    view->openNodeSearch(view->mapToScene(corner));
+    auto* search = view->findChild<QLineEdit*>("nodeSearch");
+    ASSERT_TRUE(search && search->isVisible());
+    QWidget* popup = search->window();
+    const QRect spans = popup->frameGeometry();
+    EXPECT_TRUE(inside.contains(spans)) << "opened at " << corner.x() << ", " << corner.y() << ": the list spans "
+                                        << spans.x() << ", " << spans.y() << " to " << spans.right() << ", "
+                                        << spans.bottom();
+    auto* list = view->findChild<QListWidget*>("nodeSearchList");
+    ASSERT_TRUE(list);
+    int rows = 0;
+    for (int i = 0; i < list->count(); ++i) rows += list->item(i)->isHidden() ? 0 : 1;
+    EXPECT_GE(list->viewport()->height(), rows * list->sizeHintForRow(0)) << "every entry shows without scrolling";
+    popup->hide();
+  }
+}
+
+// A click on an object's node selects the object in the editor, which answers with the selection;
+// the graph shows the object's material graph once the button is up, not under the mouse.
+TEST_F(NodeGraph, AClickedObjectsGraphIsShownWhenTheButtonIsUp) {
+  QObject::connect(&view, &NodeGraphView::objectSelected, &view, [this](quint64 id) {
+    view.followSelection({static_cast<NodeId>(id)});  // what MainWindow::applySelection does
+    view.setSelectedObject(static_cast<NodeId>(id));
+  });
+  const NodeId sphere = named(scene().objects, "Glossy Sphere");
+  const NodeId cup = named(scene().objects, "Cup");
+  const QPoint from = header(sphere);
+  QTest::mousePress(vp(), Qt::LeftButton, {}, from);
+  QTest::mouseMove(vp(), from + QPoint(30, 20));
+  EXPECT_TRUE(view.hasNode(cup)) << "nothing rebuilt under the mouse";
+  QTest::mouseRelease(vp(), Qt::LeftButton, {}, from + QPoint(30, 20));
+  EXPECT_FALSE(view.hasNode(cup));
+  EXPECT_TRUE(view.hasNode(scene().object(sphere)->material));
+  EXPECT_EQ(view.selectedNodes(), std::vector<NodeId>{sphere});
+  // Made while the sphere's graph is shown, a node joins it; a new selection starts afresh.
+  ASSERT_TRUE(view.createNode("Checker Texture", view.mapToScene(vp()->rect().center())));
+  const NodeId made = scene().textures.back().id;
+  EXPECT_TRUE(view.hasNode(made));
+  view.followSelection({cup});
+  EXPECT_FALSE(view.hasNode(made));
+  EXPECT_FALSE(view.hasNode(sphere));
+  EXPECT_TRUE(view.hasNode(cup));
+}
+
+// 5. "checker" found nothing, though "Texture" made a checker: the search knows what each entry makes.
+TEST_F(NodeGraph, TheSearchFindsANodeByWhatItMakes) {
+  const std::size_t textures = scene().textures.size();
+  QTest::keyClick(&view, Qt::Key_Tab);
+  auto* search = view.findChild<QLineEdit*>("nodeSearch");
+  auto* list = view.findChild<QListWidget*>("nodeSearchList");
+  ASSERT_TRUE(search && list);
+  auto matches = [&](const char* text) {
+    search->clear();
+    QTest::keyClicks(search, text);
+    QStringList shown;
+    for (int i = 0; i < list->count(); ++i)
+      if (!list->item(i)->isHidden()) shown << list->item(i)->text();
+    return shown;
+  };
+  EXPECT_EQ(matches("sun").size(), 1) << "a synonym: the directional light";
+  EXPECT_EQ(matches("LAMP").size(), 3) << "every light, whatever the case";
+  EXPECT_EQ(matches("tex").size(), 1);
+  const QStringList checker = matches("checker");
+  ASSERT_EQ(checker.size(), 1) << "the texture the entry makes is a checker";
+  QTest::keyClick(search, Qt::Key_Return);
+  ASSERT_EQ(scene().textures.size(), textures + 1);
+  EXPECT_EQ(scene().textures.back().kind, TextureKind::Checker);
 }
 
 }  // namespace
