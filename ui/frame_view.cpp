@@ -452,8 +452,7 @@ std::vector<FrameView::LegendItem> FrameView::legendItems(bool everything) const
     if (everything || !f.focus.empty()) items.push_back({K::Circle, kFocusColor, tr("focus point")});
   }
   if (overlays_.classes && (everything || !f.tileClass.empty())) {
-    const QString what[3] = {tr("high: the selection seen, or reflected strongly"), tr("middle: its reflections and shadows"),
-                             tr("low: faint traces of it")};
+    const QString what[3] = {tr("high: seen, or strongly reflected"), tr("middle: reflections, shadows"), tr("low: faint traces")};
     for (int c = 0; c < 3; ++c)
       if (everything || std::find(f.tileClass.begin(), f.tileClass.end(), c) != f.tileClass.end())
         items.push_back({K::Hatch, kClassColor[c], what[c]});
@@ -461,7 +460,7 @@ std::vector<FrameView::LegendItem> FrameView::legendItems(bool everything) const
   if (overlays_.order && (everything || f.queueLength > 1)) items.push_back({K::None, Qt::white, tr("numbers: place in the queue")});
   if (overlays_.samples) items.push_back({K::None, QColor(180, 255, 180), tr("numbers: samples per pixel")});
   if (overlays_.denoised && (everything || !f.denoised.empty()))
-    items.push_back({K::Dashed, kDenoisedColor, tr("denoised region, labelled frames since (newest brightest)")});
+    items.push_back({K::Dashed, kDenoisedColor, tr("denoised region (frames since)")});
   if (overlays_.reuse && (everything || f.reusedTiles > 0))
     items.push_back({K::Corner, kReusedColor, tr("%n tile(s) reusing their history", nullptr, everything ? 9999 : f.reusedTiles)});
   if (overlays_.reuse && (everything || f.rejectedTiles > 0))
