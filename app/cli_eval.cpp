@@ -322,7 +322,7 @@ int runEval(const EvalOptions& o) {
       // Not reached: a hollow square at the run's length, a bound (the legend says so; the plot's
       // labels stay short so that neighbours' can share one).
       tradeoff.push_back({QString::fromStdString(run.method), QString::fromStdString(run.method + (reached ? "" : " (not reached)")),
-                          QPointF(x, at10), !reached});
+                          QPointF(x, at10), reached});
     }
     const QString title = QString::fromStdString(cat(r.scene, ": ", r.scenario.name));
     const QString timeAxis = QStringLiteral("wall clock since the first edit (ms)");

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "frame_view.h"
 #include "retile/log.h"
@@ -48,16 +49,21 @@ void fitAxis(QAbstractAxis* axis, double lo, double hi, bool log) {
   v->applyNiceNumbers();
 }
 
-Result<bool> writeChart(QChart* chart, const std::filesystem::path& base) {
-  QChartView view(chart);  // owns the chart from here
-  view.setRenderHint(QPainter::Antialiasing);
+std::unique_ptr<QChartView> laidOut(QChart* chart) {
+  auto view = std::make_unique<QChartView>(chart);  // owns the chart from here
+  view->setRenderHint(QPainter::Antialiasing);
   // The chart lays itself out when its view is shown and resized; shown off screen, never drawn
   // to a display.
-  view.setAttribute(Qt::WA_DontShowOnScreen);
-  view.resize(kChartSize);
-  view.show();
+  view->setAttribute(Qt::WA_DontShowOnScreen);
+  view->resize(kChartSize);
+  view->show();
   chart->resize(kChartSize);
   QCoreApplication::processEvents();
+  return view;
+}
+
+Result<bool> writeChart(QChartView& view, const std::filesystem::path& base) {
+  QChart* chart = view.chart();
   const QString png = QString::fromStdString(base.string() + ".png");
   const QString svg = QString::fromStdString(base.string() + ".svg");
   QImage image(kChartSize, QImage::Format_RGB32);
@@ -101,8 +107,8 @@ QChart* newChart(const QString& title) {
 
 }  // namespace
 
-Result<bool> writeLineChart(const std::filesystem::path& base, const QString& title, const QString& xTitle,
-                            const QString& yTitle, const std::vector<ChartLine>& lines, bool logX) {
+std::unique_ptr<QChartView> lineChartView(const QString& title, const QString& xTitle, const QString& yTitle,
+                                          const std::vector<ChartLine>& lines, bool logX) {
   QChart* chart = newChart(title);
   QAbstractAxis* x = logX ? static_cast<QAbstractAxis*>(new QLogValueAxis) : new QValueAxis;
   auto* y = new QValueAxis;
@@ -132,11 +138,11 @@ Result<bool> writeLineChart(const std::filesystem::path& base, const QString& ti
   }
   fitAxis(x, xlo, xhi, logX);
   fitAxis(y, ylo, yhi, false);
-  return writeChart(chart, base);
+  return laidOut(chart);
 }
 
-Result<bool> writePointChart(const std::filesystem::path& base, const QString& title, const QString& xTitle,
-                             const QString& yTitle, const std::vector<ChartPoint>& points) {
+std::unique_ptr<QChartView> pointChartView(const QString& title, const QString& xTitle, const QString& yTitle,
+                                           const std::vector<ChartPoint>& points) {
   QChart* chart = newChart(title);
   auto* x = new QValueAxis;
   auto* y = new QValueAxis;
@@ -171,7 +177,7 @@ Result<bool> writePointChart(const std::filesystem::path& base, const QString& t
     if (!std::isfinite(p.at.x()) || !std::isfinite(p.at.y())) continue;
     auto* s = new QScatterSeries;
     s->setColor(seriesColor(i));
-    if (p.hollow) {
+    if (!p.reached) {  // an empty square: a bound, not a measurement
       s->setMarkerShape(QScatterSeries::MarkerShapeRectangle);
       s->setBrush(Qt::NoBrush);
       s->setPen(QPen(seriesColor(i), 2));
@@ -189,7 +195,17 @@ Result<bool> writePointChart(const std::filesystem::path& base, const QString& t
   fitAxis(x, std::min(xlo, 0.0), xhi, false);
   static_cast<QValueAxis*>(x)->setMin(0);  // times are never negative
   fitAxis(y, ylo, yhi, false);
-  return writeChart(chart, base);
+  return laidOut(chart);
+}
+
+Result<bool> writeLineChart(const std::filesystem::path& base, const QString& title, const QString& xTitle,
+                            const QString& yTitle, const std::vector<ChartLine>& lines, bool logX) {
+  return writeChart(*lineChartView(title, xTitle, yTitle, lines, logX), base);
+}
+
+Result<bool> writePointChart(const std::filesystem::path& base, const QString& title, const QString& xTitle,
+                             const QString& yTitle, const std::vector<ChartPoint>& points) {
+  return writeChart(*pointChartView(title, xTitle, yTitle, points), base);
 }
 
 QImage frameWithOverlays(const FrameRecord& frame, int scale) {

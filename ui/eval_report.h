@@ -3,11 +3,13 @@
 // QApplication (the offscreen platform will do); GUI thread only.
 #pragma once
 
+#include <QChartView>
 #include <QImage>
 #include <QPointF>
 #include <QString>
 
 #include <filesystem>
+#include <memory>
 #include <vector>
 
 #include "retile/error.h"
@@ -24,7 +26,7 @@ struct ChartPoint {
   QString label;        // on the plot (points that would overlap share one label)
   QString legend;       // in the legend; empty: the label
   QPointF at;
-  bool hollow = false;  // drawn as an empty square: a bound, not a measurement (never reached)
+  bool reached = true;  // false: `at`'s x is a bound (the run's length), not a time measured
 };
 
 // Writes `base`.png and `base`.svg: a line per entry (error against time, one per method).
@@ -33,6 +35,13 @@ Result<bool> writeLineChart(const std::filesystem::path& base, const QString& ti
 // The same with one labelled point per entry (the speed-against-accuracy chart).
 Result<bool> writePointChart(const std::filesystem::path& base, const QString& title, const QString& xTitle,
                              const QString& yTitle, const std::vector<ChartPoint>& points);
+
+// The same charts laid out at the report's size in a view never shown on screen, for a test to
+// look at what the files would show.
+std::unique_ptr<QChartView> lineChartView(const QString& title, const QString& xTitle, const QString& yTitle,
+                                          const std::vector<ChartLine>& lines, bool logX = false);
+std::unique_ptr<QChartView> pointChartView(const QString& title, const QString& xTitle, const QString& yTitle,
+                                           const std::vector<ChartPoint>& points);
 
 // A frame as the viewport shows it with the tile overlays (served tiles, priorities, markers,
 // denoised regions), `scale` times the image size, without the legend.
