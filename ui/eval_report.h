@@ -6,6 +6,8 @@
 #include <QChartView>
 #include <QImage>
 #include <QPointF>
+#include <QRectF>
+#include <QSizeF>
 #include <QString>
 
 #include <filesystem>
@@ -23,11 +25,27 @@ struct ChartLine {
 };
 
 struct ChartPoint {
-  QString label;        // on the plot (points that would overlap share one label)
-  QString legend;       // in the legend; empty: the label
+  QString label;        // on the plot (points drawn at one spot share one label)
+  QString legend;       // in the legend; empty: the label, with "(not reached)" when not reached
   QPointF at;
-  bool reached = true;  // false: `at`'s x is a bound (the run's length), not a time measured
+  // false: `at`'s x is a bound (the run's length), not a time measured; the point is drawn in a
+  // "not reached" band beyond the times, and its x only sizes the time axis when nothing reached.
+  bool reached = true;
 };
+
+// A label to place beside the point it names (a chart marker centred at `anchor`), `size` big,
+// within `bounds`.
+struct LabelRequest {
+  QPointF anchor;
+  QSizeF size;
+  QRectF bounds;
+};
+
+// Boxes for `labels`, in order: each the first spot going round its point and ever farther out
+// (right, left, above, below, then the diagonals) that stays within its bounds and clear of the
+// boxes placed before it and of `obstacles` (the markers); failing that, the spot that overlaps
+// least. The same every run, so that the report's charts are.
+std::vector<QRectF> placeLabels(const std::vector<LabelRequest>& labels, const std::vector<QRectF>& obstacles);
 
 // Writes `base`.png and `base`.svg: a line per entry (error against time, one per method).
 Result<bool> writeLineChart(const std::filesystem::path& base, const QString& title, const QString& xTitle,
