@@ -3,11 +3,15 @@
 // QApplication (the offscreen platform will do); GUI thread only.
 #pragma once
 
+#include <QChartView>
 #include <QImage>
 #include <QPointF>
+#include <QRectF>
+#include <QSizeF>
 #include <QString>
 
 #include <filesystem>
+#include <memory>
 #include <vector>
 
 #include "retile/error.h"
@@ -21,11 +25,27 @@ struct ChartLine {
 };
 
 struct ChartPoint {
-  QString label;        // on the plot (points that would overlap share one label)
-  QString legend;       // in the legend; empty: the label
+  QString label;        // on the plot (points drawn at one spot share one label)
+  QString legend;       // in the legend; empty: the label, with "(not reached)" when not reached
   QPointF at;
-  bool hollow = false;  // drawn as an empty square: a bound, not a measurement (never reached)
+  // false: `at`'s x is a bound (the run's length), not a time measured; the point is drawn in a
+  // "not reached" band beyond the times, and its x only sizes the time axis when nothing reached.
+  bool reached = true;
 };
+
+// A label to place beside the point it names (a chart marker centred at `anchor`), `size` big,
+// within `bounds`.
+struct LabelRequest {
+  QPointF anchor;
+  QSizeF size;
+  QRectF bounds;
+};
+
+// Boxes for `labels`, in order: each the first spot going round its point and ever farther out
+// (right, left, above, below, then the diagonals) that stays within its bounds and clear of the
+// boxes placed before it and of `obstacles` (the markers); failing that, the spot that overlaps
+// least. The same every run, so that the report's charts are.
+std::vector<QRectF> placeLabels(const std::vector<LabelRequest>& labels, const std::vector<QRectF>& obstacles);
 
 // Writes `base`.png and `base`.svg: a line per entry (error against time, one per method).
 Result<bool> writeLineChart(const std::filesystem::path& base, const QString& title, const QString& xTitle,
@@ -33,6 +53,13 @@ Result<bool> writeLineChart(const std::filesystem::path& base, const QString& ti
 // The same with one labelled point per entry (the speed-against-accuracy chart).
 Result<bool> writePointChart(const std::filesystem::path& base, const QString& title, const QString& xTitle,
                              const QString& yTitle, const std::vector<ChartPoint>& points);
+
+// The same charts laid out at the report's size in a view never shown on screen, for a test to
+// look at what the files would show.
+std::unique_ptr<QChartView> lineChartView(const QString& title, const QString& xTitle, const QString& yTitle,
+                                          const std::vector<ChartLine>& lines, bool logX = false);
+std::unique_ptr<QChartView> pointChartView(const QString& title, const QString& xTitle, const QString& yTitle,
+                                           const std::vector<ChartPoint>& points);
 
 // A frame as the viewport shows it with the tile overlays (served tiles, priorities, markers,
 // denoised regions), `scale` times the image size, without the legend.

@@ -262,14 +262,16 @@ TEST(Cli, EvalQuickWritesTheReportAndCachesReferences) {
     auto img = readImageRaw(e.path());
     ASSERT_TRUE(img.ok()) << img.error();
     // Text and grid are grey; the methods' lines and points are the only colour. A line chart
-    // has thousands of such pixels, the speed-against-accuracy chart 550 to 700 (its points
-    // overlap more or less as the timings fall); a chart drawn without its layout (a view never
-    // shown) shrinks into a corner of the page.
+    // has thousands of such pixels, the speed-against-accuracy chart 300 to 600 and under a
+    // hundred when no method reached the target (their empty squares one over the other in the
+    // "not reached" band, one square's outline about 80); a chart drawn without its layout (a
+    // view never shown) shrinks into a corner of the page.
     std::size_t coloured = 0;
     for (std::size_t i = 0; i < img->rgba.size(); i += 4)
       coloured += std::max({std::abs(img->rgba[i] - img->rgba[i + 1]), std::abs(img->rgba[i + 1] - img->rgba[i + 2]),
                             std::abs(img->rgba[i] - img->rgba[i + 2])}) > 0.25f;
-    EXPECT_GT(coloured, 250u) << e.path() << ": methods drawn, not a blank chart";
+    const bool tradeoff = e.path().stem().string().ends_with("-tradeoff");
+    EXPECT_GT(coloured, tradeoff ? 60u : 250u) << e.path() << ": methods drawn, not a blank chart";
   }
   EXPECT_EQ(charts, 9);
   EXPECT_TRUE(std::filesystem::exists(out / "strips" / "default-fig6.png"));
