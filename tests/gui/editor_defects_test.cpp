@@ -236,6 +236,8 @@ TEST(EditorDefects, TheLegendExplainsWhatIsDrawnAndNothingElse) {
   OverlaySettings o;
   o.priority = false;
   o.legend = true;
+  o.denoised = false;  // its key is a saturated orange too
+  o.reuse = false;
   v->setOverlays(o);
   v->showFrame(inPass);
   using Key = FrameView::LegendItem::Key;
@@ -326,7 +328,7 @@ TEST(EditorDefects, TheRenderSettingsFitAndQHasAnAutoSwitch) {
   EXPECT_TRUE(qAuto->isEnabled());
   qAuto->setChecked(true);
   EXPECT_FALSE(q->isEnabled());
-  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.method == "indirection"; }));
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.method == "indirection+denoise"; }));
   qAuto->setChecked(false);
   EXPECT_FALSE(q->keyboardTracking()) << "a typed value applies on Enter";
 }
@@ -377,6 +379,7 @@ TEST(EditorDefects, SaveAsHasItsShortcutAndTheTitleShowsTheFileAndChanges) {
 TEST(EditorDefects, AfterNewTheImageFillsTheViewport) {
   EditorOptions o;  // the render size follows the viewport
   o.renderScale = 4;
+  o.cameraFraming = false;
   auto w = std::make_unique<MainWindow>(makeDefaultScene(), std::filesystem::path(), o);
   w->resize(1200, 640);
   w->show();
@@ -386,11 +389,11 @@ TEST(EditorDefects, AfterNewTheImageFillsTheViewport) {
   QTest::keyClick(w.get(), Qt::Key_N, Qt::ControlModifier);  // a new document
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
   FrameView* v = w->viewport();
-  const double viewAspect = static_cast<double>(v->width()) / v->height();
+  const double viewAspect = v->imageArea().width() / v->imageArea().height();
   const double imageAspect = static_cast<double>(v->frame()->width) / v->frame()->height;
   EXPECT_NEAR(imageAspect, viewAspect, 0.05 * viewAspect) << "the image has the viewport's shape";
-  EXPECT_GT(v->imageRect().width(), 0.97 * v->width());
-  EXPECT_GT(v->imageRect().height(), 0.97 * v->height());
+  EXPECT_GT(v->imageRect().width(), 0.97 * v->imageArea().width());
+  EXPECT_GT(v->imageRect().height(), 0.97 * v->imageArea().height());
 }
 
 // 15. The live chart was cramped: labels "...", plots about 40 px tall.

@@ -210,7 +210,7 @@ TEST(Editor, ReuseReachesTheEngineAndTheOverlayShowsReusedAndRejectedTiles) {
   auto* reuse = w->findChild<QCheckBox*>("reuse");
   ASSERT_TRUE(reuse);
   reuse->setChecked(true);
-  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.method == "spiral+reuse" && f.mode == "refinement"; }));
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.method == "spiral+reuse+denoise" && f.mode == "refinement"; }));
   // Let the picture converge a little, then recolour the cup: its tiles disagree with their
   // history, most of the rest agree.
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 40; }));
@@ -251,6 +251,8 @@ TEST(Editor, TheDenoiseSettingsReachTheEngineAndTheRegionBoundariesDraw) {
   auto* denoise = w->findChild<QCheckBox*>("denoise");
   auto* threshold = w->findChild<QSpinBox*>("denoiseThreshold");
   ASSERT_TRUE(denoise && threshold);
+  EXPECT_TRUE(denoise->isChecked()) << "the editor denoises by default";
+  denoise->setChecked(false);
   EXPECT_FALSE(threshold->isEnabled()) << "the threshold goes with the denoiser";
   threshold->setValue(16);
   denoise->setChecked(true);
@@ -1277,7 +1279,7 @@ TEST(Editor, TheIndirectionClassesOverlayShowsTheClassesOfTheSelectedObject) {
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
   w->select(sphere);
   // The counters are gathered over a few frames; then an edit plans the classes.
-  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.method == "indirection" && f.frame >= 8; }));
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.method == "indirection+denoise" && f.frame >= 8; }));
   Object o = *w->scene().object(sphere), moved = o;
   moved.transform = Mat4::translate({0.02f, 0, 0}) * o.transform;
   w->edit(SetObject{o}, SetObject{moved}, "move");
