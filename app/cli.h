@@ -26,6 +26,8 @@ void addEdit(CLI::App& app, int* status);
 void addEval(CLI::App& app, int* status);
 void addCompare(CLI::App& app, int* status);
 void addImport(CLI::App& app, int* status);
+// `retile bench frames` and `retile bench rest`, under `bench` (cli_bench_editor.cpp).
+void addEditorBenches(CLI::App& bench, int* status);
 void addBench(CLI::App& app, int* status);  // bench throughput, bvh, edit, frames, denoise, scale
 
 // The Qt editor on `file` ("" or "default": the built-in scene). Needs a display.

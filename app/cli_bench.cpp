@@ -434,68 +434,6 @@ int benchDenoise(const DenoiseOptions& o) {
   return 0;
 }
 
-// Frames per second of the render thread as the editor drives it (Engine, newest frame to the
-// mailbox), at rest or while an object is dragged (one move submitted per published frame), for
-// `--seconds` after one second of warm-up.
-struct FramesOptions {
-  std::string scene;
-  ImageSize size{240, 135};
-  int seconds = 5;
-  std::string method = methodName(MethodSettings{}.kind);
-  bool drag = false;
-  std::optional<std::string> object;
-};
-
-int benchFrames(const FramesOptions& opt) {
-  auto loaded = loadScene(opt.scene);
-  if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
-  Scene scene = loaded->scene;
-  scene.settings.width = opt.size.width;
-  scene.settings.height = opt.size.height;
-  const int seconds = opt.seconds;
-  MethodSettings method;
-  methodFromName(opt.method, &method.kind);  // checked by the option
-  const bool drag = opt.drag;
-  NodeId dragged = kNoNode;
-  for (const Object& o : scene.objects)
-    if (dragged == kNoNode && (!opt.object || o.name == *opt.object)) dragged = o.id;
-  if (drag && dragged == kNoNode) return std::fprintf(stderr, "error: no object to drag\n"), 1;
-  Object moving = dragged != kNoNode ? *scene.object(dragged) : Object{};
-
-  EngineOptions options;
-  options.maxSamplesPerPixel = 0;  // refine for ever: frames must keep coming
-  Engine engine(scene, method, options);
-  engine.start();
-  std::uint64_t seen = 0, version = 0;
-  auto pump = [&](Clock::time_point until) {
-    while (Clock::now() < until) {
-      auto f = engine.latestFrame();
-      if (f && f->frame != seen) {
-        seen = f->frame;
-        if (drag) {
-          moving.transform = Mat4::translate({0.002f, 0, 0}) * moving.transform;
-          engine.submit(SetObject{moving}, ++version);
-        }
-      }
-      std::this_thread::sleep_for(std::chrono::microseconds(200));
-    }
-  };
-  pump(Clock::now() + std::chrono::seconds(1));
-  std::uint64_t first = engine.framesRendered();
-  auto start = Clock::now();
-  pump(start + std::chrono::seconds(seconds));
-  double s = std::chrono::duration<double>(Clock::now() - start).count();
-  std::uint64_t frames = engine.framesRendered() - first;
-  engine.stop();
-  for (const auto& e : engine.takeErrors())
-    if (e.rfind("warning: ", 0) != 0) return std::fprintf(stderr, "error: %s\n", e.c_str()), 1;
-  std::printf("scene          %s at %dx%d, %s%s\n", opt.scene.c_str(), scene.settings.width,
-              scene.settings.height, methodName(method.kind), drag ? ", dragging an object every frame" : ", at rest");
-  std::printf("frames/s       %.2f (%llu frames in %.1f s)\n", static_cast<double>(frames) / s,
-              static_cast<unsigned long long>(frames), s);
-  return 0;
-}
-
 }  // namespace
 
 void addBench(CLI::App& app, int* status) {
@@ -532,21 +470,7 @@ void addBench(CLI::App& app, int* status) {
   cmd->add_option("--scene", *editScene, "time the edits on this scene's first visible object instead")->type_name("SCENE");
   cmd->callback([edits, editScene, status] { *status = editScene->empty() ? benchEdit(*edits) : benchEditScene(*editScene, *edits); });
 
-  cmd = bench->add_subcommand(
-      "frames", "The editor's frames/s (render thread and mailbox), at rest or while an object is dragged");
-  auto frames = std::make_shared<FramesOptions>();
-  addScene(*cmd, &frames->scene);
-  addSize(*cmd, &frames->size, "image size");
-  addInt(*cmd, "--seconds", &frames->seconds, 1, 3600, "time measured, after one second of warm-up");
-  std::string methods;
-  for (const auto& n : methodNames()) methods += (methods.empty() ? "" : ", ") + n;
-  cmd->add_option("--method", frames->method,
-                  "the re-rendering method: " + methods + " (default: " + frames->method + ")")
-      ->type_name("NAME")
-      ->check(oneOf("method", methodNames()));
-  cmd->add_flag("--drag", frames->drag, "move an object a little on every frame shown");
-  cmd->add_option("--object", frames->object, "with --drag: the object moved (default: the first)")->type_name("NAME");
-  cmd->callback([frames, status] { *status = benchFrames(*frames); });
+  addEditorBenches(*bench, status);
 
   cmd = bench->add_subcommand("denoise", "The denoiser's cost against a frame of 1 spp, pass by pass");
   auto denoise = std::make_shared<DenoiseOptions>();
