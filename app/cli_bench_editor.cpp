@@ -60,12 +60,23 @@ struct FramesOptions {
   std::optional<std::string> object;
 };
 
+// The scene at the size the benchmark renders; nullopt (said on stderr) when it cannot be read.
+std::optional<Scene> sceneAt(const std::string& file, ImageSize size) {
+  auto loaded = loadScene(file);
+  if (!loaded) {
+    std::fprintf(stderr, "error: %s\n", loaded.error().c_str());
+    return std::nullopt;
+  }
+  Scene scene = std::move(loaded->scene);
+  scene.settings.width = size.width;
+  scene.settings.height = size.height;
+  return scene;
+}
+
 int benchFrames(const FramesOptions& opt) {
-  auto loaded = loadScene(opt.scene);
-  if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
-  Scene scene = loaded->scene;
-  scene.settings.width = opt.size.width;
-  scene.settings.height = opt.size.height;
+  std::optional<Scene> read = sceneAt(opt.scene, opt.size);
+  if (!read) return 1;
+  const Scene& scene = *read;
   NodeId dragged = kNoNode;
   for (const Object& o : scene.objects)
     if (dragged == kNoNode && (!opt.object || o.name == *opt.object)) dragged = o.id;
@@ -121,11 +132,9 @@ struct RestOptions {
 // `seconds`: how soon the pass at full resolution is done, how many samples the material's pixels
 // then hold, and the picture as the editor shows it (PNG) to judge.
 int benchRest(const RestOptions& opt) {
-  auto loaded = loadScene(opt.scene);
-  if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
-  Scene scene = loaded->scene;
-  scene.settings.width = opt.size.width;
-  scene.settings.height = opt.size.height;
+  std::optional<Scene> read = sceneAt(opt.scene, opt.size);
+  if (!read) return 1;
+  const Scene& scene = *read;
   const Material* found = nullptr;
   for (const Material& m : scene.materials)
     if (m.name == opt.material) found = &m;

@@ -6,7 +6,7 @@
 # minutes apart do not compare; the two runs of a round see nearly the same machine. The order
 # alternates (AB, BA, AB, ...) so that a drift within a round does not favour one binary. The
 # standard error assumes rounds independent, which the drift makes only roughly true: take
-# differences under about three standard errors as noise (docs/MEASUREMENTS.md).
+# differences under about three standard errors as noise.
 #
 # usage: scripts/ab-throughput.sh BIN_A BIN_B ROUNDS SCENE [retile bench throughput options]
 # e.g.   scripts/ab-throughput.sh /tmp/retile-before build/bin/retile 8 \

@@ -3,7 +3,7 @@
 # surfaces (such as the Cornell box), to tell which of two renderers that disagree is right.
 #
 # Why it exists: our renders and Tungsten's reference of the Cornell box differ by about 1 % on
-# the ceiling beside the light, beyond both renderers' noise (docs/MEASUREMENTS.md), and two
+# the ceiling beside the light, beyond both renderers' noise, and two
 # renderers cannot say which of them is off. This one shares no code with either: a brute-force
 # CPU path tracer (every ray against every triangle, numpy), next-event estimation only (a point
 # on an emitter chosen by area; emission met by a bounce is not counted, so there is no MIS to

@@ -22,7 +22,7 @@ packages=(
   libgtest-dev libgmock-dev
   libcli11-dev
   clang libclang-rt-14-dev
-  locales
+  locales time
   xvfb xauth libxkbcommon-x11-0 libxcb-cursor0 libxcb-icccm4 libxcb-image0 libxcb-keysyms1
   libxcb-randr0 libxcb-render-util0 libxcb-shape0 libxcb-xinerama0 libxcb-xkb1 fonts-dejavu-core
 )

@@ -8,7 +8,7 @@
 // between two tiles of one kind (raw and raw, or two regions' results in the one layer), a pixel
 // has one value of that kind, so its mirror image across the seam stands in. (The mirror image at
 // raw-to-layer seams too put other places' content beside them: with the change method's scattered
-// fresh tiles it doubled the error, docs/MEASUREMENTS.md.) One invocation per pixel of the image.
+// fresh tiles it doubled the error.) One invocation per pixel of the image.
 #extension GL_GOOGLE_include_directive : require
 
 #include "shared/layouts.h"

@@ -7,7 +7,7 @@
 //
 // The kernel is the 3x3 B-spline (1/4, 1/2, 1/4), not SVGF's 5x5: on lavapipe a tap costs the same
 // whatever its weight, and the 5x5's 24 taps made each iteration 2.5 times as costly for an
-// error at 4 spp lower by a tenth (docs/MEASUREMENTS.md). Taps past the domain's edge are clamped
+// error at 4 spp lower by a tenth. Taps past the domain's edge are clamped
 // onto it (its edge pixels weigh more there) rather than tested and dropped, and the three
 // edge-stopping terms share one exp2, with SVGF's cos^128 normal weight as exp(-128 (1 - cos)):
 // both agree to within a few per cent where either weight matters.

@@ -64,7 +64,7 @@ float filterOffset(float u) {
   if (hasFeature(kFeatureFilterTungstenTent) && tent < 0.0 && frame.filterWarp[8].z > 0.0) {
     // As below, with the step found without the table: its search (seven reads a side, each a
     // call over the eight lanes, in every lane of every pass) cost the spaceship about 5 % of its
-    // samples/s (docs/MEASUREMENTS.md). The CDF is tungstenTentCdf's, equal to the table's up to
+    // samples/s. The CDF is tungstenTentCdf's, equal to the table's up to
     // its float sums' rounding.
     bool negative = u < 0.5;
     float xi = negative ? 2.0 * u : 2.0 * u - 1.0;

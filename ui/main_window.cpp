@@ -46,6 +46,7 @@
 #include "edit_command.h"
 #include "fields.h"
 #include "live_chart.h"
+#include "method_panel.h"
 #include "node_graph.h"
 #include "retile/color.h"
 #include "vulkan_viewport.h"
@@ -82,13 +83,15 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
   connect(view_, &FrameView::objectPicked, this, [this](quint64 id) { select(static_cast<NodeId>(id)); });
   connect(view_, &FrameView::objectToggled, this, [this](quint64 id) { toggleSelected(static_cast<NodeId>(id)); });
   connect(view_, &FrameView::focusPlaced, this, [this](QPointF p) {
-    if (focusModeBox_->currentIndex() == 2) return;  // the cursor places it
-    const bool follows = focusModeBox_->currentIndex() == 1;
+    if (methodPanel_->focusMode() == MethodPanel::FocusMode::Cursor) return;  // the cursor places it
+    const bool follows = methodPanel_->focusMode() == MethodPanel::FocusMode::Follows;
     // Up to three points: a fourth replaces the oldest.
-    if (method_.focus.size() >= 3) method_.focus.erase(method_.focus.begin());
-    method_.focus.push_back(FocusPoint{Vec2{static_cast<float>(p.x()), static_cast<float>(p.y())}, follows});
-    engine_->submit(FocusCommand{method_.focus});
-    log(tr("focus point %1 at %2, %3%4").arg(method_.focus.size()).arg(p.x(), 0, 'f', 0).arg(p.y(), 0, 'f', 0)
+    std::vector<FocusPoint> focus = methodPanel_->settings().focus;
+    if (focus.size() >= 3) focus.erase(focus.begin());
+    focus.push_back(FocusPoint{Vec2{static_cast<float>(p.x()), static_cast<float>(p.y())}, follows});
+    methodPanel_->setFocus(focus);
+    engine_->submit(FocusCommand{focus});
+    log(tr("focus point %1 at %2, %3%4").arg(focus.size()).arg(p.x(), 0, 'f', 0).arg(p.y(), 0, 'f', 0)
             .arg(follows ? tr(", following the object") : QString()));
   });
   connect(view_, &FrameView::pixelInspected, this, [this](QPoint px, QVector3D c) {
@@ -96,10 +99,10 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
                      .arg(c.x(), 0, 'f', 4).arg(c.y(), 0, 'f', 4).arg(c.z(), 0, 'f', 4);
     inspector_->setText(pixelText_ + (regionText_.isEmpty() ? QString() : "\n\n" + regionText_));
     // An eye-tracker stand-in: the focus point follows the cursor, at most ten times a second.
-    if (focusModeBox_->currentIndex() == 2 && focusTimer_.elapsed() > 100) {
+    if (methodPanel_->focusMode() == MethodPanel::FocusMode::Cursor && focusTimer_.elapsed() > 100) {
       focusTimer_.restart();
-      method_.focus = {FocusPoint{Vec2{px.x() + 0.5f, px.y() + 0.5f}, false}};
-      engine_->submit(FocusCommand{method_.focus});
+      methodPanel_->setFocus({FocusPoint{Vec2{px.x() + 0.5f, px.y() + 0.5f}, false}});
+      engine_->submit(FocusCommand{methodPanel_->settings().focus});
     }
   });
   connect(view_, &FrameView::regionInspected, this, [this](QRect r, QVector3D mean, QVector3D lo, QVector3D hi) {
@@ -470,96 +473,19 @@ void MainWindow::buildDocks() {
   // samples are lost), and the scene's render settings.
   auto* settingsPanel = new QWidget(this);
   auto* sl = new QVBoxLayout(settingsPanel);
-  auto* methodBox = new QGroupBox(tr("Method"), settingsPanel);
-  auto* mf = new QFormLayout(methodBox);
-  methodBox_ = new QComboBox(methodBox);
-  methodBox_->setObjectName("method");
-  for (const auto& n : methodNames()) methodBox_->addItem(QString::fromStdString(n));
-  methodBox_->setCurrentText(methodName(method_.kind));
-  tileBox_ = new QComboBox(methodBox);
-  for (int t : {8, 16, 32}) tileBox_->addItem(QString::number(t), t);
-  tileBox_->setCurrentText(QString::number(method_.tileSize));
-  qualityBox_ = new QSpinBox(methodBox);
-  qualityBox_->setObjectName("quality");
-  qualityBox_->setRange(1, 4096);
-  qualityBox_->setValue(std::max(1, method_.quality));
-  qualityBox_->setKeyboardTracking(false);  // a typed Q applies on Enter, not at every digit
-  qualityBox_->setToolTip(tr("Samples per pixel of a served tile"));
-  qualityAuto_ = new QCheckBox(tr("auto"), methodBox);
-  qualityAuto_->setObjectName("qualityAuto");
-  qualityAuto_->setChecked(method_.quality == 0);
-  qualityAuto_->setEnabled(method_.kind == MethodKind::Indirection || method_.kind == MethodKind::IndirectionFocus);
-  qualityAuto_->setToolTip(tr("Indirection methods: the largest Q at which every high-priority tile fits in one frame"));
-  auto* qualityRow = new QWidget(methodBox);
-  auto* ql = new QHBoxLayout(qualityRow);
-  ql->setContentsMargins(0, 0, 0, 0);
-  ql->addWidget(qualityBox_, 1);
-  ql->addWidget(qualityAuto_);
-  smoothBox_ = new QCheckBox(tr("smooth transition"), methodBox);
-  staleBox_ = new QSpinBox(methodBox);
-  staleBox_->setObjectName("staleCap");
-  staleBox_->setRange(1, 4096);
-  staleBox_->setValue(method_.staleCap);
-  staleBox_->setKeyboardTracking(false);
-  staleBox_->setToolTip(tr("Stale samples kept per pixel by the smooth transition: the old image weighs C/(C+n) after n fresh samples"));
-  focusModeBox_ = new QComboBox(methodBox);
-  focusModeBox_->setObjectName("focusMode");
-  focusModeBox_->addItems({tr("Shift+click: static point"), tr("Shift+click: follows the object"), tr("follows the cursor")});
-  focusModeBox_->setToolTip(tr("Focus points (up to 3) for the focus methods. Shift+click adds one; 'follows the cursor' "
-                               "stands in for an eye tracker."));
-  auto* clearFocus = new QPushButton(tr("Clear focus points"), methodBox);
-  reuseBox_ = new QCheckBox(tr("reuse verified samples"), methodBox);
-  reuseBox_->setObjectName("reuse");
-  reuseBox_->setChecked(method_.reuse);
-  reuseBox_->setToolTip(tr("After an edit, a re-rendered tile keeps its converged samples while a test finds the fresh ones "
-                           "in agreement with them, and drops them for good the moment they disagree. Not with the "
-                           "global method."));
-  denoiseBox_ = new QCheckBox(tr("denoise"), methodBox);
-  denoiseBox_->setObjectName("denoise");
-  denoiseBox_->setChecked(method_.denoise);
-  denoiseBox_->setToolTip(tr("Show the image denoised: the whole frame during refinement, a growing region during a pass. "
-                             "The samples themselves are untouched (the pixel inspector can read either)."));
-  denoiseThresholdBox_ = new QSpinBox(methodBox);
-  denoiseThresholdBox_->setObjectName("denoiseThreshold");
-  denoiseThresholdBox_->setRange(0, 100);
-  denoiseThresholdBox_->setSuffix(tr(" % of the image"));
-  denoiseThresholdBox_->setValue(static_cast<int>(std::lround(method_.denoiseThreshold * 100)));
-  denoiseThresholdBox_->setKeyboardTracking(false);  // a typed value applies on Enter, not at every digit
-  denoiseThresholdBox_->setToolTip(tr("The denoised region is re-sized when its width (height) has grown by more than this "
-                                      "share of the image's width (height)"));
-  softBordersBox_ = new QCheckBox(tr("soft borders"), methodBox);
-  softBordersBox_->setObjectName("softBorders");
-  softBordersBox_->setChecked(method_.softBorders);
-  softBordersBox_->setToolTip(tr("Blend the seams between fresh and stale tiles and between denoised regions over a few pixels"));
-  denoiseThresholdBox_->setEnabled(method_.denoise);
-  softBordersBox_->setEnabled(method_.denoise);
-  mf->addRow(tr("Policy"), methodBox_);
-  mf->addRow(tr("Tile size T"), tileBox_);
-  mf->addRow(tr("Quality Q"), qualityRow);
-  mf->addRow(QString(), smoothBox_);
-  mf->addRow(tr("Stale cap C"), staleBox_);
-  mf->addRow(tr("Focus"), focusModeBox_);
-  mf->addRow(QString(), clearFocus);
-  mf->addRow(QString(), reuseBox_);
-  mf->addRow(QString(), denoiseBox_);
-  mf->addRow(tr("Denoise threshold"), denoiseThresholdBox_);
-  mf->addRow(QString(), softBordersBox_);
-  connect(methodBox_, &QComboBox::currentTextChanged, this, [this] { sendMethod(); });
-  connect(tileBox_, &QComboBox::currentIndexChanged, this, [this] { sendMethod(); });
-  connect(qualityBox_, &QSpinBox::valueChanged, this, [this] { sendMethod(); });
-  connect(qualityAuto_, &QCheckBox::toggled, this, [this] { sendMethod(); });
-  connect(smoothBox_, &QCheckBox::toggled, this, [this] { sendMethod(); });
-  connect(staleBox_, &QSpinBox::valueChanged, this, [this] { sendMethod(); });
-  connect(denoiseBox_, &QCheckBox::toggled, this, [this] { sendMethod(); });
-  connect(reuseBox_, &QCheckBox::toggled, this, [this] { sendMethod(); });
-  connect(denoiseThresholdBox_, &QSpinBox::valueChanged, this, [this] { sendMethod(); });
-  connect(softBordersBox_, &QCheckBox::toggled, this, [this] { sendMethod(); });
-  connect(clearFocus, &QPushButton::clicked, this, [this] {
-    method_.focus.clear();
-    engine_->submit(FocusCommand{method_.focus});
+  methodPanel_ = new MethodPanel(editorMethod(), settingsPanel);
+  connect(methodPanel_, &MethodPanel::changed, this, [this](const MethodSettings& m) {
+    engine_->submit(MethodCommand{m});
+    log(tr("method %1, T=%2, Q=%3%4").arg(QString::fromStdString(methodLabel(m))).arg(m.tileSize)
+            .arg(m.quality ? QString::number(m.quality) : tr("auto"),
+                 m.denoise ? tr(", denoise threshold %1 % of the image").arg(std::lround(m.denoiseThreshold * 100)) : QString()));
+  });
+  connect(methodPanel_, &MethodPanel::refused, this, [this](const QString& why) { log(tr("method: %1").arg(why)); });
+  connect(methodPanel_, &MethodPanel::focusCleared, this, [this] {
+    engine_->submit(FocusCommand{{}});
     log(tr("focus points cleared"));
   });
-  sl->addWidget(methodBox);
+  sl->addWidget(methodPanel_);
 
   auto* displayBox = new QGroupBox(tr("Display (viewport only)"), settingsPanel);
   auto* df = new QFormLayout(displayBox);
@@ -673,35 +599,6 @@ void MainWindow::buildDocks() {
   });
 }
 
-void MainWindow::sendMethod() {
-  MethodSettings m = method_;
-  methodFromName(methodBox_->currentText().toStdString(), &m.kind);
-  m.tileSize = tileBox_->currentData().toInt();
-  const bool indirection = m.kind == MethodKind::Indirection || m.kind == MethodKind::IndirectionFocus;
-  qualityAuto_->setEnabled(indirection);
-  m.quality = indirection && qualityAuto_->isChecked() ? 0 : qualityBox_->value();
-  qualityBox_->setEnabled(m.quality != 0);
-  m.smooth = smoothBox_->isChecked();
-  m.staleCap = staleBox_->value();
-  m.denoise = denoiseBox_->isChecked();
-  m.reuse = reuseBox_->isChecked() && m.kind != MethodKind::Global;
-  reuseBox_->setEnabled(m.kind != MethodKind::Global);
-  m.denoiseThreshold = denoiseThresholdBox_->value() / 100.0;
-  m.softBorders = softBordersBox_->isChecked();
-  staleBox_->setEnabled(m.smooth);
-  denoiseThresholdBox_->setEnabled(m.denoise);
-  softBordersBox_->setEnabled(m.denoise);
-  if (std::string bad = validateMethodSettings(m); !bad.empty()) {
-    log(tr("method: %1").arg(QString::fromStdString(bad)));
-    return;
-  }
-  method_ = m;
-  engine_->submit(MethodCommand{method_});
-  log(tr("method %1, T=%2, Q=%3%4").arg(QString::fromStdString(methodLabel(m))).arg(m.tileSize)
-          .arg(m.quality ? QString::number(m.quality) : tr("auto"),
-               m.denoise ? tr(", denoise threshold %1 % of the image").arg(denoiseThresholdBox_->value()) : QString()));
-}
-
 QSize MainWindow::desiredRenderSize() const {
   QSize base = options_.initialRenderSize;
   if (base.isEmpty()) {
@@ -743,7 +640,7 @@ void MainWindow::startEngine(Scene scene) {
   EngineOptions engineOptions;
   engineOptions.documentVersion = doc_.version();
   engineOptions.previewBlock = options_.previewBlock;
-  engine_ = std::make_unique<Engine>(std::move(scene), method_, engineOptions);
+  engine_ = std::make_unique<Engine>(std::move(scene), methodPanel_->settings(), engineOptions);
   engine_->setFrameCallback([this] { QMetaObject::invokeMethod(this, [this] { onFrame(); }, Qt::QueuedConnection); });
   engine_->start();
   fpsStart_ = QDateTime::currentMSecsSinceEpoch();
@@ -1128,7 +1025,7 @@ void MainWindow::replaceDocument(Scene scene, const std::filesystem::path& file)
   undo_.clear();
   selection_ = kNoNode;
   selected_.clear();
-  method_.focus.clear();
+  methodPanel_->setFocus({});
   updateTitle();
   loggedWarnings_.clear();
   startEngine(doc_.scene());

@@ -122,7 +122,6 @@ class MainWindow : public QMainWindow {
   void rebuildOutliner();
   void rebuildProperties();
   void onFrame();
-  void sendMethod();
   void showError(const QString& title, const QString& message);
   bool applyToDocument(const Edit& e);
   void updateRenderSize();
@@ -141,13 +140,13 @@ class MainWindow : public QMainWindow {
   QUndoStack undo_;
   NodeId selection_ = kNoNode;
   std::vector<NodeId> selected_;  // includes selection_
-  MethodSettings method_ = editorMethod();
   // The editor's method at start: the library's, denoised, so that a pass shows its growing regions.
   static MethodSettings editorMethod() {
     MethodSettings m;
     m.denoise = true;
     return m;
   }
+  class MethodPanel* methodPanel_ = nullptr;  // owns the method the engine renders with
   bool paused_ = false;
   int dragCounter_ = 0;
   QString lastError_;
@@ -167,21 +166,10 @@ class MainWindow : public QMainWindow {
   class LiveChart* chart_ = nullptr;
   QString pixelText_, regionText_;
   QElapsedTimer focusTimer_;
-  QSpinBox* staleBox_ = nullptr;
-  QComboBox* focusModeBox_ = nullptr;
   QComboBox* displayView_ = nullptr;  // the viewport's OCIO view
   QPlainTextEdit* log_ = nullptr;
-  QComboBox* methodBox_ = nullptr;
-  QComboBox* tileBox_ = nullptr;
-  QSpinBox* qualityBox_ = nullptr;
-  QCheckBox* smoothBox_ = nullptr;
-  QCheckBox* qualityAuto_ = nullptr;
   PropertyPanel* panelEdit_ = nullptr;  // the panel whose own edit is being applied (it shows it already)
   QSet<QString> loggedWarnings_;  // of the current document: each is logged once
-  QCheckBox* denoiseBox_ = nullptr;
-  QCheckBox* reuseBox_ = nullptr;
-  QSpinBox* denoiseThresholdBox_ = nullptr;
-  QCheckBox* softBordersBox_ = nullptr;
   QLabel* status_ = nullptr;
   QLabel* toolLabel_ = nullptr;
   QMenu* recentMenu_ = nullptr;

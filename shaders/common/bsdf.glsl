@@ -25,8 +25,7 @@ const bool kCoatUsed = (kMaterialMask & (1 << kMaskCoat)) != 0;
 const bool kMediumUsed = (kMaterialMask & (1 << kMaskMedium)) != 0;
 const bool kScatteringUsed = (kMaterialMask & (1 << kMaskScattering)) != 0;
 // The same for the preprocessor (bit 17 is kMaskMedium): the path's medium (trace.comp) is not
-// even declared without one, so that a scene without filled glass carries no dead field. (What
-// the field cost was within the machine's noise: docs/MEASUREMENTS.md, twenty-second session.)
+// even declared without one, so that a scene without filled glass carries no dead field.
 // Likewise bit 13, kMatBoundary: only then do shadow rays pass surfaces (scene.glsl traceStep).
 #define RETILE_MEDIUM ((RETILE_MATERIALS & 131072) != 0)
 #define RETILE_BOUNDARY ((RETILE_MATERIALS & 8192) != 0)

@@ -490,7 +490,7 @@ void traceStep(inout Trace tr, int below, int root) {
     // ray starts inside several boxes, go to the later slot: leaves before inner children, and
     // among each the ones the builder's collapse opened later. That took 7 % fewer loop
     // iterations in the room of 1.06 M triangles than ties in slot order, and 2 % on the
-    // spaceship; the children sorted by area for the ties did worse (docs/MEASUREMENTS.md).
+    // spaceship; the children sorted by area for the ties did worse.
     bool c01 = tNear.y <= tNear.x, c02 = tNear.z <= tNear.x, c03 = tNear.w <= tNear.x;
     bool c12 = tNear.z <= tNear.y, c13 = tNear.w <= tNear.y, c23 = tNear.w <= tNear.z;
     uvec4 rank = uvec4(uint(c01) + uint(c02) + uint(c03), uint(!c01) + uint(c12) + uint(c13),

@@ -51,7 +51,7 @@ RT_CONST(int, kTriBoundary, 0x20000000)      // kInstanceBoundary
 RT_CONST(int, kTriAlphaTested, 0x40000000)   // and kInstanceAlphaTested flags
 RT_CONST(int, kMaxLeafTriangles, 4)  // render/bvh.h maxLeafSize for mesh BVHs
 // A node names its children without items, to fit 48 bytes, so that a traversal step fetches three
-// texels instead of four (docs/MEASUREMENTS.md, fourteenth session). Its slots hold inner
+// texels instead of four. Its slots hold inner
 // children first, then leaves, then nothing (render/bvh.h buildBvh orders them so). Bits 0..25 of
 // its third texel's z and w are two bases, in units of kUnitTexels texels: `inner`, where its
 // inner children are, one unit each in slot order, and `leaves`, where its leaves' records are,

@@ -58,7 +58,7 @@ struct Case {
 
 // The living room's bound is what the filter reaches, not the 1/3 aimed at: most of its 4-spp
 // error is light arriving through the windows along rare paths, sparse sparkles no spatial filter
-// of a few iterations spreads far enough (see docs/MEASUREMENTS.md); 0.71 with opaque stand-in
+// of a few iterations spreads far enough; 0.71 with opaque stand-in
 // leaves, 0.74 since the missing leaf texture is Tungsten's checker, half of each leaf cut out by
 // its alpha (more edges, more sparse light through the plants). The Cornell box asks for a
 // tent filter: the pixels around the bright light then see it in a few of their samples (a ring of

@@ -71,7 +71,7 @@ DenoiseWork wholeFrameDenoise(int width, int height, int tileSize = 16);
 // many as make about 2^18 samples, at most 64. Frames of four samples per pixel traced the
 // 320x180 spaceship 1.14 times as fast as frames of one on lavapipe, where both cores idled 6.4
 // to 6.8 % of a 1-spp frame (its dispatches, the last invocations' tail); how much of the gain
-// that idle time makes was not settled (docs/MEASUREMENTS.md).
+// that idle time makes was not settled.
 int offlineSamplesPerFrame(int width, int height);
 
 struct FrameOptions {

@@ -385,7 +385,7 @@ enum class ShadingConvention { Consistent, Tungsten };
 // When a path may end early (Russian roulette), keeping the expected value. Standard: after three
 // bounces, each bounce survives with its throughput's largest channel, at most 0.95. Tungsten's:
 // after three bounces, only a throughput below 0.1 plays, and survives with that. Tungsten's ends
-// fewer paths, so a sample costs more and varies less (docs/MEASUREMENTS.md); Tungsten files use
+// fewer paths, so a sample costs more and varies less; Tungsten files use
 // it so that a sample is the same work and the same estimate as in Tungsten.
 enum class Roulette { Standard, Tungsten };
 // Where a ray that leaves a surface starts. Robust: a few float ulps off the surface, and never on

@@ -109,8 +109,9 @@ class RenderSession {
   // The document version of the scene the session was made from (frames report it until an edit).
   void setDocumentVersion(std::uint64_t version);
   // Previews (the editor): while edits come, and for kPreviewLingerMs after the last, frames
-  // trace a sample per `block` x `block` pixels (W x H / block^2 samples, so they come block^2
-  // times as often) over the edit's global update or its pass's prioritized tiles, which they
+  // trace W x H / block^2 samples, each standing for a `block` x `block` square of pixels (so they
+  // come block^2 times as often), over the edit's global update (a sample a block) or its pass's
+  // prioritized tiles (every tile without the smooth transition; Q / block^2 a block), which they
   // restart; then the edit's plan runs again at full resolution, the prioritized tiles first and
   // the converged rest kept as the method keeps it. 1: off (the command line, the evaluation).
   // Not with verified reuse, whose test needs every sample at its pixel.

@@ -44,7 +44,7 @@ void releaseFreedMemory();
 // branch of a shader for every invocation, so the traversal loop does float arithmetic on
 // records of other kinds (node items and packed bytes read as floats, many of them denormal),
 // and each denormal operand costs a microcode assist: on the spaceship, the four-wide BVH
-// traced 15 % more samples per second with them flushed (docs/MEASUREMENTS.md). Vulkan 1.2's
+// traced 15 % more samples per second with them flushed. Vulkan 1.2's
 // float controls would say it per shader, but lavapipe offers no flush-to-zero. Call before the
 // Vulkan device is created (its worker threads inherit). Little Retile computes needs denormals;
 // what does runs under KeepDenormals.

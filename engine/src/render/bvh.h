@@ -6,8 +6,7 @@
 // fewest expected traversal steps. On lavapipe every loop iteration of the traversal pays for the whole loop body
 // (shaders/common/scene.glsl), so what counts is the number of steps a ray takes; a four-wide node
 // decides among four children in one step, and its child boxes, quantised to 8 bits per plane
-// relative to the node's box, keep a node in 48 bytes, less than a binary node took
-// (docs/MEASUREMENTS.md has the figures). A node names its children by two bases only (layouts.h),
+// relative to the node's box, keep a node in 48 bytes, less than a binary node took. A node names its children by two bases only (layouts.h),
 // which buildBvh's order makes possible.
 #pragma once
 

@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# Writes docs/PERFORMANCE.md: today's figures, measured now on this machine. Throughput of each
+# shared scene against Tungsten's on the same machine (the figures ../shared/refs/README.md
+# records), peak memory, bytes per triangle of the synthetic room, and, given the log of a
+# `bash .ci/run` (which prints its stages' times), CI's time by stage.
+#
+# usage: scripts/performance.sh [--bin RETILE] [--ci-log FILE] [--out FILE]
+# About five minutes; the scenes are read from ../shared beside the repository.
+set -euo pipefail
+here="$(cd "$(dirname "$0")/.." && pwd)"
+bin="$here/build/bin/retile"
+ci_log=""
+out="$here/docs/PERFORMANCE.md"
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --bin) bin="$2"; shift 2 ;;
+    --ci-log) ci_log="$2"; shift 2 ;;
+    --out) out="$2"; shift 2 ;;
+    -h | --help) sed -n 2,8p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "error: unknown argument '$1'" >&2; exit 2 ;;
+  esac
+done
+[ -x "$bin" ] || { echo "error: $bin is not an executable (build first, or pass --bin)" >&2; exit 2; }
+shared="$here/../shared"
+[ -d "$shared/scenes" ] || { echo "error: $shared/scenes not found (../shared beside the repository)" >&2; exit 2; }
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+# Tungsten's samples/s on this machine, from ../shared/refs/README.md (two threads, scene loading
+# excluded; the kitchen's is the middle of its range).
+declare -A tungsten=([cornell-box]=0.80 [living-room]=0.21 [spaceship]=0.82 [kitchen]=0.2325)
+declare -A size=([cornell-box]=256x256 [living-room]=320x180 [spaceship]=320x180 [kitchen]=320x180)
+
+# Samples/s of an offline render (the reference's size, 64 spp, the scene's bounces) and the
+# process's peak memory.
+render() {
+  local name=$1
+  /usr/bin/time -f '%M' -o "$work/$name.rss" "$bin" render "$shared/scenes/$name/scene.json" --size "${size[$name]}" \
+    --spp 64 --seed 1 --out "$work/$name.exr" 2>/dev/null | grep -o '[0-9.]* M samples/s' | cut -d' ' -f1
+}
+
+{
+  echo "# Performance"
+  echo
+  echo "Today's figures, written by \`scripts/performance.sh\` on $(nproc) cores with $(vulkaninfo --summary 2>/dev/null | grep -m1 deviceName | sed 's/.*= //' || echo 'the Vulkan device found')."
+  echo "Regenerate them rather than editing this page."
+  echo
+  echo "## Throughput against Tungsten"
+  echo
+  echo "\`retile render SCENE --size WxH --spp 64\` against Tungsten's samples/s on the same machine"
+  echo "(../shared/refs/README.md). Peak memory is the whole process's."
+  echo
+  echo "| scene | size | Retile M samples/s | Tungsten | ratio | peak memory |"
+  echo "|---|---|---|---|---|---|"
+  for name in cornell-box living-room spaceship kitchen; do
+    [ -f "$shared/scenes/$name/scene.json" ] || continue
+    rate=$(render "$name")
+    rss=$(cat "$work/$name.rss")
+    printf '| %s | %s | %s | %s | %s | %d MB |\n' "$name" "${size[$name]}" "$rate" "${tungsten[$name]}" \
+      "$(awk -v a="$rate" -v b="${tungsten[$name]}" 'BEGIN { printf "%.2fx", a / b }')" $((rss / 1024))
+  done
+  echo
+  echo "## Memory and throughput against scene size"
+  echo
+  echo "\`retile bench room --triangles 100k,1M\`: a synthetic furnished room."
+  echo
+  echo '```'
+  "$bin" bench room --triangles 100k,1M 2>/dev/null
+  echo '```'
+  if [ -n "$ci_log" ]; then
+    echo
+    echo "## CI by stage"
+    echo
+    echo "From a clean clone's \`bash .ci/run\` (its \`stage\` lines):"
+    echo
+    echo "| stage | seconds |"
+    echo "|---|---|"
+    grep -a '^stage ' "$ci_log" | sed -E 's/^stage ([^:]*): ([0-9]+) s$/| \1 | \2 |/'
+  fi
+} >"$out.tmp"
+mv "$out.tmp" "$out"
+echo "wrote $out"
