@@ -80,6 +80,34 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
   statusBar()->addPermanentWidget(status_);
   showTool();
   for (PropertyPanel* p : {panel_, renderPanel_}) connect(p, &PropertyPanel::message, this, &MainWindow::notify);
+  connectViewport();
+  // The render size follows the viewport (docks moved, window resized), once the size settles:
+  // every resize restarts the accumulation.
+  resizeTimer_.setSingleShot(true);
+  resizeTimer_.setInterval(150);
+  connect(&resizeTimer_, &QTimer::timeout, this, [this] { updateRenderSize(); });
+  connect(view_, &FrameView::resized, this, [this] { resizeTimer_.start(); });
+  setAcceptDrops(true);
+  startAutosave();
+  connect(&undo_, &QUndoStack::cleanChanged, this, [this] { updateTitle(); });
+  updateTitle();
+  resize(1280, 800);
+  if (options_.keepLayout) {
+    QSettings settings;
+    restoreGeometry(settings.value("window/geometry").toByteArray());
+    restoreState(settings.value("window/docks").toByteArray());
+  }
+  startEngine(doc_.scene());
+  applySceneView();
+  rebuildOutliner();
+  rebuildProperties();
+  log(tr("viewport: %1").arg(view_->presentation()));
+  connect(view_, &FrameView::presentationChanged, this,
+          [this](const QString& p) { log(tr("viewport: presentation failed; now drawn as a %1").arg(p)); });
+}
+
+// Picking, focus points, the pixel inspector.
+void MainWindow::connectViewport() {
   connect(view_, &FrameView::objectPicked, this, [this](quint64 id) { select(static_cast<NodeId>(id)); });
   connect(view_, &FrameView::objectToggled, this, [this](quint64 id) { toggleSelected(static_cast<NodeId>(id)); });
   connect(view_, &FrameView::focusPlaced, this, [this](QPointF p) {
@@ -112,6 +140,12 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
     inspector_->setText((pixelText_.isEmpty() ? QString() : pixelText_ + "\n\n") + regionText_);
   });
   focusTimer_.start();
+  connectDrags();
+}
+
+// Camera navigation, the selection moved in the screen plane or along the gizmo's arrows, turned
+// and scaled; each whole drag is one undo step.
+void MainWindow::connectDrags() {
   // Camera navigation (Alt + left/middle/right, wheel) and moving the selection in the screen
   // plane; each whole drag is one undo step.
   connect(view_, &FrameView::dragFinished, this, [this] { ++dragCounter_; });
@@ -195,13 +229,9 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
     const float s = static_cast<float>(std::exp(px * 0.005));
     aboutOrigin(Mat4::scale(Vec3{s, s, s}), tr("Scale %1"));
   });
-  // The render size follows the viewport (docks moved, window resized), once the size settles:
-  // every resize restarts the accumulation.
-  resizeTimer_.setSingleShot(true);
-  resizeTimer_.setInterval(150);
-  connect(&resizeTimer_, &QTimer::timeout, this, [this] { updateRenderSize(); });
-  connect(view_, &FrameView::resized, this, [this] { resizeTimer_.start(); });
-  setAcceptDrops(true);
+}
+
+void MainWindow::startAutosave() {
   // Autosave every 5 minutes ($RETILE_AUTOSAVE_SECONDS overrides) to rotating recovery files.
   auto* autosaveTimer = new QTimer(this);
   int every = qEnvironmentVariableIsSet("RETILE_AUTOSAVE_SECONDS") ? qEnvironmentVariableIntValue("RETILE_AUTOSAVE_SECONDS") : 300;
@@ -210,21 +240,6 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
   QDir().mkpath(recoveryDirectory());
   QFile lock(recoveryDirectory() + "/session.lock");
   if (lock.open(QIODevice::WriteOnly)) lock.write(QByteArray::number(QCoreApplication::applicationPid()));
-  connect(&undo_, &QUndoStack::cleanChanged, this, [this] { updateTitle(); });
-  updateTitle();
-  resize(1280, 800);
-  if (options_.keepLayout) {
-    QSettings settings;
-    restoreGeometry(settings.value("window/geometry").toByteArray());
-    restoreState(settings.value("window/docks").toByteArray());
-  }
-  startEngine(doc_.scene());
-  applySceneView();
-  rebuildOutliner();
-  rebuildProperties();
-  log(tr("viewport: %1").arg(view_->presentation()));
-  connect(view_, &FrameView::presentationChanged, this,
-          [this](const QString& p) { log(tr("viewport: presentation failed; now drawn as a %1").arg(p)); });
 }
 
 MainWindow::~MainWindow() {
@@ -386,7 +401,9 @@ QDockWidget* MainWindow::addDock(const QString& title, const char* name, QWidget
   return dock;
 }
 
-void MainWindow::buildDocks() {
+// Objects, materials, lights and the scene's singletons; picking in it selects, Ctrl+click adds,
+// editing a name renames, the check box shows or hides.
+QTreeWidget* MainWindow::buildOutliner() {
   outliner_ = new QTreeWidget(this);
   outliner_->setHeaderLabels({tr("Name"), tr("Material / kind")});
   outliner_->header()->setSectionResizeMode(0, QHeaderView::Stretch);
@@ -446,7 +463,45 @@ void MainWindow::buildDocks() {
     if (after.name == o->name && after.visible == o->visible) return;
     edit(SetObject{*o}, SetObject{after}, after.visible != o->visible ? tr("Show/hide %1").arg(item->text(0)) : tr("Rename object"));
   });
-  auto* outlinerDock = addDock(tr("Outliner"), "outliner", outliner_, Qt::LeftDockWidgetArea);
+  return outliner_;
+}
+
+// The viewport's view transform, exposure and gamma: display only, no sample is lost.
+QGroupBox* MainWindow::buildDisplayBox(QWidget* parent) {
+  auto* displayBox = new QGroupBox(tr("Display (viewport only)"), parent);
+  auto* df = new QFormLayout(displayBox);
+  auto* viewBox = new QComboBox(displayBox);
+  displayView_ = viewBox;
+  viewBox->setObjectName("displayView");
+  try {
+    for (const auto& v : ColorConfig::get()->views()) viewBox->addItem(QString::fromStdString(v));
+  } catch (const std::exception& e) {
+    log(tr("colour config: %1").arg(e.what()));
+  }
+  viewBox->setCurrentText(QString::fromStdString(view_->display().view));
+  auto* exposure = new ScrubField(0.0, -16.0, 16.0, 0.0, 2, displayBox);
+  exposure->setObjectName("exposure");
+  exposure->setSuffix(tr(" stops"));
+  auto* gamma = new ScrubField(1.0, 0.1, 5.0, 1.0, 2, displayBox);
+  gamma->setObjectName("gamma");
+  df->addRow(tr("View"), viewBox);
+  df->addRow(tr("Exposure"), exposure);
+  df->addRow(tr("Gamma"), gamma);
+  auto applyDisplay = [this, viewBox, exposure, gamma] {
+    DisplaySettings d;
+    d.view = viewBox->currentText().toStdString();
+    d.exposure = static_cast<float>(exposure->value());
+    d.gamma = static_cast<float>(gamma->value());
+    view_->setDisplay(d);
+  };
+  connect(viewBox, &QComboBox::currentTextChanged, this, applyDisplay);
+  connect(exposure, &ScrubField::edited, this, applyDisplay);
+  connect(gamma, &ScrubField::edited, this, applyDisplay);
+  return displayBox;
+}
+
+void MainWindow::buildDocks() {
+  auto* outlinerDock = addDock(tr("Outliner"), "outliner", buildOutliner(), Qt::LeftDockWidgetArea);
 
   // Each panel's edits name it (`who`, the member that holds it): it shows them already, and
   // rebuilding it would drop the field being scrubbed; the other panel, which may show the same
@@ -487,36 +542,7 @@ void MainWindow::buildDocks() {
   });
   sl->addWidget(methodPanel_);
 
-  auto* displayBox = new QGroupBox(tr("Display (viewport only)"), settingsPanel);
-  auto* df = new QFormLayout(displayBox);
-  auto* viewBox = new QComboBox(displayBox);
-  displayView_ = viewBox;
-  viewBox->setObjectName("displayView");
-  try {
-    for (const auto& v : ColorConfig::get()->views()) viewBox->addItem(QString::fromStdString(v));
-  } catch (const std::exception& e) {
-    log(tr("colour config: %1").arg(e.what()));
-  }
-  viewBox->setCurrentText(QString::fromStdString(view_->display().view));
-  auto* exposure = new ScrubField(0.0, -16.0, 16.0, 0.0, 2, displayBox);
-  exposure->setObjectName("exposure");
-  exposure->setSuffix(tr(" stops"));
-  auto* gamma = new ScrubField(1.0, 0.1, 5.0, 1.0, 2, displayBox);
-  gamma->setObjectName("gamma");
-  df->addRow(tr("View"), viewBox);
-  df->addRow(tr("Exposure"), exposure);
-  df->addRow(tr("Gamma"), gamma);
-  auto applyDisplay = [this, viewBox, exposure, gamma] {
-    DisplaySettings d;
-    d.view = viewBox->currentText().toStdString();
-    d.exposure = static_cast<float>(exposure->value());
-    d.gamma = static_cast<float>(gamma->value());
-    view_->setDisplay(d);
-  };
-  connect(viewBox, &QComboBox::currentTextChanged, this, applyDisplay);
-  connect(exposure, &ScrubField::edited, this, applyDisplay);
-  connect(gamma, &ScrubField::edited, this, applyDisplay);
-  sl->addWidget(displayBox);
+  sl->addWidget(buildDisplayBox(settingsPanel));
 
   renderPanel_ = new PropertyPanel(sceneRef, pushFrom(&renderPanel_), previewFrom(&renderPanel_), settingsPanel);
   renderPanel_->setTarget({PropertyTarget::Kind::Render, kNoNode});

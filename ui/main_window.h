@@ -31,6 +31,7 @@ class QCheckBox;
 class QWidget;
 class QMenu;
 class QDockWidget;
+class QGroupBox;
 
 namespace retile::ui {
 
@@ -105,6 +106,9 @@ class MainWindow : public QMainWindow {
 
  private:
   void buildMenus();
+  void connectViewport();  // the viewport's signals: picking, focus points, the inspector, drags
+  void connectDrags();
+  void startAutosave();
   // Asks to save unsaved changes; false when the user cancels.
   bool maybeSave();
   void refreshGraph();
@@ -117,6 +121,8 @@ class MainWindow : public QMainWindow {
   // Shows the document through the view its scene asks for (RenderSettings::view), if it names one.
   void applySceneView();
   void buildDocks();
+  QTreeWidget* buildOutliner();
+  QGroupBox* buildDisplayBox(QWidget* parent);
   QDockWidget* addDock(const QString& title, const char* name, QWidget* content, Qt::DockWidgetArea area);
   void startEngine(Scene scene);
   void rebuildOutliner();
