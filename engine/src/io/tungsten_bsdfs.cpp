@@ -135,168 +135,162 @@ Material TungstenImporter::bsdf(const Value& v, const std::string& where, int de
   return m;
 }
 
-Material TungstenImporter::bsdfOwn(const Value& v, const std::string& where, int depth, bool emitter) {
-  Material m;
-  m.albedo = Vec3{1.0f};  // Tungsten's default albedo
-  if (v.isString()) {
-    auto it = named_.find(v.asString());
-    if (it != named_.end()) return it->second;
-    // An undefined name should not cost the artist the whole file: the surface gets a stand-in
-    // and the warning names what was missing, once per name.
-    const std::string& name = v.asString();
-    if (emitter) {
-      m.type = MaterialType::Null;
-      m.name = name;
-    } else {
-      // One grey stand-in per name, shared like a defined bsdf, so the artist fixes it once.
-      m.type = MaterialType::Lambert;
-      m.albedo = Vec3{0.5f};
-      m.name = name;
-      m.id = out_.scene.newId();
-      named_[name] = m;
-      out_.scene.materials.push_back(m);
-    }
-    if (undefinedWarned_.insert(cat(name, emitter)).second)
-      warn(cat(where, ": bsdf '", name, "' is not defined; ",
-               emitter ? "the emitter is drawn by its emission only (a null bsdf)" : "drawn as grey diffuse"));
-    return m;
+// A bsdf named by a string: the named one, or a stand-in for an undefined name (warned of once).
+Material TungstenImporter::namedBsdf(const Value& v, const std::string& where, bool emitter, Material m) {
+  auto it = named_.find(v.asString());
+  if (it != named_.end()) return it->second;
+  // An undefined name should not cost the artist the whole file: the surface gets a stand-in
+  // and the warning names what was missing, once per name.
+  const std::string& name = v.asString();
+  if (emitter) {
+    m.type = MaterialType::Null;
+    m.name = name;
+  } else {
+    // One grey stand-in per name, shared like a defined bsdf, so the artist fixes it once.
+    m.type = MaterialType::Lambert;
+    m.albedo = Vec3{0.5f};
+    m.name = name;
+    m.id = out_.scene.newId();
+    named_[name] = m;
+    out_.scene.materials.push_back(m);
   }
-  if (!v.isObject()) {
-    problem(where, "expected a bsdf object or name");
-    return m;
+  if (undefinedWarned_.insert(cat(name, emitter)).second)
+    warn(cat(where, ": bsdf '", name, "' is not defined; ",
+             emitter ? "the emitter is drawn by its emission only (a null bsdf)" : "drawn as grey diffuse"));
+  return m;
+}
+
+// Tungsten's transparency: its base bsdf, cut out by alpha.
+Material TungstenImporter::transparencyBsdf(const Value& v, const std::string& where, int depth, Material m) {
+  Material base;  // Tungsten's default: lambert of albedo 1
+  base.albedo = Vec3{1.0f};
+  if (const Value* b = v.find("base")) base = bsdf(*b, where + ".base", depth + 1);
+  std::string name = m.name;
+  m = base;
+  m.name = name;
+  if (const Value* a = v.find("alpha")) {
+    TextureRef t = texture(*a, where + ".alpha", true);
+    m.alpha = std::clamp(channelMean(t.constant), 0.0f, 1.0f);
+    // A missing alpha map is Tungsten's stand-in checker too: half the squares transparent.
+    if (t.isTexture) m.alphaTexture = t.texture;
   }
-  if (depth > 8) {
-    problem(where, "bsdfs nested too deeply");
-    return m;
-  }
-  m.name = string(v, "name");
-  std::string type = string(v, "type");
-  if (type.empty()) {
-    problem(where, "bsdf without a \"type\"");
-    return m;
-  }
-  if (type == "transparency") {
-    Material base;  // Tungsten's default: lambert of albedo 1
+  return m;
+}
+
+// Tungsten's coats: a dielectric layer over a substrate bsdf (Material::coatIor).
+Material TungstenImporter::coatBsdf(const Value& v, const std::string& type, const std::string& where, int depth, Material m) {
+  // Tungsten's coats: a dielectric layer over a substrate bsdf (its default: a rough conductor).
+  Material base;
+  if (const Value* sv = v.find("substrate")) {
+    base = bsdf(*sv, where + ".substrate", depth + 1);
+  } else {
+    base.type = MaterialType::RoughConductor;
     base.albedo = Vec3{1.0f};
-    if (const Value* b = v.find("base")) base = bsdf(*b, where + ".base", depth + 1);
-    std::string name = m.name;
-    m = base;
-    m.name = name;
-    if (const Value* a = v.find("alpha")) {
-      TextureRef t = texture(*a, where + ".alpha", true);
-      m.alpha = std::clamp(channelMean(t.constant), 0.0f, 1.0f);
-      // A missing alpha map is Tungsten's stand-in checker too: half the squares transparent.
-      if (t.isTexture) m.alphaTexture = t.texture;
+    base.metal = "Cu";
+    base.roughness = 0.1f;
+    base.separableShadowing = true;
+  }
+  if (!ok()) return m;
+  float ior = 1.3f, thickness = 1;  // Tungsten's defaults
+  Vec3 sigmaA{0.0f};
+  number(v, "ior", &ior, where);
+  number(v, "thickness", &thickness, where);
+  const bool rough = type == "rough_coat";
+  // Tungsten's rough coat read its absorption as "sigmaA" before it took "sigma_a".
+  if (!vec3(v, "sigma_a", &sigmaA, where) && rough) vec3(v, "sigmaA", &sigmaA, where);
+  float coatRoughness = 0.02f;  // Tungsten's default
+  if (rough) {
+    if (const Value* r = v.find("roughness")) {
+      TextureRef t = texture(*r, where + ".roughness", true);
+      coatRoughness = channelMean(t.constant);
+      if (t.isTexture) warn(cat(where, ": a rough coat's textured roughness is taken as ", coatRoughness, " everywhere"));
     }
+    if (string(v, "distribution", "ggx") != "ggx") warn(cat(where, ": the rough coat's distribution is rendered as GGX"));
+  }
+  const std::string name = m.name;
+  m = base;
+  m.name = name;
+  if (isTransmissiveType(m.type)) {
+    warn(cat(where, ": a coat over a ", materialTypeName(m.type), " substrate is rendered without the coat"));
     return m;
   }
-  if (type == "smooth_coat" || type == "rough_coat") {
-    // Tungsten's coats: a dielectric layer over a substrate bsdf (its default: a rough conductor).
-    Material base;
-    if (const Value* sv = v.find("substrate")) {
-      base = bsdf(*sv, where + ".substrate", depth + 1);
-    } else {
-      base.type = MaterialType::RoughConductor;
-      base.albedo = Vec3{1.0f};
-      base.metal = "Cu";
-      base.roughness = 0.1f;
-      base.separableShadowing = true;
-    }
-    if (!ok()) return m;
-    float ior = 1.3f, thickness = 1;  // Tungsten's defaults
-    Vec3 sigmaA{0.0f};
-    number(v, "ior", &ior, where);
-    number(v, "thickness", &thickness, where);
-    const bool rough = type == "rough_coat";
-    // Tungsten's rough coat read its absorption as "sigmaA" before it took "sigma_a".
-    if (!vec3(v, "sigma_a", &sigmaA, where) && rough) vec3(v, "sigmaA", &sigmaA, where);
-    float coatRoughness = 0.02f;  // Tungsten's default
-    if (rough) {
-      if (const Value* r = v.find("roughness")) {
-        TextureRef t = texture(*r, where + ".roughness", true);
-        coatRoughness = channelMean(t.constant);
-        if (t.isTexture) warn(cat(where, ": a rough coat's textured roughness is taken as ", coatRoughness, " everywhere"));
-      }
-      if (string(v, "distribution", "ggx") != "ggx") warn(cat(where, ": the rough coat's distribution is rendered as GGX"));
-    }
-    const std::string name = m.name;
-    m = base;
-    m.name = name;
-    if (isTransmissiveType(m.type)) {
-      warn(cat(where, ": a coat over a ", materialTypeName(m.type), " substrate is rendered without the coat"));
-      return m;
-    }
-    if (!(ior > 1.0f)) {
-      warn(cat(where, ": a coat of index ", ior, " reflects and refracts nothing; rendered without it"));
-      return m;
-    }
-    if (base.blendWith != kNoNode) warn(cat(where, ": a coat over a blended substrate is rendered on its first part only"));
-    if (m.coated()) warn(cat(where, ": a coat over a coat is rendered with the outer coat only"));
-    m.coatIor = ior;
-    m.coatAbsorption = max(sigmaA * thickness, Vec3{0.0f});
-    m.coatRoughness = rough ? std::max(coatRoughness, 1e-3f) : 0.0f;
+  if (!(ior > 1.0f)) {
+    warn(cat(where, ": a coat of index ", ior, " reflects and refracts nothing; rendered without it"));
     return m;
   }
-  if (type == "mixed") {
-    // Tungsten's blend, albedo * (ratio * bsdf0 + (1 - ratio) * bsdf1): this material is bsdf0
-    // under the blend's albedo and blends (Material::blendWith) with a copy of bsdf1 under it.
-    // A part that is a blend itself comes back as the first material of its chain of blends,
-    // which the kernel follows: bsdf1's chain goes on after bsdf0; a chain in bsdf0 goes after
-    // bsdf1 instead (the ratio turned round), where the ratio is a constant and bsdf1 no chain.
-    float ratio = 0.5f;
-    NodeId ratioTexture = kNoNode;
-    if (const Value* r = v.find("ratio")) {
-      // A bitmap ratio is read as data, its channels averaged (Tungsten's REQUEST_AVERAGE),
-      // times the bitmap's scale.
-      TextureRef t = texture(*r, where + ".ratio", true);
-      ratio = std::clamp(channelMean(t.constant), 0.0f, 1.0f);
-      if (t.isTexture) ratioTexture = t.texture;
-    }
-    TextureRef albedo;  // Tungsten's default: 1
-    if (const Value* a = v.find("albedo")) albedo = texture(*a, where + ".albedo", false);
-    auto part = [&](const char* key) {
-      const Value* pv = v.find(key);
-      if (!pv) {
-        problem(where, cat("mixed bsdf without \"", key, "\""));
-        return Material{};
-      }
-      Material p = bsdf(*pv, cat(where, ".", key), depth + 1);
-      underAlbedo(p, albedo);
-      return p;
-    };
-    const std::string name = m.name;
-    Material zero = part("bsdf0"), one = part("bsdf1");
-    if (!ok()) return m;
-    Material* first = &zero;
-    Material* rest = &one;
-    float firstRatio = ratio;
-    if (zero.blendWith != kNoNode && one.blendWith == kNoNode && ratioTexture == kNoNode) {
-      first = &one;
-      rest = &zero;
-      firstRatio = 1.0f - ratio;
-    } else if (zero.blendWith != kNoNode) {
-      warn(cat(where, ".bsdf0: a blend in a blend whose ratio is a texture or whose bsdf1 is a blend too is "
-                      "rendered as its first part"));
-      copied_.insert(zero.blendWith);  // dropped if nothing else uses it
-      zero.blendWith = kNoNode;
-      zero.blendRatio = 1;
-      zero.blendRatioTexture = kNoNode;
-    }
-    if (chainLength(*rest) + 1 > kMaxBlendChain) {
-      warn(cat(where, ": blends nested more than ", kMaxBlendChain, " materials deep; the deepest are left out"));
-      cutChain(*rest, kMaxBlendChain - 1);
-    }
-    const bool reversed = first == &one;
-    rest->id = out_.scene.newId();
-    rest->name = cat(name.empty() ? where : name, reversed ? " (bsdf0)" : " (bsdf1)");
-    out_.scene.materials.push_back(*rest);
-    m = *first;
-    m.name = name;
-    m.blendWith = rest->id;
-    m.blendRatio = firstRatio;
-    m.blendRatioTexture = reversed ? kNoNode : ratioTexture;
-    return m;
+  if (base.blendWith != kNoNode) warn(cat(where, ": a coat over a blended substrate is rendered on its first part only"));
+  if (m.coated()) warn(cat(where, ": a coat over a coat is rendered with the outer coat only"));
+  m.coatIor = ior;
+  m.coatAbsorption = max(sigmaA * thickness, Vec3{0.0f});
+  m.coatRoughness = rough ? std::max(coatRoughness, 1e-3f) : 0.0f;
+  return m;
+}
+
+// Tungsten's blend of two bsdfs (Material::blendWith).
+Material TungstenImporter::mixedBsdf(const Value& v, const std::string& where, int depth, Material m) {
+  // Tungsten's blend, albedo * (ratio * bsdf0 + (1 - ratio) * bsdf1): this material is bsdf0
+  // under the blend's albedo and blends (Material::blendWith) with a copy of bsdf1 under it.
+  // A part that is a blend itself comes back as the first material of its chain of blends,
+  // which the kernel follows: bsdf1's chain goes on after bsdf0; a chain in bsdf0 goes after
+  // bsdf1 instead (the ratio turned round), where the ratio is a constant and bsdf1 no chain.
+  float ratio = 0.5f;
+  NodeId ratioTexture = kNoNode;
+  if (const Value* r = v.find("ratio")) {
+    // A bitmap ratio is read as data, its channels averaged (Tungsten's REQUEST_AVERAGE),
+    // times the bitmap's scale.
+    TextureRef t = texture(*r, where + ".ratio", true);
+    ratio = std::clamp(channelMean(t.constant), 0.0f, 1.0f);
+    if (t.isTexture) ratioTexture = t.texture;
   }
+  TextureRef albedo;  // Tungsten's default: 1
+  if (const Value* a = v.find("albedo")) albedo = texture(*a, where + ".albedo", false);
+  auto part = [&](const char* key) {
+    const Value* pv = v.find(key);
+    if (!pv) {
+      problem(where, cat("mixed bsdf without \"", key, "\""));
+      return Material{};
+    }
+    Material p = bsdf(*pv, cat(where, ".", key), depth + 1);
+    underAlbedo(p, albedo);
+    return p;
+  };
+  const std::string name = m.name;
+  Material zero = part("bsdf0"), one = part("bsdf1");
+  if (!ok()) return m;
+  Material* first = &zero;
+  Material* rest = &one;
+  float firstRatio = ratio;
+  if (zero.blendWith != kNoNode && one.blendWith == kNoNode && ratioTexture == kNoNode) {
+    first = &one;
+    rest = &zero;
+    firstRatio = 1.0f - ratio;
+  } else if (zero.blendWith != kNoNode) {
+    warn(cat(where, ".bsdf0: a blend in a blend whose ratio is a texture or whose bsdf1 is a blend too is "
+                    "rendered as its first part"));
+    copied_.insert(zero.blendWith);  // dropped if nothing else uses it
+    zero.blendWith = kNoNode;
+    zero.blendRatio = 1;
+    zero.blendRatioTexture = kNoNode;
+  }
+  if (chainLength(*rest) + 1 > kMaxBlendChain) {
+    warn(cat(where, ": blends nested more than ", kMaxBlendChain, " materials deep; the deepest are left out"));
+    cutChain(*rest, kMaxBlendChain - 1);
+  }
+  const bool reversed = first == &one;
+  rest->id = out_.scene.newId();
+  rest->name = cat(name.empty() ? where : name, reversed ? " (bsdf0)" : " (bsdf1)");
+  out_.scene.materials.push_back(*rest);
+  m = *first;
+  m.name = name;
+  m.blendWith = rest->id;
+  m.blendRatio = firstRatio;
+  m.blendRatioTexture = reversed ? kNoNode : ratioTexture;
+  return m;
+}
+
+// The bsdfs that map onto one material type, with the parameters they share (albedo, roughness,
+// distribution).
+Material TungstenImporter::typedBsdf(const Value& v, const std::string& type, const std::string& where, Material m) {
   if (const Value* a = v.find("albedo")) {
     TextureRef t = texture(*a, where + ".albedo", false);
     m.albedo = t.constant;
@@ -433,6 +427,30 @@ Material TungstenImporter::bsdfOwn(const Value& v, const std::string& where, int
     m.coatingAbsorption = max(sigmaA * thickness, Vec3{0.0f});
   }
   return m;
+}
+
+Material TungstenImporter::bsdfOwn(const Value& v, const std::string& where, int depth, bool emitter) {
+  Material m;
+  m.albedo = Vec3{1.0f};  // Tungsten's default albedo
+  if (v.isString()) return namedBsdf(v, where, emitter, m);
+  if (!v.isObject()) {
+    problem(where, "expected a bsdf object or name");
+    return m;
+  }
+  if (depth > 8) {
+    problem(where, "bsdfs nested too deeply");
+    return m;
+  }
+  m.name = string(v, "name");
+  std::string type = string(v, "type");
+  if (type.empty()) {
+    problem(where, "bsdf without a \"type\"");
+    return m;
+  }
+  if (type == "transparency") return transparencyBsdf(v, where, depth, m);
+  if (type == "smooth_coat" || type == "rough_coat") return coatBsdf(v, type, where, depth, m);
+  if (type == "mixed") return mixedBsdf(v, where, depth, m);
+  return typedBsdf(v, type, where, m);
 }
 
 void TungstenImporter::hairFibre(const Value& v, const std::string& where, Material& m) {

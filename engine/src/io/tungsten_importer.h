@@ -107,6 +107,17 @@ class TungstenImporter {
 
   // The bsdf as its type reads it, without the bump map every type may carry (bsdf adds that).
   Material bsdfOwn(const Value& v, const std::string& where, int depth, bool emitter);
+  // A bsdf named by a string: the named one, or a stand-in for an undefined name (warned of once).
+  Material namedBsdf(const Value& v, const std::string& where, bool emitter, Material m);
+  // Tungsten's transparency: its base bsdf, cut out by alpha.
+  Material transparencyBsdf(const Value& v, const std::string& where, int depth, Material m);
+  // Tungsten's coats: a dielectric layer over a substrate bsdf (Material::coatIor).
+  Material coatBsdf(const Value& v, const std::string& type, const std::string& where, int depth, Material m);
+  // Tungsten's blend of two bsdfs (Material::blendWith).
+  Material mixedBsdf(const Value& v, const std::string& where, int depth, Material m);
+  // The bsdfs that map onto one material type, with the parameters they share (albedo, roughness,
+  // distribution).
+  Material typedBsdf(const Value& v, const std::string& type, const std::string& where, Material m);
 
   // Tungsten's hair (HairBcsdf): its melanin gives the pigment's absorption per unit of the
   // fibre's radius (d'Eon et al. 2011's eumelanin and pheomelanin, mixed by the ratio), unless
@@ -206,6 +217,17 @@ class TungstenImporter {
 
   void environmentEntry(const Value& v, const std::string& where);
 
+  // Tungsten's skydome (the Hosek-Wilkie sky model), drawn as a gradient sky, with a warning.
+  void skydome(const Value& p, const std::string& where);
+  // A cap of the sky: a sun whose disc is the cap (Light::angularRadius).
+  void sphereCap(const Value& p, const std::string& where, const Value* tv);
+  // A point light: Tungsten's emission is its intensity (W/sr), its power spreads over 4 pi.
+  void pointLight(const Value& p, const std::string& where, const Value* tv);
+  // The meshes of a shape primitive (a mesh with several material indices gives one per index),
+  // its transform `xf` made Tungsten's for the shape (a round sphere and cylinder, a disk's frame),
+  // and a disk's emission cone; none, with a warning, for a type not rendered.
+  std::vector<MeshPart> shapeParts(const Value& p, const std::string& type, const std::string& where, Vec3 scale, bool split,
+                                   Mat4& xf, float& emissionCone);
   void primitive(const Value& p, const std::string& where);
 
   fs::path file_;

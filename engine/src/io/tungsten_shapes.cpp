@@ -418,93 +418,84 @@ void TungstenImporter::environmentEntry(const Value& v, const std::string& where
   }
 }
 
-void TungstenImporter::primitive(const Value& p, const std::string& where) {
-  if (!p.isObject()) return problem(where, "expected an object");
-  std::string type = string(p, "type");
-  if (type.empty()) return problem(where, "primitive without a \"type\"");
+// Tungsten's skydome (the Hosek-Wilkie sky model), drawn as a gradient sky, with a warning.
+void TungstenImporter::skydome(const Value& p, const std::string& where) {
   Scene& s = out_.scene;
-  Vec3 scale;
-  const Value* tv = p.find("transform");
+  float intensity = 2;
+  number(p, "intensity", &intensity, where);
+  s.environment.type = EnvironmentType::Sky;
+  s.environment.intensity = intensity * 0.5f;
+  // Tungsten's dome is the sky model's upper half; below the horizon it is black.
+  s.environment.ground = Vec3{0.0f};
+  warn(cat(where, ": the physical skydome is approximated by a gradient sky, black below the horizon as Tungsten's"));
+}
 
-  if (type == "infinite_sphere") {
-    environmentFromEmission(p, where);
-    return;
+// A cap of the sky: a sun whose disc is the cap (Light::angularRadius).
+void TungstenImporter::sphereCap(const Value& p, const std::string& where, const Value* tv) {
+  Scene& s = out_.scene;
+  // A cap of the sky is a sun whose disc is the cap: its radiance is the cap's, which a
+  // directional light of the cap's solid angle times that radiance gives (Light::angularRadius).
+  Mat4 m = transform(tv, where);
+  // Tied to a skydome (Tungsten's InfiniteSphereCap::prepareForRender): the cap is the dome's
+  // sun, around the dome's +y, whatever the cap's own transform says.
+  if (std::string dome = string(p, "skydome"); !dome.empty() && primitives_) {
+    if (std::optional<Mat4> d = transformOfPrimitive(*primitives_, dome))
+      m = *d;
+    else
+      warn(cat(where, ": skydome '", dome, "' names no primitive; the cap keeps its own direction"));
   }
-  if (type == "skydome") {
-    float intensity = 2;
-    number(p, "intensity", &intensity, where);
-    s.environment.type = EnvironmentType::Sky;
-    s.environment.intensity = intensity * 0.5f;
-    // Tungsten's dome is the sky model's upper half; below the horizon it is black.
-    s.environment.ground = Vec3{0.0f};
-    warn(cat(where, ": the physical skydome is approximated by a gradient sky, black below the horizon as Tungsten's"));
-    return;
-  }
-  if (type == "infinite_sphere_cap") {
-    // A cap of the sky is a sun whose disc is the cap: its radiance is the cap's, which a
-    // directional light of the cap's solid angle times that radiance gives (Light::angularRadius).
-    Mat4 m = transform(tv, where);
-    // Tied to a skydome (Tungsten's InfiniteSphereCap::prepareForRender): the cap is the dome's
-    // sun, around the dome's +y, whatever the cap's own transform says.
-    if (std::string dome = string(p, "skydome"); !dome.empty() && primitives_) {
-      if (std::optional<Mat4> d = transformOfPrimitive(*primitives_, dome))
-        m = *d;
-      else
-        warn(cat(where, ": skydome '", dome, "' names no primitive; the cap keeps its own direction"));
-    }
-    float cap = 10;
-    number(p, "cap_angle", &cap, where);
-    Vec3 radiance{1.0f};
-    if (const Value* e = p.find("emission")) radiance = texture(*e, where, false).constant;
-    Light l;
-    l.id = s.newId();
-    l.name = string(p, "name", "sun");
-    l.type = LightType::Directional;
-    l.direction = -normalize(m.transformVector({0, 1, 0}));
-    l.angularRadius = std::isfinite(cap) ? std::clamp(radians(cap), 0.0f, kPi / 2) : radians(10.0f);
-    if (!(cap >= 0 && cap <= 90)) warn(cat(where, ": cap_angle ", cap, " is taken as ", degrees(l.angularRadius), " degrees"));
-    float solidAngle = 2 * kPi * (1 - std::cos(l.angularRadius));
-    // Given as power, its radiance is the power over the cap's solid angle (Tungsten's
-    // InfiniteSphereCap::powerToRadianceFactor).
-    if (const Value* pw = p.find("power"); pw && !p.find("emission") && solidAngle > 0)
-      radiance = texture(*pw, where + ".power", false).constant / solidAngle;
-    float power = maxComponent(radiance) * solidAngle;
-    l.color = power > 0 ? radiance / maxComponent(radiance) : Vec3{1.0f};
-    l.intensity = power;
-    s.lights.push_back(l);
-    return;
-  }
+  float cap = 10;
+  number(p, "cap_angle", &cap, where);
+  Vec3 radiance{1.0f};
+  if (const Value* e = p.find("emission")) radiance = texture(*e, where, false).constant;
+  Light l;
+  l.id = s.newId();
+  l.name = string(p, "name", "sun");
+  l.type = LightType::Directional;
+  l.direction = -normalize(m.transformVector({0, 1, 0}));
+  l.angularRadius = std::isfinite(cap) ? std::clamp(radians(cap), 0.0f, kPi / 2) : radians(10.0f);
+  if (!(cap >= 0 && cap <= 90)) warn(cat(where, ": cap_angle ", cap, " is taken as ", degrees(l.angularRadius), " degrees"));
+  float solidAngle = 2 * kPi * (1 - std::cos(l.angularRadius));
+  // Given as power, its radiance is the power over the cap's solid angle (Tungsten's
+  // InfiniteSphereCap::powerToRadianceFactor).
+  if (const Value* pw = p.find("power"); pw && !p.find("emission") && solidAngle > 0)
+    radiance = texture(*pw, where + ".power", false).constant / solidAngle;
+  float power = maxComponent(radiance) * solidAngle;
+  l.color = power > 0 ? radiance / maxComponent(radiance) : Vec3{1.0f};
+  l.intensity = power;
+  s.lights.push_back(l);
+}
 
-  if (type == "point") {
-    // A point light: Tungsten's emission is its intensity (W/sr), its power spreads over 4 pi.
-    Mat4 m = transform(tv, where);
-    Vec3 intensity{0.0f};
-    if (const Value* e = p.find("emission")) intensity = texture(*e, where + ".emission", false).constant;
-    if (const Value* pw = p.find("power")) intensity = texture(*pw, where + ".power", false).constant / (4 * kPi);
-    if (!ok()) return;
-    Light l;
-    l.id = s.newId();
-    l.name = string(p, "name", cat("point ", s.lights.size() + 1));
-    l.type = LightType::Point;
-    l.position = m.transformPoint({0, 0, 0});
-    l.intensity = maxComponent(intensity);
-    l.color = l.intensity > 0 ? intensity / l.intensity : Vec3{1.0f};
-    if (!std::isfinite(l.intensity) || !isFinite(l.position)) {
-      warn(cat(where, ": the point light's position or intensity is not finite; skipped"));
-      return;
-    }
-    s.lights.push_back(l);
-    return;
-  }
-
-  std::vector<MeshPart> parts;  // one for every shape but a mesh with several material indices
-  float emissionCone = 90;      // Material::emissionCone, a disk's cone_angle
-  Mat4 xf = transform(tv, where, &scale, type == "quad" || type == "disk");
+// A point light: Tungsten's emission is its intensity (W/sr), its power spreads over 4 pi.
+void TungstenImporter::pointLight(const Value& p, const std::string& where, const Value* tv) {
+  Scene& s = out_.scene;
+  // A point light: Tungsten's emission is its intensity (W/sr), its power spreads over 4 pi.
+  Mat4 m = transform(tv, where);
+  Vec3 intensity{0.0f};
+  if (const Value* e = p.find("emission")) intensity = texture(*e, where + ".emission", false).constant;
+  if (const Value* pw = p.find("power")) intensity = texture(*pw, where + ".power", false).constant / (4 * kPi);
   if (!ok()) return;
-  const Value* bsdfs = p.find("bsdf");
-  const bool byIndex = bsdfs && bsdfs->isArray() && !bsdfs->asArray().empty();
+  Light l;
+  l.id = s.newId();
+  l.name = string(p, "name", cat("point ", s.lights.size() + 1));
+  l.type = LightType::Point;
+  l.position = m.transformPoint({0, 0, 0});
+  l.intensity = maxComponent(intensity);
+  l.color = l.intensity > 0 ? intensity / l.intensity : Vec3{1.0f};
+  if (!std::isfinite(l.intensity) || !isFinite(l.position)) {
+    warn(cat(where, ": the point light's position or intensity is not finite; skipped"));
+    return;
+  }
+  s.lights.push_back(l);
+}
+
+// The meshes of a shape primitive (a mesh with several material indices gives one per index),
+// its transform `xf` made Tungsten's for the shape (a round sphere and cylinder, a disk's frame),
+// and a disk's emission cone; none, with a warning, for a type not rendered.
+std::vector<TungstenImporter::MeshPart> TungstenImporter::shapeParts(const Value& p, const std::string& type, const std::string& where, Vec3 scale, bool split, Mat4& xf, float& emissionCone) {
+  std::vector<MeshPart> parts;
   if (type == "mesh") {
-    parts = loadMesh(p, where, byIndex && bsdfs->asArray().size() > 1);
+    parts = loadMesh(p, where, split);
   } else if (type == "quad" || type == "cube") {
     parts.push_back({0, meshNode(type, type, shape(type))});
   } else if (type == "disk") {
@@ -534,12 +525,48 @@ void TungstenImporter::primitive(const Value& p, const std::string& where) {
     parts.push_back({0, meshNode(kind, "cylinder", shape(kind))});
   } else if (type == "curves") {
     NodeId mesh = curves(p, where);
-    if (mesh == kNoNode) return;
+    if (mesh == kNoNode) return {};
     parts.push_back({0, mesh});
   } else {
     warn(cat(where, ": primitive type '", type, "' is not supported; skipped"));
+    return {};
+  }
+  return parts;
+}
+
+void TungstenImporter::primitive(const Value& p, const std::string& where) {
+  if (!p.isObject()) return problem(where, "expected an object");
+  std::string type = string(p, "type");
+  if (type.empty()) return problem(where, "primitive without a \"type\"");
+  Scene& s = out_.scene;
+  Vec3 scale;
+  const Value* tv = p.find("transform");
+
+  if (type == "infinite_sphere") {
+    environmentFromEmission(p, where);
     return;
   }
+  if (type == "skydome") {
+    skydome(p, where);
+    return;
+  }
+  if (type == "infinite_sphere_cap") {
+    sphereCap(p, where, tv);
+    return;
+  }
+
+  if (type == "point") {
+    pointLight(p, where, tv);
+    return;
+  }
+
+  float emissionCone = 90;      // Material::emissionCone, a disk's cone_angle
+  Mat4 xf = transform(tv, where, &scale, type == "quad" || type == "disk");
+  if (!ok()) return;
+  const Value* bsdfs = p.find("bsdf");
+  const bool byIndex = bsdfs && bsdfs->isArray() && !bsdfs->asArray().empty();
+  // One part for every shape but a mesh with several material indices.
+  std::vector<MeshPart> parts = shapeParts(p, type, where, scale, byIndex && bsdfs->asArray().size() > 1, xf, emissionCone);
   if (!ok() || parts.empty()) return;
   if (!xf.isFinite() || xf.inverse().m[3][3] == 0.0f) {
     warn(cat(where, ": transform is degenerate; the primitive is skipped"));
