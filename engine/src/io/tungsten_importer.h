@@ -228,6 +228,18 @@ class TungstenImporter {
   // and a disk's emission cone; none, with a warning, for a type not rendered.
   std::vector<MeshPart> shapeParts(const Value& p, const std::string& type, const std::string& where, Vec3 scale, bool split,
                                    Mat4& xf, float& emissionCone);
+  // What a primitive emits (Tungsten's emission, or its power spread over its area): the emission
+  // belongs to the primitive in Tungsten and to the material here.
+  struct Emission {
+    Vec3 radiance{0.0f};
+    NodeId texture = kNoNode;
+    bool emissive = false;
+  };
+  Emission emissionOf(const Value& p, const std::string& where, const std::vector<MeshPart>& parts, const Mat4& xf);
+  // A medium inside glass or a boundary belongs to the primitive in Tungsten and to the material
+  // here (its int_medium fills `mat`); the one outside (ext_medium) is where the path comes from,
+  // which it remembers, so it needs nothing if something holds it inside. Returns the medium filled.
+  std::string fillMedium(const Value& p, const std::string& where, Material& mat);
   void primitive(const Value& p, const std::string& where);
 
   fs::path file_;

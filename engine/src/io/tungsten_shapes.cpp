@@ -534,6 +534,49 @@ std::vector<TungstenImporter::MeshPart> TungstenImporter::shapeParts(const Value
   return parts;
 }
 
+TungstenImporter::Emission TungstenImporter::emissionOf(const Value& p, const std::string& where,
+                                                       const std::vector<MeshPart>& parts, const Mat4& xf) {
+  Emission light;
+  if (const Value* e = p.find("emission")) {
+    TextureRef t = texture(*e, where + ".emission", false);
+    light = {t.constant, t.texture, true};
+  }
+  if (const Value* pw = p.find("power")) {
+    TextureRef t = texture(*pw, where + ".power", false);
+    float area = 0;  // the whole primitive's: its power spreads over every part
+    for (const MeshPart& part : parts)
+      if (const Mesh* mm = out_.scene.mesh(part.mesh); mm && mm->geometry) area += worldArea(*mm->geometry, xf);
+    light = {area > 0 ? t.constant / (kPi * area) : Vec3{0.0f}, t.texture, true};
+  }
+  return light;
+}
+
+std::string TungstenImporter::fillMedium(const Value& p, const std::string& where, Material& mat) {
+  std::string medium;
+  if (const std::string name = string(p, "int_medium"); !name.empty() && media_.count(name)) {
+    if (holdsMedium(mat.type)) {
+      medium = name;
+      const Filling& f = media_[name];
+      mat.interiorAbsorption = f.absorption;
+      mat.interiorScattering = f.scattering;
+      mat.interiorAnisotropy = f.anisotropy;
+    } else {
+      warn(cat(where, ": the medium '", name, "' is rendered only inside glass or a forward boundary (an int_medium); here light passes through it"));
+    }
+  }
+  if (const std::string name = string(p, "ext_medium"); !name.empty() && media_.count(name)) {
+    outside_.emplace_back(where, name);  // warned of once every primitive is read, if nothing holds it
+    if (mat.type == MaterialType::Boundary && !medium.empty())
+      warn(cat(where, ": a boundary of '", medium, "' inside the medium '", name,
+               "': a path inside it is in '", medium, "' alone, but its shadow rays count both"));
+  }
+  if (!medium.empty()) {
+    inside_.insert(medium);
+    holders_.emplace_back(where, string(p, "ext_medium"));
+  }
+  return medium;
+}
+
 void TungstenImporter::primitive(const Value& p, const std::string& where) {
   if (!p.isObject()) return problem(where, "expected an object");
   std::string type = string(p, "type");
@@ -592,24 +635,8 @@ void TungstenImporter::primitive(const Value& p, const std::string& where) {
     bumpTexture = t.texture;
     bumpStrength *= t.constant.x;  // a bitmap's scale
   }
-  Vec3 emission{0.0f};
-  NodeId emissionTexture = kNoNode;
-  bool emissive = false;
-  if (const Value* e = p.find("emission")) {
-    TextureRef t = texture(*e, where + ".emission", false);
-    emission = t.constant;
-    emissionTexture = t.texture;
-    emissive = true;
-  }
-  if (const Value* pw = p.find("power")) {
-    TextureRef t = texture(*pw, where + ".power", false);
-    float area = 0;  // the whole primitive's: its power spreads over every part
-    for (const MeshPart& part : parts)
-      if (const Mesh* mm = s.mesh(part.mesh); mm && mm->geometry) area += worldArea(*mm->geometry, xf);
-    emission = area > 0 ? t.constant / (kPi * area) : Vec3{0.0f};
-    emissionTexture = t.texture;
-    emissive = true;
-  }
+  const Emission light = emissionOf(p, where, parts, xf);
+  const bool emissive = light.emissive;
 
   // An array names one bsdf per material index (Tungsten's TriangleMesh: a triangle's index
   // picks its bsdf); an index past the array's end takes its last entry.
@@ -635,31 +662,7 @@ void TungstenImporter::primitive(const Value& p, const std::string& where) {
       mat.bumpTexture = bumpTexture;
       mat.bumpStrength = bumpStrength;
     }
-    // A medium inside glass or a boundary belongs to the primitive in Tungsten and to the
-    // material here. The one outside (ext_medium) is where the path comes from, which it
-    // remembers, so it needs nothing, if something holds it inside.
-    std::string medium;
-    if (const std::string name = string(p, "int_medium"); !name.empty() && media_.count(name)) {
-      if (holdsMedium(mat.type)) {
-        medium = name;
-        const Filling& f = media_[name];
-        mat.interiorAbsorption = f.absorption;
-        mat.interiorScattering = f.scattering;
-        mat.interiorAnisotropy = f.anisotropy;
-      } else {
-        warn(cat(where, ": the medium '", name, "' is rendered only inside glass or a forward boundary (an int_medium); here light passes through it"));
-      }
-    }
-    if (const std::string name = string(p, "ext_medium"); !name.empty() && media_.count(name)) {
-      outside_.emplace_back(where, name);  // warned of once every primitive is read, if nothing holds it
-      if (mat.type == MaterialType::Boundary && !medium.empty())
-        warn(cat(where, ": a boundary of '", medium, "' inside the medium '", name,
-                 "': a path inside it is in '", medium, "' alone, but its shadow rays count both"));
-    }
-    if (!medium.empty()) {
-      inside_.insert(medium);
-      holders_.emplace_back(where, string(p, "ext_medium"));
-    }
+    const std::string medium = fillMedium(p, where, mat);
     if ((bumpTexture != kNoNode || !medium.empty()) && !emissive) {
       // Primitives naming the same bsdf with the same bump and medium share one copy; an
       // inline bsdf is the primitive's own (two unnamed ones must not meet under the empty name).
@@ -682,8 +685,8 @@ void TungstenImporter::primitive(const Value& p, const std::string& where) {
       Material m = mat;
       m.id = s.newId();
       m.name = cat(mat.name.empty() ? std::string("emitter") : mat.name, " (", string(p, "name", cat("light ", ++emitters_)), ")");
-      m.emission = max(emission, Vec3{0.0f});
-      m.emissionTexture = emissionTexture;
+      m.emission = max(light.radiance, Vec3{0.0f});
+      m.emissionTexture = light.texture;
       m.emissionCone = emissionCone;
       s.materials.push_back(m);
       materialId = m.id;
