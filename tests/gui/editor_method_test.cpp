@@ -72,7 +72,9 @@ TEST(EditorMethod, AMaterialEditServesTheMaterialsObjectsByTheirClasses) {
   MethodSettings m;
   m.kind = MethodKind::Indirection;
   m.tileSize = 8;
-  m.quality = 0;
+  // A fixed Q long enough for the pass to span many frames: a slow GUI thread (CI, under ASan)
+  // shows only the newest frame, and a short pass could be over between two it shows.
+  m.quality = 64;
   m.indirectionFrames = 2;
   w->engine()->submit(MethodCommand{m});
   w->select(sphere);
