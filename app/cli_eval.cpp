@@ -26,6 +26,8 @@ namespace retile::cli {
 
 namespace {
 
+using Clock = std::chrono::steady_clock;
+
 std::string html(const std::string& s) {
   std::string o;
   for (char c : s) {
@@ -70,7 +72,6 @@ int runStability(const std::vector<std::string>& sceneNames, const std::vector<s
   std::filesystem::create_directories(out, ec);
   if (ec) return std::fprintf(stderr, "error: cannot create %s: %s\n", out.string().c_str(), ec.message().c_str()), 1;
   eval::References refs(out / "references", options.referenceSpp);
-  using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   std::string csv = "scene,case,method,figure,threshold,pass,detail,broken\n";
   std::string page =
@@ -202,7 +203,6 @@ int runEval(const EvalOptions& o) {
   metrics << eval::metricsCsvHeader();
   std::vector<ScenarioResult> results;
   std::vector<std::string> notes;
-  using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   auto seconds = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
 

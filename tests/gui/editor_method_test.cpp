@@ -33,13 +33,9 @@ namespace retile::ui {
 namespace {
 
 using test::makeWindow;
+using test::meanSamples;
 using test::objectNamed;
 using test::waitForFrame;
-
-double meanSamples(const FrameRecord& f) {
-  if (f.tileSamples.empty()) return 0.0;
-  return std::accumulate(f.tileSamples.begin(), f.tileSamples.end(), 0.0) / static_cast<double>(f.tileSamples.size());
-}
 
 // Types `text` into a number field as a user does: a click, the keys, then `finish`.
 void typeInto(ScrubField* field, const QString& text, Qt::Key finish) {

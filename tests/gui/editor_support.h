@@ -6,9 +6,11 @@
 
 #include <functional>
 #include <memory>
+#include <numeric>
 
 #include "frame_view.h"
 #include "main_window.h"
+#include "test_support.h"
 
 namespace retile::ui::test {
 
@@ -26,10 +28,12 @@ inline bool waitForFrame(MainWindow& w, const std::function<bool(const FrameReco
   return QTest::qWaitFor([&] { return w.viewport()->frame() && pred(*w.viewport()->frame()); }, ms);
 }
 
-inline NodeId objectNamed(const Scene& s, const std::string& name) {
-  for (const auto& o : s.objects)
-    if (o.name == name) return o.id;
-  return kNoNode;
+using retile::test::objectNamed;
+
+// The mean of a frame's samples per tile.
+inline double meanSamples(const FrameRecord& f) {
+  if (f.tileSamples.empty()) return 0.0;
+  return std::accumulate(f.tileSamples.begin(), f.tileSamples.end(), 0.0) / static_cast<double>(f.tileSamples.size());
 }
 
 // A widget point over a pixel of the viewport's newest frame that shows `object`; (-1, -1) if none.

@@ -38,6 +38,7 @@ namespace retile::ui {
 namespace {
 
 using test::makeWindow;
+using test::meanSamples;
 using test::objectNamed;
 using test::pointShowing;
 using test::waitForFrame;
@@ -85,11 +86,6 @@ TEST(Editor, EditFromThePropertiesReRendersAroundTheObjectAndUndoes) {
 }
 
 // A widget point over a pixel of the shown frame whose first hit is `object`; (-1, -1) if none.
-
-double meanSamples(const FrameRecord& f) {
-  if (f.tileSamples.empty()) return 0.0;
-  return std::accumulate(f.tileSamples.begin(), f.tileSamples.end(), 0.0) / static_cast<double>(f.tileSamples.size());
-}
 
 TEST(Editor, CameraNavigationAndDraggingTheSelectionAreSingleUndoSteps) {
   auto w = makeWindow();

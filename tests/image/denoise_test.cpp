@@ -141,11 +141,7 @@ std::vector<std::size_t> strongestEdges(const RenderImage& ref, NodeId object) {
   return out;
 }
 
-NodeId objectNamed(const Scene& s, const std::string& name) {
-  for (const Object& o : s.objects)
-    if (o.name == name) return o.id;
-  return kNoNode;
-}
+using test::objectNamed;
 
 TEST(Denoise, KeepsTexturesSilhouettesAndReflectionsSharp) {
   RETILE_RENDERER_OR_SKIP(probe);

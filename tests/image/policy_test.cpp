@@ -170,11 +170,7 @@ Scene smallDefault() {
   return s;
 }
 
-NodeId objectNamed(const Scene& s, const std::string& name) {
-  for (const auto& o : s.objects)
-    if (o.name == name) return o.id;
-  return kNoNode;
-}
+using test::objectNamed;
 
 TEST(Policies, EveryMethodConvergesToAFreshRenderAfterAMove) {
   RETILE_RENDERER_OR_SKIP(probe);

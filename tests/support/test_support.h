@@ -14,6 +14,13 @@
 
 namespace retile::test {
 
+// The first object of that name, kNoNode if none.
+inline NodeId objectNamed(const Scene& s, const std::string& name) {
+  for (const Object& o : s.objects)
+    if (o.name == name) return o.id;
+  return kNoNode;
+}
+
 std::filesystem::path sharedDir();
 // The path under ../shared, or an empty path when the folder is absent (then the test must skip).
 std::filesystem::path sharedPath(const std::string& relative);

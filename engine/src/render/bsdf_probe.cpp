@@ -1,5 +1,6 @@
 #include "render/bsdf_probe.h"
 
+#include <array>
 #include <cstring>
 
 #include "render/render_scene.h"
@@ -21,9 +22,14 @@ std::vector<BsdfAnswer> BsdfProbe::run(const std::vector<BsdfQuery>& queries) {
   constexpr std::size_t kQueryVec4s = gpu::kMaterialTexels + 3;
   std::vector<vec4> in;
   in.reserve(queries.size() * kQueryVec4s);
+  // Queries come in runs of one material (tests ask hundreds of thousands of one): each run is
+  // packed once.
+  const Material* packedFrom = nullptr;
+  std::array<vec4, gpu::kMaterialTexels> packed{};
   for (const BsdfQuery& q : queries) {
-    auto m = packMaterial(q.material);
-    in.insert(in.end(), m.begin(), m.end());
+    if (!packedFrom || !(*packedFrom == q.material)) packed = packMaterial(q.material);
+    packedFrom = &q.material;
+    in.insert(in.end(), packed.begin(), packed.end());
     in.push_back({q.wo.x, q.wo.y, q.wo.z, q.hairH});
     for (Vec3 v : {q.wi, q.u}) in.push_back({v.x, v.y, v.z, 0.0f});
   }

@@ -9,7 +9,7 @@
 namespace retile {
 
 namespace {
-std::uint32_t bitsOf(float f) { return std::bit_cast<std::uint32_t>(f); }
+std::uint32_t wordOf(float f) { return std::bit_cast<std::uint32_t>(f); }
 std::int32_t intOf(float f) { return std::bit_cast<std::int32_t>(f); }
 
 // scene.glsl's kStackSize: a push onto a full stack is dropped there, and here.
@@ -50,9 +50,9 @@ PackedTrace tracePacked(std::span<const gpu::vec4> mesh, std::span<const gpu::ve
     const gpu::vec4 r0 = texel(at), r1 = texel(at + 1), r2 = texel(at + 2);
     std::int32_t next = -1;
     if (kind == gpu::kItemNode) {
-      const std::uint32_t w0 = bitsOf(r0.w);
-      const std::array<std::uint32_t, 4> qa{bitsOf(r1.x), bitsOf(r1.y), bitsOf(r1.z), bitsOf(r1.w)};
-      const std::array<std::uint32_t, 4> qb{bitsOf(r2.x), bitsOf(r2.y), bitsOf(r2.z), bitsOf(r2.w)};
+      const std::uint32_t w0 = wordOf(r0.w);
+      const std::array<std::uint32_t, 4> qa{wordOf(r1.x), wordOf(r1.y), wordOf(r1.z), wordOf(r1.w)};
+      const std::array<std::uint32_t, 4> qb{wordOf(r2.x), wordOf(r2.y), wordOf(r2.z), wordOf(r2.w)};
       // Per axis: the planes a ray enters and leaves by (lo and hi swap where it goes negative).
       const std::uint32_t lo[3] = {qa[0], qa[1], qa[2]}, hi[3] = {qa[3], qb[0], qb[1]};
       const float originOf[3] = {r0.x, r0.y, r0.z};
