@@ -53,8 +53,7 @@ void progressBar(const std::string& label, int done, int total, double seconds) 
   std::string bar(static_cast<std::size_t>(filled), '#');
   bar.resize(width, '.');
   double eta = done > 0 ? seconds * (total - done) / done : 0;
-  std::fprintf(stderr, "\r%s [%s] %d/%d  %.1f s elapsed, %.1f s left   ", label.c_str(), bar.c_str(), done, total,
-               seconds, eta);
+  std::fprintf(stderr, "\r%s [%s] %d/%d  %.1f s elapsed, %.1f s left   ", label.c_str(), bar.c_str(), done, total, seconds, eta);
   if (done >= total) std::fprintf(stderr, "\n");
   std::fflush(stderr);
 }
@@ -69,15 +68,15 @@ int runImport(const std::string& file, const std::string& saveAs) {
   }
   const Scene& s = scene->scene;
   for (const auto& w : scene->warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-  std::printf("%s: %s scene: %zu objects, %zu meshes, %zu triangles, %zu materials, %zu textures, %zu lights\n",
-              file.c_str(), scene->format.c_str(), s.objects.size(), s.meshes.size(), s.triangleCount(),
-              s.materials.size(), s.textures.size(), s.lights.size());
+  std::printf("%s: %s scene: %zu objects, %zu meshes, %zu triangles, %zu materials, %zu textures, %zu lights\n", file.c_str(),
+              scene->format.c_str(), s.objects.size(), s.meshes.size(), s.triangleCount(), s.materials.size(), s.textures.size(),
+              s.lights.size());
   const Environment& e = s.environment;
   std::string environment = cat("environment: ", environmentTypeName(e.type));
   if (e.filled()) {
     const Vec3 a = e.mediumAbsorption, sc = e.mediumScattering;
-    environment += cat("; a medium fills the world: absorption (", a.x, ", ", a.y, ", ", a.z, "), scattering (", sc.x, ", ",
-                       sc.y, ", ", sc.z, "), anisotropy ", e.mediumAnisotropy);
+    environment += cat("; a medium fills the world: absorption (", a.x, ", ", a.y, ", ", a.z, "), scattering (", sc.x, ", ", sc.y, ", ",
+                       sc.z, "), anisotropy ", e.mediumAnisotropy);
   }
   std::printf("%s\n", environment.c_str());
   if (!saveAs.empty()) {
@@ -94,15 +93,13 @@ int runImport(const std::string& file, const std::string& saveAs) {
 }  // namespace
 
 void addImport(CLI::App& app, int* status) {
-  CLI::App* cmd =
-      app.add_subcommand("import", "Import a scene and say what it holds (objects, meshes, triangles, ...)");
+  CLI::App* cmd = app.add_subcommand("import", "Import a scene and say what it holds (objects, meshes, triangles, ...)");
   auto file = std::make_shared<std::string>();
   cmd->add_option("FILE", *file, "a scene file (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default'")
       ->required()
       ->type_name("");
   auto saveAs = std::make_shared<std::string>();
-  cmd->add_option("--save", *saveAs, "also save the imported scene in Retile's own format (.retile), atomically")
-      ->type_name("OUT.retile");
+  cmd->add_option("--save", *saveAs, "also save the imported scene in Retile's own format (.retile), atomically")->type_name("OUT.retile");
   cmd->callback([file, saveAs, status] { *status = runImport(*file, *saveAs); });
 }
 

@@ -47,17 +47,15 @@ struct ImageSize {
 };
 
 CLI::Option* addInt(CLI::App& app, const std::string& name, int* out, int lo, int hi, const std::string& help);
-CLI::Option* addNumber(CLI::App& app, const std::string& name, double* out, double lo, double hi,
-                       const std::string& help);
+CLI::Option* addNumber(CLI::App& app, const std::string& name, double* out, double lo, double hi, const std::string& help);
 // --size WxH, each side 1..kMaxImageSide.
 CLI::Option* addSize(CLI::App& app, ImageSize* out, const std::string& help);
 // Without the option `out` stays empty; `otherwise` says what is used then ("the scene's").
-CLI::Option* addInt(CLI::App& app, const std::string& name, std::optional<int>* out, int lo, int hi,
-                    const std::string& help, const std::string& otherwise);
-CLI::Option* addNumber(CLI::App& app, const std::string& name, std::optional<double>* out, double lo, double hi,
-                       const std::string& help, const std::string& otherwise);
-CLI::Option* addSize(CLI::App& app, std::optional<ImageSize>* out, const std::string& help,
-                     const std::string& otherwise);
+CLI::Option* addInt(CLI::App& app, const std::string& name, std::optional<int>* out, int lo, int hi, const std::string& help,
+                    const std::string& otherwise);
+CLI::Option* addNumber(CLI::App& app, const std::string& name, std::optional<double>* out, double lo, double hi, const std::string& help,
+                       const std::string& otherwise);
+CLI::Option* addSize(CLI::App& app, std::optional<ImageSize>* out, const std::string& help, const std::string& otherwise);
 // A positional SCENE: a file any importer reads, or "default".
 CLI::Option* addScene(CLI::App& app, std::string* out);
 // Refuses a value that is not one of `names`; `what` names their kind in the message ("method").

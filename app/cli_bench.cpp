@@ -28,8 +28,7 @@ using Clock = std::chrono::steady_clock;
 // One warm-up frame (pipeline creation, first touch of buffers), then `frames` frames of `spp`
 // samples per pixel over the whole image; their statistics summed, and their wall clock (warm-up
 // excluded).
-FrameStats traceFrames(Renderer& renderer, int w, int h, int frames, int spp, const FrameOptions& options,
-                       double* wallSeconds = nullptr) {
+FrameStats traceFrames(Renderer& renderer, int w, int h, int frames, int spp, const FrameOptions& options, double* wallSeconds = nullptr) {
   TileWork all{0, 0, w, h, spp, 0, true};
   renderer.renderFrame({all}, options);
   const auto start = Clock::now();
@@ -71,15 +70,13 @@ int frameSpp(ImageSize size, std::optional<int> sppPerFrame) {
 int benchScale(const ScaleOptions& o) {
   if (auto tooLarge = frameTooLarge(o.size, o.sppPerFrame)) return std::fprintf(stderr, "error: %s\n", tooLarge->c_str()), 2;
   const int w = o.size.width, h = o.size.height, frames = o.frames;
-  std::printf("%10s %12s %10s %12s %14s %12s\n", "triangles", "samples/s", "vs first", "upload s", "device MiB",
-              "bytes/tri");
+  std::printf("%10s %12s %10s %12s %14s %12s\n", "triangles", "samples/s", "vs first", "upload s", "device MiB", "bytes/tri");
   double first = 0;
   for (int rings : {64, 158, 354, 500, 708}) {  // 4 rings^2 triangles: ~16 k, 100 k, 500 k, 1 M, 2 M
     Scene scene = makeDefaultScene();
     Material mat;
     mat.type = MaterialType::RoughPlastic;
-    addMeshObject(scene, "dense sphere", makeSphere(rings, 2 * rings), mat,
-                  Mat4::translate({0.2f, 0.6f, 0.6f}) * Mat4::scale(Vec3{0.6f}));
+    addMeshObject(scene, "dense sphere", makeSphere(rings, 2 * rings), mat, Mat4::translate({0.2f, 0.6f, 0.6f}) * Mat4::scale(Vec3{0.6f}));
     Renderer renderer;
     auto t0 = Clock::now();
     renderer.setScene(scene);
@@ -90,8 +87,8 @@ int benchScale(const ScaleOptions& o) {
     const double rate = static_cast<double>(sum.samples) / sum.seconds;
     if (first == 0) first = rate;
     const auto tris = renderer.sceneTriangles();
-    std::printf("%10llu %10.3f M %9.2fx %12.2f %14.1f %12.1f\n", static_cast<unsigned long long>(tris), rate * 1e-6,
-                rate / first, upload, static_cast<double>(renderer.sceneDeviceBytes()) / (1 << 20),
+    std::printf("%10llu %10.3f M %9.2fx %12.2f %14.1f %12.1f\n", static_cast<unsigned long long>(tris), rate * 1e-6, rate / first, upload,
+                static_cast<double>(renderer.sceneDeviceBytes()) / (1 << 20),
                 static_cast<double>(renderer.sceneDeviceBytes()) / static_cast<double>(tris));
     std::fflush(stdout);
   }
@@ -107,7 +104,7 @@ struct RoomOptions {
   int frames = 8;
   int maxBounces = 16;
   std::optional<int> sppPerFrame;  // empty: as retile render (frameSpp)
-  std::string writeScene;  // also save the first room as a native scene, to look at
+  std::string writeScene;          // also save the first room as a native scene, to look at
   std::string roulette = "standard";
 };
 
@@ -123,8 +120,10 @@ std::vector<std::uint64_t> parseCounts(const std::string& text) {
     if (end == std::string::npos) end = text.size();
     std::string item = text.substr(start, end - start);
     std::uint64_t scale = 1;
-    if (!item.empty() && (item.back() == 'k' || item.back() == 'K')) scale = 1000, item.pop_back();
-    else if (!item.empty() && (item.back() == 'M' || item.back() == 'm')) scale = 1000000, item.pop_back();
+    if (!item.empty() && (item.back() == 'k' || item.back() == 'K'))
+      scale = 1000, item.pop_back();
+    else if (!item.empty() && (item.back() == 'M' || item.back() == 'm'))
+      scale = 1000000, item.pop_back();
     std::uint64_t v = 0;
     auto r = std::from_chars(item.data(), item.data() + item.size(), v);
     if (r.ec != std::errc() || r.ptr != item.data() + item.size() || v == 0) return {};
@@ -148,8 +147,8 @@ int benchRoom(const RoomOptions& o) {
   const std::vector<std::uint64_t> counts = parseCounts(o.triangles);
   // Loop iterations per path do not drift with the machine's speed, as samples/s does.
   // The peak RSS is the process's so far, so with counts in growing order each row's is its own.
-  std::printf("%10s %11s %9s %9s %9s %10s %9s | bytes per triangle: %6s %6s %6s %6s %6s\n", "triangles", "samples/s",
-              "iter/path", "build s", "objects", "device MiB", "peak RSS", "total", "tris", "BVH", "shade", "other");
+  std::printf("%10s %11s %9s %9s %9s %10s %9s | bytes per triangle: %6s %6s %6s %6s %6s\n", "triangles", "samples/s", "iter/path",
+              "build s", "objects", "device MiB", "peak RSS", "total", "tris", "BVH", "shade", "other");
   for (std::uint64_t n : counts) {
     Scene scene = makeFurnishedRoom(n);
     scene.settings.roulette = rouletteNamed(o.roulette);
@@ -168,10 +167,9 @@ int benchRoom(const RoomOptions& o) {
     const Renderer::SceneMemory m = renderer.sceneMemory();
     const double total = static_cast<double>(renderer.sceneDeviceBytes());
     const double iterations = static_cast<double>(sum.loopIterations) / static_cast<double>(std::max<std::uint64_t>(sum.samples, 1));
-    std::printf("%10.0f %9.3f M %9.1f %9.2f %9zu %10.1f %6.0f MB | %26.1f %6.1f %6.1f %6.1f %6.1f\n", tris, rate * 1e-6, iterations,
-                build, scene.objects.size(), total / (1 << 20), peakResidentMb(), total / tris, static_cast<double>(m.triangles) / tris,
-                static_cast<double>(m.bvh) / tris, static_cast<double>(m.shading) / tris,
-                static_cast<double>(m.textures + m.other) / tris);
+    std::printf("%10.0f %9.3f M %9.1f %9.2f %9zu %10.1f %6.0f MB | %26.1f %6.1f %6.1f %6.1f %6.1f\n", tris, rate * 1e-6, iterations, build,
+                scene.objects.size(), total / (1 << 20), peakResidentMb(), total / tris, static_cast<double>(m.triangles) / tris,
+                static_cast<double>(m.bvh) / tris, static_cast<double>(m.shading) / tris, static_cast<double>(m.textures + m.other) / tris);
     std::fflush(stdout);
   }
   return 0;
@@ -214,26 +212,24 @@ int benchThroughput(const ThroughputOptions& o) {
               static_cast<double>(sum.primaryRays + sum.bounceRays + sum.shadowRays) / sec * 1e-6,
               static_cast<double>(sum.primaryRays) / sec * 1e-6, static_cast<double>(sum.bounceRays) / sec * 1e-6,
               static_cast<double>(sum.shadowRays) / sec * 1e-6);
-  std::printf("rays/sample    %.2f\n", static_cast<double>(sum.primaryRays + sum.bounceRays + sum.shadowRays) /
-                                            static_cast<double>(sum.samples));
+  std::printf("rays/sample    %.2f\n",
+              static_cast<double>(sum.primaryRays + sum.bounceRays + sum.shadowRays) / static_cast<double>(sum.samples));
   std::printf("frame time     %.1f ms (device), %.1f ms (wall)\n", sec / frames * 1e3, wall / frames * 1e3);
   std::printf("scene upload   %.3f s (BVH bottom level %.3f s, top level %.4f s)\n", setup, renderer.lastBlasSeconds(),
               renderer.lastTlasSeconds());
   std::string kernel;
   for (const std::string& f : renderer.kernelFeatures()) kernel += (kernel.empty() ? "" : ", ") + f;
   std::printf("kernel         %s\n", kernel.c_str());
-  std::printf("top level      %llu references to %llu instances\n",
-              static_cast<unsigned long long>(renderer.sceneInstanceReferences()),
+  std::printf("top level      %llu references to %llu instances\n", static_cast<unsigned long long>(renderer.sceneInstanceReferences()),
               static_cast<unsigned long long>(renderer.sceneInstances()));
-  std::printf("loop iterations %u at most in one invocation (paths stop at %u; lavapipe's limit is near 32767); "
-              "%llu paths cut short; %u at most in one path segment\n",
-              sum.maxLoopIterations, kTraceLoopBudget, static_cast<unsigned long long>(sum.cutPaths),
-              sum.maxSegmentIterations);
+  std::printf(
+      "loop iterations %u at most in one invocation (paths stop at %u; lavapipe's limit is near 32767); "
+      "%llu paths cut short; %u at most in one path segment\n",
+      sum.maxLoopIterations, kTraceLoopBudget, static_cast<unsigned long long>(sum.cutPaths), sum.maxSegmentIterations);
   std::printf("paths          %.1f loop iterations each, %.0f per invocation (last frame)\n",
               static_cast<double>(sum.loopIterations) / static_cast<double>(std::max<std::uint64_t>(sum.samples, 1)),
               sum.pathsPerInvocation);
-  std::printf("device memory  %.3f MiB scene data, %.1f bytes per triangle\n",
-              static_cast<double>(renderer.sceneDeviceBytes()) / (1 << 20),
+  std::printf("device memory  %.3f MiB scene data, %.1f bytes per triangle\n", static_cast<double>(renderer.sceneDeviceBytes()) / (1 << 20),
               tris ? static_cast<double>(renderer.sceneDeviceBytes()) / static_cast<double>(tris) : 0.0);
   return 0;
 }
@@ -250,8 +246,12 @@ int benchBvh(int n) {
       float z0 = static_cast<float>(j) / side, z1 = static_cast<float>(j + 1) / side;
       Vec3 a{x0, height(x0, z0), z0}, b{x1, height(x1, z0), z0}, c{x1, height(x1, z1), z1}, d{x0, height(x0, z1), z1};
       Bounds3 t1, t2;
-      t1.grow(a); t1.grow(b); t1.grow(c);
-      t2.grow(a); t2.grow(c); t2.grow(d);
+      t1.grow(a);
+      t1.grow(b);
+      t1.grow(c);
+      t2.grow(a);
+      t2.grow(c);
+      t2.grow(d);
       boxes.push_back(t1);
       if (static_cast<int>(boxes.size()) < n) boxes.push_back(t2);
     }
@@ -262,7 +262,6 @@ int benchBvh(int n) {
               static_cast<double>(boxes.size()) / s * 1e-6, bvh.nodes.size(), bvh.depth);
   return 0;
 }
-
 
 // Edit cost against mesh size: the default scene plus one mesh of N triangles; times moving that
 // object and changing its material through a RenderSession (what the render thread does between
@@ -426,11 +425,10 @@ int benchDenoise(const DenoiseOptions& o) {
   std::printf("image          %dx%d, %s\n", w, h, o.scene.c_str());
   std::printf("frame          %.1f ms (1 spp traced and accumulated; medians of %d interleaved rounds)\n", traceMs, frames);
   std::printf("denoise        %.1f ms (the passes below; a frame denoised whole needs no compositor)\n", denoiseMs);
-  for (std::size_t k = 0; k < passMs.size(); ++k)
-    std::printf("  %-12s %.1f ms on the device\n", passNames[k], median(passMs[k]));
+  for (std::size_t k = 0; k < passMs.size(); ++k) std::printf("  %-12s %.1f ms on the device\n", passNames[k], median(passMs[k]));
   std::printf("compose        %.1f ms (the compositor alone)\n", composeMs);
-  std::printf("denoise share  %.1f ms a frame at %dx%d: %.0f %% of the %.1f ms frame\n", denoiseMs, w, h,
-              100.0 * denoiseMs / traceMs, traceMs);
+  std::printf("denoise share  %.1f ms a frame at %dx%d: %.0f %% of the %.1f ms frame\n", denoiseMs, w, h, 100.0 * denoiseMs / traceMs,
+              traceMs);
   return 0;
 }
 
@@ -440,14 +438,14 @@ void addBench(CLI::App& app, int* status) {
   CLI::App* bench = app.add_subcommand("bench", "Benchmarks: they print figures and never pass or fail");
   bench->require_subcommand(1);
 
-  CLI::App* cmd = bench->add_subcommand("throughput", "Samples/s, rays/s and device memory of a scene, in frames as retile render traces them");
+  CLI::App* cmd =
+      bench->add_subcommand("throughput", "Samples/s, rays/s and device memory of a scene, in frames as retile render traces them");
   auto throughput = std::make_shared<ThroughputOptions>();
   addScene(*cmd, &throughput->scene);
   addSize(*cmd, &throughput->size, "image size");
   addInt(*cmd, "--frames", &throughput->frames, 1, 100000, "frames timed, after one warm-up frame");
   addInt(*cmd, "--max-bounces", &throughput->maxBounces, 0, 1024, "longest path", "the scene's");
-  addInt(*cmd, "--paths", &throughput->paths, 1, 1 << 20, "paths per trace invocation",
-         "chosen from the last frame's cost")
+  addInt(*cmd, "--paths", &throughput->paths, 1, 1 << 20, "paths per trace invocation", "chosen from the last frame's cost")
       ->type_name("P");
   addInt(*cmd, "--spp-per-frame", &throughput->sppPerFrame, 1, 1024, "samples per pixel in each frame",
          "as retile render: about 2^18 samples a frame");
@@ -485,8 +483,8 @@ void addBench(CLI::App& app, int* status) {
   auto room = std::make_shared<RoomOptions>();
   cmd->add_option("--triangles", room->triangles, "triangle counts, k and M allowed (default: 100k,1M,4M)")
       ->type_name("LIST")
-      ->check(CLI::Validator([](std::string& v) { return parseCounts(v).empty() ? "--triangles: expected counts such as 100k,1M,4M" : std::string(); },
-                             ""));
+      ->check(CLI::Validator(
+          [](std::string& v) { return parseCounts(v).empty() ? "--triangles: expected counts such as 100k,1M,4M" : std::string(); }, ""));
   addSize(*cmd, &room->size, "image size");
   addInt(*cmd, "--frames", &room->frames, 1, 100000, "frames timed per size");
   addInt(*cmd, "--spp-per-frame", &room->sppPerFrame, 1, 1024, "samples per pixel in each frame",

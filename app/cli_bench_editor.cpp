@@ -34,7 +34,8 @@ struct EditorLike {
     cmd.add_option("--method", method, "the re-rendering method: " + methods + " (default: " + method + ")")
         ->type_name("NAME")
         ->check(oneOf("method", methodNames()));
-    cmd.add_flag_function("--no-denoise", [this](std::int64_t) { denoise = false; }, "without the editor's denoiser");
+    cmd.add_flag_function(
+        "--no-denoise", [this](std::int64_t) { denoise = false; }, "without the editor's denoiser");
     addInt(cmd, "--preview", &preview, 1, 16, "while edits come, a sample per N x N pixels (the editor's; 1: none)");
   }
   MethodSettings settings() const {
@@ -112,9 +113,8 @@ int benchFrames(const FramesOptions& opt) {
     if (e.rfind("warning: ", 0) != 0) return std::fprintf(stderr, "error: %s\n", e.c_str()), 1;
   std::printf("scene          %s at %dx%d, %s%s\n", opt.scene.c_str(), scene.settings.width, scene.settings.height,
               methodLabel(opt.editor.settings()).c_str(), opt.drag ? ", dragging an object every frame" : ", at rest");
-  std::printf("frames/s       %.2f (%llu frames in %.1f s; %llu of those shown were previews at 1/%d)\n",
-              static_cast<double>(frames) / s, static_cast<unsigned long long>(frames), s,
-              static_cast<unsigned long long>(previews), opt.editor.preview);
+  std::printf("frames/s       %.2f (%llu frames in %.1f s; %llu of those shown were previews at 1/%d)\n", static_cast<double>(frames) / s,
+              static_cast<unsigned long long>(frames), s, static_cast<unsigned long long>(previews), opt.editor.preview);
   return 0;
 }
 
@@ -145,8 +145,8 @@ int benchRest(const RestOptions& opt) {
   Engine engine(scene, opt.editor.settings(), opt.editor.engine());
   engine.start();
   std::this_thread::sleep_for(std::chrono::seconds(opt.converge));
-  std::printf("scene          %s at %dx%d, %s, preview 1/%d; converged for %d s\n", opt.scene.c_str(), opt.size.width,
-              opt.size.height, methodLabel(opt.editor.settings()).c_str(), opt.editor.preview, opt.converge);
+  std::printf("scene          %s at %dx%d, %s, preview 1/%d; converged for %d s\n", opt.scene.c_str(), opt.size.width, opt.size.height,
+              methodLabel(opt.editor.settings()).c_str(), opt.editor.preview, opt.converge);
   std::uint64_t version = 1;
   for (double r : opt.roughness) {
     material.roughness = static_cast<float>(r);
@@ -178,8 +178,8 @@ int benchRest(const RestOptions& opt) {
     }
     const auto file = std::filesystem::path(opt.outDir) / ("roughness-" + std::to_string(r).substr(0, 4) + ".png");
     if (auto w = writeRenderImage(*last->image, file); !w) return std::fprintf(stderr, "error: %s\n", w.error().c_str()), 1;
-    std::printf("roughness %.3f  %llu frames in %d s; the pass at full resolution done after %s; %.0f spp on its %zu pixels; %s\n",
-                r, static_cast<unsigned long long>(frames), opt.seconds,
+    std::printf("roughness %.3f  %llu frames in %d s; the pass at full resolution done after %s; %.0f spp on its %zu pixels; %s\n", r,
+                static_cast<unsigned long long>(frames), opt.seconds,
                 passDone ? (std::to_string(*passDone).substr(0, 4) + " s").c_str() : "more than that",
                 pixels ? spp / static_cast<double>(pixels) : 0.0, pixels, file.string().c_str());
   }
@@ -192,8 +192,8 @@ int benchRest(const RestOptions& opt) {
 }  // namespace
 
 void addEditorBenches(CLI::App& bench, int* status) {
-  CLI::App* cmd = bench.add_subcommand(
-      "frames", "The editor's frames/s (render thread and mailbox), at rest or while an object is dragged");
+  CLI::App* cmd =
+      bench.add_subcommand("frames", "The editor's frames/s (render thread and mailbox), at rest or while an object is dragged");
   auto frames = std::make_shared<FramesOptions>();
   addScene(*cmd, &frames->scene);
   addSize(*cmd, &frames->size, "image size");

@@ -61,18 +61,20 @@ void printNoise(const BlockNoise& noise, double distance) {
     std::printf("noise of the block means: not estimated (it needs blocks of two pixels or more)\n");
     return;
   }
-  std::printf("noise of the block means, estimated from the spread of each block's pixels (the reference's is an\n"
-              "upper bound: differences at pixel scale, such as edges, count as its noise):\n");
-  std::printf("  ours %.3g, the reference's %.3g: with no bias the ratio would be about %.2f\n", noise.ours,
-              noise.reference, noise.expectedRatio);
+  std::printf(
+      "noise of the block means, estimated from the spread of each block's pixels (the reference's is an\n"
+      "upper bound: differences at pixel scale, such as edges, count as its noise):\n");
+  std::printf("  ours %.3g, the reference's %.3g: with no bias the ratio would be about %.2f\n", noise.ours, noise.reference,
+              noise.expectedRatio);
   // One pair's floor is a sum dominated by a few bright, noisy blocks: it scatters widely, mostly
   // below its root-mean-square, and the ratio with it (the spaceship: 1.38 to 2.42 over six pairs).
   const double rmsFloor = std::sqrt(2.0) * noise.ours;
   std::printf("  root-mean-square floor of our noise: %.3g; ratio against it %.2f\n", rmsFloor,
               rmsFloor > 0 ? distance / rmsFloor : std::numeric_limits<double>::infinity());
-  std::printf("  block differences in units of both renders' noise: mean square %.2f (1 when only noise differs); "
-              "%d of %d blocks beyond 3 (noise alone: %.1f)\n",
-              noise.meanSquaredZ, noise.beyond3, noise.scored, 0.0027 * noise.scored);
+  std::printf(
+      "  block differences in units of both renders' noise: mean square %.2f (1 when only noise differs); "
+      "%d of %d blocks beyond 3 (noise alone: %.1f)\n",
+      noise.meanSquaredZ, noise.beyond3, noise.scored, 0.0027 * noise.scored);
 }
 
 int runCompare(const CompareOptions& o) {
@@ -86,8 +88,8 @@ int runCompare(const CompareOptions& o) {
     auto im = readRgb(f);
     if (!im) return std::fprintf(stderr, "error: %s\n", im.error().c_str()), 1;
     if (!images.empty() && (im->width != images[0].width || im->height != images[0].height)) {
-      std::fprintf(stderr, "error: %s is %dx%d, %s is %dx%d\n", f.c_str(), im->width, im->height, files[0].c_str(),
-                   images[0].width, images[0].height);
+      std::fprintf(stderr, "error: %s is %dx%d, %s is %dx%d\n", f.c_str(), im->width, im->height, files[0].c_str(), images[0].width,
+                   images[0].height);
       return 1;
     }
     images.push_back(std::move(im.value()));
@@ -96,8 +98,7 @@ int runCompare(const CompareOptions& o) {
   BlockComparison c = compareBlocks(view(0), view(1), block, exclude);
   BlockNoise noise;  // with --noise
   std::printf("compared: %d of %d %dx%d blocks\n", c.blocks, c.cols * c.rows, block, block);
-  std::printf("mean RGB: %.6g against %.6g (%+.3f %%)\n", c.meanA, c.meanRef,
-              c.meanRef > 0 ? 100.0 * (c.meanA / c.meanRef - 1.0) : 0.0);
+  std::printf("mean RGB: %.6g against %.6g (%+.3f %%)\n", c.meanA, c.meanRef, c.meanRef > 0 ? 100.0 * (c.meanA / c.meanRef - 1.0) : 0.0);
   std::printf("relative RMSE of block means against the reference: %.4f\n", c.relativeRmse);
   if (images.size() == 3) {
     BlockComparison n = compareBlocks(view(0), view(2), block, exclude);
@@ -130,8 +131,8 @@ int runCompare(const CompareOptions& o) {
                 withZ ? ", difference in units of its noise" : "");
   for (std::size_t k = 0; k < order.size() && k < static_cast<std::size_t>(worst); ++k) {
     std::size_t b = order[k];
-    std::printf("  %4d, %4d: %5.1f %%  %.4g against %.4g (%+.0f %%)", column(b), row(b), 100.0 * c.errorShare[b], c.lumA[b],
-                c.lumRef[b], apart(b));
+    std::printf("  %4d, %4d: %5.1f %%  %.4g against %.4g (%+.0f %%)", column(b), row(b), 100.0 * c.errorShare[b], c.lumA[b], c.lumRef[b],
+                apart(b));
     if (withZ && !std::isnan(noise.z[b])) std::printf("  z %+.1f", noise.z[b]);
     std::printf("\n");
   }
@@ -143,8 +144,7 @@ int runCompare(const CompareOptions& o) {
     std::printf("largest differences in units of their noise (block at pixel x, y: z, luminance against reference):\n");
     for (std::size_t k = 0; k < order.size() && k < static_cast<std::size_t>(worst) && std::abs(noise.z[order[k]]) > 3.0; ++k) {
       std::size_t b = order[k];
-      std::printf("  %4d, %4d: z %+6.1f  %.4g against %.4g (%+.1f %%)\n", column(b), row(b), noise.z[b], c.lumA[b],
-                  c.lumRef[b], apart(b));
+      std::printf("  %4d, %4d: z %+6.1f  %.4g against %.4g (%+.1f %%)\n", column(b), row(b), noise.z[b], c.lumA[b], c.lumRef[b], apart(b));
     }
   }
   return 0;
@@ -153,14 +153,13 @@ int runCompare(const CompareOptions& o) {
 }  // namespace
 
 void addCompare(CLI::App& app, int* status) {
-  CLI::App* cmd = app.add_subcommand(
-      "compare", "How far IMAGE is from REFERENCE (another renderer's), in units of our own noise: relative RMSE of "
-                 "block means");
+  CLI::App* cmd = app.add_subcommand("compare",
+                                     "How far IMAGE is from REFERENCE (another renderer's), in units of our own noise: relative RMSE of "
+                                     "block means");
   auto o = std::make_shared<CompareOptions>();
   cmd->add_option("IMAGE", o->image, "our render (EXR, PNG, any image OpenImageIO reads)")->required()->type_name("");
   cmd->add_option("REFERENCE", o->reference, "the image to compare against")->required()->type_name("");
-  cmd->add_option("--noise", o->noise,
-                  "a second render of IMAGE's scene at another seed: its distance from IMAGE is the noise floor")
+  cmd->add_option("--noise", o->noise, "a second render of IMAGE's scene at another seed: its distance from IMAGE is the noise floor")
       ->type_name("IMAGE2");
   addInt(*cmd, "--block", &o->block, 1, 4096, "side of the blocks averaged");
   cmd->add_option("--exclude", o->exclude,

@@ -168,18 +168,18 @@ int runEdit(EditOptions o) {
       char q[192];
       if (affectedCount > 0)
         std::snprintf(q, sizeof q, "%.3f,%.5f,%.3f,%.5f,%.5f,%.3f,%.3f", psnr(a, r), ssim(a, r), psnrHvsM(a, r),
-                      rootMeanSquaredError(a, r, affected.data()), rootMeanSquaredError(a, r, rest.data()),
-                      psnr(a, r, affected.data()), psnr(a, r, rest.data()));
+                      rootMeanSquaredError(a, r, affected.data()), rootMeanSquaredError(a, r, rest.data()), psnr(a, r, affected.data()),
+                      psnr(a, r, rest.data()));
       else  // nothing changed: no affected scores, the rest is the whole image
-        std::snprintf(q, sizeof q, "%.3f,%.5f,%.3f,,%.5f,,%.3f", psnr(a, r), ssim(a, r), psnrHvsM(a, r),
-                      rootMeanSquaredError(a, r), psnr(a, r));
+        std::snprintf(q, sizeof q, "%.3f,%.5f,%.3f,,%.5f,,%.3f", psnr(a, r), ssim(a, r), psnrHvsM(a, r), rootMeanSquaredError(a, r),
+                      psnr(a, r));
       scores = q;
     }
     std::snprintf(line, sizeof line, "%d,%zu,%s,%s,%llu,%zu,%zu,%d,%.3f,%.4f,%.3f,%s,%zu,%d,%d,%s,%d,%d\n", frame, sub.step,
                   rec.method.c_str(), rec.mode.c_str(), static_cast<unsigned long long>(rec.samples), rec.servedTiles.size(),
                   rec.queueLength - rec.queueServed, rec.quality, rec.frameMs, rec.scheduleMs, rec.traceMs,
-                  std::isnan(err) ? "" : std::to_string(err).c_str(), rec.denoised.size(), outer.width, outer.height,
-                  scores.c_str(), rec.reusedTiles, rec.rejectedTiles);
+                  std::isnan(err) ? "" : std::to_string(err).c_str(), rec.denoised.size(), outer.width, outer.height, scores.c_str(),
+                  rec.reusedTiles, rec.rejectedTiles);
     csv << line;
     if (images && rec.image) {
       char name[64];
@@ -218,10 +218,10 @@ int runEdit(EditOptions o) {
   csv.close();
   std::printf("method         %s, T=%d, Q=%s\n", methodLabel(method).c_str(), method.tileSize,
               method.quality ? std::to_string(method.quality).c_str() : "auto");
-  std::printf("frames         %d after %d converging; every frame traced %s %dx%d samples\n", frame, converge,
-              exact ? "exactly" : "NOT", w, h);
-  std::printf("frame rate     %.1f frames/s (%.1f ms a frame, wall clock, frames pipelined)\n",
-              wallMs > 0 ? frame * 1e3 / wallMs : 0.0, frame ? wallMs / frame : 0.0);
+  std::printf("frames         %d after %d converging; every frame traced %s %dx%d samples\n", frame, converge, exact ? "exactly" : "NOT", w,
+              h);
+  std::printf("frame rate     %.1f frames/s (%.1f ms a frame, wall clock, frames pipelined)\n", wallMs > 0 ? frame * 1e3 / wallMs : 0.0,
+              frame ? wallMs / frame : 0.0);
   std::printf("scheduling     %.2f %% of frame time (%.3f ms a frame)\n", wallMs > 0 ? 100.0 * sumScheduleMs / wallMs : 0.0,
               frame ? sumScheduleMs / frame : 0.0);
   if (!ref.empty()) {
@@ -229,8 +229,7 @@ int runEdit(EditOptions o) {
       std::printf("settled        %d frames after the last edit (relative RMSE of %dx%d blocks below %.3g from then on)\n",
                   settledFrame - lastEditFrame, block, block, threshold);
     else
-      std::printf("settled        not within the script (relative RMSE of %dx%d blocks stayed above %.3g)\n", block, block,
-                  threshold);
+      std::printf("settled        not within the script (relative RMSE of %dx%d blocks stayed above %.3g)\n", block, block, threshold);
   }
   std::printf("wrote          %s\n", (outDir / "frames.csv").string().c_str());
   return exact ? 0 : 1;
@@ -240,22 +239,17 @@ int runEdit(EditOptions o) {
 
 void addEdit(CLI::App& app, int* status) {
   CLI::App* cmd = app.add_subcommand(
-      "edit",
-      "Converge a scene, play a script of timed edits under one method, and write every frame (EXR) and frames.csv");
+      "edit", "Converge a scene, play a script of timed edits under one method, and write every frame (EXR) and frames.csv");
   auto o = std::make_shared<EditOptions>();
   std::string methods;
   for (const auto& n : methodNames()) methods += (methods.empty() ? "" : ", ") + n;
   addScene(*cmd, &o->scene);
-  cmd->add_option("--script", o->script, "the edits, a scenario script (resources/scripts/*.json)")
-      ->required()
-      ->type_name("EDITS.json");
+  cmd->add_option("--script", o->script, "the edits, a scenario script (resources/scripts/*.json)")->required()->type_name("EDITS.json");
   cmd->add_option("--method", o->methodName, "the re-rendering method: " + methods)
       ->required()
       ->type_name("NAME")
       ->check(oneOf("method", methodNames()));
-  cmd->add_option("--out-dir", o->outDir, "where frames.csv and the frames go (made if missing)")
-      ->required()
-      ->type_name("DIR");
+  cmd->add_option("--out-dir", o->outDir, "where frames.csv and the frames go (made if missing)")->required()->type_name("DIR");
   addSize(*cmd, &o->size, "image size", "the scene's");
   addInt(*cmd, "--tile", &o->method.tileSize, 8, 32, "tile side T: 8, 16 or 32 pixels")->type_name("T");
   const int quality = o->method.quality;
@@ -266,8 +260,7 @@ void addEdit(CLI::App& app, int* status) {
   };
   cmd->add_option_function<std::string>(
          "--quality", [o, readQuality](const std::string& text) { o->method.quality = readQuality(text).value(); },
-         cat("samples per pixel of a served tile, or 'auto', the indirection methods' choice (1..4096; default: ",
-             quality, ")"))
+         cat("samples per pixel of a served tile, or 'auto', the indirection methods' choice (1..4096; default: ", quality, ")"))
       ->type_name("Q|auto")
       ->check(CLI::Validator(
           [readQuality](std::string& text) {
@@ -277,27 +270,22 @@ void addEdit(CLI::App& app, int* status) {
           ""));
   cmd->add_flag("--smooth", o->method.smooth, "smooth transition: tiles not yet served keep capped stale samples");
   addInt(*cmd, "--stale-cap", &o->method.staleCap, 1, 1 << 20, "with --smooth: stale samples kept per pixel");
-  addInt(*cmd, "--converge", &o->converge, 0, 1 << 20, "samples per pixel before the first edit", "the script's")
-      ->type_name("SPP");
+  addInt(*cmd, "--converge", &o->converge, 0, 1 << 20, "samples per pixel before the first edit", "the script's")->type_name("SPP");
   addInt(*cmd, "--max-bounces", &o->maxBounces, 0, 1024, "longest path", "the scene's");
   addInt(*cmd, "--reference", &o->reference, 1, 1 << 20,
          "render the final state fresh at SPP (reference.exr) and score every frame against it", "none")
       ->type_name("SPP");
   addInt(*cmd, "--block", &o->block, 1, 64, "with --reference: side of the blocks the relative RMSE averages");
-  addNumber(*cmd, "--threshold", &o->threshold, 0, 1e30,
-            "with --reference: relative RMSE below which a frame counts as settled")
+  addNumber(*cmd, "--threshold", &o->threshold, 0, 1e30, "with --reference: relative RMSE below which a frame counts as settled")
       ->type_name("REL");
   CLI::Option* denoise = cmd->add_flag("--denoise", o->method.denoise, "denoise what the method shows");
   addNumber(*cmd, "--denoise-threshold", &o->method.denoiseThreshold, 0, 1,
             "share of the image's width (height) a pass's region grows by before it is denoised again at its new size")
       ->type_name("SHARE")
       ->needs(denoise);
-  cmd->add_flag("--no-soft-borders", o->noSoftBorders, "no blending at seams between tiles showing different things")
-      ->needs(denoise);
-  CLI::Option* reuse = cmd->add_flag("--reuse", o->method.reuse,
-                                     "verified reuse: restarted tiles keep samples a test finds in agreement");
-  addNumber(*cmd, "--reuse-rate", &o->method.reuseFalseReject, 1e-12, 0.49,
-            "chance that one test of an unchanged tile drops its history")
+  cmd->add_flag("--no-soft-borders", o->noSoftBorders, "no blending at seams between tiles showing different things")->needs(denoise);
+  CLI::Option* reuse = cmd->add_flag("--reuse", o->method.reuse, "verified reuse: restarted tiles keep samples a test finds in agreement");
+  addNumber(*cmd, "--reuse-rate", &o->method.reuseFalseReject, 1e-12, 0.49, "chance that one test of an unchanged tile drops its history")
       ->type_name("A")
       ->needs(reuse);
   cmd->add_flag("--no-images", o->noImages, "write frames.csv only, no EXR per frame");

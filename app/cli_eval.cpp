@@ -31,11 +31,16 @@ using Clock = std::chrono::steady_clock;
 std::string html(const std::string& s) {
   std::string o;
   for (char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else if (c == '"') o += "&quot;";
-    else o += c;
+    if (c == '<')
+      o += "&lt;";
+    else if (c == '>')
+      o += "&gt;";
+    else if (c == '&')
+      o += "&amp;";
+    else if (c == '"')
+      o += "&quot;";
+    else
+      o += c;
   }
   return o;
 }
@@ -66,8 +71,8 @@ struct ScenarioResult {
   std::vector<std::string> charts;  // file bases, relative to the output directory
 };
 
-int runStability(const std::vector<std::string>& sceneNames, const std::vector<std::string>& cases,
-                 const eval::StabilityOptions& options, const std::filesystem::path& out) {
+int runStability(const std::vector<std::string>& sceneNames, const std::vector<std::string>& cases, const eval::StabilityOptions& options,
+                 const std::filesystem::path& out) {
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
   if (ec) return std::fprintf(stderr, "error: cannot create %s: %s\n", out.string().c_str(), ec.message().c_str()), 1;
@@ -91,8 +96,7 @@ int runStability(const std::vector<std::string>& sceneNames, const std::vector<s
     for (const auto& c : cases) {
       const int index = static_cast<int>(&c - cases.data());
       auto result = eval::runStabilityCase(c, loaded->scene, options, refs, [&](const std::string& what) {
-        progressBar(what, index, static_cast<int>(cases.size()),
-                    std::chrono::duration<double>(Clock::now() - start).count());
+        progressBar(what, index, static_cast<int>(cases.size()), std::chrono::duration<double>(Clock::now() - start).count());
       });
       if (!result) {
         std::fprintf(stderr, "\n%s: %s: cannot run: %s\n", sceneName.c_str(), c.c_str(), result.error().c_str());
@@ -101,8 +105,9 @@ int runStability(const std::vector<std::string>& sceneNames, const std::vector<s
         ++broken;
         continue;
       }
-      page += cat("<h2>", html(sceneName), ": ", html(c), "</h2>\n<p>", html(result->description), " Affected pixels: ",
-                  result->affected, ". Figure: ", html(result->figure), ".</p>\n<table><tr><th>method</th><th>figure</th>"
+      page += cat("<h2>", html(sceneName), ": ", html(c), "</h2>\n<p>", html(result->description), " Affected pixels: ", result->affected,
+                  ". Figure: ", html(result->figure),
+                  ".</p>\n<table><tr><th>method</th><th>figure</th>"
                   "<th>threshold</th><th>result</th><th>also measured</th></tr>\n");
       std::printf("\n%s: %s (%s)\n", sceneName.c_str(), c.c_str(), result->figure.c_str());
       for (const auto& f : result->figures) {
@@ -110,14 +115,13 @@ int runStability(const std::vector<std::string>& sceneNames, const std::vector<s
         failed += !f.pass;
         broken += !f.broken.empty();
         const std::string verdict = !f.broken.empty() ? "BROKEN: " + f.broken : (f.pass ? "pass" : "fail");
-        std::printf("  %-26s %9s  <= %9s  %s%s%s\n", f.method.c_str(), fixed(f.value, 4).c_str(),
-                    fixed(f.threshold, 4).c_str(), verdict.c_str(), f.detail.empty() ? "" : "  ", f.detail.c_str());
+        std::printf("  %-26s %9s  <= %9s  %s%s%s\n", f.method.c_str(), fixed(f.value, 4).c_str(), fixed(f.threshold, 4).c_str(),
+                    verdict.c_str(), f.detail.empty() ? "" : "  ", f.detail.c_str());
         csv += cat(sceneName, ",", c, ",", f.method, ",", std::isnan(f.value) ? std::string() : fixed(f.value, 5), ",",
-                   std::isnan(f.threshold) ? std::string() : fixed(f.threshold, 5), ",", f.pass ? 1 : 0, ",\"", f.detail,
-                   "\",\"", f.broken, "\"\n");
-        page += cat("<tr><td>", html(f.method), "</td><td>", fixed(f.value, 4), "</td><td>", fixed(f.threshold, 4),
-                    "</td><td class=\"", f.pass ? "pass" : "fail", "\">", html(verdict), "</td><td>", html(f.detail),
-                    "</td></tr>\n");
+                   std::isnan(f.threshold) ? std::string() : fixed(f.threshold, 5), ",", f.pass ? 1 : 0, ",\"", f.detail, "\",\"", f.broken,
+                   "\"\n");
+        page += cat("<tr><td>", html(f.method), "</td><td>", fixed(f.value, 4), "</td><td>", fixed(f.threshold, 4), "</td><td class=\"",
+                    f.pass ? "pass" : "fail", "\">", html(verdict), "</td><td>", html(f.detail), "</td></tr>\n");
       }
       page += "</table>\n";
     }
@@ -150,8 +154,7 @@ int runEval(const EvalOptions& o) {
   if (o.target) opt.target = *o.target;
   const std::vector<std::string> methodLabels = o.methods.empty() ? eval::defaultMethods() : o.methods;
   std::vector<MethodSettings> methods;
-  for (const auto& label : methodLabels)
-    methods.push_back(eval::parseMethodLabel(label).value());  // checked by the option
+  for (const auto& label : methodLabels) methods.push_back(eval::parseMethodLabel(label).value());  // checked by the option
   const std::vector<std::string>& scenarioNames = o.scenarios;
   std::vector<Scenario> scripts;
   for (const auto& file : o.scripts) {
@@ -241,8 +244,7 @@ int runEval(const EvalOptions& o) {
   for (const auto& n : notes) std::fprintf(stderr, "note: %s\n", n.c_str());
 
   int totalFrames = 0, doneFrames = 0;
-  for (const Job& j : jobs)
-    totalFrames += static_cast<int>(methods.size()) * (j.plan.converge + static_cast<int>(j.plan.frames.size()));
+  for (const Job& j : jobs) totalFrames += static_cast<int>(methods.size()) * (j.plan.converge + static_cast<int>(j.plan.frames.size()));
 
   for (Job& job : jobs) {
     ScenarioResult res;
@@ -330,17 +332,16 @@ int runEval(const EvalOptions& o) {
       Result<bool> written;
     };
     std::vector<Chart> made;
-    made.push_back({base + "-psnr", ui::writeLineChart(out / "charts" / (base + "-psnr"), title + " — PSNR, whole image",
-                                                       timeAxis, "PSNR (dB)", whole, true)});
-    made.push_back({base + "-affected",
-                    ui::writeLineChart(out / "charts" / (base + "-affected"),
-                                       title + (r.affected > 0 ? " — PSNR, affected region" : " — PSNR (nothing changed)"),
-                                       timeAxis, "PSNR (dB)", affected, true)});
-    made.push_back({base + "-tradeoff",
-                    ui::writePointChart(out / "charts" / (base + "-tradeoff"), title + " — speed against accuracy",
-                                        QString::fromStdString(cat("time to ", opt.target * 100,
-                                                                   " % relative RMSE in the affected region (ms)")),
-                                        "PSNR of the affected region at frame 10 (dB)", tradeoff)});
+    made.push_back({base + "-psnr", ui::writeLineChart(out / "charts" / (base + "-psnr"), title + " — PSNR, whole image", timeAxis,
+                                                       "PSNR (dB)", whole, true)});
+    made.push_back(
+        {base + "-affected", ui::writeLineChart(out / "charts" / (base + "-affected"),
+                                                title + (r.affected > 0 ? " — PSNR, affected region" : " — PSNR (nothing changed)"),
+                                                timeAxis, "PSNR (dB)", affected, true)});
+    made.push_back({base + "-tradeoff", ui::writePointChart(out / "charts" / (base + "-tradeoff"), title + " — speed against accuracy",
+                                                            QString::fromStdString(cat("time to ", opt.target * 100,
+                                                                                       " % relative RMSE in the affected region (ms)")),
+                                                            "PSNR of the affected region at frame 10 (dB)", tradeoff)});
     for (auto& c : made) {
       if (!c.written) return std::fprintf(stderr, "error: %s\n", c.written.error().c_str()), 1;
       r.charts.push_back(c.name);
@@ -360,8 +361,7 @@ int runEval(const EvalOptions& o) {
       "th{background:#f2f2f2}td:first-child,th:first-child{text-align:left}img{max-width:100%}"
       ".note{color:#555}</style></head><body>\n<h1>Retile evaluation</h1>\n";
   page += cat("<p>", opt.width, "x", opt.height, ", every method on the same budget (", opt.width, "x", opt.height,
-              " samples a frame), references of ", opt.referenceSpp,
-              " spp. Scored: frame 1, every ", opt.every,
+              " samples a frame), references of ", opt.referenceSpp, " spp. Scored: frame 1, every ", opt.every,
               "th frame while edits arrive, every frame at rest. PSNR, SSIM and PSNR-HVS-M compare display-referred "
               "images (sRGB view, clamped); the <em>affected region</em> is where the scenario's references differ from "
               "the start beyond their noise. Time to target: from frame 1 until the affected region's relative RMSE "
@@ -369,16 +369,17 @@ int runEval(const EvalOptions& o) {
               opt.target * 100, " %.</p>\n");
   page += "<p>Data: <a href=\"metrics.csv\">metrics.csv</a> (every frame), <a href=\"summary.csv\">summary.csv</a>.</p>\n";
   for (const auto& n : notes) page += "<p class=\"note\">" + html(n) + "</p>\n";
-  page += "<h2>What each scene costs the renderer</h2>\n<table><tr><th>scene</th><th>triangles</th><th>device memory "
-          "(BVH included)</th><th>bytes per triangle</th><th>trace kernel compiled with</th></tr>\n";
+  page +=
+      "<h2>What each scene costs the renderer</h2>\n<table><tr><th>scene</th><th>triangles</th><th>device memory "
+      "(BVH included)</th><th>bytes per triangle</th><th>trace kernel compiled with</th></tr>\n";
   for (const auto& [name, m] : models) {
     std::string features;
     for (const auto& f : m.kernelFeatures) features += (features.empty() ? "" : ", ") + f;
     page += cat("<tr><td>", html(name), "</td><td>", m.triangles, "</td><td>", fixed(static_cast<double>(m.deviceBytes) / (1 << 20), 2),
                 " MiB</td><td>", fixed(m.bytesPerTriangle, 1), "</td><td>", html(features), "</td></tr>\n");
     std::printf("%s: %llu triangles, %.2f MiB on the device (%.1f bytes per triangle), kernel: %s\n", name.c_str(),
-                static_cast<unsigned long long>(m.triangles), static_cast<double>(m.deviceBytes) / (1 << 20),
-                m.bytesPerTriangle, features.c_str());
+                static_cast<unsigned long long>(m.triangles), static_cast<double>(m.deviceBytes) / (1 << 20), m.bytesPerTriangle,
+                features.c_str());
   }
   page += "</table>\n";
   for (const auto& r : results) {
@@ -402,33 +403,33 @@ int runEval(const EvalOptions& o) {
       page += cat("<p><a href=\"charts/", c, ".svg\"><img src=\"charts/", c, ".png\" alt=\"", c, "\"></a></p>\n");
     page += cat("<p>Frames ");
     for (std::size_t i = 0; i < r.stripFrames.size(); ++i) page += cat(i ? ", " : "", r.stripFrames[i]);
-    page += cat(" with the overlays: tiles traced that frame outlined, queue priority as a heat map, the point of "
-                "change and focus points marked, denoised regions framed.</p>\n<p><img src=\"strips/",
-                base, ".png\" alt=\"strip\"></p>\n");
+    page +=
+        cat(" with the overlays: tiles traced that frame outlined, queue priority as a heat map, the point of "
+            "change and focus points marked, denoised regions framed.</p>\n<p><img src=\"strips/",
+            base, ".png\" alt=\"strip\"></p>\n");
   }
   page += "</body></html>\n";
   if (auto w = writeFileAtomic(out / "index.html", page); !w) return std::fprintf(stderr, "error: %s\n", w.error().c_str()), 1;
 
-  std::printf("%-10s %-10s %-22s %9s %9s %9s %9s %9s %9s %9s\n", "scene", "scenario", "method", "psnr@1", "psnr@10",
-              "psnr@100", "aff@1", "aff@10", "aff@100", "target ms");
+  std::printf("%-10s %-10s %-22s %9s %9s %9s %9s %9s %9s %9s\n", "scene", "scenario", "method", "psnr@1", "psnr@10", "psnr@100", "aff@1",
+              "aff@10", "aff@100", "target ms");
   for (const auto& r : results)
     for (const auto& s : r.summaries)
       std::printf("%-10s %-10s %-22s %9s %9s %9s %9s %9s %9s %9s\n", s.scene.c_str(), s.scenario.c_str(), s.method.c_str(),
                   fixed(s.psnrAt[0], 2).c_str(), fixed(s.psnrAt[1], 2).c_str(), fixed(s.psnrAt[2], 2).c_str(),
-                  fixed(s.psnrAffectedAt[0], 2).c_str(), fixed(s.psnrAffectedAt[1], 2).c_str(),
-                  fixed(s.psnrAffectedAt[2], 2).c_str(),
+                  fixed(s.psnrAffectedAt[0], 2).c_str(), fixed(s.psnrAffectedAt[1], 2).c_str(), fixed(s.psnrAffectedAt[2], 2).c_str(),
                   s.framesToTarget >= 0 ? fixed(s.msToTarget, 0).c_str() : "not");
-  std::printf("wrote %s (%d charts, %zu strips) in %.0f s\n", (out / "index.html").string().c_str(), chartsWritten,
-              results.size(), seconds());
+  std::printf("wrote %s (%d charts, %zu strips) in %.0f s\n", (out / "index.html").string().c_str(), chartsWritten, results.size(),
+              seconds());
   return 0;
 }
 
 }  // namespace
 
 void addEval(CLI::App& app, int* status) {
-  CLI::App* cmd = app.add_subcommand(
-      "eval", "Every method through the same scenarios, scored against cached references: a report in --out-dir "
-              "(index.html, CSV, charts); with --stability, the stability suite");
+  CLI::App* cmd = app.add_subcommand("eval",
+                                     "Every method through the same scenarios, scored against cached references: a report in --out-dir "
+                                     "(index.html, CSV, charts); with --stability, the stability suite");
   auto o = std::make_shared<EvalOptions>();
   const eval::Options full, quick = eval::Options::quick();
   const eval::StabilityOptions stable;
@@ -437,19 +438,20 @@ void addEval(CLI::App& app, int* status) {
     for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
     return s;
   };
-  cmd->add_option("SCENE", o->scenes, "scene files (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default' "
-                                      "(default: default)")
+  cmd->add_option("SCENE", o->scenes,
+                  "scene files (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default' "
+                  "(default: default)")
       ->type_name("");
-  cmd->add_option("--out-dir", o->outDir, "where the report and the references go (made if missing; references "
-                                          "already there are reused)")
+  cmd->add_option("--out-dir", o->outDir,
+                  "where the report and the references go (made if missing; references "
+                  "already there are reused)")
       ->required()
       ->type_name("DIR");
   cmd->add_flag("--quick", o->quick, "small images, short scenarios, lower references (what the tests run)");
-  cmd->add_flag("--stability", o->stability,
-                "run the stability suite (stability.csv, stability.html) instead of the scenarios");
+  cmd->add_flag("--stability", o->stability, "run the stability suite (stability.csv, stability.html) instead of the scenarios");
   addSize(*cmd, &o->size, "image size",
-          cat(full.width, "x", full.height, ", ", quick.width, "x", quick.height, " with --quick; --stability: ",
-              stable.width, "x", stable.height));
+          cat(full.width, "x", full.height, ", ", quick.width, "x", quick.height, " with --quick; --stability: ", stable.width, "x",
+              stable.height));
   // Every list is checked item by item when it is read, so a typo fails before any rendering.
   auto checkEach = [](auto read) {
     return CLI::Validator(
@@ -461,9 +463,9 @@ void addEval(CLI::App& app, int* status) {
   };
   std::string labels;
   for (const auto& n : methodNames()) labels += (labels.empty() ? "" : ", ") + n;
-  cmd->add_option("--methods", o->methods,
-                  "comma-separated methods, each of " + labels + " with +smooth, +denoise, +reuse (default: " +
-                      join(eval::defaultMethods()) + ")")
+  cmd->add_option(
+         "--methods", o->methods,
+         "comma-separated methods, each of " + labels + " with +smooth, +denoise, +reuse (default: " + join(eval::defaultMethods()) + ")")
       ->type_name("LIST")
       ->delimiter(',')
       ->allow_extra_args(false)
@@ -486,13 +488,11 @@ void addEval(CLI::App& app, int* status) {
   addInt(*cmd, "--converge", &o->converge, 0, 1 << 20, "samples per pixel before the first edit",
          cat(full.converge, ", ", quick.converge, " with --quick"))
       ->type_name("SPP");
-  addNumber(*cmd, "--target", &o->target, 1e-6, 10,
-            "relative RMSE of the affected region that counts as reached",
+  addNumber(*cmd, "--target", &o->target, 1e-6, 10, "relative RMSE of the affected region that counts as reached",
             cat(full.target, ", ", quick.target, " with --quick"))
       ->type_name("REL");
   CLI::Option* stability = cmd->get_option("--stability");
-  cmd->add_option("--cases", o->cases, "with --stability: comma-separated cases (default: all): " +
-                                           join(eval::stabilityCaseNames()))
+  cmd->add_option("--cases", o->cases, "with --stability: comma-separated cases (default: all): " + join(eval::stabilityCaseNames()))
       ->type_name("LIST")
       ->delimiter(',')
       ->allow_extra_args(false)

@@ -16,8 +16,7 @@ namespace {
 Result<double> readNumber(const std::string& text, double lo, double hi) {
   auto v = numbers::toDouble(text);
   if (!v || !std::isfinite(*v)) return Result<double>::failure(cat("'", text, "' is not a number"));
-  if (*v < lo || *v > hi)
-    return Result<double>::failure(cat(text, " is outside ", numbers::format(lo), "..", numbers::format(hi)));
+  if (*v < lo || *v > hi) return Result<double>::failure(cat(text, " is outside ", numbers::format(lo), "..", numbers::format(hi)));
   return *v;
 }
 
@@ -34,15 +33,16 @@ Result<ImageSize> readSize(const std::string& text) {
 // An option read by `read`: CLI11 only collects the text. The check runs first (CLI11 puts the
 // option's name before its message), so the callback's second reading cannot fail.
 template <class Read, class Store>
-CLI::Option* addRead(CLI::App& app, const std::string& name, Read read, Store store, const std::string& type,
-                     const std::string& help) {
+CLI::Option* addRead(CLI::App& app, const std::string& name, Read read, Store store, const std::string& type, const std::string& help) {
   CLI::Validator check(
       [read](std::string& text) {
         auto r = read(text);
         return r ? std::string() : r.error();
       },
       "");
-  return app.add_option_function<std::string>(name, [read, store](const std::string& text) { store(read(text).value()); }, help)
+  return app
+      .add_option_function<std::string>(
+          name, [read, store](const std::string& text) { store(read(text).value()); }, help)
       ->check(check)
       ->type_name(type);
 }
@@ -60,8 +60,7 @@ std::string sizeRange() { return cat("each side 1..", kMaxImageSide); }
 Result<int> readInt(const std::string& text, int lo, int hi) {
   int v = 0;
   auto r = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (r.ec != std::errc() || r.ptr != text.data() + text.size())
-    return Result<int>::failure(cat("'", text, "' is not a whole number"));
+  if (r.ec != std::errc() || r.ptr != text.data() + text.size()) return Result<int>::failure(cat("'", text, "' is not a whole number"));
   if (v < lo || v > hi) return Result<int>::failure(cat(v, " is outside ", lo, "..", hi));
   return v;
 }
@@ -72,35 +71,32 @@ CLI::Option* addInt(CLI::App& app, const std::string& name, int* out, int lo, in
       withRange(help, intRange(lo, hi), std::to_string(*out)));
 }
 
-CLI::Option* addInt(CLI::App& app, const std::string& name, std::optional<int>* out, int lo, int hi,
-                    const std::string& help, const std::string& otherwise) {
+CLI::Option* addInt(CLI::App& app, const std::string& name, std::optional<int>* out, int lo, int hi, const std::string& help,
+                    const std::string& otherwise) {
   return addRead(
       app, name, [lo, hi](const std::string& t) { return readInt(t, lo, hi); }, [out](int v) { *out = v; }, "N",
       withRange(help, intRange(lo, hi), otherwise));
 }
 
-CLI::Option* addNumber(CLI::App& app, const std::string& name, double* out, double lo, double hi,
-                       const std::string& help) {
+CLI::Option* addNumber(CLI::App& app, const std::string& name, double* out, double lo, double hi, const std::string& help) {
   return addRead(
-      app, name, [lo, hi](const std::string& t) { return readNumber(t, lo, hi); }, [out](double v) { *out = v; },
-      "X", withRange(help, numberRange(lo, hi), numbers::format(*out)));
+      app, name, [lo, hi](const std::string& t) { return readNumber(t, lo, hi); }, [out](double v) { *out = v; }, "X",
+      withRange(help, numberRange(lo, hi), numbers::format(*out)));
 }
 
-CLI::Option* addNumber(CLI::App& app, const std::string& name, std::optional<double>* out, double lo, double hi,
-                       const std::string& help, const std::string& otherwise) {
+CLI::Option* addNumber(CLI::App& app, const std::string& name, std::optional<double>* out, double lo, double hi, const std::string& help,
+                       const std::string& otherwise) {
   return addRead(
-      app, name, [lo, hi](const std::string& t) { return readNumber(t, lo, hi); }, [out](double v) { *out = v; },
-      "X", withRange(help, numberRange(lo, hi), otherwise));
+      app, name, [lo, hi](const std::string& t) { return readNumber(t, lo, hi); }, [out](double v) { *out = v; }, "X",
+      withRange(help, numberRange(lo, hi), otherwise));
 }
 
 CLI::Option* addSize(CLI::App& app, ImageSize* out, const std::string& help) {
   return addRead(
-      app, "--size", readSize, [out](ImageSize v) { *out = v; }, "WxH",
-      withRange(help, sizeRange(), cat(out->width, "x", out->height)));
+      app, "--size", readSize, [out](ImageSize v) { *out = v; }, "WxH", withRange(help, sizeRange(), cat(out->width, "x", out->height)));
 }
 
-CLI::Option* addSize(CLI::App& app, std::optional<ImageSize>* out, const std::string& help,
-                     const std::string& otherwise) {
+CLI::Option* addSize(CLI::App& app, std::optional<ImageSize>* out, const std::string& help, const std::string& otherwise) {
   return addRead(
       app, "--size", readSize, [out](ImageSize v) { *out = v; }, "WxH", withRange(help, sizeRange(), otherwise));
 }

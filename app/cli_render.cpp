@@ -51,19 +51,22 @@ int runRender(const RenderOptions& o) {
   auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   FrameStats stats;
-  RenderImage image = renderer.render(req, [&](int done, int total) {
-    progressBar("rendering", done, total, elapsed());
-    return true;
-  }, &stats);
+  RenderImage image = renderer.render(
+      req,
+      [&](int done, int total) {
+        progressBar("rendering", done, total, elapsed());
+        return true;
+      },
+      &stats);
   auto written = writeRenderImage(image, out, display);
   if (!written) {
     std::fprintf(stderr, "error: %s\n", written.error().c_str());
     return 1;
   }
   double seconds = elapsed();
-  std::printf("wrote %s (%dx%d, %.0f spp%s, %.1f s, %.3f M samples/s)\n", std::filesystem::absolute(out).string().c_str(),
-              image.width, image.height, image.sampleCount.empty() ? 0.0 : static_cast<double>(image.sampleCount[0]),
-              req.denoise ? ", denoised" : "", seconds, stats.seconds > 0 ? static_cast<double>(stats.samples) / stats.seconds * 1e-6 : 0.0);
+  std::printf("wrote %s (%dx%d, %.0f spp%s, %.1f s, %.3f M samples/s)\n", std::filesystem::absolute(out).string().c_str(), image.width,
+              image.height, image.sampleCount.empty() ? 0.0 : static_cast<double>(image.sampleCount[0]), req.denoise ? ", denoised" : "",
+              seconds, stats.seconds > 0 ? static_cast<double>(stats.samples) / stats.seconds * 1e-6 : 0.0);
   return 0;
 }
 
@@ -89,8 +92,7 @@ void addRender(CLI::App& app, int* status) {
                   "the PNG's OCIO view of the sRGB display: Standard, Filmic or Raw (default: the scene's, as a Tungsten "
                   "camera's tonemap says; else Standard)")
       ->type_name("NAME");
-  addNumber(*cmd, "--exposure", &o->exposure, -64, 64, "stops, applied before the PNG's view transform")
-      ->type_name("STOPS");
+  addNumber(*cmd, "--exposure", &o->exposure, -64, 64, "stops, applied before the PNG's view transform")->type_name("STOPS");
   cmd->add_flag("--denoise", o->denoise, "denoise the whole image (the EXR keeps the raw samples too)");
   cmd->callback([o, status] { *status = runRender(*o); });
 }

@@ -30,8 +30,8 @@ bool unknownCommand(const CLI::App& app, const std::vector<std::string>& args) {
     if (option && at->get_option_no_throw(word.substr(0, word.find('='))) != nullptr) return false;
     const CLI::App* next = option ? nullptr : findCommand(*at, word);
     if (!next) {
-      std::fprintf(stderr, "%s: unknown %s '%s'\nRun '%s --help' for the commands.\n", path.c_str(),
-                   option ? "option" : "command", word.c_str(), path.c_str());
+      std::fprintf(stderr, "%s: unknown %s '%s'\nRun '%s --help' for the commands.\n", path.c_str(), option ? "option" : "command",
+                   word.c_str(), path.c_str());
       return true;
     }
     at = next;
@@ -73,8 +73,9 @@ int main(int argc, char** argv) {
   retile::cli::addBench(app, &status);
   retile::cli::addImport(app, &status);
   // After the commands, which would otherwise inherit it.
-  app.footer("SCENE is a file (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default'.\n"
-             "`retile COMMAND --help` lists a command's options.");
+  app.footer(
+      "SCENE is a file (glTF, OBJ, FBX, PLY, Tungsten scene.json, .retile) or 'default'.\n"
+      "`retile COMMAND --help` lists a command's options.");
 
   try {
     // The editor takes the command line as it is (Qt reads its own options from it): nothing
@@ -88,8 +89,7 @@ int main(int argc, char** argv) {
     // --help and --version end the parse this way too, with exit code 0.
     if (e.get_exit_code() == 0) return app.exit(e);
     const std::string command = commandPath(app);
-    std::fprintf(stderr, "%s: error: %s\nRun '%s --help' for its options.\n", command.c_str(), e.what(),
-                 command.c_str());
+    std::fprintf(stderr, "%s: error: %s\nRun '%s --help' for its options.\n", command.c_str(), e.what(), command.c_str());
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

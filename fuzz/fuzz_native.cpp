@@ -7,7 +7,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::string text(reinterpret_cast<const char*>(data), size);
   auto imported = nativeSceneFromString(text, "input.retile", fuzz::inputPath(""));
   if (!imported) {
-    if (imported.error().find("input.retile") == std::string::npos) fuzz::invariant("an error that does not name the file", imported.error());
+    if (imported.error().find("input.retile") == std::string::npos)
+      fuzz::invariant("an error that does not name the file", imported.error());
     return 0;
   }
   fuzz::checkImportedScene(imported->scene);

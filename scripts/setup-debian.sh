@@ -11,6 +11,7 @@ set -euo pipefail
 # locale (de_DE) as an artist in much of Europe does.
 # libcli11-dev: the command line's parser (header-only): options, ranges and --help of every command.
 # clang, libclang-rt-14-dev: the fuzz targets (libFuzzer's runtime is only recommended by clang).
+# clang-format: the sources' format, checked by scripts/format.sh --check.
 packages=(
   build-essential cmake ninja-build pkg-config git file dpkg-dev
   qt6-base-dev qt6-base-dev-tools qt6-charts-dev qt6-svg-dev libqt6opengl6-dev libgl-dev
@@ -21,7 +22,7 @@ packages=(
   libopencolorio-dev
   libgtest-dev libgmock-dev
   libcli11-dev
-  clang libclang-rt-14-dev
+  clang libclang-rt-14-dev clang-format
   locales time
   xvfb xauth libxkbcommon-x11-0 libxcb-cursor0 libxcb-icccm4 libxcb-image0 libxcb-keysyms1
   libxcb-randr0 libxcb-render-util0 libxcb-shape0 libxcb-xinerama0 libxcb-xkb1 fonts-dejavu-core

@@ -6,6 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 stage() { local name=$1 start=$SECONDS; shift; "$@"; echo "stage $name: $((SECONDS - start)) s"; }
 stage set-up bash scripts/setup-debian.sh
+stage format bash scripts/format.sh --check
 cmake --preset ci
 stage build cmake --build --preset ci
 stage suites ctest --preset ci "$@"

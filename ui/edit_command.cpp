@@ -3,8 +3,7 @@
 namespace retile::ui {
 
 EditCommand::EditCommand(Edit before, Edit after, const QString& text, Apply apply, int dragId)
-    : EditCommand(std::vector<std::pair<Edit, Edit>>{{std::move(before), std::move(after)}}, text, std::move(apply),
-                  dragId) {}
+    : EditCommand(std::vector<std::pair<Edit, Edit>>{{std::move(before), std::move(after)}}, text, std::move(apply), dragId) {}
 
 EditCommand::EditCommand(std::vector<std::pair<Edit, Edit>> steps, const QString& text, Apply apply, int dragId)
     : steps_(std::move(steps)), apply_(std::move(apply)), dragId_(dragId) {

@@ -32,8 +32,7 @@ constexpr QSize kChartSize{900, 520};
 
 // Ten colours that stay apart (Tableau 10); the default theme repeats after five.
 QColor seriesColor(std::size_t i) {
-  static const QRgb colors[] = {0x4e79a7, 0xf28e2b, 0xe15759, 0x76b7b2, 0x59a14f,
-                                0xedc948, 0xb07aa1, 0xff9da7, 0x9c755f, 0xbab0ac};
+  static const QRgb colors[] = {0x4e79a7, 0xf28e2b, 0xe15759, 0x76b7b2, 0x59a14f, 0xedc948, 0xb07aa1, 0xff9da7, 0x9c755f, 0xbab0ac};
   return QColor::fromRgb(colors[i % 10]);
 }
 
@@ -56,8 +55,7 @@ constexpr double kLogPad = 1.1;
 QString tickText(double v) {
   for (int decimals = 0; decimals < 6; ++decimals) {
     const double scaled = v * std::pow(10.0, decimals);
-    if (std::abs(scaled - std::round(scaled)) < 1e-6 * std::max(1.0, std::abs(scaled)))
-      return QString::number(v, 'f', decimals);
+    if (std::abs(scaled - std::round(scaled)) < 1e-6 * std::max(1.0, std::abs(scaled))) return QString::number(v, 'f', decimals);
   }
   return QString::number(v, 'g', 6);
 }
@@ -104,9 +102,11 @@ std::vector<double> logTicks(double lo, double hi) {
     for (double v : t) widest = std::max(widest, std::log10(v / from)), from = v;
     return std::max(widest, std::log10(hi / from));
   };
-  const std::vector<double> sets[] = {decadeTicks(lo, hi, {1}), decadeTicks(lo, hi, {1, 2, 5}),
+  const std::vector<double> sets[] = {decadeTicks(lo, hi, {1}),
+                                      decadeTicks(lo, hi, {1, 2, 5}),
                                       decadeTicks(lo, hi, {1, 2, 3, 5}),
-                                      decadeTicks(lo, hi, {1, 2, 3, 4, 5, 6, 7, 8, 9}), linearTicks(lo, hi, 6),
+                                      decadeTicks(lo, hi, {1, 2, 3, 4, 5, 6, 7, 8, 9}),
+                                      linearTicks(lo, hi, 6),
                                       linearTicks(lo, hi, 10)};
   const std::vector<double>* best = nullptr;
   for (const auto& t : sets)
@@ -278,8 +278,7 @@ double area(const QRectF& r) { return r.isEmpty() ? 0 : r.width() * r.height(); 
 
 // How much of a label at `spot` would be hidden or would hide something: the part outside its
 // bounds, and the parts over the labels placed before it or over markers.
-double overlap(const QRectF& spot, const QRectF& bounds, const std::vector<QRectF>& placed,
-               const std::vector<QRectF>& obstacles) {
+double overlap(const QRectF& spot, const QRectF& bounds, const std::vector<QRectF>& placed, const std::vector<QRectF>& obstacles) {
   double cost = area(spot) - area(spot & bounds);
   for (const auto* rects : {&placed, &obstacles})
     for (const QRectF& r : *rects) cost += area(spot & r);
@@ -295,8 +294,7 @@ std::vector<QRectF> labelSpots(const LabelRequest& l) {
   std::vector<QRectF> spots;
   for (int ring = 0; ring < kRings; ++ring)
     for (QPoint d : kDirections) {
-      const QPointF centre(l.anchor.x() + d.x() * (r + w / 2 + ring * h),
-                           l.anchor.y() + d.y() * (r + h / 2 + ring * h));
+      const QPointF centre(l.anchor.x() + d.x() * (r + w / 2 + ring * h), l.anchor.y() + d.y() * (r + h / 2 + ring * h));
       spots.emplace_back(centre - QPointF(w / 2, h / 2), l.size);
     }
   return spots;
@@ -344,8 +342,10 @@ void labelMarkers(QChart* chart, const std::vector<Marker>& markers, const Band&
     auto same = std::find_if(groups.begin(), groups.end(), [&](const Group& g) {
       return g.first->reached == m.reached && std::hypot(g.at.x() - at.x(), g.at.y() - at.y()) < 3;
     });
-    if (same != groups.end()) same->names += m.label;
-    else groups.push_back({at, {m.label}, &m});
+    if (same != groups.end())
+      same->names += m.label;
+    else
+      groups.push_back({at, {m.label}, &m});
   }
   std::vector<QGraphicsSimpleTextItem*> items;
   std::vector<LabelRequest> requests;
@@ -449,13 +449,13 @@ std::unique_ptr<QChartView> pointChartView(const QString& title, const QString& 
   return view;
 }
 
-Result<bool> writeLineChart(const std::filesystem::path& base, const QString& title, const QString& xTitle,
-                            const QString& yTitle, const std::vector<ChartLine>& lines, bool logX) {
+Result<bool> writeLineChart(const std::filesystem::path& base, const QString& title, const QString& xTitle, const QString& yTitle,
+                            const std::vector<ChartLine>& lines, bool logX) {
   return writeChart(*lineChartView(title, xTitle, yTitle, lines, logX), base);
 }
 
-Result<bool> writePointChart(const std::filesystem::path& base, const QString& title, const QString& xTitle,
-                             const QString& yTitle, const std::vector<ChartPoint>& points) {
+Result<bool> writePointChart(const std::filesystem::path& base, const QString& title, const QString& xTitle, const QString& yTitle,
+                             const std::vector<ChartPoint>& points) {
   return writeChart(*pointChartView(title, xTitle, yTitle, points), base);
 }
 
@@ -470,16 +470,14 @@ QImage frameWithOverlays(const FrameRecord& frame, int scale) {
   return view.composed();
 }
 
-Result<bool> writeStrip(const std::filesystem::path& file, const std::vector<QString>& captions,
-                        const std::vector<StripRow>& rows) {
+Result<bool> writeStrip(const std::filesystem::path& file, const std::vector<QString>& captions, const std::vector<StripRow>& rows) {
   int cellW = 0, cellH = 0;
   for (const StripRow& r : rows)
     for (const QImage& c : r.cells) cellW = std::max(cellW, c.width()), cellH = std::max(cellH, c.height());
   if (rows.empty() || cellW == 0) return Result<bool>::failure(cat(file.string(), ": no frames to show"));
   const int labelW = 170, captionH = 24, gap = 4;
   const int cols = static_cast<int>(captions.size());
-  QImage strip(labelW + cols * (cellW + gap), captionH + static_cast<int>(rows.size()) * (cellH + gap),
-               QImage::Format_RGB32);
+  QImage strip(labelW + cols * (cellW + gap), captionH + static_cast<int>(rows.size()) * (cellH + gap), QImage::Format_RGB32);
   strip.fill(QColor(24, 24, 28));
   QPainter p(&strip);
   p.setPen(Qt::white);

@@ -25,8 +25,8 @@ struct ChartLine {
 };
 
 struct ChartPoint {
-  QString label;        // on the plot (points drawn at one spot share one label)
-  QString legend;       // in the legend; empty: the label, with "(not reached)" when not reached
+  QString label;   // on the plot (points drawn at one spot share one label)
+  QString legend;  // in the legend; empty: the label, with "(not reached)" when not reached
   QPointF at;
   // false: `at`'s x is a bound (the run's length), not a time measured; the point is drawn in a
   // "not reached" band beyond the times, and its x only sizes the time axis when nothing reached.
@@ -48,11 +48,11 @@ struct LabelRequest {
 std::vector<QRectF> placeLabels(const std::vector<LabelRequest>& labels, const std::vector<QRectF>& obstacles);
 
 // Writes `base`.png and `base`.svg: a line per entry (error against time, one per method).
-Result<bool> writeLineChart(const std::filesystem::path& base, const QString& title, const QString& xTitle,
-                            const QString& yTitle, const std::vector<ChartLine>& lines, bool logX = false);
+Result<bool> writeLineChart(const std::filesystem::path& base, const QString& title, const QString& xTitle, const QString& yTitle,
+                            const std::vector<ChartLine>& lines, bool logX = false);
 // The same with one labelled point per entry (the speed-against-accuracy chart).
-Result<bool> writePointChart(const std::filesystem::path& base, const QString& title, const QString& xTitle,
-                             const QString& yTitle, const std::vector<ChartPoint>& points);
+Result<bool> writePointChart(const std::filesystem::path& base, const QString& title, const QString& xTitle, const QString& yTitle,
+                             const std::vector<ChartPoint>& points);
 
 // The same charts laid out at the report's size in a view never shown on screen, for a test to
 // look at what the files would show.
@@ -71,7 +71,6 @@ struct StripRow {
   QString label;
   std::vector<QImage> cells;
 };
-Result<bool> writeStrip(const std::filesystem::path& file, const std::vector<QString>& captions,
-                        const std::vector<StripRow>& rows);
+Result<bool> writeStrip(const std::filesystem::path& file, const std::vector<QString>& captions, const std::vector<StripRow>& rows);
 
 }  // namespace retile::ui

@@ -147,8 +147,10 @@ void ScrubField::commitTyped() {
   const double clamped = std::clamp(*v, minimum(), maximum());
   if (clamped != *v)
     refuse(tr("%1 is outside %2 to %3: set to %4").arg(typed, textFromValue(minimum()), textFromValue(maximum()), textFromValue(clamped)));
-  if (clamped == value()) lineEdit()->setText(prefix() + textFromValue(clamped) + suffix());
-  else setValue(clamped);
+  if (clamped == value())
+    lineEdit()->setText(prefix() + textFromValue(clamped) + suffix());
+  else
+    setValue(clamped);
 }
 
 void ScrubField::keyPressEvent(QKeyEvent* e) {
@@ -189,8 +191,7 @@ void ScrubField::contextMenuEvent(QContextMenuEvent* e) {
   if (menu.exec(e->globalPos()) == reset) setValue(default_);
 }
 
-ColorField::ColorField(QColor value, QColor defaultValue, QWidget* parent)
-    : QPushButton(parent), default_(defaultValue) {
+ColorField::ColorField(QColor value, QColor defaultValue, QWidget* parent) : QPushButton(parent), default_(defaultValue) {
   setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
   setMinimumWidth(56);
   setColor(value);

@@ -201,8 +201,10 @@ QImage FrameView::composed() const {
 }
 
 void FrameView::refresh() {
-  if (vulkan_) vulkan_->setPicture(composed());
-  else update();
+  if (vulkan_)
+    vulkan_->setPicture(composed());
+  else
+    update();
 }
 
 void FrameView::resizeEvent(QResizeEvent*) {
@@ -464,15 +466,17 @@ std::vector<FrameView::LegendItem> FrameView::legendItems(bool everything) const
   if (overlays_.reuse && (everything || f.reusedTiles > 0))
     items.push_back({K::Corner, kReusedColor, tr("%n tile(s) reusing their history", nullptr, everything ? 9999 : f.reusedTiles)});
   if (overlays_.reuse && (everything || f.rejectedTiles > 0))
-    items.push_back({K::CrossHatch, kRejectedColor, tr("%n history(ies) rejected, frames since", nullptr, everything ? 9999 : f.rejectedTiles)});
+    items.push_back(
+        {K::CrossHatch, kRejectedColor, tr("%n history(ies) rejected, frames since", nullptr, everything ? 9999 : f.rejectedTiles)});
   // The strip's height must not follow the method (a new one would resize the render): the
   // longest label stands in for it.
   const QString method = everything ? QStringLiteral("indirection+focus+smooth+denoise+reuse") : QString::fromStdString(f.method);
   const QString mode = everything ? QStringLiteral("global-update") : QString::fromStdString(f.mode);
-  items.push_back({K::None, QColor(200, 200, 200), tr("%1, %2: %3 of %4 tiles")
-                                                      .arg(method, mode)
-                                                      .arg(everything ? 99999 : static_cast<qulonglong>(f.queueServed))
-                                                      .arg(everything ? 99999 : static_cast<qulonglong>(f.queueLength))});
+  items.push_back({K::None, QColor(200, 200, 200),
+                   tr("%1, %2: %3 of %4 tiles")
+                       .arg(method, mode)
+                       .arg(everything ? 99999 : static_cast<qulonglong>(f.queueServed))
+                       .arg(everything ? 99999 : static_cast<qulonglong>(f.queueLength))});
   return items;
 }
 
@@ -546,7 +550,8 @@ void FrameView::drawLegend(QPainter& p) const {
     p.setBrush(Qt::NoBrush);
     p.setPen(QPen(item.color, 2.0));
     switch (item.key) {
-      case K::None: break;
+      case K::None:
+        break;
       case K::Ramp: {
         QLinearGradient g(key.topLeft(), key.topRight());
         for (int s = 0; s <= 4; ++s) {
@@ -557,12 +562,16 @@ void FrameView::drawLegend(QPainter& p) const {
         p.fillRect(key, g);
         break;
       }
-      case K::Outline: p.drawRect(key.adjusted(1, 1, -1, -1)); break;
+      case K::Outline:
+        p.drawRect(key.adjusted(1, 1, -1, -1));
+        break;
       case K::Cross:
         p.drawLine(c - QPointF(6, 0), c + QPointF(6, 0));
         p.drawLine(c - QPointF(0, 6), c + QPointF(0, 6));
         break;
-      case K::Circle: p.drawEllipse(c, 5.5, 5.5); break;
+      case K::Circle:
+        p.drawEllipse(c, 5.5, 5.5);
+        break;
       case K::Hatch:
       case K::CrossHatch:
         p.fillRect(key, QBrush(item.color, item.key == K::Hatch ? Qt::BDiagPattern : Qt::DiagCrossPattern));
@@ -607,7 +616,8 @@ void FrameView::inspectRegion() {
   float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (int y = rr.top(); y <= rr.bottom(); ++y)
     for (int x = rr.left(); x <= rr.right(); ++x) {
-      const float* c = inspected(img).data() + (static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x)) * 3;
+      const float* c =
+          inspected(img).data() + (static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x)) * 3;
       for (int k = 0; k < 3; ++k) {
         sum[k] += c[k];
         lo[k] = std::min(lo[k], c[k]);
@@ -717,14 +727,25 @@ void FrameView::mouseMoveEvent(QMouseEvent* e) {
       if (r.width() > 0) setWipe((e->position().x() - r.x()) / r.width());
       break;
     }
-    case Drag::Orbit: emit orbitDragged(d); break;
-    case Drag::Pan: emit panDragged(d); break;
-    case Drag::Dolly: emit dollyDragged(-d.y() / 200.0); break;
-    case Drag::Rotate: emit rotateDragged(d.x()); break;
-    case Drag::Scale: emit scaleDragged(d.x()); break;
+    case Drag::Orbit:
+      emit orbitDragged(d);
+      break;
+    case Drag::Pan:
+      emit panDragged(d);
+      break;
+    case Drag::Dolly:
+      emit dollyDragged(-d.y() / 200.0);
+      break;
+    case Drag::Rotate:
+      emit rotateDragged(d.x());
+      break;
+    case Drag::Scale:
+      emit scaleDragged(d.x());
+      break;
     case Drag::Axis: {
       QRectF r = imageRect();
-      if (frame_ && r.width() > 0) emit axisDragged(dragAxis_, QPointF(d.x() * frame_->width / r.width(), d.y() * frame_->height / r.height()));
+      if (frame_ && r.width() > 0)
+        emit axisDragged(dragAxis_, QPointF(d.x() * frame_->width / r.width(), d.y() * frame_->height / r.height()));
       break;
     }
     case Drag::Object: {
@@ -732,7 +753,8 @@ void FrameView::mouseMoveEvent(QMouseEvent* e) {
       if (frame_ && r.width() > 0) emit objectDragged(QPointF(d.x() * frame_->width / r.width(), d.y() * frame_->height / r.height()));
       break;
     }
-    case Drag::None: break;
+    case Drag::None:
+      break;
   }
 }
 
@@ -743,8 +765,8 @@ void FrameView::mouseReleaseEvent(QMouseEvent* e) {
     if (std::hypot(d.x(), d.y()) < 4 || draft_.width() < 2 || draft_.height() < 2) {
       QRectF r = imageRect();
       if (frame_ && r.width() > 0)
-        emit focusPlaced(QPointF((regionStart_.x() - r.x()) / r.width() * frame_->width,
-                                 (regionStart_.y() - r.y()) / r.height() * frame_->height));
+        emit focusPlaced(
+            QPointF((regionStart_.x() - r.x()) / r.width() * frame_->width, (regionStart_.y() - r.y()) / r.height() * frame_->height));
     } else {
       emit renderRegionDrawn(draft_);
     }

@@ -20,15 +20,15 @@ namespace retile::ui {
 class VulkanViewport;
 
 struct OverlaySettings {
-  bool priority = true;   // per-tile priority as a heat map
-  bool order = false;     // the queue position as numbers
-  bool samples = false;   // accumulated samples per tile
-  bool served = true;     // tiles traced this frame, outlined
-  bool markers = true;    // point of change and focus points
+  bool priority = true;  // per-tile priority as a heat map
+  bool order = false;    // the queue position as numbers
+  bool samples = false;  // accumulated samples per tile
+  bool served = true;    // tiles traced this frame, outlined
+  bool markers = true;   // point of change and focus points
   bool legend = true;
-  bool classes = false;   // indirection classes: high, middle, low (indirection methods only)
-  bool denoised = true;   // the denoised regions' boundaries, labelled with their age
-  bool reuse = true;      // verified reuse: tiles reusing their history, tiles whose history was rejected
+  bool classes = false;  // indirection classes: high, middle, low (indirection methods only)
+  bool denoised = true;  // the denoised regions' boundaries, labelled with their age
+  bool reuse = true;     // verified reuse: tiles reusing their history, tiles whose history was rejected
 };
 
 class FrameView : public QWidget {
@@ -132,18 +132,18 @@ class FrameView : public QWidget {
 
  signals:
   void presentationChanged(const QString& presentation);  // the viewport fell back to the widget
-  void objectPicked(quint64 object);  // 0: nothing under the cursor
-  void objectToggled(quint64 object);  // Ctrl+click on an object: into or out of the selection
+  void objectPicked(quint64 object);                      // 0: nothing under the cursor
+  void objectToggled(quint64 object);                     // Ctrl+click on an object: into or out of the selection
   void focusPlaced(QPointF imagePixel);
   // Drags, in widget pixels since the last event. A drag starts with a press and ends with the
   // release (dragFinished), so a whole drag can be one undo step.
-  void orbitDragged(QPointF delta);       // Alt + left
-  void panDragged(QPointF delta);         // Alt + middle
-  void dollyDragged(double amount);       // Alt + right, or the wheel (positive: closer)
-  void objectDragged(QPointF imageDelta);  // Move tool, left drag starting on the selection: image pixels
+  void orbitDragged(QPointF delta);                // Alt + left
+  void panDragged(QPointF delta);                  // Alt + middle
+  void dollyDragged(double amount);                // Alt + right, or the wheel (positive: closer)
+  void objectDragged(QPointF imageDelta);          // Move tool, left drag starting on the selection: image pixels
   void axisDragged(int axis, QPointF imageDelta);  // Move tool, drag of a gizmo arrow
-  void rotateDragged(double pixels);              // Rotate tool: horizontal drag turns about world y
-  void scaleDragged(double pixels);               // Scale tool: horizontal drag scales uniformly
+  void rotateDragged(double pixels);               // Rotate tool: horizontal drag turns about world y
+  void scaleDragged(double pixels);                // Scale tool: horizontal drag scales uniformly
   void dragFinished();
   void resized();
   // Pixel inspector: linear values under the cursor, and the statistics of a Ctrl+drag region
@@ -190,10 +190,10 @@ class FrameView : public QWidget {
   QPointF toWidget(QPointF imagePixel) const;
   void drawGizmo(QPainter& p) const;
   QPointF last_, regionStart_;
-  QRect region_;  // the inspected region in image pixels
-  quint64 selected_ = 0;              // the primary selection
-  std::vector<quint64> selection_;    // all selected objects
-  mutable QImage outline_;            // the multi-selection's outline, at the frame's resolution
+  QRect region_;                             // the inspected region in image pixels
+  quint64 selected_ = 0;                     // the primary selection
+  std::vector<quint64> selection_;           // all selected objects
+  mutable QImage outline_;                   // the multi-selection's outline, at the frame's resolution
   mutable const void* outlineOf_ = nullptr;  // the image record it was made for
   std::shared_ptr<const RenderImage> snapshotLinear_;
   QImage snapshot_;

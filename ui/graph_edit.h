@@ -64,9 +64,7 @@ std::string uniqueName(const std::vector<Node>& nodes, std::string base) {
   QString b = QString::fromStdString(base);
   b.remove(suffix);
   if (b.isEmpty()) b = QStringLiteral("Node");
-  auto taken = [&](const std::string& n) {
-    return std::any_of(nodes.begin(), nodes.end(), [&](const Node& x) { return x.name == n; });
-  };
+  auto taken = [&](const std::string& n) { return std::any_of(nodes.begin(), nodes.end(), [&](const Node& x) { return x.name == n; }); };
   if (!taken(b.toStdString())) return b.toStdString();
   for (int i = 1;; ++i) {
     std::string n = QStringLiteral("%1.%2").arg(b).arg(i, 3, 10, QLatin1Char('0')).toStdString();

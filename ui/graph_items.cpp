@@ -14,12 +14,9 @@ struct TextureInput {
   const char* name;
   NodeId Material::*field;
 };
-constexpr TextureInput kTextureInputs[] = {{"albedo", &Material::albedoTexture},
-                                           {"roughness", &Material::roughnessTexture},
-                                           {"alpha", &Material::alphaTexture},
-                                           {"bump", &Material::bumpTexture},
-                                           {"emission", &Material::emissionTexture},
-                                           {"blend ratio", &Material::blendRatioTexture}};
+constexpr TextureInput kTextureInputs[] = {{"albedo", &Material::albedoTexture},     {"roughness", &Material::roughnessTexture},
+                                           {"alpha", &Material::alphaTexture},       {"bump", &Material::bumpTexture},
+                                           {"emission", &Material::emissionTexture}, {"blend ratio", &Material::blendRatioTexture}};
 
 constexpr qreal kEndDotR = kSocketR - 2;  // inside the socket's ring, which stays visible around it
 
@@ -27,21 +24,31 @@ constexpr qreal kEndDotR = kSocketR - 2;  // inside the socket's ring, which sta
 
 int columnOf(NodeKind k) {
   switch (k) {
-    case NodeKind::Texture: return 0;
-    case NodeKind::Material: return 1;
-    case NodeKind::Object: return 2;
-    default: return 3;
+    case NodeKind::Texture:
+      return 0;
+    case NodeKind::Material:
+      return 1;
+    case NodeKind::Object:
+      return 2;
+    default:
+      return 3;
   }
 }
 
 QColor headerColor(NodeKind k) {
   switch (k) {
-    case NodeKind::Texture: return {176, 112, 40};
-    case NodeKind::Material: return {52, 132, 82};
-    case NodeKind::Object: return {52, 96, 168};
-    case NodeKind::Light: return {168, 148, 36};
-    case NodeKind::Camera: return {118, 80, 160};
-    case NodeKind::Settings: return {92, 92, 104};
+    case NodeKind::Texture:
+      return {176, 112, 40};
+    case NodeKind::Material:
+      return {52, 132, 82};
+    case NodeKind::Object:
+      return {52, 96, 168};
+    case NodeKind::Light:
+      return {168, 148, 36};
+    case NodeKind::Camera:
+      return {118, 80, 160};
+    case NodeKind::Settings:
+      return {92, 92, 104};
   }
   return Qt::gray;
 }
@@ -103,8 +110,7 @@ void GraphNodeItem::paint(QPainter* p, const QStyleOptionGraphicsItem*, QWidget*
   p->setPen(Qt::white);
   const qreal swatchSpace = swatch.isValid() ? 22 : 0;
   const QRectF titleRect(8, 0, kNodeWidth - 16 - swatchSpace, kHeaderH);
-  p->drawText(titleRect, Qt::AlignVCenter | Qt::AlignLeft,
-              QFontMetricsF(titleFont).elidedText(title, Qt::ElideRight, titleRect.width()));
+  p->drawText(titleRect, Qt::AlignVCenter | Qt::AlignLeft, QFontMetricsF(titleFont).elidedText(title, Qt::ElideRight, titleRect.width()));
   if (swatch.isValid()) {
     p->setPen(QPen(QColor(20, 20, 20), 1));
     p->setBrush(swatch);
@@ -118,8 +124,7 @@ void GraphNodeItem::paint(QPainter* p, const QStyleOptionGraphicsItem*, QWidget*
   p->setFont(small);
   p->setPen(QColor(178, 178, 186));
   const QRectF subRect(8, kHeaderH, kNodeWidth - 16, kSubtitleH);
-  p->drawText(subRect, Qt::AlignVCenter | Qt::AlignLeft,
-              QFontMetricsF(small).elidedText(subtitle, Qt::ElideRight, subRect.width()));
+  p->drawText(subRect, Qt::AlignVCenter | Qt::AlignLeft, QFontMetricsF(small).elidedText(subtitle, Qt::ElideRight, subRect.width()));
 
   auto socket = [&](QPointF c, const QString& name) {
     p->setPen(QPen(QColor(18, 18, 20), 1.2));
@@ -137,20 +142,21 @@ void GraphNodeItem::paint(QPainter* p, const QStyleOptionGraphicsItem*, QWidget*
     const QPointF c = outputPos();
     socket(c, output);
     p->setPen(QColor(222, 222, 228));
-    p->drawText(QRectF(kNodeWidth / 2, c.y() - kRowH / 2, kNodeWidth / 2 - 12, kRowH),
-                Qt::AlignVCenter | Qt::AlignRight, output);
+    p->drawText(QRectF(kNodeWidth / 2, c.y() - kRowH / 2, kNodeWidth / 2 - 12, kRowH), Qt::AlignVCenter | Qt::AlignRight, output);
   }
 }
 
 QPen linkPen(const QString& input, LinkLook look) {
   switch (look) {
-    case LinkLook::Highlighted: return QPen(socketColor(input).lighter(145), 5);
+    case LinkLook::Highlighted:
+      return QPen(socketColor(input).lighter(145), 5);
     case LinkLook::Faded: {
       QColor c = socketColor(input);
       c.setAlpha(70);
       return QPen(c, 2);
     }
-    case LinkLook::Normal: break;
+    case LinkLook::Normal:
+      break;
   }
   return QPen(socketColor(input), 2.5);
 }

@@ -94,8 +94,7 @@ NodePositions layOutIslands(const Scene& s, const std::vector<GraphNodeItem*>& n
 
   // Shelves of islands, the tallest first (each shelf is as tall as its first island, so the
   // others fill it best), about as wide for their height as the panel is.
-  std::stable_sort(islands.begin(), islands.end(),
-                   [](const Island& a, const Island& b) { return a.size.height() > b.size.height(); });
+  std::stable_sort(islands.begin(), islands.end(), [](const Island& a, const Island& b) { return a.size.height() > b.size.height(); });
   double area = 0, widest = 0;
   for (const Island& i : islands) {
     area += (i.size.width() + kIslandGapX) * (i.size.height() + kIslandGapY);
@@ -108,9 +107,8 @@ NodePositions layOutIslands(const Scene& s, const std::vector<GraphNodeItem*>& n
   std::vector<Shelf> shelves;
   NodePositions at;
   for (const Island& i : islands) {
-    auto shelf = std::find_if(shelves.begin(), shelves.end(), [&](const Shelf& f) {
-      return f.x + i.size.width() <= width && i.size.height() <= f.height;
-    });
+    auto shelf = std::find_if(shelves.begin(), shelves.end(),
+                              [&](const Shelf& f) { return f.x + i.size.width() <= width && i.size.height() <= f.height; });
     if (shelf == shelves.end()) {
       const qreal y = shelves.empty() ? 0 : shelves.back().y + shelves.back().height + kIslandGapY;
       shelves.push_back({y, i.size.height(), 0});
@@ -134,8 +132,7 @@ std::set<NodeId> neighbourhood(const Scene& s, const std::vector<NodeId>& roots)
   return found;
 }
 
-NodePositions layOutNeighbourhood(const Scene& s, const std::vector<GraphNodeItem*>& nodes,
-                                  const std::vector<NodeId>& roots) {
+NodePositions layOutNeighbourhood(const Scene& s, const std::vector<GraphNodeItem*>& nodes, const std::vector<NodeId>& roots) {
   std::unordered_map<NodeId, GraphNodeItem*> byId;
   for (GraphNodeItem* n : nodes) byId[n->id] = n;
   // Distance from the roots along the longest chain of links, so that a node sits left of every
@@ -176,8 +173,7 @@ NodePositions layOutNeighbourhood(const Scene& s, const std::vector<GraphNodeIte
   for (const auto& [d, column] : columns) {
     std::vector<GraphNodeItem*> order = column;
     if (d == 0)
-      std::stable_sort(order.begin(), order.end(),
-                       [&](const GraphNodeItem* a, const GraphNodeItem* b) { return rank(a) < rank(b); });
+      std::stable_sort(order.begin(), order.end(), [&](const GraphNodeItem* a, const GraphNodeItem* b) { return rank(a) < rank(b); });
     std::stable_sort(order.begin(), order.end(), [&](const GraphNodeItem* a, const GraphNodeItem* b) {
       return (wanted.count(a->id) ? wanted[a->id] : 0) < (wanted.count(b->id) ? wanted[b->id] : 0);
     });

@@ -42,8 +42,7 @@ std::set<NodeId> neighbourhood(const Scene& s, const std::vector<NodeId>& roots)
 // The roots in the rightmost column; every other node one column left of the furthest of its
 // consumers, level with the socket it feeds where the column has room. Nodes that feed none of
 // the others (say, one just created) go with the roots.
-NodePositions layOutNeighbourhood(const Scene& s, const std::vector<GraphNodeItem*>& nodes,
-                                  const std::vector<NodeId>& roots);
+NodePositions layOutNeighbourhood(const Scene& s, const std::vector<GraphNodeItem*>& nodes, const std::vector<NodeId>& roots);
 
 // The centre of a view `view` across (scene units) over nodes that span `all`: the middle of
 // `all` where it fits; where it does not, `focus` (its top-left part if it is too big itself) with

@@ -99,8 +99,9 @@ LiveChart::LiveChart(QWidget* parent) : QWidget(parent) {
   auto* row = new QHBoxLayout;
   referenceButton_ = new QPushButton(tr("Render reference"), this);
   referenceButton_->setObjectName("renderReference");
-  referenceButton_->setToolTip(tr("Renders the current scene state at the viewport's size in the background; the error "
-                                  "chart then follows the viewport against it until the next edit."));
+  referenceButton_->setToolTip(
+      tr("Renders the current scene state at the viewport's size in the background; the error "
+         "chart then follows the viewport against it until the next edit."));
   status_ = new QLabel(tr("No reference yet."), this);
   status_->setWordWrap(true);
   row->addWidget(referenceButton_);
@@ -150,8 +151,8 @@ void LiveChart::addFrame(const FrameRecord& frame) {
     if (std::isfinite(lastError_)) error_->append(now, lastError_);
     status_->setText(tr("Reference of version %1: relative RMSE %2").arg(refVersion_).arg(lastError_, 0, 'f', 4));
   } else if (!reference_.empty() && frame.documentVersion != refVersion_) {
-    status_->setText(tr("The scene changed since the reference (version %1, now %2): render a new one.")
-                         .arg(refVersion_).arg(frame.documentVersion));
+    status_->setText(
+        tr("The scene changed since the reference (version %1, now %2): render a new one.").arg(refVersion_).arg(frame.documentVersion));
   }
   trim(now);
   fitY(samplesPerSecond_, rateAxis_, 0.01);
@@ -186,21 +187,24 @@ void LiveChart::renderReference(const Scene& scene, std::uint64_t documentVersio
       failure = QString::fromUtf8(e.what());
     }
     if (*cancel) return;
-    QMetaObject::invokeMethod(this, [this, color = std::move(color), failure, w, h, documentVersion, cancel]() mutable {
-      if (*cancel) return;  // reset() or a newer request came after the render ended
-      referenceButton_->setEnabled(true);
-      if (!failure.isEmpty()) {
-        status_->setText(tr("Reference failed: %1").arg(failure));
-        return;
-      }
-      reference_ = std::move(color);
-      refWidth_ = w;
-      refHeight_ = h;
-      refVersion_ = documentVersion;
-      error_->clear();
-      status_->setText(tr("Reference of version %1 ready.").arg(documentVersion));
-      emit referenceReady();
-    }, Qt::QueuedConnection);
+    QMetaObject::invokeMethod(
+        this,
+        [this, color = std::move(color), failure, w, h, documentVersion, cancel]() mutable {
+          if (*cancel) return;  // reset() or a newer request came after the render ended
+          referenceButton_->setEnabled(true);
+          if (!failure.isEmpty()) {
+            status_->setText(tr("Reference failed: %1").arg(failure));
+            return;
+          }
+          reference_ = std::move(color);
+          refWidth_ = w;
+          refHeight_ = h;
+          refVersion_ = documentVersion;
+          error_->clear();
+          status_->setText(tr("Reference of version %1 ready.").arg(documentVersion));
+          emit referenceReady();
+        },
+        Qt::QueuedConnection);
   });
 }
 

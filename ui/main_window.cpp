@@ -119,12 +119,19 @@ void MainWindow::connectViewport() {
     focus.push_back(FocusPoint{Vec2{static_cast<float>(p.x()), static_cast<float>(p.y())}, follows});
     methodPanel_->setFocus(focus);
     engine_->submit(FocusCommand{focus});
-    log(tr("focus point %1 at %2, %3%4").arg(focus.size()).arg(p.x(), 0, 'f', 0).arg(p.y(), 0, 'f', 0)
+    log(tr("focus point %1 at %2, %3%4")
+            .arg(focus.size())
+            .arg(p.x(), 0, 'f', 0)
+            .arg(p.y(), 0, 'f', 0)
             .arg(follows ? tr(", following the object") : QString()));
   });
   connect(view_, &FrameView::pixelInspected, this, [this](QPoint px, QVector3D c) {
-    pixelText_ = tr("pixel %1, %2: R %3  G %4  B %5 (linear)").arg(px.x()).arg(px.y())
-                     .arg(c.x(), 0, 'f', 4).arg(c.y(), 0, 'f', 4).arg(c.z(), 0, 'f', 4);
+    pixelText_ = tr("pixel %1, %2: R %3  G %4  B %5 (linear)")
+                     .arg(px.x())
+                     .arg(px.y())
+                     .arg(c.x(), 0, 'f', 4)
+                     .arg(c.y(), 0, 'f', 4)
+                     .arg(c.z(), 0, 'f', 4);
     inspector_->setText(pixelText_ + (regionText_.isEmpty() ? QString() : "\n\n" + regionText_));
     // An eye-tracker stand-in: the focus point follows the cursor, at most ten times a second.
     if (methodPanel_->focusMode() == MethodPanel::FocusMode::Cursor && focusTimer_.elapsed() > 100) {
@@ -136,7 +143,11 @@ void MainWindow::connectViewport() {
   connect(view_, &FrameView::regionInspected, this, [this](QRect r, QVector3D mean, QVector3D lo, QVector3D hi) {
     auto v = [](QVector3D c) { return QString("%1  %2  %3").arg(c.x(), 0, 'f', 4).arg(c.y(), 0, 'f', 4).arg(c.z(), 0, 'f', 4); };
     regionText_ = tr("region %1x%2 at %3, %4\nmean %5\nmin  %6\nmax  %7")
-                      .arg(r.width()).arg(r.height()).arg(r.x()).arg(r.y()).arg(v(mean), v(lo), v(hi));
+                      .arg(r.width())
+                      .arg(r.height())
+                      .arg(r.x())
+                      .arg(r.y())
+                      .arg(v(mean), v(lo), v(hi));
     inspector_->setText((pixelText_.isEmpty() ? QString() : pixelText_ + "\n\n") + regionText_);
   });
   focusTimer_.start();
@@ -150,29 +161,34 @@ void MainWindow::connectDrags() {
   // plane; each whole drag is one undo step.
   connect(view_, &FrameView::dragFinished, this, [this] { ++dragCounter_; });
   connect(view_, &FrameView::orbitDragged, this, [this](QPointF d) {
-    editCamera([d](Camera& c) {
-      Vec3 offset = c.position - c.target;
-      float yaw = static_cast<float>(-d.x() * 0.008), pitch = static_cast<float>(-d.y() * 0.008);
-      Mat4 turn = Mat4::rotateY(yaw);
-      offset = turn.transformPoint(offset);
-      Vec3 right = normalize(cross(normalize(c.target - c.position), c.up));
-      // Rodrigues' rotation of the offset about the camera's right axis.
-      Vec3 tilted = offset * std::cos(pitch) + cross(right, offset) * std::sin(pitch) +
-                    right * (dot(right, offset) * (1.0f - std::cos(pitch)));
-      // Stay clear of the poles, where "up" would flip.
-      if (std::abs(dot(normalize(tilted), Vec3{0, 1, 0})) < 0.97f) offset = tilted;
-      c.position = c.target + offset;
-    }, tr("Orbit"));
+    editCamera(
+        [d](Camera& c) {
+          Vec3 offset = c.position - c.target;
+          float yaw = static_cast<float>(-d.x() * 0.008), pitch = static_cast<float>(-d.y() * 0.008);
+          Mat4 turn = Mat4::rotateY(yaw);
+          offset = turn.transformPoint(offset);
+          Vec3 right = normalize(cross(normalize(c.target - c.position), c.up));
+          // Rodrigues' rotation of the offset about the camera's right axis.
+          Vec3 tilted =
+              offset * std::cos(pitch) + cross(right, offset) * std::sin(pitch) + right * (dot(right, offset) * (1.0f - std::cos(pitch)));
+          // Stay clear of the poles, where "up" would flip.
+          if (std::abs(dot(normalize(tilted), Vec3{0, 1, 0})) < 0.97f) offset = tilted;
+          c.position = c.target + offset;
+        },
+        tr("Orbit"));
   });
   connect(view_, &FrameView::panDragged, this, [this](QPointF d) {
-    editCamera([this, d](Camera& c) {
-      Vec3 fwd = normalize(c.target - c.position);
-      Vec3 right = normalize(cross(fwd, c.up)), up = cross(right, fwd);
-      float k = 2.0f * length(c.target - c.position) * std::tan(c.verticalFov * 0.5f) / static_cast<float>(std::max(1.0, view_->imageRect().height()));
-      Vec3 move = right * static_cast<float>(-d.x() * k) + up * static_cast<float>(d.y() * k);
-      c.position = c.position + move;
-      c.target = c.target + move;
-    }, tr("Pan"));
+    editCamera(
+        [this, d](Camera& c) {
+          Vec3 fwd = normalize(c.target - c.position);
+          Vec3 right = normalize(cross(fwd, c.up)), up = cross(right, fwd);
+          float k = 2.0f * length(c.target - c.position) * std::tan(c.verticalFov * 0.5f) /
+                    static_cast<float>(std::max(1.0, view_->imageRect().height()));
+          Vec3 move = right * static_cast<float>(-d.x() * k) + up * static_cast<float>(d.y() * k);
+          c.position = c.position + move;
+          c.target = c.target + move;
+        },
+        tr("Pan"));
   });
   connect(view_, &FrameView::dollyDragged, this, [this](double a) {
     editCamera([a](Camera& c) { c.position = c.target + (c.position - c.target) * static_cast<float>(std::exp(-a)); }, tr("Dolly"));
@@ -195,7 +211,11 @@ void MainWindow::connectDrags() {
   });
   connect(view_, &FrameView::renderRegionDrawn, this, [this](QRect r) {
     engine_->submit(RegionCommand{RegionRect{r.x(), r.y(), r.width(), r.height()}});
-    log(tr("render region %1x%2 at %3, %4 (Render > Clear render region, or Ctrl+Alt+R)").arg(r.width()).arg(r.height()).arg(r.x()).arg(r.y()));
+    log(tr("render region %1x%2 at %3, %4 (Render > Clear render region, or Ctrl+Alt+R)")
+            .arg(r.width())
+            .arg(r.height())
+            .arg(r.x())
+            .arg(r.y()));
   });
   // The gizmo: drag an arrow to move along a world axis; E and R turn and scale about the origin.
   connect(view_, &FrameView::axisDragged, this, [this](int axis, QPointF d) {
@@ -208,8 +228,7 @@ void MainWindow::connectDrags() {
     const float t = static_cast<float>((d.x() * dir.x() + d.y() * dir.y()) / len2) * gizmoLength_;
     Vec3 step{0.0f};
     (axis == 0 ? step.x : axis == 1 ? step.y : step.z) = t;
-    editSelected([&](Object& x) { x.transform = Mat4::translate(step) * x.transform; },
-                 tr("Move %2 along %1").arg(QChar('x' + axis)));
+    editSelected([&](Object& x) { x.transform = Mat4::translate(step) * x.transform; }, tr("Move %2 along %1").arg(QChar('x' + axis)));
   });
   auto aboutOrigin = [this](const Mat4& m, const QString& what) {
     // A multi-selection turns and scales as a group, about the centre of its pivots.
@@ -222,24 +241,12 @@ void MainWindow::connectDrags() {
     const Mat4 about = Mat4::translate(at) * m * Mat4::translate(at * -1.0f);
     editSelected([&](Object& x) { x.transform = about * x.transform; }, what);
   };
-  connect(view_, &FrameView::rotateDragged, this, [aboutOrigin](double px) {
-    aboutOrigin(Mat4::rotateY(static_cast<float>(px * 0.01)), tr("Rotate %1"));
-  });
+  connect(view_, &FrameView::rotateDragged, this,
+          [aboutOrigin](double px) { aboutOrigin(Mat4::rotateY(static_cast<float>(px * 0.01)), tr("Rotate %1")); });
   connect(view_, &FrameView::scaleDragged, this, [aboutOrigin](double px) {
     const float s = static_cast<float>(std::exp(px * 0.005));
     aboutOrigin(Mat4::scale(Vec3{s, s, s}), tr("Scale %1"));
   });
-}
-
-void MainWindow::startAutosave() {
-  // Autosave every 5 minutes ($RETILE_AUTOSAVE_SECONDS overrides) to rotating recovery files.
-  auto* autosaveTimer = new QTimer(this);
-  int every = qEnvironmentVariableIsSet("RETILE_AUTOSAVE_SECONDS") ? qEnvironmentVariableIntValue("RETILE_AUTOSAVE_SECONDS") : 300;
-  connect(autosaveTimer, &QTimer::timeout, this, [this] { autosave(); });
-  autosaveTimer->start(std::max(1, every) * 1000);
-  QDir().mkpath(recoveryDirectory());
-  QFile lock(recoveryDirectory() + "/session.lock");
-  if (lock.open(QIODevice::WriteOnly)) lock.write(QByteArray::number(QCoreApplication::applicationPid()));
 }
 
 MainWindow::~MainWindow() {
@@ -263,8 +270,10 @@ void MainWindow::buildMenus() {
   connect(recentMenu_, &QMenu::aboutToShow, this, [this] { rebuildRecentMenu(); });
   file->addAction(tr("&Save"), QKeySequence::Save, this, [this] {
     // Imported files (glTF, scene.json) are not overwritten in another format: ask for a .retile.
-    if (file_.empty() || file_.extension() != ".retile") saveAs();
-    else saveTo(file_);
+    if (file_.empty() || file_.extension() != ".retile")
+      saveAs();
+    else
+      saveTo(file_);
   });
   // Spelled out: QKeySequence::SaveAs is empty on desktops without a key theme.
   file->addAction(tr("Save &As..."), QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_S), this, [this] { saveAs(); });
@@ -429,8 +438,10 @@ QTreeWidget* MainWindow::buildOutliner() {
     auto kind = static_cast<PropertyTarget::Kind>(items[0]->data(0, kKindRole).toInt());
     if (kind == PropertyTarget::Kind::Object) {
       if (!ok || !id || !doc_.scene().object(static_cast<NodeId>(id))) return;
-      if (id != selection_ || selected_.size() > 1) select(static_cast<NodeId>(id));  // a plain click ends a multi-selection
-      else panel_->setTarget({PropertyTarget::Kind::Object, static_cast<NodeId>(id)});  // back from the camera, say
+      if (id != selection_ || selected_.size() > 1)
+        select(static_cast<NodeId>(id));  // a plain click ends a multi-selection
+      else
+        panel_->setTarget({PropertyTarget::Kind::Object, static_cast<NodeId>(id)});  // back from the camera, say
     } else if (kind != PropertyTarget::Kind::None) {
       panel_->setTarget({kind, static_cast<NodeId>(id)});
     }
@@ -531,7 +542,9 @@ void MainWindow::buildDocks() {
   methodPanel_ = new MethodPanel(editorMethod(), settingsPanel);
   connect(methodPanel_, &MethodPanel::changed, this, [this](const MethodSettings& m) {
     engine_->submit(MethodCommand{m});
-    log(tr("method %1, T=%2, Q=%3%4").arg(QString::fromStdString(methodLabel(m))).arg(m.tileSize)
+    log(tr("method %1, T=%2, Q=%3%4")
+            .arg(QString::fromStdString(methodLabel(m)))
+            .arg(m.tileSize)
             .arg(m.quality ? QString::number(m.quality) : tr("auto"),
                  m.denoise ? tr(", denoise threshold %1 % of the image").arg(std::lround(m.denoiseThreshold * 100)) : QString()));
   });
@@ -563,9 +576,8 @@ void MainWindow::buildDocks() {
   inspectSource->setObjectName("inspectSource");
   inspectSource->addItems({tr("Read the image as shown"), tr("Read the raw accumulation")});
   inspectSource->setToolTip(tr("With denoising the image shown is a view; the accumulated samples are kept as they are"));
-  connect(inspectSource, &QComboBox::currentIndexChanged, this, [this](int i) {
-    view_->setInspect(i == 1 ? FrameView::Inspect::Raw : FrameView::Inspect::Shown);
-  });
+  connect(inspectSource, &QComboBox::currentIndexChanged, this,
+          [this](int i) { view_->setInspect(i == 1 ? FrameView::Inspect::Raw : FrameView::Inspect::Shown); });
   inspector_ = new QLabel(inspectorHint(), inspectorPanel);
   inspector_->setObjectName("inspector");
   inspector_->setWordWrap(true);
@@ -617,8 +629,8 @@ void MainWindow::buildDocks() {
     c->setMinimumContentsLength(6);
   }
   QTimer::singleShot(0, this, [this, outlinerDock, propDock, graphDock, settingsScroll] {
-    const int left = std::max(330, settingsScroll->widget()->minimumSizeHint().width() +
-                                       settingsScroll->verticalScrollBar()->sizeHint().width() + 8);
+    const int left =
+        std::max(330, settingsScroll->widget()->minimumSizeHint().width() + settingsScroll->verticalScrollBar()->sizeHint().width() + 8);
     resizeDocks({outlinerDock, propDock}, {left, 360}, Qt::Horizontal);
     resizeDocks({graphDock}, {230}, Qt::Vertical);
     graph_->frameAll();
@@ -667,7 +679,10 @@ void MainWindow::startEngine(Scene scene) {
   engineOptions.documentVersion = doc_.version();
   engineOptions.previewBlock = options_.previewBlock;
   engine_ = std::make_unique<Engine>(std::move(scene), methodPanel_->settings(), engineOptions);
-  engine_->setFrameCallback([this] { QMetaObject::invokeMethod(this, [this] { onFrame(); }, Qt::QueuedConnection); });
+  engine_->setFrameCallback([this] {
+    QMetaObject::invokeMethod(
+        this, [this] { onFrame(); }, Qt::QueuedConnection);
+  });
   engine_->start();
   fpsStart_ = QDateTime::currentMSecsSinceEpoch();
   framesSeen_ = 0;
@@ -744,10 +759,13 @@ bool MainWindow::applyToDocument(const Edit& e) {
   // from the outliner's own itemChanged, whose item a rebuild deletes.
   if (!outlinerRefreshQueued_) {
     outlinerRefreshQueued_ = true;
-    QMetaObject::invokeMethod(this, [this] {
-      outlinerRefreshQueued_ = false;
-      rebuildOutliner();
-    }, Qt::QueuedConnection);
+    QMetaObject::invokeMethod(
+        this,
+        [this] {
+          outlinerRefreshQueued_ = false;
+          rebuildOutliner();
+        },
+        Qt::QueuedConnection);
   }
   refreshGraph();
   // Everything else that changes what the panel shows (a drag in the viewport, the node graph,
@@ -788,14 +806,18 @@ void MainWindow::refreshGraph() {
   // Coalesced: a drag applies an edit per mouse move, the graph needs only the last state.
   if (graphRefreshQueued_ || !graph_) return;
   graphRefreshQueued_ = true;
-  QMetaObject::invokeMethod(this, [this] {
-    graphRefreshQueued_ = false;
-    graph_->setDocument(doc_.scene());
-  }, Qt::QueuedConnection);
+  QMetaObject::invokeMethod(
+      this,
+      [this] {
+        graphRefreshQueued_ = false;
+        graph_->setDocument(doc_.scene());
+      },
+      Qt::QueuedConnection);
 }
 
 void MainWindow::edit(const Edit& before, const Edit& after, const QString& text, int dragId) {
-  undo_.push(new EditCommand(before, after, text, [this](const Edit& e) { return applyToDocument(e); }, dragId));
+  undo_.push(new EditCommand(
+      before, after, text, [this](const Edit& e) { return applyToDocument(e); }, dragId));
 }
 
 void MainWindow::select(NodeId object) {
@@ -828,12 +850,16 @@ void MainWindow::applySelection() {
   engine_->submit(SelectCommand{selection_});
   if (graph_) {
     graph_->followSelection(selected_);
-    if (selected_.size() > 1) graph_->selectNodes(selected_);
-    else graph_->setSelectedObject(selection_);
+    if (selected_.size() > 1)
+      graph_->selectNodes(selected_);
+    else
+      graph_->setSelectedObject(selection_);
   }
   updateGizmo();
-  if (selection_ != kNoNode) panel_->setTarget({PropertyTarget::Kind::Object, selection_});
-  else if (panel_->target().kind == PropertyTarget::Kind::Object) panel_->setTarget({});
+  if (selection_ != kNoNode)
+    panel_->setTarget({PropertyTarget::Kind::Object, selection_});
+  else if (panel_->target().kind == PropertyTarget::Kind::Object)
+    panel_->setTarget({});
   {
     QSignalBlocker block(outliner_);
     outliner_->clearSelection();
@@ -861,8 +887,8 @@ void MainWindow::editSelected(const std::function<void(Object&)>& change, const 
   }
   if (steps.empty()) return;
   const QString target = steps.size() == 1 ? name : tr("%n objects", nullptr, static_cast<int>(steps.size()));
-  undo_.push(new EditCommand(std::move(steps), what.arg(target), [this](const Edit& e) { return applyToDocument(e); },
-                             dragCounter_ + 1));
+  undo_.push(new EditCommand(
+      std::move(steps), what.arg(target), [this](const Edit& e) { return applyToDocument(e); }, dragCounter_ + 1));
 }
 
 void MainWindow::rebuildOutliner() {
@@ -924,8 +950,8 @@ void MainWindow::rebuildOutliner() {
   for (QTreeWidgetItem* it : items) {
     const Key k = keyOf(it);
     const bool object = k.first == static_cast<int>(PropertyTarget::Kind::Object);
-    const bool selected = object ? std::find(selected_.begin(), selected_.end(), static_cast<NodeId>(k.second)) != selected_.end()
-                                 : picked.contains(k);
+    const bool selected =
+        object ? std::find(selected_.begin(), selected_.end(), static_cast<NodeId>(k.second)) != selected_.end() : picked.contains(k);
     if (selected) it->setSelected(true);
     if (hasCurrent && current == k) outliner_->setCurrentItem(it, 0, QItemSelectionModel::NoUpdate);
   }
@@ -940,95 +966,6 @@ void MainWindow::rebuildProperties() {
   renderPanel_->rebuild();
 }
 
-QString MainWindow::recoveryDirectory() {
-  QString base = qEnvironmentVariable("RETILE_RECOVERY_DIR");
-  if (base.isEmpty()) base = QStandardPaths::writableLocation(QStandardPaths::AppDataLocation) + "/recovery";
-  return base;
-}
-
-QStringList MainWindow::recoveryCandidates() {
-  QDir dir(recoveryDirectory());
-  if (!dir.exists("session.lock")) return {};  // the last session closed cleanly
-  QStringList out;
-  for (const QFileInfo& f : dir.entryInfoList({"autosave-*.retile"}, QDir::Files, QDir::Time)) out << f.absoluteFilePath();
-  return out;
-}
-
-bool MainWindow::autosave() {
-  if (undo_.index() == autosavedIndex_ || undo_.isClean()) return false;
-  QString file = recoveryDirectory() + QString("/autosave-%1.retile").arg(autosaveSlot_);
-  auto r = saveNativeScene(doc_.scene(), file.toStdString());
-  if (!r) {
-    log(tr("autosave failed: %1").arg(QString::fromStdString(r.error())));
-    return false;
-  }
-  autosaveSlot_ = (autosaveSlot_ + 1) % 3;
-  autosavedIndex_ = undo_.index();
-  log(tr("autosaved to %1").arg(file));
-  return true;
-}
-
-void MainWindow::rememberRecent(const std::filesystem::path& file) {
-  QSettings settings;
-  QStringList recent = settings.value("recentFiles").toStringList();
-  QString f = QString::fromStdString(std::filesystem::absolute(file).string());
-  recent.removeAll(f);
-  recent.prepend(f);
-  while (recent.size() > 10) recent.removeLast();
-  settings.setValue("recentFiles", recent);
-}
-
-void MainWindow::rebuildRecentMenu() {
-  recentMenu_->clear();
-  QSettings settings;
-  for (const QString& f : settings.value("recentFiles").toStringList()) {
-    QAction* a = recentMenu_->addAction(f, this, [this, f] {
-      if (maybeSave()) openFile(f.toStdString());
-    });
-    a->setEnabled(QFileInfo::exists(f));  // greyed when the file has gone
-  }
-  if (recentMenu_->isEmpty()) recentMenu_->addAction(tr("(none yet)"))->setEnabled(false);
-}
-
-void MainWindow::dragEnterEvent(QDragEnterEvent* e) {
-  if (e->mimeData()->hasUrls()) e->acceptProposedAction();
-}
-
-void MainWindow::dropEvent(QDropEvent* e) {
-  for (const QUrl& url : e->mimeData()->urls())
-    if (url.isLocalFile()) {
-      if (!maybeSave()) return;
-      openFile(url.toLocalFile().toStdString());
-      return;
-    }
-}
-
-bool MainWindow::openFile(const std::filesystem::path& file) {
-  auto r = importScene(file);
-  if (!r) {
-    showError(tr("Cannot open scene"), QString::fromStdString(r.error()));
-    return false;
-  }
-  replaceDocument(std::move(r->scene), file);
-  opened(file, r->warnings);
-  return true;
-}
-
-void MainWindow::opened(const std::filesystem::path& file, const std::vector<std::string>& warnings) {
-  log(tr("opened %1").arg(QString::fromStdString(file.string())));
-  rememberRecent(file);
-  for (const auto& w : warnings) log(tr("warning: %1").arg(QString::fromStdString(w)));
-  if (warnings.empty()) return;
-  const QString text = tr("%n warning(s) opening %1: see the Log", nullptr, static_cast<int>(warnings.size()))
-                           .arg(QString::fromStdString(file.filename().string()));
-  view_->showNotice(text, 8000);
-  statusBar()->showMessage(text, 15000);
-  if (auto* logDock = findChild<QDockWidget*>("log")) {
-    logDock->show();
-    logDock->raise();
-  }
-}
-
 void MainWindow::notify(const QString& text) {
   statusBar()->showMessage(text, 8000);
   log(text);
@@ -1037,10 +974,18 @@ void MainWindow::notify(const QString& text) {
 void MainWindow::showTool() {
   QString name;
   switch (view_->tool()) {
-    case FrameView::Tool::Select: name = tr("Select (Q): click picks"); break;
-    case FrameView::Tool::Move: name = tr("Move (W): drag the selection or an arrow"); break;
-    case FrameView::Tool::Rotate: name = tr("Rotate (E): drag turns about the selection's centre"); break;
-    case FrameView::Tool::Scale: name = tr("Scale (R): drag scales about the selection's centre"); break;
+    case FrameView::Tool::Select:
+      name = tr("Select (Q): click picks");
+      break;
+    case FrameView::Tool::Move:
+      name = tr("Move (W): drag the selection or an arrow");
+      break;
+    case FrameView::Tool::Rotate:
+      name = tr("Rotate (E): drag turns about the selection's centre");
+      break;
+    case FrameView::Tool::Scale:
+      name = tr("Scale (R): drag scales about the selection's centre");
+      break;
   }
   toolLabel_->setText(tr("Tool: %1").arg(name));
 }
@@ -1081,50 +1026,6 @@ void MainWindow::applySceneView() {
   log(tr("view: %1, as the scene asks").arg(displayView_->currentText()));
 }
 
-bool MainWindow::maybeSave() {
-  if (undo_.isClean() || qEnvironmentVariableIsSet("RETILE_NO_PROMPTS")) return true;
-  auto answer = QMessageBox::question(this, tr("Unsaved changes"), tr("Save the changes to the current scene first?"),
-                                      QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel);
-  if (answer == QMessageBox::Cancel) return false;
-  if (answer == QMessageBox::Discard) return true;
-  std::filesystem::path target = file_;
-  if (target.empty() || target.extension() != ".retile") {
-    QString f = QFileDialog::getSaveFileName(this, tr("Save scene"), QString(), tr("Retile scenes (*.retile)"));
-    if (f.isEmpty()) return false;
-    target = f.toStdString();
-  }
-  return saveTo(target);
-}
-
-bool MainWindow::saveAs() {
-  QFileDialog dialog(this, tr("Save scene as"), QString(), tr("Retile scenes (*.retile)"));
-  dialog.setObjectName("saveAsDialog");
-  dialog.setAcceptMode(QFileDialog::AcceptSave);
-  dialog.setDefaultSuffix("retile");
-  if (dialog.exec() != QDialog::Accepted || dialog.selectedFiles().isEmpty()) return false;
-  return saveTo(dialog.selectedFiles().front().toStdString());
-}
-
-void MainWindow::updateTitle() {
-  const QString name = file_.empty() ? tr("built-in scene") : QString::fromStdString(file_.filename().string());
-  setWindowTitle(tr("%1[*] - Retile").arg(name));
-  setWindowModified(!undo_.isClean());
-}
-
-bool MainWindow::saveTo(const std::filesystem::path& file) {
-  auto r = saveNativeScene(doc_.scene(), file);
-  if (!r) {
-    showError(tr("Cannot save"), QString::fromStdString(r.error()));
-    return false;
-  }
-  file_ = file;
-  undo_.setClean();
-  updateTitle();
-  rememberRecent(file);
-  log(tr("saved %1").arg(QString::fromStdString(file.string())));
-  return true;
-}
-
 void MainWindow::closeEvent(QCloseEvent* e) {
   if (!maybeSave()) {
     e->ignore();
@@ -1145,8 +1046,10 @@ void MainWindow::closeEvent(QCloseEvent* e) {
 
 void MainWindow::keyPressEvent(QKeyEvent* e) {
   if (e->key() == Qt::Key_F && !(e->modifiers() & Qt::ControlModifier)) {
-    if (graph_ && graph_->mouseOver()) graph_->frameSelected();  // the panel under the mouse
-    else frameSelected();
+    if (graph_ && graph_->mouseOver())
+      graph_->frameSelected();  // the panel under the mouse
+    else
+      frameSelected();
     return;
   }
   QMainWindow::keyPressEvent(e);
@@ -1165,13 +1068,15 @@ void MainWindow::frameSelected() {
   if (!m || !m->geometry) return;
   Bounds3 b = transformBounds(o->transform, m->geometry->bounds());
   if (b.empty()) return;
-  editCamera([&](Camera& c) {
-    Vec3 fwd = normalize(c.target - c.position);
-    float radius = 0.5f * length(b.extent());
-    float dist = radius / std::sin(0.5f * c.verticalFov) * 1.1f;
-    c.target = b.center();
-    c.position = c.target - fwd * dist;
-  }, tr("Frame selected"));
+  editCamera(
+      [&](Camera& c) {
+        Vec3 fwd = normalize(c.target - c.position);
+        float radius = 0.5f * length(b.extent());
+        float dist = radius / std::sin(0.5f * c.verticalFov) * 1.1f;
+        c.target = b.center();
+        c.position = c.target - fwd * dist;
+      },
+      tr("Frame selected"));
   ++dragCounter_;
 }
 

@@ -77,8 +77,12 @@ class MainWindow : public QMainWindow {
   QUndoStack* undoStack() { return &undo_; }
   FrameView* viewport() { return view_; }
   PropertyPanel* properties() { return panel_; }
-  class LiveChart* chart() { return chart_; }
-  class NodeGraphView* graph() { return graph_; }
+  class LiveChart* chart() {
+    return chart_;
+  }
+  class NodeGraphView* graph() {
+    return graph_;
+  }
   Engine* engine() { return engine_.get(); }
   QTreeWidget* outliner() { return outliner_; }
   NodeId selection() const { return selection_; }  // the last picked object: gizmo, Properties
@@ -175,7 +179,7 @@ class MainWindow : public QMainWindow {
   QComboBox* displayView_ = nullptr;  // the viewport's OCIO view
   QPlainTextEdit* log_ = nullptr;
   PropertyPanel* panelEdit_ = nullptr;  // the panel whose own edit is being applied (it shows it already)
-  QSet<QString> loggedWarnings_;  // of the current document: each is logged once
+  QSet<QString> loggedWarnings_;        // of the current document: each is logged once
   QLabel* status_ = nullptr;
   QLabel* toolLabel_ = nullptr;
   QMenu* recentMenu_ = nullptr;

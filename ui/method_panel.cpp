@@ -54,24 +54,29 @@ MethodPanel::MethodPanel(MethodSettings initial, QWidget* parent) : QGroupBox(tr
   ql->addWidget(quality_, 1);
   ql->addWidget(qualityAuto_);
   smooth_ = checkBox(tr("smooth transition"), "smooth", m.smooth, QString(), this);
-  staleCap_ = spinBox("staleCap", 1, 4096, m.staleCap,
-                      tr("Stale samples kept per pixel by the smooth transition: the old image weighs C/(C+n) after n fresh samples"), this);
+  staleCap_ =
+      spinBox("staleCap", 1, 4096, m.staleCap,
+              tr("Stale samples kept per pixel by the smooth transition: the old image weighs C/(C+n) after n fresh samples"), this);
   focusMode_ = new QComboBox(this);
   focusMode_->setObjectName("focusMode");
   focusMode_->addItems({tr("Shift+click: static point"), tr("Shift+click: follows the object"), tr("follows the cursor")});
-  focusMode_->setToolTip(tr("Focus points (up to 3) for the focus methods. Shift+click adds one; 'follows the cursor' "
-                            "stands in for an eye tracker."));
+  focusMode_->setToolTip(
+      tr("Focus points (up to 3) for the focus methods. Shift+click adds one; 'follows the cursor' "
+         "stands in for an eye tracker."));
   auto* clearFocus = new QPushButton(tr("Clear focus points"), this);
   reuse_ = checkBox(tr("reuse verified samples"), "reuse", m.reuse,
                     tr("After an edit, a re-rendered tile keeps its converged samples while a test finds the fresh ones "
                        "in agreement with them, and drops them for good the moment they disagree. Not with the "
-                       "global method."), this);
+                       "global method."),
+                    this);
   denoise_ = checkBox(tr("denoise"), "denoise", m.denoise,
                       tr("Show the image denoised: the whole frame during refinement, a growing region during a pass. "
-                         "The samples themselves are untouched (the pixel inspector can read either)."), this);
+                         "The samples themselves are untouched (the pixel inspector can read either)."),
+                      this);
   threshold_ = spinBox("denoiseThreshold", 0, 100, static_cast<int>(std::lround(m.denoiseThreshold * 100)),
                        tr("The denoised region is re-sized when its width (height) has grown by more than this "
-                          "share of the image's width (height)"), this);
+                          "share of the image's width (height)"),
+                       this);
   threshold_->setSuffix(tr(" % of the image"));
   softBorders_ = checkBox(tr("soft borders"), "softBorders", m.softBorders,
                           tr("Blend the seams between fresh and stale tiles and between denoised regions over a few pixels"), this);

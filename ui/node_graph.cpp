@@ -110,8 +110,7 @@ void NodeGraphView::buildScopeBar() {
   };
   showSelection_ = button(tr("Selection"), "graphShowSelection", Scope::Selection,
                           tr("The selected objects, their materials and those materials' textures"));
-  showAll_ = button(tr("All"), "graphShowAll", Scope::All,
-                    tr("Every node of the scene (A frames as much as is legible)"));
+  showAll_ = button(tr("All"), "graphShowAll", Scope::All, tr("Every node of the scene (A frames as much as is legible)"));
   scopeNote_ = new QLabel(scopeBar_);
   scopeNote_->setObjectName(QStringLiteral("graphScopeNote"));
   row->addWidget(scopeNote_);
@@ -122,9 +121,12 @@ void NodeGraphView::updateScopeBar() {
   showSelection_->setChecked(scope_ == Scope::Selection);
   showAll_->setChecked(scope_ == Scope::All);
   QString note;
-  if (scope_ == Scope::Selection && roots_.empty()) note = tr("nothing selected: every node");
-  else if (focused() && roots_.size() == 1) note = tr("%1 and its material").arg(nameOf(scene_, roots_.front()));
-  else if (focused()) note = tr("%n objects and their materials", nullptr, static_cast<int>(roots_.size()));
+  if (scope_ == Scope::Selection && roots_.empty())
+    note = tr("nothing selected: every node");
+  else if (focused() && roots_.size() == 1)
+    note = tr("%1 and its material").arg(nameOf(scene_, roots_.front()));
+  else if (focused())
+    note = tr("%n objects and their materials", nullptr, static_cast<int>(roots_.size()));
   scopeNote_->setText(note);
   scopeNote_->setVisible(!note.isEmpty());
   scopeBar_->adjustSize();
@@ -178,9 +180,7 @@ void NodeGraphView::resetLayout() {
   frameAll();
 }
 
-bool NodeGraphView::exists(NodeId id) const {
-  return scene_.material(id) || scene_.object(id) || scene_.light(id) || scene_.texture(id);
-}
+bool NodeGraphView::exists(NodeId id) const { return scene_.material(id) || scene_.object(id) || scene_.light(id) || scene_.texture(id); }
 
 void NodeGraphView::rebuild() {
   std::vector<NodeId> selection;
@@ -228,9 +228,15 @@ std::vector<GraphNodeItem*> NodeGraphView::addNodes() {
     if (!all && !shown_.count(t.id)) continue;
     QString sub;
     switch (t.kind) {
-      case TextureKind::File: sub = tr("File: %1").arg(QString::fromStdString(t.path.filename().string())); break;
-      case TextureKind::Embedded: sub = tr("Embedded %1").arg(QString::fromStdString(t.encodedFormat)); break;
-      case TextureKind::Checker: sub = tr("Checker %1x%2").arg(t.checkerResU).arg(t.checkerResV); break;
+      case TextureKind::File:
+        sub = tr("File: %1").arg(QString::fromStdString(t.path.filename().string()));
+        break;
+      case TextureKind::Embedded:
+        sub = tr("Embedded %1").arg(QString::fromStdString(t.encodedFormat));
+        break;
+      case TextureKind::Checker:
+        sub = tr("Checker %1x%2").arg(t.checkerResU).arg(t.checkerResV);
+        break;
     }
     GraphNodeItem* n = add(t.id, NodeKind::Texture, t.name, sub);
     n->output = QStringLiteral("texture");
@@ -267,9 +273,8 @@ std::vector<GraphNodeItem*> NodeGraphView::addNodes() {
     const double fov = static_cast<double>(c.verticalFov) * 180.0 / kPi;
     // With a lens, the distance in focus (the subtitle has room for little more).
     add(kCameraNode, NodeKind::Camera, tr("Camera").toStdString(),
-        c.apertureRadius > 0
-            ? tr("%1\u00b0, in focus at %2").arg(fov, 0, 'f', 1).arg(static_cast<double>(c.focusDistance), 0, 'g', 3)
-            : tr("Field of view %1\u00b0").arg(fov, 0, 'f', 1));
+        c.apertureRadius > 0 ? tr("%1\u00b0, in focus at %2").arg(fov, 0, 'f', 1).arg(static_cast<double>(c.focusDistance), 0, 'g', 3)
+                             : tr("Field of view %1\u00b0").arg(fov, 0, 'f', 1));
     const RenderSettings& r = scene_.settings;
     add(kSettingsNode, NodeKind::Settings, tr("Render Settings").toStdString(),
         tr("%1x%2, %3 spp, %4 bounces").arg(r.width).arg(r.height).arg(r.samplesPerPixel).arg(r.maxBounces));
@@ -506,7 +511,6 @@ void NodeGraphView::highlightLink(const Link* target) {
   }
 }
 
-
 bool NodeGraphView::request(GraphEdit edit, const Scene& result) {
   if (edit.steps.empty()) return false;
   const unsigned count = documentCount_;
@@ -542,8 +546,7 @@ bool NodeGraphView::insertDropped(const Link& target) {
   const QString input = target.input;  // `target` goes with the rebuild that request() may do
   EditBuilder b(scene_);
   if (!b.assign(to, input, node)) return false;
-  return request(b.finish(tr("Insert %1 into %2.%3").arg(nameOf(scene_, node), nameOf(scene_, to), input)),
-                 b.scene());
+  return request(b.finish(tr("Insert %1 into %2.%3").arg(nameOf(scene_, node), nameOf(scene_, to), input)), b.scene());
 }
 
 bool NodeGraphView::createNode(const QString& type, QPointF scenePos) {
@@ -564,14 +567,16 @@ bool NodeGraphView::createNode(const QString& type, QPointF scenePos) {
   } else if (type.endsWith(QLatin1String("Light"))) {
     Light l;
     l.id = id;
-    if (type == QLatin1String("Spot Light")) l.type = LightType::Spot;
-    else if (type == QLatin1String("Directional Light")) l.type = LightType::Directional;
-    else if (type != QLatin1String("Point Light")) return false;
+    if (type == QLatin1String("Spot Light"))
+      l.type = LightType::Spot;
+    else if (type == QLatin1String("Directional Light"))
+      l.type = LightType::Directional;
+    else if (type != QLatin1String("Point Light"))
+      return false;
     l.name = uniqueName(scene_.lights, type.toStdString());
     // Above the middle of the scene, where a new light is visible in the default view.
     const Bounds3 bounds = scene_.worldBounds();
-    l.position = bounds.empty() ? Vec3{0.0f, 2.0f, 0.0f}
-                                : Vec3{bounds.center().x, bounds.hi.y + 1.0f, bounds.center().z};
+    l.position = bounds.empty() ? Vec3{0.0f, 2.0f, 0.0f} : Vec3{bounds.center().x, bounds.hi.y + 1.0f, bounds.center().z};
     l.intensity = l.type == LightType::Directional ? 1.0f : 5.0f;
     b.step(RemoveNode{id}, AddLight{l});
   } else {
@@ -589,17 +594,15 @@ bool NodeGraphView::deleteSelected() {
     if (n->isSelected() && n->deletable()) chosen.push_back(n);
   if (chosen.empty()) return false;
   // Users before what they use: a deleted object needs no material reassignment first.
-  auto rank = [](NodeKind k) {
-    return k == NodeKind::Object ? 0 : k == NodeKind::Light ? 1 : k == NodeKind::Material ? 2 : 3;
-  };
+  auto rank = [](NodeKind k) { return k == NodeKind::Object ? 0 : k == NodeKind::Light ? 1 : k == NodeKind::Material ? 2 : 3; };
   std::sort(chosen.begin(), chosen.end(), [&](const GraphNodeItem* a, const GraphNodeItem* b) {
     return rank(a->kind) != rank(b->kind) ? rank(a->kind) < rank(b->kind) : a->id < b->id;
   });
   EditBuilder b(scene_);
   for (const GraphNodeItem* n : chosen)
     if (!b.remove(n->id)) return false;
-  const QString text = chosen.size() == 1 ? tr("Delete %1").arg(nameOf(scene_, chosen.front()->id))
-                                          : tr("Delete %1 nodes").arg(chosen.size());
+  const QString text =
+      chosen.size() == 1 ? tr("Delete %1").arg(nameOf(scene_, chosen.front()->id)) : tr("Delete %1 nodes").arg(chosen.size());
   return request(b.finish(text), b.scene());
 }
 
@@ -632,9 +635,9 @@ bool NodeGraphView::duplicateSelected() {
   }
   if (made.empty()) return false;
   pendingSelection_ = made;
-  return request(b.finish(made.size() == 1 ? tr("Duplicate %1").arg(nameOf(b.scene(), made.front()))
-                                            : tr("Duplicate %1 nodes").arg(made.size())),
-                 b.scene());
+  return request(
+      b.finish(made.size() == 1 ? tr("Duplicate %1").arg(nameOf(b.scene(), made.front())) : tr("Duplicate %1 nodes").arg(made.size())),
+      b.scene());
 }
 
 void NodeGraphView::copySelected() {
@@ -763,8 +766,10 @@ void NodeGraphView::frameSelected() {
   QRectF r;
   for (const auto& [id, n] : nodes_)
     if (n->isSelected()) r |= n->sceneBoundingRect();
-  if (r.isEmpty()) frameAll();
-  else frameRect(r, r);
+  if (r.isEmpty())
+    frameAll();
+  else
+    frameRect(r, r);
 }
 
 void NodeGraphView::frameAll() {
@@ -797,11 +802,9 @@ namespace {
 // Keys the graph handles while it has focus, even when a window action uses the same shortcut.
 bool graphKey(const QKeyEvent* k) {
   const auto mods = k->modifiers() & ~Qt::KeypadModifier;
-  if (mods == Qt::ControlModifier)
-    return k->key() == Qt::Key_D || k->key() == Qt::Key_C || k->key() == Qt::Key_V;
+  if (mods == Qt::ControlModifier) return k->key() == Qt::Key_D || k->key() == Qt::Key_C || k->key() == Qt::Key_V;
   if (mods == Qt::NoModifier)
-    return k->key() == Qt::Key_Tab || k->key() == Qt::Key_F2 || k->key() == Qt::Key_Delete ||
-           k->key() == Qt::Key_Backspace;
+    return k->key() == Qt::Key_Tab || k->key() == Qt::Key_F2 || k->key() == Qt::Key_Delete || k->key() == Qt::Key_Backspace;
   return false;
 }
 
@@ -841,21 +844,32 @@ void NodeGraphView::keyPressEvent(QKeyEvent* e) {
   const auto mods = e->modifiers() & ~Qt::KeypadModifier;
   if (mods == Qt::ControlModifier) {
     switch (e->key()) {
-      case Qt::Key_D: duplicateSelected(); return;
-      case Qt::Key_C: copySelected(); return;
-      case Qt::Key_V: paste(); return;
-      default: break;
+      case Qt::Key_D:
+        duplicateSelected();
+        return;
+      case Qt::Key_C:
+        copySelected();
+        return;
+      case Qt::Key_V:
+        paste();
+        return;
+      default:
+        break;
     }
   } else if (mods == Qt::NoModifier) {
     switch (e->key()) {
       case Qt::Key_F:
       case Qt::Key_A:
         if (!mouseOver()) break;  // the window frames the viewport
-        if (e->key() == Qt::Key_F) frameSelected();
-        else frameAll();
+        if (e->key() == Qt::Key_F)
+          frameSelected();
+        else
+          frameAll();
         return;
       case Qt::Key_Delete:
-      case Qt::Key_Backspace: deleteSelected(); return;
+      case Qt::Key_Backspace:
+        deleteSelected();
+        return;
       case Qt::Key_F2:
         for (NodeId id : selectedNodes())
           if (nodes_.at(id)->deletable()) {
@@ -871,7 +885,8 @@ void NodeGraphView::keyPressEvent(QKeyEvent* e) {
           return;
         }
         break;
-      default: break;
+      default:
+        break;
     }
   }
   QGraphicsView::keyPressEvent(e);
@@ -973,7 +988,9 @@ void NodeGraphView::mouseMoveEvent(QMouseEvent* e) {
   const QPointF sp = mapToScene(e->pos());
   if ((e->pos() - pressPos_).manhattanLength() >= QApplication::startDragDistance()) moved_ = true;
   switch (drag_) {
-    case Drag::None: QGraphicsView::mouseMoveEvent(e); break;
+    case Drag::None:
+      QGraphicsView::mouseMoveEvent(e);
+      break;
     case Drag::Pan: {
       const QPoint d = e->pos() - lastPos_;
       horizontalScrollBar()->setValue(horizontalScrollBar()->value() - d.x());
@@ -1025,8 +1042,11 @@ void NodeGraphView::mouseReleaseEvent(QMouseEvent* e) {
   mouseDown_ = false;
   switch (d) {
     case Drag::None:
-    case Drag::Pan: break;
-    case Drag::Link: finishLinkDrag(mapToScene(e->pos())); break;
+    case Drag::Pan:
+      break;
+    case Drag::Link:
+      finishLinkDrag(mapToScene(e->pos()));
+      break;
     case Drag::Move: {
       // A click (no drag) on one of several selected nodes selects just it.
       if (!moved_ && !(pressModifiers_ & (Qt::ShiftModifier | Qt::ControlModifier)) && nodes_.count(pressedNode_))
@@ -1036,7 +1056,9 @@ void NodeGraphView::mouseReleaseEvent(QMouseEvent* e) {
       if (target) insertDropped(*target);
       break;
     }
-    case Drag::Marquee: marquee_->hide(); break;
+    case Drag::Marquee:
+      marquee_->hide();
+      break;
   }
   if (rootsPending_) followSelection(pendingRoots_);
 }

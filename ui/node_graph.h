@@ -115,7 +115,7 @@ class NodeGraphView : public QGraphicsView {
 
  signals:
   void editRequested(const retile::ui::GraphEdit& edit);  // the owner applies it as one undo step
-  void objectSelected(quint64 id);                          // the user selected an object's node
+  void objectSelected(quint64 id);                        // the user selected an object's node
 
  protected:
   bool event(QEvent* e) override;
@@ -146,7 +146,7 @@ class NodeGraphView : public QGraphicsView {
   bool focused() const { return scope_ == Scope::Selection && !roots_.empty(); }
   // The positions of what is shown: the selection's graph and the whole one are laid out apart.
   std::unordered_map<NodeId, QPointF>& positions() { return focused() ? focusPositions_ : positions_; }
-  bool exists(NodeId id) const;  // a material, object, light or texture of the document
+  bool exists(NodeId id) const;            // a material, object, light or texture of the document
   std::vector<GraphNodeItem*> addNodes();  // the items of what is shown, in column order
   void placeNodes(const std::vector<GraphNodeItem*>& order);
   void addLinks(const std::vector<GraphNodeItem*>& order);
@@ -192,14 +192,14 @@ class NodeGraphView : public QGraphicsView {
 
   Drag drag_ = Drag::None;
   Qt::MouseButton dragButton_ = Qt::NoButton;  // only its release ends the drag
-  QPoint pressPos_, lastPos_;        // viewport pixels
+  QPoint pressPos_, lastPos_;                  // viewport pixels
   QPointF pressScene_;
   NodeId pressedNode_ = kNoNode;
   bool moved_ = false;
   Qt::KeyboardModifiers pressModifiers_;
   std::vector<std::pair<NodeId, QPointF>> moveStart_;
-  NodeId linkFrom_ = kNoNode;        // the output end of the link being dragged
-  NodeId detachedTo_ = kNoNode;      // a picked-up link's old input, or kNoNode for a new link
+  NodeId linkFrom_ = kNoNode;    // the output end of the link being dragged
+  NodeId detachedTo_ = kNoNode;  // a picked-up link's old input, or kNoNode for a new link
   QString detachedInput_;
   QGraphicsPathItem* dragLink_ = nullptr;
   QGraphicsRectItem* marquee_ = nullptr;

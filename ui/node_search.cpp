@@ -13,8 +13,7 @@ namespace retile::ui {
 const std::vector<CreatableType>& creatableTypeTable() {
   static const std::vector<CreatableType> types = {
       {QStringLiteral("Material"),
-       {"surface", "shader", "bsdf", "diffuse", "lambert", "plastic", "metal", "conductor", "glass", "dielectric",
-        "emitter"}},
+       {"surface", "shader", "bsdf", "diffuse", "lambert", "plastic", "metal", "conductor", "glass", "dielectric", "emitter"}},
       {QStringLiteral("Checker Texture"), {"texture", "checker", "checkerboard", "pattern", "grid", "uv"}},
       {QStringLiteral("Point Light"), {"lamp", "bulb", "omni"}},
       {QStringLiteral("Spot Light"), {"lamp", "cone", "spotlight"}},
@@ -28,8 +27,8 @@ QString searchMatch(const CreatableType& type, const QString& filter) {
   QString synonym;
   for (const QString& w : words) {
     if (type.name.contains(w, Qt::CaseInsensitive)) continue;
-    auto it = std::find_if(type.synonyms.begin(), type.synonyms.end(),
-                           [&](const QString& s) { return s.contains(w, Qt::CaseInsensitive); });
+    auto it =
+        std::find_if(type.synonyms.begin(), type.synonyms.end(), [&](const QString& s) { return s.contains(w, Qt::CaseInsensitive); });
     if (it == type.synonyms.end()) return {};
     synonym = *it;
   }
@@ -62,8 +61,7 @@ NodeSearchPopup::NodeSearchPopup(QWidget* parent, std::function<void(const QStri
 QRect NodeSearchPopup::allowedArea() const {
   QWidget* window = parentWidget() ? parentWidget()->window() : nullptr;
   QRect area = window ? window->frameGeometry() : QRect();
-  if (QScreen* s = window ? window->screen() : screen())
-    area = area.isValid() ? area & s->availableGeometry() : s->availableGeometry();
+  if (QScreen* s = window ? window->screen() : screen()) area = area.isValid() ? area & s->availableGeometry() : s->availableGeometry();
   return area;
 }
 

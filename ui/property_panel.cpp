@@ -51,8 +51,8 @@ class PropertyPanel::Builder {
     return l;
   }
 
-  ScrubField* number(const QString& name, const QString& objectName, double value, double min, double max, double def,
-                     int decimals, std::function<void(double, int)> apply) {
+  ScrubField* number(const QString& name, const QString& objectName, double value, double min, double max, double def, int decimals,
+                     std::function<void(double, int)> apply) {
     auto* f = new ScrubField(value, min, max, def, decimals, p_->body_);
     f->setObjectName(objectName);
     connectField(f, std::move(apply));
@@ -65,13 +65,17 @@ class PropertyPanel::Builder {
   // named by `prefix` and `key` ("Interior", "interior" gives "interiorAbsorption" and on), each
   // edit made through `edit` on the member of T it shows.
   template <class T>
-  void medium(const QString& prefix, const QString& key, const T& target, Vec3 T::*absorption, Vec3 T::*scattering,
-              float T::*anisotropy, const std::function<void(const QString&, int, const std::function<void(T&)>&)>& edit) {
+  void medium(const QString& prefix, const QString& key, const T& target, Vec3 T::*absorption, Vec3 T::*scattering, float T::*anisotropy,
+              const std::function<void(const QString&, int, const std::function<void(T&)>&)>& edit) {
     for (Vec3 T::*field : {absorption, scattering}) {
-      const QString what = PropertyPanel::tr("%1 %2").arg(prefix, field == absorption ? PropertyPanel::tr("absorption") : PropertyPanel::tr("scattering"));
-      vec3(what, key + (field == absorption ? "Absorption" : "Scattering"), target.*field, 0.01, [edit, what, field](int channel, double v, int drag) {
-        edit(what, drag, [channel, v, field](T& x) { axisOf(x.*field, channel) = std::max(0.0f, static_cast<float>(v)); });
-      }, true);
+      const QString what =
+          PropertyPanel::tr("%1 %2").arg(prefix, field == absorption ? PropertyPanel::tr("absorption") : PropertyPanel::tr("scattering"));
+      vec3(
+          what, key + (field == absorption ? "Absorption" : "Scattering"), target.*field, 0.01,
+          [edit, what, field](int channel, double v, int drag) {
+            edit(what, drag, [channel, v, field](T& x) { axisOf(x.*field, channel) = std::max(0.0f, static_cast<float>(v)); });
+          },
+          true);
     }
     const QString what = PropertyPanel::tr("%1 anisotropy").arg(prefix);
     number(what, key + "Anisotropy", target.*anisotropy, -0.99, 0.99, 0.0, 3, [edit, what, anisotropy](double v, int drag) {
@@ -119,8 +123,7 @@ class PropertyPanel::Builder {
     return f;
   }
 
-  QComboBox* choice(const QString& name, const QString& objectName, const QStringList& items, int index,
-                    std::function<void(int)> apply) {
+  QComboBox* choice(const QString& name, const QString& objectName, const QStringList& items, int index, std::function<void(int)> apply) {
     auto* c = new QComboBox(p_->body_);
     c->setObjectName(objectName);
     c->addItems(items);
@@ -218,10 +221,13 @@ void PropertyPanel::rebuildLater(int drag) {
   // Not from inside a field's signal: rebuilding deletes the field.
   if (rebuildQueued_) return;
   rebuildQueued_ = true;
-  QMetaObject::invokeMethod(this, [this] {
-    rebuildQueued_ = false;
-    rebuild();
-  }, Qt::QueuedConnection);
+  QMetaObject::invokeMethod(
+      this,
+      [this] {
+        rebuildQueued_ = false;
+        rebuild();
+      },
+      Qt::QueuedConnection);
 }
 
 bool PropertyPanel::shows(const Edit& e) const {
@@ -234,11 +240,16 @@ bool PropertyPanel::shows(const Edit& e) const {
       return o && (std::holds_alternative<SetMaterial>(e) || std::holds_alternative<RemoveNode>(e)) && id == o->material;
     }
     case K::Material:
-    case K::Light: return id == target_.id;
-    case K::Camera: return std::holds_alternative<SetCamera>(e);
-    case K::Environment: return std::holds_alternative<SetEnvironment>(e);
-    case K::Render: return std::holds_alternative<SetRenderSettings>(e);
-    case K::None: return false;
+    case K::Light:
+      return id == target_.id;
+    case K::Camera:
+      return std::holds_alternative<SetCamera>(e);
+    case K::Environment:
+      return std::holds_alternative<SetEnvironment>(e);
+    case K::Render:
+      return std::holds_alternative<SetRenderSettings>(e);
+    case K::None:
+      return false;
   }
   return false;
 }
@@ -266,10 +277,17 @@ void PropertyPanel::rebuild() {
     case PropertyTarget::Kind::Light:
       if (const Light* l = s.light(target_.id)) buildLight(b, *l);
       break;
-    case PropertyTarget::Kind::Camera: buildCamera(b); break;
-    case PropertyTarget::Kind::Environment: buildEnvironment(b); break;
-    case PropertyTarget::Kind::Render: buildRender(b); break;
-    case PropertyTarget::Kind::None: break;
+    case PropertyTarget::Kind::Camera:
+      buildCamera(b);
+      break;
+    case PropertyTarget::Kind::Environment:
+      buildEnvironment(b);
+      break;
+    case PropertyTarget::Kind::Render:
+      buildRender(b);
+      break;
+    case PropertyTarget::Kind::None:
+      break;
   }
   if (form_->rowCount() == 0)
     form_->addRow(new QLabel(tr("Click an object in the viewport, or anything in the outliner or the node graph."), body_));
@@ -315,8 +333,8 @@ void PropertyPanel::buildObject(Builder& b, const Object& o) {
   // A room's walls culled, the camera outside sees in through them (a Tungsten mesh's
   // backface_culling).
   b.check(tr("Front faces only"), "cullBackFaces", o.cullBackFaces, [edit](bool on) {
-    edit(on ? tr("Cull back faces") : tr("Show back faces"), 0, [on](Object& x) { x.cullBackFaces = on; });
-  })->setToolTip(tr("Rays pass through the object's back faces, shadow rays too: a wall seen from behind is not there"));
+     edit(on ? tr("Cull back faces") : tr("Show back faces"), 0, [on](Object& x) { x.cullBackFaces = on; });
+   })->setToolTip(tr("Rays pass through the object's back faces, shadow rays too: a wall seen from behind is not there"));
 }
 
 void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
@@ -338,9 +356,8 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   });
   // A boundary has no surface, and hair's colour is its pigment's absorption.
   if (m.type != MaterialType::Boundary && m.type != MaterialType::Hair)
-    b.color(tr("Albedo"), "albedo", m.albedo, defaults.albedo, [edit](Vec3 c, int drag) {
-      edit(tr("Albedo"), drag, [c](Material& x) { x.albedo = c; });
-    });
+    b.color(tr("Albedo"), "albedo", m.albedo, defaults.albedo,
+            [edit](Vec3 c, int drag) { edit(tr("Albedo"), drag, [c](Material& x) { x.albedo = c; }); });
   const bool rough = hasRoughness(m.type);
   if (rough) {  // smooth types ignore roughness: no field that does nothing
     // A slider as well as the field: the gesture look-dev artists use most.
@@ -370,18 +387,16 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     });
     form_->addRow(tr("Roughness"), row);
     if (isMicrofacet(m.type))
-      b.choice(tr("Distribution"), "distribution", {tr("GGX"), tr("Beckmann")}, m.beckmann ? 1 : 0, [edit](int i) {
-        edit(tr("Distribution"), 0, [i](Material& x) { x.beckmann = i == 1; });
-      });
+      b.choice(tr("Distribution"), "distribution", {tr("GGX"), tr("Beckmann")}, m.beckmann ? 1 : 0,
+               [edit](int i) { edit(tr("Distribution"), 0, [i](Material& x) { x.beckmann = i == 1; }); });
     if (isMicrofacet(m.type))
       b.choice(tr("Shadowing"), "shadowing", {tr("Height-correlated"), tr("Separable (Tungsten)")}, m.separableShadowing ? 1 : 0,
                [edit](int i) { edit(tr("Shadowing"), 0, [i](Material& x) { x.separableShadowing = i == 1; }); });
   }
   if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic || m.type == MaterialType::Dielectric ||
       m.type == MaterialType::RoughDielectric || m.type == MaterialType::ThinSheet) {
-    b.number(tr("IOR"), "ior", m.ior, 1.0, 4.0, defaults.ior, 3, [edit](double v, int drag) {
-      edit(tr("IOR"), drag, [v](Material& x) { x.ior = static_cast<float>(v); });
-    });
+    b.number(tr("IOR"), "ior", m.ior, 1.0, 4.0, defaults.ior, 3,
+             [edit](double v, int drag) { edit(tr("IOR"), drag, [v](Material& x) { x.ior = static_cast<float>(v); }); });
   }
   if (!isTransmissiveType(m.type)) {
     // A clear coat over any opaque type; 0 takes it off.
@@ -395,10 +410,13 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       b.number(tr("Coat roughness"), "coatRoughness", m.coatRoughness, 0.0, 1.0, defaults.coatRoughness, 3, [edit](double v, int drag) {
         edit(tr("Coat roughness"), drag, [v](Material& x) { x.coatRoughness = static_cast<float>(v); });
       });
-      b.vec3(tr("Coat absorption"), "coatAbsorption", m.coatAbsorption, 0.01, [edit](int channel, double v, int drag) {
-        edit(tr("Coat absorption"), drag,
-             [channel, v](Material& x) { axisOf(x.coatAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
-      }, true);
+      b.vec3(
+          tr("Coat absorption"), "coatAbsorption", m.coatAbsorption, 0.01,
+          [edit](int channel, double v, int drag) {
+            edit(tr("Coat absorption"), drag,
+                 [channel, v](Material& x) { axisOf(x.coatAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
+          },
+          true);
     }
   }
   if (holdsMedium(m.type))
@@ -406,9 +424,8 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
                        &Material::interiorAnisotropy, edit);
   if (m.type == MaterialType::Boundary) return;  // no surface: no texture, emission, alpha or blend applies
   if (m.type == MaterialType::Phong)
-    b.number(tr("Diffuse ratio"), "diffuseRatio", m.diffuseRatio, 0.0, 1.0, defaults.diffuseRatio, 3, [edit](double v, int drag) {
-      edit(tr("Diffuse ratio"), drag, [v](Material& x) { x.diffuseRatio = static_cast<float>(v); });
-    });
+    b.number(tr("Diffuse ratio"), "diffuseRatio", m.diffuseRatio, 0.0, 1.0, defaults.diffuseRatio, 3,
+             [edit](double v, int drag) { edit(tr("Diffuse ratio"), drag, [v](Material& x) { x.diffuseRatio = static_cast<float>(v); }); });
   if (m.type == MaterialType::DiffuseTransmission)
     b.number(tr("Transmittance"), "transmittance", m.transmittance, 0.0, 1.0, defaults.transmittance, 3, [edit](double v, int drag) {
       edit(tr("Transmittance"), drag, [v](Material& x) { x.transmittance = static_cast<float>(v); });
@@ -419,30 +436,38 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic || m.type == MaterialType::ThinSheet ||
       m.type == MaterialType::Hair) {
     const QString label = m.type == MaterialType::ThinSheet ? tr("Absorption")
-                          : m.type == MaterialType::Hair     ? tr("Pigment absorption")
-                                                             : tr("Coating absorption");
-    QWidget* w = b.vec3(label, "coatingAbsorption", m.coatingAbsorption, 0.01, [edit, label](int channel, double v, int drag) {
-      edit(label, drag, [channel, v](Material& x) { axisOf(x.coatingAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
-    }, true);
+                          : m.type == MaterialType::Hair    ? tr("Pigment absorption")
+                                                            : tr("Coating absorption");
+    QWidget* w = b.vec3(
+        label, "coatingAbsorption", m.coatingAbsorption, 0.01,
+        [edit, label](int channel, double v, int drag) {
+          edit(label, drag, [channel, v](Material& x) { axisOf(x.coatingAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
+        },
+        true);
     if (m.type == MaterialType::Hair)
-      w->setToolTip(tr("Per unit of the fibre's radius. Eumelanin (brown to black) absorbs about 0.42, 0.70, 1.37 per unit of "
-                       "concentration, pheomelanin (red to blond) 0.19, 0.40, 1.05"));
+      w->setToolTip(
+          tr("Per unit of the fibre's radius. Eumelanin (brown to black) absorbs about 0.42, 0.70, 1.37 per unit of "
+             "concentration, pheomelanin (red to blond) 0.19, 0.40, 1.05"));
   }
   if (m.type == MaterialType::Hair)
-    b.number(tr("Scale tilt (degrees)"), "hairTilt", m.hairTilt, -45.0, 45.0, defaults.hairTilt, 1, [edit](double v, int drag) {
-      edit(tr("Scale tilt"), drag, [v](Material& x) { x.hairTilt = static_cast<float>(v); });
-    })->setToolTip(tr("How far the cuticle's scales lean the highlights along the fibre: the white one towards the tip, the coloured one back"));
+    b.number(tr("Scale tilt (degrees)"), "hairTilt", m.hairTilt, -45.0, 45.0, defaults.hairTilt, 1,
+             [edit](double v, int drag) { edit(tr("Scale tilt"), drag, [v](Material& x) { x.hairTilt = static_cast<float>(v); }); })
+        ->setToolTip(
+            tr("How far the cuticle's scales lean the highlights along the fibre: the white one towards the tip, the coloured one back"));
   if (m.type == MaterialType::ThinSheet)
-    b.number(tr("Film thickness (nm)"), "filmThickness", m.filmThickness, 0.0, 5000.0, defaults.filmThickness, 1, [this, id, edit](double v, int drag) {
-      const Material* cur = scene_().material(id);
-      const bool was = cur && cur->filmThickness > 0;
-      edit(tr("Film thickness"), drag, [v](Material& x) { x.filmThickness = static_cast<float>(v); });
-      if (was != (v > 0)) rebuildLater(drag);  // the interference's form shows only with a film
-    })->setToolTip(tr("Thin-film interference over a film this thick: colours that change with the angle, as on a soap bubble; 0 for none"));
+    b.number(tr("Film thickness (nm)"), "filmThickness", m.filmThickness, 0.0, 5000.0, defaults.filmThickness, 1,
+             [this, id, edit](double v, int drag) {
+               const Material* cur = scene_().material(id);
+               const bool was = cur && cur->filmThickness > 0;
+               edit(tr("Film thickness"), drag, [v](Material& x) { x.filmThickness = static_cast<float>(v); });
+               if (was != (v > 0)) rebuildLater(drag);  // the interference's form shows only with a film
+             })
+        ->setToolTip(
+            tr("Thin-film interference over a film this thick: colours that change with the angle, as on a soap bubble; 0 for none"));
   if (m.type == MaterialType::ThinSheet && m.filmThickness > 0)
-    b.choice(tr("Interference"), "interferenceConvention", {tr("Physical"), tr("Tungsten")}, m.tungstenGlass ? 1 : 0,
-             [edit](int i) { edit(tr("Interference"), 0, [i](Material& x) { x.tungstenGlass = i == 1; }); })
-        ->setToolTip(tr("Tungsten's form, for scenes made for it, shows a few per cent of the physical colours"));
+    b.choice(tr("Interference"), "interferenceConvention", {tr("Physical"), tr("Tungsten")}, m.tungstenGlass ? 1 : 0, [edit](int i) {
+       edit(tr("Interference"), 0, [i](Material& x) { x.tungstenGlass = i == 1; });
+     })->setToolTip(tr("Tungsten's form, for scenes made for it, shows a few per cent of the physical colours"));
   if (m.type == MaterialType::Conductor || m.type == MaterialType::RoughConductor) {
     QStringList metals;
     for (const auto& n : conductorNames()) metals << QString::fromStdString(n);
@@ -461,16 +486,15 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     const char* name;
     NodeId Material::*field;
   };
-  for (const Slot& slot : {Slot{"Albedo texture", "albedoTexture", &Material::albedoTexture},
-                           Slot{"Roughness texture", "roughnessTexture", &Material::roughnessTexture},
-                           Slot{"Alpha texture", "alphaTexture", &Material::alphaTexture},
-                           Slot{"Bump texture", "bumpTexture", &Material::bumpTexture},
-                           Slot{"Emission texture", "emissionTexture", &Material::emissionTexture}}) {
+  for (const Slot& slot :
+       {Slot{"Albedo texture", "albedoTexture", &Material::albedoTexture},
+        Slot{"Roughness texture", "roughnessTexture", &Material::roughnessTexture},
+        Slot{"Alpha texture", "alphaTexture", &Material::alphaTexture}, Slot{"Bump texture", "bumpTexture", &Material::bumpTexture},
+        Slot{"Emission texture", "emissionTexture", &Material::emissionTexture}}) {
     if (slot.field == &Material::roughnessTexture && !readsRoughnessSlot(m.type)) continue;
     if (slot.field == &Material::albedoTexture && m.type == MaterialType::Hair) continue;
     auto field = slot.field;
-    const char* label =
-        field == &Material::roughnessTexture && roughnessSlotIsThickness(m.type) ? "Thickness texture" : slot.label;
+    const char* label = field == &Material::roughnessTexture && roughnessSlotIsThickness(m.type) ? "Thickness texture" : slot.label;
     b.nodeChoice(tr(label), slot.name, scene_().textures, m.*field, [this, edit, field](NodeId t) {
       edit(tr("Assign texture"), 0, [t, field](Material& x) { x.*field = t; });
       rebuildLater();
@@ -478,8 +502,9 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     const Texture* tex = scene_().texture(m.*slot.field);
     if (tex && tex->kind == TextureKind::File) texturePath(b, *tex, QString("%1Path").arg(slot.name));
     if (slot.field == &Material::bumpTexture && tex)
-      b.number(tr("Bump strength"), "bumpStrength", m.bumpStrength, -1e4, 1e4, defaults.bumpStrength, 3,
-               [edit](double v, int drag) { edit(tr("Bump strength"), drag, [v](Material& x) { x.bumpStrength = static_cast<float>(v); }); });
+      b.number(tr("Bump strength"), "bumpStrength", m.bumpStrength, -1e4, 1e4, defaults.bumpStrength, 3, [edit](double v, int drag) {
+        edit(tr("Bump strength"), drag, [v](Material& x) { x.bumpStrength = static_cast<float>(v); });
+      });
   }
 
   // Shown as a swatch (the colour, normalised: files give radiance above 1) and a strength, the
@@ -510,22 +535,24 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     if (was != (v > 0)) rebuildLater(drag);  // the cone shows only while it emits
   });
   if (m.emissive())
-    b.number(tr("Emission cone half angle"), "emissionCone", m.emissionCone, 0.0, 90.0, defaults.emissionCone, 1, [edit](double v, int drag) {
-      edit(tr("Emission cone"), drag, [v](Material& x) { x.emissionCone = static_cast<float>(v); });
-    })->setToolTip(tr("The half-angle about the normal within which the front emits: 90 lights the whole hemisphere, less makes a spot with a hard edge"));
-  b.number(tr("Alpha"), "alpha", m.alpha, 0.0, 1.0, 1.0, 3, [edit](double v, int drag) {
-    edit(tr("Alpha"), drag, [v](Material& x) { x.alpha = static_cast<float>(v); });
-  });
+    b.number(tr("Emission cone half angle"), "emissionCone", m.emissionCone, 0.0, 90.0, defaults.emissionCone, 1,
+             [edit](double v, int drag) { edit(tr("Emission cone"), drag, [v](Material& x) { x.emissionCone = static_cast<float>(v); }); })
+        ->setToolTip(tr("The half-angle about the normal within which the front emits: 90 lights the whole hemisphere, less makes a spot "
+                        "with a hard edge"));
+  b.number(tr("Alpha"), "alpha", m.alpha, 0.0, 1.0, 1.0, 3,
+           [edit](double v, int drag) { edit(tr("Alpha"), drag, [v](Material& x) { x.alpha = static_cast<float>(v); }); });
 
   // A blend with another material (Tungsten's mixed bsdf): this one's share, the other's the rest.
-  b.nodeChoice(tr("Blend with"), "blendWith", scene_().materials, m.blendWith, [this, edit](NodeId other) {
-    edit(tr("Blend with"), 0, [other](Material& x) { x.setBlendWith(other); });
-    rebuildLater();
-  }, id);
+  b.nodeChoice(
+      tr("Blend with"), "blendWith", scene_().materials, m.blendWith,
+      [this, edit](NodeId other) {
+        edit(tr("Blend with"), 0, [other](Material& x) { x.setBlendWith(other); });
+        rebuildLater();
+      },
+      id);
   if (m.blendWith != kNoNode) {
-    b.number(tr("Blend ratio"), "blendRatio", m.blendRatio, 0.0, 1.0, 0.5, 3, [edit](double v, int drag) {
-      edit(tr("Blend ratio"), drag, [v](Material& x) { x.blendRatio = static_cast<float>(v); });
-    });
+    b.number(tr("Blend ratio"), "blendRatio", m.blendRatio, 0.0, 1.0, 0.5, 3,
+             [edit](double v, int drag) { edit(tr("Blend ratio"), drag, [v](Material& x) { x.blendRatio = static_cast<float>(v); }); });
     // A mask that varies the ratio over the surface (the mean of its channels scales it).
     b.nodeChoice(tr("Blend ratio texture"), "blendRatioTexture", scene_().textures, m.blendRatioTexture, [this, edit](NodeId t) {
       edit(tr("Assign texture"), 0, [t](Material& x) { x.blendRatioTexture = t; });
@@ -575,12 +602,10 @@ void PropertyPanel::buildLight(Builder& b, const Light& l) {
     edit(tr("Light type"), 0, [i](Light& x) { x.type = static_cast<LightType>(i); });
     rebuildLater();
   });
-  b.color(tr("Colour"), "lightColor", l.color, defaults.color, [edit](Vec3 c, int drag) {
-    edit(tr("Light colour"), drag, [c](Light& x) { x.color = c; });
-  });
-  b.number(tr("Intensity"), "intensity", l.intensity, 0.0, 1e6, defaults.intensity, 3, [edit](double v, int drag) {
-    edit(tr("Light intensity"), drag, [v](Light& x) { x.intensity = static_cast<float>(v); });
-  });
+  b.color(tr("Colour"), "lightColor", l.color, defaults.color,
+          [edit](Vec3 c, int drag) { edit(tr("Light colour"), drag, [c](Light& x) { x.color = c; }); });
+  b.number(tr("Intensity"), "intensity", l.intensity, 0.0, 1e6, defaults.intensity, 3,
+           [edit](double v, int drag) { edit(tr("Light intensity"), drag, [v](Light& x) { x.intensity = static_cast<float>(v); }); });
   if (l.type != LightType::Directional)
     b.vec3(tr("Position"), "lightPosition", l.position, 0.01, [edit](int axis, double v, int drag) {
       edit(tr("Move light"), drag, [&](Light& x) { axisOf(x.position, axis) = static_cast<float>(v); });
@@ -624,12 +649,10 @@ void PropertyPanel::buildCamera(Builder& b) {
     edit(tr("Field of view"), drag, [v](Camera& x) { x.verticalFov = radians(static_cast<float>(v)); });
   });
   // Depth of field: a lens of this radius, sharp at the focus distance (0: a pinhole).
-  b.number(tr("Aperture radius"), "apertureRadius", c.apertureRadius, 0.0, 10.0, 0.0, 4, [edit](double v, int drag) {
-    edit(tr("Aperture radius"), drag, [v](Camera& x) { x.apertureRadius = static_cast<float>(v); });
-  });
-  b.number(tr("Focus distance"), "focusDistance", c.focusDistance, 0.001, 1e5, 1.0, 3, [edit](double v, int drag) {
-    edit(tr("Focus distance"), drag, [v](Camera& x) { x.focusDistance = static_cast<float>(v); });
-  });
+  b.number(tr("Aperture radius"), "apertureRadius", c.apertureRadius, 0.0, 10.0, 0.0, 4,
+           [edit](double v, int drag) { edit(tr("Aperture radius"), drag, [v](Camera& x) { x.apertureRadius = static_cast<float>(v); }); });
+  b.number(tr("Focus distance"), "focusDistance", c.focusDistance, 0.001, 1e5, 1.0, 3,
+           [edit](double v, int drag) { edit(tr("Focus distance"), drag, [v](Camera& x) { x.focusDistance = static_cast<float>(v); }); });
 }
 
 void PropertyPanel::buildEnvironment(Builder& b) {
@@ -654,24 +677,20 @@ void PropertyPanel::buildEnvironment(Builder& b) {
     edit(tr("Environment intensity"), drag, [v](Environment& x) { x.intensity = static_cast<float>(v); });
   });
   if (e.type != EnvironmentType::Sky) {
-    b.color(tr("Colour"), "environmentColor", e.color, Vec3{1.0f}, [edit](Vec3 c, int drag) {
-      edit(tr("Environment colour"), drag, [c](Environment& x) { x.color = c; });
-    });
+    b.color(tr("Colour"), "environmentColor", e.color, Vec3{1.0f},
+            [edit](Vec3 c, int drag) { edit(tr("Environment colour"), drag, [c](Environment& x) { x.color = c; }); });
   }
   if (e.type == EnvironmentType::Map)
     b.number(tr("Rotation"), "environmentRotation", degrees(e.rotation), -360.0, 360.0, 0.0, 1, [edit](double v, int drag) {
       edit(tr("Environment rotation"), drag, [v](Environment& x) { x.rotation = radians(static_cast<float>(v)); });
     });
   if (e.type == EnvironmentType::Sky) {
-    b.color(tr("Zenith"), "zenith", e.zenith, defaults.zenith, [edit](Vec3 c, int drag) {
-      edit(tr("Sky zenith"), drag, [c](Environment& x) { x.zenith = c; });
-    });
-    b.color(tr("Horizon"), "horizon", e.horizon, defaults.horizon, [edit](Vec3 c, int drag) {
-      edit(tr("Sky horizon"), drag, [c](Environment& x) { x.horizon = c; });
-    });
-    b.color(tr("Ground"), "ground", e.ground, defaults.ground, [edit](Vec3 c, int drag) {
-      edit(tr("Sky ground"), drag, [c](Environment& x) { x.ground = c; });
-    });
+    b.color(tr("Zenith"), "zenith", e.zenith, defaults.zenith,
+            [edit](Vec3 c, int drag) { edit(tr("Sky zenith"), drag, [c](Environment& x) { x.zenith = c; }); });
+    b.color(tr("Horizon"), "horizon", e.horizon, defaults.horizon,
+            [edit](Vec3 c, int drag) { edit(tr("Sky horizon"), drag, [c](Environment& x) { x.horizon = c; }); });
+    b.color(tr("Ground"), "ground", e.ground, defaults.ground,
+            [edit](Vec3 c, int drag) { edit(tr("Sky ground"), drag, [c](Environment& x) { x.ground = c; }); });
   }
   // The medium filling the world (fog), as a glass's or boundary's interior.
   b.medium<Environment>(tr("Medium"), "medium", e, &Environment::mediumAbsorption, &Environment::mediumScattering,
@@ -686,21 +705,18 @@ void PropertyPanel::buildRender(Builder& b) {
   };
   const RenderSettings& r = scene_().settings;
   b.header(tr("Render settings"));
-  b.number(tr("Max bounces"), "maxBounces", r.maxBounces, 0, 1024, RenderSettings{}.maxBounces, 0, [edit](double v, int drag) {
-    edit(tr("Max bounces"), drag, [v](RenderSettings& x) { x.maxBounces = static_cast<int>(v); });
-  });
+  b.number(tr("Max bounces"), "maxBounces", r.maxBounces, 0, 1024, RenderSettings{}.maxBounces, 0,
+           [edit](double v, int drag) { edit(tr("Max bounces"), drag, [v](RenderSettings& x) { x.maxBounces = static_cast<int>(v); }); });
   // Light that arrives in fewer bounces is left out: 1 hides the lights seen directly.
-  b.number(tr("Min bounces"), "minBounces", r.minBounces, 0, 1024, RenderSettings{}.minBounces, 0, [edit](double v, int drag) {
-    edit(tr("Min bounces"), drag, [v](RenderSettings& x) { x.minBounces = static_cast<int>(v); });
-  });
+  b.number(tr("Min bounces"), "minBounces", r.minBounces, 0, 1024, RenderSettings{}.minBounces, 0,
+           [edit](double v, int drag) { edit(tr("Min bounces"), drag, [v](RenderSettings& x) { x.minBounces = static_cast<int>(v); }); });
   // Off, only paths that hit a light see it (Tungsten's enable_light_sampling false): noisier, and
   // point, spot and sun lights without a disc go dark.
   b.check(tr("Light sampling"), "lightSampling", r.lightSampling, [edit](bool on) {
     edit(on ? tr("Light sampling on") : tr("Light sampling off"), 0, [on](RenderSettings& x) { x.lightSampling = on; });
   });
-  b.number(tr("Seed"), "seed", r.seed, 0, 1e9, 0, 0, [edit](double v, int drag) {
-    edit(tr("Seed"), drag, [v](RenderSettings& x) { x.seed = static_cast<std::uint32_t>(v); });
-  });
+  b.number(tr("Seed"), "seed", r.seed, 0, 1e9, 0, 0,
+           [edit](double v, int drag) { edit(tr("Seed"), drag, [v](RenderSettings& x) { x.seed = static_cast<std::uint32_t>(v); }); });
   QStringList filters{tr("Box"), tr("Tent"), tr("Gaussian"), tr("Blackman-Harris")};
   b.choice(tr("Pixel filter"), "pixelFilter", filters, static_cast<int>(r.pixelFilter), [this, edit](int i) {
     if (i < 0 || i >= kPixelFilterCount) return;
@@ -710,10 +726,9 @@ void PropertyPanel::buildRender(Builder& b) {
     });
     rebuildLater();  // the width field shows the new default
   });
-  b.number(tr("Filter width (px)"), "filterWidth", r.filterWidth, 0.5, 8.0, defaultFilterWidth(r.pixelFilter), 2,
-           [edit](double v, int drag) {
-             edit(tr("Filter width"), drag, [v](RenderSettings& x) { x.filterWidth = static_cast<float>(v); });
-           });
+  b.number(
+      tr("Filter width (px)"), "filterWidth", r.filterWidth, 0.5, 8.0, defaultFilterWidth(r.pixelFilter), 2,
+      [edit](double v, int drag) { edit(tr("Filter width"), drag, [v](RenderSettings& x) { x.filterWidth = static_cast<float>(v); }); });
   // Tungsten scene files come with Tungsten's way of drawing its tent and Gaussian, so they converge
   // to the picture their author saw; any scene may switch.
   b.choice(tr("Filter sampling"), "filterSampling", {tr("Exact"), tr("As Tungsten draws it")}, static_cast<int>(r.filterSampling),
@@ -722,17 +737,15 @@ void PropertyPanel::buildRender(Builder& b) {
              edit(tr("Filter sampling"), 0, [i](RenderSettings& x) { x.filterSampling = static_cast<FilterSampling>(i); });
            });
   // Tungsten scene files come with its shading-normal convention too (see ShadingConvention).
-  b.choice(tr("Shading normals"), "shading", {tr("Consistent"), tr("As Tungsten shades them")}, static_cast<int>(r.shading),
-           [edit](int i) {
-             if (i < 0 || i > 1) return;
-             edit(tr("Shading normals"), 0, [i](RenderSettings& x) { x.shading = static_cast<ShadingConvention>(i); });
-           });
+  b.choice(tr("Shading normals"), "shading", {tr("Consistent"), tr("As Tungsten shades them")}, static_cast<int>(r.shading), [edit](int i) {
+    if (i < 0 || i > 1) return;
+    edit(tr("Shading normals"), 0, [i](RenderSettings& x) { x.shading = static_cast<ShadingConvention>(i); });
+  });
   // And with its Russian roulette, so that a sample is the same work as in Tungsten (see Roulette).
-  b.choice(tr("Russian roulette"), "roulette", {tr("Standard"), tr("As Tungsten plays it")}, static_cast<int>(r.roulette),
-           [edit](int i) {
-             if (i < 0 || i > 1) return;
-             edit(tr("Russian roulette"), 0, [i](RenderSettings& x) { x.roulette = static_cast<Roulette>(i); });
-           });
+  b.choice(tr("Russian roulette"), "roulette", {tr("Standard"), tr("As Tungsten plays it")}, static_cast<int>(r.roulette), [edit](int i) {
+    if (i < 0 || i > 1) return;
+    edit(tr("Russian roulette"), 0, [i](RenderSettings& x) { x.roulette = static_cast<Roulette>(i); });
+  });
   // And with where its rays leave a surface, which decides what leaks through cracks (see RayOffset).
   b.choice(tr("Ray offset"), "rayOffset", {tr("Robust"), tr("As Tungsten's (skip 0.0005 units)")}, static_cast<int>(r.rayOffset),
            [edit](int i) {
@@ -740,12 +753,10 @@ void PropertyPanel::buildRender(Builder& b) {
              edit(tr("Ray offset"), 0, [i](RenderSettings& x) { x.rayOffset = static_cast<RayOffset>(i); });
            });
   // The scene's own image: what `retile render` renders and the framing the viewport can show.
-  b.number(tr("Width (px)"), "resolutionWidth", r.width, 1, kMaxImageSide, RenderSettings{}.width, 0, [edit](double v, int drag) {
-    edit(tr("Resolution"), drag, [v](RenderSettings& x) { x.width = static_cast<int>(v); });
-  });
-  b.number(tr("Height (px)"), "resolutionHeight", r.height, 1, kMaxImageSide, RenderSettings{}.height, 0, [edit](double v, int drag) {
-    edit(tr("Resolution"), drag, [v](RenderSettings& x) { x.height = static_cast<int>(v); });
-  });
+  b.number(tr("Width (px)"), "resolutionWidth", r.width, 1, kMaxImageSide, RenderSettings{}.width, 0,
+           [edit](double v, int drag) { edit(tr("Resolution"), drag, [v](RenderSettings& x) { x.width = static_cast<int>(v); }); });
+  b.number(tr("Height (px)"), "resolutionHeight", r.height, 1, kMaxImageSide, RenderSettings{}.height, 0,
+           [edit](double v, int drag) { edit(tr("Resolution"), drag, [v](RenderSettings& x) { x.height = static_cast<int>(v); }); });
   // The viewport converges for as long as it is left; `retile render` stops here.
   b.number(tr("Samples per pixel"), "samplesPerPixel", r.samplesPerPixel, 1, 1048576, RenderSettings{}.samplesPerPixel, 0,
            [edit](double v, int drag) {
@@ -756,7 +767,9 @@ void PropertyPanel::buildRender(Builder& b) {
 }
 
 QString PropertyPanel::viewportText() const {
-  return tr("%1 x %2, %3").arg(renderSize_.width()).arg(renderSize_.height())
+  return tr("%1 x %2, %3")
+      .arg(renderSize_.width())
+      .arg(renderSize_.height())
       .arg(cameraFraming_ ? tr("framed as the scene") : tr("filling the view"));
 }
 

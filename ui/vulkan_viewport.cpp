@@ -40,12 +40,11 @@ class PresentRenderer : public QVulkanWindowRenderer {
     if (!check(f_->vkCreatePipelineLayout(dev_, &pl, nullptr, &layout_), "vkCreatePipelineLayout")) return;
     VkDescriptorPoolSize ps{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, QVulkanWindow::MAX_CONCURRENT_FRAME_COUNT};
     VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, nullptr, 0,
-                                  QVulkanWindow::MAX_CONCURRENT_FRAME_COUNT, 1, &ps};
+                                  QVulkanWindow::MAX_CONCURRENT_FRAME_COUNT,     1,       &ps};
     if (!check(f_->vkCreateDescriptorPool(dev_, &dp, nullptr, &pool_), "vkCreateDescriptorPool")) return;
     for (int i = 0; i < w_->concurrentFrameCount(); ++i) {
       VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO, nullptr, pool_, 1, &setLayout_};
-      if (!check(f_->vkAllocateDescriptorSets(dev_, &ai, &frames_[static_cast<std::size_t>(i)].set), "vkAllocateDescriptorSets"))
-        return;
+      if (!check(f_->vkAllocateDescriptorSets(dev_, &ai, &frames_[static_cast<std::size_t>(i)].set), "vkAllocateDescriptorSets")) return;
     }
     createPipeline();
   }
@@ -253,7 +252,8 @@ void VulkanViewport::fail(const QString& why) {
   failed_ = true;
   watchdog_.stop();
   if (auto handler = onFailure_)
-    QMetaObject::invokeMethod(target_, [handler, why] { handler(why); }, Qt::QueuedConnection);
+    QMetaObject::invokeMethod(
+        target_, [handler, why] { handler(why); }, Qt::QueuedConnection);
 }
 
 void VulkanViewport::framePresented() { waiting_.invalidate(); }

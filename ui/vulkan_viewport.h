@@ -53,8 +53,8 @@ class VulkanViewport : public QVulkanWindow {
   std::function<void(const QString&)> onFailure_;
   bool failed_ = false;
   QTimer watchdog_;
-  QElapsedTimer waiting_;    // since the oldest picture not yet presented (invalid: none waits)
-  QElapsedTimer notStarted_; // since the window was exposed without valid presentation
+  QElapsedTimer waiting_;     // since the oldest picture not yet presented (invalid: none waits)
+  QElapsedTimer notStarted_;  // since the window was exposed without valid presentation
 };
 
 }  // namespace retile::ui

@@ -29,8 +29,7 @@ bool silentlyRepaired(const std::string& path) {
 
 // Files the glTF specification says a 2.0 loader must refuse.
 bool mustBeRefused(const std::string& path) {
-  return path.find("Compatibility_04-minVersion") != std::string::npos ||
-         path.find("Compatibility_05-extRequired") != std::string::npos;
+  return path.find("Compatibility_04-minVersion") != std::string::npos || path.find("Compatibility_05-extRequired") != std::string::npos;
 }
 
 TEST(Corpus, EveryFileImportsOrFailsCleanly) {

@@ -179,16 +179,15 @@ class Bsdfs : public ::testing::Test {
     const int first = upperOnly ? nt : 0;
     const double cell = (1.0 / nt) * (2.0 * kPi / np);
     double f = 0, pdf = 0;
-    runBatched(
-        (2 * nt - first) * np,
-        [&](int k) {
-          const int i = first + k / np, j = k % np;
-          return BsdfQuery{m, wo, direction(-1.0f + (i + 0.5f) / nt, 2.0f * kPi * (j + 0.5f) / np), Vec3{0.5f}};
-        },
-        [&](const BsdfAnswer& a) {
-          f += luminance(a.f) * cell;
-          pdf += a.pdf * cell;
-        });
+    runBatched((2 * nt - first) * np,
+               [&](int k) {
+                 const int i = first + k / np, j = k % np;
+                 return BsdfQuery{m, wo, direction(-1.0f + (i + 0.5f) / nt, 2.0f * kPi * (j + 0.5f) / np), Vec3{0.5f}};
+               },
+               [&](const BsdfAnswer& a) {
+                 f += luminance(a.f) * cell;
+                 pdf += a.pdf * cell;
+               });
     return {f, pdf};
   }
 
@@ -219,7 +218,8 @@ TEST_F(Bsdfs, SampledPdfsAndWeightsAreWhatEvalGives) {
   std::uniform_real_distribution<float> U(0.0f, 1.0f);
   for (const Case& c : smoothLobed()) {
     std::vector<BsdfQuery> q;
-    for (int i = 0; i < 4000; ++i) q.push_back({c.m, direction(0.05f + 0.95f * U(rng), 6.283f * U(rng)), Vec3{0, 0, 1}, {U(rng), U(rng), U(rng)}});
+    for (int i = 0; i < 4000; ++i)
+      q.push_back({c.m, direction(0.05f + 0.95f * U(rng), 6.283f * U(rng)), Vec3{0, 0, 1}, {U(rng), U(rng), U(rng)}});
     int checked = 0;
     for (const auto& a : run(q)) {
       if (maxComponent(a.weight) <= 0.0f || a.delta) continue;
@@ -463,58 +463,60 @@ TEST_F(Bsdfs, AThinFilmReflectsEachChannelByItsPhase) {
   const double eta = 1.33;
   const double lambda[3] = {650, 510, 475};
   for (bool tungsten : {false, true})
-  for (float film : {0.0f, 300.0f, 820.0f}) {
-    for (float cosO : {0.95f, 0.6f, 0.25f}) {
-      const double s2 = (1 - cosO * cosO) / (eta * eta), ct = std::sqrt(1 - s2);
-      const double rs = (cosO - eta * ct) / (cosO + eta * ct), rp = (eta * cosO - ct) / (eta * cosO + ct);
-      const double Rs = rs * rs, Rp = rp * rp;
-      Material m = coated(material(MaterialType::ThinSheet, 1.0f), 60.0f);
-      m.ior = static_cast<float>(eta);
-      m.filmThickness = film;
-      m.tungstenGlass = tungsten;
-      const Vec3 wo = direction(cosO, 0.3f);
-      std::vector<BsdfQuery> q;
-      std::mt19937 rng(3);
-      std::uniform_real_distribution<float> U(0.0f, 1.0f);
-      const int n = 4096;
-      for (int i = 0; i < n; ++i) q.push_back({m, wo, wo, {(i + U(rng)) / n, U(rng), U(rng)}});
-      double sum[3] = {0, 0, 0};
-      for (const auto& a : run(q))
-        for (int c = 0; c < 3; ++c) sum[c] += (c == 0 ? a.weight.x : c == 1 ? a.weight.y : a.weight.z) / n;
-      for (int c = 0; c < 3; ++c) {
-        const double cosPhi = std::cos(4 * kPi * eta * film * ct / lambda[c]);
-        auto passes = [&](double R) {
-          return tungsten ? (1 - R) * (1 - R) / std::sqrt(1 + R * R * R * R - 2 * R * R * cosPhi) : (1 - R) * (1 - R) / (1 + R * R - 2 * R * cosPhi);
-        };
-        // No film is the plain sheet.
-        const double expected = film == 0.0f ? Rs / (1 + Rs) + Rp / (1 + Rp) : 1 - 0.5 * (passes(Rs) + passes(Rp));
-        EXPECT_NEAR(sum[c], expected, 2e-3) << (tungsten ? "Tungsten's" : "Airy's") << ", film " << film << " nm, cos " << cosO << ", channel " << c;
-        // A film that absorbs nothing passes what it does not reflect, in every channel.
-        if (film > 0.0f) {
-          Material clear = m;
-          clear.coatingAbsorption = Vec3{0.0f};
-          std::vector<BsdfQuery> cq;
-          // Stratified in the choice between the two, finely: a channel's weight differs from its
-          // mean's by R / pR, so an imbalance of one sample in k shows as about 1 / k.
-          const int k = 65536;
-          for (int i = 0; i < k; ++i) cq.push_back({clear, wo, wo, {(i + 0.5f) / k, 0.5f, 0.5f}});
-          double both = 0;
-          for (const auto& ans : run(cq)) both += (c == 0 ? ans.weight.x : c == 1 ? ans.weight.y : ans.weight.z) / k;
-          EXPECT_NEAR(both, 1.0, 1e-4) << "reflected and passed, channel " << c;
-        }
-        if (film > 0.0f && !tungsten) {
-          // Airy's mean over the phase is the plain sheet's: numerically, over a period.
-          double mean = 0;
-          for (int k = 0; k < 720; ++k) {
-            const double cp = std::cos(2 * kPi * (k + 0.5) / 720);
-            auto airy = [&](double R) { return (1 - R) * (1 - R) / (1 + R * R - 2 * R * cp); };
-            mean += (1 - 0.5 * (airy(Rs) + airy(Rp))) / 720;
+    for (float film : {0.0f, 300.0f, 820.0f}) {
+      for (float cosO : {0.95f, 0.6f, 0.25f}) {
+        const double s2 = (1 - cosO * cosO) / (eta * eta), ct = std::sqrt(1 - s2);
+        const double rs = (cosO - eta * ct) / (cosO + eta * ct), rp = (eta * cosO - ct) / (eta * cosO + ct);
+        const double Rs = rs * rs, Rp = rp * rp;
+        Material m = coated(material(MaterialType::ThinSheet, 1.0f), 60.0f);
+        m.ior = static_cast<float>(eta);
+        m.filmThickness = film;
+        m.tungstenGlass = tungsten;
+        const Vec3 wo = direction(cosO, 0.3f);
+        std::vector<BsdfQuery> q;
+        std::mt19937 rng(3);
+        std::uniform_real_distribution<float> U(0.0f, 1.0f);
+        const int n = 4096;
+        for (int i = 0; i < n; ++i) q.push_back({m, wo, wo, {(i + U(rng)) / n, U(rng), U(rng)}});
+        double sum[3] = {0, 0, 0};
+        for (const auto& a : run(q))
+          for (int c = 0; c < 3; ++c) sum[c] += (c == 0 ? a.weight.x : c == 1 ? a.weight.y : a.weight.z) / n;
+        for (int c = 0; c < 3; ++c) {
+          const double cosPhi = std::cos(4 * kPi * eta * film * ct / lambda[c]);
+          auto passes = [&](double R) {
+            return tungsten ? (1 - R) * (1 - R) / std::sqrt(1 + R * R * R * R - 2 * R * R * cosPhi)
+                            : (1 - R) * (1 - R) / (1 + R * R - 2 * R * cosPhi);
+          };
+          // No film is the plain sheet.
+          const double expected = film == 0.0f ? Rs / (1 + Rs) + Rp / (1 + Rp) : 1 - 0.5 * (passes(Rs) + passes(Rp));
+          EXPECT_NEAR(sum[c], expected, 2e-3) << (tungsten ? "Tungsten's" : "Airy's") << ", film " << film << " nm, cos " << cosO
+                                              << ", channel " << c;
+          // A film that absorbs nothing passes what it does not reflect, in every channel.
+          if (film > 0.0f) {
+            Material clear = m;
+            clear.coatingAbsorption = Vec3{0.0f};
+            std::vector<BsdfQuery> cq;
+            // Stratified in the choice between the two, finely: a channel's weight differs from its
+            // mean's by R / pR, so an imbalance of one sample in k shows as about 1 / k.
+            const int k = 65536;
+            for (int i = 0; i < k; ++i) cq.push_back({clear, wo, wo, {(i + 0.5f) / k, 0.5f, 0.5f}});
+            double both = 0;
+            for (const auto& ans : run(cq)) both += (c == 0 ? ans.weight.x : c == 1 ? ans.weight.y : ans.weight.z) / k;
+            EXPECT_NEAR(both, 1.0, 1e-4) << "reflected and passed, channel " << c;
           }
-          EXPECT_NEAR(mean, Rs / (1 + Rs) + Rp / (1 + Rp), 1e-7);
+          if (film > 0.0f && !tungsten) {
+            // Airy's mean over the phase is the plain sheet's: numerically, over a period.
+            double mean = 0;
+            for (int k = 0; k < 720; ++k) {
+              const double cp = std::cos(2 * kPi * (k + 0.5) / 720);
+              auto airy = [&](double R) { return (1 - R) * (1 - R) / (1 + R * R - 2 * R * cp); };
+              mean += (1 - 0.5 * (airy(Rs) + airy(Rp))) / 720;
+            }
+            EXPECT_NEAR(mean, Rs / (1 + Rs) + Rp / (1 + Rp), 1e-7);
+          }
         }
       }
     }
-  }
 }
 
 // Tungsten's Phong (PhongBsdf): f cos = albedo cos(wi) (r / pi + (1 - r) (n + 2) / (2 pi)
@@ -565,7 +567,8 @@ TEST_F(Bsdfs, DiffuseTransmissionSplitsLambertBetweenTheSides) {
     EXPECT_NEAR(r[0].f.y, 0.9 * 0.7 * 0.5 / kPi, 1e-5) << "reflected, side " << side;
     EXPECT_NEAR(r[1].f.y, 0.9 * 0.3 * 0.5 / kPi, 1e-5) << "transmitted, side " << side;
     std::vector<BsdfQuery> q;
-    for (int i = 0; i < 4096; ++i) q.push_back({transmitting(1.0f, 0.3f), wo, wo, {(i % 64 + 0.5f) / 64, (i / 64 + 0.5f) / 64, (i + 0.5f) / 4096}});
+    for (int i = 0; i < 4096; ++i)
+      q.push_back({transmitting(1.0f, 0.3f), wo, wo, {(i % 64 + 0.5f) / 64, (i / 64 + 0.5f) / 64, (i + 0.5f) / 4096}});
     double through = 0, total = 0;
     for (const auto& a : run(q)) {
       total += luminance(a.weight) / 4096;
@@ -671,7 +674,12 @@ TEST_F(Bsdfs, HairKeepsWhatItsLobesAttenuationsSay) {
       const double expected = f + (1 - f) * (1 - f) * t * (1 + f * t);
       std::vector<BsdfQuery> q;
       for (int i = 0; i < 256; ++i)
-        for (int j = 0; j < 256; ++j) q.push_back({hair(0.02f, a, 0.0f), wo, wo, {(i + 0.5f) / 256, (j + 0.5f) / 256, ((i * 256 + j) * 0.618034f) - std::floor((i * 256 + j) * 0.618034f)}, h});
+        for (int j = 0; j < 256; ++j)
+          q.push_back({hair(0.02f, a, 0.0f),
+                       wo,
+                       wo,
+                       {(i + 0.5f) / 256, (j + 0.5f) / 256, ((i * 256 + j) * 0.618034f) - std::floor((i * 256 + j) * 0.618034f)},
+                       h});
       double sum = 0;
       for (const auto& r : run(q)) sum += luminance(r.weight) / static_cast<double>(q.size());
       EXPECT_NEAR(sum, expected, 0.01 * expected + 1e-4) << "h " << h << ", absorption " << a;

@@ -51,10 +51,8 @@ TEST(Cli, ImportAndRenderUnderACommaDecimalLocale) {
   EXPECT_EQ(nativeSceneToString(reread->scene), nativeSceneToString(original->scene));
 
   std::filesystem::path out = test::tempDir() / "box.exr";
-  ChildResult rendered = runChild(RETILE_CLI_PATH,
-                                  {"render", scene.string(), "--size", "24x24", "--spp", "2", "--exposure", "0.5",
-                                   "--out", out.string()},
-                                  limits);
+  ChildResult rendered = runChild(
+      RETILE_CLI_PATH, {"render", scene.string(), "--size", "24x24", "--spp", "2", "--exposure", "0.5", "--out", out.string()}, limits);
   ASSERT_EQ(rendered.exitCode, 0) << rendered.err;
   auto image = readImageRaw(out);
   ASSERT_TRUE(image.ok()) << image.error();
@@ -79,7 +77,8 @@ TEST(Cli, APngIsShownThroughTheScenesViewUnlessToldOtherwise) {
   ChildLimits limits;
   limits.timeout = std::chrono::minutes(5);
   auto render = [&](const std::string& name, const std::vector<std::string>& view) {
-    std::vector<std::string> args = {"render", (dir / "raw.retile").string(), "--size", "16x16", "--spp", "2", "--out", (dir / name).string()};
+    std::vector<std::string> args = {"render", (dir / "raw.retile").string(), "--size", "16x16", "--spp", "2",
+                                     "--out",  (dir / name).string()};
     args.insert(args.end(), view.begin(), view.end());
     ChildResult r = runChild(RETILE_CLI_PATH, args, limits);
     EXPECT_EQ(r.exitCode, 0) << r.err;
@@ -120,8 +119,7 @@ TEST(Cli, CompareTellsABiasFromNoiseByBlockSize) {
   ChildLimits limits;
   limits.timeout = std::chrono::minutes(2);
   ChildResult r = runChild(RETILE_CLI_PATH,
-                           {"compare", (dir / "a.exr").string(), (dir / "ref.exr").string(), "--noise", (dir / "b.exr").string()},
-                           limits);
+                           {"compare", (dir / "a.exr").string(), (dir / "ref.exr").string(), "--noise", (dir / "b.exr").string()}, limits);
   ASSERT_EQ(r.exitCode, 0) << r.err;
   auto ratioAt = [&](int size) {
     const std::string key = cat("block ", size < 10 ? " " : "", size, ": ");
@@ -159,17 +157,18 @@ TEST(Cli, HelpAtEveryLevelListsTheOptions) {
   };
   const std::vector<Case> cases = {
       {{"--help"}, {"render", "edit", "eval", "compare", "bench", "import", "--version", "retile [SCENE]"}},
-      {{"render", "--help"}, {"Usage: retile render", "--spp", "--size", "--seed", "--max-bounces", "--out", "--view",
-                              "--exposure", "--denoise", "1..1048576"}},
-      {{"edit", "-h"}, {"--script", "--method", "--out-dir", "--stale-cap", "--no-images", "--quality", "--reference",
-                        "--threshold", "--denoise-threshold", "--no-soft-borders", "--reuse-rate", "spiral"}},
-      {{"eval", "--help"}, {"--quick", "--stability", "--methods", "--scenarios", "--script", "--reference-spp",
-                            "--every", "--target", "--cases", "ghosting"}},
+      {{"render", "--help"},
+       {"Usage: retile render", "--spp", "--size", "--seed", "--max-bounces", "--out", "--view", "--exposure", "--denoise", "1..1048576"}},
+      {{"edit", "-h"},
+       {"--script", "--method", "--out-dir", "--stale-cap", "--no-images", "--quality", "--reference", "--threshold", "--denoise-threshold",
+        "--no-soft-borders", "--reuse-rate", "spiral"}},
+      {{"eval", "--help"},
+       {"--quick", "--stability", "--methods", "--scenarios", "--script", "--reference-spp", "--every", "--target", "--cases", "ghosting"}},
       {{"compare", "--help"}, {"IMAGE", "REFERENCE", "--noise", "--block", "--exclude", "--worst"}},
       {{"import", "--help"}, {"FILE", "--save"}},
       {{"bench", "--help"}, {"throughput", "bvh", "edit", "frames", "denoise", "scale"}},
-      {{"bench", "throughput", "--help"}, {"Usage: retile bench throughput", "--paths", "--frames", "--max-bounces",
-                                           "--size", "--spp-per-frame"}},
+      {{"bench", "throughput", "--help"},
+       {"Usage: retile bench throughput", "--paths", "--frames", "--max-bounces", "--size", "--spp-per-frame"}},
       {{"bench", "frames", "--help"}, {"--seconds", "--method", "--drag", "--object"}},
       {{"bench", "edit", "--help"}, {"--edits"}},
       {{"bench", "bvh", "--help"}, {"--triangles"}},
@@ -240,9 +239,8 @@ TEST(Cli, EvalQuickWritesTheReportAndCachesReferences) {
   const std::filesystem::path out = test::tempDir() / "eval";
   ChildLimits limits;
   limits.timeout = std::chrono::minutes(10);
-  ChildResult run = runChild(RETILE_CLI_PATH, {"eval", "default", "--quick", "--scenarios", "fig6,material,light",
-                                               "--out-dir", out.string()},
-                             limits);
+  ChildResult run =
+      runChild(RETILE_CLI_PATH, {"eval", "default", "--quick", "--scenarios", "fig6,material,light", "--out-dir", out.string()}, limits);
   ASSERT_EQ(run.exitCode, 0) << run.err;
   for (const char* f : {"index.html", "metrics.csv", "summary.csv"}) EXPECT_TRUE(std::filesystem::exists(out / f)) << f;
 
@@ -280,9 +278,8 @@ TEST(Cli, EvalQuickWritesTheReportAndCachesReferences) {
   EXPECT_NE(page->find("charts/default-fig6-tradeoff.png"), std::string::npos);
 
   // Again, one scenario: every reference comes from disk.
-  ChildResult again = runChild(RETILE_CLI_PATH, {"eval", "--quick", "--methods", "spiral", "--scenarios", "material",
-                                                 "--out-dir", out.string()},
-                               limits);
+  ChildResult again =
+      runChild(RETILE_CLI_PATH, {"eval", "--quick", "--methods", "spiral", "--scenarios", "material", "--out-dir", out.string()}, limits);
   ASSERT_EQ(again.exitCode, 0) << again.err;
   EXPECT_NE(again.err.find("references: 0 rendered, 2 reused"), std::string::npos) << again.err;
 }

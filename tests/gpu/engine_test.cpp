@@ -256,8 +256,7 @@ TEST(Engine, AFailedDeviceIsReplacedAndTheEditsSurvive) {
   ASSERT_EQ(errors.size(), 1u);
   EXPECT_NE(errors[0].find("starts again on a new device"), std::string::npos) << errors[0];
   const std::uint64_t atFailure = engine.framesRendered();
-  ASSERT_TRUE(waitFor(engine, [&](const FrameRecord&) { return engine.framesRendered() > atFailure + 3; }))
-      << "frames flow again";
+  ASSERT_TRUE(waitFor(engine, [&](const FrameRecord&) { return engine.framesRendered() > atFailure + 3; })) << "frames flow again";
   EXPECT_TRUE(engine.running());
   auto f = engine.latestFrame();
   ASSERT_TRUE(f && f->image);

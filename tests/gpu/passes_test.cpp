@@ -28,8 +28,7 @@ Scene wallScene(int w, int h, Vec3 emission) {
   m.emission = emission;
   NodeId mat = test::addMaterial(s, m);
   // The quad faces +y; turn it to face the camera (+z) and push it back.
-  test::addMeshObject(s, "wall", makeQuad(), mat,
-                      Mat4::translate({0, 0, -5}) * Mat4::rotateX(kPi / 2) * Mat4::scale({100, 1, 100}));
+  test::addMeshObject(s, "wall", makeQuad(), mat, Mat4::translate({0, 0, -5}) * Mat4::rotateX(kPi / 2) * Mat4::scale({100, 1, 100}));
   return s;
 }
 
@@ -440,7 +439,8 @@ FirstHitCheck compareFirstHits(Renderer& r, const Scene& s, const MeshGeometry& 
       for (std::size_t k = 0; k < ids.size(); ++k)
         for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
           Vec3 v[3];
-          for (int j = 0; j < 3; ++j) v[j] = placements[k].transformPoint(mesh.positions[mesh.indices[t * 3 + static_cast<std::size_t>(j)]]);
+          for (int j = 0; j < 3; ++j)
+            v[j] = placements[k].transformPoint(mesh.positions[mesh.indices[t * 3 + static_cast<std::size_t>(j)]]);
           float th, u, vv;
           if (intersectTriangle(ray.origin, ray.dir, v[0], v[1], v[2], best, &th, &u, &vv)) {
             best = th;

@@ -67,10 +67,13 @@ TEST(EditorDefects, PropertiesFollowADragInTheViewport) {
   QTest::mouseRelease(v, Qt::LeftButton, Qt::NoModifier, on + QPoint(40, 0));
   const double moved = w->scene().object(cup)->transform.transformPoint(Vec3{0.0f}).x;
   ASSERT_GT(std::abs(moved - before), 0.05) << "the drag moved the cup";
-  ASSERT_TRUE(QTest::qWaitFor([&] {
-    auto* field = w->findChild<ScrubField*>("position0");
-    return field && std::abs(field->value() - moved) < 1e-3;
-  }, 2000)) << "the X field shows the new position";
+  ASSERT_TRUE(QTest::qWaitFor(
+      [&] {
+        auto* field = w->findChild<ScrubField*>("position0");
+        return field && std::abs(field->value() - moved) < 1e-3;
+      },
+      2000))
+      << "the X field shows the new position";
 }
 
 // 2. After scrubbing a field, Ctrl+Z and the A/B keys went to the field, not the window.

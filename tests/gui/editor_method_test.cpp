@@ -93,17 +93,18 @@ TEST(EditorMethod, AMaterialEditServesTheMaterialsObjectsByTheirClasses) {
   Material rougher = before;
   rougher.roughness = 0.4f;
   w->edit(SetMaterial{before}, SetMaterial{rougher}, "roughness");
-  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) {
-    return f.documentVersion == w->documentVersion() && f.mode == "incremental" && f.queueLength > 0;
-  }));
+  ASSERT_TRUE(waitForFrame(
+      *w, [&](const FrameRecord& f) { return f.documentVersion == w->documentVersion() && f.mode == "incremental" && f.queueLength > 0; }));
   const FrameRecord pass = *w->viewport()->frame();
   EXPECT_FALSE(pass.tileClass.empty()) << "the classes stay shown during the pass";
   // The tiles served first: every tile of both objects comes before any tile of neither.
   auto rank = [&](std::size_t t) { return pass.tilePriority[t] < 0 ? 1e9f : 1.0f - pass.tilePriority[t]; };
   float lastObject = 0, firstOther = 1e9f;
   for (std::size_t t = 0; t < pass.tilePriority.size(); ++t) {
-    if (ofSphere[t] || ofTwin[t]) lastObject = std::max(lastObject, rank(t));
-    else if (pass.tileClass[t] == 3) firstOther = std::min(firstOther, rank(t));
+    if (ofSphere[t] || ofTwin[t])
+      lastObject = std::max(lastObject, rank(t));
+    else if (pass.tileClass[t] == 3)
+      firstOther = std::min(firstOther, rank(t));
   }
   EXPECT_LT(lastObject, firstOther) << "both objects' tiles lead the queue";
 }
@@ -125,14 +126,17 @@ TEST(EditorMethod, AtTheDefaultsTheDenoisedRegionGrowsNestedAndLabelled) {
   w->edit(SetObject{o}, SetObject{moved}, "move");
   std::size_t most = 0;
   std::vector<DenoisedRegion> stack;
-  ASSERT_TRUE(QTest::qWaitFor([&] {
-    auto f = w->viewport()->frame();
-    if (f && f->mode == "incremental" && f->denoised.size() > most) {
-      most = f->denoised.size();
-      stack = f->denoised;
-    }
-    return most >= 3;
-  }, 120000)) << "the region grew " << most << " times";
+  ASSERT_TRUE(QTest::qWaitFor(
+      [&] {
+        auto f = w->viewport()->frame();
+        if (f && f->mode == "incremental" && f->denoised.size() > most) {
+          most = f->denoised.size();
+          stack = f->denoised;
+        }
+        return most >= 3;
+      },
+      120000))
+      << "the region grew " << most << " times";
   for (std::size_t i = 1; i < stack.size(); ++i) {
     const RegionRect &in = stack[i - 1].rect, &out = stack[i].rect;
     EXPECT_TRUE(in.x >= out.x && in.y >= out.y && in.x + in.width <= out.x + out.width && in.y + in.height <= out.y + out.height)
@@ -179,8 +183,7 @@ TEST(EditorMethod, TheLegendNamesEveryMarkInItsOwnColourAndCoversNothing) {
   const QImage pic = v->composed();
   const QPointF at = v->widgetPoint(QPointF(10, 10)) + QPointF(9, 0);  // on its ring
   bool ringFound = false;
-  for (int dx = -2; dx <= 2 && !ringFound; ++dx)
-    ringFound = pic.pixelColor(at.toPoint() + QPoint(dx, 0)) == FrameView::kFocusColor;
+  for (int dx = -2; dx <= 2 && !ringFound; ++dx) ringFound = pic.pixelColor(at.toPoint() + QPoint(dx, 0)) == FrameView::kFocusColor;
   EXPECT_TRUE(ringFound);
   // Nothing is cut off, and the legend lies beside the image, not over it.
   const QRectF strip = v->legendRect();
@@ -377,7 +380,8 @@ TEST(EditorMethod, TurningAndScalingKeepThePositionAndTheToolIsShown) {
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
   auto position = [&] {
     Vec3 p;
-    for (int a = 0; a < 3; ++a) (a == 0 ? p.x : a == 1 ? p.y : p.z) = static_cast<float>(w->findChild<ScrubField*>(QString("position%1").arg(a))->value());
+    for (int a = 0; a < 3; ++a)
+      (a == 0 ? p.x : a == 1 ? p.y : p.z) = static_cast<float>(w->findChild<ScrubField*>(QString("position%1").arg(a))->value());
     return p;
   };
   const Vec3 before = position();
@@ -438,8 +442,7 @@ TEST(EditorMethod, OpenedFilesAreRecentWarningsAreSeenAndPanelsComeBack) {
   auto* logDock = w->findChild<QDockWidget*>("log");
   w->findChild<QDockWidget*>("nodeGraphDock")->raise();
   w->opened(file, {"texture 'Gone': /nonexistent/gone.png is missing"});  // as the command line reports it
-  EXPECT_TRUE(QSettings().value("recentFiles").toStringList().contains(
-      QString::fromStdString(std::filesystem::absolute(file).string())));
+  EXPECT_TRUE(QSettings().value("recentFiles").toStringList().contains(QString::fromStdString(std::filesystem::absolute(file).string())));
   EXPECT_TRUE(w->viewport()->notice().contains("warning")) << w->viewport()->notice().toStdString();
   EXPECT_TRUE(w->statusBar()->currentMessage().contains("warning"));
   EXPECT_FALSE(logDock->visibleRegion().isEmpty()) << "the Log is raised";

@@ -43,7 +43,6 @@ using test::objectNamed;
 using test::pointShowing;
 using test::waitForFrame;
 
-
 TEST(Editor, EditFromThePropertiesReRendersAroundTheObjectAndUndoes) {
   auto w = makeWindow();
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; })) << "frames reach the viewport";
@@ -397,7 +396,6 @@ TEST(Editor, AutosaveRotatesAndACleanCloseLeavesNothingToRecover) {
   w->close();
   EXPECT_TRUE(MainWindow::recoveryCandidates().isEmpty());
 }
-
 
 TEST(Editor, AMaterialTakesABumpMapAndItsStrengthFromItsPanel) {
   auto w = makeWindow();
@@ -1018,12 +1016,10 @@ TEST(Editor, TheLiveChartPlotsThroughputAndErrorAgainstAReference) {
   ASSERT_TRUE(button);
   button->click();
   ASSERT_TRUE(QTest::qWaitFor([&] { return chart->hasReference(); }, 120000)) << "the reference renders in the background";
-  ASSERT_TRUE(QTest::qWaitFor([&] { return chart->errorPoints() >= 2; }, 60000))
-      << chart->findChild<QLabel*>()->text().toStdString();
+  ASSERT_TRUE(QTest::qWaitFor([&] { return chart->errorPoints() >= 2; }, 60000)) << chart->findChild<QLabel*>()->text().toStdString();
   EXPECT_GT(chart->lastError(), 0.0);
   EXPECT_LT(chart->lastError(), 0.3) << "the viewport shows the same scene as the reference";
 }
-
 
 TEST(Editor, LinkingADifferentMaterialInTheNodeGraphChangesTheObjectsMaterial) {
   auto w = makeWindow();
@@ -1047,7 +1043,6 @@ TEST(Editor, LinkingADifferentMaterialInTheNodeGraphChangesTheObjectsMaterial) {
   EXPECT_EQ(w->scene().object(sphere)->material, before) << "one undo step restores the assignment";
 }
 
-
 TEST(Editor, TheMoveGizmoDragsAlongOneAxisAndEAndRTurnAndScale) {
   auto w = makeWindow();
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
@@ -1061,7 +1056,8 @@ TEST(Editor, TheMoveGizmoDragsAlongOneAxisAndEAndRTurnAndScale) {
   auto frame = v->frame();
   const QRectF r = v->imageRect();
   auto widget = [&](QPointF px) {
-    return QPoint(static_cast<int>(r.x() + px.x() * r.width() / frame->width), static_cast<int>(r.y() + px.y() * r.height() / frame->height));
+    return QPoint(static_cast<int>(r.x() + px.x() * r.width() / frame->width),
+                  static_cast<int>(r.y() + px.y() * r.height() / frame->height));
   };
   // The gizmo is placed from the camera: project the x arrow the same way and drag along it.
   const Mat4 start = w->scene().object(sphere)->transform;
@@ -1113,7 +1109,6 @@ TEST(Editor, TheMoveGizmoDragsAlongOneAxisAndEAndRTurnAndScale) {
   EXPECT_TRUE(w->scene().object(sphere)->transform == q0);
 }
 
-
 // The acceptance walk-through as a new user would do it: open the living room, click the table,
 // raise its glossiness, drag a glass vase, switch on an overlay. Each step must reach the render
 // thread while the window keeps handling events; the longest event-loop stall is printed, not
@@ -1126,11 +1121,10 @@ TEST(Editor, LivingRoomWalkThrough) {
   qint64 longest = 0;
   beat.start();
   QTimer heartbeat;
-  QObject::connect(&heartbeat, &QTimer::timeout, [&] {
-    longest = std::max(longest, beat.restart());
-  });
+  QObject::connect(&heartbeat, &QTimer::timeout, [&] { longest = std::max(longest, beat.restart()); });
   heartbeat.start(10);
-  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 3; }, 120000));
+  ASSERT_TRUE(waitForFrame(
+      *w, [](const FrameRecord& f) { return f.frame >= 3; }, 120000));
   FrameView* v = w->viewport();
   const Scene& s = w->scene();
   // The object of a material with the most pixels on screen.
@@ -1176,8 +1170,9 @@ TEST(Editor, LivingRoomWalkThrough) {
         for (int x = 0; x < f->width; ++x)
           if (strict ? interior(x, y) : idAt(x, y) == object) {
             double d = (x - cx) * (x - cx) + (y - cy) * (y - cy);
-            if (d < bestD) bestD = d, at = QPoint(static_cast<int>(r.x() + (x + 0.5) * r.width() / f->width),
-                                                   static_cast<int>(r.y() + (y + 0.5) * r.height() / f->height));
+            if (d < bestD)
+              bestD = d, at = QPoint(static_cast<int>(r.x() + (x + 0.5) * r.width() / f->width),
+                                     static_cast<int>(r.y() + (y + 0.5) * r.height() / f->height));
           }
       if (bestD < 1e30) break;  // a thin object may have no interior pixel at this size
     }
@@ -1194,7 +1189,8 @@ TEST(Editor, LivingRoomWalkThrough) {
   rough->setValue(0.01);
   EXPECT_NEAR(s.material(wood)->roughness, 0.01f, 1e-6f);
   std::uint64_t version = w->documentVersion();
-  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version && !f.servedTiles.empty(); }, 60000));
+  ASSERT_TRUE(waitForFrame(
+      *w, [&](const FrameRecord& f) { return f.documentVersion == version && !f.servedTiles.empty(); }, 60000));
 
   // The table's wood is a file texture: its path is editable; a missing file is a substitute,
   // not a failure.
@@ -1206,7 +1202,9 @@ TEST(Editor, LivingRoomWalkThrough) {
   const NodeId woodTexture = s.material(wood)->albedoTexture;
   EXPECT_EQ(s.texture(woodTexture)->path.string(), "textures/no-such-wood.png");
   version = w->documentVersion();
-  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; }, 60000)) << "frames keep coming";
+  ASSERT_TRUE(waitForFrame(
+      *w, [&](const FrameRecord& f) { return f.documentVersion == version; }, 60000))
+      << "frames keep coming";
   w->undoStack()->undo();
   EXPECT_TRUE(s.texture(woodTexture)->path.string().find("wood5") != std::string::npos);
 
@@ -1223,18 +1221,20 @@ TEST(Editor, LivingRoomWalkThrough) {
   QTest::mouseRelease(v, Qt::LeftButton, Qt::NoModifier, at + QPoint(20, 0));
   EXPECT_GT(length(s.object(vase)->transform.transformPoint(Vec3{0.0f}) - before), 1e-3f) << "the vase moved";
   version = w->documentVersion();
-  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version && f.mode == "incremental"; }, 60000));
+  ASSERT_TRUE(waitForFrame(
+      *w, [&](const FrameRecord& f) { return f.documentVersion == version && f.mode == "incremental"; }, 60000));
 
   OverlaySettings o = v->overlays();
   o.priority = true;
   o.order = true;
   v->setOverlays(o);
   const std::uint64_t shown = v->frame()->frame;
-  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.frame > shown + 2; }, 60000)) << "frames keep coming";
+  ASSERT_TRUE(waitForFrame(
+      *w, [&](const FrameRecord& f) { return f.frame > shown + 2; }, 60000))
+      << "frames keep coming";
   std::printf("living room walk-through: longest event-loop stall %lld ms\n", static_cast<long long>(longest));
   RecordProperty("longest_stall_ms", static_cast<int>(longest));
 }
-
 
 TEST(Editor, ShiftDragDrawsARenderRegionAndShiftClickPlacesAFocusPoint) {
   auto w = makeWindow();
@@ -1265,7 +1265,6 @@ TEST(Editor, ShiftDragDrawsARenderRegionAndShiftClickPlacesAFocusPoint) {
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& fr) { return fr.focus.size() == 1; }));
   EXPECT_NEAR(v->frame()->focus[0].x, 0.1 * f->width, 2.0);
 }
-
 
 TEST(Editor, TheIndirectionClassesOverlayShowsTheClassesOfTheSelectedObject) {
   auto w = makeWindow();

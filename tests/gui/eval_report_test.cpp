@@ -79,11 +79,9 @@ ChartPoint point(const QString& method, double ms, double psnr, bool reached = t
 // `retile eval --quick`'s drag scenario on the built-in scene (2026-12): five methods within
 // 80 ms and 0.1 dB of each other, two of them the same point, four never reaching the target.
 std::vector<ChartPoint> dragTradeoff() {
-  return {point("global", 960, 15.44, false),     point("spiral", 1070, 23.20),
-          point("focus", 990, 23.19, false),      point("indirection", 990, 18.40, false),
-          point("change", 1070, 23.20),           point("spiral+smooth", 994, 23.20),
-          point("global+denoise", 903, 20.68),    point("spiral+denoise", 900, 26.94),
-          point("spiral+reuse", 1050, 23.27, false)};
+  return {point("global", 960, 15.44, false),      point("spiral", 1070, 23.20),        point("focus", 990, 23.19, false),
+          point("indirection", 990, 18.40, false), point("change", 1070, 23.20),        point("spiral+smooth", 994, 23.20),
+          point("global+denoise", 903, 20.68),     point("spiral+denoise", 900, 26.94), point("spiral+reuse", 1050, 23.27, false)};
 }
 
 // The labels of "spiral, focus, spiral+reuse" were drawn over those of "change, spiral+smooth".
@@ -101,8 +99,7 @@ TEST(EvalReport, LabelsOfNearbyPointsDoNotOverlapEachOtherOrThePoints) {
     boxes.push_back(t->sceneBoundingRect());
     named += t->text().split(QRegularExpression(", |\n"));  // names that share a label
   }
-  for (const ChartPoint& p : points)
-    EXPECT_TRUE(named.contains(p.label)) << p.label.toStdString() << " is labelled on the plot";
+  for (const ChartPoint& p : points) EXPECT_TRUE(named.contains(p.label)) << p.label.toStdString() << " is labelled on the plot";
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     for (std::size_t j = i + 1; j < boxes.size(); ++j) EXPECT_FALSE(boxes[i].intersects(boxes[j])) << i << " and " << j;
     for (const QRectF& m : markers) EXPECT_FALSE(boxes[i].intersects(m)) << "label " << i << " covers a point";
@@ -114,8 +111,8 @@ TEST(EvalReport, PlacedLabelsAroundAClusterStayApartAndWithinBounds) {
   const QRectF bounds(0, 0, 600, 400);
   std::vector<LabelRequest> labels;
   std::vector<QRectF> markers;
-  for (QPointF at : {QPointF(300, 200), QPointF(302, 201), QPointF(305, 199), QPointF(310, 200), QPointF(296, 203),
-                     QPointF(300, 215), QPointF(590, 5)}) {
+  for (QPointF at : {QPointF(300, 200), QPointF(302, 201), QPointF(305, 199), QPointF(310, 200), QPointF(296, 203), QPointF(300, 215),
+                     QPointF(590, 5)}) {
     labels.push_back({at, QSizeF(90, 16), bounds});
     markers.push_back(QRectF(at - QPointF(5, 5), QSizeF(10, 10)));
   }
@@ -132,8 +129,8 @@ TEST(EvalReport, PlacedLabelsAroundAClusterStayApartAndWithinBounds) {
 // Never-reached methods were drawn at the run's length, on the time axis, as hollow squares that
 // all looked alike: read as a time measured.
 TEST(EvalReport, ANotReachedPointLiesBeyondTheTimesAndSaysNotReached) {
-  auto view = pointChartView("t", "time (ms)", "PSNR (dB)",
-                             {point("fast", 100, 20), point("slow", 200, 22), point("never", 250, 18, false)});
+  auto view =
+      pointChartView("t", "time (ms)", "PSNR (dB)", {point("fast", 100, 20), point("slow", 200, 22), point("never", 250, 18, false)});
   QChart* chart = view->chart();
   QScatterSeries* never = seriesNamed(chart, "never");
   QScatterSeries* slow = seriesNamed(chart, "slow");
@@ -158,8 +155,8 @@ TEST(EvalReport, ANotReachedPointLiesBeyondTheTimesAndSaysNotReached) {
 
 // The PSNR-against-time charts labelled one tick ("1000") on their log time axis.
 TEST(EvalReport, ALogTimeAxisLabelsSeveralTicksAcrossTheData) {
-  for (auto [lo, hi] : {std::pair{30.0, 3000.0}, std::pair{300.0, 1300.0}, std::pair{660.0, 1700.0},
-                        std::pair{900.0, 1100.0}, std::pair{0.5, 2e5}}) {
+  for (auto [lo, hi] :
+       {std::pair{30.0, 3000.0}, std::pair{300.0, 1300.0}, std::pair{660.0, 1700.0}, std::pair{900.0, 1100.0}, std::pair{0.5, 2e5}}) {
     SCOPED_TRACE(testing::Message() << lo << " to " << hi << " ms");
     ChartLine line{"spiral", {}};
     for (int i = 0; i <= 20; ++i) line.points.emplace_back(lo * std::pow(hi / lo, i / 20.0), 20 + i * 0.5);

@@ -37,11 +37,9 @@ std::string describe(const Scene& s) {
     return nodes;
   };
   for (const Material& m : sorted(s.materials))
-    out << "M" << m.id << " " << m.name << " " << static_cast<int>(m.type) << " " << m.albedo.x << " " << m.roughness
-        << " " << m.albedoTexture << " " << m.roughnessTexture << " " << m.alphaTexture << " " << m.bumpTexture << " "
-        << m.blendWith << "\n";
-  for (const Object& o : sorted(s.objects))
-    out << "O" << o.id << " " << o.name << " " << o.mesh << " " << o.material << "\n";
+    out << "M" << m.id << " " << m.name << " " << static_cast<int>(m.type) << " " << m.albedo.x << " " << m.roughness << " "
+        << m.albedoTexture << " " << m.roughnessTexture << " " << m.alphaTexture << " " << m.bumpTexture << " " << m.blendWith << "\n";
+  for (const Object& o : sorted(s.objects)) out << "O" << o.id << " " << o.name << " " << o.mesh << " " << o.material << "\n";
   for (const Texture& t : sorted(s.textures)) out << "T" << t.id << " " << t.name << "\n";
   for (const Light& l : sorted(s.lights)) out << "L" << l.id << " " << l.name << "\n";
   out << "E" << static_cast<int>(s.environment.type) << " " << s.environment.map << "\n";
@@ -496,8 +494,7 @@ TEST_F(NodeGraph, RenameEditorKeepsItsKeysFromTheGraphAndTheWindow) {
 
 TEST_F(NodeGraph, AnOwnerEchoingTheObjectSelectionKeepsAMultiSelection) {
   // The main window answers objectSelected with setSelectedObject, as for the outliner and viewport.
-  QObject::connect(&view, &NodeGraphView::objectSelected, &view,
-                   [this](quint64 id) { view.setSelectedObject(static_cast<NodeId>(id)); });
+  QObject::connect(&view, &NodeGraphView::objectSelected, &view, [this](quint64 id) { view.setSelectedObject(static_cast<NodeId>(id)); });
   const NodeId lacquer = named(scene().materials, "Red Lacquer");
   const NodeId sphere = named(scene().objects, "Glossy Sphere");
   const NodeId cup = named(scene().objects, "Cup");
@@ -578,7 +575,8 @@ TEST_F(NodeGraph, GesturesBeforeTheOwnersQueuedRefreshBuildOnEachOther) {
       EXPECT_TRUE(r.ok()) << e.text.toStdString() << ": " << (r.ok() ? std::string() : r.error());
     }
     edits.push_back(e);
-    QMetaObject::invokeMethod(&view, [this] { view.setDocument(doc.scene()); }, Qt::QueuedConnection);
+    QMetaObject::invokeMethod(
+        &view, [this] { view.setDocument(doc.scene()); }, Qt::QueuedConnection);
   });
   const std::size_t materials = scene().materials.size();
   ASSERT_TRUE(view.createNode("Material", {0, 0}));
@@ -759,17 +757,15 @@ class NodeGraphArtist : public ::testing::Test {
         const QRectF box = n->mapRectToScene(QRectF(0, 0, 190, n->boundingRect().height() - 4));
         const QRectF near = box.adjusted(-8, -8, 8, 8);
         if (near.contains(ends[0]) || near.contains(ends[1])) continue;  // a node the link joins
-        EXPECT_FALSE(stroke.intersects(box)) << where << ": a link from " << ends[0].x() << ", " << ends[0].y()
-                                             << " to " << ends[1].x() << ", " << ends[1].y() << " crosses the node at "
-                                             << box.x() << ", " << box.y();
+        EXPECT_FALSE(stroke.intersects(box)) << where << ": a link from " << ends[0].x() << ", " << ends[0].y() << " to " << ends[1].x()
+                                             << ", " << ends[1].y() << " crosses the node at " << box.x() << ", " << box.y();
       }
     }
     EXPECT_GT(links, 0) << where;
   }
   // With RETILE_GRAPH_SHOTS=DIR, what the graph shows is saved there for a person to look at.
   void shoot(const char* name) {
-    if (const char* dir = std::getenv("RETILE_GRAPH_SHOTS"))
-      view->grab().save(QString::fromLocal8Bit(dir) + "/" + name + ".png");
+    if (const char* dir = std::getenv("RETILE_GRAPH_SHOTS")) view->grab().save(QString::fromLocal8Bit(dir) + "/" + name + ".png");
   }
 
   QWidget window;
@@ -869,9 +865,7 @@ TEST_F(NodeGraphArtist, LinksAreDrawnAboveNodesAndEndAtTheirSockets) {
   auto drawn = [&](NodeId from, const QString& output, NodeId to, const QString& input) {
     const QPointF a = view->socketScenePos(from, output, true), b = view->socketScenePos(to, input, false);
     for (const QGraphicsPathItem* p : links)
-      if (QLineF(p->path().pointAtPercent(0), a).length() < 0.5 &&
-          QLineF(p->path().pointAtPercent(1), b).length() < 0.5)
-        return p;
+      if (QLineF(p->path().pointAtPercent(0), a).length() < 0.5 && QLineF(p->path().pointAtPercent(1), b).length() < 0.5) return p;
     return static_cast<const QGraphicsPathItem*>(nullptr);
   };
   int checked = 0;
@@ -906,9 +900,8 @@ TEST_F(NodeGraphArtist, TheNodeSearchStaysInsideTheWindow) {
     ASSERT_TRUE(search && search->isVisible());
     QWidget* popup = search->window();
     const QRect spans = popup->frameGeometry();
-    EXPECT_TRUE(inside.contains(spans)) << "opened at " << corner.x() << ", " << corner.y() << ": the list spans "
-                                        << spans.x() << ", " << spans.y() << " to " << spans.right() << ", "
-                                        << spans.bottom();
+    EXPECT_TRUE(inside.contains(spans)) << "opened at " << corner.x() << ", " << corner.y() << ": the list spans " << spans.x() << ", "
+                                        << spans.y() << " to " << spans.right() << ", " << spans.bottom();
     auto* list = view->findChild<QListWidget*>("nodeSearchList");
     ASSERT_TRUE(list);
     int rows = 0;

@@ -106,15 +106,14 @@ TEST(VulkanViewport, AFailedPresentationFallsBackToTheWidget) {
   EXPECT_TRUE(w->viewport()->presentation().startsWith("widget (the Vulkan device was lost"))
       << w->viewport()->presentation().toStdString();
   const std::uint64_t before = w->engine()->framesRendered();
-  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord&) { return w->engine()->framesRendered() > before + 2; }))
-      << "rendering goes on";
+  ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord&) { return w->engine()->framesRendered() > before + 2; })) << "rendering goes on";
   w->engine()->submit(PauseCommand{true});
   QTest::qWait(500);
   QApplication::processEvents();
   FrameView* view = w->viewport();
   const QPoint at = view->mapTo(w.get(), QPoint(0, 0));
-  const QImage shown = w->screen()->grabWindow(w->winId(), at.x(), at.y(), view->width(), view->height())
-                           .toImage().convertToFormat(QImage::Format_RGB32);
+  const QImage shown =
+      w->screen()->grabWindow(w->winId(), at.x(), at.y(), view->width(), view->height()).toImage().convertToFormat(QImage::Format_RGB32);
   const QImage expected = view->composed().convertToFormat(QImage::Format_RGB32);
   ASSERT_EQ(shown.size(), expected.size());
   double diff = 0;

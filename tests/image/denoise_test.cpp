@@ -90,8 +90,10 @@ TEST(Denoise, RemovesMostNoiseAtFourSamplesAndNothingOnceConverged) {
       for (float v : den.display) ASSERT_TRUE(std::isfinite(v));
       double eRaw = clampedRmse(den.color, ref.color), eDen = clampedRmse(den.display, ref.color);
       std::printf("%s at %d spp: raw %.5f, denoised %.5f (%.2f)\n", c.name, spp, eRaw, eDen, eDen / eRaw);
-      if (spp == 4) EXPECT_LE(eDen, c.atFour * eRaw);
-      else EXPECT_LE(eDen, 1.1 * eRaw) << "no lasting blur";
+      if (spp == 4)
+        EXPECT_LE(eDen, c.atFour * eRaw);
+      else
+        EXPECT_LE(eDen, 1.1 * eRaw) << "no lasting blur";
     }
   }
 }
@@ -132,7 +134,8 @@ std::vector<std::size_t> strongestEdges(const RenderImage& ref, NodeId object) {
     for (int x = 1; x + 1 < ref.width; ++x) {
       auto i = static_cast<std::size_t>(y * ref.width + x);
       bool inside = true;
-      for (int d : {0, -1, 1, -ref.width, ref.width}) inside = inside && ref.objectId[static_cast<std::size_t>(static_cast<int>(i) + d)] == object;
+      for (int d : {0, -1, 1, -ref.width, ref.width})
+        inside = inside && ref.objectId[static_cast<std::size_t>(static_cast<int>(i) + d)] == object;
       if (inside) c.push_back({edgeContrast(ref.color, ref.width, {i}), i});
     }
   std::sort(c.begin(), c.end(), std::greater<>());

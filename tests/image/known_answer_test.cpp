@@ -163,8 +163,8 @@ TEST(KnownAnswer, AThinSheetAbsorbsWithoutAPlasticInTheScene) {
   s.settings.maxBounces = 1;
   s.environment.color = Vec3{1.0f};
   const Material sheet = thinSheet(Vec3{0.5f, 1.0f, 2.0f});
-  const NodeId quad = test::addMeshObject(s, "sheet", makeQuad(), test::addMaterial(s, sheet),
-                                          Mat4::translate({0, 0, -4}) * Mat4::rotateX(kPi / 2));
+  const NodeId quad =
+      test::addMeshObject(s, "sheet", makeQuad(), test::addMaterial(s, sheet), Mat4::translate({0, 0, -4}) * Mat4::rotateX(kPi / 2));
   const RenderImage img = renderScene(*r, s, 16);
   const double rf = 0.04, passes = 1 - 2 * rf / (1 + rf);
   for (int c = 0; c < 3; ++c) {
@@ -198,8 +198,8 @@ TEST(KnownAnswer, AThinSheetsThicknessTextureScalesItsAbsorptionAndFilm) {
     s.textures.push_back(t);
     Material sheet = thinSheet(Vec3{0.5f, 1.0f, 2.0f});
     sheet.roughnessTexture = t.id;
-    const NodeId quad = test::addMeshObject(s, "sheet", makeQuad(), test::addMaterial(s, sheet),
-                                            Mat4::translate({0, 0, -4}) * Mat4::rotateX(kPi / 2));
+    const NodeId quad =
+        test::addMeshObject(s, "sheet", makeQuad(), test::addMaterial(s, sheet), Mat4::translate({0, 0, -4}) * Mat4::rotateX(kPi / 2));
     const RenderImage img = renderScene(*r, s, 16);
     const double rf = 0.04, passes = 1 - 2 * rf / (1 + rf);
     for (int c = 0; c < 3; ++c) {
@@ -364,7 +364,8 @@ TEST(KnownAnswer, ALampInsideGlassShinesThroughAsItsConventionSays) {
     Material lamp = grey(0.0f);
     lamp.emission = Vec3{1.0f};
     // Facing the camera, halfway through the slab.
-    test::addMeshObject(s, "lamp", makeQuad(), test::addMaterial(s, lamp), Mat4::translate({0, 0, -5}) * Mat4::rotateX(kPi / 2) * Mat4::scale({8, 1, 8}));
+    test::addMeshObject(s, "lamp", makeQuad(), test::addMaterial(s, lamp),
+                        Mat4::translate({0, 0, -5}) * Mat4::rotateX(kPi / 2) * Mat4::scale({8, 1, 8}));
     RenderImage img = renderScene(*r, s, 64);
     double sum = 0;
     for (int y = 14; y < 18; ++y)
@@ -479,7 +480,8 @@ double overAFloorExpected(double sigmaT, double sigmaS, double g, double lightY,
   for (int i = 1; i < steps; ++i) sum += (i % 2 ? 4 : 2) * scattered(depth * i / steps);
   *single = above * sum * depth / steps / 3;
   const double up = lightY - 0.01, toLight = std::sqrt(0.25 + up * up);
-  return *single + above * std::exp(-sigmaT * depth) * albedo / kPi * intensity * (up / toLight) / (toLight * toLight) * dimmed(0.01, toLight);
+  return *single +
+         above * std::exp(-sigmaT * depth) * albedo / kPi * intensity * (up / toLight) / (toLight * toLight) * dimmed(0.01, toLight);
 }
 
 // mediumOverAFloor in the holder's medium (kOverAFloorAbsorption and kOverAFloorScattering in the
@@ -492,8 +494,8 @@ void expectOverAFloor(Renderer& r, const Material& holder, float lightY, float i
   RenderImage img = renderScene(r, s, 256);
   for (int c = 0; c < 3; ++c) {
     double single = 0;
-    const double expected = overAFloorExpected(sigmaA[c] + sigmaS[c], sigmaS[c], holder.interiorAnisotropy, lightY, intensity,
-                                               albedo, &single, everywhere ? 5 : 2, world);
+    const double expected = overAFloorExpected(sigmaA[c] + sigmaS[c], sigmaS[c], holder.interiorAnisotropy, lightY, intensity, albedo,
+                                               &single, everywhere ? 5 : 2, world);
     double mean = 0;
     for (int i = 0; i < 16 * 16; ++i) mean += img.color[3 * i + c] / 256.0;
     EXPECT_NEAR(mean, expected, 0.02 * expected) << "channel " << c << ": single scattering " << single;
@@ -573,7 +575,8 @@ TEST(KnownAnswer, ACameraInsideFogSeesThroughItsWayOut) {
   Scene s = test::emptyScene(32, 32);
   s.camera = test::frontCamera(10);
   s.environment.color = Vec3{1.0f};
-  test::addMeshObject(s, "fog", makeCube(), test::addMaterial(s, boundaryOf(Vec3{sigma[0], sigma[1], sigma[2]})), Mat4::scale({10, 10, 10}));
+  test::addMeshObject(s, "fog", makeCube(), test::addMaterial(s, boundaryOf(Vec3{sigma[0], sigma[1], sigma[2]})),
+                      Mat4::scale({10, 10, 10}));
   for (float z : {0.0f, 6.0f}) {
     s.camera.position.z = z;
     s.camera.target.z = z - 1;
@@ -615,7 +618,8 @@ TEST(KnownAnswer, AShadowRayCountsEveryBoundaryItCrosses) {
   NodeId plane = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, grey(0.5f)), Mat4::scale({4, 1, 4}));
   const NodeId fog = test::addMaterial(s, boundaryOf(sigma));
   for (int i = 0; i < 5; ++i)
-    test::addMeshObject(s, "slab", makeCube(), fog, Mat4::translate({0, 2.5f + 2.0f * static_cast<float>(i), 0}) * Mat4::scale({40, 1, 40}));
+    test::addMeshObject(s, "slab", makeCube(), fog,
+                        Mat4::translate({0, 2.5f + 2.0f * static_cast<float>(i), 0}) * Mat4::scale({40, 1, 40}));
   addSun(s, 2.0f);
   for (Renderer* r : {direct.get(), records.get()}) {
     RenderImage img = renderScene(*r, s, 4);
@@ -655,7 +659,8 @@ TEST(KnownAnswer, TheWorldsMediumDimsWhatTheCameraSeesAndHidesTheSky) {
   test::addMeshObject(s, "light", makeCube(), test::addMaterial(s, light), Mat4::translate({0, 0, -10.5f}) * Mat4::scale({40, 40, 1}));
   auto beer = [](Vec3 depth) { return Vec3{std::exp(-depth.x), std::exp(-depth.y), std::exp(-depth.z)}; };
   expectCentre(beer(sigma * 10.0f), "a wall ten units ahead");
-  test::addMeshObject(s, "glass", makeCube(), test::addMaterial(s, filledGlass(Vec3{0.0f})), Mat4::translate({0, 0, -5}) * Mat4::scale({40, 40, 1}));
+  test::addMeshObject(s, "glass", makeCube(), test::addMaterial(s, filledGlass(Vec3{0.0f})),
+                      Mat4::translate({0, 0, -5}) * Mat4::scale({40, 40, 1}));
   expectCentre(beer(sigma * 9.0f), "through empty glass");
   test::addMeshObject(s, "fog", makeCube(), test::addMaterial(s, boundaryOf(fog)), Mat4::scale({4, 4, 4}));
   expectCentre(beer(fog * 2.0f + sigma * 7.0f), "from inside a fog box");
@@ -762,8 +767,10 @@ TEST(KnownAnswer, MinBouncesLeaveOutTheLightOfShorterPaths) {
       RenderImage img = renderScene(*r, s, 1024);
       double expected = minBounces > bounces ? 0.0 : le * (std::pow(rho, minBounces) - std::pow(rho, bounces + 1)) / (1 - rho);
       double mean = test::meanLuminance(img, 0, 0, 16, 16);
-      if (expected == 0) EXPECT_EQ(mean, 0.0);
-      else EXPECT_NEAR(mean, expected, expected * 0.015) << "expected " << expected;
+      if (expected == 0)
+        EXPECT_EQ(mean, 0.0);
+      else
+        EXPECT_NEAR(mean, expected, expected * 0.015) << "expected " << expected;
     }
   }
 }
@@ -854,8 +861,10 @@ TEST(KnownAnswer, TungstensRaysSkipWhatLiesWithinItsEpsilon) {
     const double mean = meanOver(img, floor, &n);
     ASSERT_EQ(n, 16 * 16) << "the camera sees the floor alone";
     // Robust: only the rare ray that grazes out past the lid's edge, 5 units away.
-    if (offset == RayOffset::Robust) EXPECT_LT(mean, 1e-6) << "no light gets under the lid";
-    else EXPECT_NEAR(mean, 0.6, 0.01);
+    if (offset == RayOffset::Robust)
+      EXPECT_LT(mean, 1e-6) << "no light gets under the lid";
+    else
+      EXPECT_NEAR(mean, 0.6, 0.01);
   }
 }
 
@@ -893,7 +902,8 @@ TEST(KnownAnswer, AnObjectHitFromTheFrontOnlyIsPassedFromBehind) {
       {"culled, facing up, from between", up, false, true, true, floor, 0.8},
       {"culled, facing up, from above", up, false, true, false, lid, 0.0},
       {"culled, turned to face down, from above", up * Mat4::rotateX(kPi), false, true, false, floor, 0.0},
-      {"culled, mirrored to face down, from above", Mat4::translate({0, 1, 0}) * Mat4::scale({100, -1, 100}), false, true, false, floor, 0.0},
+      {"culled, mirrored to face down, from above", Mat4::translate({0, 1, 0}) * Mat4::scale({100, -1, 100}), false, true, false, floor,
+       0.0},
       {"culled, mirrored, from between", Mat4::translate({0, 1, 0}) * Mat4::scale({100, -1, 100}), false, true, true, floor, 0.0},
       {"culled, the floor's mesh, from between", up, true, true, true, floor, 0.8},
       {"not culled, the floor's mesh, from between", up, true, false, true, floor, 0.0},
@@ -913,8 +923,10 @@ TEST(KnownAnswer, AnObjectHitFromTheFrontOnlyIsPassedFromBehind) {
     s.camera.target = {2, 0, 1};
     s.camera.up = {0, 0, -1};
     s.camera.verticalFov = radians(20.0f);
-    if (first) r->setScene(s);
-    else r->updateScene(s, kUpdateInstances | kUpdateLights | kUpdateCamera);  // SetObject's, and SetCamera's
+    if (first)
+      r->setScene(s);
+    else
+      r->updateScene(s, kUpdateInstances | kUpdateLights | kUpdateCamera);  // SetObject's, and SetCamera's
     first = false;
     RenderImage img = r->render(req);
     int n;
@@ -957,8 +969,8 @@ TEST(KnownAnswer, ATiltedSkyLightsWhatItsBrightHalfFaces) {
 
   // A small bright patch off to one side, mostly reached by light samples: the plane under the
   // tilted sky is lit as the plane and camera turned the other way are under the upright sky.
-  s.environment.map = addImageTexture(s, dir, "patch sky", 64, 32,
-                                      [](int x, int y) { return y >= 6 && y < 10 && x >= 10 && x < 18 ? 50.0f : 0.05f; });
+  s.environment.map =
+      addImageTexture(s, dir, "patch sky", 64, 32, [](int x, int y) { return y >= 6 && y < 10 && x >= 10 && x < 18 ? 50.0f : 0.05f; });
   const Mat4 tilt = Mat4::rotateZ(0.3f) * Mat4::rotateX(-0.5f), back = tilt.transposed();
   s.environment.orientation = tilt;
   s.environment.rotation = 0;
@@ -1192,7 +1204,8 @@ TEST(KnownAnswer, ABitmapIsReadAtItsNearestTexelOrHeldAtItsEdgesWhenAsked) {
     const RenderImage img = renderScene(*r, s, 64);
     double left = 0, right = 0;
     for (int y = 0; y < img.height; ++y)
-      for (int x = 0; x < img.width; ++x) (x < img.width / 2 ? left : right) += img.color[(static_cast<std::size_t>(y) * img.width + x) * 3 + 1];
+      for (int x = 0; x < img.width; ++x)
+        (x < img.width / 2 ? left : right) += img.color[(static_cast<std::size_t>(y) * img.width + x) * 3 + 1];
     const double half = img.width / 2.0 * img.height;
     return std::pair{left / half, right / half};
   };
@@ -1349,7 +1362,7 @@ TEST(KnownAnswer, PixelFiltersSpreadAnEdgeAsTheyShould) {
 double smallLightOnPlane(Renderer& r, float height, NodeId* planeOut) {
   Scene s = test::emptyScene(16, 16);
   lookStraightDown(s, 0.5f, 2);  // just the spot below the light
-  s.settings.maxBounces = 1;         // direct light only
+  s.settings.maxBounces = 1;     // direct light only
   Material plane;
   plane.albedo = Vec3{1.0f};
   *planeOut = test::addMeshObject(s, "plane", makeQuad(), test::addMaterial(s, plane), Mat4::scale({100, 1, 100}));
@@ -1514,7 +1527,8 @@ TEST(KnownAnswer, AnEmissionConeLightsOnlyWithinIt) {
   lamp.emission = Vec3{4.0f};
   lamp.emissionCone = 30;
   const NodeId lampMaterial = test::addMaterial(s, lamp);
-  NodeId light = test::addMeshObject(s, "light", makeQuad(), lampMaterial, Mat4::translate({0, 1, 0}) * Mat4::rotateX(kPi) * Mat4::scale({0.5f, 1, 0.5f}));
+  NodeId light = test::addMeshObject(s, "light", makeQuad(), lampMaterial,
+                                     Mat4::translate({0, 1, 0}) * Mat4::rotateX(kPi) * Mat4::scale({0.5f, 1, 0.5f}));
   RenderRequest req;
   req.samplesPerPixel = 256;
   req.seed = 3;
@@ -1811,8 +1825,8 @@ TEST(KnownAnswer, EveryMaterialGivesOnlyFiniteSamples) {
       RenderImage img = renderScene(*r, s, spp, 7);
       int dropped = 0;
       for (float c : img.sampleCount) dropped += spp - static_cast<int>(c);
-      EXPECT_EQ(dropped, 0) << materialTypeName(type) << " at roughness " << roughness << " dropped " << dropped
-                            << " of " << img.sampleCount.size() * spp << " samples as non-finite" << (coat ? ", coated" : "");
+      EXPECT_EQ(dropped, 0) << materialTypeName(type) << " at roughness " << roughness << " dropped " << dropped << " of "
+                            << img.sampleCount.size() * spp << " samples as non-finite" << (coat ? ", coated" : "");
       EXPECT_TRUE(test::allFinite(img)) << materialTypeName(type);
     }
   }
@@ -1842,7 +1856,7 @@ TEST(KnownAnswer, ConvergedRenderEqualsMeanOfIndependentRenders) {
     }
     m /= k;
     double var = std::max(0.0, (m2 / k - m * m) * k / (k - 1));  // spread of one N-sample mean
-    double se = std::sqrt(var / k + var / k);  // of (mean of K parts) minus (one K*N render)
+    double se = std::sqrt(var / k + var / k);                    // of (mean of K parts) minus (one K*N render)
     sumDiff += big.color[i] - m;
     sumMean += m;
     if (se <= 1e-6) continue;

@@ -15,7 +15,7 @@
 namespace retile {
 namespace {
 
-const MethodKind kAll[] = {MethodKind::Global, MethodKind::Spiral, MethodKind::Focus,
+const MethodKind kAll[] = {MethodKind::Global,      MethodKind::Spiral,           MethodKind::Focus,
                            MethodKind::Indirection, MethodKind::IndirectionFocus, MethodKind::Change};
 
 // An emissive wall filling the view with an emissive box in front of it: with no bounces every
@@ -42,7 +42,8 @@ WallScene wallScene(int w, int h) {
   boxMat.name = "box";
   boxMat.albedo = Vec3{0.0f};
   boxMat.emission = Vec3{0.5f};
-  ws.box = test::addMeshObject(s, "box", makeCube(), test::addMaterial(s, boxMat), Mat4::translate({-0.8f, 0.3f, -3}) * Mat4::scale(Vec3{0.4f}));
+  ws.box =
+      test::addMeshObject(s, "box", makeCube(), test::addMaterial(s, boxMat), Mat4::translate({-0.8f, 0.3f, -3}) * Mat4::scale(Vec3{0.4f}));
   return ws;
 }
 
@@ -375,8 +376,10 @@ TEST(Reuse, EveryMethodWithReuseConvergesToAFreshRenderAfterEachKindOfEdit) {
     const double noise = maxRelDiff(ref1, ref2);
     const double oldMean = meanGreen(oldImage) / meanGreen(refImage) - 1;
     const bool global = std::string(c.name) == "light 4 % brighter";
-    if (global) ASSERT_GT(std::abs(oldMean), 0.03) << "the light must change the picture by more than the test allows";
-    else ASSERT_GT(maxRelDiff(blocks(oldImage), ref1), 3 * noise + 0.05) << "the edit must be visible";
+    if (global)
+      ASSERT_GT(std::abs(oldMean), 0.03) << "the light must change the picture by more than the test allows";
+    else
+      ASSERT_GT(maxRelDiff(blocks(oldImage), ref1), 3 * noise + 0.05) << "the edit must be visible";
     for (MethodKind kind : {MethodKind::Spiral, MethodKind::Focus, MethodKind::Indirection, MethodKind::Change}) {
       for (bool smooth : {false, true}) {
         if (smooth && kind != MethodKind::Spiral) continue;
@@ -397,12 +400,11 @@ TEST(Reuse, EveryMethodWithReuseConvergesToAFreshRenderAfterEachKindOfEdit) {
         // power grows with their count): here within about 400 spp against 96 of history.
         FrameRecord r = settle(s, global ? 400 : 96);
         ASSERT_FALSE(r.tileReuse.empty());
-        std::printf("%s %s%s+reuse: reused %d rejected %d of %d\n", c.name, methodName(kind), smooth ? "+smooth" : "",
-                    r.reusedTiles, r.rejectedTiles, r.cols * r.rows);
+        std::printf("%s %s%s+reuse: reused %d rejected %d of %d\n", c.name, methodName(kind), smooth ? "+smooth" : "", r.reusedTiles,
+                    r.rejectedTiles, r.cols * r.rows);
         EXPECT_LT(maxRelDiff(blocks(*r.image), ref1), 3 * noise + 0.05) << "noise between two fresh renders: " << noise;
         if (global) {
-          EXPECT_NEAR(meanGreen(*r.image) / meanGreen(refImage), 1.0, 0.01) << "no old light kept: it was "
-                                                                            << 100 * oldMean << " % off";
+          EXPECT_NEAR(meanGreen(*r.image) / meanGreen(refImage), 1.0, 0.01) << "no old light kept: it was " << 100 * oldMean << " % off";
           EXPECT_GT(r.rejectedTiles, r.cols * r.rows / 2) << "the light's change is found in most tiles";
         } else {
           EXPECT_GT(r.reusedTiles, r.cols * r.rows / 3) << "tiles the edit did not change keep their history";

@@ -28,8 +28,8 @@ const StabilityResult& runCase(const std::string& name) {
   auto r = runStabilityCase(name, makeDefaultScene(), o, refs);
   if (!r) throw Error(r.error());
   for (const auto& f : r->figures)
-    std::printf("%-16s %-24s %8.4f <= %8.4f %s %s %s\n", name.c_str(), f.method.c_str(), f.value, f.threshold,
-                f.pass ? "pass" : "FAIL", f.detail.c_str(), f.broken.c_str());
+    std::printf("%-16s %-24s %8.4f <= %8.4f %s %s %s\n", name.c_str(), f.method.c_str(), f.value, f.threshold, f.pass ? "pass" : "FAIL",
+                f.detail.c_str(), f.broken.c_str());
   return results.emplace(name, std::move(r.value())).first->second;
 }
 
@@ -84,12 +84,11 @@ TEST(StabilityGuarantees, EveryMethodConvergesAfterAnEditEveryFrame) {
   for (const auto& f : runCase("burst").figures) EXPECT_LE(f.value, f.threshold) << f.method << " " << f.detail;
 }
 
-INSTANTIATE_TEST_SUITE_P(Cases, Stability, ::testing::ValuesIn(stabilityCaseNames()),
-                         [](const ::testing::TestParamInfo<std::string>& p) {
-                           std::string n = p.param;
-                           for (char& c : n) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-                           return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(Cases, Stability, ::testing::ValuesIn(stabilityCaseNames()), [](const ::testing::TestParamInfo<std::string>& p) {
+  std::string n = p.param;
+  for (char& c : n) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return n;
+});
 
 }  // namespace
 }  // namespace retile::eval

@@ -17,9 +17,9 @@ std::unique_ptr<Renderer> makeRenderer(std::string* whyNot, const RendererOption
 std::unique_ptr<Renderer> makeRecordsRenderer(std::string* whyNot);
 bool requireDevice();  // CI is set: no device is a failure
 
-#define RETILE_RENDERER_OR_SKIP(var)                                                  \
-  std::string var##_why;                                                              \
-  auto var = ::retile::test::makeRenderer(&var##_why);                                \
+#define RETILE_RENDERER_OR_SKIP(var)                                                              \
+  std::string var##_why;                                                                          \
+  auto var = ::retile::test::makeRenderer(&var##_why);                                            \
   if (!var && ::retile::test::requireDevice()) FAIL() << "no Vulkan device in CI: " << var##_why; \
   if (!var) GTEST_SKIP() << "skipped: no Vulkan device: " << var##_why;
 

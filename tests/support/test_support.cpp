@@ -35,7 +35,8 @@ void removeTempRoots() {
   std::lock_guard lock(tempRootsMutex);
   if (::testing::UnitTest::GetInstance()->Failed()) {
     const fs::path kept = fs::temp_directory_path() / ("retile-test-" + std::to_string(::getpid()) + "-*");
-    if (!tempRoots.empty()) std::fprintf(stderr, "retile tests: a test failed, so the files tests wrote stay in %s\n", kept.string().c_str());
+    if (!tempRoots.empty())
+      std::fprintf(stderr, "retile tests: a test failed, so the files tests wrote stay in %s\n", kept.string().c_str());
     return;
   }
   std::error_code ec;
@@ -118,8 +119,7 @@ NodeId addMaterial(Scene& s, Material m) {
   return m.id;
 }
 
-NodeId addMeshObject(Scene& s, const std::string& name, std::shared_ptr<const MeshGeometry> g, NodeId material,
-                     const Mat4& transform) {
+NodeId addMeshObject(Scene& s, const std::string& name, std::shared_ptr<const MeshGeometry> g, NodeId material, const Mat4& transform) {
   Mesh mesh;
   mesh.id = s.newId();
   mesh.name = name;

@@ -25,8 +25,8 @@ std::filesystem::path sharedDir();
 // The path under ../shared, or an empty path when the folder is absent (then the test must skip).
 std::filesystem::path sharedPath(const std::string& relative);
 
-#define RETILE_SHARED_OR_SKIP(var, relative)                                                   \
-  auto var = ::retile::test::sharedPath(relative);                                             \
+#define RETILE_SHARED_OR_SKIP(var, relative)       \
+  auto var = ::retile::test::sharedPath(relative); \
   if (var.empty()) GTEST_SKIP() << "skipped: ../shared/" << (relative) << " is not present";
 
 std::filesystem::path tempDir();  // a fresh directory per test
@@ -62,8 +62,7 @@ class ScopedCommaLocale {
 
 // Scene building blocks.
 NodeId addMaterial(Scene& s, Material m);
-NodeId addMeshObject(Scene& s, const std::string& name, std::shared_ptr<const MeshGeometry> g, NodeId material,
-                     const Mat4& transform);
+NodeId addMeshObject(Scene& s, const std::string& name, std::shared_ptr<const MeshGeometry> g, NodeId material, const Mat4& transform);
 Scene emptyScene(int width, int height);
 
 // Image statistics over the pixels where `mask` is true (all when empty).

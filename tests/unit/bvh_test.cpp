@@ -386,7 +386,8 @@ TEST(RenderScene, PackedTraversalFindsWhatBruteForceFinds) {
   test::addMeshObject(s, "a", diagonalRod({1, 1, 1}, 1500, 1), mat, Mat4::identity());
   const NodeId b = test::addMeshObject(s, "b", diagonalRod({1, -1, 1}, 1500, 2), mat, Mat4::identity());
   // Small soups all over the middle: opened, their references are runs of triangles.
-  for (std::uint32_t i = 0; i < 40; ++i) test::addMeshObject(s, "crumbs", diagonalRod({0.6f, 0.6f, -0.6f}, 12, 10 + i), mat, Mat4::identity());
+  for (std::uint32_t i = 0; i < 40; ++i)
+    test::addMeshObject(s, "crumbs", diagonalRod({0.6f, 0.6f, -0.6f}, 12, 10 + i), mat, Mat4::identity());
   const auto sphere = makeSphere(12, 24);
   test::addMeshObject(s, "ball", sphere, mat, Mat4::translate({0.3f, 0.2f, -0.4f}) * Mat4::scale(Vec3{0.5f}));
   test::addMeshObject(s, "ball 2", sphere, mat, Mat4::translate({-0.6f, -0.3f, 0.5f}) * Mat4::scale(Vec3{0.4f}));
@@ -420,8 +421,9 @@ TEST(RenderScene, PackedTraversalFindsWhatBruteForceFinds) {
           const Vec3 v1 = o.transform.transformPoint(g.positions[g.indices[3 * t + 1]]);
           const Vec3 v2 = o.transform.transformPoint(g.positions[g.indices[3 * t + 2]]);
           float tt, u, v;
-          const Vec3 front = o.transform.inverse().transposed().transformVector(
-              cross(g.positions[g.indices[3 * t + 1]] - g.positions[g.indices[3 * t]], g.positions[g.indices[3 * t + 2]] - g.positions[g.indices[3 * t]]));
+          const Vec3 front =
+              o.transform.inverse().transposed().transformVector(cross(g.positions[g.indices[3 * t + 1]] - g.positions[g.indices[3 * t]],
+                                                                       g.positions[g.indices[3 * t + 2]] - g.positions[g.indices[3 * t]]));
           if (o.cullBackFaces && dot(front, r.d) > 0) continue;
           if (intersectTriangle(r.o, r.d, v0, v1, v2, best, &tt, &u, &v) && tt > 0) {
             best = tt;
@@ -526,7 +528,9 @@ TEST(RenderScene, SmallEditsKeepTheBraidFactor) {
   records.update(s, kUpdateAll, nullptr);
   const std::size_t openedForRecords = records.data().instanceReferences;
   EXPECT_GT(openedForRecords, rods.size());
-  auto object = [&](NodeId id) -> Object& { return *std::find_if(s.objects.begin(), s.objects.end(), [&](const Object& o) { return o.id == id; }); };
+  auto object = [&](NodeId id) -> Object& {
+    return *std::find_if(s.objects.begin(), s.objects.end(), [&](const Object& o) { return o.id == id; });
+  };
 
   // Hidden and shown again, then two of sixteen hidden (an eighth).
   object(rods[3]).visible = false;
@@ -561,8 +565,7 @@ TEST(RenderScene, InstancesApartKeepOneReferenceEach) {
   Scene s = test::emptyScene(8, 8);
   const NodeId mat = test::addMaterial(s, Material{});
   const auto sphere = makeSphere(16, 32);
-  for (int i = 0; i < 6; ++i)
-    test::addMeshObject(s, "ball", sphere, mat, Mat4::translate({4.0f * static_cast<float>(i), 0, 0}));
+  for (int i = 0; i < 6; ++i) test::addMeshObject(s, "ball", sphere, mat, Mat4::translate({4.0f * static_cast<float>(i), 0, 0}));
   RenderSceneBuilder builder;
   // Entered through records, where each reference costs a step. (Direct, opening the balls costs
   // nothing more, and the surface area heuristic may open them.)
@@ -659,7 +662,8 @@ TEST(RenderScene, LightGroupsTurnedOnStayOnUntilTheirGainFallsFarther) {
     fresh.update(s, kUpdateAll, nullptr);
     gain[static_cast<std::size_t>(k)] = fresh.data().lightGroupGain;
     EXPECT_EQ(fresh.data().lightGroups > 0, fresh.data().lightGroupGain >= kLightGroupMinGain) << k;
-    between = between || (gain[static_cast<std::size_t>(k)] >= kLightGroupKeepGain && gain[static_cast<std::size_t>(k)] < kLightGroupMinGain);
+    between =
+        between || (gain[static_cast<std::size_t>(k)] >= kLightGroupKeepGain && gain[static_cast<std::size_t>(k)] < kLightGroupMinGain);
   }
   ASSERT_LT(gain[0], kLightGroupKeepGain) << "facing the same way";
   ASSERT_GE(gain[kSteps], kLightGroupMinGain) << "facing apart";
@@ -849,7 +853,9 @@ TEST(RenderScene, OnlyARoughTypeOrASheetReadsItsRoughnessTexture) {
   RenderSceneBuilder builder;
   builder.update(s, kUpdateAll, nullptr);
   const RenderSceneData& d = builder.data();
-  auto roughnessTexture = [&](std::size_t material) { return std::bit_cast<std::int32_t>(d.materials[material * gpu::kMaterialTexels + 3].w); };
+  auto roughnessTexture = [&](std::size_t material) {
+    return std::bit_cast<std::int32_t>(d.materials[material * gpu::kMaterialTexels + 3].w);
+  };
   EXPECT_GE(roughnessTexture(0), 0) << "the sheet: its thickness";
   EXPECT_EQ(d.materials[0 * gpu::kMaterialTexels + 1].x, 300.0f) << "its film in the roughness slot";
   EXPECT_GE(roughnessTexture(1), 0) << "the rough plastic";
@@ -867,7 +873,8 @@ TEST(RenderScene, TexturesKeepTheirTexelsWhenOthersComeAndGo) {
   auto bytes = [&](const std::string& name, const std::vector<int>& row) {
     const auto file = dir / (name + ".ppm");
     std::vector<std::uint8_t> rgb;
-    for (int v : row) rgb.insert(rgb.end(), {static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v / 2), static_cast<std::uint8_t>(255 - v)});
+    for (int v : row)
+      rgb.insert(rgb.end(), {static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(v / 2), static_cast<std::uint8_t>(255 - v)});
     test::writePpm(file, static_cast<int>(row.size()), 1, rgb);
     return file;
   };
@@ -890,8 +897,9 @@ TEST(RenderScene, TexturesKeepTheirTexelsWhenOthersComeAndGo) {
                                                   std::bit_cast<std::int32_t>(info->z), std::bit_cast<std::int32_t>(info->w)};
     const std::size_t words = static_cast<std::size_t>(w * h) * ((flags & gpu::kTexEightBit) ? 1 : 2);
     EXPECT_LE(static_cast<std::size_t>(offset) * 2 + words, d.texels.size());
-    return std::pair{std::array{flags, w, h},
-                     std::vector<std::uint32_t>(d.texels.begin() + offset * 2, d.texels.begin() + offset * 2 + static_cast<std::ptrdiff_t>(words))};
+    return std::pair{
+        std::array{flags, w, h},
+        std::vector<std::uint32_t>(d.texels.begin() + offset * 2, d.texels.begin() + offset * 2 + static_cast<std::ptrdiff_t>(words))};
   };
   const auto odd = texture(0), half = texture(1), one = texture(2);
   EXPECT_EQ(odd.first, (std::array{gpu::kTexBitmap | gpu::kTexEightBit, 3, 1}));
@@ -918,8 +926,9 @@ TEST(RenderScene, TexturesKeepTheirTexelsWhenOthersComeAndGo) {
   s.textures.erase(s.textures.begin());
   s.textures.back().colorSpace = TextureColorSpace::SRGB;
   builder.update(s, kUpdateTextures, &warnings);
-  EXPECT_EQ(builder.data().features() & static_cast<std::uint32_t>(gpu::kFeatureByteTexels | gpu::kFeatureHalfTexels | gpu::kFeatureSrgbTexels),
-            static_cast<std::uint32_t>(gpu::kFeatureByteTexels | gpu::kFeatureSrgbTexels));
+  EXPECT_EQ(
+      builder.data().features() & static_cast<std::uint32_t>(gpu::kFeatureByteTexels | gpu::kFeatureHalfTexels | gpu::kFeatureSrgbTexels),
+      static_cast<std::uint32_t>(gpu::kFeatureByteTexels | gpu::kFeatureSrgbTexels));
 }
 
 // Sets the scene's environment to a map of two texels, 1 then 3, written as EXR to `file`.
@@ -1164,8 +1173,8 @@ TEST(RenderScene, TheCameraIsInTheMediumAroundIt) {
   Material veil;
   veil.type = MaterialType::Boundary;
   test::addMeshObject(s, "fog", makeCube(), test::addMaterial(s, fog), Mat4::scale({10, 10, 10}));
-  const NodeId milkObject = test::addMeshObject(s, "milk", makeCube(), test::addMaterial(s, milk),
-                                                Mat4::translate({2, 0, 0}) * Mat4::scale({2, 2, 2}));
+  const NodeId milkObject =
+      test::addMeshObject(s, "milk", makeCube(), test::addMaterial(s, milk), Mat4::translate({2, 0, 0}) * Mat4::scale({2, 2, 2}));
   test::addMeshObject(s, "lens", makeCube(), test::addMaterial(s, lens), Mat4::translate({-2, 0, 0}) * Mat4::scale({2, 2, 2}));
   test::addMeshObject(s, "veil", makeCube(), test::addMaterial(s, veil), Mat4::translate({0, 0, 2}) * Mat4::scale({2, 2, 2}));
   const Vec3 fogged{0.1f, 0.2f, 0.3f};
@@ -1306,7 +1315,8 @@ TEST(RenderScene, AWallDoesNotTellTheCamerasMediumABoundaryDoes) {
                          Mat4::translate({0.5f, 0, 0}) * Mat4::rotateZ(kPi / 2), Mat4::translate({-0.5f, 0, 0}) * Mat4::rotateZ(-kPi / 2),
                          Mat4::translate({0, 0, -0.5f}) * Mat4::rotateX(kPi / 2)};
   for (const Mat4& m : walls) test::addMeshObject(s, "wall", makeQuad(), wall, m);
-  const NodeId front = test::addMeshObject(s, "front", makeQuad(), test::addMaterial(s, gas), Mat4::translate({0, 0, 0.5f}) * Mat4::rotateX(kPi / 2));
+  const NodeId front =
+      test::addMeshObject(s, "front", makeQuad(), test::addMaterial(s, gas), Mat4::translate({0, 0, 0.5f}) * Mat4::rotateX(kPi / 2));
   const Vec3 inside{0.1f, -0.2f, 0.1f}, before{0.2f, 0.1f, 3.0f};
   for (bool direct : {true, false}) {
     RenderSceneBuilder builder;
@@ -1314,7 +1324,8 @@ TEST(RenderScene, AWallDoesNotTellTheCamerasMediumABoundaryDoes) {
     builder.update(s, kUpdateAll, nullptr);
     EXPECT_EQ(mediaAround(builder.data(), inside).in.scattering, Vec3(1.0f)) << "inside the box";
     EXPECT_EQ(mediaAround(builder.data(), before).in.scattering, Vec3(0.0f)) << "before its open side";
-    s.object(front)->transform = Mat4::translate({0, 0, 0.5f}) * Mat4::rotateY(0.3f) * Mat4::rotateX(-kPi / 2) * Mat4::scale({1.5f, 1, 1.5f});
+    s.object(front)->transform =
+        Mat4::translate({0, 0, 0.5f}) * Mat4::rotateY(0.3f) * Mat4::rotateX(-kPi / 2) * Mat4::scale({1.5f, 1, 1.5f});
     builder.update(s, kUpdateInstances, nullptr);
     EXPECT_TRUE(builder.data().instanceTransforms);
     EXPECT_EQ(mediaAround(builder.data(), inside).in.scattering, Vec3(0.0f)) << "facing in, the quad holds the gas outside";

@@ -70,7 +70,8 @@ TEST(Color, TungstenGammaTexturesDecodeWithTungstensTable) {
 TEST(Color, EightBitTexturesKeepTheirBytes) {
   const auto file = test::tempDir() / "all-bytes.ppm";
   std::vector<std::uint8_t> rgb;
-  for (int v = 0; v < 256; ++v) rgb.insert(rgb.end(), {static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(255 - v), static_cast<std::uint8_t>(v / 2)});
+  for (int v = 0; v < 256; ++v)
+    rgb.insert(rgb.end(), {static_cast<std::uint8_t>(v), static_cast<std::uint8_t>(255 - v), static_cast<std::uint8_t>(v / 2)});
   test::writePpm(file, 256, 1, rgb);
   Texture t;
   t.kind = TextureKind::File;

@@ -251,7 +251,8 @@ TEST(Curves, TungstenCurvesImportAsTubesOfHair) {
   std::vector<Strand> list;
   for (int i = 0; i < 400; ++i) list.push_back({{float(i), 0, 0}, {float(i), 1, 0}, {float(i), 2, 0}, {float(i), 3, 0}});
   write(dir / "hair.hair", hairFile(list, nullptr, 0.02f));
-  std::ofstream(dir / "scene.json") << R"({"bsdfs": [{"name": "brown", "type": "hair", "melanin_ratio": 0.25, "melanin_concentration": 2, "roughness": 0.2, "scale_angle": 3.5}],
+  std::ofstream(dir / "scene.json")
+      << R"({"bsdfs": [{"name": "brown", "type": "hair", "melanin_ratio": 0.25, "melanin_concentration": 2, "roughness": 0.2, "scale_angle": 3.5}],
       "primitives": [{"type": "curves", "name": "fur", "file": "hair.hair", "bsdf": "brown", "transform": {"scale": 2}},
                      {"type": "curves", "name": "half", "file": "hair.hair", "bsdf": "brown", "subsample": 0.5, "curve_thickness": 0.01},
                      {"type": "curves", "name": "plain", "file": "hair.hair"},

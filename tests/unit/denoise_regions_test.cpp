@@ -35,8 +35,8 @@ TEST(DenoiseRegions, GrowsOnlyPastTheThresholdOnEitherAxisAndCoversTheFrameAtThe
   for (std::size_t i = 1; i < pushed.size(); ++i) {
     bool grewW = pushed[i].width - pushed[i - 1].width > 40, grewH = pushed[i].height - pushed[i - 1].height > 12;
     bool last = i + 1 == pushed.size();  // when the pass re-rendered its last tile
-    EXPECT_TRUE(grewW || grewH || last) << "resize " << i << ": " << pushed[i - 1].width << "x" << pushed[i - 1].height
-                                         << " -> " << pushed[i].width << "x" << pushed[i].height;
+    EXPECT_TRUE(grewW || grewH || last) << "resize " << i << ": " << pushed[i - 1].width << "x" << pushed[i - 1].height << " -> "
+                                        << pushed[i].width << "x" << pushed[i].height;
   }
   EXPECT_EQ(pushed.back().width, 320);
   EXPECT_EQ(pushed.back().height, 96) << "the last region is the whole frame";

@@ -54,8 +54,9 @@ TEST(Dependencies, EngineIncludesNoQt) {
 }
 
 TEST(Dependencies, PublicHeadersExposeNoThirdPartyOrPrivateHeaders) {
-  std::string found = breaches(sourceRoot() / "engine" / "include",
-                               std::regex(R"(^(vulkan|assimp|OpenImageIO|OpenColorIO|glslang|core/|render/|vk/|io/|color/|schedule/|eval/|scene/))"));
+  std::string found =
+      breaches(sourceRoot() / "engine" / "include",
+               std::regex(R"(^(vulkan|assimp|OpenImageIO|OpenColorIO|glslang|core/|render/|vk/|io/|color/|schedule/|eval/|scene/))"));
   EXPECT_EQ(found, "") << "engine/include/retile names only standard C++ and engine types:\n" << found;
 }
 

@@ -26,13 +26,13 @@ TEST(Json, ErrorsNameLineAndColumn) {
 }
 
 TEST(Json, RejectsHostileInput) {
-  EXPECT_FALSE(parse(std::string(10000, '[')).ok());       // nesting bomb
-  EXPECT_FALSE(parse("{\"a\": 1e999}").ok());                // overflow to infinity
+  EXPECT_FALSE(parse(std::string(10000, '[')).ok());  // nesting bomb
+  EXPECT_FALSE(parse("{\"a\": 1e999}").ok());         // overflow to infinity
   EXPECT_FALSE(parse("\"unterminated").ok());
-  EXPECT_FALSE(parse("{\"a\": \"\\ud800\"}").ok());          // lone surrogate
+  EXPECT_FALSE(parse("{\"a\": \"\\ud800\"}").ok());  // lone surrogate
   EXPECT_FALSE(parse("[1, 2] trailing").ok());
   EXPECT_FALSE(parse("").ok());
-  EXPECT_FALSE(parse(std::string("\"a\0b\"", 5)).ok());     // control character in a string
+  EXPECT_FALSE(parse(std::string("\"a\0b\"", 5)).ok());  // control character in a string
 }
 
 TEST(Json, WriteRoundTripsFloatsExactly) {

@@ -21,8 +21,8 @@
 namespace retile {
 namespace {
 
-#define RETILE_COMMA_LOCALE(var)      \
-  test::ScopedCommaLocale var;        \
+#define RETILE_COMMA_LOCALE(var) \
+  test::ScopedCommaLocale var;   \
   ASSERT_TRUE(var.active()) << var.error();
 
 TEST(Numbers, UnderflowReadsAsZeroAndOverflowAsInfinity) {
@@ -105,8 +105,8 @@ TEST(NativeScene, SavedUnderACommaDecimalLocaleReadsBackIdenticalUnderC) {
 
 TEST(Import, EverySharedSceneOpensTheSameUnderACommaDecimalLocale) {
   RETILE_SHARED_OR_SKIP(scenes, "scenes");
-  for (const char* name : {"cornell-box/scene.json", "cornell-box/cornell-box.obj", "living-room/scene.json",
-                           "spaceship/scene.json", "bunny/bunny.obj"}) {
+  for (const char* name :
+       {"cornell-box/scene.json", "cornell-box/cornell-box.obj", "living-room/scene.json", "spaceship/scene.json", "bunny/bunny.obj"}) {
     SCOPED_TRACE(name);
     auto inC = importScene(scenes / name);
     test::ScopedCommaLocale comma;

@@ -128,7 +128,7 @@ TEST(Metrics, TheAffectedRegionIsWhatChangedBeyondNoise) {
     for (std::size_t i = 0; i < n; ++i) {
       const int x = static_cast<int>(i % 20);
       float value = 0.5f + (edited && x >= 16 ? 0.15f : 0.0f);  // the edit brightens the right fifth
-      value += jitter(rng) * sigma / std::sqrt(spp);           // the mean's own noise
+      value += jitter(rng) * sigma / std::sqrt(spp);            // the mean's own noise
       for (int c = 0; c < 3; ++c) im.color[3 * i + c] = value;
       im.moment2[i] = value * value + sigma * sigma;
     }

@@ -304,7 +304,8 @@ TEST(Native, BrokenFilesGiveClearErrors) {
       {"{\"format\": \"retile-scene\", \"version\": 1, \"materials\": [{\"id\": 1, \"type\": \"glitter\"}]}", "unknown value 'glitter'"},
       {"{\"format\": \"retile-scene\", \"version\": 1, \"meshes\": [{\"id\": 1}, {\"id\": 1}]}", "not unique"},
       {"{\"format\": \"retile-scene\", \"version\": 1, \"settings\": {\"width\": 1e9}}", "outside 1..16384"},
-      {"{\"format\": \"retile-scene\", \"version\": 1, \"settings\": {\"ray_offset\": \"sideways\"}}", "settings.ray_offset: unknown ray_offset 'sideways' (robust, tungsten)"},
+      {"{\"format\": \"retile-scene\", \"version\": 1, \"settings\": {\"ray_offset\": \"sideways\"}}",
+       "settings.ray_offset: unknown ray_offset 'sideways' (robust, tungsten)"},
   };
   int i = 0;
   for (const Case& c : cases) {

@@ -32,8 +32,7 @@ EditFacts moveFacts(NodeId object, Vec2 from, Vec2 to, int size = 20) {
   f.moved = true;
   f.centreBefore = from;
   f.centreAfter = to;
-  for (Vec2 c : {from, to})
-    f.screen.push_back({static_cast<int>(c.x) - size / 2, static_cast<int>(c.y) - size / 2, size, size});
+  for (Vec2 c : {from, to}) f.screen.push_back({static_cast<int>(c.x) - size / 2, static_cast<int>(c.y) - size / 2, size, size});
   return f;
 }
 
@@ -175,8 +174,7 @@ TEST(Planner, OneBatchPrioritizesEveryPointOfChange) {
   light.pointOfChange = {300, 160};
   Plan plan = p.planBatch({moveFacts(kCup, {20, 20}, {24, 20}), light});
   ASSERT_GE(plan.order.size(), 2u);
-  EXPECT_EQ(std::set<int>(plan.order.begin(), plan.order.begin() + 2),
-            (std::set<int>{g.tileAt({24, 20}), g.tileAt({300, 160})}));
+  EXPECT_EQ(std::set<int>(plan.order.begin(), plan.order.begin() + 2), (std::set<int>{g.tileAt({24, 20}), g.tileAt({300, 160})}));
   EXPECT_EQ(p.pointsOfChange().size(), 2u);
 }
 

@@ -101,8 +101,7 @@ TEST(Indirection, MotionReplacesHighTilesAndNeverGrowsTheSet) {
   ASSERT_EQ(moved.size(), high.size());
   for (int t : moved) EXPECT_GE(g.col(t), 17) << "200 px to the right of columns 5 and 6";
   auto jumped = followMotion(g, high, {32.0f, 16.0f});
-  EXPECT_EQ(std::set<int>(jumped.begin(), jumped.end()),
-            (std::set<int>{g.index(7, 6), g.index(8, 6), g.index(7, 7), g.index(8, 7)}));
+  EXPECT_EQ(std::set<int>(jumped.begin(), jumped.end()), (std::set<int>{g.index(7, 6), g.index(8, 6), g.index(7, 7), g.index(8, 7)}));
   EXPECT_TRUE(followMotion(g, high, {-1000.0f, 0.0f}).empty()) << "tiles moved off screen drop out";
 }
 
@@ -162,8 +161,10 @@ TEST(Scheduler, SmoothTransitionCapsStaleSumsAndKeepsTheBudget) {
   s.startPass(spiralOrder(g, 0), 2, 1, true, 4);
   FramePlan p = s.nextFrame();
   for (const auto& c : p.chunks) {
-    if (c.tile == 0) EXPECT_TRUE(c.restart) << "the prioritized tile restarts";
-    else EXPECT_EQ(c.capStale, 4) << "the others keep at most 4 stale samples";
+    if (c.tile == 0)
+      EXPECT_TRUE(c.restart) << "the prioritized tile restarts";
+    else
+      EXPECT_EQ(c.capStale, 4) << "the others keep at most 4 stale samples";
   }
   EXPECT_NEAR(s.tileSamples()[1], 4.0 + 2.0, 1e-9);
 }

@@ -23,9 +23,7 @@ const Object* objectWithMaterial(const Scene& s, const std::string& prefix) {
   return nullptr;
 }
 
-Bounds3 worldBounds(const Scene& s, const Object& o) {
-  return transformBounds(o.transform, s.mesh(o.mesh)->geometry->bounds());
-}
+Bounds3 worldBounds(const Scene& s, const Object& o) { return transformBounds(o.transform, s.mesh(o.mesh)->geometry->bounds()); }
 
 TEST(Tungsten, CornellBoxMatchesTheObjVersion) {
   RETILE_SHARED_OR_SKIP(file, "scenes/cornell-box/scene.json");
@@ -288,8 +286,9 @@ TEST(Tungsten, ACameraMediumNothingHoldsFillsTheWorld) {
                      {"type": "sphere", "name": "jar", "bsdf": "glass", "int_medium": "ink", "ext_medium": "fog"}]})"));
   ASSERT_TRUE(held.ok()) << held.error();
   EXPECT_TRUE(std::any_of(held->warnings.begin(), held->warnings.end(), [](const std::string& w) {
-    return w.find("1 glass or boundary primitives with a medium inside name another ext_medium than the camera's 'fog', the first primitives[0] (none)") !=
-           std::string::npos;
+    return w.find(
+               "1 glass or boundary primitives with a medium inside name another ext_medium than the camera's 'fog', the first "
+               "primitives[0] (none)") != std::string::npos;
   }));
 
   auto undefined = importTungsten(writeScene(R"({"camera": {"medium": "smoke"}, "primitives": [{"type": "quad", "emission": 1}]})"));
@@ -433,19 +432,20 @@ TEST(Tungsten, AHomogeneousMediumFillsItsGlass) {
 // direction fixed to a quad (its normal, +y in the quad's space) is the sky's up (+y in the map's
 // frame) when both have the same transform, tilted, turned and given an "up" alike.
 TEST(Tungsten, TheSkyTurnsAsAPrimitiveWithItsTransform) {
-  const char* transforms[] = {
-      R"({})",
-      R"({"rotation": [0, 30, 0]})",
-      R"({"rotation": [90, 0, 0]})",
-      R"({"rotation": [20, -70, 45], "position": [3, 1, 2], "scale": 4})",
-      R"({"up": [0, 0, 1]})",
-      R"({"up": [1, 1, 0], "rotation": [0, 90, 0]})",
-      R"([0, 0, 1, 5,  1, 0, 0, 0,  0, 1, 0, 0,  0, 0, 0, 1])"};
+  const char* transforms[] = {R"({})",
+                              R"({"rotation": [0, 30, 0]})",
+                              R"({"rotation": [90, 0, 0]})",
+                              R"({"rotation": [20, -70, 45], "position": [3, 1, 2], "scale": 4})",
+                              R"({"up": [0, 0, 1]})",
+                              R"({"up": [1, 1, 0], "rotation": [0, 90, 0]})",
+                              R"([0, 0, 1, 5,  1, 0, 0, 0,  0, 1, 0, 0,  0, 0, 0, 1])"};
   for (const char* t : transforms) {
     SCOPED_TRACE(t);
     auto r = importTungsten(writeScene(std::string(R"({"primitives": [
-        {"type": "infinite_sphere", "emission": 1, "transform": )") + t + R"(},
-        {"type": "quad", "name": "q", "bsdf": {"type": "lambert"}, "transform": )" + t + "}]}"));
+        {"type": "infinite_sphere", "emission": 1, "transform": )") +
+                                       t + R"(},
+        {"type": "quad", "name": "q", "bsdf": {"type": "lambert"}, "transform": )" +
+                                       t + "}]}"));
     ASSERT_TRUE(r.ok()) << r.error();
     for (const auto& w : r->warnings) EXPECT_EQ(w.find("environment"), std::string::npos) << w;
     ASSERT_EQ(r->scene.objects.size(), 1u);
@@ -619,7 +619,7 @@ TEST(Tungsten, RecomputedNormalsMergeByPositionAndKeepCreases) {
   std::ofstream(dir / "box.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
                                     "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
   const float c = std::cos(radians(10.0f)), sn = std::sin(radians(10.0f));
-  std::ofstream(dir / "fold.obj") << "v 0 0 0\nv 0 0 1\nv -1 0 0\n"  // flat, facing +y
+  std::ofstream(dir / "fold.obj") << "v 0 0 0\nv 0 0 1\nv -1 0 0\n"                      // flat, facing +y
                                   << "v 0 0 0\nv 0 0 1\nv " << c << " " << sn << " 0\n"  // tilted 10 degrees
                                   << "f 1 3 2\nf 4 5 6\n";
   std::ofstream(dir / "scene.json") << R"({"bsdfs": [{"name": "a", "type": "lambert"}], "primitives": [
@@ -634,7 +634,8 @@ TEST(Tungsten, RecomputedNormalsMergeByPositionAndKeepCreases) {
   for (std::size_t t = 0; t < box.indices.size(); t += 3) {
     const Vec3 a = box.positions[box.indices[t]], b = box.positions[box.indices[t + 1]], d = box.positions[box.indices[t + 2]];
     const Vec3 face = normalize(cross(b - a, d - a));
-    for (int k = 0; k < 3; ++k) EXPECT_GT(dot(box.normals[box.indices[t + static_cast<std::size_t>(k)]], face), 0.9999f) << "triangle " << t / 3;
+    for (int k = 0; k < 3; ++k)
+      EXPECT_GT(dot(box.normals[box.indices[t + static_cast<std::size_t>(k)]], face), 0.9999f) << "triangle " << t / 3;
   }
   const MeshGeometry& fold = *s.mesh(s.objects[1].mesh)->geometry;
   ASSERT_EQ(fold.normals.size(), fold.positions.size());
@@ -1049,11 +1050,12 @@ TEST(Tungsten, TheCamerasTonemapIsTheScenesView) {
   const std::pair<const char*, const char*> cases[] = {
       {R"("tonemap": "filmic",)", "Filmic"}, {"", "Standard"}, {R"("tonemap": "linear",)", "Raw"}, {R"("tonemap": "reinhard",)", "Filmic"}};
   for (auto [tonemap, view] : cases) {
-    auto r = importTungsten(writeScene(std::string(R"({"camera": {)") + tonemap +
-                                       R"( "fov": 40}, "primitives": [{"type": "quad", "emission": 1}]})"));
+    auto r = importTungsten(
+        writeScene(std::string(R"({"camera": {)") + tonemap + R"( "fov": 40}, "primitives": [{"type": "quad", "emission": 1}]})"));
     ASSERT_TRUE(r.ok()) << r.error();
     EXPECT_EQ(r->scene.settings.view, view) << tonemap;
-    EXPECT_EQ(r->warnings.size(), std::string(view) == "Filmic" && std::string(tonemap).find("reinhard") != std::string::npos ? 1u : 0u) << tonemap;
+    EXPECT_EQ(r->warnings.size(), std::string(view) == "Filmic" && std::string(tonemap).find("reinhard") != std::string::npos ? 1u : 0u)
+        << tonemap;
   }
 }
 
@@ -1096,7 +1098,11 @@ TEST(Tungsten, SpheresAndDisksKeepTheirTrueArea) {
 // A disk's cone_angle narrows where Tungsten's disk emits (Disk::evalDirect): its emitter's
 // material takes it as its emission cone. Wider than the hemisphere is said and taken as 90.
 TEST(Tungsten, ADisksConeAngleIsItsEmissionCone) {
-  const std::pair<const char*, float> cases[] = {{"", 90}, {R"(, "cone_angle": 90)", 90}, {R"(, "cone_angle": 120)", 90}, {R"(, "cone_angle": 30)", 30}, {R"(, "cone_angle": -30)", 30}};
+  const std::pair<const char*, float> cases[] = {{"", 90},
+                                                 {R"(, "cone_angle": 90)", 90},
+                                                 {R"(, "cone_angle": 120)", 90},
+                                                 {R"(, "cone_angle": 30)", 30},
+                                                 {R"(, "cone_angle": -30)", 30}};
   for (const auto& [cone, expected] : cases) {
     auto r = importTungsten(writeScene(std::string(R"({"primitives": [{"type": "disk", "emission": 1)") + cone + "}]}"));
     ASSERT_TRUE(r.ok()) << r.error();
@@ -1104,7 +1110,8 @@ TEST(Tungsten, ADisksConeAngleIsItsEmissionCone) {
     const Material* m = r->scene.material(r->scene.objects[0].material);
     ASSERT_NE(m, nullptr);
     EXPECT_EQ(m->emissionCone, expected) << cone;
-    const bool said = std::any_of(r->warnings.begin(), r->warnings.end(), [](const std::string& w) { return w.find("cone_angle 120") != std::string::npos; });
+    const bool said = std::any_of(r->warnings.begin(), r->warnings.end(),
+                                  [](const std::string& w) { return w.find("cone_angle 120") != std::string::npos; });
     EXPECT_EQ(said, std::string(cone).find("120") != std::string::npos) << cone;
     // The native format keeps it.
     auto file = test::tempDir() / "cone.retile";
@@ -1204,7 +1211,8 @@ TEST(Tungsten, AnalyticShapesCarryTungstensUvs) {
       matrix += (matrix.empty() ? "" : ", ") + std::to_string(v);
     }
   auto r = importTungsten(writeScene(R"({"primitives": [{"type": "quad"}, {"type": "cube"}, {"type": "cylinder"},
-      {"type": "disk", "transform": [)" + matrix + "]}]}"));
+      {"type": "disk", "transform": [)" +
+                                     matrix + "]}]}"));
   ASSERT_TRUE(r.ok()) << r.error();
   const Scene& s = r->scene;
   ASSERT_EQ(s.objects.size(), 4u);
@@ -1216,7 +1224,8 @@ TEST(Tungsten, AnalyticShapesCarryTungstensUvs) {
     for (std::size_t i = 0; i + 2 < g.indices.size(); i += 3) {
       const Vec3 a = g.positions[g.indices[i]], b = g.positions[g.indices[i + 1]], cc = g.positions[g.indices[i + 2]];
       if (length(cross(b - a, cc - a)) < 1e-9f) continue;  // a lathe's degenerate triangles at a cap's centre
-      ASSERT_GT(dot(cross(b - a, cc - a), g.normals[g.indices[i]] + g.normals[g.indices[i + 1]] + g.normals[g.indices[i + 2]]), 0) << o << " " << i;
+      ASSERT_GT(dot(cross(b - a, cc - a), g.normals[g.indices[i]] + g.normals[g.indices[i + 1]] + g.normals[g.indices[i + 2]]), 0)
+          << o << " " << i;
     }
   }
   for (std::size_t i = 0; i < geometry(0).positions.size(); ++i) {

@@ -28,14 +28,14 @@ bool mentions(const std::vector<std::string>& warnings, const std::string& text)
 std::shared_ptr<const MeshGeometry> hostileGeometry() {
   auto g = std::make_shared<MeshGeometry>();
   g->positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {kNaN, 0, 0}, {3e38f, 0, 0}, {0, -kInf, 0}, {1e30f, 1e30f, 1e30f}};
-  g->indices = {0, 1, 2, 0, 2, 3,  // the quad
-                0, 1, 4,           // a NaN vertex
-                0, 5, 1,           // near the float limit
-                6, 0, 1,           // an infinity
-                0, 1, 99,          // past the vertex list
-                7, 7, 7,           // absurd, and degenerate
-                0, 1};             // two indices left over
-  g->normals = {{0, 0, 1}};        // one normal for eight vertices
+  g->indices = {0, 1, 2,  0, 2, 3,  // the quad
+                0, 1, 4,            // a NaN vertex
+                0, 5, 1,            // near the float limit
+                6, 0, 1,            // an infinity
+                0, 1, 99,           // past the vertex list
+                7, 7, 7,            // absurd, and degenerate
+                0, 1};              // two indices left over
+  g->normals = {{0, 0, 1}};         // one normal for eight vertices
   return g;
 }
 

@@ -28,11 +28,9 @@ class ColorConfig {
   virtual std::string display() const = 0;
 
   // Linear RGB (3 floats per pixel) to 8-bit RGBA through exposure, the view and gamma.
-  virtual void toDisplay8(const float* rgb, std::size_t pixels, const DisplaySettings& settings,
-                          std::uint8_t* rgba) const = 0;
+  virtual void toDisplay8(const float* rgb, std::size_t pixels, const DisplaySettings& settings, std::uint8_t* rgba) const = 0;
   // The same, to display-referred floats (3 per pixel), unclamped.
-  virtual void toDisplayFloat(const float* rgb, std::size_t pixels, const DisplaySettings& settings,
-                              float* out) const = 0;
+  virtual void toDisplayFloat(const float* rgb, std::size_t pixels, const DisplaySettings& settings, float* out) const = 0;
   // sRGB-encoded values to linear, in place (RGBA floats; alpha untouched).
   virtual void srgbToLinear(float* rgba, std::size_t pixels) const = 0;
 };

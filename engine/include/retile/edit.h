@@ -14,25 +14,50 @@
 namespace retile {
 
 // Whole-value edits: the new value replaces the node with the same id.
-struct SetMaterial { Material material; };
-struct SetObject { Object object; };      // transform, visibility, name, material assignment
-struct SetLight { Light light; };
-struct SetTexture { Texture texture; };
-struct SetCamera { Camera camera; };
-struct SetEnvironment { Environment environment; };
-struct SetRenderSettings { RenderSettings settings; };
+struct SetMaterial {
+  Material material;
+};
+struct SetObject {
+  Object object;
+};  // transform, visibility, name, material assignment
+struct SetLight {
+  Light light;
+};
+struct SetTexture {
+  Texture texture;
+};
+struct SetCamera {
+  Camera camera;
+};
+struct SetEnvironment {
+  Environment environment;
+};
+struct SetRenderSettings {
+  RenderSettings settings;
+};
 // Adding nodes: the id must be unused (take it from Scene::newId on the document).
-struct AddMesh { Mesh mesh; };
-struct AddMaterial { Material material; };
-struct AddObject { Object object; };
-struct AddLight { Light light; };
-struct AddTexture { Texture texture; };
+struct AddMesh {
+  Mesh mesh;
+};
+struct AddMaterial {
+  Material material;
+};
+struct AddObject {
+  Object object;
+};
+struct AddLight {
+  Light light;
+};
+struct AddTexture {
+  Texture texture;
+};
 // Removes any node; references to it (an object's material, a material's texture) are cleared.
-struct RemoveNode { NodeId id = kNoNode; };
+struct RemoveNode {
+  NodeId id = kNoNode;
+};
 
-using Edit = std::variant<SetMaterial, SetObject, SetLight, SetTexture, SetCamera, SetEnvironment,
-                          SetRenderSettings, AddMesh, AddMaterial, AddObject, AddLight, AddTexture,
-                          RemoveNode>;
+using Edit = std::variant<SetMaterial, SetObject, SetLight, SetTexture, SetCamera, SetEnvironment, SetRenderSettings, AddMesh, AddMaterial,
+                          AddObject, AddLight, AddTexture, RemoveNode>;
 
 // What an applied edit invalidates in a render scene. A renderer updates only what is flagged:
 // a transform never touches mesh BVHs, a material never touches instances.
@@ -40,9 +65,9 @@ enum UpdateFlags : std::uint32_t {
   kUpdateNone = 0,
   kUpdateMaterials = 1u << 0,
   kUpdateTextures = 1u << 1,
-  kUpdateInstances = 1u << 2,   // transforms, visibility, material assignment: top-level BVH
-  kUpdateGeometry = 1u << 3,    // meshes added or removed: bottom-level BVHs
-  kUpdateLights = 1u << 4,      // delta lights, or emitters moved/recoloured
+  kUpdateInstances = 1u << 2,  // transforms, visibility, material assignment: top-level BVH
+  kUpdateGeometry = 1u << 3,   // meshes added or removed: bottom-level BVHs
+  kUpdateLights = 1u << 4,     // delta lights, or emitters moved/recoloured
   kUpdateCamera = 1u << 5,
   kUpdateEnvironment = 1u << 6,
   kUpdateSettings = 1u << 7,

@@ -27,12 +27,24 @@
 
 namespace retile {
 
-struct SelectCommand { NodeId object = kNoNode; };
-struct FocusCommand { std::vector<FocusPoint> focus; };
-struct MethodCommand { MethodSettings method; };
-struct ResizeCommand { int width = 0, height = 0; };
-struct PauseCommand { bool paused = false; };  // paused: no frames; resuming keeps the samples
-struct RegionCommand { RegionRect region; };  // a render region; empty: the whole image
+struct SelectCommand {
+  NodeId object = kNoNode;
+};
+struct FocusCommand {
+  std::vector<FocusPoint> focus;
+};
+struct MethodCommand {
+  MethodSettings method;
+};
+struct ResizeCommand {
+  int width = 0, height = 0;
+};
+struct PauseCommand {
+  bool paused = false;
+};  // paused: no frames; resuming keeps the samples
+struct RegionCommand {
+  RegionRect region;
+};  // a render region; empty: the whole image
 using Command = std::variant<Edit, SelectCommand, FocusCommand, MethodCommand, ResizeCommand, PauseCommand, RegionCommand>;
 
 // Commands in arrival order. A command of the same kind and target as one still queued replaces

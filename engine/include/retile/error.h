@@ -34,11 +34,10 @@ class AssertionError : public Error {
 
 // The location comes from the macro, not std::source_location: clang 14 (the fuzz build's
 // compiler) cannot compile libstdc++ 12's source_location.
-[[noreturn]] void assertionFailed(const char* expr, const std::string& values, const char* file, int line,
-                                  const char* function);
+[[noreturn]] void assertionFailed(const char* expr, const std::string& values, const char* file, int line, const char* function);
 
-#define RETILE_ASSERT(cond, values)                                                       \
-  do {                                                                                    \
+#define RETILE_ASSERT(cond, values)                                                        \
+  do {                                                                                     \
     if (!(cond)) ::retile::assertionFailed(#cond, (values), __FILE__, __LINE__, __func__); \
   } while (false)
 

@@ -64,20 +64,20 @@ std::vector<std::string> defaultMethods();
 
 // A scenario played on a copy of the scene, frame by frame, without rendering.
 struct Plan {
-  Scene start;                           // the scene before the first frame
-  NodeId selection = kNoNode;            // set up before converging (leading select steps)
+  Scene start;                 // the scene before the first frame
+  NodeId selection = kNoNode;  // set up before converging (leading select steps)
   std::optional<std::vector<FocusPoint>> focus;
   int converge = 0;
   struct Frame {
-    std::vector<Edit> edits;             // applied before the frame is traced
+    std::vector<Edit> edits;  // applied before the frame is traced
     std::optional<NodeId> select;
     std::optional<std::vector<FocusPoint>> focus;
     std::optional<std::pair<int, int>> resize;  // the viewport's new size (the stability suite)
-    int state = -1;                      // index into states when the frame is scored, else -1
+    int state = -1;                             // index into states when the frame is scored, else -1
   };
-  std::vector<Frame> frames;             // frame f (from 1) is frames[f - 1]
-  std::vector<Scene> states;             // the scene as each scored frame shows it
-  int lastEditFrame = 0;                 // 0: the scenario edits nothing
+  std::vector<Frame> frames;  // frame f (from 1) is frames[f - 1]
+  std::vector<Scene> states;  // the scene as each scored frame shows it
+  int lastEditFrame = 0;      // 0: the scenario edits nothing
 };
 // Scores frames 1 and 10 (the summary's), every `every`-th frame and every frame from the last
 // edit on.
@@ -113,8 +113,7 @@ struct Targets {
   std::vector<std::uint8_t> affected, rest;
   std::size_t affectedCount = 0;
 };
-Result<Targets> prepareTargets(const Plan& plan, References& refs,
-                               const std::function<void(int done, int total)>& progress = {});
+Result<Targets> prepareTargets(const Plan& plan, References& refs, const std::function<void(int done, int total)>& progress = {});
 
 // One frame's figures. Scores are NaN on frames that are not scored (and affected ones when the
 // scenario changed no pixel).
@@ -194,25 +193,24 @@ struct StabilityOptions {
 };
 
 struct StabilityFigure {
-  std::string method;    // or the variant of the extreme case ("Q=1", "T=8 3840x2160", ...)
-  double value = NAN;    // the case's figure
+  std::string method;  // or the variant of the extreme case ("Q=1", "T=8 3840x2160", ...)
+  double value = NAN;  // the case's figure
   double threshold = NAN;
   bool pass = false;
-  std::string detail;    // what else was measured (tiles never served, ...)
-  std::string broken;    // an invariant that broke; empty: none
+  std::string detail;  // what else was measured (tiles never served, ...)
+  std::string broken;  // an invariant that broke; empty: none
 };
 
 struct StabilityResult {
   std::string name, description, figure;  // figure: what the value measures
-  std::size_t affected = 0;                // pixels the case changes
+  std::size_t affected = 0;               // pixels the case changes
   std::vector<StabilityFigure> figures;
 };
 
 // ghosting, burst, off-screen, behind-camera, fill-screen, camera-mid-pass, resize-mid-pass,
 // light-global, mirror-only, offscreen-shadow, extreme.
 std::vector<std::string> stabilityCaseNames();
-Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& scene, const StabilityOptions& options,
-                                         References& refs,
+Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& scene, const StabilityOptions& options, References& refs,
                                          const std::function<void(const std::string& what)>& progress = {});
 
 }  // namespace retile::eval

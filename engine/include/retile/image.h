@@ -16,13 +16,13 @@ namespace retile {
 struct RenderImage {
   int width = 0;
   int height = 0;
-  std::vector<float> color;          // RGB, linear scene-referred
-  std::vector<float> albedo;         // RGB of the first hit
-  std::vector<float> normal;         // XYZ world-space shading normal of the first hit
-  std::vector<float> depth;          // distance to the first hit; +inf for the background
-  std::vector<NodeId> objectId;      // object of the first hit; kNoNode for the background
-  std::vector<float> sampleCount;    // samples accumulated per pixel
-  std::vector<float> moment2;        // mean of the samples' squared luminance (with the mean: variance)
+  std::vector<float> color;        // RGB, linear scene-referred
+  std::vector<float> albedo;       // RGB of the first hit
+  std::vector<float> normal;       // XYZ world-space shading normal of the first hit
+  std::vector<float> depth;        // distance to the first hit; +inf for the background
+  std::vector<NodeId> objectId;    // object of the first hit; kNoNode for the background
+  std::vector<float> sampleCount;  // samples accumulated per pixel
+  std::vector<float> moment2;      // mean of the samples' squared luminance (with the mean: variance)
   // RGB as displayed: the denoised layer and the raw accumulation composed with soft borders
   // (DenoiseWork). Empty when nothing was composed: then `color` is what is shown.
   std::vector<float> display;
@@ -43,7 +43,6 @@ struct DisplaySettings {
 // EXR: linear half-float R,G,B (the shown image: denoised when it was) plus raw.* (the
 // accumulation, when denoised), albedo.*, N.*, Z and id channels. PNG: 8-bit through the
 // display transform. Chosen by extension; written atomically (temporary file, then rename).
-Result<bool> writeRenderImage(const RenderImage& image, const std::filesystem::path& file,
-                              const DisplaySettings& display = {});
+Result<bool> writeRenderImage(const RenderImage& image, const std::filesystem::path& file, const DisplaySettings& display = {});
 
 }  // namespace retile

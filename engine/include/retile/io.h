@@ -25,8 +25,8 @@ struct ImportOptions {
 
 struct ImportedScene {
   Scene scene;
-  std::string format;                  // "tungsten", "assimp:gltf", "native", ...
-  std::vector<std::string> warnings;   // missing textures, dropped NaN vertices, substitutes
+  std::string format;                 // "tungsten", "assimp:gltf", "native", ...
+  std::vector<std::string> warnings;  // missing textures, dropped NaN vertices, substitutes
 };
 
 // Chooses the importer by content and extension: native (.retile), Tungsten/Bitterli JSON

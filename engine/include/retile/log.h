@@ -29,10 +29,16 @@ std::string cat(const Args&... args) {
 }
 
 template <class... Args>
-void logInfo(const Args&... args) { logMessage(LogLevel::Info, cat(args...)); }
+void logInfo(const Args&... args) {
+  logMessage(LogLevel::Info, cat(args...));
+}
 template <class... Args>
-void logWarning(const Args&... args) { logMessage(LogLevel::Warning, cat(args...)); }
+void logWarning(const Args&... args) {
+  logMessage(LogLevel::Warning, cat(args...));
+}
 template <class... Args>
-void logDebug(const Args&... args) { logMessage(LogLevel::Debug, cat(args...)); }
+void logDebug(const Args&... args) {
+  logMessage(LogLevel::Debug, cat(args...));
+}
 
 }  // namespace retile

@@ -39,9 +39,7 @@ constexpr Vec3 operator/(Vec3 a, float s) { return {a.x / s, a.y / s, a.z / s}; 
 constexpr Vec3& operator+=(Vec3& a, Vec3 b) { return a = a + b; }
 constexpr Vec3& operator*=(Vec3& a, float s) { return a = a * s; }
 constexpr float dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-constexpr Vec3 cross(Vec3 a, Vec3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
+constexpr Vec3 cross(Vec3 a, Vec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 inline float length(Vec3 a) { return std::sqrt(dot(a, a)); }
 inline Vec3 normalize(Vec3 a) {
   float l = length(a);
@@ -62,8 +60,14 @@ constexpr float degrees(float rad) { return rad * (180.0f / kPi); }
 struct Bounds3 {
   Vec3 lo{std::numeric_limits<float>::infinity()};
   Vec3 hi{-std::numeric_limits<float>::infinity()};
-  void grow(Vec3 p) { lo = min(lo, p); hi = max(hi, p); }
-  void grow(const Bounds3& b) { lo = min(lo, b.lo); hi = max(hi, b.hi); }
+  void grow(Vec3 p) {
+    lo = min(lo, p);
+    hi = max(hi, p);
+  }
+  void grow(const Bounds3& b) {
+    lo = min(lo, b.lo);
+    hi = max(hi, b.hi);
+  }
   bool empty() const { return lo.x > hi.x || lo.y > hi.y || lo.z > hi.z; }
   Vec3 center() const { return (lo + hi) * 0.5f; }
   Vec3 extent() const { return hi - lo; }

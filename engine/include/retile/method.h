@@ -24,17 +24,17 @@ bool methodFromName(const std::string& name, MethodKind* out);
 std::vector<std::string> methodNames();
 
 struct FocusPoint {
-  Vec2 pixel{0.0f};     // image position; for a following point, its offset is kept from the PoC
+  Vec2 pixel{0.0f};      // image position; for a following point, its offset is kept from the PoC
   bool follows = false;  // follows the edited object's screen motion (reflections) or stays (shadows)
 };
 
 struct MethodSettings {
   MethodKind kind = MethodKind::Spiral;
-  int tileSize = 16;     // T: 8, 16 or 32
-  int quality = 64;      // Q >= 1 samples per pixel of a served tile; 0 = automatic (indirection)
-  bool smooth = false;   // smooth transition: tiles after the prioritized ones keep capped stale sums
-  int staleCap = 8;      // smooth: stale samples kept per pixel; the old image's weight after n
-                         // frames of fresh samples at q each is staleCap / (staleCap + n q)
+  int tileSize = 16;              // T: 8, 16 or 32
+  int quality = 64;               // Q >= 1 samples per pixel of a served tile; 0 = automatic (indirection)
+  bool smooth = false;            // smooth transition: tiles after the prioritized ones keep capped stale sums
+  int staleCap = 8;               // smooth: stale samples kept per pixel; the old image's weight after n
+                                  // frames of fresh samples at q each is staleCap / (staleCap + n q)
   std::vector<FocusPoint> focus;  // up to 3
   int indirectionFrames = 4;      // frames over which the indirection counters are gathered
   // Denoising (schedule/denoise_regions.h): the global method and continuous refinement denoise
@@ -44,7 +44,7 @@ struct MethodSettings {
   // 1920 wide is about a tenth).
   bool denoise = false;
   double denoiseThreshold = 0.1;
-  bool softBorders = true;  // with denoise: seams between tiles showing different things blend
+  bool softBorders = true;                  // with denoise: seams between tiles showing different things blend
   static constexpr int kFeatherPixels = 4;  // over this many pixels each side
   // Verified reuse (schedule/reuse.h): a restarted tile keeps its samples beside the fresh ones
   // while a test finds them in agreement. The false-reject rate is the chance that one test of

@@ -51,8 +51,7 @@ double psnrHvsM(MetricImage a, MetricImage ref, const std::uint8_t* mask = nullp
 // pass the same test (pooling finds small changes spread over many noisy pixels). 1 marks a
 // changed pixel. Both references are linear renders of the same size with moment2 and
 // sampleCount (Renderer::render fills them).
-std::vector<std::uint8_t> affectedPixels(const RenderImage& before, const RenderImage& after, double z = 4.0,
-                                         double relative = 0.01);
+std::vector<std::uint8_t> affectedPixels(const RenderImage& before, const RenderImage& after, double z = 4.0, double relative = 0.01);
 
 // Two linear renders of the same view compared the way Retile is checked against another renderer
 // (issue 15): both averaged over aligned block x block squares (partial ones at the right and

@@ -55,13 +55,13 @@ enum TileShows : std::uint32_t {
 
 // The denoiser and the compositor in one frame (schedule/denoise_regions.h decides what).
 struct DenoiseWork {
-  bool compose = false;  // compose the displayed image (RenderImage::display) from the codes below
-  bool filter = false;   // denoise the domain first (into the layer, for tiles with kShowWriteLayer)
+  bool compose = false;                     // compose the displayed image (RenderImage::display) from the codes below
+  bool filter = false;                      // denoise the domain first (into the layer, for tiles with kShowWriteLayer)
   int x = 0, y = 0, width = 0, height = 0;  // the domain, pixels
   int tileSize = 16;
   std::vector<std::uint32_t> tileCodes;  // per tile of tileSize: TileShows
-  int featherPixels = 0;  // soft borders: seams between tiles showing different things blend over this
-  bool timePasses = false;  // measure each pass on the device (FrameStats::denoisePasses); benchmarks
+  int featherPixels = 0;                 // soft borders: seams between tiles showing different things blend over this
+  bool timePasses = false;               // measure each pass on the device (FrameStats::denoisePasses); benchmarks
 };
 
 // The whole image denoised (global + denoise, continuous refinement, `retile render --denoise`).
@@ -75,8 +75,8 @@ DenoiseWork wholeFrameDenoise(int width, int height, int tileSize = 16);
 int offlineSamplesPerFrame(int width, int height);
 
 struct FrameOptions {
-  bool accumulate = true;    // false: trace only (a probe); readbackFrameLuminance() gives the result
-  int selectionTileSize = 0; // > 0: count what the tracer sees of the selection per tile of this size
+  bool accumulate = true;     // false: trace only (a probe); readbackFrameLuminance() gives the result
+  int selectionTileSize = 0;  // > 0: count what the tracer sees of the selection per tile of this size
   // Paths each trace invocation runs one after another; 0 chooses from the last frame's cost.
   // Fixed by tests and benchmarks: which invocation traces a sample never changes its value.
   int pathsPerInvocation = 0;
@@ -107,12 +107,12 @@ struct SelectionCounts {
 inline constexpr std::uint32_t kTraceLoopBudget = 30000;
 
 struct FrameStats {
-  std::uint64_t samples = 0;       // path samples traced this frame
+  std::uint64_t samples = 0;  // path samples traced this frame
   std::uint64_t primaryRays = 0;
   std::uint64_t bounceRays = 0;
   std::uint64_t shadowRays = 0;
-  double seconds = 0;              // wall time from submitting the frame until it was seen complete
-                                   // (trace + accumulate on the device, when waited for at once)
+  double seconds = 0;  // wall time from submitting the frame until it was seen complete
+                       // (trace + accumulate on the device, when waited for at once)
   // lavapipe stops the loops of eight lock-stepped invocations after about 32767 of the loop
   // iterations the trace pass counts (trace.comp); paths end before that, at kTraceLoopBudget.
   std::uint32_t maxLoopIterations = 0;  // the most any one invocation counted (exact for its eight)
@@ -121,7 +121,7 @@ struct FrameStats {
   // The most one path segment (a ray, its shading and shadow ray, for the eight) counted: paths
   // stop when the count passes kTraceLoopBudget, so this must stay below the ~2700 left to the limit.
   std::uint32_t maxSegmentIterations = 0;
-  double pathsPerInvocation = 0;        // each invocation traces this many paths one after another
+  double pathsPerInvocation = 0;  // each invocation traces this many paths one after another
   // With DenoiseWork::timePasses: the device's time for each denoiser pass, in record order.
   struct PassTime {
     const char* name;
@@ -139,11 +139,11 @@ struct FrameTicket {
 };
 
 struct RenderRequest {
-  int width = 0, height = 0;       // 0: the scene's settings
-  int samplesPerPixel = 0;         // 0: the scene's settings
-  int maxBounces = -1;             // -1: the scene's settings
+  int width = 0, height = 0;  // 0: the scene's settings
+  int samplesPerPixel = 0;    // 0: the scene's settings
+  int maxBounces = -1;        // -1: the scene's settings
   std::uint32_t seed = 0;
-  bool denoise = false;            // the result's display is the whole frame denoised
+  bool denoise = false;  // the result's display is the whole frame denoised
 };
 
 class Renderer {
@@ -193,8 +193,7 @@ class Renderer {
   // frames of offlineSamplesPerFrame(W, H) each, then read back. `progress` gets (samples per
   // pixel done, total) after each frame and may return false to stop early.
   // Uses the scene last given to setScene/updateScene.
-  RenderImage render(const RenderRequest& request, const std::function<bool(int, int)>& progress = {},
-                     FrameStats* total = nullptr);
+  RenderImage render(const RenderRequest& request, const std::function<bool(int, int)>& progress = {}, FrameStats* total = nullptr);
 
   // Device memory held by the scene's buffers (BVH included), and triangles, for the benchmarks.
   std::uint64_t sceneDeviceBytes() const;

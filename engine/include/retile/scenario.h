@@ -36,10 +36,10 @@ namespace retile {
 
 struct ScenarioStep {
   enum class Kind { Select, Move, Wait, Material, Light, Camera, Focus } kind = Kind::Wait;
-  std::string target;           // object, material or light name
+  std::string target;                   // object, material or light name
   std::vector<std::string> candidates;  // select: names to try in order
   int frames = 1;
-  Vec3 vector{0.0f};            // move: per frame
+  Vec3 vector{0.0f};  // move: per frame
   std::optional<float> roughness, ior, intensity;
   std::optional<Vec3> albedo, emission, color, position;
   std::optional<Vec3> cameraPosition, cameraTarget;
@@ -60,7 +60,7 @@ Result<Scenario> loadScenario(const std::filesystem::path& file);
 // What one frame of a step does: edits to apply, and for select and focus steps their values.
 struct StepEdits {
   std::vector<Edit> edits;
-  std::optional<NodeId> select;             // a select step
+  std::optional<NodeId> select;                  // a select step
   std::optional<std::vector<FocusPoint>> focus;  // a focus step
 };
 // The edits of frame `frameInStep` (from 0) of a step, against `scene` as it is now (focus points

@@ -58,9 +58,9 @@ struct Texture {
   NodeId id = kNoNode;
   std::string name;
   TextureKind kind = TextureKind::File;
-  std::filesystem::path path;           // File: absolute, or relative to Scene::baseDirectory
-  std::vector<std::uint8_t> encoded;    // Embedded: the file's bytes (PNG, JPEG, ...)
-  std::string encodedFormat;            // Embedded: a file extension hint such as "png"
+  std::filesystem::path path;         // File: absolute, or relative to Scene::baseDirectory
+  std::vector<std::uint8_t> encoded;  // Embedded: the file's bytes (PNG, JPEG, ...)
+  std::string encodedFormat;          // Embedded: a file extension hint such as "png"
   TextureColorSpace colorSpace = TextureColorSpace::Auto;
   MissingTexture whenMissing = MissingTexture::Checker;
   // How a bitmap is read between and beyond its texels: bilinear, or the nearest texel (a Tungsten
@@ -154,7 +154,7 @@ struct Material {
   MaterialType type = MaterialType::Lambert;
   Vec3 albedo{0.8f};
   NodeId albedoTexture = kNoNode;
-  float roughness = 0.1f;          // microfacet alpha for rough types; sigma for Oren-Nayar; hair: its cones' width
+  float roughness = 0.1f;  // microfacet alpha for rough types; sigma for Oren-Nayar; hair: its cones' width
   // (Tungsten's roughness: the R lobe's angular deviation is pi / 2 times it, at least 0.04)
   // Rough types: the microfacet distribution. GGX's long tails are the default; Beckmann for
   // files that ask for it (Tungsten's "distribution": "beckmann"), drawn as Tungsten draws it.
@@ -167,7 +167,7 @@ struct Material {
   // there it is its thickness (Tungsten's textured thickness), which scales both its absorption
   // (coatingAbsorption) and its film (filmThickness) point by point.
   NodeId roughnessTexture = kNoNode;
-  float ior = 1.5f;                // dielectric index (plastic coating, glass, thin sheet)
+  float ior = 1.5f;  // dielectric index (plastic coating, glass, thin sheet)
   // Glass as Tungsten has it (its dielectric and rough_dielectric): albedo tints the reflection
   // as well as the transmission, and radiance is not scaled by (n_t / n_i)^2 where it crosses
   // the surface. The two agree on light that passes in and out again; they differ where a path
@@ -188,8 +188,8 @@ struct Material {
   // enable_interference, over its thickness times 500): the sheet's reflectance then varies by
   // channel (red, green and blue taken at 650, 510 and 475 nm) and with the angle. 0: none.
   float filmThickness = 0.0f;
-  float transmittance = 0.5f;      // diffuse transmission: the share of albedo passed through
-  float diffuseRatio = 0.2f;       // Phong: the share of albedo reflected as Lambert (Tungsten's default)
+  float transmittance = 0.5f;  // diffuse transmission: the share of albedo passed through
+  float diffuseRatio = 0.2f;   // Phong: the share of albedo reflected as Lambert (Tungsten's default)
   // A clear coat over this material (Tungsten's smooth_coat): a smooth dielectric layer of index
   // coatIor (0: none) that reflects by Fresnel and through which the material is seen with both
   // directions refracted, dimmed inside by exp(-coatAbsorption (1 / cos + 1 / cos)) (sigma_a
@@ -218,8 +218,8 @@ struct Material {
            (maxComponent(interiorAbsorption) > 0 || maxComponent(interiorScattering) > 0);
   }
   bool coated() const { return coatIor > 1.0f; }
-  std::string metal = "Cu";        // conductors: a named metal (see conductorNames) or "custom"
-  Vec3 eta{0.2f, 0.92f, 1.1f};     // conductors with metal == "custom"
+  std::string metal = "Cu";     // conductors: a named metal (see conductorNames) or "custom"
+  Vec3 eta{0.2f, 0.92f, 1.1f};  // conductors with metal == "custom"
   Vec3 k{3.9f, 2.45f, 2.14f};
   // The front's emitted radiance is emission times emissionStrength: the colour, and a strength
   // that at 0 turns the light off and keeps its colour (importers leave the strength at 1).
@@ -231,8 +231,8 @@ struct Material {
   // the whole hemisphere; less, a spot with a hard edge (Tungsten's disk cone_angle). Seen from
   // outside the cone the emitter is dark, and light samples from there find nothing.
   float emissionCone = 90.0f;
-  float alpha = 1.0f;              // coverage; < 1 or an alpha texture makes a cut-out
-  NodeId alphaTexture = kNoNode;   // its alpha channel, else the mean of its channels
+  float alpha = 1.0f;             // coverage; < 1 or an alpha texture makes a cut-out
+  NodeId alphaTexture = kNoNode;  // its alpha channel, else the mean of its channels
   // Tilts the shading normal by the slope of this texture's value (the mean of its channels), as
   // Tungsten's bump maps do (BitmapTexture::derivatives: the difference across two texels); the
   // slope is scaled by bumpStrength.
@@ -321,15 +321,15 @@ struct Camera {
 enum class EnvironmentType { Constant, Map, Sky };
 struct Environment {
   EnvironmentType type = EnvironmentType::Constant;
-  Vec3 color{0.0f};                   // Constant: radiance; Map: multiplier
+  Vec3 color{0.0f};  // Constant: radiance; Map: multiplier
   float intensity = 1.0f;
-  NodeId map = kNoNode;               // Map: an equirectangular texture
-  float rotation = 0.0f;              // radians about +y
+  NodeId map = kNoNode;   // Map: an equirectangular texture
+  float rotation = 0.0f;  // radians about +y
   // The map's own frame (its up is this matrix's y axis), turned by `rotation` about +y after it.
   // Identity but for tilted skies from imports (a Tungsten infinite_sphere rotated about x or z,
   // or given an "up"); only its rotation part counts.
   Mat4 orientation;
-  Vec3 zenith{0.35f, 0.55f, 0.95f};   // Sky: a gradient from zenith to horizon, ground below
+  Vec3 zenith{0.35f, 0.55f, 0.95f};  // Sky: a gradient from zenith to horizon, ground below
   Vec3 horizon{0.9f, 0.92f, 0.95f};
   Vec3 ground{0.3f, 0.28f, 0.25f};
   // The medium that fills the world outside every glass and boundary (fog, haze; a Tungsten
@@ -419,7 +419,7 @@ struct RenderSettings {
   // New scenes (the built-in one, glTF/OBJ/FBX imports): Blackman-Harris 1.5 px, as Blender.
   PixelFilter pixelFilter = PixelFilter::BlackmanHarris;
   float filterWidth = 1.5f;
-  FilterSampling filterSampling = FilterSampling::Exact;  // Tungsten scene files: Tungsten
+  FilterSampling filterSampling = FilterSampling::Exact;      // Tungsten scene files: Tungsten
   ShadingConvention shading = ShadingConvention::Consistent;  // Tungsten files: what their integrator asks
   Roulette roulette = Roulette::Standard;                     // Tungsten files: Tungsten's
   RayOffset rayOffset = RayOffset::Robust;                    // Tungsten files: Tungsten's
@@ -444,7 +444,9 @@ class Scene {
 
   NodeId newId() { return nextId_++; }
   NodeId peekNextId() const { return nextId_; }
-  void reserveIds(NodeId next) { if (next > nextId_) nextId_ = next; }
+  void reserveIds(NodeId next) {
+    if (next > nextId_) nextId_ = next;
+  }
 
   Mesh* mesh(NodeId id);
   const Mesh* mesh(NodeId id) const;

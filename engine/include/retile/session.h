@@ -25,9 +25,7 @@ struct RegionRect {
   int x = 0, y = 0, width = 0, height = 0;
   bool empty() const { return width <= 0 || height <= 0; }
   // Whether the rectangle (x, y, w, h) shares a pixel with this region.
-  bool overlaps(int ox, int oy, int ow, int oh) const {
-    return ox < x + width && x < ox + ow && oy < y + height && y < oy + oh;
-  }
+  bool overlaps(int ox, int oy, int ow, int oh) const { return ox < x + width && x < ox + ow && oy < y + height && y < oy + oh; }
 };
 
 // A denoised region of the displayed image (schedule/denoise_regions.h).
@@ -46,26 +44,26 @@ struct FrameRecord {
   int staleCap = 0;
   int width = 0, height = 0;
   int tileSize = 0, cols = 0, rows = 0;
-  int quality = 0;                    // Q of the current pass (automatic Q resolved)
-  Vec2 pointOfChange{0.0f};           // image position of the last edit's point of change
-  std::vector<Vec2> pointsOfChange;   // of every edit of the last batch (planned together)
-  std::vector<Vec2> focus;            // focus points in use (followed ones moved)
+  int quality = 0;                   // Q of the current pass (automatic Q resolved)
+  Vec2 pointOfChange{0.0f};          // image position of the last edit's point of change
+  std::vector<Vec2> pointsOfChange;  // of every edit of the last batch (planned together)
+  std::vector<Vec2> focus;           // focus points in use (followed ones moved)
   NodeId selection = kNoNode;
-  std::vector<float> tilePriority;    // per tile: 1 at the head of the queue to 0 at its end; -1 unqueued
-  std::vector<std::uint8_t> tileClass;  // indirection: 0 high, 1 middle, 2 low, 3 rest; else empty
-  std::vector<float> tileSamples;     // per tile: mean samples per pixel since its last restart
-  std::vector<int> servedTiles;       // tiles traced this frame, in order
-  RegionRect region;                  // the render region (empty: the whole image is rendered)
+  std::vector<float> tilePriority;       // per tile: 1 at the head of the queue to 0 at its end; -1 unqueued
+  std::vector<std::uint8_t> tileClass;   // indirection: 0 high, 1 middle, 2 low, 3 rest; else empty
+  std::vector<float> tileSamples;        // per tile: mean samples per pixel since its last restart
+  std::vector<int> servedTiles;          // tiles traced this frame, in order
+  RegionRect region;                     // the render region (empty: the whole image is rendered)
   std::vector<DenoisedRegion> denoised;  // stacked denoised regions, oldest (innermost) first; empty: none
   // Verified reuse, per tile (empty without reuse): 0 no history, 1 reusing its history, 2 history
   // rejected; and for rejected tiles the frame that rejected it (else 0).
   std::vector<std::uint8_t> tileReuse;
   std::vector<std::uint64_t> tileRejectedAt;
   int reusedTiles = 0, rejectedTiles = 0;
-  std::size_t queueLength = 0;        // tiles in the current pass
-  std::size_t queueServed = 0;        // tiles of the pass finished
-  std::uint64_t samples = 0;          // samples traced this frame: width x height, a preview's fewer
-  int block = 1;                      // > 1: a preview while edits come, a sample per block x block pixels
+  std::size_t queueLength = 0;  // tiles in the current pass
+  std::size_t queueServed = 0;  // tiles of the pass finished
+  std::uint64_t samples = 0;    // samples traced this frame: width x height, a preview's fewer
+  int block = 1;                // > 1: a preview while edits come, a sample per block x block pixels
   double scheduleMs = 0, traceMs = 0, readbackMs = 0, frameMs = 0;
   std::shared_ptr<const RenderImage> image;  // the accumulated image after this frame (may be null)
 };
@@ -134,7 +132,6 @@ class RenderSession {
   std::size_t framesInFlight() const;  // submitted and not finished
   // Renderer::prepareMoves: the render thread calls it once its first frame is out.
   void prepareMoves();
-
 
  private:
   // Waits for the frame in flight and takes what planning needs from it (counters, the probe).

@@ -14,8 +14,7 @@ namespace retile {
 
 // Reads a whole file; fails with a message naming the file when it is missing, unreadable, a
 // directory, or larger than maxBytes.
-Result<std::string> readFile(const std::filesystem::path& path,
-                             std::uint64_t maxBytes = std::uint64_t(1) << 32);
+Result<std::string> readFile(const std::filesystem::path& path, std::uint64_t maxBytes = std::uint64_t(1) << 32);
 
 // Writes `bytes` to a temporary file beside `path`, flushes it to disk and renames it over
 // `path`, so a crash or a full disk never leaves a half-written file in its place.
@@ -30,8 +29,7 @@ std::filesystem::path temporarySibling(const std::filesystem::path& path);
 // Finds a file named by a scene: accepts either path separator and matches every component
 // case-insensitively when the exact name does not exist (files made on Windows name textures
 // TEST.PNG while the disk holds test.png). Returns nullopt when nothing matches.
-std::optional<std::filesystem::path> resolveScenePath(const std::filesystem::path& base,
-                                                      std::string_view reference);
+std::optional<std::filesystem::path> resolveScenePath(const std::filesystem::path& base, std::string_view reference);
 
 std::string lowercase(std::string_view s);
 std::string extensionLower(const std::filesystem::path& path);  // without the dot

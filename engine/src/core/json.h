@@ -63,9 +63,7 @@ class Value {
   void set(std::string key, Value value);
 
  private:
-  std::variant<std::monostate, bool, double, std::string, std::shared_ptr<Array>,
-               std::shared_ptr<Object>>
-      v_;
+  std::variant<std::monostate, bool, double, std::string, std::shared_ptr<Array>, std::shared_ptr<Object>> v_;
 };
 
 const char* typeName(Value::Type t);

@@ -11,8 +11,7 @@ std::mutex gMutex;
 std::atomic<int> gMinimum{static_cast<int>(LogLevel::Warning)};
 
 void stderrSink(LogLevel level, std::string_view message) {
-  std::fprintf(stderr, "retile: %s: %.*s\n", logLevelName(level), static_cast<int>(message.size()),
-               message.data());
+  std::fprintf(stderr, "retile: %s: %.*s\n", logLevelName(level), static_cast<int>(message.size()), message.data());
 }
 
 LogSink& sink() {
@@ -24,10 +23,14 @@ LogSink& sink() {
 
 const char* logLevelName(LogLevel level) {
   switch (level) {
-    case LogLevel::Debug: return "debug";
-    case LogLevel::Info: return "info";
-    case LogLevel::Warning: return "warning";
-    case LogLevel::Error: return "error";
+    case LogLevel::Debug:
+      return "debug";
+    case LogLevel::Info:
+      return "info";
+    case LogLevel::Warning:
+      return "warning";
+    case LogLevel::Error:
+      return "error";
   }
   return "?";
 }

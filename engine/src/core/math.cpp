@@ -198,8 +198,8 @@ Trs decompose(const Mat4& m) {
 }
 
 Mat4 compose(const Trs& t) {
-  return Mat4::translate(t.translation) * Mat4::rotateZ(radians(t.rotationDegrees.z)) *
-         Mat4::rotateY(radians(t.rotationDegrees.y)) * Mat4::rotateX(radians(t.rotationDegrees.x)) * Mat4::scale(t.scale);
+  return Mat4::translate(t.translation) * Mat4::rotateZ(radians(t.rotationDegrees.z)) * Mat4::rotateY(radians(t.rotationDegrees.y)) *
+         Mat4::rotateX(radians(t.rotationDegrees.x)) * Mat4::scale(t.scale);
 }
 
 Bounds3 transformBounds(const Mat4& m, const Bounds3& b) {

@@ -54,14 +54,29 @@ KeepDenormals::~KeepDenormals() {
 std::string signalDescription(int sig) {
   const char* name = "";
   switch (sig) {
-    case SIGSEGV: name = "SIGSEGV"; break;
-    case SIGABRT: name = "SIGABRT"; break;
-    case SIGBUS: name = "SIGBUS"; break;
-    case SIGFPE: name = "SIGFPE"; break;
-    case SIGILL: name = "SIGILL"; break;
-    case SIGKILL: name = "SIGKILL"; break;
-    case SIGXCPU: name = "SIGXCPU"; break;
-    default: break;
+    case SIGSEGV:
+      name = "SIGSEGV";
+      break;
+    case SIGABRT:
+      name = "SIGABRT";
+      break;
+    case SIGBUS:
+      name = "SIGBUS";
+      break;
+    case SIGFPE:
+      name = "SIGFPE";
+      break;
+    case SIGILL:
+      name = "SIGILL";
+      break;
+    case SIGKILL:
+      name = "SIGKILL";
+      break;
+    case SIGXCPU:
+      name = "SIGXCPU";
+      break;
+    default:
+      break;
   }
   const char* what = strsignal(sig);
   return *name ? cat(name, " (", what ? what : "?", ")") : cat("signal ", sig, " (", what ? what : "?", ")");
@@ -73,8 +88,7 @@ std::filesystem::path executableDirectory() {
   return ec ? std::filesystem::path() : exe.parent_path();
 }
 
-ChildResult runChild(const std::filesystem::path& program, const std::vector<std::string>& args,
-                     const ChildLimits& limits) {
+ChildResult runChild(const std::filesystem::path& program, const std::vector<std::string>& args, const ChildLimits& limits) {
   ChildResult result;
   int outPipe[2], errPipe[2];
   if (::pipe2(outPipe, O_CLOEXEC) != 0) {

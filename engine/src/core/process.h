@@ -21,15 +21,14 @@ struct ChildResult {
   bool started = false;
   bool timedOut = false;
   bool outputTooLarge = false;
-  int exitCode = -1;      // valid when the child exited normally
-  int signal = 0;         // non-zero when a signal killed it
-  std::string out;        // everything the child wrote to stdout
-  std::string err;        // and to stderr
-  std::string startError; // why it could not be started
+  int exitCode = -1;       // valid when the child exited normally
+  int signal = 0;          // non-zero when a signal killed it
+  std::string out;         // everything the child wrote to stdout
+  std::string err;         // and to stderr
+  std::string startError;  // why it could not be started
 };
 
-ChildResult runChild(const std::filesystem::path& program, const std::vector<std::string>& args,
-                     const ChildLimits& limits);
+ChildResult runChild(const std::filesystem::path& program, const std::vector<std::string>& args, const ChildLimits& limits);
 
 // Human-readable name of a signal, e.g. "SIGSEGV (segmentation fault)".
 std::string signalDescription(int sig);

@@ -38,8 +38,7 @@ Options Options::quick() {
 std::vector<std::string> builtInScenarioNames() { return {"fig6", "material", "light", "camera", "drag"}; }
 
 std::vector<std::string> defaultMethods() {
-  return {"global",         "spiral",         "focus",         "indirection", "change", "spiral+smooth",
-          "global+denoise", "spiral+denoise", "spiral+reuse"};
+  return {"global", "spiral", "focus", "indirection", "change", "spiral+smooth", "global+denoise", "spiral+denoise", "spiral+reuse"};
 }
 
 Result<MethodSettings> parseMethodLabel(const std::string& label) {
@@ -54,11 +53,16 @@ Result<MethodSettings> parseMethodLabel(const std::string& label) {
   }
   if (!methodFromName(parts[0], &m.kind)) return R::failure(cat("unknown method '", parts[0], "' in '", label, "'"));
   for (std::size_t i = 1; i < parts.size(); ++i) {
-    if (parts[i] == "smooth") m.smooth = true;
-    else if (parts[i] == "denoise") m.denoise = true;
-    else if (parts[i] == "reuse") m.reuse = true;
-    else if (parts[i] == "focus" && m.kind == MethodKind::Indirection) m.kind = MethodKind::IndirectionFocus;
-    else return R::failure(cat("unknown option '", parts[i], "' in method '", label, "' (smooth, denoise, reuse)"));
+    if (parts[i] == "smooth")
+      m.smooth = true;
+    else if (parts[i] == "denoise")
+      m.denoise = true;
+    else if (parts[i] == "reuse")
+      m.reuse = true;
+    else if (parts[i] == "focus" && m.kind == MethodKind::Indirection)
+      m.kind = MethodKind::IndirectionFocus;
+    else
+      return R::failure(cat("unknown option '", parts[i], "' in method '", label, "' (smooth, denoise, reuse)"));
   }
   if (m.kind == MethodKind::Indirection || m.kind == MethodKind::IndirectionFocus) m.quality = 0;
   if (std::string bad = validateMethodSettings(m); !bad.empty()) return R::failure(cat(label, ": ", bad));
@@ -70,7 +74,7 @@ namespace {
 struct Projected {
   float fraction = 0;  // of the image covered by the projected bounds, clipped
   Vec2 centre{0.0f};
-  float height = 0;    // of the clipped projected bounds, pixels
+  float height = 0;  // of the clipped projected bounds, pixels
 };
 
 std::optional<Projected> project(const Scene& s, const Bounds3& b) {
@@ -228,8 +232,7 @@ std::vector<Case> builtInScenarios(const Scene& scene, const Options& o, const s
     } else {
       Case c;
       c.name = "light";
-      c.description = cat("A light edit: '", what, "' turns warmer and 1.5 times as strong, then ", o.restFrames,
-                          " frames at rest.");
+      c.description = cat("A light edit: '", what, "' turns warmer and 1.5 times as strong, then ", o.restFrames, " frames at rest.");
       c.script.converge = std::max(o.converge / 4, 1);
       c.script.steps = {edit, rest};
       out.push_back(std::move(c));
@@ -238,8 +241,8 @@ std::vector<Case> builtInScenarios(const Scene& scene, const Options& o, const s
   if (wanted("camera")) {
     Case c;
     c.name = "camera";
-    c.description = cat("A camera move: the camera orbits its target by 0.5 degrees a frame for ", o.cameraFrames,
-                        " frames, then ", o.restFrames, " frames at rest.");
+    c.description = cat("A camera move: the camera orbits its target by 0.5 degrees a frame for ", o.cameraFrames, " frames, then ",
+                        o.restFrames, " frames at rest.");
     c.script.converge = std::max(o.converge / 4, 1);
     const Vec3 target = scene.camera.target, offset = scene.camera.position - target;
     for (int f = 1; f <= o.cameraFrames; ++f) {
@@ -265,8 +268,8 @@ std::vector<Case> builtInScenarios(const Scene& scene, const Options& o, const s
       move.kind = ScenarioStep::Kind::Move;
       move.vector = right * (size * 0.02f);
       move.frames = o.dragFrames;
-      c.description = cat("A continuous drag: '", shown(*subject), "' slides sideways by a fiftieth of its size a frame for ",
-                          o.dragFrames, " frames, then ", o.restFrames, " frames at rest.");
+      c.description = cat("A continuous drag: '", shown(*subject), "' slides sideways by a fiftieth of its size a frame for ", o.dragFrames,
+                          " frames, then ", o.restFrames, " frames at rest.");
       c.script.converge = std::max(o.converge / 4, 1);
       c.script.steps = {select, focus, move, rest};
       out.push_back(std::move(c));
@@ -362,8 +365,8 @@ Result<RenderImage> readReference(const std::filesystem::path& file, int width, 
   std::ifstream in(file, std::ios::binary);
   char magic[8];
   std::int32_t wh[2];
-  if (!in.read(magic, 8) || std::memcmp(magic, kMagic, 8) != 0 || !in.read(reinterpret_cast<char*>(wh), sizeof wh) ||
-      wh[0] != width || wh[1] != height)
+  if (!in.read(magic, 8) || std::memcmp(magic, kMagic, 8) != 0 || !in.read(reinterpret_cast<char*>(wh), sizeof wh) || wh[0] != width ||
+      wh[1] != height)
     return Result<RenderImage>::failure(cat(file.string(), ": not a reference of ", width, "x", height));
   RenderImage img;
   img.width = width;
@@ -514,8 +517,7 @@ Result<Run> runMethod(const Plan& plan, const Targets& targets, const MethodSett
   auto t0 = Clock::now();
   for (int f = 0; f < plan.converge; ++f) session.renderFrame(false);
   run.convergeMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-  std::uint64_t budget = static_cast<std::uint64_t>(plan.start.settings.width) *
-                         static_cast<std::uint64_t>(plan.start.settings.height);
+  std::uint64_t budget = static_cast<std::uint64_t>(plan.start.settings.width) * static_cast<std::uint64_t>(plan.start.settings.height);
   double ms = 0;
   std::uint64_t samples = 0;
   for (std::size_t i = 0; i < plan.frames.size(); ++i) {
@@ -580,8 +582,10 @@ Summary summarize(const Run& run, double target) {
   for (const FrameScore& fs : run.frames) {
     if (!fs.scored()) continue;
     double e = std::isnan(fs.relRmseAffected) ? fs.relRmse : fs.relRmseAffected;
-    if (!(e <= target)) from = nullptr;
-    else if (!from) from = &fs;
+    if (!(e <= target))
+      from = nullptr;
+    else if (!from)
+      from = &fs;
   }
   if (from) {
     s.framesToTarget = from->frame;
@@ -608,11 +612,10 @@ std::string metricsCsvHeader() {
 }
 
 std::string metricsCsvRow(const Run& r, const FrameScore& f) {
-  return cat(r.scenario, ",", r.scene, ",", r.method, ",", f.frame, ",", num(f.ms, 3), ",", f.samples, ",",
-             num(f.rmse, 6), ",", num(f.psnr, 3), ",", num(f.ssim, 5), ",", num(f.psnrHvsM, 3), ",",
-             num(f.rmseAffected, 6), ",", num(f.rmseRest, 6), ",", num(f.psnrAffected, 3), ",", num(f.psnrRest, 3), ",",
-             num(f.relRmse, 5), ",", num(f.relRmseAffected, 5), ",", num(f.frameMs, 3), ",", f.mode, ",", f.quality, ",",
-             f.servedTiles, ",", f.denoiseRegions, "\n");
+  return cat(r.scenario, ",", r.scene, ",", r.method, ",", f.frame, ",", num(f.ms, 3), ",", f.samples, ",", num(f.rmse, 6), ",",
+             num(f.psnr, 3), ",", num(f.ssim, 5), ",", num(f.psnrHvsM, 3), ",", num(f.rmseAffected, 6), ",", num(f.rmseRest, 6), ",",
+             num(f.psnrAffected, 3), ",", num(f.psnrRest, 3), ",", num(f.relRmse, 5), ",", num(f.relRmseAffected, 5), ",",
+             num(f.frameMs, 3), ",", f.mode, ",", f.quality, ",", f.servedTiles, ",", f.denoiseRegions, "\n");
 }
 
 std::string summaryCsvHeader() {

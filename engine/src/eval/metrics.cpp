@@ -14,8 +14,7 @@ namespace retile {
 namespace {
 
 void checkSizes(MetricImage a, MetricImage ref) {
-  RETILE_ASSERT(a.width == ref.width && a.height == ref.height && a.width >= 0 && a.height >= 0,
-                "metrics compare images of the same size");
+  RETILE_ASSERT(a.width == ref.width && a.height == ref.height && a.width >= 0 && a.height >= 0, "metrics compare images of the same size");
   RETILE_ASSERT((a.rgb && ref.rgb) || a.width * a.height == 0, "metrics need pixels");
 }
 
@@ -24,8 +23,7 @@ bool masked(const std::uint8_t* mask, std::size_t pixel) { return !mask || mask[
 std::vector<double> luma(MetricImage im, double scale) {
   const std::size_t n = static_cast<std::size_t>(im.width) * static_cast<std::size_t>(im.height);
   std::vector<double> y(n);
-  for (std::size_t i = 0; i < n; ++i)
-    y[i] = scale * (0.299 * im.rgb[3 * i] + 0.587 * im.rgb[3 * i + 1] + 0.114 * im.rgb[3 * i + 2]);
+  for (std::size_t i = 0; i < n; ++i) y[i] = scale * (0.299 * im.rgb[3 * i] + 0.587 * im.rgb[3 * i + 1] + 0.114 * im.rgb[3 * i + 2]);
   return y;
 }
 
@@ -95,8 +93,7 @@ double maskingOf(const Block& pixels, const Block& coefficients) {
       if (u != 0 || v != 0) energy += coefficients[u][v] * coefficients[u][v] * maskWeight(u, v);
   double activity = spread(pixels, 0, 0, 8);
   if (activity != 0)
-    activity = (spread(pixels, 0, 0, 4) + spread(pixels, 0, 4, 4) + spread(pixels, 4, 4, 4) + spread(pixels, 4, 0, 4)) /
-               activity;
+    activity = (spread(pixels, 0, 0, 4) + spread(pixels, 0, 4, 4) + spread(pixels, 4, 4, 4) + spread(pixels, 4, 0, 4)) / activity;
   return std::sqrt(energy * activity) / 32.0;
 }
 
@@ -118,13 +115,9 @@ double meanSquaredError(MetricImage a, MetricImage ref, const std::uint8_t* mask
   return count ? sum / (3.0 * static_cast<double>(count)) : 0.0;
 }
 
-double rootMeanSquaredError(MetricImage a, MetricImage ref, const std::uint8_t* mask) {
-  return std::sqrt(meanSquaredError(a, ref, mask));
-}
+double rootMeanSquaredError(MetricImage a, MetricImage ref, const std::uint8_t* mask) { return std::sqrt(meanSquaredError(a, ref, mask)); }
 
-double psnr(MetricImage a, MetricImage ref, const std::uint8_t* mask) {
-  return toDecibels(meanSquaredError(a, ref, mask), 1.0);
-}
+double psnr(MetricImage a, MetricImage ref, const std::uint8_t* mask) { return toDecibels(meanSquaredError(a, ref, mask), 1.0); }
 
 double ssim(MetricImage a, MetricImage ref, const std::uint8_t* mask) {
   checkSizes(a, ref);
@@ -391,15 +384,15 @@ BlockNoise blockNoise(MetricImage a, MetricImage b, MetricImage ref, int block, 
       for (std::size_t c = 0; c < 3; ++c) channel[c] += ref.rgb[3 * i + c];
     }
     for (std::size_t c = 0; c < 3; ++c) norm += (channel[c] / n) * (channel[c] / n);  // as compareBlocks normalises
-    if (in.size() < 2) continue;  // no spread to estimate a noise from
+    if (in.size() < 2) continue;                                                      // no spread to estimate a noise from
     // Per channel and in luminance (c = 3): A - B has twice our pixel variance; Ref - (A + B) / 2
     // has the reference's plus half ours.
     double ours[4], theirs[4];
     for (std::size_t c = 0; c < 4; ++c) {
       auto value = [c](MetricImage im, std::size_t i) { return c < 3 ? double(im.rgb[3 * i + c]) : pixelLuminance(im, i); };
       ours[c] = 0.5 * spread(in, [&](std::size_t i) { return value(a, i) - value(b, i); });
-      theirs[c] = std::max(0.0, spread(in, [&](std::size_t i) { return value(ref, i) - 0.5 * (value(a, i) + value(b, i)); }) -
-                                    0.5 * ours[c]);
+      theirs[c] =
+          std::max(0.0, spread(in, [&](std::size_t i) { return value(ref, i) - 0.5 * (value(a, i) + value(b, i)); }) - 0.5 * ours[c]);
     }
     for (std::size_t c = 0; c < 3; ++c) {
       varOurs += ours[c] / n;

@@ -109,8 +109,8 @@ Result<Scenario> parseScenario(const std::string& text, const std::string& name)
       s.kind = ScenarioStep::Kind::Light;
       s.target = str("light");
       std::optional<Vec3> move;
-      ok = r.vec3("move", &move) && r.vec3("color", &s.color) && r.number("intensity", &s.intensity) &&
-           r.vec3("position", &s.position) && r.frames(&s.frames, 1);
+      ok = r.vec3("move", &move) && r.vec3("color", &s.color) && r.number("intensity", &s.intensity) && r.vec3("position", &s.position) &&
+           r.frames(&s.frames, 1);
       if (move) s.vector = *move;
     } else if (const Value* c = v.find("camera")) {
       s.kind = ScenarioStep::Kind::Camera;
@@ -188,8 +188,9 @@ Result<StepEdits> stepEdits(const ScenarioStep& step, int frameInStep, const Sce
       return out;
     case K::Move: {
       const Object* o = step.target.empty() ? scene.object(selection) : objectByName(scene, step.target);
-      if (!o) return R::failure(step.target.empty() ? std::string("move: nothing is selected")
-                                                    : cat("move: no object named '", step.target, "'"));
+      if (!o)
+        return R::failure(step.target.empty() ? std::string("move: nothing is selected")
+                                              : cat("move: no object named '", step.target, "'"));
       Object moved = *o;
       moved.transform = Mat4::translate(step.vector) * o->transform;
       out.edits.push_back(SetObject{moved});

@@ -11,8 +11,8 @@
 namespace retile::eval {
 
 std::vector<std::string> stabilityCaseNames() {
-  return {"ghosting",        "burst",           "off-screen",   "behind-camera", "fill-screen",      "camera-mid-pass",
-          "resize-mid-pass", "light-global",    "mirror-only",  "offscreen-shadow", "extreme"};
+  return {"ghosting",        "burst",        "off-screen",  "behind-camera",    "fill-screen", "camera-mid-pass",
+          "resize-mid-pass", "light-global", "mirror-only", "offscreen-shadow", "extreme"};
 }
 
 namespace {
@@ -95,8 +95,8 @@ bool allFinite(const std::vector<float>& v) {
 
 }  // namespace
 
-Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& sceneIn, const StabilityOptions& o,
-                                         References& refs, const std::function<void(const std::string&)>& progress) {
+Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& sceneIn, const StabilityOptions& o, References& refs,
+                                         const std::function<void(const std::string&)>& progress) {
   using R = Result<StabilityResult>;
   StabilityResult out;
   out.name = name;
@@ -129,8 +129,8 @@ Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& s
   // The frame whose figure counts is the last one unless a case says otherwise.
   if (name == "ghosting") {
     if (auto r = needSubject(); !r) return R::failure(r.error());
-    out.description = cat("A drag at Q=512 of '", subject->name, "' by its own size over 10 frames, larger than the ",
-                          W * H / 512, " pixels refreshed per frame; the figure 20 frames after the drag: what is left "
+    out.description = cat("A drag at Q=512 of '", subject->name, "' by its own size over 10 frames, larger than the ", W * H / 512,
+                          " pixels refreshed per frame; the figure 20 frames after the drag: what is left "
                           "of it at its old positions.");
     for (auto& v : variants) v.method.quality = 512;
     b.plan.selection = subject->id;
@@ -169,12 +169,12 @@ Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& s
       for (int f = 0; f < 5; ++f)
         if (auto r = b.frame({moved(*b.now.object(subject->id), (to - box.center()) * 0.2f)}); !r) return R::failure(r.error());
     } else {
-      out.description = cat("'", subject->name, "' grows about its centre until it fills the frame; the figure 40 "
+      out.description = cat("'", subject->name,
+                            "' grows about its centre until it fills the frame; the figure 40 "
                             "frames later.");
       Object grown = *subject;
       const float k = std::max(2.0f, 2.0f * distance / std::max(size, 1e-6f));
-      grown.transform = Mat4::translate(box.center()) * Mat4::scale(Vec3{k}) * Mat4::translate(box.center() * -1.0f) *
-                        subject->transform;
+      grown.transform = Mat4::translate(box.center()) * Mat4::scale(Vec3{k}) * Mat4::translate(box.center() * -1.0f) * subject->transform;
       if (auto r = b.frame({SetObject{grown}}); !r) return R::failure(r.error());
     }
     b.rest(40);
@@ -185,15 +185,16 @@ Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& s
     if (auto r = b.frame({moved(*subject, scene.camera.up * (size * 0.1f))}); !r) return R::failure(r.error());
     b.rest(2);
     if (name == "camera-mid-pass") {
-      out.description = cat("'", subject->name, "' moves, and 3 frames into the pass the camera orbits 3 degrees; the "
+      out.description = cat("'", subject->name,
+                            "' moves, and 3 frames into the pass the camera orbits 3 degrees; the "
                             "figure 40 frames later.");
       Camera c = scene.camera;
       c.position = c.target + Mat4::rotateY(radians(3.0f)).transformVector(c.position - c.target);
       if (auto r = b.frame({SetCamera{c}}); !r) return R::failure(r.error());
     } else {
       const int w2 = W * 3 / 4 + 1, h2 = H * 3 / 4 + 1;
-      out.description = cat("'", subject->name, "' moves, and 3 frames into the pass the viewport is resized to ", w2, "x",
-                            h2, " (odd sizes); the figure 40 frames later, whole image.");
+      out.description = cat("'", subject->name, "' moves, and 3 frames into the pass the viewport is resized to ", w2, "x", h2,
+                            " (odd sizes); the figure 40 frames later, whole image.");
       b.resize(w2, h2);
     }
     b.rest(40);
@@ -217,7 +218,8 @@ Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& s
         }
       }
     if (step.target.empty()) return R::failure(cat(name, ": the scene has no light or emitter"));
-    out.description = cat("'", step.target, "' becomes 1.5 times as strong: every lit pixel changes; the figure 60 "
+    out.description = cat("'", step.target,
+                          "' becomes 1.5 times as strong: every lit pixel changes; the figure 60 "
                           "frames later.");
     auto e = stepEdits(step, 0, scene, kNoNode);
     if (!e) return R::failure(e.error());
@@ -247,8 +249,9 @@ Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& s
     const Object* hidden = objectNamed(base, "Hidden Sphere");
     if (!hidden) return R::failure(cat(name, ": the added sphere is missing"));
     b.plan.selection = hidden->id;
-    out.description = "A mirror is put between the camera and its target and a sphere behind the camera; the sphere's "
-                      "material changes colour, seen only in the mirror; the figure 20 frames later.";
+    out.description =
+        "A mirror is put between the camera and its target and a sphere behind the camera; the sphere's "
+        "material changes colour, seen only in the mirror; the figure 20 frames later.";
     Material m = *base.material(hidden->material);
     m.albedo = {0.8f, 0.1f, 0.6f};
     if (auto r = b.frame({SetMaterial{m}}); !r) return R::failure(r.error());
@@ -265,9 +268,10 @@ Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& s
     const Object* hidden = objectNamed(base, "Shadow Caster");
     if (!hidden) return R::failure(cat(name, ": the added sphere is missing"));
     b.plan.selection = hidden->id;
-    out.description = "A sphere above the frame, seen only by its shadow on the floor, moves sideways over 10 frames "
-                      "(built-in scene; it is the selection, as when picked in the outliner); the figure 10 frames "
-                      "later.";
+    out.description =
+        "A sphere above the frame, seen only by its shadow on the floor, moves sideways over 10 frames "
+        "(built-in scene; it is the selection, as when picked in the outliner); the figure 10 frames "
+        "later.";
     for (int f = 0; f < 10; ++f)
       if (auto r = b.frame({moved(*b.now.object(hidden->id), Vec3{0.04f, 0, 0})}); !r) return R::failure(r.error());
     b.rest(10);

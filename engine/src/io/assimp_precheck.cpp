@@ -20,9 +20,15 @@ namespace fs = std::filesystem;
 // Extensions Debian's Assimp 5.2.5 implements (its glTF2 importer; Draco through libdraco).
 // A file that requires any other one cannot be shown as its author intended.
 const std::set<std::string, std::less<>> kSupportedGltfExtensions = {
-    "KHR_materials_pbrSpecularGlossiness", "KHR_materials_unlit",    "KHR_lights_punctual",
-    "KHR_texture_transform",               "KHR_materials_sheen",    "KHR_materials_clearcoat",
-    "KHR_materials_transmission",          "KHR_materials_volume",   "KHR_materials_ior",
+    "KHR_materials_pbrSpecularGlossiness",
+    "KHR_materials_unlit",
+    "KHR_lights_punctual",
+    "KHR_texture_transform",
+    "KHR_materials_sheen",
+    "KHR_materials_clearcoat",
+    "KHR_materials_transmission",
+    "KHR_materials_volume",
+    "KHR_materials_ior",
     "KHR_draco_mesh_compression",
 };
 
@@ -63,7 +69,8 @@ Result<std::vector<std::string>> checkGltf(const fs::path& file, bool binary) {
       auto v = parseVersion(mv->asString());
       if (!v) return Result<std::vector<std::string>>::failure(cat("asset.minVersion '", mv->asString(), "' is not a version number"));
       if (*v > std::make_pair(2, 0))
-        return Result<std::vector<std::string>>::failure(cat("the file needs glTF ", mv->asString(), " or later (asset.minVersion); this importer reads glTF 2.0"));
+        return Result<std::vector<std::string>>::failure(
+            cat("the file needs glTF ", mv->asString(), " or later (asset.minVersion); this importer reads glTF 2.0"));
     }
   }
   if (const json::Value* req = root->find("extensionsRequired"); req && req->isArray()) {
@@ -73,8 +80,8 @@ Result<std::vector<std::string>> checkGltf(const fs::path& file, bool binary) {
     if (!missing.empty()) {
       std::string list;
       for (const auto& m : missing) list += (list.empty() ? "" : ", ") + m;
-      return Result<std::vector<std::string>>::failure(cat("the file requires the glTF extension", missing.size() > 1 ? "s " : " ", list,
-                       ", which this importer does not implement"));
+      return Result<std::vector<std::string>>::failure(
+          cat("the file requires the glTF extension", missing.size() > 1 ? "s " : " ", list, ", which this importer does not implement"));
     }
   }
   return std::vector<std::string>{};
@@ -99,8 +106,10 @@ std::vector<std::string> checkObj(const fs::path& file) {
   std::vector<std::string> libraries;
   std::string line;
   while (std::getline(in, line)) {
-    if (startsWithKeyword(line, "mtllib")) libraries.push_back(restOfLine(line, 6));
-    else if (startsWithKeyword(line, "usemtl")) used.insert(restOfLine(line, 6));
+    if (startsWithKeyword(line, "mtllib"))
+      libraries.push_back(restOfLine(line, 6));
+    else if (startsWithKeyword(line, "usemtl"))
+      used.insert(restOfLine(line, 6));
   }
   std::set<std::string, std::less<>> defined;
   for (const auto& lib : libraries) {
@@ -121,8 +130,8 @@ std::vector<std::string> checkObj(const fs::path& file) {
     std::string list;
     for (std::size_t i = 0; i < unknown.size() && i < 5; ++i) list += (i ? ", '" : "'") + unknown[i] + "'";
     if (unknown.size() > 5) list += cat(" and ", unknown.size() - 5, " more");
-    warnings.push_back(cat("usemtl names material", unknown.size() > 1 ? "s " : " ", list,
-                           " that no material library defines; shown as default grey"));
+    warnings.push_back(
+        cat("usemtl names material", unknown.size() > 1 ? "s " : " ", list, " that no material library defines; shown as default grey"));
   }
   return warnings;
 }

@@ -76,8 +76,7 @@ struct Converter {
       t.kind = TextureKind::File;
       t.name = fs::path(ref).filename().string();
       t.path = ref;
-      if (!resolveScenePath(file.parent_path(), ref))
-        warn(cat("texture '", ref, "' not found; it will render as a magenta checker"));
+      if (!resolveScenePath(file.parent_path(), ref)) warn(cat("texture '", ref, "' not found; it will render as a magenta checker"));
     }
     scene.textures.push_back(t);
     textureIds[key] = t.id;
@@ -150,8 +149,7 @@ struct Converter {
     } else {
       aiColor4D spec;
       float shininess = 0;
-      bool hasSpec = mat->Get(AI_MATKEY_COLOR_SPECULAR, spec) == AI_SUCCESS &&
-                     std::max({spec.r, spec.g, spec.b}) > 0.01f;
+      bool hasSpec = mat->Get(AI_MATKEY_COLOR_SPECULAR, spec) == AI_SUCCESS && std::max({spec.r, spec.g, spec.b}) > 0.01f;
       if (hasSpec) {
         m.type = MaterialType::RoughPlastic;
         mat->Get(AI_MATKEY_SHININESS, shininess);
@@ -181,8 +179,7 @@ struct Converter {
     float opacity = 1;
     aiString alphaMode;
     // glTF copies baseColorFactor.a into opacity even for OPAQUE materials, where it means nothing.
-    bool opaqueGltf = gltf && !(mat->Get(AI_MATKEY_GLTF_ALPHAMODE, alphaMode) == AI_SUCCESS &&
-                                std::string(alphaMode.C_Str()) != "OPAQUE");
+    bool opaqueGltf = gltf && !(mat->Get(AI_MATKEY_GLTF_ALPHAMODE, alphaMode) == AI_SUCCESS && std::string(alphaMode.C_Str()) != "OPAQUE");
     if (!opaqueGltf && mat->Get(AI_MATKEY_OPACITY, opacity) == AI_SUCCESS && std::isfinite(opacity) && opacity < 0.999f) {
       int illum = 0;
       mat->Get("$mat.illum", 0, 0, illum);  // OBJ illumination model; 4, 6, 7 and 9 are glass
@@ -209,7 +206,9 @@ struct Converter {
       if (mat->Get(AI_MATKEY_VOLUME_THICKNESS_FACTOR, thickness) == AI_SUCCESS && thickness > 0 &&
           mat->Get(AI_MATKEY_VOLUME_ATTENUATION_DISTANCE, distance) == AI_SUCCESS && std::isfinite(distance) && distance > 0 &&
           mat->Get(AI_MATKEY_VOLUME_ATTENUATION_COLOR, color) == AI_SUCCESS) {
-        auto absorption = [&](float turned) { return std::isfinite(turned) ? -std::log(std::clamp(turned, 1e-6f, 1.0f)) / distance : 0.0f; };
+        auto absorption = [&](float turned) {
+          return std::isfinite(turned) ? -std::log(std::clamp(turned, 1e-6f, 1.0f)) / distance : 0.0f;
+        };
         m.interiorAbsorption = Vec3{absorption(color.r), absorption(color.g), absorption(color.b)};
       }
     }
@@ -265,17 +264,14 @@ struct Converter {
     if (!am || !am->mVertices || am->mNumVertices == 0 || !am->mFaces || am->mNumFaces == 0) return kNoNode;
     auto g = std::make_shared<MeshGeometry>();
     g->positions.resize(am->mNumVertices);
-    for (unsigned v = 0; v < am->mNumVertices; ++v)
-      g->positions[v] = {am->mVertices[v].x, am->mVertices[v].y, am->mVertices[v].z};
+    for (unsigned v = 0; v < am->mNumVertices; ++v) g->positions[v] = {am->mVertices[v].x, am->mVertices[v].y, am->mVertices[v].z};
     if (am->mNormals) {
       g->normals.resize(am->mNumVertices);
-      for (unsigned v = 0; v < am->mNumVertices; ++v)
-        g->normals[v] = {am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z};
+      for (unsigned v = 0; v < am->mNumVertices; ++v) g->normals[v] = {am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z};
     }
     if (am->mTextureCoords[0]) {
       g->uvs.resize(am->mNumVertices);
-      for (unsigned v = 0; v < am->mNumVertices; ++v)
-        g->uvs[v] = {am->mTextureCoords[0][v].x, am->mTextureCoords[0][v].y};
+      for (unsigned v = 0; v < am->mNumVertices; ++v) g->uvs[v] = {am->mTextureCoords[0][v].x, am->mTextureCoords[0][v].y};
     }
     std::size_t skipped = 0;
     for (unsigned f = 0; f < am->mNumFaces; ++f) {
@@ -288,7 +284,9 @@ struct Converter {
     }
     if (skipped) warn(cat("mesh ", index, ": skipped ", skipped, " faces that are not triangles"));
     std::size_t dropped = sanitizeGeometry(*g);
-    if (dropped) warn(cat("mesh ", index, " ('", am->mName.C_Str(), "'): dropped ", dropped, " triangles with NaN, infinite or out-of-range vertices"));
+    if (dropped)
+      warn(
+          cat("mesh ", index, " ('", am->mName.C_Str(), "'): dropped ", dropped, " triangles with NaN, infinite or out-of-range vertices"));
     if (g->indices.empty()) return kNoNode;
     Mesh m;
     m.id = scene.newId();
@@ -316,13 +314,17 @@ struct Converter {
       l.direction = normalize(world.transformVector({al->mDirection.x, al->mDirection.y, al->mDirection.z}));
       if (length(l.direction) == 0) l.direction = {0, -1, 0};
       switch (al->mType) {
-        case aiLightSource_POINT: l.type = LightType::Point; break;
+        case aiLightSource_POINT:
+          l.type = LightType::Point;
+          break;
         case aiLightSource_SPOT:
           l.type = LightType::Spot;
           l.spotAngle = std::isfinite(al->mAngleOuterCone) ? std::clamp(al->mAngleOuterCone, 0.01f, kPi / 2) : radians(30);
           l.spotBlend = std::isfinite(al->mAngleInnerCone) ? std::clamp(1 - al->mAngleInnerCone / l.spotAngle, 0.0f, 1.0f) : 0.1f;
           break;
-        case aiLightSource_DIRECTIONAL: l.type = LightType::Directional; break;
+        case aiLightSource_DIRECTIONAL:
+          l.type = LightType::Directional;
+          break;
         default:
           warn(cat("light '", l.name, "' is of a type we do not render (area/ambient); skipped"));
           continue;
@@ -445,9 +447,8 @@ Result<std::string> convertWithAssimp(const fs::path& file) {
   // Files without normals get smooth ones, but not across hard edges: Assimp's default of 175
   // degrees rounds a box's corners into its faces (the Cornell box's blocks shade wrongly).
   importer.SetPropertyFloat(AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, 60.0f);
-  unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_SortByPType |
-                   aiProcess_JoinIdenticalVertices | aiProcess_GenSmoothNormals | aiProcess_FindInvalidData |
-                   aiProcess_FindDegenerates;
+  unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_JoinIdenticalVertices |
+                   aiProcess_GenSmoothNormals | aiProcess_FindInvalidData | aiProcess_FindDegenerates;
   const aiScene* ai = importer.ReadFile(file.string(), flags);
   if (!ai) {
     std::string why = importer.GetErrorString();

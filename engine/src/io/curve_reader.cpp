@@ -44,7 +44,8 @@ CurveResult readHair(const std::filesystem::path& path, const std::string& d) {
   char magic[4];
   std::uint32_t strands = 0, points = 0, fields = 0, defaultSegments = 0;
   float defaultThickness = 0, defaultTransparency = 0, defaultColor[3];
-  if (!in.read(&magic) || std::memcmp(magic, "HAIR", 4) != 0) return CurveResult::failure(cat(name, ": not a .hair file (no HAIR signature)"));
+  if (!in.read(&magic) || std::memcmp(magic, "HAIR", 4) != 0)
+    return CurveResult::failure(cat(name, ": not a .hair file (no HAIR signature)"));
   if (!in.read(&strands) || !in.read(&points) || !in.read(&fields) || !in.read(&defaultSegments) || !in.read(&defaultThickness) ||
       !in.read(&defaultTransparency) || !in.read(&defaultColor) || in.left() < 88)
     return CurveResult::failure(cat(name, ": truncated header"));
@@ -53,7 +54,9 @@ CurveResult readHair(const std::filesystem::path& path, const std::string& d) {
   if (!hasPoints) return CurveResult::failure(cat(name, ": the file has no points"));
   // What the arrays need, checked before anything is allocated.
   const std::uint64_t need = (hasSegments ? 2ull * strands : 0) + 12ull * points + (hasThickness ? 4ull * points : 0);
-  if (need > in.left()) return CurveResult::failure(cat(name, ": truncated (", strands, " strands and ", points, " points need ", need, " bytes, ", in.left(), " follow the header)"));
+  if (need > in.left())
+    return CurveResult::failure(
+        cat(name, ": truncated (", strands, " strands and ", points, " points need ", need, " bytes, ", in.left(), " follow the header)"));
   CurveSet c;
   c.ends.resize(strands);
   std::uint64_t total = 0;
@@ -89,9 +92,11 @@ CurveResult readFiber(const std::filesystem::path& path, const std::string& d) {
   if (!in.read(&magic) || magic != kMagic) return CurveResult::failure(cat(name, ": not a .fiber file (no FIBER signature)"));
   if (!in.read(&major) || !in.read(&minor) || !in.read(&content) || !in.read(&headerLength) || !in.read(&vertices) || !in.read(&curves))
     return CurveResult::failure(cat(name, ": truncated header"));
-  if (major != 1 || content != 0) return CurveResult::failure(cat(name, ": fiber version ", major, " content type ", content, " is not supported (1, 0)"));
+  if (major != 1 || content != 0)
+    return CurveResult::failure(cat(name, ": fiber version ", major, " content type ", content, " is not supported (1, 0)"));
   // Every vertex has its position in the file, and every curve its count.
-  if (vertices > d.size() / 12 || curves > d.size() / 2) return CurveResult::failure(cat(name, ": ", vertices, " vertices and ", curves, " curves cannot fit in ", d.size(), " bytes"));
+  if (vertices > d.size() / 12 || curves > d.size() / 2)
+    return CurveResult::failure(cat(name, ": ", vertices, " vertices and ", curves, " curves cannot fit in ", d.size(), " bytes"));
   CurveSet c;
   std::vector<std::uint16_t> counts;
   std::uint64_t offset = headerLength;
@@ -121,8 +126,7 @@ CurveResult readFiber(const std::filesystem::path& path, const std::string& d) {
       using T = std::remove_pointer_t<decltype(out)>;
       const std::uint64_t present = dataLength / sizeof(T);
       if (present == 0) return false;
-      for (std::uint64_t i = 0; i < elements; ++i)
-        std::memcpy(&out[i], data + std::min(i, present - 1) * sizeof(T), sizeof(T));
+      for (std::uint64_t i = 0; i < elements; ++i) std::memcpy(&out[i], data + std::min(i, present - 1) * sizeof(T), sizeof(T));
       return true;
     };
     if (attribute == "num_vertices" && perCurve && type == 3 && perElement == 1) {
@@ -158,9 +162,9 @@ Result<CurveSet> readCurves(const std::filesystem::path& path, std::vector<std::
   auto data = readFile(path, options.maxFileBytes);
   if (!data) return CurveResult::failure(data.error());
   const std::string ext = extensionLower(path);
-  CurveResult read = ext == "hair" ? readHair(path, data.value())
-           : ext == "fiber" ? readFiber(path, data.value())
-                            : CurveResult::failure(cat(path.string(), ": unsupported curve format '.", ext, "' (hair or fiber)"));
+  CurveResult read = ext == "hair"    ? readHair(path, data.value())
+                     : ext == "fiber" ? readFiber(path, data.value())
+                                      : CurveResult::failure(cat(path.string(), ": unsupported curve format '.", ext, "' (hair or fiber)"));
   if (!read) return read;
   CurveSet& c = read.value();
   // A strand with a node that is not finite is dropped whole (its spline would run off to
@@ -186,7 +190,8 @@ Result<CurveSet> readCurves(const std::filesystem::path& path, std::vector<std::
     }
     kept.ends.push_back(static_cast<std::uint32_t>(kept.positions.size()));
   }
-  if (dropped && warnings) warnings->push_back(cat(path.filename().string(), ": dropped ", dropped, " strands with a position that is not finite"));
+  if (dropped && warnings)
+    warnings->push_back(cat(path.filename().string(), ": dropped ", dropped, " strands with a position that is not finite"));
   if (radii && warnings) warnings->push_back(cat(path.filename().string(), ": ", radii, " negative or non-finite radii taken as 0"));
   return kept;
 }

@@ -16,7 +16,6 @@ namespace retile {
 // fit its size or each other, or that has no positions fails with a message naming the file; a
 // strand with a node that is not finite is dropped, and a radius that is negative or not finite
 // becomes 0, each with a warning.
-Result<CurveSet> readCurves(const std::filesystem::path& path, std::vector<std::string>* warnings,
-                            const ImportOptions& options = {});
+Result<CurveSet> readCurves(const std::filesystem::path& path, std::vector<std::string>* warnings, const ImportOptions& options = {});
 
 }  // namespace retile

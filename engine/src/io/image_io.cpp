@@ -158,8 +158,7 @@ LinearImage TextureImage::toLinear() && {
   }
   const std::array<float, 256> colour = byteValues();
   out.rgba.resize(rgba8.size());
-  for (std::size_t i = 0; i < rgba8.size(); ++i)
-    out.rgba[i] = i % 4 == 3 ? static_cast<float>(rgba8[i]) / 255.0f : colour[rgba8[i]];
+  for (std::size_t i = 0; i < rgba8.size(); ++i) out.rgba[i] = i % 4 == 3 ? static_cast<float>(rgba8[i]) / 255.0f : colour[rgba8[i]];
   rgba8 = {};
   return out;
 }
@@ -200,9 +199,13 @@ Result<TextureImage> loadTexture(const Texture& tex, const fs::path& base, const
     case TextureColorSpace::TungstenGamma:
       if (!dec.isFloat) tungstenGamma(img);
       break;
-    case TextureColorSpace::SRGB: srgb = true; break;
+    case TextureColorSpace::SRGB:
+      srgb = true;
+      break;
     case TextureColorSpace::Linear:
-    case TextureColorSpace::Raw: srgb = false; break;
+    case TextureColorSpace::Raw:
+      srgb = false;
+      break;
     case TextureColorSpace::Auto:
       // Integer data is encoded unless its file says linear: OpenImageIO tags a PPM "Rec709" (the
       // transfer curve of its standard, not linear light), which the sRGB curve decodes closely.

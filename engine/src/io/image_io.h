@@ -32,10 +32,10 @@ struct TextureImage {
   enum class Curve { Linear, SRGB };
   int width = 0;
   int height = 0;
-  bool hasAlpha = false;             // the file had an alpha channel (else alpha is 1 / 255)
-  std::vector<std::uint8_t> rgba8;   // when not empty: RGBA, row 0 at the top
-  Curve curve = Curve::Linear;       // of rgba8's colour
-  std::vector<float> rgba;           // otherwise: linear RGBA
+  bool hasAlpha = false;            // the file had an alpha channel (else alpha is 1 / 255)
+  std::vector<std::uint8_t> rgba8;  // when not empty: RGBA, row 0 at the top
+  Curve curve = Curve::Linear;      // of rgba8's colour
+  std::vector<float> rgba;          // otherwise: linear RGBA
   bool eightBit() const { return !rgba8.empty(); }
   // What each byte value of rgba8's colour decodes to by `curve` (alpha is value / 255).
   std::array<float, 256> byteValues() const;
@@ -45,8 +45,7 @@ struct TextureImage {
 
 // Decodes a texture node's image (file or embedded). Colour conversion follows tex.colorSpace
 // (Auto: 8/16-bit integer formats are sRGB, float formats linear).
-Result<TextureImage> loadTexture(const Texture& tex, const std::filesystem::path& baseDirectory,
-                                 const ImageLimits& limits = {});
+Result<TextureImage> loadTexture(const Texture& tex, const std::filesystem::path& baseDirectory, const ImageLimits& limits = {});
 
 // Reads any image OIIO knows as linear floats without conversion (for tests and references).
 Result<LinearImage> readImageRaw(const std::filesystem::path& file, const ImageLimits& limits = {});

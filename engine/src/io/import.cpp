@@ -55,20 +55,18 @@ Result<ImportedScene> importAssimp(const fs::path& file, const ImportOptions& op
   limits.timeout = options.assimpTimeout;
   limits.addressSpaceBytes = options.assimpMemoryLimit;
   ChildResult child = runChild(worker, {fs::absolute(file).string()}, limits);
-  if (!child.started)
-    return R::failure(cat(file.string(), ": cannot start the import worker ", worker.string(), ": ", child.startError));
+  if (!child.started) return R::failure(cat(file.string(), ": cannot start the import worker ", worker.string(), ": ", child.startError));
   if (child.timedOut)
-    return R::failure(cat(file.string(), ": the importer did not finish within ",
-                          options.assimpTimeout.count() / 1000.0, " s and was stopped; nothing was loaded"));
+    return R::failure(cat(file.string(), ": the importer did not finish within ", options.assimpTimeout.count() / 1000.0,
+                          " s and was stopped; nothing was loaded"));
   if (child.outputTooLarge) return R::failure(cat(file.string(), ": the imported scene is too large"));
   if (child.signal)
     return R::failure(cat(file.string(), ": the Assimp importer crashed on this file (", signalDescription(child.signal),
                           "); it ran in a separate process, so nothing else was affected, and nothing was loaded"));
-  if (child.exitCode == 127)
-    return R::failure(cat(file.string(), ": cannot run the import worker ", worker.string()));
+  if (child.exitCode == 127) return R::failure(cat(file.string(), ": cannot run the import worker ", worker.string()));
   if (child.exitCode == 3)
-    return R::failure(cat(file.string(), ": the importer ran out of memory (limit ",
-                          options.assimpMemoryLimit >> 20, " MiB); nothing was loaded"));
+    return R::failure(
+        cat(file.string(), ": the importer ran out of memory (limit ", options.assimpMemoryLimit >> 20, " MiB); nothing was loaded"));
   if (child.exitCode != 0) {
     std::string why = firstLineWithPrefix(child.err, "error: ");
     if (why.empty()) why = firstLineWithPrefix(child.err, "assimp: ");

@@ -30,27 +30,38 @@ Value mat4(const Mat4& m) {
 
 const char* colorSpaceName(TextureColorSpace c) {
   switch (c) {
-    case TextureColorSpace::Auto: return "auto";
-    case TextureColorSpace::SRGB: return "srgb";
-    case TextureColorSpace::Linear: return "linear";
-    case TextureColorSpace::Raw: return "raw";
-    case TextureColorSpace::TungstenGamma: return "tungsten_gamma";
+    case TextureColorSpace::Auto:
+      return "auto";
+    case TextureColorSpace::SRGB:
+      return "srgb";
+    case TextureColorSpace::Linear:
+      return "linear";
+    case TextureColorSpace::Raw:
+      return "raw";
+    case TextureColorSpace::TungstenGamma:
+      return "tungsten_gamma";
   }
   return "auto";
 }
 const char* textureKindName(TextureKind k) {
   switch (k) {
-    case TextureKind::File: return "file";
-    case TextureKind::Embedded: return "embedded";
-    case TextureKind::Checker: return "checker";
+    case TextureKind::File:
+      return "file";
+    case TextureKind::Embedded:
+      return "embedded";
+    case TextureKind::Checker:
+      return "checker";
   }
   return "file";
 }
 const char* lightTypeName(LightType t) {
   switch (t) {
-    case LightType::Point: return "point";
-    case LightType::Spot: return "spot";
-    case LightType::Directional: return "directional";
+    case LightType::Point:
+      return "point";
+    case LightType::Spot:
+      return "spot";
+    case LightType::Directional:
+      return "directional";
   }
   return "point";
 }
@@ -80,46 +91,63 @@ class Reader {
   }
 
   void number(const char* key, float* out, bool required = false) {
-    field(key, [&](const Value& f) { return json::toFloat(f, out); }, "a finite number", required);
+    field(
+        key, [&](const Value& f) { return json::toFloat(f, out); }, "a finite number", required);
   }
   void integer(const char* key, int* out) {
-    field(key, [&](const Value& f) {
-      if (!f.isNumber() || f.asNumber() != std::floor(f.asNumber()) || std::abs(f.asNumber()) > 1e9) return false;
-      *out = static_cast<int>(f.asNumber());
-      return true;
-    }, "an integer");
+    field(
+        key,
+        [&](const Value& f) {
+          if (!f.isNumber() || f.asNumber() != std::floor(f.asNumber()) || std::abs(f.asNumber()) > 1e9) return false;
+          *out = static_cast<int>(f.asNumber());
+          return true;
+        },
+        "an integer");
   }
   void id(const char* key, NodeId* out, bool required = false) {
-    field(key, [&](const Value& f) {
-      if (!f.isNumber() || f.asNumber() < 0 || f.asNumber() > 9e15 || f.asNumber() != std::floor(f.asNumber())) return false;
-      *out = static_cast<NodeId>(f.asNumber());
-      return true;
-    }, "a node id", required);
+    field(
+        key,
+        [&](const Value& f) {
+          if (!f.isNumber() || f.asNumber() < 0 || f.asNumber() > 9e15 || f.asNumber() != std::floor(f.asNumber())) return false;
+          *out = static_cast<NodeId>(f.asNumber());
+          return true;
+        },
+        "a node id", required);
   }
   void vec3(const char* key, Vec3* out) {
-    field(key, [&](const Value& f) { return json::toVec3(f, out); }, "three numbers");
+    field(
+        key, [&](const Value& f) { return json::toVec3(f, out); }, "three numbers");
   }
   void boolean(const char* key, bool* out) {
-    field(key, [&](const Value& f) {
-      if (!f.isBool()) return false;
-      *out = f.asBool();
-      return true;
-    }, "true or false");
+    field(
+        key,
+        [&](const Value& f) {
+          if (!f.isBool()) return false;
+          *out = f.asBool();
+          return true;
+        },
+        "true or false");
   }
   void string(const char* key, std::string* out, bool required = false) {
-    field(key, [&](const Value& f) {
-      if (!f.isString()) return false;
-      *out = f.asString();
-      return true;
-    }, "a string", required);
+    field(
+        key,
+        [&](const Value& f) {
+          if (!f.isString()) return false;
+          *out = f.asString();
+          return true;
+        },
+        "a string", required);
   }
   void matrix(const char* key, Mat4* out) {
-    field(key, [&](const Value& f) {
-      if (!f.isArray() || f.asArray().size() != 16) return false;
-      for (int i = 0; i < 16; ++i)
-        if (!json::toFloat(f.asArray()[static_cast<std::size_t>(i)], &out->m[i / 4][i % 4])) return false;
-      return true;
-    }, "16 numbers");
+    field(
+        key,
+        [&](const Value& f) {
+          if (!f.isArray() || f.asArray().size() != 16) return false;
+          for (int i = 0; i < 16; ++i)
+            if (!json::toFloat(f.asArray()[static_cast<std::size_t>(i)], &out->m[i / 4][i % 4])) return false;
+          return true;
+        },
+        "16 numbers");
   }
   template <class T>
   void blob(const char* key, std::vector<T>* out) {
@@ -157,43 +185,49 @@ const char* materialName(MaterialType t) { return materialTypeName(t); }
 
 namespace {
 
-Value nativeSceneToJson(const Scene& s) {
-  Value root(json::Object{});
-  root.set("format", kFormatTag);
-  root.set("version", kNativeFormatVersion);
-  root.set("next_id", s.peekNextId());
+// Each item of `items` written by toJson, in order.
+template <class T, class F>
+json::Array arrayOf(const std::vector<T>& items, F toJson) {
+  json::Array a;
+  for (const T& x : items) a.push_back(toJson(x));
+  return a;
+}
 
+Value settingsToJson(const RenderSettings& r) {
   Value settings(json::Object{});
-  settings.set("width", s.settings.width);
-  settings.set("height", s.settings.height);
-  settings.set("max_bounces", s.settings.maxBounces);
+  settings.set("width", r.width);
+  settings.set("height", r.height);
+  settings.set("max_bounces", r.maxBounces);
   // Written only where they are not the defaults, as files from before them have neither.
-  if (s.settings.minBounces != 0) settings.set("min_bounces", s.settings.minBounces);
-  if (!s.settings.lightSampling) settings.set("light_sampling", false);
-  settings.set("spp", s.settings.samplesPerPixel);
-  settings.set("seed", s.settings.seed);
-  settings.set("pixel_filter", pixelFilterName(s.settings.pixelFilter));
-  settings.set("filter_width", s.settings.filterWidth);
+  if (r.minBounces != 0) settings.set("min_bounces", r.minBounces);
+  if (!r.lightSampling) settings.set("light_sampling", false);
+  settings.set("spp", r.samplesPerPixel);
+  settings.set("seed", r.seed);
+  settings.set("pixel_filter", pixelFilterName(r.pixelFilter));
+  settings.set("filter_width", r.filterWidth);
   // Only scenes that came from Tungsten files say it; everything else draws the filter exactly.
-  if (s.settings.filterSampling == FilterSampling::Tungsten) settings.set("filter_sampling", "tungsten");
-  if (s.settings.shading == ShadingConvention::Tungsten) settings.set("shading", "tungsten");
-  if (s.settings.roulette == Roulette::Tungsten) settings.set("roulette", "tungsten");
-  if (s.settings.rayOffset == RayOffset::Tungsten) settings.set("ray_offset", "tungsten");
-  if (!s.settings.view.empty()) settings.set("view", s.settings.view);
-  root.set("settings", settings);
+  if (r.filterSampling == FilterSampling::Tungsten) settings.set("filter_sampling", "tungsten");
+  if (r.shading == ShadingConvention::Tungsten) settings.set("shading", "tungsten");
+  if (r.roulette == Roulette::Tungsten) settings.set("roulette", "tungsten");
+  if (r.rayOffset == RayOffset::Tungsten) settings.set("ray_offset", "tungsten");
+  if (!r.view.empty()) settings.set("view", r.view);
+  return settings;
+}
 
+Value cameraToJson(const Camera& c) {
   Value cam(json::Object{});
-  cam.set("position", json::fromVec3(s.camera.position));
-  cam.set("target", json::fromVec3(s.camera.target));
-  cam.set("up", json::fromVec3(s.camera.up));
-  cam.set("vertical_fov", s.camera.verticalFov);
-  if (s.camera.apertureRadius > 0) {
-    cam.set("aperture_radius", s.camera.apertureRadius);
-    cam.set("focus_distance", s.camera.focusDistance);
+  cam.set("position", json::fromVec3(c.position));
+  cam.set("target", json::fromVec3(c.target));
+  cam.set("up", json::fromVec3(c.up));
+  cam.set("vertical_fov", c.verticalFov);
+  if (c.apertureRadius > 0) {
+    cam.set("aperture_radius", c.apertureRadius);
+    cam.set("focus_distance", c.focusDistance);
   }
-  root.set("camera", cam);
+  return cam;
+}
 
-  const Environment& e = s.environment;
+Value environmentToJson(const Environment& e) {
   Value env(json::Object{});
   env.set("type", environmentTypeName(e.type));
   env.set("color", json::fromVec3(e.color));
@@ -207,128 +241,134 @@ Value nativeSceneToJson(const Scene& s) {
   env.set("medium_absorption", json::fromVec3(e.mediumAbsorption));
   env.set("medium_scattering", json::fromVec3(e.mediumScattering));
   env.set("medium_anisotropy", e.mediumAnisotropy);
-  root.set("environment", env);
+  return env;
+}
 
-  json::Array meshes;
-  for (const Mesh& m : s.meshes) {
-    Value v(json::Object{});
-    v.set("id", m.id);
-    v.set("name", m.name);
-    if (m.geometry) {
-      v.set("positions", blob(m.geometry->positions));
-      v.set("normals", blob(m.geometry->normals));
-      v.set("uvs", blob(m.geometry->uvs));
-      v.set("indices", blob(m.geometry->indices));
-    }
-    meshes.push_back(std::move(v));
+Value meshToJson(const Mesh& m) {
+  Value v(json::Object{});
+  v.set("id", m.id);
+  v.set("name", m.name);
+  if (m.geometry) {
+    v.set("positions", blob(m.geometry->positions));
+    v.set("normals", blob(m.geometry->normals));
+    v.set("uvs", blob(m.geometry->uvs));
+    v.set("indices", blob(m.geometry->indices));
   }
-  root.set("meshes", std::move(meshes));
+  return v;
+}
 
-  json::Array textures;
-  for (const Texture& t : s.textures) {
-    Value v(json::Object{});
-    v.set("id", t.id);
-    v.set("name", t.name);
-    v.set("kind", textureKindName(t.kind));
-    v.set("color_space", colorSpaceName(t.colorSpace));
-    if (t.whenMissing == MissingTexture::Tungsten) v.set("when_missing", "tungsten");
-    if (!t.interpolate) v.set("interpolate", false);
-    if (t.clampToEdge) v.set("clamp", true);
-    if (t.kind == TextureKind::File) {
-      // Stored as written, plus the absolute location so a copy saved elsewhere still finds it.
-      v.set("path", t.path.generic_string());
-      fs::path abs = t.path.is_absolute() ? t.path : s.baseDirectory / t.path;
-      v.set("absolute_path", abs.lexically_normal().generic_string());
-    } else if (t.kind == TextureKind::Embedded) {
-      v.set("format", t.encodedFormat);
-      v.set("data", blob(t.encoded));
-    } else {
-      v.set("on", json::fromVec3(t.checkerOn));
-      v.set("off", json::fromVec3(t.checkerOff));
-      v.set("res_u", t.checkerResU);
-      v.set("res_v", t.checkerResV);
-      if (t.tungstenCells) v.set("cells", "tungsten");
-    }
-    textures.push_back(std::move(v));
+Value textureToJson(const Texture& t, const fs::path& baseDirectory) {
+  Value v(json::Object{});
+  v.set("id", t.id);
+  v.set("name", t.name);
+  v.set("kind", textureKindName(t.kind));
+  v.set("color_space", colorSpaceName(t.colorSpace));
+  if (t.whenMissing == MissingTexture::Tungsten) v.set("when_missing", "tungsten");
+  if (!t.interpolate) v.set("interpolate", false);
+  if (t.clampToEdge) v.set("clamp", true);
+  if (t.kind == TextureKind::File) {
+    // Stored as written, plus the absolute location so a copy saved elsewhere still finds it.
+    v.set("path", t.path.generic_string());
+    fs::path abs = t.path.is_absolute() ? t.path : baseDirectory / t.path;
+    v.set("absolute_path", abs.lexically_normal().generic_string());
+  } else if (t.kind == TextureKind::Embedded) {
+    v.set("format", t.encodedFormat);
+    v.set("data", blob(t.encoded));
+  } else {
+    v.set("on", json::fromVec3(t.checkerOn));
+    v.set("off", json::fromVec3(t.checkerOff));
+    v.set("res_u", t.checkerResU);
+    v.set("res_v", t.checkerResV);
+    if (t.tungstenCells) v.set("cells", "tungsten");
   }
-  root.set("textures", std::move(textures));
+  return v;
+}
 
-  json::Array materials;
-  for (const Material& m : s.materials) {
-    Value v(json::Object{});
-    v.set("id", m.id);
-    v.set("name", m.name);
-    v.set("type", materialTypeName(m.type));
-    v.set("albedo", json::fromVec3(m.albedo));
-    v.set("albedo_texture", m.albedoTexture);
-    v.set("roughness", m.roughness);
-    if (m.beckmann) v.set("distribution", "beckmann");
-    if (m.separableShadowing) v.set("shadowing", "separable");
-    v.set("roughness_texture", m.roughnessTexture);
-    v.set("ior", m.ior);
-    if (m.tungstenGlass) v.set("glass", "tungsten");
-    v.set("coating_absorption", json::fromVec3(m.coatingAbsorption));
-    if (m.filmThickness != 0) v.set("film_thickness", m.filmThickness);
-    if (m.type == MaterialType::Hair) v.set("hair_tilt", m.hairTilt);
-    v.set("transmittance", m.transmittance);
-    v.set("diffuse_ratio", m.diffuseRatio);
-    v.set("interior_absorption", json::fromVec3(m.interiorAbsorption));
-    v.set("interior_scattering", json::fromVec3(m.interiorScattering));
-    v.set("interior_anisotropy", m.interiorAnisotropy);
-    if (m.coatIor != 0) {
-      v.set("coat_ior", m.coatIor);
-      v.set("coat_absorption", json::fromVec3(m.coatAbsorption));
-      v.set("coat_roughness", m.coatRoughness);
-    }
-    v.set("metal", m.metal);
-    v.set("eta", json::fromVec3(m.eta));
-    v.set("k", json::fromVec3(m.k));
-    v.set("emission", json::fromVec3(m.emission));
-    if (m.emissionStrength != 1) v.set("emission_strength", m.emissionStrength);
-    v.set("alpha", m.alpha);
-    v.set("alpha_texture", m.alphaTexture);
-    v.set("bump_texture", m.bumpTexture);
-    v.set("emission_texture", m.emissionTexture);
-    if (m.emissionCone != 90) v.set("emission_cone", m.emissionCone);
-    v.set("bump_strength", m.bumpStrength);
-    v.set("blend_with", m.blendWith);
-    v.set("blend_ratio", m.blendRatio);
-    v.set("blend_ratio_texture", m.blendRatioTexture);
-    materials.push_back(std::move(v));
+Value materialToJson(const Material& m) {
+  Value v(json::Object{});
+  v.set("id", m.id);
+  v.set("name", m.name);
+  v.set("type", materialTypeName(m.type));
+  v.set("albedo", json::fromVec3(m.albedo));
+  v.set("albedo_texture", m.albedoTexture);
+  v.set("roughness", m.roughness);
+  if (m.beckmann) v.set("distribution", "beckmann");
+  if (m.separableShadowing) v.set("shadowing", "separable");
+  v.set("roughness_texture", m.roughnessTexture);
+  v.set("ior", m.ior);
+  if (m.tungstenGlass) v.set("glass", "tungsten");
+  v.set("coating_absorption", json::fromVec3(m.coatingAbsorption));
+  if (m.filmThickness != 0) v.set("film_thickness", m.filmThickness);
+  if (m.type == MaterialType::Hair) v.set("hair_tilt", m.hairTilt);
+  v.set("transmittance", m.transmittance);
+  v.set("diffuse_ratio", m.diffuseRatio);
+  v.set("interior_absorption", json::fromVec3(m.interiorAbsorption));
+  v.set("interior_scattering", json::fromVec3(m.interiorScattering));
+  v.set("interior_anisotropy", m.interiorAnisotropy);
+  if (m.coatIor != 0) {
+    v.set("coat_ior", m.coatIor);
+    v.set("coat_absorption", json::fromVec3(m.coatAbsorption));
+    v.set("coat_roughness", m.coatRoughness);
   }
-  root.set("materials", std::move(materials));
+  v.set("metal", m.metal);
+  v.set("eta", json::fromVec3(m.eta));
+  v.set("k", json::fromVec3(m.k));
+  v.set("emission", json::fromVec3(m.emission));
+  if (m.emissionStrength != 1) v.set("emission_strength", m.emissionStrength);
+  v.set("alpha", m.alpha);
+  v.set("alpha_texture", m.alphaTexture);
+  v.set("bump_texture", m.bumpTexture);
+  v.set("emission_texture", m.emissionTexture);
+  if (m.emissionCone != 90) v.set("emission_cone", m.emissionCone);
+  v.set("bump_strength", m.bumpStrength);
+  v.set("blend_with", m.blendWith);
+  v.set("blend_ratio", m.blendRatio);
+  v.set("blend_ratio_texture", m.blendRatioTexture);
+  return v;
+}
 
-  json::Array objects;
-  for (const Object& o : s.objects) {
-    Value v(json::Object{});
-    v.set("id", o.id);
-    v.set("name", o.name);
-    v.set("mesh", o.mesh);
-    v.set("material", o.material);
-    v.set("transform", mat4(o.transform));
-    v.set("visible", o.visible);
-    if (o.cullBackFaces) v.set("backface_culling", true);
-    objects.push_back(std::move(v));
-  }
-  root.set("objects", std::move(objects));
+Value objectToJson(const Object& o) {
+  Value v(json::Object{});
+  v.set("id", o.id);
+  v.set("name", o.name);
+  v.set("mesh", o.mesh);
+  v.set("material", o.material);
+  v.set("transform", mat4(o.transform));
+  v.set("visible", o.visible);
+  if (o.cullBackFaces) v.set("backface_culling", true);
+  return v;
+}
 
-  json::Array lights;
-  for (const Light& l : s.lights) {
-    Value v(json::Object{});
-    v.set("id", l.id);
-    v.set("name", l.name);
-    v.set("type", lightTypeName(l.type));
-    v.set("color", json::fromVec3(l.color));
-    v.set("intensity", l.intensity);
-    v.set("position", json::fromVec3(l.position));
-    v.set("direction", json::fromVec3(l.direction));
-    v.set("spot_angle", l.spotAngle);
-    v.set("spot_blend", l.spotBlend);
-    v.set("angular_radius", l.angularRadius);
-    v.set("visible", l.visible);
-    lights.push_back(std::move(v));
-  }
-  root.set("lights", std::move(lights));
+Value lightToJson(const Light& l) {
+  Value v(json::Object{});
+  v.set("id", l.id);
+  v.set("name", l.name);
+  v.set("type", lightTypeName(l.type));
+  v.set("color", json::fromVec3(l.color));
+  v.set("intensity", l.intensity);
+  v.set("position", json::fromVec3(l.position));
+  v.set("direction", json::fromVec3(l.direction));
+  v.set("spot_angle", l.spotAngle);
+  v.set("spot_blend", l.spotBlend);
+  v.set("angular_radius", l.angularRadius);
+  v.set("visible", l.visible);
+  return v;
+}
+
+Value nativeSceneToJson(const Scene& s) {
+  Value root(json::Object{});
+  root.set("format", kFormatTag);
+  root.set("version", kNativeFormatVersion);
+  root.set("next_id", s.peekNextId());
+
+  root.set("settings", settingsToJson(s.settings));
+  root.set("camera", cameraToJson(s.camera));
+  root.set("environment", environmentToJson(s.environment));
+  root.set("meshes", arrayOf(s.meshes, meshToJson));
+  root.set("textures", arrayOf(s.textures, [&](const Texture& t) { return textureToJson(t, s.baseDirectory); }));
+  root.set("materials", arrayOf(s.materials, materialToJson));
+  root.set("objects", arrayOf(s.objects, objectToJson));
+  root.set("lights", arrayOf(s.lights, lightToJson));
   return root;
 }
 
@@ -338,8 +378,202 @@ template <class E>
 void readConvention(Reader& r, const char* key, const char* ours, E* out) {
   std::string name;
   r.string(key, &name);
-  if (name == "tungsten") *out = E::Tungsten;
-  else if (!name.empty() && name != ours) r.problem(key, cat("unknown ", key, " '", name, "' (", ours, ", tungsten)"));
+  if (name == "tungsten")
+    *out = E::Tungsten;
+  else if (!name.empty() && name != ours)
+    r.problem(key, cat("unknown ", key, " '", name, "' (", ours, ", tungsten)"));
+}
+
+void readSettings(Reader& r, RenderSettings& settings) {
+  r.integer("width", &settings.width);
+  r.integer("height", &settings.height);
+  r.integer("max_bounces", &settings.maxBounces);
+  r.integer("min_bounces", &settings.minBounces);
+  r.boolean("light_sampling", &settings.lightSampling);
+  r.integer("spp", &settings.samplesPerPixel);
+  int seed = 0;
+  r.integer("seed", &seed);
+  settings.seed = static_cast<std::uint32_t>(seed);
+  // Files from before the pixel filter have none: a box, as they were rendered.
+  std::string filter;
+  r.string("pixel_filter", &filter);
+  if (filter.empty()) settings.pixelFilter = PixelFilter::Box;
+  if (!filter.empty() && !parsePixelFilter(filter, &settings.pixelFilter))
+    r.problem("pixel_filter", cat("unknown filter '", filter, "' (box, tent, gaussian, blackman_harris)"));
+  settings.filterWidth = defaultFilterWidth(settings.pixelFilter);
+  r.number("filter_width", &settings.filterWidth);
+  if (!(settings.filterWidth > 0.0f && settings.filterWidth <= 16.0f))
+    r.problem("filter_width", "expected a width in pixels within (0, 16]");
+  readConvention(r, "filter_sampling", "exact", &settings.filterSampling);
+  readConvention(r, "shading", "consistent", &settings.shading);
+  readConvention(r, "roulette", "standard", &settings.roulette);
+  readConvention(r, "ray_offset", "robust", &settings.rayOffset);
+  r.string("view", &settings.view);
+}
+
+void readCamera(Reader& r, Camera& c) {
+  r.vec3("position", &c.position);
+  r.vec3("target", &c.target);
+  r.vec3("up", &c.up);
+  r.number("vertical_fov", &c.verticalFov);
+  r.number("aperture_radius", &c.apertureRadius);
+  r.number("focus_distance", &c.focusDistance);
+}
+
+void readEnvironment(Reader& r, Environment& e) {
+  r.enumeration("type", &e.type, environmentTypeName, 3);
+  r.vec3("color", &e.color);
+  r.number("intensity", &e.intensity);
+  r.id("map", &e.map);
+  r.number("rotation", &e.rotation);
+  r.matrix("orientation", &e.orientation);
+  r.vec3("zenith", &e.zenith);
+  r.vec3("horizon", &e.horizon);
+  r.vec3("ground", &e.ground);
+  r.vec3("medium_absorption", &e.mediumAbsorption);
+  r.vec3("medium_scattering", &e.mediumScattering);
+  r.number("medium_anisotropy", &e.mediumAnisotropy);
+}
+
+Mesh readMesh(Reader& r, const fs::path& file, std::vector<std::string>* warnings) {
+  Mesh m;
+  auto g = std::make_shared<MeshGeometry>();
+  r.id("id", &m.id, true);
+  r.string("name", &m.name);
+  r.blob("positions", &g->positions);
+  r.blob("normals", &g->normals);
+  r.blob("uvs", &g->uvs);
+  r.blob("indices", &g->indices);
+  std::size_t dropped = sanitizeGeometry(*g);
+  if (dropped) warnings->push_back(cat(file.string(), ": mesh '", m.name, "': dropped ", dropped, " invalid triangles"));
+  m.geometry = std::move(g);
+  return m;
+}
+
+Texture readTexture(Reader& r, const fs::path& baseDir) {
+  Texture t;
+  r.id("id", &t.id, true);
+  r.string("name", &t.name);
+  r.enumeration("kind", &t.kind, textureKindName, 3);
+  r.enumeration("color_space", &t.colorSpace, colorSpaceName, kTextureColorSpaceCount);
+  std::string whenMissing;
+  r.string("when_missing", &whenMissing);
+  if (whenMissing == "tungsten")
+    t.whenMissing = MissingTexture::Tungsten;
+  else if (!whenMissing.empty() && whenMissing != "checker")
+    r.problem("when_missing", cat("unknown stand-in '", whenMissing, "' (checker, tungsten)"));
+  r.boolean("interpolate", &t.interpolate);
+  r.boolean("clamp", &t.clampToEdge);
+  std::string path, absolute;
+  r.string("path", &path);
+  r.string("absolute_path", &absolute);
+  if (t.kind == TextureKind::File) {
+    // Prefer the recorded relative path when it still resolves next to this file.
+    std::error_code ec;
+    if (!path.empty() && (fs::path(path).is_absolute() || fs::exists(baseDir / path, ec)))
+      t.path = path;
+    else if (!absolute.empty())
+      t.path = absolute;
+    else
+      t.path = path;
+  }
+  r.string("format", &t.encodedFormat);
+  r.blob("data", &t.encoded);
+  r.vec3("on", &t.checkerOn);
+  r.vec3("off", &t.checkerOff);
+  r.integer("res_u", &t.checkerResU);
+  r.integer("res_v", &t.checkerResV);
+  std::string cells;
+  r.string("cells", &cells);
+  if (cells == "tungsten")
+    t.tungstenCells = true;
+  else if (!cells.empty() && cells != "floor")
+    r.problem("cells", cat("unknown cell count '", cells, "' (floor, tungsten)"));
+  return t;
+}
+
+Material readMaterial(Reader& r) {
+  Material m;
+  r.id("id", &m.id, true);
+  r.string("name", &m.name);
+  r.enumeration("type", &m.type, materialName, kMaterialTypeCount);
+  r.vec3("albedo", &m.albedo);
+  r.id("albedo_texture", &m.albedoTexture);
+  r.number("roughness", &m.roughness);
+  std::string distribution;
+  r.string("distribution", &distribution);
+  if (distribution == "beckmann")
+    m.beckmann = true;
+  else if (!distribution.empty() && distribution != "ggx")
+    r.problem("distribution", cat("unknown distribution '", distribution, "' (ggx, beckmann)"));
+  std::string shadowing;
+  r.string("shadowing", &shadowing);
+  if (shadowing == "separable")
+    m.separableShadowing = true;
+  else if (!shadowing.empty() && shadowing != "correlated")
+    r.problem("shadowing", cat("unknown shadowing '", shadowing, "' (correlated, separable)"));
+  r.id("roughness_texture", &m.roughnessTexture);
+  r.number("ior", &m.ior);
+  std::string glass;
+  r.string("glass", &glass);
+  if (glass == "tungsten")
+    m.tungstenGlass = true;
+  else if (!glass.empty() && glass != "physical")
+    r.problem("glass", cat("unknown glass convention '", glass, "' (physical, tungsten)"));
+  r.vec3("coating_absorption", &m.coatingAbsorption);
+  r.number("film_thickness", &m.filmThickness);
+  r.number("hair_tilt", &m.hairTilt);
+  r.number("transmittance", &m.transmittance);
+  r.number("diffuse_ratio", &m.diffuseRatio);
+  r.vec3("interior_absorption", &m.interiorAbsorption);
+  r.vec3("interior_scattering", &m.interiorScattering);
+  r.number("interior_anisotropy", &m.interiorAnisotropy);
+  r.number("coat_ior", &m.coatIor);
+  r.vec3("coat_absorption", &m.coatAbsorption);
+  r.number("coat_roughness", &m.coatRoughness);
+  r.string("metal", &m.metal);
+  r.vec3("eta", &m.eta);
+  r.vec3("k", &m.k);
+  r.vec3("emission", &m.emission);
+  r.number("emission_strength", &m.emissionStrength);
+  r.number("alpha", &m.alpha);
+  r.id("alpha_texture", &m.alphaTexture);
+  r.id("bump_texture", &m.bumpTexture);
+  r.id("emission_texture", &m.emissionTexture);
+  r.number("emission_cone", &m.emissionCone);
+  r.number("bump_strength", &m.bumpStrength);
+  r.id("blend_with", &m.blendWith);
+  r.number("blend_ratio", &m.blendRatio);
+  r.id("blend_ratio_texture", &m.blendRatioTexture);
+  return m;
+}
+
+Object readObject(Reader& r) {
+  Object o;
+  r.id("id", &o.id, true);
+  r.string("name", &o.name);
+  r.id("mesh", &o.mesh);
+  r.id("material", &o.material);
+  r.matrix("transform", &o.transform);
+  r.boolean("visible", &o.visible);
+  r.boolean("backface_culling", &o.cullBackFaces);
+  return o;
+}
+
+Light readLight(Reader& r) {
+  Light l;
+  r.id("id", &l.id, true);
+  r.string("name", &l.name);
+  r.enumeration("type", &l.type, lightTypeName, 3);
+  r.vec3("color", &l.color);
+  r.number("intensity", &l.intensity);
+  r.vec3("position", &l.position);
+  r.vec3("direction", &l.direction);
+  r.number("spot_angle", &l.spotAngle);
+  r.number("spot_blend", &l.spotBlend);
+  r.number("angular_radius", &l.angularRadius);
+  r.boolean("visible", &l.visible);
+  return l;
 }
 
 }  // namespace
@@ -366,8 +600,8 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
   const Value* ver = root.find("version");
   if (!ver || !ver->isNumber()) return R::failure(cat(file.string(), ": no format version"));
   if (ver->asNumber() > kNativeFormatVersion)
-    return R::failure(cat(file.string(), ": written by a newer Retile (format version ", ver->asNumber(),
-                          ", this build reads up to ", kNativeFormatVersion, ")"));
+    return R::failure(cat(file.string(), ": written by a newer Retile (format version ", ver->asNumber(), ", this build reads up to ",
+                          kNativeFormatVersion, ")"));
 
   ImportedScene out;
   out.format = "native";
@@ -382,55 +616,15 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
 
   if (const Value* v = root.find("settings")) {
     Reader r(&error, "settings", v);
-    r.integer("width", &s.settings.width);
-    r.integer("height", &s.settings.height);
-    r.integer("max_bounces", &s.settings.maxBounces);
-    r.integer("min_bounces", &s.settings.minBounces);
-    r.boolean("light_sampling", &s.settings.lightSampling);
-    r.integer("spp", &s.settings.samplesPerPixel);
-    int seed = 0;
-    r.integer("seed", &seed);
-    s.settings.seed = static_cast<std::uint32_t>(seed);
-    // Files from before the pixel filter have none: a box, as they were rendered.
-    std::string filter;
-    r.string("pixel_filter", &filter);
-    if (filter.empty()) s.settings.pixelFilter = PixelFilter::Box;
-    if (!filter.empty() && !parsePixelFilter(filter, &s.settings.pixelFilter))
-      r.problem("pixel_filter", cat("unknown filter '", filter, "' (box, tent, gaussian, blackman_harris)"));
-    s.settings.filterWidth = defaultFilterWidth(s.settings.pixelFilter);
-    r.number("filter_width", &s.settings.filterWidth);
-    if (!(s.settings.filterWidth > 0.0f && s.settings.filterWidth <= 16.0f))
-      r.problem("filter_width", "expected a width in pixels within (0, 16]");
-    readConvention(r, "filter_sampling", "exact", &s.settings.filterSampling);
-    readConvention(r, "shading", "consistent", &s.settings.shading);
-    readConvention(r, "roulette", "standard", &s.settings.roulette);
-    readConvention(r, "ray_offset", "robust", &s.settings.rayOffset);
-    r.string("view", &s.settings.view);
+    readSettings(r, s.settings);
   }
   if (const Value* v = root.find("camera")) {
     Reader r(&error, "camera", v);
-    r.vec3("position", &s.camera.position);
-    r.vec3("target", &s.camera.target);
-    r.vec3("up", &s.camera.up);
-    r.number("vertical_fov", &s.camera.verticalFov);
-    r.number("aperture_radius", &s.camera.apertureRadius);
-    r.number("focus_distance", &s.camera.focusDistance);
+    readCamera(r, s.camera);
   }
   if (const Value* v = root.find("environment")) {
     Reader r(&error, "environment", v);
-    Environment& e = s.environment;
-    r.enumeration("type", &e.type, environmentTypeName, 3);
-    r.vec3("color", &e.color);
-    r.number("intensity", &e.intensity);
-    r.id("map", &e.map);
-    r.number("rotation", &e.rotation);
-    r.matrix("orientation", &e.orientation);
-    r.vec3("zenith", &e.zenith);
-    r.vec3("horizon", &e.horizon);
-    r.vec3("ground", &e.ground);
-    r.vec3("medium_absorption", &e.mediumAbsorption);
-    r.vec3("medium_scattering", &e.mediumScattering);
-    r.number("medium_anisotropy", &e.mediumAnisotropy);
+    readEnvironment(r, s.environment);
   }
   auto list = [&](const char* key) -> const json::Array* {
     const Value* v = root.find(key);
@@ -444,142 +638,27 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
   if (auto* a = list("meshes"))
     for (std::size_t i = 0; i < a->size() && error.empty(); ++i) {
       Reader r(&error, where("meshes", i), &(*a)[i]);
-      Mesh m;
-      auto g = std::make_shared<MeshGeometry>();
-      r.id("id", &m.id, true);
-      r.string("name", &m.name);
-      r.blob("positions", &g->positions);
-      r.blob("normals", &g->normals);
-      r.blob("uvs", &g->uvs);
-      r.blob("indices", &g->indices);
-      std::size_t dropped = sanitizeGeometry(*g);
-      if (dropped) out.warnings.push_back(cat(file.string(), ": mesh '", m.name, "': dropped ", dropped, " invalid triangles"));
-      m.geometry = std::move(g);
-      s.meshes.push_back(std::move(m));
+      s.meshes.push_back(readMesh(r, file, &out.warnings));
     }
   if (auto* a = list("textures"))
     for (std::size_t i = 0; i < a->size() && error.empty(); ++i) {
       Reader r(&error, where("textures", i), &(*a)[i]);
-      Texture t;
-      r.id("id", &t.id, true);
-      r.string("name", &t.name);
-      r.enumeration("kind", &t.kind, textureKindName, 3);
-      r.enumeration("color_space", &t.colorSpace, colorSpaceName, kTextureColorSpaceCount);
-      std::string whenMissing;
-      r.string("when_missing", &whenMissing);
-      if (whenMissing == "tungsten") t.whenMissing = MissingTexture::Tungsten;
-      else if (!whenMissing.empty() && whenMissing != "checker")
-        r.problem("when_missing", cat("unknown stand-in '", whenMissing, "' (checker, tungsten)"));
-      r.boolean("interpolate", &t.interpolate);
-      r.boolean("clamp", &t.clampToEdge);
-      std::string path, absolute;
-      r.string("path", &path);
-      r.string("absolute_path", &absolute);
-      if (t.kind == TextureKind::File) {
-        // Prefer the recorded relative path when it still resolves next to this file.
-        std::error_code ec;
-        if (!path.empty() && (fs::path(path).is_absolute() || fs::exists(baseDir / path, ec)))
-          t.path = path;
-        else if (!absolute.empty())
-          t.path = absolute;
-        else
-          t.path = path;
-      }
-      r.string("format", &t.encodedFormat);
-      r.blob("data", &t.encoded);
-      r.vec3("on", &t.checkerOn);
-      r.vec3("off", &t.checkerOff);
-      r.integer("res_u", &t.checkerResU);
-      r.integer("res_v", &t.checkerResV);
-      std::string cells;
-      r.string("cells", &cells);
-      if (cells == "tungsten") t.tungstenCells = true;
-      else if (!cells.empty() && cells != "floor") r.problem("cells", cat("unknown cell count '", cells, "' (floor, tungsten)"));
-      s.textures.push_back(std::move(t));
+      s.textures.push_back(readTexture(r, baseDir));
     }
   if (auto* a = list("materials"))
     for (std::size_t i = 0; i < a->size() && error.empty(); ++i) {
       Reader r(&error, where("materials", i), &(*a)[i]);
-      Material m;
-      r.id("id", &m.id, true);
-      r.string("name", &m.name);
-      r.enumeration("type", &m.type, materialName, kMaterialTypeCount);
-      r.vec3("albedo", &m.albedo);
-      r.id("albedo_texture", &m.albedoTexture);
-      r.number("roughness", &m.roughness);
-      std::string distribution;
-      r.string("distribution", &distribution);
-      if (distribution == "beckmann") m.beckmann = true;
-      else if (!distribution.empty() && distribution != "ggx")
-        r.problem("distribution", cat("unknown distribution '", distribution, "' (ggx, beckmann)"));
-      std::string shadowing;
-      r.string("shadowing", &shadowing);
-      if (shadowing == "separable") m.separableShadowing = true;
-      else if (!shadowing.empty() && shadowing != "correlated")
-        r.problem("shadowing", cat("unknown shadowing '", shadowing, "' (correlated, separable)"));
-      r.id("roughness_texture", &m.roughnessTexture);
-      r.number("ior", &m.ior);
-      std::string glass;
-      r.string("glass", &glass);
-      if (glass == "tungsten") m.tungstenGlass = true;
-      else if (!glass.empty() && glass != "physical")
-        r.problem("glass", cat("unknown glass convention '", glass, "' (physical, tungsten)"));
-      r.vec3("coating_absorption", &m.coatingAbsorption);
-      r.number("film_thickness", &m.filmThickness);
-      r.number("hair_tilt", &m.hairTilt);
-      r.number("transmittance", &m.transmittance);
-      r.number("diffuse_ratio", &m.diffuseRatio);
-      r.vec3("interior_absorption", &m.interiorAbsorption);
-      r.vec3("interior_scattering", &m.interiorScattering);
-      r.number("interior_anisotropy", &m.interiorAnisotropy);
-      r.number("coat_ior", &m.coatIor);
-      r.vec3("coat_absorption", &m.coatAbsorption);
-      r.number("coat_roughness", &m.coatRoughness);
-      r.string("metal", &m.metal);
-      r.vec3("eta", &m.eta);
-      r.vec3("k", &m.k);
-      r.vec3("emission", &m.emission);
-      r.number("emission_strength", &m.emissionStrength);
-      r.number("alpha", &m.alpha);
-      r.id("alpha_texture", &m.alphaTexture);
-      r.id("bump_texture", &m.bumpTexture);
-      r.id("emission_texture", &m.emissionTexture);
-      r.number("emission_cone", &m.emissionCone);
-      r.number("bump_strength", &m.bumpStrength);
-      r.id("blend_with", &m.blendWith);
-      r.number("blend_ratio", &m.blendRatio);
-      r.id("blend_ratio_texture", &m.blendRatioTexture);
-      s.materials.push_back(std::move(m));
+      s.materials.push_back(readMaterial(r));
     }
   if (auto* a = list("objects"))
     for (std::size_t i = 0; i < a->size() && error.empty(); ++i) {
       Reader r(&error, where("objects", i), &(*a)[i]);
-      Object o;
-      r.id("id", &o.id, true);
-      r.string("name", &o.name);
-      r.id("mesh", &o.mesh);
-      r.id("material", &o.material);
-      r.matrix("transform", &o.transform);
-      r.boolean("visible", &o.visible);
-      r.boolean("backface_culling", &o.cullBackFaces);
-      s.objects.push_back(std::move(o));
+      s.objects.push_back(readObject(r));
     }
   if (auto* a = list("lights"))
     for (std::size_t i = 0; i < a->size() && error.empty(); ++i) {
       Reader r(&error, where("lights", i), &(*a)[i]);
-      Light l;
-      r.id("id", &l.id, true);
-      r.string("name", &l.name);
-      r.enumeration("type", &l.type, lightTypeName, 3);
-      r.vec3("color", &l.color);
-      r.number("intensity", &l.intensity);
-      r.vec3("position", &l.position);
-      r.vec3("direction", &l.direction);
-      r.number("spot_angle", &l.spotAngle);
-      r.number("spot_blend", &l.spotBlend);
-      r.number("angular_radius", &l.angularRadius);
-      r.boolean("visible", &l.visible);
-      s.lights.push_back(std::move(l));
+      s.lights.push_back(readLight(r));
     }
   if (!error.empty()) return R::failure(cat(file.string(), ": ", error));
 
@@ -621,8 +700,7 @@ Result<ImportedScene> nativeSceneFromString(const std::string& text, const fs::p
     s.environment.map = kNoNode;
   }
   if (s.settings.width < 1 || s.settings.height < 1 || s.settings.width > kMaxImageSide || s.settings.height > kMaxImageSide)
-    return R::failure(cat(file.string(), ": settings: size ", s.settings.width, "x", s.settings.height, " is outside 1..",
-                          kMaxImageSide));
+    return R::failure(cat(file.string(), ": settings: size ", s.settings.width, "x", s.settings.height, " is outside 1..", kMaxImageSide));
   s.reserveIds(std::max(nextId, maxId + 1));
   return out;
 }

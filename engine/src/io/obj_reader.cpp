@@ -59,8 +59,7 @@ struct KeyHash {
 
 }  // namespace
 
-Result<MeshGeometry> readObjGeometry(const std::filesystem::path& file, std::vector<std::string>* warnings,
-                                     const ImportOptions& options) {
+Result<MeshGeometry> readObjGeometry(const std::filesystem::path& file, std::vector<std::string>* warnings, const ImportOptions& options) {
   auto text = readFile(file, options.maxFileBytes);
   if (!text) return Result<MeshGeometry>::failure(text.error());
   const std::string& s = text.value();
@@ -74,9 +73,7 @@ Result<MeshGeometry> readObjGeometry(const std::filesystem::path& file, std::vec
   std::size_t badFaces = 0;
   int line = 1;
 
-  auto fail = [&](const std::string& what) {
-    return Result<MeshGeometry>::failure(cat(file.string(), ": line ", line, ": ", what));
-  };
+  auto fail = [&](const std::string& what) { return Result<MeshGeometry>::failure(cat(file.string(), ": line ", line, ": ", what)); };
 
   for (; c.p < c.end; ++line) {
     c.skipSpace();
@@ -133,23 +130,19 @@ Result<MeshGeometry> readObjGeometry(const std::filesystem::path& file, std::vec
       if (bad || poly.size() < 3) {
         ++badFaces;
       } else {
-        for (std::size_t i = 1; i + 1 < poly.size(); ++i)
-          g.indices.insert(g.indices.end(), {poly[0], poly[i], poly[i + 1]});
-        if (g.indices.size() / 3 > options.maxTriangles)
-          return fail(cat("more than ", options.maxTriangles, " triangles"));
+        for (std::size_t i = 1; i + 1 < poly.size(); ++i) g.indices.insert(g.indices.end(), {poly[0], poly[i], poly[i + 1]});
+        if (g.indices.size() / 3 > options.maxTriangles) return fail(cat("more than ", options.maxTriangles, " triangles"));
       }
     }
     (void)lineStart;
     c.nextLine();
   }
 
-  if (badFaces && warnings)
-    warnings->push_back(cat(file.string(), ": skipped ", badFaces, " faces with missing or out-of-range indices"));
+  if (badFaces && warnings) warnings->push_back(cat(file.string(), ": skipped ", badFaces, " faces with missing or out-of-range indices"));
   if (nrm.empty()) g.normals.clear();
   if (tex.empty()) g.uvs.clear();
   std::size_t dropped = sanitizeGeometry(g);
-  if (dropped && warnings)
-    warnings->push_back(cat(file.string(), ": dropped ", dropped, " triangles with NaN or infinite vertices"));
+  if (dropped && warnings) warnings->push_back(cat(file.string(), ": dropped ", dropped, " triangles with NaN or infinite vertices"));
   if (g.indices.empty()) return Result<MeshGeometry>::failure(cat(file.string(), ": contains no triangles"));
   return g;
 }
@@ -173,8 +166,7 @@ std::size_t sanitizeGeometry(MeshGeometry& g, std::vector<std::int32_t>* perTria
     }
     if (ok) {
       if (perTriangle && i / 3 < perTriangle->size()) (*perTriangle)[kept.size() / 3] = (*perTriangle)[i / 3];
-      kept.insert(kept.end(), g.indices.begin() + static_cast<std::ptrdiff_t>(i),
-                  g.indices.begin() + static_cast<std::ptrdiff_t>(i) + 3);
+      kept.insert(kept.end(), g.indices.begin() + static_cast<std::ptrdiff_t>(i), g.indices.begin() + static_cast<std::ptrdiff_t>(i) + 3);
     } else {
       ++dropped;
     }

@@ -11,8 +11,10 @@ void TungstenImporter::underAlbedo(Material& p, const TextureRef& albedo, int de
   if (albedo.constant == Vec3{1.0f} && !albedo.isTexture) return;  // nothing changes: shared as it is
   Material copy = *next;
   copied_.insert(next->id);
-  if (depth + 2 < kMaxBlendChain) underAlbedo(copy, albedo, depth + 1);
-  else copy.blendWith = kNoNode;
+  if (depth + 2 < kMaxBlendChain)
+    underAlbedo(copy, albedo, depth + 1);
+  else
+    copy.blendWith = kNoNode;
   copy.id = out_.scene.newId();
   out_.scene.materials.push_back(copy);
   p.blendWith = copy.id;
@@ -56,7 +58,9 @@ NodeId TungstenImporter::fileTexture(const std::string& ref, TextureColorSpace c
   t.clampToEdge = clampToEdge;
   // One warning per missing file, however many materials use it; the environment says its own.
   if (!resolveScenePath(base_, ref) && !quietMissingTexture_ && missingWarned_.insert(ref).second)
-    warn(cat("texture '", ref, "' not found; until the file is there it renders as Tungsten renders a missing texture, a black and white checker (as colour and as alpha)"));
+    warn(cat("texture '", ref,
+             "' not found; until the file is there it renders as Tungsten renders a missing texture, a black and white checker (as colour "
+             "and as alpha)"));
   out_.scene.textures.push_back(t);
   textures_[key] = t.id;
   return t.id;
@@ -95,7 +99,10 @@ TextureRef TungstenImporter::texture(const Value& v, const std::string& where, b
     if (const Value* c = v.find("clamp"); c && c->isBool()) clampToEdge = c->asBool();
     r.isTexture = true;
     r.constant = Vec3{scale};
-    r.texture = fileTexture(f, data ? TextureColorSpace::Raw : gamma ? TextureColorSpace::TungstenGamma : TextureColorSpace::Linear,
+    r.texture = fileTexture(f,
+                            data    ? TextureColorSpace::Raw
+                            : gamma ? TextureColorSpace::TungstenGamma
+                                    : TextureColorSpace::Linear,
                             interpolate, clampToEdge);
     return r;
   }
@@ -265,8 +272,9 @@ Material TungstenImporter::mixedBsdf(const Value& v, const std::string& where, i
     rest = &zero;
     firstRatio = 1.0f - ratio;
   } else if (zero.blendWith != kNoNode) {
-    warn(cat(where, ".bsdf0: a blend in a blend whose ratio is a texture or whose bsdf1 is a blend too is "
-                    "rendered as its first part"));
+    warn(cat(where,
+             ".bsdf0: a blend in a blend whose ratio is a texture or whose bsdf1 is a blend too is "
+             "rendered as its first part"));
     copied_.insert(zero.blendWith);  // dropped if nothing else uses it
     zero.blendWith = kNoNode;
     zero.blendRatio = 1;
@@ -322,8 +330,7 @@ Material TungstenImporter::typedBsdf(const Value& v, const std::string& type, co
       // Tungsten also names each metal's table from Palik's handbook "<metal>_palik". Its RGB
       // values are the plain name's, except copper's, whose eta and k differ by under 7 %.
       const std::string palik = "_palik";
-      if (named.size() > palik.size() && named.ends_with(palik) &&
-          conductorIor(named.substr(0, named.size() - palik.size()), &e2, &k2))
+      if (named.size() > palik.size() && named.ends_with(palik) && conductorIor(named.substr(0, named.size() - palik.size()), &e2, &k2))
         named.resize(named.size() - palik.size());
       if (conductorIor(named, &e2, &k2)) {
         m.metal = named;
@@ -392,7 +399,8 @@ Material TungstenImporter::typedBsdf(const Value& v, const std::string& type, co
     m.coatingAbsorption = max(sigmaA * (2.0f * thickness), Vec3{0.0f});
     // Tungsten's film is its thickness times 500 nm thick (ThinSheetBsdf), its interference
     // drawn as Tungsten draws it.
-    if (const Value* e = v.find("enable_interference"); e && e->isBool() && e->asBool()) m.filmThickness = std::max(500.0f * thickness, 0.0f);
+    if (const Value* e = v.find("enable_interference"); e && e->isBool() && e->asBool())
+      m.filmThickness = std::max(500.0f * thickness, 0.0f);
     m.tungstenGlass = true;
   } else if (type == "null") {
     m.type = MaterialType::Null;
@@ -405,7 +413,7 @@ Material TungstenImporter::typedBsdf(const Value& v, const std::string& type, co
       exponent = 64;
     }
     m.roughness = std::sqrt(2.0f / (exponent + 2.0f));  // the inverse of n = 2 / a^2 - 2
-    m.diffuseRatio = 0.2f;  // Tungsten's default
+    m.diffuseRatio = 0.2f;                              // Tungsten's default
     number(v, "diffuse_ratio", &m.diffuseRatio, where);
   } else if (type == "diffuse_transmission") {
     m.type = MaterialType::DiffuseTransmission;
@@ -487,8 +495,10 @@ std::optional<TungstenImporter::Filling> TungstenImporter::mediumFilling(const V
   float density = 1;
   const Value *a = medium.find("sigma_a"), *sc = medium.find("sigma_s"), *d = medium.find("density");
   const std::string type = string(medium, "type");
-  if (type != "homogeneous") *why = cat("a ", type.empty() ? "medium of no type" : cat(type, " medium"), "; only homogeneous ones are");
-  else if (!exponentialTransmittance(medium.find("transmittance"))) *why = "a non-exponential transmittance";
+  if (type != "homogeneous")
+    *why = cat("a ", type.empty() ? "medium of no type" : cat(type, " medium"), "; only homogeneous ones are");
+  else if (!exponentialTransmittance(medium.find("transmittance")))
+    *why = "a non-exponential transmittance";
   else if (!((!a || json::toVec3(*a, &sigmaA)) && (!sc || json::toVec3(*sc, &sigmaS)) && (!d || json::toFloat(*d, &density))))
     *why = "sigma_a, sigma_s or density is not a number";
   if (!why->empty()) return std::nullopt;
@@ -500,8 +510,8 @@ std::optional<TungstenImporter::Filling> TungstenImporter::mediumFilling(const V
   // Tungsten writes its default, 1024, into every medium it saves: only a tighter limit matters.
   float bounces = 0;
   if (const Value* v = medium.find("max_bounces"); v && json::toFloat(*v, &bounces) && bounces < out_.scene.settings.maxBounces)
-    warn(cat("media: '", name, "': its max_bounces of ", bounces, " is not kept (the scene's limit of ",
-             out_.scene.settings.maxBounces, " bounces applies)"));
+    warn(cat("media: '", name, "': its max_bounces of ", bounces, " is not kept (the scene's limit of ", out_.scene.settings.maxBounces,
+             " bounces applies)"));
   if (const Value* phase = medium.find("phase_function"); phase && maxComponent(f.scattering) > 0) {
     // An object with its type (Tungsten's form); the type alone as a string is read too.
     const std::string phaseType = phase->isString() ? phase->asString() : phase->isObject() ? string(*phase, "type") : "";

@@ -60,7 +60,9 @@ Result<ImportedScene> TungstenImporter::run() {
     if (const Value* v = in->find("enable_light_sampling"); v && v->isBool()) s.settings.lightSampling = v->asBool();
     // Tungsten can turn it off in media alone; here it is one setting for surfaces and media.
     if (const Value* v = in->find("enable_volume_light_sampling"); v && v->isBool() && !v->asBool() && s.settings.lightSampling)
-      warn("integrator: enable_volume_light_sampling false is not rendered; lights are sampled from media too, which gives the same picture with less noise, except that point lights and suns, which Tungsten's media then never see, light them here");
+      warn(
+          "integrator: enable_volume_light_sampling false is not rendered; lights are sampled from media too, which gives the same picture "
+          "with less noise, except that point lights and suns, which Tungsten's media then never see, light them here");
     if (std::string type = string(*in, "type", "path_tracer"); type != "path_tracer")
       warn(cat("integrator: '", type, "' is rendered by path tracing, which converges to the same picture"));
   }
@@ -77,8 +79,10 @@ Result<ImportedScene> TungstenImporter::run() {
       const std::string name = string(medium, "name", "?");
       mediaNamed_.insert(name);
       std::string why;
-      if (auto filling = mediumFilling(medium, name, &why)) media_[name] = *filling;
-      else warn(cat("media: '", name, "' is not rendered (", why, "); light travels through it as through a vacuum"));
+      if (auto filling = mediumFilling(medium, name, &why))
+        media_[name] = *filling;
+      else
+        warn(cat("media: '", name, "' is not rendered (", why, "); light travels through it as through a vacuum"));
     }
   }
   if (const Value* p = root.find("primitives"); p && ok()) {
@@ -109,7 +113,9 @@ Result<ImportedScene> TungstenImporter::run() {
     }
     for (const auto& [where, name] : outside_)
       if (!inside_.count(name) && name != world)
-        warn(cat(where, ": the medium '", name, "' around it is rendered only inside glass or a forward boundary (an int_medium) or around the camera, and neither holds it; light passes through it"));
+        warn(cat(where, ": the medium '", name,
+                 "' around it is rendered only inside glass or a forward boundary (an int_medium) or around the camera, and neither holds "
+                 "it; light passes through it"));
   }
   // Not Tungsten's own key, but Bitterli's living room names its sky this way (an envmap; the
   // room has no other light). Tungsten renders these files without a `constant` entry: the
@@ -119,7 +125,8 @@ Result<ImportedScene> TungstenImporter::run() {
     for (std::size_t i = 0; i < e->asArray().size(); ++i) {
       const Value& entry = e->asArray()[i];
       if (entry.isObject() && string(entry, "type") == "constant") {
-        warn(cat("emissions[", i, "]: a constant sky outside \"primitives\" is left out, as Tungsten leaves it out "
+        warn(cat("emissions[", i,
+                 "]: a constant sky outside \"primitives\" is left out, as Tungsten leaves it out "
                  "(add an infinite_sphere primitive to light the scene with it)"));
         continue;
       }
@@ -262,10 +269,14 @@ Mat4 TungstenImporter::transform(const Value* v, const std::string& where, Vec3*
   }
   // Gram-Schmidt in an order that keeps the explicitly given axes (Tungsten's rules).
   int order[3] = {2, 1, 0};
-  if (given[0] && !given[1] && !given[2]) order[0] = 0, order[1] = 2, order[2] = 1;
-  else if (!given[0] && given[1] && !given[2]) order[0] = 1, order[1] = 2, order[2] = 0;
-  else if (given[0] && given[1] && !given[2]) order[0] = 1, order[1] = 0, order[2] = 2;
-  else if (given[0] && !given[1] && given[2]) order[0] = 2, order[1] = 0, order[2] = 1;
+  if (given[0] && !given[1] && !given[2])
+    order[0] = 0, order[1] = 2, order[2] = 1;
+  else if (!given[0] && given[1] && !given[2])
+    order[0] = 1, order[1] = 2, order[2] = 0;
+  else if (given[0] && given[1] && !given[2])
+    order[0] = 1, order[1] = 0, order[2] = 2;
+  else if (given[0] && !given[1] && given[2])
+    order[0] = 2, order[1] = 0, order[2] = 1;
   Vec3& a = axis[order[0]];
   Vec3& b = axis[order[1]];
   Vec3& c = axis[order[2]];
@@ -277,9 +288,12 @@ Mat4 TungstenImporter::transform(const Value* v, const std::string& where, Vec3*
   c = c - a * dot(a, c) - b * dot(b, c);
   c = length(c) < 1e-6f ? cross(a, b) : normalize(c);
   if (dot(cross(axis[0], axis[1]), axis[2]) < 0) {
-    if (!given[0]) axis[0] = -axis[0];
-    else if (!given[1]) axis[1] = -axis[1];
-    else axis[2] = -axis[2];
+    if (!given[0])
+      axis[0] = -axis[0];
+    else if (!given[1])
+      axis[1] = -axis[1];
+    else
+      axis[2] = -axis[2];
   }
   Mat4 basis;
   for (int col = 0; col < 3; ++col)

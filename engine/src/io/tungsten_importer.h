@@ -226,8 +226,8 @@ class TungstenImporter {
   // The meshes of a shape primitive (a mesh with several material indices gives one per index),
   // its transform `xf` made Tungsten's for the shape (a round sphere and cylinder, a disk's frame),
   // and a disk's emission cone; none, with a warning, for a type not rendered.
-  std::vector<MeshPart> shapeParts(const Value& p, const std::string& type, const std::string& where, Vec3 scale, bool split,
-                                   Mat4& xf, float& emissionCone);
+  std::vector<MeshPart> shapeParts(const Value& p, const std::string& type, const std::string& where, Vec3 scale, bool split, Mat4& xf,
+                                   float& emissionCone);
   // What a primitive emits (Tungsten's emission, or its power spread over its area): the emission
   // belongs to the primitive in Tungsten and to the material here.
   struct Emission {
@@ -248,13 +248,13 @@ class TungstenImporter {
   ImportedScene out_;
   std::string error_;
   std::map<std::string, Material> named_;
-  std::string focusPivot_;  // the thin lens camera's focus_pivot
+  std::string focusPivot_;             // the thin lens camera's focus_pivot
   const Value* primitives_ = nullptr;  // the file's primitives, while they are imported
   std::map<std::string, NodeId> textures_;
   std::set<std::string> missingWarned_;
   bool quietMissingTexture_ = false;
   std::map<std::string, NodeId> meshIds_;
-  std::map<NodeId, NodeId> mirroredOf_;  // a mesh -> its copy wound the other way
+  std::map<NodeId, NodeId> mirroredOf_;                     // a mesh -> its copy wound the other way
   std::map<std::string, std::vector<MeshPart>> meshParts_;  // a mesh file's parts, by loadMesh's key
   std::map<std::string, std::shared_ptr<const MeshGeometry>> shapes_;
   int emitters_ = 0;
@@ -274,11 +274,11 @@ class TungstenImporter {
   // homogeneous medium's own, into every file they save; no key means the same.
   static bool exponentialTransmittance(const Value* t);
   std::optional<Filling> mediumFilling(const Value& medium, const std::string& name, std::string* why);
-  std::map<std::string, Filling> media_;  // homogeneous media by name
-  std::set<std::string> mediaNamed_;      // every medium's name, rendered or not
-  std::set<std::string> inside_;  // the media some glass or boundary holds
+  std::map<std::string, Filling> media_;                      // homogeneous media by name
+  std::set<std::string> mediaNamed_;                          // every medium's name, rendered or not
+  std::set<std::string> inside_;                              // the media some glass or boundary holds
   std::vector<std::pair<std::string, std::string>> holders_;  // where a medium is held, and the ext_medium named there
-  std::string cameraMedium_;      // the camera's
+  std::string cameraMedium_;                                  // the camera's
   std::vector<std::pair<std::string, std::string>> outside_;  // where an ext_medium is named, and the name
 };
 

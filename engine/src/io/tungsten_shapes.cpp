@@ -88,12 +88,18 @@ std::shared_ptr<const MeshGeometry> TungstenImporter::shape(const std::string& k
   auto it = shapes_.find(kind);
   if (it != shapes_.end()) return it->second;
   std::shared_ptr<const MeshGeometry> g;
-  if (kind == "quad") g = tungstenQuad();
-  else if (kind == "cube") g = tungstenCube();
-  else if (kind == "sphere") g = withArea(tungstenSphere(), 4 * kPi);
-  else if (kind == "disk") g = withArea(tungstenDisk(64), kPi);
-  else if (kind == "cylinder") g = tungstenCylinder(true);
-  else if (kind == "open cylinder") g = tungstenCylinder(false);
+  if (kind == "quad")
+    g = tungstenQuad();
+  else if (kind == "cube")
+    g = tungstenCube();
+  else if (kind == "sphere")
+    g = withArea(tungstenSphere(), 4 * kPi);
+  else if (kind == "disk")
+    g = withArea(tungstenDisk(64), kPi);
+  else if (kind == "cylinder")
+    g = tungstenCylinder(true);
+  else if (kind == "open cylinder")
+    g = tungstenCylinder(false);
   shapes_[kind] = g;
   return g;
 }
@@ -245,8 +251,7 @@ NodeId TungstenImporter::curves(const Value& p, const std::string& where) {
     return kNoNode;
   }
   // Each primitive its own mesh: the same file with other settings is other tubes.
-  return meshNode(cat("curves|", ++curvesMeshes_), fs::path(f).stem().string(),
-                  std::make_shared<MeshGeometry>(std::move(tubes.geometry)));
+  return meshNode(cat("curves|", ++curvesMeshes_), fs::path(f).stem().string(), std::make_shared<MeshGeometry>(std::move(tubes.geometry)));
 }
 
 std::vector<TungstenImporter::MeshPart> TungstenImporter::loadMesh(const Value& p, const std::string& where, bool split) {
@@ -270,18 +275,24 @@ std::vector<TungstenImporter::MeshPart> TungstenImporter::loadMesh(const Value& 
   Result<MeshGeometry> g = Result<MeshGeometry>::failure("");
   std::vector<std::int32_t> materials;  // per triangle, wo3 only
   std::string ext = extensionLower(*path);
-  if (ext == "obj") g = readObjGeometry(*path, &warnings, options_);
-  else if (ext == "wo3") g = readWo3(*path, &materials);
-  else g = Result<MeshGeometry>::failure(cat(path->string(), ": unsupported mesh format '.", ext, "' (obj or wo3)"));
+  if (ext == "obj")
+    g = readObjGeometry(*path, &warnings, options_);
+  else if (ext == "wo3")
+    g = readWo3(*path, &materials);
+  else
+    g = Result<MeshGeometry>::failure(cat(path->string(), ": unsupported mesh format '.", ext, "' (obj or wo3)"));
   for (auto& w : warnings) out_.warnings.push_back(w);
   if (!g) {
     warn(cat(where, ": ", g.error(), "; the primitive is skipped"));
     return {};
   }
   MeshGeometry geom = std::move(g.value());
-  if (!smooth) geom.normals.clear();  // flat shading
-  else if (recompute) creasedNormals(geom);  // across the parts' seams
-  else if (geom.normals.empty()) smoothNormals(geom);
+  if (!smooth)
+    geom.normals.clear();  // flat shading
+  else if (recompute)
+    creasedNormals(geom);  // across the parts' seams
+  else if (geom.normals.empty())
+    smoothNormals(geom);
   const std::string name = fs::path(f).stem().string();
   std::vector<MeshPart> parts;
   if (!split || materials.size() * 3 != geom.indices.size() ||
@@ -400,8 +411,8 @@ void TungstenImporter::environmentFromEmission(const Value& p, const std::string
     e.color = t.constant * powerScale;
     const Texture* tex = out_.scene.texture(t.texture);
     if (tex && tex->kind == TextureKind::File && !resolveScenePath(base_, tex->path.string()))
-      warn(cat("environment map '", tex->path.string(), "' is missing: the scene is lit by a constant sky of radiance ",
-               luminance(e.color), " instead"));
+      warn(cat("environment map '", tex->path.string(), "' is missing: the scene is lit by a constant sky of radiance ", luminance(e.color),
+               " instead"));
   } else {
     e.type = EnvironmentType::Constant;
     e.color = t.constant * powerScale;
@@ -492,7 +503,8 @@ void TungstenImporter::pointLight(const Value& p, const std::string& where, cons
 // The meshes of a shape primitive (a mesh with several material indices gives one per index),
 // its transform `xf` made Tungsten's for the shape (a round sphere and cylinder, a disk's frame),
 // and a disk's emission cone; none, with a warning, for a type not rendered.
-std::vector<TungstenImporter::MeshPart> TungstenImporter::shapeParts(const Value& p, const std::string& type, const std::string& where, Vec3 scale, bool split, Mat4& xf, float& emissionCone) {
+std::vector<TungstenImporter::MeshPart> TungstenImporter::shapeParts(const Value& p, const std::string& type, const std::string& where,
+                                                                     Vec3 scale, bool split, Mat4& xf, float& emissionCone) {
   std::vector<MeshPart> parts;
   if (type == "mesh") {
     parts = loadMesh(p, where, split);
@@ -534,8 +546,8 @@ std::vector<TungstenImporter::MeshPart> TungstenImporter::shapeParts(const Value
   return parts;
 }
 
-TungstenImporter::Emission TungstenImporter::emissionOf(const Value& p, const std::string& where,
-                                                       const std::vector<MeshPart>& parts, const Mat4& xf) {
+TungstenImporter::Emission TungstenImporter::emissionOf(const Value& p, const std::string& where, const std::vector<MeshPart>& parts,
+                                                        const Mat4& xf) {
   Emission light;
   if (const Value* e = p.find("emission")) {
     TextureRef t = texture(*e, where + ".emission", false);
@@ -561,14 +573,15 @@ std::string TungstenImporter::fillMedium(const Value& p, const std::string& wher
       mat.interiorScattering = f.scattering;
       mat.interiorAnisotropy = f.anisotropy;
     } else {
-      warn(cat(where, ": the medium '", name, "' is rendered only inside glass or a forward boundary (an int_medium); here light passes through it"));
+      warn(cat(where, ": the medium '", name,
+               "' is rendered only inside glass or a forward boundary (an int_medium); here light passes through it"));
     }
   }
   if (const std::string name = string(p, "ext_medium"); !name.empty() && media_.count(name)) {
     outside_.emplace_back(where, name);  // warned of once every primitive is read, if nothing holds it
     if (mat.type == MaterialType::Boundary && !medium.empty())
-      warn(cat(where, ": a boundary of '", medium, "' inside the medium '", name,
-               "': a path inside it is in '", medium, "' alone, but its shadow rays count both"));
+      warn(cat(where, ": a boundary of '", medium, "' inside the medium '", name, "': a path inside it is in '", medium,
+               "' alone, but its shadow rays count both"));
   }
   if (!medium.empty()) {
     inside_.insert(medium);
@@ -603,7 +616,7 @@ void TungstenImporter::primitive(const Value& p, const std::string& where) {
     return;
   }
 
-  float emissionCone = 90;      // Material::emissionCone, a disk's cone_angle
+  float emissionCone = 90;  // Material::emissionCone, a disk's cone_angle
   Mat4 xf = transform(tv, where, &scale, type == "quad" || type == "disk");
   if (!ok()) return;
   const Value* bsdfs = p.find("bsdf");
@@ -643,9 +656,10 @@ void TungstenImporter::primitive(const Value& p, const std::string& where) {
   if (byIndex && bsdfs->asArray().size() > 1 && type != "mesh")
     warn(cat(where, ": ", bsdfs->asArray().size(), " bsdfs by material index on a ", type, "; it takes the first"));
   for (const MeshPart& part : parts) {
-    const std::size_t index = byIndex ? static_cast<std::size_t>(std::clamp<std::int64_t>(part.material, 0,
-                                                                   static_cast<std::int64_t>(bsdfs->asArray().size()) - 1))
-                                      : 0;
+    const std::size_t index =
+        byIndex
+            ? static_cast<std::size_t>(std::clamp<std::int64_t>(part.material, 0, static_cast<std::int64_t>(bsdfs->asArray().size()) - 1))
+            : 0;
     const Value* b = byIndex ? &bsdfs->asArray()[index] : bsdfs;
     const std::string bsdfWhere = byIndex ? cat(where, ".bsdf[", index, "]") : where + ".bsdf";
     Material mat;

@@ -11,7 +11,8 @@ namespace retile {
 
 BsdfProbe::BsdfProbe(vk::Context& ctx)
     : ctx_(ctx),
-      pipeline_(std::make_unique<vk::ComputePipeline>(ctx, "bsdf_probe.comp", std::vector<vk::Binding>{vk::Binding::Storage, vk::Binding::Storage},
+      pipeline_(std::make_unique<vk::ComputePipeline>(ctx, "bsdf_probe.comp",
+                                                      std::vector<vk::Binding>{vk::Binding::Storage, vk::Binding::Storage},
                                                       static_cast<std::uint32_t>(sizeof(std::uint32_t)))) {}
 
 BsdfProbe::~BsdfProbe() = default;

@@ -23,13 +23,13 @@ struct BsdfQuery {
 };
 
 struct BsdfAnswer {
-  Vec3 f;            // eval(wo, wi): f * |cos wi|
-  float pdf = 0;     // what sampling would give wi (0 for delta lobes)
-  Vec3 sampledWi;    // sample(wo, u)
+  Vec3 f;          // eval(wo, wi): f * |cos wi|
+  float pdf = 0;   // what sampling would give wi (0 for delta lobes)
+  Vec3 sampledWi;  // sample(wo, u)
   float sampledPdf = 0;
-  Vec3 weight;       // f * |cos| / pdf of the sample; 0 when it failed
+  Vec3 weight;  // f * |cos| / pdf of the sample; 0 when it failed
   bool delta = false, transmitted = false;
-  Vec3 fAtSample;    // eval(wo, sampledWi)
+  Vec3 fAtSample;  // eval(wo, sampledWi)
   float pdfAtSample = 0;
 };
 

@@ -50,8 +50,7 @@ struct Builder {
   const BvhBuildOptions& opt;
   std::vector<BuildNode> nodes;
 
-  Builder(std::span<const Bounds3> b, std::vector<std::uint32_t>& o, const BvhBuildOptions& op)
-      : order(o), opt(op) {
+  Builder(std::span<const Bounds3> b, std::vector<std::uint32_t>& o, const BvhBuildOptions& op) : order(o), opt(op) {
     boxes.reserve(b.size());
     centroids.resize(b.size());
     for (std::size_t i = 0; i < b.size(); ++i) {
@@ -191,20 +190,38 @@ std::size_t cutPieces(const std::vector<BuildNode>& bn, std::int32_t n, std::uin
   // Opens node i: its two children, or a failed cut when it is a leaf.
   auto open = [&](std::int32_t i, auto&& then) {
     const BuildNode& b = bn[static_cast<std::size_t>(i)];
-    if (b.left < 0) exists = false;
-    else then(b.left, b.right);
+    if (b.left < 0)
+      exists = false;
+    else
+      then(b.left, b.right);
   };
   open(n, [&](std::int32_t l, std::int32_t r) {
     auto both = [&](std::int32_t a, std::int32_t b) { put(a), put(b); };
     switch (id) {
-      case 0: put(l), put(r); break;
-      case 1: open(l, both), put(r); break;
-      case 2: put(l), open(r, both); break;
-      case 3: open(l, both), open(r, both); break;
-      case 4: open(l, [&](std::int32_t a, std::int32_t b) { open(a, both), put(b); }), put(r); break;
-      case 5: open(l, [&](std::int32_t a, std::int32_t b) { put(a), open(b, both); }), put(r); break;
-      case 6: put(l), open(r, [&](std::int32_t a, std::int32_t b) { open(a, both), put(b); }); break;
-      default: put(l), open(r, [&](std::int32_t a, std::int32_t b) { put(a), open(b, both); }); break;
+      case 0:
+        put(l), put(r);
+        break;
+      case 1:
+        open(l, both), put(r);
+        break;
+      case 2:
+        put(l), open(r, both);
+        break;
+      case 3:
+        open(l, both), open(r, both);
+        break;
+      case 4:
+        open(l, [&](std::int32_t a, std::int32_t b) { open(a, both), put(b); }), put(r);
+        break;
+      case 5:
+        open(l, [&](std::int32_t a, std::int32_t b) { put(a), open(b, both); }), put(r);
+        break;
+      case 6:
+        put(l), open(r, [&](std::int32_t a, std::int32_t b) { open(a, both), put(b); });
+        break;
+      default:
+        put(l), open(r, [&](std::int32_t a, std::int32_t b) { put(a), open(b, both); });
+        break;
     }
   });
   return exists ? count : 0;

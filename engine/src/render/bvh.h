@@ -6,8 +6,8 @@
 // fewest expected traversal steps. On lavapipe every loop iteration of the traversal pays for the whole loop body
 // (shaders/common/scene.glsl), so what counts is the number of steps a ray takes; a four-wide node
 // decides among four children in one step, and its child boxes, quantised to 8 bits per plane
-// relative to the node's box, keep a node in 48 bytes, less than a binary node took. A node names its children by two bases only (layouts.h),
-// which buildBvh's order makes possible.
+// relative to the node's box, keep a node in 48 bytes, less than a binary node took. A node names its children by two bases only
+// (layouts.h), which buildBvh's order makes possible.
 #pragma once
 
 #include <array>
@@ -53,14 +53,14 @@ Bounds3 dequantize(const QuantizedNode& q, int child);
 
 struct BvhBuildOptions {
   int maxLeafSize = kMaxLeafSize;  // leaves never hold more
-  int bins = 16;        // SAH bins per axis
+  int bins = 16;                   // SAH bins per axis
   // The traversal steps of input primitive i (a leaf's cost is its primitives'); one when unset.
   std::function<float(std::uint32_t)> primCost;
 };
 
 struct Bvh {
-  std::vector<BvhNode> nodes;           // nodes[0] is the root; children after their parent
-  std::vector<std::uint32_t> primOrder; // packed primitive i is input primitive primOrder[i]
+  std::vector<BvhNode> nodes;            // nodes[0] is the root; children after their parent
+  std::vector<std::uint32_t> primOrder;  // packed primitive i is input primitive primOrder[i]
   Bounds3 bounds;
   int depth = 0;
 };

@@ -61,20 +61,18 @@ void Denoiser::allocate() {
     auto push = static_cast<std::uint32_t>(sizeof(gpu::DenoisePush));
     using B = Binding;
     prepare_ = std::make_unique<vk::ComputePipeline>(
-        ctx_, "denoise_prepare.comp",
-        std::vector<B>{B::UniformTexel, B::UniformTexel, B::Storage, B::Storage, B::Storage, B::Storage}, push);
+        ctx_, "denoise_prepare.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::Storage, B::Storage, B::Storage, B::Storage},
+        push);
     variance_ = std::make_unique<vk::ComputePipeline>(
-        ctx_, "denoise_variance.comp",
-        std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
+        ctx_, "denoise_variance.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
     // The a-trous iterations ping-pong between two buffers: one pipeline (and descriptor set) each way.
     for (auto* p : {&atrousAB_, &atrousBA_})
-      *p = std::make_unique<vk::ComputePipeline>(
-          ctx_, "denoise_atrous.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage}, push);
+      *p = std::make_unique<vk::ComputePipeline>(ctx_, "denoise_atrous.comp",
+                                                 std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage}, push);
     finish_ = std::make_unique<vk::ComputePipeline>(
-        ctx_, "denoise_finish.comp",
-        std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
-    compose_ = std::make_unique<vk::ComputePipeline>(
-        ctx_, "compose.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
+        ctx_, "denoise_finish.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
+    compose_ = std::make_unique<vk::ComputePipeline>(ctx_, "compose.comp",
+                                                     std::vector<B>{B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
   }
   const VkDeviceSize pixels = static_cast<VkDeviceSize>(width_) * static_cast<VkDeviceSize>(height_);
   const VkDeviceSize px = pixels * sizeof(gpu::vec4);
@@ -151,8 +149,7 @@ void Denoiser::record(VkCommandBuffer cb, const DenoiseWork& work) {
   gpu::DenoisePush push{};
   push.image = {static_cast<std::uint32_t>(width_), static_cast<std::uint32_t>(height_), 1,
                 static_cast<std::uint32_t>(std::max(work.featherPixels, 0))};
-  push.tiles = {static_cast<std::uint32_t>(work.tileSize),
-                static_cast<std::uint32_t>((width_ + work.tileSize - 1) / work.tileSize), 0, 0};
+  push.tiles = {static_cast<std::uint32_t>(work.tileSize), static_cast<std::uint32_t>((width_ + work.tileSize - 1) / work.tileSize), 0, 0};
   std::uint32_t gy;
   if (work.filter) {
     int x0 = std::clamp(work.x, 0, width_), y0 = std::clamp(work.y, 0, height_);
@@ -195,13 +192,12 @@ std::vector<FrameStats::PassTime> Denoiser::passTimes() {
   std::vector<FrameStats::PassTime> out;
   if (timedPasses_.size() < 2) return out;
   std::vector<std::uint64_t> ticks(timedPasses_.size());
-  vk::checkVk(vkGetQueryPoolResults(ctx_.device(), timestamps_, 0, static_cast<std::uint32_t>(ticks.size()),
-                                    ticks.size() * sizeof(std::uint64_t), ticks.data(), sizeof(std::uint64_t),
-                                    VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-              "reading the denoiser's timestamps");
+  vk::checkVk(
+      vkGetQueryPoolResults(ctx_.device(), timestamps_, 0, static_cast<std::uint32_t>(ticks.size()), ticks.size() * sizeof(std::uint64_t),
+                            ticks.data(), sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+      "reading the denoiser's timestamps");
   const double msPerTick = static_cast<double>(ctx_.properties().limits.timestampPeriod) * 1e-6;
-  for (std::size_t i = 1; i < ticks.size(); ++i)
-    out.push_back({timedPasses_[i], static_cast<double>(ticks[i] - ticks[i - 1]) * msPerTick});
+  for (std::size_t i = 1; i < ticks.size(); ++i) out.push_back({timedPasses_[i], static_cast<double>(ticks[i] - ticks[i - 1]) * msPerTick});
   timedPasses_.clear();
   return out;
 }

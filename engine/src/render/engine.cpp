@@ -15,9 +15,8 @@ namespace {
 // (select, focus, method, resize, pause) coalesce by kind.
 std::uint64_t commandKey(const Command& c) {
   if (const Edit* e = std::get_if<Edit>(&c)) {
-    if (std::holds_alternative<AddMesh>(*e) || std::holds_alternative<AddMaterial>(*e) ||
-        std::holds_alternative<AddObject>(*e) || std::holds_alternative<AddLight>(*e) ||
-        std::holds_alternative<AddTexture>(*e) || std::holds_alternative<RemoveNode>(*e))
+    if (std::holds_alternative<AddMesh>(*e) || std::holds_alternative<AddMaterial>(*e) || std::holds_alternative<AddObject>(*e) ||
+        std::holds_alternative<AddLight>(*e) || std::holds_alternative<AddTexture>(*e) || std::holds_alternative<RemoveNode>(*e))
       return 0;  // structural: never coalesced
     return editCoalesceKey(*e);
   }
@@ -202,8 +201,8 @@ void Engine::run() {
       }
       if (cb) cb();
     };
-    bool converged = options_.maxSamplesPerPixel > 0 && last && !changed && last->mode == "refinement" &&
-                     !last->tileSamples.empty() && regionConverged(*last, options_.maxSamplesPerPixel);
+    bool converged = options_.maxSamplesPerPixel > 0 && last && !changed && last->mode == "refinement" && !last->tileSamples.empty() &&
+                     regionConverged(*last, options_.maxSamplesPerPixel);
     try {
       if (paused || converged) {
         // Show the frame still unfinished before resting.

@@ -19,9 +19,7 @@ inline constexpr std::uint64_t kMaxTexelBytes = static_cast<std::uint64_t>(gpu::
 
 inline vec4 v4(Vec3 v, float w) { return {v.x, v.y, v.z, w}; }
 inline float bitsOf(std::int32_t i) { return std::bit_cast<float>(i); }
-inline vec4 ints(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d) {
-  return {bitsOf(a), bitsOf(b), bitsOf(c), bitsOf(d)};
-}
+inline vec4 ints(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d) { return {bitsOf(a), bitsOf(b), bitsOf(c), bitsOf(d)}; }
 
 // Calls `visit` on `m` and on each material it blends with, as the kernel follows the chain
 // (fetchMaterial): at most kMaxBlendChain, up to a missing one or one that blends with itself.

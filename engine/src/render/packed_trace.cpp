@@ -20,20 +20,19 @@ Vec3 safeInverse(Vec3 d) {
   return {inv(d.x), inv(d.y), inv(d.z)};
 }
 
-std::int32_t childItem(std::uint32_t slot, std::uint32_t innerCount, std::uint32_t starts, std::uint32_t innerBase,
-                       std::uint32_t leafBase, int leafKind) {
+std::int32_t childItem(std::uint32_t slot, std::uint32_t innerCount, std::uint32_t starts, std::uint32_t innerBase, std::uint32_t leafBase,
+                       int leafKind) {
   const bool inner = slot < innerCount;
-  const std::uint32_t unit =
-      inner ? innerBase + slot : leafBase + ((starts >> (gpu::kStartBits * slot)) & ((1u << gpu::kStartBits) - 1u));
+  const std::uint32_t unit = inner ? innerBase + slot : leafBase + ((starts >> (gpu::kStartBits * slot)) & ((1u << gpu::kStartBits) - 1u));
   return static_cast<std::int32_t>(unit * gpu::kUnitTexels) << gpu::kItemOffsetShift | (inner ? gpu::kItemNode : leafKind);
 }
 }  // namespace
 
-PackedTrace tracePacked(std::span<const gpu::vec4> mesh, std::span<const gpu::vec4> top, std::int32_t root, bool direct,
-                        Vec3 origin, Vec3 direction, float tMax) {
+PackedTrace tracePacked(std::span<const gpu::vec4> mesh, std::span<const gpu::vec4> top, std::int32_t root, bool direct, Vec3 origin,
+                        Vec3 direction, float tMax) {
   auto texel = [&](std::int64_t k) -> const gpu::vec4& {
     return k < static_cast<std::int64_t>(mesh.size()) ? mesh[static_cast<std::size_t>(k)]
-                                                        : top[static_cast<std::size_t>(k - static_cast<std::int64_t>(mesh.size()))];
+                                                      : top[static_cast<std::size_t>(k - static_cast<std::int64_t>(mesh.size()))];
   };
   PackedTrace out;
   out.t = tMax;
@@ -89,22 +88,20 @@ PackedTrace tracePacked(std::span<const gpu::vec4> mesh, std::span<const gpu::ve
       // Ranks, nearest entry first, ties to the later slot (scene.glsl).
       const bool c01 = tNear[1] <= tNear[0], c02 = tNear[2] <= tNear[0], c03 = tNear[3] <= tNear[0];
       const bool c12 = tNear[2] <= tNear[1], c13 = tNear[3] <= tNear[1], c23 = tNear[3] <= tNear[2];
-      const std::uint32_t rank[4] = {std::uint32_t{c01} + c02 + c03, std::uint32_t{!c01} + c12 + c13,
-                                     std::uint32_t{!c02} + !c12 + c23, std::uint32_t{!c03} + !c13 + !c23};
+      const std::uint32_t rank[4] = {std::uint32_t{c01} + c02 + c03, std::uint32_t{!c01} + c12 + c13, std::uint32_t{!c02} + !c12 + c23,
+                                     std::uint32_t{!c03} + !c13 + !c23};
       std::uint32_t inOrder = 0;
       for (int c = 0; c < 4; ++c) inOrder |= std::uint32_t{entered[c]} << rank[c];
       const std::uint32_t left = inOrder & (15u << static_cast<std::uint32_t>((item >> 2) & 3));
       const std::uint32_t rest = left & (left - 1u);
-      auto slotOfRank = [&](std::uint32_t pos) {
-        return rank[0] == pos ? 0u : (rank[1] == pos ? 1u : (rank[2] == pos ? 2u : 3u));
-      };
+      auto slotOfRank = [&](std::uint32_t pos) { return rank[0] == pos ? 0u : (rank[1] == pos ? 1u : (rank[2] == pos ? 2u : 3u)); };
       if (left != 0u) {
         const auto pos = static_cast<std::uint32_t>(std::countr_zero(left));
         next = childItem(slotOfRank(pos), innerCount, starts, innerBase, leafBase, leafKind);
         if (rest != 0u && static_cast<int>(stack.size()) < kStackSize) {
           const auto pos2 = static_cast<std::uint32_t>(std::countr_zero(rest));
           stack.push_back((rest & (rest - 1u)) == 0u ? childItem(slotOfRank(pos2), innerCount, starts, innerBase, leafBase, leafKind)
-                                                    : (item & ~12) | static_cast<std::int32_t>((pos + 1) << 2));
+                                                     : (item & ~12) | static_cast<std::int32_t>((pos + 1) << 2));
         }
       }
     } else if (kind == gpu::kItemTriangles) {

@@ -26,7 +26,7 @@ struct PackedTrace {
 
 // The buffer is `mesh` followed by `top` (RenderSceneData::meshTraversal and topTraversal);
 // `root` is the instance BVH's root item. direct: packed with kFeatureDirectReferences.
-PackedTrace tracePacked(std::span<const gpu::vec4> mesh, std::span<const gpu::vec4> top, std::int32_t root, bool direct,
-                        Vec3 origin, Vec3 direction, float tMax);
+PackedTrace tracePacked(std::span<const gpu::vec4> mesh, std::span<const gpu::vec4> top, std::int32_t root, bool direct, Vec3 origin,
+                        Vec3 direction, float tMax);
 
 }  // namespace retile

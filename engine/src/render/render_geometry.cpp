@@ -27,7 +27,6 @@ using namespace pack;
 
 namespace {
 
-
 // The item naming the record of `kind` at texel `offset` of the traversal buffer (layouts.h).
 std::int32_t traversalItem(std::int64_t offset, int kind) {
   if (offset + 4 > gpu::kMaxTraversalTexels)
@@ -47,13 +46,13 @@ std::uint32_t traversalUnit(std::int64_t offset) {
 // Appends a node's three texels (layouts.h): n's boxes, quantised, its slots' layout (innerCount
 // inner children, `used` slots, leaves of instance records or of triangles, where slots 1..3's
 // leaves start) and its two bases, the leaves' `leafUnits` units from leafUnit on.
-void pushNode(std::vector<vec4>& out, const BvhNode& n, std::uint32_t innerCount, std::uint32_t used, bool instances,
-              std::uint32_t starts, std::uint32_t innerUnit, std::uint32_t leafUnit, std::int32_t leafUnits) {
+void pushNode(std::vector<vec4>& out, const BvhNode& n, std::uint32_t innerCount, std::uint32_t used, bool instances, std::uint32_t starts,
+              std::uint32_t innerUnit, std::uint32_t leafUnit, std::int32_t leafUnits) {
   if (leafUnits > 0) traversalUnit(gpu::kUnitTexels * (std::int64_t{leafUnit} + leafUnits - 1));  // the last within the limit too
   auto word = [](std::uint32_t u) { return std::bit_cast<float>(u); };
   const QuantizedNode q = quantize(n);
-  const std::uint32_t layout = innerCount << gpu::kLayoutInner | used << gpu::kLayoutUsed |
-                               (instances ? 1u : 0u) << gpu::kLayoutInstances | starts << gpu::kLayoutStarts;
+  const std::uint32_t layout = innerCount << gpu::kLayoutInner | used << gpu::kLayoutUsed | (instances ? 1u : 0u) << gpu::kLayoutInstances |
+                               starts << gpu::kLayoutStarts;
   out.push_back({q.origin[0], q.origin[1], q.origin[2], word(q.exponents | (layout & 255u) << 24)});
   out.push_back({word(q.lo[0]), word(q.lo[1]), word(q.lo[2]), word(q.hi[0])});
   out.push_back({word(q.hi[1]), word(q.hi[2]), word(innerUnit | (layout >> 8 & 63u) << gpu::kBaseBits),
@@ -63,8 +62,7 @@ void pushNode(std::vector<vec4>& out, const BvhNode& n, std::uint32_t innerCount
 // Appends `nodes` (render/bvh.h, child indices local to them) to `out`, a part of the traversal
 // buffer that starts at its texel `outBase`. Their leaves' records are at texel `leafBase`, one
 // unit per triangle of a mesh BVH, or two per reference of the instance BVH (`instances`).
-void appendNodes(std::vector<vec4>& out, const std::vector<BvhNode>& nodes, std::int64_t outBase, std::int64_t leafBase,
-                 bool instances) {
+void appendNodes(std::vector<vec4>& out, const std::vector<BvhNode>& nodes, std::int64_t outBase, std::int64_t leafBase, bool instances) {
   const std::int64_t base = outBase + static_cast<std::int64_t>(out.size());
   const std::int64_t leafTexels = instances ? gpu::kInstanceRecordTexels : gpu::kTriTexels;
   static_assert(gpu::kNodeTexels == gpu::kUnitTexels && gpu::kTriTexels == gpu::kUnitTexels &&
@@ -165,8 +163,8 @@ void appendDirectTop(std::vector<vec4>& out, std::int64_t outBase, const std::ve
     }
     const std::uint32_t innerUnit =
         innerCount == 0 ? 0 : traversalUnit(first + static_cast<std::int64_t>(inner[static_cast<std::size_t>(u.tlas)]) * gpu::kNodeTexels);
-    pushNode(out, slots, innerCount, used, false, starts, innerUnit, leafUnits > 0 ? traversalUnit(std::int64_t{leafUnit} * gpu::kUnitTexels) : 0,
-             leafUnits);
+    pushNode(out, slots, innerCount, used, false, starts, innerUnit,
+             leafUnits > 0 ? traversalUnit(std::int64_t{leafUnit} * gpu::kUnitTexels) : 0, leafUnits);
   }
   out.insert(out.end(), leaves.begin(), leaves.end());
 }
@@ -225,7 +223,8 @@ std::vector<SampleRay> sampleRays(const Scene& scene, const std::vector<vec4>& m
     const float r = std::sqrt(random()), phi = 2 * kPi * random();
     const Vec3 a = std::abs(n.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
     const Vec3 u = normalize(cross(a, n)), v = cross(n, u);
-    return SampleRay{at + n * offset, normalize(u * (r * std::cos(phi)) + v * (r * std::sin(phi)) + n * std::sqrt(std::max(0.0f, 1 - r * r)))};
+    return SampleRay{at + n * offset,
+                     normalize(u * (r * std::cos(phi)) + v * (r * std::sin(phi)) + n * std::sqrt(std::max(0.0f, 1 - r * r)))};
   };
   // Traces a path from `ray` for up to `bounces` bounces; whether its first ray hit.
   auto follow = [&](SampleRay ray, int bounces) {
@@ -248,7 +247,8 @@ std::vector<SampleRay> sampleRays(const Scene& scene, const std::vector<vec4>& m
   const Camera& cam = scene.camera;
   const Mat4 toWorld = Mat4::lookAt(cam.position, cam.target, cam.up);
   const float tanHalf = std::tan(0.5f * std::clamp(cam.verticalFov, 1e-3f, 3.1f));
-  const float aspect = scene.settings.height > 0 ? static_cast<float>(scene.settings.width) / static_cast<float>(scene.settings.height) : 1.0f;
+  const float aspect =
+      scene.settings.height > 0 ? static_cast<float>(scene.settings.width) / static_cast<float>(scene.settings.height) : 1.0f;
   int seen = 0;
   for (int path = 0; path < kSamplePaths; ++path) {
     const float x = (2 * random() - 1) * tanHalf * aspect, y = (2 * random() - 1) * tanHalf;
@@ -416,8 +416,7 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
     const vec4* shade = fresh ? e.shading.data() : data_.triangleShading.data() + std::size_t{e.triOffset} * gpu::kTriShadeTexels;
     traversal.insert(traversal.end(), tri, tri + n * gpu::kTriTexels);
     shading.insert(shading.end(), shade, shade + n * gpu::kTriShadeTexels);
-    for (std::size_t p = 0; p < n; ++p)
-      traversal[(offset + p) * gpu::kTriTexels].w = bitsOf(static_cast<std::int32_t>(offset + p));
+    for (std::size_t p = 0; p < n; ++p) traversal[(offset + p) * gpu::kTriTexels].w = bitsOf(static_cast<std::int32_t>(offset + p));
     e.triOffset = offset;
     e.triangles = std::vector<vec4>();  // `= {}` would clear and keep the memory
     e.shading = std::vector<vec4>();
@@ -467,9 +466,9 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   // move builds one instance BVH, whose size stays proportional to the number of objects.
   struct Ref {
     std::uint32_t cand;
-    std::int32_t item;  // where traversal enters the instance's BVH
-    std::int32_t node;  // that BVH's node index when item is an inner node, else -1
-    Bounds3 bounds;     // world space
+    std::int32_t item;           // where traversal enters the instance's BVH
+    std::int32_t node;           // that BVH's node index when item is an inner node, else -1
+    Bounds3 bounds;              // world space
     std::int32_t triangles = 0;  // a leaf's, when item is one
   };
   auto braid = [&](std::size_t budget) {
@@ -608,10 +607,13 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   auto pack = [&](const Bvh& tlas, const std::vector<Ref>& refs, bool packDirect) {
     std::vector<vec4> top;
     if (packDirect) {
-      appendDirectTop(top, base, tlas.nodes, [&](std::int32_t p) {
-        const Ref& r = refs[tlas.primOrder[static_cast<std::size_t>(p)]];
-        return DirectRef{r.item >> gpu::kItemOffsetShift, r.node >= 0, r.triangles};
-      }, data_.meshTraversal);
+      appendDirectTop(
+          top, base, tlas.nodes,
+          [&](std::int32_t p) {
+            const Ref& r = refs[tlas.primOrder[static_cast<std::size_t>(p)]];
+            return DirectRef{r.item >> gpu::kItemOffsetShift, r.node >= 0, r.triangles};
+          },
+          data_.meshTraversal);
       return top;
     }
     const auto records = base + static_cast<std::int64_t>(tlas.nodes.size()) * gpu::kNodeTexels;
@@ -623,9 +625,9 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
       for (int row = 0; row < 3; ++row) top.push_back({inv.m[row][0], inv.m[row][1], inv.m[row][2], inv.m[row][3]});
       top.insert(top.end(), gpu::kInstanceRecordTexels - 4, vec4{});
     }
-    RETILE_ASSERT(records + static_cast<std::int64_t>(refs.size()) * gpu::kInstanceRecordTexels ==
-                      base + static_cast<std::int64_t>(top.size()),
-                  "instance records out of place");
+    RETILE_ASSERT(
+        records + static_cast<std::int64_t>(refs.size()) * gpu::kInstanceRecordTexels == base + static_cast<std::int64_t>(top.size()),
+        "instance records out of place");
     return top;
   };
   data_.tlasRoot = traversalItem(base, gpu::kItemNode);
@@ -652,7 +654,8 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     if (c.visible) visibleIds.push_back(c.object->id);
   std::sort(visibleIds.begin(), visibleIds.end());
   std::vector<NodeId> differ;  // objects visible now or then but not both
-  std::set_symmetric_difference(visibleIds.begin(), visibleIds.end(), braidVisible_.begin(), braidVisible_.end(), std::back_inserter(differ));
+  std::set_symmetric_difference(visibleIds.begin(), visibleIds.end(), braidVisible_.begin(), braidVisible_.end(),
+                                std::back_inserter(differ));
   if (chooseBraid || differ.size() > std::max<std::size_t>(braidVisible_.size() / 8, 2)) {
     braidVisible_ = std::move(visibleIds);
     braidFactor_ = {0, 0};
@@ -668,13 +671,15 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     std::vector<SampleSurface> surfaces;
     for (std::size_t i = 0; i < cands.size(); ++i)
       if (cands[i].visible)
-        surfaces.push_back({cands[i].mesh->triOffset, static_cast<std::uint32_t>(cands[i].mesh->bvh.primOrder.size()), &cands[i].transform, &inverseOf[i]});
-    const std::vector<SampleRay> rays = sampleRays(scene, data_.meshTraversal, probeTop, data_.tlasRoot, direct, surfaces, [&](std::int32_t instance) -> const Mat4& {
-      return inverseOf[static_cast<std::size_t>(instance)];
-    });
+        surfaces.push_back({cands[i].mesh->triOffset, static_cast<std::uint32_t>(cands[i].mesh->bvh.primOrder.size()), &cands[i].transform,
+                            &inverseOf[i]});
+    const std::vector<SampleRay> rays =
+        sampleRays(scene, data_.meshTraversal, probeTop, data_.tlasRoot, direct, surfaces,
+                   [&](std::int32_t instance) -> const Mat4& { return inverseOf[static_cast<std::size_t>(instance)]; });
     auto stepsOf = [&](const std::vector<vec4>& packed, bool packDirect) {
       std::uint64_t steps = 0;
-      for (const SampleRay& r : rays) steps += tracePacked(data_.meshTraversal, packed, data_.tlasRoot, packDirect, r.origin, r.direction, kRayFar).steps;
+      for (const SampleRay& r : rays)
+        steps += tracePacked(data_.meshTraversal, packed, data_.tlasRoot, packDirect, r.origin, r.direction, kRayFar).steps;
       return steps;
     };
     // The factor for packing `packDirect`, and with `keep` its instance BVH and packing. Factor 1
@@ -727,6 +732,5 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   data_.instanceReferences = refs.size();
   return renamed;
 }
-
 
 }  // namespace retile

@@ -56,8 +56,6 @@ LinearImage bakeSky(const Environment& e) {
   return img;
 }
 
-
-
 // Vose's alias method: O(1) sampling of an emitter proportional to its power.
 std::vector<vec4> aliasTable(const std::vector<float>& weights) {
   std::size_t n = weights.size();
@@ -113,8 +111,10 @@ void pushLightGroupShape(std::vector<vec4>& out, const vec4* e, const float* pow
     bounds.grow(w0 + Vec3{t[2].x, t[2].y, t[2].z});
     if (!(power[k] > 0)) continue;
     const Vec3 nrm{t[4].x, t[4].y, t[4].z};
-    if (length(normal) == 0) normal = nrm, onPlane = w0;
-    else if (!(dot(normal, nrm) > 1 - 1e-5f)) planar = false;
+    if (length(normal) == 0)
+      normal = nrm, onPlane = w0;
+    else if (!(dot(normal, nrm) > 1 - 1e-5f))
+      planar = false;
   }
   const float radius = bounds.empty() ? 0.0f : 0.5f * length(bounds.extent());
   Vec3 centre = bounds.empty() ? Vec3{0.0f} : bounds.center();
@@ -128,8 +128,10 @@ void pushLightGroupShape(std::vector<vec4>& out, const vec4* e, const float* pow
       if (!(std::abs(dot(normal, v) - offset) <= slack)) planar = false;
   }
   planar = planar && length(normal) > 0;
-  if (planar) centre = centre - normal * (dot(normal, centre) - offset);  // onto the plane, which the kernel measures from it
-  else normal = Vec3{0.0f};
+  if (planar)
+    centre = centre - normal * (dot(normal, centre) - offset);  // onto the plane, which the kernel measures from it
+  else
+    normal = Vec3{0.0f};
   // What it gives a point at distance d is about its radiance times the solid angle of its area
   // (a plane's seen at the plane's cosine, a solid's a quarter of its area, a convex body's mean
   // projection), over d^2.
@@ -138,11 +140,12 @@ void pushLightGroupShape(std::vector<vec4>& out, const vec4* e, const float* pow
   out.push_back(v4(normal, scale / std::max(radius * radius, 1e-30f)));
 }
 
-
 // What an environment's light-sampling distribution and baked sky are made from, as a key: its
 // map (the texture and what was decoded for it) or its sky's colours; empty for a constant.
 std::string environmentSource(const Environment& e, const Texture* map, const std::string& mapSignature) {
-  auto bits = [](Vec3 v) { return cat(std::bit_cast<std::uint32_t>(v.x), ",", std::bit_cast<std::uint32_t>(v.y), ",", std::bit_cast<std::uint32_t>(v.z)); };
+  auto bits = [](Vec3 v) {
+    return cat(std::bit_cast<std::uint32_t>(v.x), ",", std::bit_cast<std::uint32_t>(v.y), ",", std::bit_cast<std::uint32_t>(v.z));
+  };
   if (e.type == EnvironmentType::Map && map) return cat("map|", map->id, "|", mapSignature);
   if (e.type == EnvironmentType::Sky) return cat("sky|", bits(e.zenith), "|", bits(e.horizon), "|", bits(e.ground));
   return {};
@@ -161,7 +164,8 @@ double lightGroupGain(const std::vector<vec4>& shapes, const std::vector<double>
   const Vec3 extent = bounds.extent();
   double byPower = 0, byWeight = 0;
   for (int i = 0; i < n * n * n; ++i) {
-    const Vec3 f{(static_cast<float>(i % n) + 0.5f) / n, (static_cast<float>(i / n % n) + 0.5f) / n, (static_cast<float>(i / (n * n)) + 0.5f) / n};
+    const Vec3 f{(static_cast<float>(i % n) + 0.5f) / n, (static_cast<float>(i / n % n) + 0.5f) / n,
+                 (static_cast<float>(i / (n * n)) + 0.5f) / n};
     const Vec3 p = bounds.lo + Vec3{f.x * extent.x, f.y * extent.y, f.z * extent.z};
     double sum = 0, moment = 0;
     for (std::size_t g = 0; g < power.size(); ++g) {
@@ -236,8 +240,8 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
       const double total = std::accumulate(power.begin() + static_cast<std::ptrdiff_t>(grp.first),
                                            power.begin() + static_cast<std::ptrdiff_t>(grp.first + grp.count), 0.0);
       groupPower.push_back(total);
-      pushLightGroupShape(data_.lightGroupShapes, data_.emitters.data() + grp.first * gpu::kEmitterTexels,
-                          power.data() + grp.first, grp.count, total);
+      pushLightGroupShape(data_.lightGroupShapes, data_.emitters.data() + grp.first * gpu::kEmitterTexels, power.data() + grp.first,
+                          grp.count, total);
     }
   }
   // The choice per point costs every light sample a pass over the groups (a tenth of the
@@ -283,8 +287,7 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
   // Through a world's medium that dims every channel, no light from infinitely far gets through.
   const bool skyHidden = data_.worldMedium.dimsEveryChannel();
   for (const Light& l : scene.lights)
-    if (l.visible && l.intensity > 0 && maxComponent(l.color) > 0 && !(skyHidden && l.type == LightType::Directional))
-      lights.push_back(&l);
+    if (l.visible && l.intensity > 0 && maxComponent(l.color) > 0 && !(skyHidden && l.type == LightType::Directional)) lights.push_back(&l);
   std::stable_partition(lights.begin(), lights.end(), [&](const Light* l) { return isSun(*l); });
   for (const Light* light : lights) {
     const Light& l = *light;
@@ -311,12 +314,14 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
     data_.deltaLights.push_back(v4(intensity, cosInner));
     data_.deltaLights.push_back({0, 0, 0, 0});
     float lum = luminance(intensity);
-    if (type == gpu::kLightPoint) deltaPower_ += 4 * kPi * lum;
-    else if (type == gpu::kLightSpot) deltaPower_ += 2 * kPi * (1 - 0.5f * (cosInner + cosOuter)) * lum;
-    else deltaPower_ += kPi * radius * radius * lum;
+    if (type == gpu::kLightPoint)
+      deltaPower_ += 4 * kPi * lum;
+    else if (type == gpu::kLightSpot)
+      deltaPower_ += 2 * kPi * (1 - 0.5f * (cosInner + cosOuter)) * lum;
+    else
+      deltaPower_ += kPi * radius * radius * lum;
   }
 }
-
 
 std::uint32_t RenderSceneBuilder::packEnvironment(const Scene& scene, std::vector<std::string>* warnings) {
   const Environment& e = scene.environment;
@@ -334,7 +339,8 @@ std::uint32_t RenderSceneBuilder::packEnvironment(const Scene& scene, std::vecto
     // like any bitmap and stored once.
     const Texture* t = scene.texture(e.map);
     map = t ? textureIndex(t->id) : -1;
-    if (map >= 0 && (std::bit_cast<std::int32_t>(data_.textureInfo[static_cast<std::size_t>(map) * gpu::kTextureTexels].w) & 15) != gpu::kTexBitmap)
+    if (map >= 0 &&
+        (std::bit_cast<std::int32_t>(data_.textureInfo[static_cast<std::size_t>(map) * gpu::kTextureTexels].w) & 15) != gpu::kTexBitmap)
       map = -1;  // it could not be read (packTextures said why) and stands in as a checker
     if (map < 0 && warnings)
       warnings->push_back(cat("environment: ", t ? cat("the map '", t->name, "' could not be read") : std::string("no map texture is set"),
@@ -361,7 +367,8 @@ std::uint32_t RenderSceneBuilder::packEnvironment(const Scene& scene, std::vecto
       const std::size_t at = data_.texels.size();
       int scale = 0;
       appendHalves(data_.texels, baked.rgba, &scale);
-      data_.textureInfo.push_back(ints(static_cast<std::int32_t>(at / 2), baked.width, baked.height, gpu::kTexBitmap | scale << gpu::kTexScaleShift));
+      data_.textureInfo.push_back(
+          ints(static_cast<std::int32_t>(at / 2), baked.width, baked.height, gpu::kTexBitmap | scale << gpu::kTexScaleShift));
       data_.textureInfo.push_back({0, 0, 0, 0});
       data_.textureInfo.push_back({0, 0, 0, 0});
       data_.halfTexels = true;
@@ -418,7 +425,8 @@ double RenderSceneBuilder::environmentDistribution(std::size_t firstWord, int w,
     double acc = 0;
     row[0] = 0;
     for (int x = 0; x < w; ++x) {
-      const float lum = luminance(packedTexel(data_.texels, firstWord, static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x), flags));
+      const float lum = luminance(packedTexel(
+          data_.texels, firstWord, static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x), flags));
       acc += std::max(lum, 0.0f) * sinTheta;
       row[x + 1] = static_cast<float>(acc);
     }
@@ -447,7 +455,9 @@ void RenderSceneBuilder::choosePickProbabilities(const Scene&) {
   // through a small window) is never starved.
   float pe = data_.emitters.empty() ? 0.0f : std::max(emitterPower_, 1e-6f);
   // No light from the environment gets through a world's medium that dims every channel.
-  float pv = data_.environmentType == gpu::kEnvNone || data_.worldMedium.dimsEveryChannel() ? 0.0f : std::max(environmentPower_ * kPi * radius * radius, 1e-6f);
+  float pv = data_.environmentType == gpu::kEnvNone || data_.worldMedium.dimsEveryChannel()
+                 ? 0.0f
+                 : std::max(environmentPower_ * kPi * radius * radius, 1e-6f);
   float pd = data_.deltaLights.empty() ? 0.0f : std::max(deltaPower_, 1e-6f);
   float sum = pe + pv + pd;
   float p[3] = {0, 0, 0};

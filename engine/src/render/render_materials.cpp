@@ -29,10 +29,14 @@ namespace {
 
 std::string textureSignature(const Texture& t, const std::filesystem::path& base) {
   switch (t.kind) {
-    case TextureKind::File: return cat("file|", (t.path.is_absolute() ? t.path : base / t.path).string(), "|", static_cast<int>(t.colorSpace));
+    case TextureKind::File:
+      return cat("file|", (t.path.is_absolute() ? t.path : base / t.path).string(), "|", static_cast<int>(t.colorSpace));
     case TextureKind::Embedded:
-      return cat("emb|", t.encoded.size(), "|", fnv1a64(std::string_view(reinterpret_cast<const char*>(t.encoded.data()), t.encoded.size())), "|", static_cast<int>(t.colorSpace));
-    case TextureKind::Checker: return "checker";  // analytic: nothing decoded to cache
+      return cat("emb|", t.encoded.size(), "|",
+                 fnv1a64(std::string_view(reinterpret_cast<const char*>(t.encoded.data()), t.encoded.size())), "|",
+                 static_cast<int>(t.colorSpace));
+    case TextureKind::Checker:
+      return "checker";  // analytic: nothing decoded to cache
   }
   return {};
 }
@@ -40,8 +44,8 @@ std::string textureSignature(const Texture& t, const std::filesystem::path& base
 }  // namespace
 
 // The kernel's material mask holds a bit per type, then Beckmann's, the coat's and the media's.
-static_assert(kMaterialTypeCount <= gpu::kMaskBeckmann && gpu::kMaskBeckmann < gpu::kMaskCoat &&
-              gpu::kMaskCoat < gpu::kMaskMedium && gpu::kMaskMedium < gpu::kMaskScattering && gpu::kMaskScattering < 32);
+static_assert(kMaterialTypeCount <= gpu::kMaskBeckmann && gpu::kMaskBeckmann < gpu::kMaskCoat && gpu::kMaskCoat < gpu::kMaskMedium &&
+              gpu::kMaskMedium < gpu::kMaskScattering && gpu::kMaskScattering < 32);
 static_assert((1 << gpu::kMaskMedium) == 131072, "common/bsdf.glsl's RETILE_MEDIUM tests this bit");
 
 namespace {
@@ -59,10 +63,12 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
   // Hair has no complex index: the slot carries its scales' tilt in radians, and its index is
   // the fibre's.
-  if (m.type == MaterialType::Hair) eta = Vec3{std::isfinite(m.hairTilt) ? std::clamp(m.hairTilt, -45.0f, 45.0f) * (kPi / 180) : 0.0f, 0.0f, 0.0f};
+  if (m.type == MaterialType::Hair)
+    eta = Vec3{std::isfinite(m.hairTilt) ? std::clamp(m.hairTilt, -45.0f, 45.0f) * (kPi / 180) : 0.0f, 0.0f, 0.0f};
   const bool rough = isMicrofacet(m.type);
   int type = static_cast<int>(m.type) | (rough && m.beckmann ? gpu::kMatBeckmann : 0) |
-             (rough && m.separableShadowing ? gpu::kMatSeparable : 0) | ((isGlassType(m.type) || m.type == MaterialType::ThinSheet) && m.tungstenGlass ? gpu::kMatTungstenGlass : 0);
+             (rough && m.separableShadowing ? gpu::kMatSeparable : 0) |
+             ((isGlassType(m.type) || m.type == MaterialType::ThinSheet) && m.tungstenGlass ? gpu::kMatTungstenGlass : 0);
   // Keep roughness away from zero, where GGX turns into a delta the rough code cannot sample.
   float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
   if (rough || m.type == MaterialType::Phong) roughness = std::max(roughness, 1e-3f);
@@ -79,15 +85,16 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   if (m.type == MaterialType::DiffuseTransmission) fdrInt = std::isfinite(m.transmittance) ? m.transmittance : 0.5f;
   if (m.type == MaterialType::Phong) fdrInt = std::isfinite(m.diffuseRatio) ? m.diffuseRatio : 0.2f;
   return {v4(max(m.albedo, Vec3{0.0f}), bitsOf(type)),
-          vec4{roughness, ior, std::clamp(m.alpha, 0.0f, 1.0f), std::clamp(fdrInt, 0.0f, 1.0f)},
-          v4(eta, bitsOf(albedoTexture)), v4(k, bitsOf(roughnessTexture)),
-          v4(max(m.radiance(), Vec3{0.0f}), bitsOf(alphaTexture)),
+          vec4{roughness, ior, std::clamp(m.alpha, 0.0f, 1.0f), std::clamp(fdrInt, 0.0f, 1.0f)}, v4(eta, bitsOf(albedoTexture)),
+          v4(k, bitsOf(roughnessTexture)), v4(max(m.radiance(), Vec3{0.0f}), bitsOf(alphaTexture)),
           vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, bitsOf(emissionTexture), bitsOf(blendWith)},
           v4(max(m.coatingAbsorption, Vec3{0.0f}), std::isfinite(m.blendRatio) ? std::clamp(m.blendRatio, 0.0f, 1.0f) : 1.0f),
           vec4{bitsOf(blendRatioTexture), coated ? std::min(m.coatIor, 10.0f) : 0.0f, emissionConeCos(m), 0},
           // The ninth holds the coat or, for glass, which takes no coat, its medium's absorption;
           // the tenth the medium's scattering and its phase function's asymmetry.
-          v4(coated ? max(m.coatAbsorption, Vec3{0.0f}) : m.filled() ? max(m.interiorAbsorption, Vec3{0.0f}) : Vec3{0.0f},
+          v4(coated       ? max(m.coatAbsorption, Vec3{0.0f})
+             : m.filled() ? max(m.interiorAbsorption, Vec3{0.0f})
+                          : Vec3{0.0f},
              coated && m.coatRoughness > 0 ? std::clamp(m.coatRoughness, 1e-3f, 1.0f) : 0.0f),
           v4(m.filled() ? max(m.interiorScattering, Vec3{0.0f}) : Vec3{0.0f},
              std::isfinite(m.interiorAnisotropy) ? std::clamp(m.interiorAnisotropy, -0.99f, 0.99f) : 0.0f)};
@@ -107,8 +114,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
   auto pack = [&](const Material& m) {
     data_.materialTypes |= 1u << static_cast<int>(m.type);
     // The kernel compiles Beckmann's distribution in only for scenes that use it.
-    if (m.beckmann && isMicrofacet(m.type))
-      data_.materialTypes |= 1u << gpu::kMaskBeckmann;
+    if (m.beckmann && isMicrofacet(m.type)) data_.materialTypes |= 1u << gpu::kMaskBeckmann;
     if (coatRendered(m)) data_.materialTypes |= 1u << gpu::kMaskCoat;
     if (m.filled()) data_.materialTypes |= 1u << gpu::kMaskMedium;
     if (m.filled() && maxComponent(m.interiorScattering) > 0) data_.materialTypes |= 1u << gpu::kMaskScattering;
@@ -125,8 +131,9 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     // material for whether its shadow rays pass, and a surface that were partly a boundary would
     // block them all the same.
     const auto it = materialIndex_.find(m.blendWith);
-    const bool boundary = m.type == MaterialType::Boundary ||
-                          (it != materialIndex_.end() && scene.materials[static_cast<std::size_t>(it->second)].type == MaterialType::Boundary);
+    const bool boundary =
+        m.type == MaterialType::Boundary ||
+        (it != materialIndex_.end() && scene.materials[static_cast<std::size_t>(it->second)].type == MaterialType::Boundary);
     if (!boundary && it != materialIndex_.end() && m.blendWith != m.id && (m.blendRatio < 1.0f || texturedRatio)) {
       blendWith = it->second;
       data_.materialBlend = true;
@@ -151,7 +158,6 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
   fallback.albedo = Vec3{0.6f};
   pack(fallback);
 }
-
 
 namespace pack {
 
@@ -187,7 +193,8 @@ Vec3 appendHalves(std::vector<std::uint32_t>& out, const std::vector<float>& rgb
 Vec3 packedTexel(const std::vector<std::uint32_t>& texels, std::size_t firstWord, std::size_t i, int flags) {
   if (flags & gpu::kTexEightBit) {
     const std::uint32_t w = texels[firstWord + i];
-    Vec3 c{static_cast<float>(w & 255u) / 255.0f, static_cast<float>((w >> 8) & 255u) / 255.0f, static_cast<float>((w >> 16) & 255u) / 255.0f};
+    Vec3 c{static_cast<float>(w & 255u) / 255.0f, static_cast<float>((w >> 8) & 255u) / 255.0f,
+           static_cast<float>((w >> 16) & 255u) / 255.0f};
     if (flags & gpu::kTexSrgb) c = Vec3{srgbCurve(c.x), srgbCurve(c.y), srgbCurve(c.z)};
     return c;
   }
@@ -270,8 +277,9 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
           d.flags |= scale << gpu::kTexScaleShift;
         }
       } else if (warnings) {
-        warnings->push_back(cat(img.error(), t.whenMissing == MissingTexture::Tungsten ? "; shown as Tungsten shows it (a black and white checker)"
-                                                                                    : "; shown as a magenta checker"));
+        warnings->push_back(cat(img.error(), t.whenMissing == MissingTexture::Tungsten
+                                                 ? "; shown as Tungsten shows it (a black and white checker)"
+                                                 : "; shown as a magenta checker"));
       }
     }
     d.offset = at;
@@ -281,8 +289,8 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
       d.ok = false;
       d.signature.clear();  // tried again at the next update, when others may have left
       if (warnings)
-        warnings->push_back(cat("texture '", t.name, "': the scene's textures need more than the renderer's ",
-                                kMaxTexelBytes >> 20, " MiB of texels; shown as a checker"));
+        warnings->push_back(cat("texture '", t.name, "': the scene's textures need more than the renderer's ", kMaxTexelBytes >> 20,
+                                " MiB of texels; shown as a checker"));
     }
     if (d.ok) {
       const bool eightBit = (d.flags & gpu::kTexEightBit) != 0;
@@ -309,6 +317,5 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
   sceneHalfTexels_ = data_.halfTexels;
   packedSky_.clear();
 }
-
 
 }  // namespace retile

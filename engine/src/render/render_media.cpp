@@ -44,7 +44,9 @@ MediaAround mediaAround(const RenderSceneData& d, Vec3 point) {
     const std::size_t mbase = static_cast<std::size_t>(material) * gpu::kMaterialTexels;
     const vec4 &interior = d.materials[mbase + 8], &scattering = d.materials[mbase + 9];
     const int type = intOf(d.materials[mbase].w) & gpu::kMatTypeBits;
-    return MediumAt{{interior.x, interior.y, interior.z}, {scattering.x, scattering.y, scattering.z}, scattering.w,
+    return MediumAt{{interior.x, interior.y, interior.z},
+                    {scattering.x, scattering.y, scattering.z},
+                    scattering.w,
                     type == gpu::kMatDielectric || type == gpu::kMatRoughDielectric};
   };
   // The first two holders a ray from the point leaves by faces it did not come in by (-1: it
@@ -104,7 +106,7 @@ MediaAround mediaAround(const RenderSceneData& d, Vec3 point) {
   // leaves the scene is not against it (one side of an open boundary, a water surface, is its
   // medium's), so the holder most rays leave wins, and none only when no ray leaves one. Where
   // every ray meets a wall first, they are cast again through the walls.
-  static const Vec3 kDirections[14] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},  {0, -1, 0}, {0, 0, 1},  {0, 0, -1}, {1, 1, 1},
+  static const Vec3 kDirections[14] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},   {0, -1, 0}, {0, 0, 1},   {0, 0, -1},  {1, 1, 1},
                                        {1, 1, -1}, {1, -1, 1}, {1, -1, -1}, {-1, 1, 1}, {-1, 1, -1}, {-1, -1, 1}, {-1, -1, -1}};
   const Mat4 turn = Mat4::rotateY(0.37f) * Mat4::rotateX(0.23f);
   Left rays[14];
@@ -143,9 +145,7 @@ bool closedSurface(const MeshGeometry& g) {
   const float cell = std::max(maxComponent(b.extent()), 1e-30f) * 1e-6f;
   using Cell = std::array<std::int64_t, 3>;
   struct CellHash {
-    std::size_t operator()(const Cell& c) const {
-      return static_cast<std::size_t>(c[0] * 73856093 ^ c[1] * 19349663 ^ c[2] * 83492791);
-    }
+    std::size_t operator()(const Cell& c) const { return static_cast<std::size_t>(c[0] * 73856093 ^ c[1] * 19349663 ^ c[2] * 83492791); }
   };
   std::unordered_map<Cell, std::uint32_t, CellHash> welded;
   std::vector<std::uint32_t> id(g.positions.size());
@@ -176,8 +176,7 @@ bool RenderSceneBuilder::lightInScatteringGlass(const Scene& scene) const {
   auto isGlass = [](const Material& m) { return m.type == MaterialType::Dielectric || m.type == MaterialType::RoughDielectric; };
   auto scatteringGlass = [&](const Material* m) { return m && isGlass(*m) && m->filled() && maxComponent(m->interiorScattering) > 0; };
   // Most scenes have none: then no instance needs looking at (this runs at every object move).
-  if (std::none_of(scene.materials.begin(), scene.materials.end(), [&](const Material& m) { return scatteringGlass(&m); }))
-    return false;
+  if (std::none_of(scene.materials.begin(), scene.materials.end(), [&](const Material& m) { return scatteringGlass(&m); })) return false;
   std::vector<Bounds3> glass, lights;
   for (std::size_t i = 0; i < data_.instanceObject.size(); ++i) {
     const Object* o = scene.object(data_.instanceObject[i]);
@@ -212,6 +211,5 @@ bool RenderSceneBuilder::lightInScatteringGlass(const Scene& scene) const {
       if (meet(g, l)) return true;
   return false;
 }
-
 
 }  // namespace retile

@@ -75,8 +75,8 @@ float halfToFloat(std::uint16_t h) {
 
 std::uint64_t RenderSceneData::deviceBytes() const {
   auto v = [](const auto& x) { return static_cast<std::uint64_t>(x.size() * sizeof(x[0])); };
-  return v(meshTraversal) + v(topTraversal) + v(triangleShading) + v(instances) + v(materials) +
-         v(textureInfo) + v(texels) + v(emitters) + v(emitterAlias) + v(deltaLights) + v(environmentCdf);
+  return v(meshTraversal) + v(topTraversal) + v(triangleShading) + v(instances) + v(materials) + v(textureInfo) + v(texels) + v(emitters) +
+         v(emitterAlias) + v(deltaLights) + v(environmentCdf);
 }
 
 int filterFeature(const RenderSettings& s) {
@@ -124,10 +124,10 @@ int RenderSceneBuilder::materialIndex(NodeId id) const {
 std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags, std::vector<std::string>* warnings) {
   if (first_) flags = kUpdateAll;
   first_ = false;
-  data_.tungstenShading = scene.settings.shading == ShadingConvention::Tungsten;  // a kernel variant, no array
-  data_.tungstenRoulette = scene.settings.roulette == Roulette::Tungsten;        // likewise
-  data_.tungstenEpsilon = scene.settings.rayOffset == RayOffset::Tungsten;       // likewise
-  data_.filterFeature = filterFeature(scene.settings);                          // likewise
+  data_.tungstenShading = scene.settings.shading == ShadingConvention::Tungsten;                            // a kernel variant, no array
+  data_.tungstenRoulette = scene.settings.roulette == Roulette::Tungsten;                                   // likewise
+  data_.tungstenEpsilon = scene.settings.rayOffset == RayOffset::Tungsten;                                  // likewise
+  data_.filterFeature = filterFeature(scene.settings);                                                      // likewise
   data_.minBounces = std::clamp(scene.settings.minBounces, 0, std::max(scene.settings.maxBounces, 0) + 1);  // likewise
   const bool lightSamplingChanged = data_.lightSampling != scene.settings.lightSampling;
   data_.lightSampling = scene.settings.lightSampling;

@@ -64,9 +64,9 @@ enum DirtyArrays : std::uint32_t {
   kDirtyGeometry = 1u << 0,   // meshTraversal, triangleShading
   kDirtyInstances = 1u << 1,  // instances, topTraversal
   kDirtyMaterials = 1u << 2,
-  kDirtyTextures = 1u << 3,   // textureInfo, texels
-  kDirtyEmitters = 1u << 4,   // emitters, emitterAlias, deltaLights
-  kDirtyEnvironment = 1u << 5,  // environmentCdf
+  kDirtyTextures = 1u << 3,       // textureInfo, texels
+  kDirtyEmitters = 1u << 4,       // emitters, emitterAlias, deltaLights
+  kDirtyEnvironment = 1u << 5,    // environmentCdf
   kDirtyTriangleNames = 1u << 6,  // meshTraversal only: the instances its triangles name (direct)
   kDirtyAllArrays = 0xffu,
 };
@@ -90,13 +90,13 @@ struct RenderSceneData {
   // items hold offsets into the whole buffer, the second part starting after the first.
   std::vector<vec4> meshTraversal;
   std::vector<vec4> topTraversal;
-  std::int32_t tlasRoot = -1;          // item of the instance BVH's root
-  std::vector<vec4> triangleShading;   // kTriShadeTexels per triangle
-  std::vector<vec4> instances;         // kInstanceTexels per instance
-  std::vector<vec4> materials;         // kMaterialTexels per material
-  std::vector<vec4> textureInfo;       // kTextureTexels per texture
-  std::vector<std::uint32_t> texels;   // every bitmap: 8-bit RGBA or RGBA16F words (layouts.h kTexEightBit)
-  std::vector<vec4> emitters;          // kEmitterTexels per emissive triangle
+  std::int32_t tlasRoot = -1;         // item of the instance BVH's root
+  std::vector<vec4> triangleShading;  // kTriShadeTexels per triangle
+  std::vector<vec4> instances;        // kInstanceTexels per instance
+  std::vector<vec4> materials;        // kMaterialTexels per material
+  std::vector<vec4> textureInfo;      // kTextureTexels per texture
+  std::vector<std::uint32_t> texels;  // every bitmap: 8-bit RGBA or RGBA16F words (layouts.h kTexEightBit)
+  std::vector<vec4> emitters;         // kEmitterTexels per emissive triangle
   // One per emitter (keep probability, alias index, light group), then the light groups' records
   // (layouts.h kLightGroupTexels). An emitter's alias and its pick probability (emitters' radiance.w)
   // are within its group, or, with no light groups, among all emitters.
@@ -116,40 +116,40 @@ struct RenderSceneData {
   // emitters, environment, delta lights; all 0 without light sampling (RenderSettings::lightSampling),
   // which turns off next-event estimation and leaves every hit's emission its full weight.
   float lightPick[3] = {0, 0, 0};
-  bool lightSampling = true;           // RenderSettings::lightSampling
-  int minBounces = 0;                  // RenderSettings::minBounces (kFeatureMinBounces when > 0)
-  int environmentType = 0;             // kEnvNone / kEnvConstant / kEnvMap
-  int environmentMap = -1;             // texture index of the map
+  bool lightSampling = true;  // RenderSettings::lightSampling
+  int minBounces = 0;         // RenderSettings::minBounces (kFeatureMinBounces when > 0)
+  int environmentType = 0;    // kEnvNone / kEnvConstant / kEnvMap
+  int environmentMap = -1;    // texture index of the map
   int environmentWidth = 0, environmentHeight = 0;
   Vec3 environmentTint{0.0f};
-  Mat4 environmentToMap;               // world directions to the map's frame (a rotation)
-  MediumAt worldMedium;                // Environment::medium..., none unless filled()
-  std::uint64_t triangleCount = 0;     // packed triangles: each mesh's once, and the copies of small shared ones
+  Mat4 environmentToMap;            // world directions to the map's frame (a rotation)
+  MediumAt worldMedium;             // Environment::medium..., none unless filled()
+  std::uint64_t triangleCount = 0;  // packed triangles: each mesh's once, and the copies of small shared ones
   std::uint64_t instancedTriangles = 0;
   // Some visible instance pauses traversal on its candidate hits (RETILE_ALPHA_TEST): a cut-out
   // (cutOuts), every ray, or a thin sheet (sheetShadows), shadow rays.
   bool cutOuts = false, sheetShadows = false;
   bool alphaTested() const { return cutOuts || sheetShadows; }
-  bool cullBack = false;               // some visible instance is hit from the front only
-  std::uint32_t materialTypes = 0;     // bit kMat... of each material type present
-  bool materialTextures = false;       // some material reads an albedo or roughness texture
-  bool materialBump = false;           // some material has a bump map
-  bool emissionTextures = false;       // some emissive material has an emission texture
-  bool emissionCones = false;          // some emissive material emits into a cone (Material::emissionCone)
+  bool cullBack = false;            // some visible instance is hit from the front only
+  std::uint32_t materialTypes = 0;  // bit kMat... of each material type present
+  bool materialTextures = false;    // some material reads an albedo or roughness texture
+  bool materialBump = false;        // some material has a bump map
+  bool emissionTextures = false;    // some emissive material has an emission texture
+  bool emissionCones = false;       // some emissive material emits into a cone (Material::emissionCone)
   // How the packed bitmaps' texels are stored (layouts.h kFeatureByteTexels and on).
   bool byteTexels = false, halfTexels = false, srgbTexels = false;
-  bool materialBlend = false;          // some material blends with another
+  bool materialBlend = false;  // some material blends with another
   // Some light or emitter may lie inside glass whose medium scatters (their bounds meet). Where
   // none does, a scattering point in such glass samples no light (trace.comp scatterInMedium).
   bool lightInScatteringGlass = true;
-  bool instanceTransforms = false;     // some instance's transform is not the identity
-  bool directReferences = false;       // the instance BVH is packed direct (layouts.h kFeatureDirectReferences)
+  bool instanceTransforms = false;  // some instance's transform is not the identity
+  bool directReferences = false;    // the instance BVH is packed direct (layouts.h kFeatureDirectReferences)
 
-  bool tungstenShading = false;        // RenderSettings::shading is Tungsten's
-  bool tungstenRoulette = false;       // RenderSettings::roulette is Tungsten's
-  bool tungstenEpsilon = false;        // RenderSettings::rayOffset is Tungsten's
+  bool tungstenShading = false;                  // RenderSettings::shading is Tungsten's
+  bool tungstenRoulette = false;                 // RenderSettings::roulette is Tungsten's
+  bool tungstenEpsilon = false;                  // RenderSettings::rayOffset is Tungsten's
   int filterFeature = gpu::kFeatureFilterTable;  // filterFeature(RenderSettings)
-  std::uint32_t features() const;      // kFeature... (layouts.h) of what the arrays hold
+  std::uint32_t features() const;                // kFeature... (layouts.h) of what the arrays hold
 
   std::uint64_t deviceBytes() const;
 };
@@ -194,9 +194,9 @@ class RenderSceneBuilder {
     // them into RenderSceneData; empty after.
     std::vector<vec4> triangles;
     std::vector<vec4> shading;
-    std::vector<float> steps;      // expectedSteps of each BVH node
-    std::int32_t rootItem = -1;    // in data_.meshTraversal
-    std::uint32_t triOffset = 0;   // global index of its first packed triangle (in data_ once placed)
+    std::vector<float> steps;     // expectedSteps of each BVH node
+    std::int32_t rootItem = -1;   // in data_.meshTraversal
+    std::uint32_t triOffset = 0;  // global index of its first packed triangle (in data_ once placed)
     // The transform its vertices were packed with (its first object's, or the one it is a copy
     // for): an object's instance maps world space to it.
     Mat4 placed, placedInverse;

@@ -29,9 +29,23 @@ constexpr VkBufferUsageFlags kStorageUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
 
 // Binding numbers of trace.comp (shaders/common/scene.glsl and trace.comp).
 enum TraceBinding : std::uint32_t {
-  kBindFrame = 0, kBindWork = 1, kBindTraversal = 2, kBindTriShade = 3, kBindInstances = 4, kBindMaterials = 5,
-  kBindTexInfo = 6, kBindTexels = 7, kBindEmitters = 8, kBindAlias = 9, kBindDelta = 10, kBindEnvCdf = 11,
-  kBindSamples = 12, kBindAux = 13, kBindStats = 14, kBindSelection = 15, kBindFilterWarp = 16,
+  kBindFrame = 0,
+  kBindWork = 1,
+  kBindTraversal = 2,
+  kBindTriShade = 3,
+  kBindInstances = 4,
+  kBindMaterials = 5,
+  kBindTexInfo = 6,
+  kBindTexels = 7,
+  kBindEmitters = 8,
+  kBindAlias = 9,
+  kBindDelta = 10,
+  kBindEnvCdf = 11,
+  kBindSamples = 12,
+  kBindAux = 13,
+  kBindStats = 14,
+  kBindSelection = 15,
+  kBindFilterWarp = 16,
 };
 
 std::uint32_t groupsFor(std::uint64_t invocations, std::uint32_t local, std::uint32_t* groupsY) {
@@ -60,8 +74,8 @@ std::uint64_t traceInvocations(std::uint64_t slots, double iterationsPerPath, in
   if (fixedPaths > 0) return (slots + static_cast<std::uint64_t>(fixedPaths) - 1) / static_cast<std::uint64_t>(fixedPaths);
   constexpr double kIterationTarget = gpu::kLoopBudget * 0.4;
   constexpr std::uint64_t kMaxPathsPerInvocation = 128, kMinInvocations = 512;
-  auto paths = static_cast<std::uint64_t>(std::clamp(kIterationTarget / std::max(iterationsPerPath, 1.0), 1.0,
-                                                     static_cast<double>(kMaxPathsPerInvocation)));
+  auto paths = static_cast<std::uint64_t>(
+      std::clamp(kIterationTarget / std::max(iterationsPerPath, 1.0), 1.0, static_cast<double>(kMaxPathsPerInvocation)));
   return std::max(std::min(slots, kMinInvocations), (slots + paths - 1) / paths);
 }
 
@@ -112,10 +126,10 @@ struct Renderer::Impl {
   bool warpTungsten = false;
   bool hasScene = false;
   NodeId selectedObject = kNoNode;
-  std::vector<NodeId> countedGroup;  // counted beside the selection: every object of its material
-  int countTileSize = 0;            // tile size the selection buffer is laid out for
-  std::size_t countTiles = 0;        // tiles it holds counters for
-  std::vector<std::uint32_t> setWords;  // the sets' words on the device (layouts.h)
+  std::vector<NodeId> countedGroup;      // counted beside the selection: every object of its material
+  int countTileSize = 0;                 // tile size the selection buffer is laid out for
+  std::size_t countTiles = 0;            // tiles it holds counters for
+  std::vector<std::uint32_t> setWords;   // the sets' words on the device (layouts.h)
   std::vector<gpu::WorkItem> lastItems;  // the last frame's work, for readbackFrameLuminance
 
   // Pipelined frames: the submitted frame's results land in one of two slots, so that the frame
@@ -127,8 +141,8 @@ struct Renderer::Impl {
     bool hasDisplay = false;
     bool hasHistory = false;
     int width = 0, height = 0;
-    Buffer image;                   // host-visible copies: accumulation, its auxiliary part, the display
-    std::vector<NodeId> objects;    // instance -> object when submitted (edits may follow)
+    Buffer image;                 // host-visible copies: accumulation, its auxiliary part, the display
+    std::vector<NodeId> objects;  // instance -> object when submitted (edits may follow)
     FrameStats stats;
     std::uint64_t invocations = 0;
     std::chrono::steady_clock::time_point submitted;
@@ -138,15 +152,15 @@ struct Renderer::Impl {
   std::uint64_t inFlight = 0;  // ticket of the submitted frame not yet completed (0: none)
 
   explicit Impl(const RendererOptions& o) : ctx(vk::DeviceChoice{o.device, o.validation || kDebugValidation}) {
-    accumulate = std::make_unique<vk::ComputePipeline>(
-        ctx, "accumulate.comp",
-        std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::Storage, Binding::Storage, Binding::Storage,
-                             Binding::Storage, Binding::Storage},
-        static_cast<std::uint32_t>(sizeof(gpu::AccumulatePush)));
+    accumulate =
+        std::make_unique<vk::ComputePipeline>(ctx, "accumulate.comp",
+                                              std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::Storage, Binding::Storage,
+                                                                   Binding::Storage, Binding::Storage, Binding::Storage},
+                                              static_cast<std::uint32_t>(sizeof(gpu::AccumulatePush)));
     directReferences = o.directReferences;
     builder.setDirectReferences(directReferences);
-    frameUbo = Buffer(ctx, sizeof(gpu::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                      true, "frame constants");
+    frameUbo = Buffer(ctx, sizeof(gpu::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true,
+                      "frame constants");
     stats = Buffer(ctx, gpu::kStatsCount * sizeof(std::uint32_t), kStorageUsage, true, "ray statistics");
     selection = Buffer(ctx, 16, kStorageUsage, true, "selection counters");
     work = Buffer(ctx, sizeof(gpu::WorkItem) * 64, kStorageUsage, true, "work items");
@@ -176,11 +190,10 @@ struct Renderer::Impl {
         // Room for the top part to grow, so that adding objects does not re-upload the meshes.
         // The two parts are copied in place: a joined copy on the host would add the size of
         // every mesh to the peak memory of loading a scene.
-        const VkDeviceSize room = std::min<VkDeviceSize>(
-            meshBytes + (2 * d.topTraversal.size() + 256) * sizeof(gpu::vec4), gpu::kMaxTraversalTexels * sizeof(gpu::vec4));
+        const VkDeviceSize room = std::min<VkDeviceSize>(meshBytes + (2 * d.topTraversal.size() + 256) * sizeof(gpu::vec4),
+                                                         gpu::kMaxTraversalTexels * sizeof(gpu::vec4));
         if (!traversal.valid() || traversal.size() < need || traversal.size() > 2 * room + 65536)
-          traversal = Buffer(ctx, std::max(room, need), kTexelUsage | VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT, false,
-                             "BVH and triangles");
+          traversal = Buffer(ctx, std::max(room, need), kTexelUsage | VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT, false, "BVH and triangles");
         traversal.upload(d.meshTraversal.data(), meshBytes, 0);
         traversal.upload(d.topTraversal.data(), need - meshBytes, meshBytes);
       } else {
@@ -221,11 +234,10 @@ struct Renderer::Impl {
     if (!slot) {
       slot = std::make_unique<vk::ComputePipeline>(
           ctx, "trace.comp",
-          std::vector<Binding>{Binding::Storage, Binding::Storage, Binding::StorageTexel, Binding::UniformTexel,
-                               Binding::UniformTexel, Binding::UniformTexel,
-                               Binding::UniformTexel, Binding::StorageTexel, Binding::UniformTexel,
-                               Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel, Binding::Storage,
-                               Binding::Storage, Binding::Storage, Binding::Storage, Binding::UniformTexel},
+          std::vector<Binding>{Binding::Storage, Binding::Storage, Binding::StorageTexel, Binding::UniformTexel, Binding::UniformTexel,
+                               Binding::UniformTexel, Binding::UniformTexel, Binding::StorageTexel, Binding::UniformTexel,
+                               Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel, Binding::Storage, Binding::Storage,
+                               Binding::Storage, Binding::Storage, Binding::UniformTexel},
           static_cast<std::uint32_t>(sizeof(gpu::TracePush)),
           std::vector<vk::ShaderDefine>{{"RETILE_ALPHA_TEST", alpha ? "1" : "0"},
                                         {"RETILE_MATERIALS", std::to_string(materialTypes)},
@@ -305,7 +317,8 @@ struct Renderer::Impl {
       ctx.submitAndWait([&](VkCommandBuffer cb) { vkCmdFillBuffer(cb, history.handle(), 0, VK_WHOLE_SIZE, 0); });
       if (!reusePass)
         reusePass = std::make_unique<vk::ComputePipeline>(
-            ctx, "reuse.comp", std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::Storage, Binding::Storage, Binding::Storage},
+            ctx, "reuse.comp",
+            std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::Storage, Binding::Storage, Binding::Storage},
             static_cast<std::uint32_t>(sizeof(gpu::ReusePush)));
       rebind = true;
     }
@@ -367,8 +380,8 @@ struct Renderer::Impl {
   // changes). Returns where the counters start, in words.
   std::uint32_t prepareSelection(int tileSize) {
     if (tileSize <= 0) return 0;
-    const std::size_t tiles = static_cast<std::size_t>((width + tileSize - 1) / tileSize) *
-                              static_cast<std::size_t>((height + tileSize - 1) / tileSize);
+    const std::size_t tiles =
+        static_cast<std::size_t>((width + tileSize - 1) / tileSize) * static_cast<std::size_t>((height + tileSize - 1) / tileSize);
     std::vector<std::uint32_t> words = countedSetWords();
     const VkDeviceSize bytes = (words.size() + tiles * gpu::kSelectionCounters) * sizeof(std::uint32_t);
     if (tileSize != countTileSize || tiles != countTiles || words.size() != setWords.size() || selection.size() < bytes) {
@@ -425,8 +438,7 @@ struct Renderer::Impl {
 
   std::vector<float> readbackFrameLuminance() {
     completeInFlight();  // the frame in flight uses what this touches
-    std::vector<float> lum(static_cast<std::size_t>(width) * static_cast<std::size_t>(height),
-                           std::numeric_limits<float>::quiet_NaN());
+    std::vector<float> lum(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), std::numeric_limits<float>::quiet_NaN());
     std::uint64_t slots = 0;
     for (const auto& w : lastItems) slots = std::max(slots, w.info.y + itemSlots(w));
     if (slots == 0) return lum;
@@ -444,7 +456,8 @@ struct Renderer::Impl {
         }
         int x = w.rect.x + static_cast<int>(p % static_cast<std::uint64_t>(w.rect.z));
         int y = w.rect.y + static_cast<int>(p / static_cast<std::uint64_t>(w.rect.z));
-        if (n > 0) lum[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)] = static_cast<float>(sum / n);
+        if (n > 0)
+          lum[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)] = static_cast<float>(sum / n);
       }
     }
     return lum;
@@ -491,12 +504,12 @@ struct Renderer::Impl {
     u.bounces = {d.minBounces, d.lightGroups, 0, 0};
     std::copy_n(d.lightGroupShapes.begin(), std::min<std::size_t>(d.lightGroupShapes.size(), std::size(u.lightGroups)), u.lightGroups);
     const bool counting = countTile > 0 && counters > 0;
-    u.work = {itemCount, static_cast<std::uint32_t>(slots), counting ? counters + 1 : 0u, counting ? static_cast<std::uint32_t>(countTile) : 0u};
+    u.work = {itemCount, static_cast<std::uint32_t>(slots), counting ? counters + 1 : 0u,
+              counting ? static_cast<std::uint32_t>(countTile) : 0u};
     // Tungsten draws its box exactly, and has no other filter the table could stand for.
     const int drawn = d.filterFeature;  // the compiled kernel's
     const bool tungsten = drawn == gpu::kFeatureFilterTungsten || drawn == gpu::kFeatureFilterTungstenTent;
-    if (warpFilter != sceneSettings.pixelFilter || warpWidth != sceneSettings.filterWidth || warpTungsten != tungsten ||
-        warp.empty()) {
+    if (warpFilter != sceneSettings.pixelFilter || warpWidth != sceneSettings.filterWidth || warpTungsten != tungsten || warp.empty()) {
       warpFilter = sceneSettings.pixelFilter;
       warpWidth = sceneSettings.filterWidth;
       warpTungsten = tungsten;
@@ -559,8 +572,10 @@ struct Renderer::Impl {
     lastItems = items;
     const bool compose = options.denoise.compose && options.accumulate;
     if (compose) denoiser.prepare(options.denoise);
-    if (options.accumulate && !items.empty()) displayCurrent = compose;
-    else if (compose) displayCurrent = true;
+    if (options.accumulate && !items.empty())
+      displayCurrent = compose;
+    else if (compose)
+      displayCurrent = true;
 
     const std::uint64_t ticket = nextTicket++;
     Slot& slot = slots_[ticket % 2];
@@ -604,8 +619,7 @@ struct Renderer::Impl {
         std::uint32_t gx = groupsFor(invocations, gpu::kTraceWorkgroup, &gy);
         trace->dispatch(cb, gx, gy, &tp, sizeof tp);
         vk::computeBarrier(cb);
-        gpu::AccumulatePush ap{0, static_cast<std::uint32_t>(pixels), static_cast<std::uint32_t>(items.size()),
-                               history.valid() ? 1u : 0u};
+        gpu::AccumulatePush ap{0, static_cast<std::uint32_t>(pixels), static_cast<std::uint32_t>(items.size()), history.valid() ? 1u : 0u};
         gx = groupsFor(pixels, gpu::kAccumulateWorkgroup, &gy);
         if (options.accumulate) accumulate->dispatch(cb, gx, gy, &ap, sizeof ap);
       }
@@ -669,8 +683,8 @@ struct Renderer::Impl {
     auto n = static_cast<std::size_t>(slot.width) * static_cast<std::size_t>(slot.height);
     // Read through the mapping: the slot is not touched by the frame now in flight.
     const auto* acc = static_cast<const gpu::vec4*>(slot.image.mapped());
-    RenderImage img = convert(acc, acc + n * 2, slot.hasDisplay ? acc + n * (2 + gpu::kAuxVec4s) : nullptr, slot.width,
-                              slot.height, slot.objects);
+    RenderImage img =
+        convert(acc, acc + n * 2, slot.hasDisplay ? acc + n * (2 + gpu::kAuxVec4s) : nullptr, slot.width, slot.height, slot.objects);
     if (slot.hasHistory) img.history = convertHistory(acc + n * (3 + gpu::kAuxVec4s), n);
     return img;
   }
@@ -686,8 +700,7 @@ struct Renderer::Impl {
       shown.resize(n);
       denoiser.display().download(shown.data(), n * sizeof(gpu::vec4));
     }
-    RenderImage img = convert(acc.data(), ax.data(), displayCurrent ? shown.data() : nullptr, width, height,
-                              builder.data().instanceObject);
+    RenderImage img = convert(acc.data(), ax.data(), displayCurrent ? shown.data() : nullptr, width, height, builder.data().instanceObject);
     if (history.valid()) {
       std::vector<gpu::vec4> h(n * 2);
       history.download(h.data(), h.size() * sizeof(gpu::vec4));
@@ -755,7 +768,8 @@ struct Renderer::Impl {
       img.depth[i] = a.w >= 1e29f ? std::numeric_limits<float>::infinity() : a.w;
       std::int32_t inst;
       std::memcpy(&inst, &b.w, sizeof inst);
-      img.objectId[i] = (inst > 0 && static_cast<std::size_t>(inst) <= objects.size()) ? objects[static_cast<std::size_t>(inst - 1)] : kNoNode;
+      img.objectId[i] =
+          (inst > 0 && static_cast<std::size_t>(inst) <= objects.size()) ? objects[static_cast<std::size_t>(inst - 1)] : kNoNode;
     }
     return img;
   }
@@ -845,7 +859,8 @@ void Renderer::prepareMoves() {
   // A move gives an instance a transform, and then no reference is packed direct. An object
   // duplicated in place shares its mesh with the original: no transform, but not direct either.
   const auto direct = static_cast<std::uint32_t>(gpu::kFeatureDirectReferences);
-  impl_->traceVariant(d.alphaTested(), d.materialTypes, (d.features() | static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms)) & ~direct);
+  impl_->traceVariant(d.alphaTested(), d.materialTypes,
+                      (d.features() | static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms)) & ~direct);
   if (d.features() & direct) impl_->traceVariant(d.alphaTested(), d.materialTypes, d.features() & ~direct);
 }
 

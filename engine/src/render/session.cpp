@@ -29,8 +29,7 @@ CameraFrame cameraFrame(const Camera& c, int width, int height) {
   CameraFrame f;
   f.forward = normalize(c.target - c.position);
   f.right = normalize(cross(f.forward, c.up));
-  if (!(length(f.right) > 0))
-    f.right = normalize(cross(f.forward, std::abs(f.forward.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 0, 1}));
+  if (!(length(f.right) > 0)) f.right = normalize(cross(f.forward, std::abs(f.forward.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 0, 1}));
   f.up = cross(f.right, f.forward);
   f.tanHalf = std::tan(0.5f * c.verticalFov);
   f.aspect = static_cast<float>(width) / static_cast<float>(std::max(height, 1));
@@ -60,10 +59,10 @@ struct RenderSession::Impl {
   std::map<NodeId, Bounds3> meshBounds;  // object-space bounds, so an edit never walks a mesh
   std::vector<EditFacts> batch;          // edits applied since the last frame, planned together
   DenoiseRegions denoise;
-  bool newPass = false;                  // a plan started a pass (or a global update) since the last frame
-  std::vector<char> leading;             // per tile: ranked first by the pass's policy
-  NodeId counting = kNoNode;             // the object the renderer's counters describe
-  NodeId countingMaterial = kNoNode;     // its material when counting began: the group's
+  bool newPass = false;               // a plan started a pass (or a global update) since the last frame
+  std::vector<char> leading;          // per tile: ranked first by the pass's policy
+  NodeId counting = kNoNode;          // the object the renderer's counters describe
+  NodeId countingMaterial = kNoNode;  // its material when counting began: the group's
   // Frames submitted and not yet finished, oldest first (at most two: one read back while the
   // next traces). Their records are filled at submission and completed when they finish.
   struct Pending {
@@ -79,18 +78,18 @@ struct RenderSession::Impl {
   std::deque<Pending> pending;
   std::shared_ptr<const RenderImage> lastImage;
   std::uint64_t lastImageFrame = 0;  // the frame lastImage shows the accumulation after
-  RegionRect region;  // the render region in pixels (empty: the whole image)
+  RegionRect region;                 // the render region in pixels (empty: the whole image)
   // Verified reuse, per tile: its state, the frame of its last restart with reuse (a test of
   // samples read back before it is about the previous edit and is ignored) and of its rejection;
   // tiles the last read-back rejected, applied with the next frame.
   std::vector<TileReuse> reuse;
   std::vector<std::uint64_t> reuseStarted, reuseRejectedAt;
   std::vector<int> pendingRejects;
-  std::uint64_t pass = 0;               // counts the passes started (execute)
-  std::vector<std::uint64_t> reusePass; // per tile: the pass that last started its history
-  std::vector<double> reuseCredit;      // per tile: spp of history it keeps (the scheduler's credit)
-  int previewBlock = 1;                 // setPreview
-  bool previewed = false;               // the last frame was a preview: the next full one plans the edit again
+  std::uint64_t pass = 0;                // counts the passes started (execute)
+  std::vector<std::uint64_t> reusePass;  // per tile: the pass that last started its history
+  std::vector<double> reuseCredit;       // per tile: spp of history it keeps (the scheduler's credit)
+  int previewBlock = 1;                  // setPreview
+  bool previewed = false;                // the last frame was a preview: the next full one plans the edit again
   Clock::time_point lastEdit{};
 
   // The block size of the next frame: the preview's while edits come (or came a moment ago) and
@@ -203,8 +202,10 @@ struct RenderSession::Impl {
           }
         }
       tested[ti] = retile::testReuse(fresh, hist, r.width, r.height, falseRejectRate);
-      if (tested[ti].reject()) pendingRejects.push_back(t);
-      else kept.push_back(t);
+      if (tested[ti].reject())
+        pendingRejects.push_back(t);
+      else
+        kept.push_back(t);
     }
     // Changes too small for one tile: each kept tile pooled with its kept neighbours, then all
     // the kept tiles together (a light a few per cent brighter changes every lit tile a little).
@@ -255,9 +256,14 @@ struct RenderSession::Impl {
 
   void execute(const Plan& p) {
     switch (p.kind) {
-      case PlanKind::None: break;
-      case PlanKind::GlobalUpdate: scheduler.globalUpdate(); break;
-      case PlanKind::Probe: scheduler.probe(); break;
+      case PlanKind::None:
+        break;
+      case PlanKind::GlobalUpdate:
+        scheduler.globalUpdate();
+        break;
+      case PlanKind::Probe:
+        scheduler.probe();
+        break;
       case PlanKind::Pass:
         scheduler.startPass(p.order, p.quality, p.prioritized, p.smooth, p.staleCap);
         ++pass;
@@ -282,8 +288,8 @@ struct RenderSession::Impl {
       bool indirection = m.kind == MethodKind::Indirection || m.kind == MethodKind::IndirectionFocus;
       bool anyLeading = std::find(leading.begin(), leading.end(), 1) != leading.end();
       std::vector<char> grows = indirection && anyLeading ? leading : std::vector<char>(static_cast<std::size_t>(grid.count()), 1);
-      f = denoise.incremental(scheduler.startedTiles(), grows, m.denoiseThreshold,
-                              scheduler.queueServed() + 1 >= scheduler.queueLength(), frameNumber);
+      f = denoise.incremental(scheduler.startedTiles(), grows, m.denoiseThreshold, scheduler.queueServed() + 1 >= scheduler.queueLength(),
+                              frameNumber);
     } else {
       f = denoise.unchanged();
     }
@@ -301,10 +307,18 @@ struct RenderSession::Impl {
     for (std::size_t t = 0; t < f.source.size(); ++t) {
       std::uint32_t code = kShowStale;
       switch (f.source[t]) {
-        case TileSource::Stale: code = kShowStale; break;
-        case TileSource::Previous: code = kShowPreviousLayer; break;
-        case TileSource::Fresh: code = kShowFresh; break;
-        case TileSource::Region: code = kShowLayer + static_cast<std::uint32_t>(f.region[t]); break;
+        case TileSource::Stale:
+          code = kShowStale;
+          break;
+        case TileSource::Previous:
+          code = kShowPreviousLayer;
+          break;
+        case TileSource::Fresh:
+          code = kShowFresh;
+          break;
+        case TileSource::Region:
+          code = kShowLayer + static_cast<std::uint32_t>(f.region[t]);
+          break;
       }
       if (f.write[t]) code |= kShowWriteLayer;
       if (f.filtered[t]) code |= kShowFiltered;
@@ -492,8 +506,7 @@ Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t d
     }
   }
   std::uint32_t flags = applied.value();
-  if (const auto* add = std::get_if<AddMesh>(&edit); add && add->mesh.geometry)
-    d.meshBounds[add->mesh.id] = add->mesh.geometry->bounds();
+  if (const auto* add = std::get_if<AddMesh>(&edit); add && add->mesh.geometry) d.meshBounds[add->mesh.id] = add->mesh.geometry->bounds();
   if (const auto* add = std::get_if<AddObject>(&edit)) targets.push_back(add->object.id);
   for (auto& w : d.renderer.updateScene(scene_, flags)) sceneWarnings_.push_back(std::move(w));
   // Coalesced commands may arrive out of version order: the record shows the newest applied.
@@ -526,8 +539,7 @@ Result<std::uint32_t> RenderSession::applyEdit(const Edit& edit, std::uint64_t d
       const TileRect r = screenRect(cam, d.width, d.height, b);
       if (r.pixels() <= 0) continue;
       EditFacts each = facts;
-      each.pointOfChange = projectedCentre(cam, d.width, d.height, b)
-                               .value_or(Vec2{r.x + r.width * 0.5f, r.y + r.height * 0.5f});
+      each.pointOfChange = projectedCentre(cam, d.width, d.height, b).value_or(Vec2{r.x + r.width * 0.5f, r.y + r.height * 0.5f});
       each.screen = {r};
       d.batch.push_back(std::move(each));
     }
@@ -568,8 +580,7 @@ void RenderSession::completeGpu() {
     SelectionCounts c = d.renderer.takeSelectionCounts();
     if (c.tileSize == grid.tileSize()) {
       // The object's own centre now is where its later motion is measured from.
-      std::optional<Vec2> centre = projectedCentre(scene_.camera, d.width, d.height,
-                                                   objectBounds(scene_, d.meshBounds, d.counting));
+      std::optional<Vec2> centre = projectedCentre(scene_.camera, d.width, d.height, objectBounds(scene_, d.meshBounds, d.counting));
       auto counts = [](const SelectionCounts::Set& s) { return IndirectionCounts{s.direct, s.reflection, s.shadow}; };
       d.planner.setCounts(d.counting, counts(c.object), centre, d.countingMaterial, counts(c.group));
     }
@@ -614,8 +625,10 @@ void RenderSession::submitFrame(bool readImage) {
   const int block = d.frameBlock(edited, method().reuse);
   d.syncCounting(scene_);
   std::vector<double> samplesBefore;
-  if (method().reuse) samplesBefore = d.scheduler.tileSamples();
-  else d.scheduler.setCredit({});
+  if (method().reuse)
+    samplesBefore = d.scheduler.tileSamples();
+  else
+    d.scheduler.setCredit({});
   FramePlan plan = d.scheduler.nextFrame(block);
   std::vector<TileWork> work;
   work.reserve(plan.chunks.size());

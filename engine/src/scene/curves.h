@@ -34,8 +34,8 @@ struct CurveSet {
 void applyCurveThickness(CurveSet& curves, const float* thickness, bool taper);
 
 struct CurveTubeOptions {
-  int sides = 4;             // of each tube's cross-section, 3 or more
-  int subdivisions = 2;      // straight sections per spline piece, before the budget
+  int sides = 4;         // of each tube's cross-section, 3 or more
+  int subdivisions = 2;  // straight sections per spline piece, before the budget
   std::uint64_t maxTriangles = 12'000'000;
 };
 
@@ -43,7 +43,7 @@ struct CurveTubes {
   MeshGeometry geometry;
   std::size_t strandsKept = 0;  // strands with a tube (of those with three nodes or more)
   std::size_t strandsUsable = 0;
-  int subdivisions = 0;          // what the budget allowed
+  int subdivisions = 0;  // what the budget allowed
   int sides = 0;
 };
 

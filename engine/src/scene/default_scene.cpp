@@ -18,9 +18,16 @@ Scene makeDefaultScene() {
   NodeId cube = addMesh(s, "Cube", makeCube());
   NodeId sphere = addMesh(s, "Sphere", makeSphere());
   NodeId cup = addMesh(s, "Cup",
-                       makeLathe({{0.0f, 0.0f}, {0.085f, 0.0f}, {0.1f, 0.01f}, {0.11f, 0.06f},
-                                  {0.12f, 0.2f}, {0.12f, 0.21f}, {0.108f, 0.21f}, {0.098f, 0.06f},
-                                  {0.085f, 0.018f}, {0.0f, 0.018f}},
+                       makeLathe({{0.0f, 0.0f},
+                                  {0.085f, 0.0f},
+                                  {0.1f, 0.01f},
+                                  {0.11f, 0.06f},
+                                  {0.12f, 0.2f},
+                                  {0.12f, 0.21f},
+                                  {0.108f, 0.21f},
+                                  {0.098f, 0.06f},
+                                  {0.085f, 0.018f},
+                                  {0.0f, 0.018f}},
                                  64));
 
   Texture checker;
@@ -75,17 +82,14 @@ Scene makeDefaultScene() {
   NodeId lightMat = addMaterial(s, light);
 
   addObject(s, "Ground", quad, groundMat, Mat4::scale({12, 1, 12}));
-  addObject(s, "Glossy Sphere", sphere, glossyMat,
-            Mat4::translate({-0.85f, 0.45f, 0.1f}) * Mat4::scale(Vec3{0.45f}));
+  addObject(s, "Glossy Sphere", sphere, glossyMat, Mat4::translate({-0.85f, 0.45f, 0.1f}) * Mat4::scale(Vec3{0.45f}));
   addObject(s, "Cup", cup, ceramicMat, Mat4::translate({0.35f, 0.0f, 0.35f}));
   addObject(s, "Steel Panel", cube, steelMat,
-            Mat4::translate({0.3f, 0.45f, -0.25f}) * Mat4::rotateY(radians(-8.0f)) *
-                Mat4::scale({1.1f, 0.9f, 0.04f}));
+            Mat4::translate({0.3f, 0.45f, -0.25f}) * Mat4::rotateY(radians(-8.0f)) * Mat4::scale({1.1f, 0.9f, 0.04f}));
   addObject(s, "Checkered Box", cube, checkerMat,
             Mat4::translate({1.35f, 0.3f, 0.25f}) * Mat4::rotateY(radians(30.0f)) * Mat4::scale(Vec3{0.6f}));
   // Facing down: the quad's front is +y, so flip it.
-  addObject(s, "Area Light", quad, lightMat,
-            Mat4::translate({-0.6f, 3.0f, 1.2f}) * Mat4::rotateX(kPi) * Mat4::scale({1.2f, 1.0f, 1.2f}));
+  addObject(s, "Area Light", quad, lightMat, Mat4::translate({-0.6f, 3.0f, 1.2f}) * Mat4::rotateX(kPi) * Mat4::scale({1.2f, 1.0f, 1.2f}));
 
   s.environment.type = EnvironmentType::Sky;
   s.environment.intensity = 0.8f;

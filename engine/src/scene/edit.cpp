@@ -30,10 +30,11 @@ std::string checkMedium(Vec3 absorption, Vec3 scattering, float anisotropy) {
 }
 
 std::string checkMaterial(const Scene& s, const Material& m) {
-  if (!isFinite(m.albedo) || !isFinite(m.emission) || !finite(m.emissionStrength) || !isFinite(m.eta) || !isFinite(m.k) || !isFinite(m.coatingAbsorption) ||
-      !isFinite(m.coatAbsorption) || !finite(m.coatIor) || !isFinite(m.interiorAbsorption) || !isFinite(m.interiorScattering) || !finite(m.interiorAnisotropy) || !finite(m.coatRoughness) ||
-      !finite(m.roughness) || !finite(m.ior) || !finite(m.alpha) || !finite(m.bumpStrength) || !finite(m.blendRatio) ||
-      !finite(m.transmittance) || !finite(m.diffuseRatio) || !finite(m.filmThickness) || !finite(m.emissionCone) || !finite(m.hairTilt))
+  if (!isFinite(m.albedo) || !isFinite(m.emission) || !finite(m.emissionStrength) || !isFinite(m.eta) || !isFinite(m.k) ||
+      !isFinite(m.coatingAbsorption) || !isFinite(m.coatAbsorption) || !finite(m.coatIor) || !isFinite(m.interiorAbsorption) ||
+      !isFinite(m.interiorScattering) || !finite(m.interiorAnisotropy) || !finite(m.coatRoughness) || !finite(m.roughness) ||
+      !finite(m.ior) || !finite(m.alpha) || !finite(m.bumpStrength) || !finite(m.blendRatio) || !finite(m.transmittance) ||
+      !finite(m.diffuseRatio) || !finite(m.filmThickness) || !finite(m.emissionCone) || !finite(m.hairTilt))
     return cat("material '", m.name, "': a parameter is not a finite number");
   if (auto why = checkMedium(m.interiorAbsorption, m.interiorScattering, m.interiorAnisotropy); !why.empty())
     return cat("material '", m.name, "': ", why);
@@ -50,14 +51,13 @@ std::string checkMaterial(const Scene& s, const Material& m) {
 std::string checkObject(const Scene& s, const Object& o) {
   if (!o.transform.isFinite()) return cat("object '", o.name, "': transform is not finite");
   if (o.mesh != kNoNode && !s.mesh(o.mesh)) return cat("object '", o.name, "': mesh ", o.mesh, " does not exist");
-  if (o.material != kNoNode && !s.material(o.material))
-    return cat("object '", o.name, "': material ", o.material, " does not exist");
+  if (o.material != kNoNode && !s.material(o.material)) return cat("object '", o.name, "': material ", o.material, " does not exist");
   return {};
 }
 
 std::string checkLight(const Light& l) {
-  if (!isFinite(l.color) || !isFinite(l.position) || !isFinite(l.direction) || !finite(l.intensity) ||
-      !finite(l.spotAngle) || !finite(l.spotBlend) || !finite(l.angularRadius))
+  if (!isFinite(l.color) || !isFinite(l.position) || !isFinite(l.direction) || !finite(l.intensity) || !finite(l.spotAngle) ||
+      !finite(l.spotBlend) || !finite(l.angularRadius))
     return cat("light '", l.name, "': a parameter is not a finite number");
   // radians(90) in float may round a hair past pi / 2.
   if (l.angularRadius < 0 || l.angularRadius > kPi / 2 + 1e-6f)
@@ -66,8 +66,8 @@ std::string checkLight(const Light& l) {
 }
 
 std::string checkCamera(const Camera& c) {
-  if (!isFinite(c.position) || !isFinite(c.target) || !isFinite(c.up) || !finite(c.verticalFov) ||
-      !finite(c.apertureRadius) || !finite(c.focusDistance))
+  if (!isFinite(c.position) || !isFinite(c.target) || !isFinite(c.up) || !finite(c.verticalFov) || !finite(c.apertureRadius) ||
+      !finite(c.focusDistance))
     return "camera: a parameter is not a finite number";
   if (c.verticalFov <= 0 || c.verticalFov >= kPi) return "camera: field of view must be between 0 and 180 degrees";
   if (c.apertureRadius < 0) return "camera: the aperture radius must not be negative";
@@ -130,15 +130,12 @@ NodeId editTarget(const Edit& edit) {
                     edit);
 }
 
-std::uint64_t editCoalesceKey(const Edit& edit) {
-  return (static_cast<std::uint64_t>(edit.index()) << 56) ^ editTarget(edit);
-}
+std::uint64_t editCoalesceKey(const Edit& edit) { return (static_cast<std::uint64_t>(edit.index()) << 56) ^ editTarget(edit); }
 
 const char* editName(const Edit& edit) {
-  static const char* const names[] = {"set material", "set object", "set light", "set texture",
-                                      "set camera", "set environment", "set render settings",
-                                      "add mesh", "add material", "add object", "add light",
-                                      "add texture", "remove node"};
+  static const char* const names[] = {"set material",    "set object",          "set light",  "set texture",  "set camera",
+                                      "set environment", "set render settings", "add mesh",   "add material", "add object",
+                                      "add light",       "add texture",         "remove node"};
   return names[edit.index()];
 }
 
@@ -182,144 +179,139 @@ bool sameButName(Node a, const Node& b) {
 
 bool changesImage(const Scene& s, const Edit& edit) {
   const InUse u = inUse(s);
-  return std::visit(
-      Overloaded{
-          [&](const SetMaterial& e) {
-            const Material* old = s.material(e.material.id);
-            return !old || (u.has(u.materials, old->id) && !sameButName(*old, e.material));
-          },
-          [&](const SetObject& e) {
-            const Object* old = s.object(e.object.id);
-            return !old || ((old->visible || e.object.visible) && !sameButName(*old, e.object));
-          },
-          [&](const SetLight& e) {
-            const Light* old = s.light(e.light.id);
-            return !old || ((old->visible || e.light.visible) && !sameButName(*old, e.light));
-          },
-          [&](const SetTexture& e) {
-            const Texture* old = s.texture(e.texture.id);
-            return !old || (u.has(u.textures, old->id) && !sameButName(*old, e.texture));
-          },
-          [&](const AddMesh&) { return false; },
-          [&](const AddMaterial&) { return false; },
-          [&](const AddTexture&) { return false; },
-          [&](const AddObject& e) { return e.object.visible; },
-          [&](const AddLight& e) { return e.light.visible; },
-          [&](const RemoveNode& e) {
-            if (const Object* o = s.object(e.id)) return o->visible;
-            if (const Light* l = s.light(e.id)) return l->visible;
-            if (s.material(e.id)) return u.has(u.materials, e.id);
-            if (s.texture(e.id)) return u.has(u.textures, e.id);
-            if (s.mesh(e.id)) return u.has(u.meshes, e.id);
-            return true;
-          },
-          [&](const auto&) { return true; },
-      },
-      edit);
+  return std::visit(Overloaded{
+                        [&](const SetMaterial& e) {
+                          const Material* old = s.material(e.material.id);
+                          return !old || (u.has(u.materials, old->id) && !sameButName(*old, e.material));
+                        },
+                        [&](const SetObject& e) {
+                          const Object* old = s.object(e.object.id);
+                          return !old || ((old->visible || e.object.visible) && !sameButName(*old, e.object));
+                        },
+                        [&](const SetLight& e) {
+                          const Light* old = s.light(e.light.id);
+                          return !old || ((old->visible || e.light.visible) && !sameButName(*old, e.light));
+                        },
+                        [&](const SetTexture& e) {
+                          const Texture* old = s.texture(e.texture.id);
+                          return !old || (u.has(u.textures, old->id) && !sameButName(*old, e.texture));
+                        },
+                        [&](const AddMesh&) { return false; },
+                        [&](const AddMaterial&) { return false; },
+                        [&](const AddTexture&) { return false; },
+                        [&](const AddObject& e) { return e.object.visible; },
+                        [&](const AddLight& e) { return e.light.visible; },
+                        [&](const RemoveNode& e) {
+                          if (const Object* o = s.object(e.id)) return o->visible;
+                          if (const Light* l = s.light(e.id)) return l->visible;
+                          if (s.material(e.id)) return u.has(u.materials, e.id);
+                          if (s.texture(e.id)) return u.has(u.textures, e.id);
+                          if (s.mesh(e.id)) return u.has(u.meshes, e.id);
+                          return true;
+                        },
+                        [&](const auto&) { return true; },
+                    },
+                    edit);
 }
 
 Result<std::uint32_t> applyEdit(Scene& s, const Edit& edit) {
-  return std::visit(
-      Overloaded{
-          [&](const SetMaterial& e) -> Applied {
-            if (auto why = checkMaterial(s, e.material); !why.empty()) return fail(why);
-            const Material* old = s.material(e.material.id);
-            if (!old) return fail(cat("material ", e.material.id, " does not exist"));
-            // Emission decides which triangles are lights.
-            std::uint32_t flags = kUpdateMaterials;
-            if (old->radiance() != e.material.radiance()) flags |= kUpdateLights;
-            return replaceNode(s.materials, e.material, "material", flags);
-          },
-          [&](const SetObject& e) -> Applied {
-            if (auto why = checkObject(s, e.object); !why.empty()) return fail(why);
-            return replaceNode(s.objects, e.object, "object", kUpdateInstances | kUpdateLights);
-          },
-          [&](const SetLight& e) -> Applied {
-            if (auto why = checkLight(e.light); !why.empty()) return fail(why);
-            return replaceNode(s.lights, e.light, "light", kUpdateLights);
-          },
-          [&](const SetTexture& e) -> Applied {
-            return replaceNode(s.textures, e.texture, "texture",
-                               kUpdateTextures | kUpdateMaterials | kUpdateEnvironment);
-          },
-          [&](const SetCamera& e) -> Applied {
-            if (auto why = checkCamera(e.camera); !why.empty()) return fail(why);
-            s.camera = e.camera;
-            return kUpdateCamera;
-          },
-          [&](const SetEnvironment& e) -> Applied {
-            const Environment& v = e.environment;
-            if (!isFinite(v.color) || !std::isfinite(v.intensity) || !std::isfinite(v.rotation) ||
-                !isFinite(v.zenith) || !isFinite(v.horizon) || !isFinite(v.ground) || !v.orientation.isFinite() ||
-                !isFinite(v.mediumAbsorption) || !isFinite(v.mediumScattering) || !std::isfinite(v.mediumAnisotropy))
-              return fail("environment: a parameter is not a finite number");
-            if (auto why = checkMedium(v.mediumAbsorption, v.mediumScattering, v.mediumAnisotropy); !why.empty())
-              return fail("environment: " + why);
-            if (v.map != kNoNode && !s.texture(v.map)) return fail("environment: map texture does not exist");
-            // Only the medium changed (a drag in its fields): no sky to decode and pack again.
-            Environment sky = v;
-            sky.mediumAbsorption = s.environment.mediumAbsorption;
-            sky.mediumScattering = s.environment.mediumScattering;
-            sky.mediumAnisotropy = s.environment.mediumAnisotropy;
-            const bool skyChanged = !(sky == s.environment);
-            s.environment = v;
-            return skyChanged ? kUpdateEnvironment : kUpdateMaterials;
-          },
-          [&](const SetRenderSettings& e) -> Applied {
-            if (auto why = checkSettings(e.settings); !why.empty()) return fail(why);
-            s.settings = e.settings;
-            return kUpdateSettings;
-          },
-          [&](const AddMesh& e) -> Applied {
-            if (!e.mesh.geometry) return fail("new mesh has no geometry");
-            return addNode(s, s.meshes, e.mesh, "mesh", kUpdateGeometry);
-          },
-          [&](const AddMaterial& e) -> Applied {
-            if (auto why = checkMaterial(s, e.material); !why.empty()) return fail(why);
-            return addNode(s, s.materials, e.material, "material", kUpdateMaterials);
-          },
-          [&](const AddObject& e) -> Applied {
-            if (auto why = checkObject(s, e.object); !why.empty()) return fail(why);
-            return addNode(s, s.objects, e.object, "object", kUpdateInstances | kUpdateLights);
-          },
-          [&](const AddLight& e) -> Applied {
-            if (auto why = checkLight(e.light); !why.empty()) return fail(why);
-            return addNode(s, s.lights, e.light, "light", kUpdateLights);
-          },
-          [&](const AddTexture& e) -> Applied {
-            return addNode(s, s.textures, e.texture, "texture", kUpdateTextures);
-          },
-          [&](const RemoveNode& e) -> Applied {
-            NodeId id = e.id;
-            std::uint32_t flags = 0;
-            auto erase = [&](auto& nodes, std::uint32_t f) {
-              auto n = std::erase_if(nodes, [&](const auto& node) { return node.id == id; });
-              if (n) flags |= f;
-            };
-            erase(s.meshes, kUpdateGeometry | kUpdateInstances | kUpdateLights);
-            erase(s.materials, kUpdateMaterials | kUpdateInstances | kUpdateLights);
-            erase(s.objects, kUpdateInstances | kUpdateLights);
-            erase(s.lights, kUpdateLights);
-            erase(s.textures, kUpdateTextures | kUpdateMaterials | kUpdateEnvironment);
-            if (!flags) return fail(cat("node ", id, " does not exist"));
-            // Clear dangling references so the scene stays consistent.
-            for (Object& o : s.objects) {
-              if (o.mesh == id) o.mesh = kNoNode;
-              if (o.material == id) o.material = kNoNode;
-            }
-            for (Material& m : s.materials) {
-              for (NodeId* t : m.textureSlots())
-                if (*t == id) *t = kNoNode;
-              if (m.blendWith == id) m.blendWith = kNoNode;
-            }
-            if (s.environment.map == id) {
-              s.environment.map = kNoNode;
-              s.environment.type = EnvironmentType::Constant;
-            }
-            return flags;
-          },
-      },
-      edit);
+  return std::visit(Overloaded{
+                        [&](const SetMaterial& e) -> Applied {
+                          if (auto why = checkMaterial(s, e.material); !why.empty()) return fail(why);
+                          const Material* old = s.material(e.material.id);
+                          if (!old) return fail(cat("material ", e.material.id, " does not exist"));
+                          // Emission decides which triangles are lights.
+                          std::uint32_t flags = kUpdateMaterials;
+                          if (old->radiance() != e.material.radiance()) flags |= kUpdateLights;
+                          return replaceNode(s.materials, e.material, "material", flags);
+                        },
+                        [&](const SetObject& e) -> Applied {
+                          if (auto why = checkObject(s, e.object); !why.empty()) return fail(why);
+                          return replaceNode(s.objects, e.object, "object", kUpdateInstances | kUpdateLights);
+                        },
+                        [&](const SetLight& e) -> Applied {
+                          if (auto why = checkLight(e.light); !why.empty()) return fail(why);
+                          return replaceNode(s.lights, e.light, "light", kUpdateLights);
+                        },
+                        [&](const SetTexture& e) -> Applied {
+                          return replaceNode(s.textures, e.texture, "texture", kUpdateTextures | kUpdateMaterials | kUpdateEnvironment);
+                        },
+                        [&](const SetCamera& e) -> Applied {
+                          if (auto why = checkCamera(e.camera); !why.empty()) return fail(why);
+                          s.camera = e.camera;
+                          return kUpdateCamera;
+                        },
+                        [&](const SetEnvironment& e) -> Applied {
+                          const Environment& v = e.environment;
+                          if (!isFinite(v.color) || !std::isfinite(v.intensity) || !std::isfinite(v.rotation) || !isFinite(v.zenith) ||
+                              !isFinite(v.horizon) || !isFinite(v.ground) || !v.orientation.isFinite() || !isFinite(v.mediumAbsorption) ||
+                              !isFinite(v.mediumScattering) || !std::isfinite(v.mediumAnisotropy))
+                            return fail("environment: a parameter is not a finite number");
+                          if (auto why = checkMedium(v.mediumAbsorption, v.mediumScattering, v.mediumAnisotropy); !why.empty())
+                            return fail("environment: " + why);
+                          if (v.map != kNoNode && !s.texture(v.map)) return fail("environment: map texture does not exist");
+                          // Only the medium changed (a drag in its fields): no sky to decode and pack again.
+                          Environment sky = v;
+                          sky.mediumAbsorption = s.environment.mediumAbsorption;
+                          sky.mediumScattering = s.environment.mediumScattering;
+                          sky.mediumAnisotropy = s.environment.mediumAnisotropy;
+                          const bool skyChanged = !(sky == s.environment);
+                          s.environment = v;
+                          return skyChanged ? kUpdateEnvironment : kUpdateMaterials;
+                        },
+                        [&](const SetRenderSettings& e) -> Applied {
+                          if (auto why = checkSettings(e.settings); !why.empty()) return fail(why);
+                          s.settings = e.settings;
+                          return kUpdateSettings;
+                        },
+                        [&](const AddMesh& e) -> Applied {
+                          if (!e.mesh.geometry) return fail("new mesh has no geometry");
+                          return addNode(s, s.meshes, e.mesh, "mesh", kUpdateGeometry);
+                        },
+                        [&](const AddMaterial& e) -> Applied {
+                          if (auto why = checkMaterial(s, e.material); !why.empty()) return fail(why);
+                          return addNode(s, s.materials, e.material, "material", kUpdateMaterials);
+                        },
+                        [&](const AddObject& e) -> Applied {
+                          if (auto why = checkObject(s, e.object); !why.empty()) return fail(why);
+                          return addNode(s, s.objects, e.object, "object", kUpdateInstances | kUpdateLights);
+                        },
+                        [&](const AddLight& e) -> Applied {
+                          if (auto why = checkLight(e.light); !why.empty()) return fail(why);
+                          return addNode(s, s.lights, e.light, "light", kUpdateLights);
+                        },
+                        [&](const AddTexture& e) -> Applied { return addNode(s, s.textures, e.texture, "texture", kUpdateTextures); },
+                        [&](const RemoveNode& e) -> Applied {
+                          NodeId id = e.id;
+                          std::uint32_t flags = 0;
+                          auto erase = [&](auto& nodes, std::uint32_t f) {
+                            auto n = std::erase_if(nodes, [&](const auto& node) { return node.id == id; });
+                            if (n) flags |= f;
+                          };
+                          erase(s.meshes, kUpdateGeometry | kUpdateInstances | kUpdateLights);
+                          erase(s.materials, kUpdateMaterials | kUpdateInstances | kUpdateLights);
+                          erase(s.objects, kUpdateInstances | kUpdateLights);
+                          erase(s.lights, kUpdateLights);
+                          erase(s.textures, kUpdateTextures | kUpdateMaterials | kUpdateEnvironment);
+                          if (!flags) return fail(cat("node ", id, " does not exist"));
+                          // Clear dangling references so the scene stays consistent.
+                          for (Object& o : s.objects) {
+                            if (o.mesh == id) o.mesh = kNoNode;
+                            if (o.material == id) o.material = kNoNode;
+                          }
+                          for (Material& m : s.materials) {
+                            for (NodeId* t : m.textureSlots())
+                              if (*t == id) *t = kNoNode;
+                            if (m.blendWith == id) m.blendWith = kNoNode;
+                          }
+                          if (s.environment.map == id) {
+                            s.environment.map = kNoNode;
+                            s.environment.type = EnvironmentType::Constant;
+                          }
+                          return flags;
+                        },
+                    },
+                    edit);
 }
 
 Result<std::uint32_t> Document::apply(const Edit& edit) {

@@ -41,8 +41,7 @@ std::shared_ptr<const MeshGeometry> makeSphere(int rings, int segments) {
       Vec3 n{std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi)};
       g->positions.push_back(n);
       g->normals.push_back(n);
-      g->uvs.push_back({static_cast<float>(s) / static_cast<float>(segments),
-                        static_cast<float>(r) / static_cast<float>(rings)});
+      g->uvs.push_back({static_cast<float>(s) / static_cast<float>(segments), static_cast<float>(r) / static_cast<float>(rings)});
     }
   }
   auto idx = [&](int r, int s) { return static_cast<std::uint32_t>(r * (segments + 1) + s); };
@@ -75,8 +74,7 @@ std::shared_ptr<const MeshGeometry> makeLathe(const std::vector<Vec2>& profile, 
       const Vec2& q = pn[static_cast<std::size_t>(i)];
       g->positions.push_back({p.x * c, p.y, -p.x * sn});
       g->normals.push_back(normalize(Vec3{q.x * c, q.y, -q.x * sn}));
-      g->uvs.push_back({static_cast<float>(s) / static_cast<float>(segments),
-                        static_cast<float>(i) / static_cast<float>(n - 1)});
+      g->uvs.push_back({static_cast<float>(s) / static_cast<float>(segments), static_cast<float>(i) / static_cast<float>(n - 1)});
     }
   auto idx = [&](int i, int s) { return static_cast<std::uint32_t>(i * (segments + 1) + s); };
   for (int i = 0; i + 1 < n; ++i)
@@ -126,8 +124,7 @@ NodeId addObject(Scene& s, std::string name, NodeId mesh, NodeId material, const
   return s.objects.back().id;
 }
 
-NodeId addMeshObject(Scene& s, const std::string& name, std::shared_ptr<const MeshGeometry> g, Material m,
-                     const Mat4& xf) {
+NodeId addMeshObject(Scene& s, const std::string& name, std::shared_ptr<const MeshGeometry> g, Material m, const Mat4& xf) {
   const NodeId mesh = addMesh(s, name, std::move(g));
   m.name = name;
   const NodeId material = addMaterial(s, std::move(m));

@@ -28,7 +28,6 @@ NodeId addMesh(Scene& s, std::string name, std::shared_ptr<const MeshGeometry> g
 NodeId addMaterial(Scene& s, Material m);
 NodeId addObject(Scene& s, std::string name, NodeId mesh, NodeId material, const Mat4& xf);
 // A mesh, its own material and an object using both: `name` names all three.
-NodeId addMeshObject(Scene& s, const std::string& name, std::shared_ptr<const MeshGeometry> g, Material m,
-                     const Mat4& xf);
+NodeId addMeshObject(Scene& s, const std::string& name, std::shared_ptr<const MeshGeometry> g, Material m, const Mat4& xf);
 
 }  // namespace retile

@@ -9,19 +9,26 @@ namespace retile {
 
 const char* environmentTypeName(EnvironmentType t) {
   switch (t) {
-    case EnvironmentType::Constant: return "constant";
-    case EnvironmentType::Map: return "map";
-    case EnvironmentType::Sky: return "sky";
+    case EnvironmentType::Constant:
+      return "constant";
+    case EnvironmentType::Map:
+      return "map";
+    case EnvironmentType::Sky:
+      return "sky";
   }
   return "constant";
 }
 
 const char* pixelFilterName(PixelFilter f) {
   switch (f) {
-    case PixelFilter::Box: return "box";
-    case PixelFilter::Tent: return "tent";
-    case PixelFilter::Gaussian: return "gaussian";
-    case PixelFilter::BlackmanHarris: return "blackman_harris";
+    case PixelFilter::Box:
+      return "box";
+    case PixelFilter::Tent:
+      return "tent";
+    case PixelFilter::Gaussian:
+      return "gaussian";
+    case PixelFilter::BlackmanHarris:
+      return "blackman_harris";
   }
   return "box";
 }
@@ -37,10 +44,14 @@ bool parsePixelFilter(std::string_view name, PixelFilter* out) {
 
 float defaultFilterWidth(PixelFilter f) {
   switch (f) {
-    case PixelFilter::Box: return 1.0f;
-    case PixelFilter::Tent: return 2.0f;
-    case PixelFilter::Gaussian: return 4.0f;
-    case PixelFilter::BlackmanHarris: return 1.5f;
+    case PixelFilter::Box:
+      return 1.0f;
+    case PixelFilter::Tent:
+      return 2.0f;
+    case PixelFilter::Gaussian:
+      return 4.0f;
+    case PixelFilter::BlackmanHarris:
+      return 1.5f;
   }
   return 1.0f;
 }
@@ -52,9 +63,12 @@ std::vector<float> pixelFilterWarp(PixelFilter f, float width, int segments) {
   auto weight = [&](double x) {
     const double t = x / radius;  // -1..1
     switch (f) {
-      case PixelFilter::Box: return 1.0;
-      case PixelFilter::Tent: return std::max(0.0, 1.0 - std::abs(t));
-      case PixelFilter::Gaussian: return std::exp(-0.5 * (3.0 * t) * (3.0 * t));  // +-3 sigma across the width
+      case PixelFilter::Box:
+        return 1.0;
+      case PixelFilter::Tent:
+        return std::max(0.0, 1.0 - std::abs(t));
+      case PixelFilter::Gaussian:
+        return std::exp(-0.5 * (3.0 * t) * (3.0 * t));  // +-3 sigma across the width
       case PixelFilter::BlackmanHarris: {
         const double a = std::numbers::pi * (t + 1.0);  // 0..2 pi across the width
         return std::max(0.0, 0.35875 - 0.48829 * std::cos(a) + 0.14128 * std::cos(2 * a) - 0.01168 * std::cos(3 * a));
@@ -83,7 +97,6 @@ std::vector<float> pixelFilterWarp(PixelFilter f, float width, int segments) {
   return warp;
 }
 
-
 std::vector<float> tungstenFilterCdf(PixelFilter f) {
   // Tungsten's ReconstructionFilter::precompute: the weights at the steps' inner ends, in float
   // as there, normalised by their sum.
@@ -93,16 +106,15 @@ std::vector<float> tungstenFilterCdf(PixelFilter f) {
   };
   std::vector<float> w(kTungstenFilterSteps);
   float sum = 0;
-  for (int i = 0; i < kTungstenFilterSteps; ++i) sum += (w[static_cast<std::size_t>(i)] = weight(static_cast<float>(i) / kTungstenFilterSteps));
+  for (int i = 0; i < kTungstenFilterSteps; ++i)
+    sum += (w[static_cast<std::size_t>(i)] = weight(static_cast<float>(i) / kTungstenFilterSteps));
   std::vector<float> cdf(kTungstenFilterSteps - 1);
   float c = 0;
   for (int i = 1; i < kTungstenFilterSteps; ++i) cdf[static_cast<std::size_t>(i) - 1] = (c += w[static_cast<std::size_t>(i) - 1] / sum);
   return cdf;
 }
 
-Mat4 environmentToMap(const Environment& e) {
-  return e.orientation.rotationPart().transposed() * Mat4::rotateY(-e.rotation);
-}
+Mat4 environmentToMap(const Environment& e) { return e.orientation.rotationPart().transposed() * Mat4::rotateY(-e.rotation); }
 
 Bounds3 MeshGeometry::bounds() const {
   Bounds3 b;
@@ -121,8 +133,9 @@ Vec3 objectPivot(const Scene& s, const Object& o) {
 namespace {
 
 const char* const kMaterialNames[kMaterialTypeCount] = {
-    "lambert", "oren_nayar", "plastic", "rough_plastic", "conductor", "rough_conductor",
-    "mirror",  "dielectric", "rough_dielectric", "thinsheet", "null", "phong", "diffuse_transmission", "boundary", "hair"};
+    "lambert",    "oren_nayar",       "plastic",   "rough_plastic", "conductor", "rough_conductor",      "mirror",
+    "dielectric", "rough_dielectric", "thinsheet", "null",          "phong",     "diffuse_transmission", "boundary",
+    "hair"};
 
 // RGB complex indices of refraction of common metals (the same RGB values Tungsten's scenes
 // name, from the RPI refractive index tables), so that scene files naming a metal look as

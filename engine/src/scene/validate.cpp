@@ -45,8 +45,7 @@ void checkMedium(Vec3& c, const std::string& what, std::vector<std::string>& war
 // Keeps the triangles whose three indices are in range and whose vertices are sane; drops the
 // vertices no kept triangle uses (so the mesh's bounds, and the camera framed from them, hold only
 // real geometry); drops normals and uvs that are not one per vertex or not finite.
-std::shared_ptr<const MeshGeometry> repairGeometry(const MeshGeometry& g, const std::string& what,
-                                                   std::vector<std::string>& warnings) {
+std::shared_ptr<const MeshGeometry> repairGeometry(const MeshGeometry& g, const std::string& what, std::vector<std::string>& warnings) {
   const std::size_t n = g.positions.size();
   const bool normalsFit = g.normals.size() == n, uvsFit = g.uvs.size() == n;
   std::size_t badIndex = 0, badVertex = 0;
@@ -56,15 +55,22 @@ std::shared_ptr<const MeshGeometry> repairGeometry(const MeshGeometry& g, const 
     bool inRange = true, finite = true;
     for (std::size_t k = 0; k < 3; ++k) {
       std::uint32_t i = g.indices[t + k];
-      if (i >= n) inRange = false;
-      else if (!sane(g.positions[i])) finite = false;
+      if (i >= n)
+        inRange = false;
+      else if (!sane(g.positions[i]))
+        finite = false;
     }
-    if (!inRange) ++badIndex;
-    else if (!finite) ++badVertex;
-    else kept.insert(kept.end(), g.indices.begin() + static_cast<std::ptrdiff_t>(t), g.indices.begin() + static_cast<std::ptrdiff_t>(t + 3));
+    if (!inRange)
+      ++badIndex;
+    else if (!finite)
+      ++badVertex;
+    else
+      kept.insert(kept.end(), g.indices.begin() + static_cast<std::ptrdiff_t>(t), g.indices.begin() + static_cast<std::ptrdiff_t>(t + 3));
   }
-  bool badNormals = !g.normals.empty() && (!normalsFit || !std::all_of(g.normals.begin(), g.normals.end(), [](Vec3 v) { return isFinite(v); }));
-  bool badUvs = !g.uvs.empty() && (!uvsFit || !std::all_of(g.uvs.begin(), g.uvs.end(), [](Vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }));
+  bool badNormals =
+      !g.normals.empty() && (!normalsFit || !std::all_of(g.normals.begin(), g.normals.end(), [](Vec3 v) { return isFinite(v); }));
+  bool badUvs = !g.uvs.empty() &&
+                (!uvsFit || !std::all_of(g.uvs.begin(), g.uvs.end(), [](Vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }));
   const bool ragged = g.indices.size() % 3 != 0;
   // A vertex no triangle uses still counts in the mesh's bounds: garbage ones must go too.
   const bool insaneVertex = !std::all_of(g.positions.begin(), g.positions.end(), [](Vec3 p) { return sane(p); });
@@ -74,7 +80,8 @@ std::shared_ptr<const MeshGeometry> repairGeometry(const MeshGeometry& g, const 
 
   if (badIndex) warnings.push_back(cat(what, ": ", badIndex, " triangles name vertices past its ", n, "; dropped"));
   if (badVertex)
-    warnings.push_back(cat(what, ": ", badVertex, " triangles have non-finite or absurd coordinates (beyond ", kMaxCoordinate, "); dropped"));
+    warnings.push_back(
+        cat(what, ": ", badVertex, " triangles have non-finite or absurd coordinates (beyond ", kMaxCoordinate, "); dropped"));
   if (ragged) warnings.push_back(cat(what, ": ", g.indices.size() % 3, " indices left over after the last whole triangle; dropped"));
   if (badNormals) warnings.push_back(cat(what, ": its normals are not one finite normal per vertex; the surface's own are used"));
   if (badUvs) warnings.push_back(cat(what, ": its uvs are not one finite pair per vertex; dropped"));
@@ -98,8 +105,8 @@ bool cameraUsable(const Camera& c) {
   Vec3 forward = c.target - c.position;
   if (!(length(forward) > 0) || !(length(c.up) > 0)) return false;
   // The up vector must not be along the view direction.
-  return length(cross(normalize(forward), normalize(c.up))) > 1e-4f && std::isfinite(c.verticalFov) &&
-         c.verticalFov > 1e-3f && c.verticalFov < 3.1f;
+  return length(cross(normalize(forward), normalize(c.up))) > 1e-4f && std::isfinite(c.verticalFov) && c.verticalFov > 1e-3f &&
+         c.verticalFov < 3.1f;
 }
 
 // The front view of the scene's bounds (from +z, y up), as the importers frame a file without a
@@ -207,15 +214,14 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
   clampValue(s.filterWidth, 0.25f, 16.0f, defaultFilterWidth(s.pixelFilter), "pixel filter width", warnings);
 
   if (!cameraUsable(scene.camera)) {
-    warnings.push_back(cat("the camera (at ", scene.camera.position.x, ", ", scene.camera.position.y, ", ",
-                           scene.camera.position.z, ") is not finite, too far out or looks nowhere; framing the scene instead"));
+    warnings.push_back(cat("the camera (at ", scene.camera.position.x, ", ", scene.camera.position.y, ", ", scene.camera.position.z,
+                           ") is not finite, too far out or looks nowhere; framing the scene instead"));
     scene.camera = framingCamera(scene);
   }
   Camera& cam = scene.camera;
-  if (!(std::isfinite(cam.apertureRadius) && cam.apertureRadius >= 0 && std::isfinite(cam.focusDistance) &&
-        cam.focusDistance > 0)) {
-    warnings.push_back(cat("the camera's lens (aperture radius ", cam.apertureRadius, ", focus distance ",
-                           cam.focusDistance, ") is not usable; rendering through a pinhole"));
+  if (!(std::isfinite(cam.apertureRadius) && cam.apertureRadius >= 0 && std::isfinite(cam.focusDistance) && cam.focusDistance > 0)) {
+    warnings.push_back(cat("the camera's lens (aperture radius ", cam.apertureRadius, ", focus distance ", cam.focusDistance,
+                           ") is not usable; rendering through a pinhole"));
     cam.apertureRadius = 0.0f;
     cam.focusDistance = 1.0f;
   }

@@ -37,12 +37,12 @@ enum class TileSource : std::uint8_t {
 };
 
 struct DenoiseFrame {
-  bool filter = false;     // run the denoiser over `domain` this frame
+  bool filter = false;  // run the denoiser over `domain` this frame
   TileRect domain;
-  std::vector<TileSource> source;  // per tile
-  std::vector<int> region;         // per tile: the region index for Region tiles, else -1
-  std::vector<char> write;         // per tile: takes this frame's result (its region is the new one)
-  std::vector<char> filtered;      // per tile: takes part in this frame's filter
+  std::vector<TileSource> source;      // per tile
+  std::vector<int> region;             // per tile: the region index for Region tiles, else -1
+  std::vector<char> write;             // per tile: takes this frame's result (its region is the new one)
+  std::vector<char> filtered;          // per tile: takes part in this frame's filter
   std::vector<DenoiseRegion> regions;  // the stack, oldest (innermost) first
   bool wholeFrame = false;
 };
@@ -59,8 +59,8 @@ class DenoiseRegions {
   // counts for the region's rectangle (all tiles, or the prioritized ones). `threshold`: a share
   // of the image's width (for the region's width) and height (for its height).
   // `passComplete`: the pass has started every tile it will re-render.
-  DenoiseFrame incremental(const std::vector<char>& started, const std::vector<char>& grows, double threshold,
-                           bool passComplete, std::uint64_t frame);
+  DenoiseFrame incremental(const std::vector<char>& started, const std::vector<char>& grows, double threshold, bool passComplete,
+                           std::uint64_t frame);
   // A frame that accumulates nothing (the change probe): the display stays as it was.
   DenoiseFrame unchanged() const;
 
@@ -69,9 +69,9 @@ class DenoiseRegions {
 
   TileGrid grid_;
   std::vector<DenoiseRegion> stack_;
-  std::vector<int> regionOf_;  // per tile, -1: none
-  std::vector<char> started_;  // the last incremental frame's
-  std::vector<char> written_;  // tiles that took the newest region's result this frame
+  std::vector<int> regionOf_;     // per tile, -1: none
+  std::vector<char> started_;     // the last incremental frame's
+  std::vector<char> written_;     // tiles that took the newest region's result this frame
   std::vector<char> layerValid_;  // the layer holds a denoised result of the tile's samples as they are
   bool whole_ = false;
 };

@@ -7,13 +7,9 @@ namespace retile {
 
 Planner::Planner(const TileGrid& grid, const MethodSettings& method) : grid_(grid), method_(method) {}
 
-bool Planner::indirection() const {
-  return method_.kind == MethodKind::Indirection || method_.kind == MethodKind::IndirectionFocus;
-}
+bool Planner::indirection() const { return method_.kind == MethodKind::Indirection || method_.kind == MethodKind::IndirectionFocus; }
 
-bool Planner::focusPolicy() const {
-  return method_.kind == MethodKind::Focus || method_.kind == MethodKind::IndirectionFocus;
-}
+bool Planner::focusPolicy() const { return method_.kind == MethodKind::Focus || method_.kind == MethodKind::IndirectionFocus; }
 
 void Planner::dropCounts(bool gatherAgain) {
   counts_ = {};
@@ -60,8 +56,8 @@ bool Planner::countThisFrame(AccumMode mode) const {
 
 bool Planner::frameCounted() { return countFramesLeft_ > 0 && --countFramesLeft_ == 0; }
 
-void Planner::setCounts(NodeId object, const IndirectionCounts& counts, std::optional<Vec2> centre,
-                        NodeId groupMaterial, const IndirectionCounts& group) {
+void Planner::setCounts(NodeId object, const IndirectionCounts& counts, std::optional<Vec2> centre, NodeId groupMaterial,
+                        const IndirectionCounts& group) {
   if (object != countTarget_) return;  // gathered for an object no longer of interest
   counts_ = counts;
   countsFor_ = object;
@@ -165,8 +161,7 @@ Plan Planner::indirectionPass(const std::vector<char>& touched, Vec2 motion, con
   classes_ = std::move(cls);
 
   int q = method_.quality;
-  if (q == 0)
-    q = mustFit.empty() ? kDefaultAutomaticQuality : automaticQuality(grid_, mustFit, kMaxAutomaticQuality);
+  if (q == 0) q = mustFit.empty() ? kDefaultAutomaticQuality : automaticQuality(grid_, mustFit, kMaxAutomaticQuality);
   return pass(std::move(order), prioritized, q);
 }
 
@@ -201,8 +196,7 @@ Plan Planner::planBatch(const std::vector<EditFacts>& batch) {
     if (f.object == object && object != kNoNode && f.centreAfter) {
       centreNow = f.centreAfter;
       if (f.moved && f.centreBefore)
-        batchMotion = Vec2{batchMotion.x + f.centreAfter->x - f.centreBefore->x,
-                           batchMotion.y + f.centreAfter->y - f.centreBefore->y};
+        batchMotion = Vec2{batchMotion.x + f.centreAfter->x - f.centreBefore->x, batchMotion.y + f.centreAfter->y - f.centreBefore->y};
     }
   for (FocusPoint& fp : method_.focus)
     if (fp.follows) fp.pixel = Vec2{fp.pixel.x + batchMotion.x, fp.pixel.y + batchMotion.y};
@@ -256,8 +250,7 @@ Plan Planner::planQuiet(bool passActive) {
 Plan Planner::planFromProbe(const std::vector<float>& tileDifference) {
   const auto n = static_cast<std::size_t>(grid_.count());
   std::vector<float> d(n, 0.0f);
-  for (std::size_t i = 0; i < n && i < tileDifference.size(); ++i)
-    d[i] = std::isfinite(tileDifference[i]) ? tileDifference[i] : 0.0f;
+  for (std::size_t i = 0; i < n && i < tileDifference.size(); ++i) d[i] = std::isfinite(tileDifference[i]) ? tileDifference[i] : 0.0f;
   std::vector<float> sorted = d;
   std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(n / 2), sorted.end());
   const float threshold = kChangedOverMedian * sorted[n / 2];
@@ -265,8 +258,7 @@ Plan Planner::planFromProbe(const std::vector<float>& tileDifference) {
   // Changed tiles and those the edit touched restart first; the rest follow by difference
   // (with the smooth transition they keep capped stale sums).
   std::vector<char> first(n, 0);
-  for (std::size_t t = 0; t < n; ++t)
-    first[t] = d[t] > threshold || (t < lastTouched_.size() && lastTouched_[t]);
+  for (std::size_t t = 0; t < n; ++t) first[t] = d[t] > threshold || (t < lastTouched_.size() && lastTouched_[t]);
   std::vector<int> order;
   for (int t : byChange)
     if (first[static_cast<std::size_t>(t)]) order.push_back(t);

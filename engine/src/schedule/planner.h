@@ -22,12 +22,12 @@ namespace retile {
 
 // What one edit changed on screen, measured by the session right after applying it.
 struct EditFacts {
-  bool global = false;            // camera or render settings: every sample is stale
-  Vec2 pointOfChange{0.0f};       // projected centre of the targets' bounds (light position; else centre)
-  std::vector<TileRect> screen;   // image rectangles the targets cover, before and after the edit
-  NodeId object = kNoNode;        // the one object the edit changed (a move; a material only it uses)
-  NodeId material = kNoNode;      // a material edit: the material (the batch holds a fact per object using it)
-  bool moved = false;             // that object's transform changed
+  bool global = false;                            // camera or render settings: every sample is stale
+  Vec2 pointOfChange{0.0f};                       // projected centre of the targets' bounds (light position; else centre)
+  std::vector<TileRect> screen;                   // image rectangles the targets cover, before and after the edit
+  NodeId object = kNoNode;                        // the one object the edit changed (a move; a material only it uses)
+  NodeId material = kNoNode;                      // a material edit: the material (the batch holds a fact per object using it)
+  bool moved = false;                             // that object's transform changed
   std::optional<Vec2> centreBefore, centreAfter;  // its projected bounds centre
 };
 
@@ -76,8 +76,8 @@ class Planner {
   // `centre`: the object's projected centre now, from which its later motion is measured.
   // `group`: the counts of every object using `groupMaterial` (the object's material), which a
   // material edit of it plans by as a move plans by the object's.
-  void setCounts(NodeId object, const IndirectionCounts& counts, std::optional<Vec2> centre,
-                 NodeId groupMaterial = kNoNode, const IndirectionCounts& group = {});
+  void setCounts(NodeId object, const IndirectionCounts& counts, std::optional<Vec2> centre, NodeId groupMaterial = kNoNode,
+                 const IndirectionCounts& group = {});
   bool haveCounts() const { return !counts_.empty() && countsFor_ != kNoNode; }
 
   // One plan for all edits applied since the last frame (a batch), with all their points of change.
@@ -120,7 +120,7 @@ class Planner {
   TileGrid grid_;
   MethodSettings method_;
   std::vector<Vec2> pointsOfChange_;
-  std::vector<char> lastTouched_;   // the last batch's touched tiles, for the change policy's pass
+  std::vector<char> lastTouched_;  // the last batch's touched tiles, for the change policy's pass
 
   NodeId countTarget_ = kNoNode;
   int countFramesLeft_ = 0;

@@ -16,10 +16,10 @@ std::vector<int> spiralOrder(const TileGrid& grid, int center) {
   visit(cx, cy);
   for (int ring = 1; ring <= maxRing; ++ring) {
     int x0 = cx - ring, x1 = cx + ring, y0 = cy - ring, y1 = cy + ring;
-    for (int c = x0; c <= x1; ++c) visit(c, y0);          // top, left to right
-    for (int r = y0 + 1; r <= y1; ++r) visit(x1, r);      // right, downwards
-    for (int c = x1 - 1; c >= x0; --c) visit(c, y1);      // bottom, right to left
-    for (int r = y1 - 1; r > y0; --r) visit(x0, r);       // left, upwards
+    for (int c = x0; c <= x1; ++c) visit(c, y0);      // top, left to right
+    for (int r = y0 + 1; r <= y1; ++r) visit(x1, r);  // right, downwards
+    for (int c = x1 - 1; c >= x0; --c) visit(c, y1);  // bottom, right to left
+    for (int r = y1 - 1; r > y0; --r) visit(x0, r);   // left, upwards
   }
   return order;
 }
@@ -45,8 +45,7 @@ std::vector<int> interleavedSpirals(const TileGrid& grid, const std::vector<int>
   return order;
 }
 
-IndirectionPlan indirectionPlan(const TileGrid& grid, const IndirectionCounts& counts, int center,
-                                const std::vector<int>& restOrder) {
+IndirectionPlan indirectionPlan(const TileGrid& grid, const IndirectionCounts& counts, int center, const std::vector<int>& restOrder) {
   auto n = static_cast<std::size_t>(grid.count());
   IndirectionPlan plan;
   plan.classes.assign(n, TileClass::Rest);
@@ -58,9 +57,12 @@ IndirectionPlan indirectionPlan(const TileGrid& grid, const IndirectionCounts& c
     double refl = at(counts.reflection, t), sh = at(counts.shadow, t);
     double c = std::max(refl, sh);
     TileClass k = TileClass::Rest;
-    if (at(counts.direct, t) > 0 || c > third) k = TileClass::High;
-    else if (c > sixth || sh > twelfth) k = TileClass::Middle;
-    else if (c > twelfth) k = TileClass::Low;
+    if (at(counts.direct, t) > 0 || c > third)
+      k = TileClass::High;
+    else if (c > sixth || sh > twelfth)
+      k = TileClass::Middle;
+    else if (c > twelfth)
+      k = TileClass::Low;
     plan.classes[t] = k;
   }
   for (TileClass k : {TileClass::High, TileClass::Middle, TileClass::Low})
@@ -98,8 +100,7 @@ std::vector<int> followMotion(const TileGrid& grid, const std::vector<int>& tile
 std::vector<int> changeOrder(const TileGrid& grid, const std::vector<float>& difference, int center) {
   // NaN would break the sort's ordering: a tile without a usable difference ranks as unchanged.
   std::vector<float> d(static_cast<std::size_t>(grid.count()), 0.0f);
-  for (std::size_t i = 0; i < d.size() && i < difference.size(); ++i)
-    d[i] = difference[i] == difference[i] ? difference[i] : 0.0f;
+  for (std::size_t i = 0; i < d.size() && i < difference.size(); ++i) d[i] = difference[i] == difference[i] ? difference[i] : 0.0f;
   std::vector<int> order = spiralOrder(grid, center);
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return d[static_cast<std::size_t>(a)] > d[static_cast<std::size_t>(b)]; });

@@ -28,18 +28,17 @@ struct IndirectionCounts {
 enum class TileClass : std::uint8_t { High = 0, Middle = 1, Low = 2, Rest = 3 };
 
 struct IndirectionPlan {
-  std::vector<int> order;               // high, middle, low, then the rest
-  std::vector<TileClass> classes;       // per tile
-  std::vector<int> high;                // the high tiles (their count drives automatic Q)
-  int prioritized = 0;                  // tiles in the high, middle and low classes
+  std::vector<int> order;          // high, middle, low, then the rest
+  std::vector<TileClass> classes;  // per tile
+  std::vector<int> high;           // the high tiles (their count drives automatic Q)
+  int prioritized = 0;             // tiles in the high, middle and low classes
 };
 
 // Classes: high = any direct hit, or reflection or shadow count > M/3 (M the largest per-tile
 // reflection-or-shadow count); middle = above M/6, or any shadow above M/12 (shadows never fall
 // to low: users missed them); low = above M/12; the rest after. Within a class, by spiral distance
 // from `center`; the rest follows `restOrder` (a spiral, or focus spirals).
-IndirectionPlan indirectionPlan(const TileGrid& grid, const IndirectionCounts& counts, int center,
-                                const std::vector<int>& restOrder);
+IndirectionPlan indirectionPlan(const TileGrid& grid, const IndirectionCounts& counts, int center, const std::vector<int>& restOrder);
 
 // The largest Q at which all `tiles` fit into one frame's budget of grid.pixels() samples;
 // never below 1 (a screen-filling object) and never above `maxQ`.

@@ -12,13 +12,16 @@ double normalQuantileTwoSided(double p) {
   double lo = 0.0, hi = 40.0;
   for (int i = 0; i < 200; ++i) {
     double mid = 0.5 * (lo + hi);
-    if (std::erfc(mid / std::sqrt(2.0)) > p) lo = mid; else hi = mid;
+    if (std::erfc(mid / std::sqrt(2.0)) > p)
+      lo = mid;
+    else
+      hi = mid;
   }
   return 0.5 * (lo + hi);
 }
 
-ReuseTest testReuse(const std::vector<LuminanceSums>& fresh, const std::vector<LuminanceSums>& history, int width,
-                    int height, double falseRejectRate, double margin) {
+ReuseTest testReuse(const std::vector<LuminanceSums>& fresh, const std::vector<LuminanceSums>& history, int width, int height,
+                    double falseRejectRate, double margin) {
   ReuseTest out;
   const int bx = (width + 3) / 4, by = (height + 3) / 4;
   // Per block and for the whole tile, per quantity (luminance, R, G, B): the summed difference

@@ -56,8 +56,8 @@ constexpr double kReuseMargin = 0.005;
 
 // Tests one tile: `fresh` and `history` hold the tile's pixels row by row (width x height). Pixels
 // without fresh samples or without a history take no part.
-ReuseTest testReuse(const std::vector<LuminanceSums>& fresh, const std::vector<LuminanceSums>& history, int width,
-                    int height, double falseRejectRate, double margin = kReuseMargin);
+ReuseTest testReuse(const std::vector<LuminanceSums>& fresh, const std::vector<LuminanceSums>& history, int width, int height,
+                    double falseRejectRate, double margin = kReuseMargin);
 
 // Pools tiles' whole-tile sums into one test (luminance, R, G, B; Bonferroni over the four): a
 // change too small for any one tile's test, spread over many tiles (a light a few per cent

@@ -7,10 +7,14 @@ namespace retile {
 
 const char* accumModeName(AccumMode m) {
   switch (m) {
-    case AccumMode::GlobalUpdate: return "global-update";
-    case AccumMode::Incremental: return "incremental";
-    case AccumMode::Refinement: return "refinement";
-    case AccumMode::Probe: return "probe";
+    case AccumMode::GlobalUpdate:
+      return "global-update";
+    case AccumMode::Incremental:
+      return "incremental";
+    case AccumMode::Refinement:
+      return "refinement";
+    case AccumMode::Probe:
+      return "probe";
   }
   return "?";
 }
@@ -73,8 +77,7 @@ void TileScheduler::globalUpdate() {
 void TileScheduler::probe() { pendingProbe_ = true; }
 
 void TileScheduler::setRegion(std::vector<char> tiles) {
-  if (static_cast<int>(tiles.size()) != grid_.count() || std::none_of(tiles.begin(), tiles.end(), [](char c) { return c; }))
-    tiles.clear();
+  if (static_cast<int>(tiles.size()) != grid_.count() || std::none_of(tiles.begin(), tiles.end(), [](char c) { return c; })) tiles.clear();
   region_ = std::move(tiles);
   // A pass keeps its order; tiles outside the region drop out of it.
   if (!region_.empty() && pos_ < queue_.size()) {
@@ -117,8 +120,7 @@ AccumMode TileScheduler::mode() const {
 std::vector<float> TileScheduler::priorities() const {
   std::vector<float> p(static_cast<std::size_t>(grid_.count()), -1.0f);
   float last = queue_.size() > 1 ? static_cast<float>(queue_.size() - 1) : 1.0f;
-  for (std::size_t i = 0; i < queue_.size(); ++i)
-    p[static_cast<std::size_t>(queue_[i])] = 1.0f - static_cast<float>(i) / last;
+  for (std::size_t i = 0; i < queue_.size(); ++i) p[static_cast<std::size_t>(queue_[i])] = 1.0f - static_cast<float>(i) / last;
   return p;
 }
 
@@ -141,9 +143,12 @@ void TileScheduler::emit(FramePlan& plan, int tile, TileRect rect, int quality, 
   // Sample indices only grow per tile, so no pixel ever sees the same index twice.
   nextIndex_[t] += static_cast<std::uint32_t>(quality);
   double share = wholeTile ? 1.0 : static_cast<double>(rect.pixels()) / static_cast<double>(grid_.rect(tile).pixels());
-  if (restart) samples_[t] = quality * share;
-  else if (cap > 0) samples_[t] = std::min(samples_[t], static_cast<double>(cap)) + quality * share;
-  else samples_[t] += quality * share;
+  if (restart)
+    samples_[t] = quality * share;
+  else if (cap > 0)
+    samples_[t] = std::min(samples_[t], static_cast<double>(cap)) + quality * share;
+  else
+    samples_[t] += quality * share;
   if (plan.servedTiles.empty() || std::find(plan.servedTiles.begin(), plan.servedTiles.end(), tile) == plan.servedTiles.end())
     plan.servedTiles.push_back(tile);
   plan.chunks.push_back(c);
@@ -189,12 +194,12 @@ void TileScheduler::fillRemainder(FramePlan& plan, std::int64_t remainder, const
 // Raises the candidates with the fewest samples in all (history credit counted) to a common level
 // L, each by whole samples per pixel, as far as `budget` goes (L at least the lowest + 1, so
 // something is served when one sample of the lowest fits). Returns the samples spent.
-std::int64_t TileScheduler::waterFill(FramePlan& plan, std::vector<int> order, std::int64_t budget,
-                                      std::vector<char>& served) {
+std::int64_t TileScheduler::waterFill(FramePlan& plan, std::vector<int> order, std::int64_t budget, std::vector<char>& served) {
   if (order.empty() || budget <= 0) return 0;
   std::vector<double> have(static_cast<std::size_t>(grid_.count()));
   for (int t : order) have[static_cast<std::size_t>(t)] = held(t);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return have[static_cast<std::size_t>(a)] < have[static_cast<std::size_t>(b)]; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return have[static_cast<std::size_t>(a)] < have[static_cast<std::size_t>(b)]; });
   auto cost = [&](double level) {
     std::int64_t c = 0;
     for (int t : order) {
@@ -206,7 +211,10 @@ std::int64_t TileScheduler::waterFill(FramePlan& plan, std::vector<int> order, s
   double lo = have[static_cast<std::size_t>(order.front())], hi = lo + 1e6;
   for (int i = 0; i < 60; ++i) {
     const double mid = 0.5 * (lo + hi);
-    if (cost(mid) <= budget) lo = mid; else hi = mid;
+    if (cost(mid) <= budget)
+      lo = mid;
+    else
+      hi = mid;
   }
   std::int64_t spent = 0;
   for (int t : order) {

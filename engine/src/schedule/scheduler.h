@@ -92,7 +92,7 @@ class TileScheduler {
 
  private:
   struct PassTile {
-    int need = 0;         // spp still to serve to the whole tile
+    int need = 0;  // spp still to serve to the whole tile
     bool started = false;
   };
   void emit(FramePlan& plan, int tile, TileRect rect, int quality, bool restart, int cap, bool wholeTile);

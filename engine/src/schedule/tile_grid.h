@@ -21,8 +21,11 @@ class TileGrid {
  public:
   TileGrid() = default;
   TileGrid(int width, int height, int tileSize)
-      : width_(std::max(width, 1)), height_(std::max(height, 1)), tile_(std::max(tileSize, 1)),
-        cols_((width_ + tile_ - 1) / tile_), rows_((height_ + tile_ - 1) / tile_) {}
+      : width_(std::max(width, 1)),
+        height_(std::max(height, 1)),
+        tile_(std::max(tileSize, 1)),
+        cols_((width_ + tile_ - 1) / tile_),
+        rows_((height_ + tile_ - 1) / tile_) {}
 
   int width() const { return width_; }
   int height() const { return height_; }

@@ -8,8 +8,7 @@
 
 namespace retile::vk {
 
-Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, bool hostVisible, const char* what)
-    : ctx_(&ctx), size_(size) {
+Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, bool hostVisible, const char* what) : ctx_(&ctx), size_(size) {
   // Zero-sized buffers are not allowed; keep a minimal one so descriptors stay valid.
   VkDeviceSize allocSize = size ? size : 16;
   VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};

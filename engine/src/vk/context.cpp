@@ -15,7 +15,8 @@ namespace retile::vk {
 const char* resultName(VkResult r) {
   switch (r) {
 #define RETILE_VK_CASE(x) \
-  case x: return #x;
+  case x:                 \
+    return #x;
     RETILE_VK_CASE(VK_SUCCESS)
     RETILE_VK_CASE(VK_NOT_READY)
     RETILE_VK_CASE(VK_TIMEOUT)
@@ -39,7 +40,8 @@ const char* resultName(VkResult r) {
     RETILE_VK_CASE(VK_ERROR_INVALID_EXTERNAL_HANDLE)
     RETILE_VK_CASE(VK_ERROR_FRAGMENTATION)
 #undef RETILE_VK_CASE
-    default: return "VK_ERROR_(unnamed)";
+    default:
+      return "VK_ERROR_(unnamed)";
   }
 }
 
@@ -51,8 +53,7 @@ void throwVk(VkResult r, const char* what) {
 
 namespace {
 
-VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                             VkDebugUtilsMessageTypeFlagsEXT,
+VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
                                              const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
   LogLevel level = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? LogLevel::Error : LogLevel::Warning;
   logMessage(level, cat("Vulkan validation: ", data && data->pMessage ? data->pMessage : "?"));
@@ -61,11 +62,16 @@ VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBits
 
 int typeRank(VkPhysicalDeviceType t) {
   switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
-    default: return 4;
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      return 3;
+    default:
+      return 4;
   }
 }
 
@@ -112,8 +118,7 @@ Context::Context(const DeviceChoice& choiceIn) {
   checkVk(r, "creating the Vulkan instance");
 
   if (!layers.empty()) {
-    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-        vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
     if (create) {
       VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
       mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
@@ -151,9 +156,8 @@ Context::Context(const DeviceChoice& choiceIn) {
   }
   if (usable.empty())
     throw NoDeviceError("Vulkan: no device with Vulkan 1.2 compute found (on Debian, install mesa-vulkan-drivers for lavapipe)");
-  std::stable_sort(usable.begin(), usable.end(), [](const Candidate& a, const Candidate& b) {
-    return typeRank(a.props.deviceType) < typeRank(b.props.deviceType);
-  });
+  std::stable_sort(usable.begin(), usable.end(),
+                   [](const Candidate& a, const Candidate& b) { return typeRank(a.props.deviceType) < typeRank(b.props.deviceType); });
   const Candidate* chosen = &usable.front();
   if (!choice.preferred.empty()) {
     const Candidate* match = nullptr;
@@ -205,8 +209,8 @@ Context::~Context() {
     vkDestroyDevice(device_, nullptr);
   }
   if (messenger_) {
-    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-        vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+    auto destroy =
+        reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
     if (destroy) destroy(instance_, messenger_, nullptr);
   }
   if (instance_) vkDestroyInstance(instance_, nullptr);

@@ -8,10 +8,14 @@ namespace {
 
 VkDescriptorType descriptorType(Binding b) {
   switch (b) {
-    case Binding::Uniform: return VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-    case Binding::Storage: return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    case Binding::UniformTexel: return VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
-    case Binding::StorageTexel: return VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;
+    case Binding::Uniform:
+      return VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    case Binding::Storage:
+      return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    case Binding::UniformTexel:
+      return VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+    case Binding::StorageTexel:
+      return VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;
   }
   return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 }
@@ -115,8 +119,7 @@ void computeBarrier(VkCommandBuffer cb) {
   mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
   mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT;
   vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, 0, nullptr,
-                       0, nullptr);
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, 0, nullptr, 0, nullptr);
 }
 
 }  // namespace retile::vk

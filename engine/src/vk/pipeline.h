@@ -17,8 +17,8 @@ enum class Binding { Uniform, Storage, UniformTexel, StorageTexel };
 
 class ComputePipeline {
  public:
-  ComputePipeline(Context& ctx, const std::string& entry, const std::vector<Binding>& bindings,
-                  std::uint32_t pushConstantBytes, const std::vector<ShaderDefine>& defines = {});
+  ComputePipeline(Context& ctx, const std::string& entry, const std::vector<Binding>& bindings, std::uint32_t pushConstantBytes,
+                  const std::vector<ShaderDefine>& defines = {});
   ~ComputePipeline();
   ComputePipeline(const ComputePipeline&) = delete;
   ComputePipeline& operator=(const ComputePipeline&) = delete;
@@ -27,8 +27,7 @@ class ComputePipeline {
   void bind(std::uint32_t index, Buffer& buffer, VkFormat format = VK_FORMAT_UNDEFINED);
   // Records bind + push constants + dispatch of `groups` workgroups along x (split over y when
   // it exceeds the device limit; shaders fold gl_WorkGroupID.y back in).
-  void dispatch(VkCommandBuffer cb, std::uint32_t groupsX, std::uint32_t groupsY, const void* push,
-                std::uint32_t pushBytes);
+  void dispatch(VkCommandBuffer cb, std::uint32_t groupsX, std::uint32_t groupsY, const void* push, std::uint32_t pushBytes);
 
   const std::string& name() const { return entry_; }
 

@@ -70,9 +70,8 @@ constexpr glslang::EShTargetLanguageVersion kSpirvTarget = glslang::EShTargetSpv
 constexpr bool kOptimize = true;
 
 std::string compileConfiguration() {
-  return cat("glslang ", GLSLANG_VERSION_MAJOR, ".", GLSLANG_VERSION_MINOR, ".", GLSLANG_VERSION_PATCH, " glsl ",
-             kGlslVersion, " vulkan ", static_cast<int>(kVulkanTarget), " spirv ", static_cast<int>(kSpirvTarget),
-             kOptimize ? " optimized" : " unoptimized");
+  return cat("glslang ", GLSLANG_VERSION_MAJOR, ".", GLSLANG_VERSION_MINOR, ".", GLSLANG_VERSION_PATCH, " glsl ", kGlslVersion, " vulkan ",
+             static_cast<int>(kVulkanTarget), " spirv ", static_cast<int>(kSpirvTarget), kOptimize ? " optimized" : " unoptimized");
 }
 
 }  // namespace
