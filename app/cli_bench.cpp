@@ -120,10 +120,8 @@ std::vector<std::uint64_t> parseCounts(const std::string& text) {
     if (end == std::string::npos) end = text.size();
     std::string item = text.substr(start, end - start);
     std::uint64_t scale = 1;
-    if (!item.empty() && (item.back() == 'k' || item.back() == 'K'))
-      scale = 1000, item.pop_back();
-    else if (!item.empty() && (item.back() == 'M' || item.back() == 'm'))
-      scale = 1000000, item.pop_back();
+    if (!item.empty() && (item.back() == 'k' || item.back() == 'K')) scale = 1000, item.pop_back();
+    else if (!item.empty() && (item.back() == 'M' || item.back() == 'm')) scale = 1000000, item.pop_back();
     std::uint64_t v = 0;
     auto r = std::from_chars(item.data(), item.data() + item.size(), v);
     if (r.ec != std::errc() || r.ptr != item.data() + item.size() || v == 0) return {};

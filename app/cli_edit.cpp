@@ -228,8 +228,7 @@ int runEdit(EditOptions o) {
     if (settledFrame > 0)
       std::printf("settled        %d frames after the last edit (relative RMSE of %dx%d blocks below %.3g from then on)\n",
                   settledFrame - lastEditFrame, block, block, threshold);
-    else
-      std::printf("settled        not within the script (relative RMSE of %dx%d blocks stayed above %.3g)\n", block, block, threshold);
+    else std::printf("settled        not within the script (relative RMSE of %dx%d blocks stayed above %.3g)\n", block, block, threshold);
   }
   std::printf("wrote          %s\n", (outDir / "frames.csv").string().c_str());
   return exact ? 0 : 1;

@@ -342,10 +342,8 @@ void labelMarkers(QChart* chart, const std::vector<Marker>& markers, const Band&
     auto same = std::find_if(groups.begin(), groups.end(), [&](const Group& g) {
       return g.first->reached == m.reached && std::hypot(g.at.x() - at.x(), g.at.y() - at.y()) < 3;
     });
-    if (same != groups.end())
-      same->names += m.label;
-    else
-      groups.push_back({at, {m.label}, &m});
+    if (same != groups.end()) same->names += m.label;
+    else groups.push_back({at, {m.label}, &m});
   }
   std::vector<QGraphicsSimpleTextItem*> items;
   std::vector<LabelRequest> requests;

@@ -147,10 +147,8 @@ void ScrubField::commitTyped() {
   const double clamped = std::clamp(*v, minimum(), maximum());
   if (clamped != *v)
     refuse(tr("%1 is outside %2 to %3: set to %4").arg(typed, textFromValue(minimum()), textFromValue(maximum()), textFromValue(clamped)));
-  if (clamped == value())
-    lineEdit()->setText(prefix() + textFromValue(clamped) + suffix());
-  else
-    setValue(clamped);
+  if (clamped == value()) lineEdit()->setText(prefix() + textFromValue(clamped) + suffix());
+  else setValue(clamped);
 }
 
 void ScrubField::keyPressEvent(QKeyEvent* e) {

@@ -201,10 +201,8 @@ QImage FrameView::composed() const {
 }
 
 void FrameView::refresh() {
-  if (vulkan_)
-    vulkan_->setPicture(composed());
-  else
-    update();
+  if (vulkan_) vulkan_->setPicture(composed());
+  else update();
 }
 
 void FrameView::resizeEvent(QResizeEvent*) {
@@ -550,8 +548,7 @@ void FrameView::drawLegend(QPainter& p) const {
     p.setBrush(Qt::NoBrush);
     p.setPen(QPen(item.color, 2.0));
     switch (item.key) {
-      case K::None:
-        break;
+      case K::None: break;
       case K::Ramp: {
         QLinearGradient g(key.topLeft(), key.topRight());
         for (int s = 0; s <= 4; ++s) {
@@ -562,16 +559,12 @@ void FrameView::drawLegend(QPainter& p) const {
         p.fillRect(key, g);
         break;
       }
-      case K::Outline:
-        p.drawRect(key.adjusted(1, 1, -1, -1));
-        break;
+      case K::Outline: p.drawRect(key.adjusted(1, 1, -1, -1)); break;
       case K::Cross:
         p.drawLine(c - QPointF(6, 0), c + QPointF(6, 0));
         p.drawLine(c - QPointF(0, 6), c + QPointF(0, 6));
         break;
-      case K::Circle:
-        p.drawEllipse(c, 5.5, 5.5);
-        break;
+      case K::Circle: p.drawEllipse(c, 5.5, 5.5); break;
       case K::Hatch:
       case K::CrossHatch:
         p.fillRect(key, QBrush(item.color, item.key == K::Hatch ? Qt::BDiagPattern : Qt::DiagCrossPattern));
@@ -727,21 +720,11 @@ void FrameView::mouseMoveEvent(QMouseEvent* e) {
       if (r.width() > 0) setWipe((e->position().x() - r.x()) / r.width());
       break;
     }
-    case Drag::Orbit:
-      emit orbitDragged(d);
-      break;
-    case Drag::Pan:
-      emit panDragged(d);
-      break;
-    case Drag::Dolly:
-      emit dollyDragged(-d.y() / 200.0);
-      break;
-    case Drag::Rotate:
-      emit rotateDragged(d.x());
-      break;
-    case Drag::Scale:
-      emit scaleDragged(d.x());
-      break;
+    case Drag::Orbit: emit orbitDragged(d); break;
+    case Drag::Pan: emit panDragged(d); break;
+    case Drag::Dolly: emit dollyDragged(-d.y() / 200.0); break;
+    case Drag::Rotate: emit rotateDragged(d.x()); break;
+    case Drag::Scale: emit scaleDragged(d.x()); break;
     case Drag::Axis: {
       QRectF r = imageRect();
       if (frame_ && r.width() > 0)
@@ -753,8 +736,7 @@ void FrameView::mouseMoveEvent(QMouseEvent* e) {
       if (frame_ && r.width() > 0) emit objectDragged(QPointF(d.x() * frame_->width / r.width(), d.y() * frame_->height / r.height()));
       break;
     }
-    case Drag::None:
-      break;
+    case Drag::None: break;
   }
 }
 

@@ -24,31 +24,21 @@ constexpr qreal kEndDotR = kSocketR - 2;  // inside the socket's ring, which sta
 
 int columnOf(NodeKind k) {
   switch (k) {
-    case NodeKind::Texture:
-      return 0;
-    case NodeKind::Material:
-      return 1;
-    case NodeKind::Object:
-      return 2;
-    default:
-      return 3;
+    case NodeKind::Texture: return 0;
+    case NodeKind::Material: return 1;
+    case NodeKind::Object: return 2;
+    default: return 3;
   }
 }
 
 QColor headerColor(NodeKind k) {
   switch (k) {
-    case NodeKind::Texture:
-      return {176, 112, 40};
-    case NodeKind::Material:
-      return {52, 132, 82};
-    case NodeKind::Object:
-      return {52, 96, 168};
-    case NodeKind::Light:
-      return {168, 148, 36};
-    case NodeKind::Camera:
-      return {118, 80, 160};
-    case NodeKind::Settings:
-      return {92, 92, 104};
+    case NodeKind::Texture: return {176, 112, 40};
+    case NodeKind::Material: return {52, 132, 82};
+    case NodeKind::Object: return {52, 96, 168};
+    case NodeKind::Light: return {168, 148, 36};
+    case NodeKind::Camera: return {118, 80, 160};
+    case NodeKind::Settings: return {92, 92, 104};
   }
   return Qt::gray;
 }
@@ -148,15 +138,13 @@ void GraphNodeItem::paint(QPainter* p, const QStyleOptionGraphicsItem*, QWidget*
 
 QPen linkPen(const QString& input, LinkLook look) {
   switch (look) {
-    case LinkLook::Highlighted:
-      return QPen(socketColor(input).lighter(145), 5);
+    case LinkLook::Highlighted: return QPen(socketColor(input).lighter(145), 5);
     case LinkLook::Faded: {
       QColor c = socketColor(input);
       c.setAlpha(70);
       return QPen(c, 2);
     }
-    case LinkLook::Normal:
-      break;
+    case LinkLook::Normal: break;
   }
   return QPen(socketColor(input), 2.5);
 }

@@ -270,10 +270,8 @@ void MainWindow::buildMenus() {
   connect(recentMenu_, &QMenu::aboutToShow, this, [this] { rebuildRecentMenu(); });
   file->addAction(tr("&Save"), QKeySequence::Save, this, [this] {
     // Imported files (glTF, scene.json) are not overwritten in another format: ask for a .retile.
-    if (file_.empty() || file_.extension() != ".retile")
-      saveAs();
-    else
-      saveTo(file_);
+    if (file_.empty() || file_.extension() != ".retile") saveAs();
+    else saveTo(file_);
   });
   // Spelled out: QKeySequence::SaveAs is empty on desktops without a key theme.
   file->addAction(tr("Save &As..."), QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_S), this, [this] { saveAs(); });
@@ -438,10 +436,8 @@ QTreeWidget* MainWindow::buildOutliner() {
     auto kind = static_cast<PropertyTarget::Kind>(items[0]->data(0, kKindRole).toInt());
     if (kind == PropertyTarget::Kind::Object) {
       if (!ok || !id || !doc_.scene().object(static_cast<NodeId>(id))) return;
-      if (id != selection_ || selected_.size() > 1)
-        select(static_cast<NodeId>(id));  // a plain click ends a multi-selection
-      else
-        panel_->setTarget({PropertyTarget::Kind::Object, static_cast<NodeId>(id)});  // back from the camera, say
+      if (id != selection_ || selected_.size() > 1) select(static_cast<NodeId>(id));    // a plain click ends a multi-selection
+      else panel_->setTarget({PropertyTarget::Kind::Object, static_cast<NodeId>(id)});  // back from the camera, say
     } else if (kind != PropertyTarget::Kind::None) {
       panel_->setTarget({kind, static_cast<NodeId>(id)});
     }
@@ -850,16 +846,12 @@ void MainWindow::applySelection() {
   engine_->submit(SelectCommand{selection_});
   if (graph_) {
     graph_->followSelection(selected_);
-    if (selected_.size() > 1)
-      graph_->selectNodes(selected_);
-    else
-      graph_->setSelectedObject(selection_);
+    if (selected_.size() > 1) graph_->selectNodes(selected_);
+    else graph_->setSelectedObject(selection_);
   }
   updateGizmo();
-  if (selection_ != kNoNode)
-    panel_->setTarget({PropertyTarget::Kind::Object, selection_});
-  else if (panel_->target().kind == PropertyTarget::Kind::Object)
-    panel_->setTarget({});
+  if (selection_ != kNoNode) panel_->setTarget({PropertyTarget::Kind::Object, selection_});
+  else if (panel_->target().kind == PropertyTarget::Kind::Object) panel_->setTarget({});
   {
     QSignalBlocker block(outliner_);
     outliner_->clearSelection();
@@ -974,18 +966,10 @@ void MainWindow::notify(const QString& text) {
 void MainWindow::showTool() {
   QString name;
   switch (view_->tool()) {
-    case FrameView::Tool::Select:
-      name = tr("Select (Q): click picks");
-      break;
-    case FrameView::Tool::Move:
-      name = tr("Move (W): drag the selection or an arrow");
-      break;
-    case FrameView::Tool::Rotate:
-      name = tr("Rotate (E): drag turns about the selection's centre");
-      break;
-    case FrameView::Tool::Scale:
-      name = tr("Scale (R): drag scales about the selection's centre");
-      break;
+    case FrameView::Tool::Select: name = tr("Select (Q): click picks"); break;
+    case FrameView::Tool::Move: name = tr("Move (W): drag the selection or an arrow"); break;
+    case FrameView::Tool::Rotate: name = tr("Rotate (E): drag turns about the selection's centre"); break;
+    case FrameView::Tool::Scale: name = tr("Scale (R): drag scales about the selection's centre"); break;
   }
   toolLabel_->setText(tr("Tool: %1").arg(name));
 }
@@ -1046,10 +1030,8 @@ void MainWindow::closeEvent(QCloseEvent* e) {
 
 void MainWindow::keyPressEvent(QKeyEvent* e) {
   if (e->key() == Qt::Key_F && !(e->modifiers() & Qt::ControlModifier)) {
-    if (graph_ && graph_->mouseOver())
-      graph_->frameSelected();  // the panel under the mouse
-    else
-      frameSelected();
+    if (graph_ && graph_->mouseOver()) graph_->frameSelected();  // the panel under the mouse
+    else frameSelected();
     return;
   }
   QMainWindow::keyPressEvent(e);

@@ -121,12 +121,9 @@ void NodeGraphView::updateScopeBar() {
   showSelection_->setChecked(scope_ == Scope::Selection);
   showAll_->setChecked(scope_ == Scope::All);
   QString note;
-  if (scope_ == Scope::Selection && roots_.empty())
-    note = tr("nothing selected: every node");
-  else if (focused() && roots_.size() == 1)
-    note = tr("%1 and its material").arg(nameOf(scene_, roots_.front()));
-  else if (focused())
-    note = tr("%n objects and their materials", nullptr, static_cast<int>(roots_.size()));
+  if (scope_ == Scope::Selection && roots_.empty()) note = tr("nothing selected: every node");
+  else if (focused() && roots_.size() == 1) note = tr("%1 and its material").arg(nameOf(scene_, roots_.front()));
+  else if (focused()) note = tr("%n objects and their materials", nullptr, static_cast<int>(roots_.size()));
   scopeNote_->setText(note);
   scopeNote_->setVisible(!note.isEmpty());
   scopeBar_->adjustSize();
@@ -228,15 +225,9 @@ std::vector<GraphNodeItem*> NodeGraphView::addNodes() {
     if (!all && !shown_.count(t.id)) continue;
     QString sub;
     switch (t.kind) {
-      case TextureKind::File:
-        sub = tr("File: %1").arg(QString::fromStdString(t.path.filename().string()));
-        break;
-      case TextureKind::Embedded:
-        sub = tr("Embedded %1").arg(QString::fromStdString(t.encodedFormat));
-        break;
-      case TextureKind::Checker:
-        sub = tr("Checker %1x%2").arg(t.checkerResU).arg(t.checkerResV);
-        break;
+      case TextureKind::File: sub = tr("File: %1").arg(QString::fromStdString(t.path.filename().string())); break;
+      case TextureKind::Embedded: sub = tr("Embedded %1").arg(QString::fromStdString(t.encodedFormat)); break;
+      case TextureKind::Checker: sub = tr("Checker %1x%2").arg(t.checkerResU).arg(t.checkerResV); break;
     }
     GraphNodeItem* n = add(t.id, NodeKind::Texture, t.name, sub);
     n->output = QStringLiteral("texture");
@@ -567,12 +558,9 @@ bool NodeGraphView::createNode(const QString& type, QPointF scenePos) {
   } else if (type.endsWith(QLatin1String("Light"))) {
     Light l;
     l.id = id;
-    if (type == QLatin1String("Spot Light"))
-      l.type = LightType::Spot;
-    else if (type == QLatin1String("Directional Light"))
-      l.type = LightType::Directional;
-    else if (type != QLatin1String("Point Light"))
-      return false;
+    if (type == QLatin1String("Spot Light")) l.type = LightType::Spot;
+    else if (type == QLatin1String("Directional Light")) l.type = LightType::Directional;
+    else if (type != QLatin1String("Point Light")) return false;
     l.name = uniqueName(scene_.lights, type.toStdString());
     // Above the middle of the scene, where a new light is visible in the default view.
     const Bounds3 bounds = scene_.worldBounds();
@@ -766,10 +754,8 @@ void NodeGraphView::frameSelected() {
   QRectF r;
   for (const auto& [id, n] : nodes_)
     if (n->isSelected()) r |= n->sceneBoundingRect();
-  if (r.isEmpty())
-    frameAll();
-  else
-    frameRect(r, r);
+  if (r.isEmpty()) frameAll();
+  else frameRect(r, r);
 }
 
 void NodeGraphView::frameAll() {
@@ -844,32 +830,21 @@ void NodeGraphView::keyPressEvent(QKeyEvent* e) {
   const auto mods = e->modifiers() & ~Qt::KeypadModifier;
   if (mods == Qt::ControlModifier) {
     switch (e->key()) {
-      case Qt::Key_D:
-        duplicateSelected();
-        return;
-      case Qt::Key_C:
-        copySelected();
-        return;
-      case Qt::Key_V:
-        paste();
-        return;
-      default:
-        break;
+      case Qt::Key_D: duplicateSelected(); return;
+      case Qt::Key_C: copySelected(); return;
+      case Qt::Key_V: paste(); return;
+      default: break;
     }
   } else if (mods == Qt::NoModifier) {
     switch (e->key()) {
       case Qt::Key_F:
       case Qt::Key_A:
         if (!mouseOver()) break;  // the window frames the viewport
-        if (e->key() == Qt::Key_F)
-          frameSelected();
-        else
-          frameAll();
+        if (e->key() == Qt::Key_F) frameSelected();
+        else frameAll();
         return;
       case Qt::Key_Delete:
-      case Qt::Key_Backspace:
-        deleteSelected();
-        return;
+      case Qt::Key_Backspace: deleteSelected(); return;
       case Qt::Key_F2:
         for (NodeId id : selectedNodes())
           if (nodes_.at(id)->deletable()) {
@@ -885,8 +860,7 @@ void NodeGraphView::keyPressEvent(QKeyEvent* e) {
           return;
         }
         break;
-      default:
-        break;
+      default: break;
     }
   }
   QGraphicsView::keyPressEvent(e);
@@ -988,9 +962,7 @@ void NodeGraphView::mouseMoveEvent(QMouseEvent* e) {
   const QPointF sp = mapToScene(e->pos());
   if ((e->pos() - pressPos_).manhattanLength() >= QApplication::startDragDistance()) moved_ = true;
   switch (drag_) {
-    case Drag::None:
-      QGraphicsView::mouseMoveEvent(e);
-      break;
+    case Drag::None: QGraphicsView::mouseMoveEvent(e); break;
     case Drag::Pan: {
       const QPoint d = e->pos() - lastPos_;
       horizontalScrollBar()->setValue(horizontalScrollBar()->value() - d.x());
@@ -1042,11 +1014,8 @@ void NodeGraphView::mouseReleaseEvent(QMouseEvent* e) {
   mouseDown_ = false;
   switch (d) {
     case Drag::None:
-    case Drag::Pan:
-      break;
-    case Drag::Link:
-      finishLinkDrag(mapToScene(e->pos()));
-      break;
+    case Drag::Pan: break;
+    case Drag::Link: finishLinkDrag(mapToScene(e->pos())); break;
     case Drag::Move: {
       // A click (no drag) on one of several selected nodes selects just it.
       if (!moved_ && !(pressModifiers_ & (Qt::ShiftModifier | Qt::ControlModifier)) && nodes_.count(pressedNode_))
@@ -1056,9 +1025,7 @@ void NodeGraphView::mouseReleaseEvent(QMouseEvent* e) {
       if (target) insertDropped(*target);
       break;
     }
-    case Drag::Marquee:
-      marquee_->hide();
-      break;
+    case Drag::Marquee: marquee_->hide(); break;
   }
   if (rootsPending_) followSelection(pendingRoots_);
 }

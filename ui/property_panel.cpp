@@ -240,16 +240,11 @@ bool PropertyPanel::shows(const Edit& e) const {
       return o && (std::holds_alternative<SetMaterial>(e) || std::holds_alternative<RemoveNode>(e)) && id == o->material;
     }
     case K::Material:
-    case K::Light:
-      return id == target_.id;
-    case K::Camera:
-      return std::holds_alternative<SetCamera>(e);
-    case K::Environment:
-      return std::holds_alternative<SetEnvironment>(e);
-    case K::Render:
-      return std::holds_alternative<SetRenderSettings>(e);
-    case K::None:
-      return false;
+    case K::Light: return id == target_.id;
+    case K::Camera: return std::holds_alternative<SetCamera>(e);
+    case K::Environment: return std::holds_alternative<SetEnvironment>(e);
+    case K::Render: return std::holds_alternative<SetRenderSettings>(e);
+    case K::None: return false;
   }
   return false;
 }
@@ -277,17 +272,10 @@ void PropertyPanel::rebuild() {
     case PropertyTarget::Kind::Light:
       if (const Light* l = s.light(target_.id)) buildLight(b, *l);
       break;
-    case PropertyTarget::Kind::Camera:
-      buildCamera(b);
-      break;
-    case PropertyTarget::Kind::Environment:
-      buildEnvironment(b);
-      break;
-    case PropertyTarget::Kind::Render:
-      buildRender(b);
-      break;
-    case PropertyTarget::Kind::None:
-      break;
+    case PropertyTarget::Kind::Camera: buildCamera(b); break;
+    case PropertyTarget::Kind::Environment: buildEnvironment(b); break;
+    case PropertyTarget::Kind::Render: buildRender(b); break;
+    case PropertyTarget::Kind::None: break;
   }
   if (form_->rowCount() == 0)
     form_->addRow(new QLabel(tr("Click an object in the viewport, or anything in the outliner or the node graph."), body_));

@@ -313,11 +313,8 @@ bool VulkanViewport::event(QEvent* e) {
     case QEvent::MouseMove:
     case QEvent::Wheel:
     case QEvent::KeyPress:
-    case QEvent::KeyRelease:
-      QCoreApplication::sendEvent(target_, e);
-      return true;
-    default:
-      return QVulkanWindow::event(e);
+    case QEvent::KeyRelease: QCoreApplication::sendEvent(target_, e); return true;
+    default: return QVulkanWindow::event(e);
   }
 }
 

@@ -101,10 +101,8 @@ TEST(EditorMethod, AMaterialEditServesTheMaterialsObjectsByTheirClasses) {
   auto rank = [&](std::size_t t) { return pass.tilePriority[t] < 0 ? 1e9f : 1.0f - pass.tilePriority[t]; };
   float lastObject = 0, firstOther = 1e9f;
   for (std::size_t t = 0; t < pass.tilePriority.size(); ++t) {
-    if (ofSphere[t] || ofTwin[t])
-      lastObject = std::max(lastObject, rank(t));
-    else if (pass.tileClass[t] == 3)
-      firstOther = std::min(firstOther, rank(t));
+    if (ofSphere[t] || ofTwin[t]) lastObject = std::max(lastObject, rank(t));
+    else if (pass.tileClass[t] == 3) firstOther = std::min(firstOther, rank(t));
   }
   EXPECT_LT(lastObject, firstOther) << "both objects' tiles lead the queue";
 }

@@ -90,10 +90,8 @@ TEST(Denoise, RemovesMostNoiseAtFourSamplesAndNothingOnceConverged) {
       for (float v : den.display) ASSERT_TRUE(std::isfinite(v));
       double eRaw = clampedRmse(den.color, ref.color), eDen = clampedRmse(den.display, ref.color);
       std::printf("%s at %d spp: raw %.5f, denoised %.5f (%.2f)\n", c.name, spp, eRaw, eDen, eDen / eRaw);
-      if (spp == 4)
-        EXPECT_LE(eDen, c.atFour * eRaw);
-      else
-        EXPECT_LE(eDen, 1.1 * eRaw) << "no lasting blur";
+      if (spp == 4) EXPECT_LE(eDen, c.atFour * eRaw);
+      else EXPECT_LE(eDen, 1.1 * eRaw) << "no lasting blur";
     }
   }
 }

@@ -767,10 +767,8 @@ TEST(KnownAnswer, MinBouncesLeaveOutTheLightOfShorterPaths) {
       RenderImage img = renderScene(*r, s, 1024);
       double expected = minBounces > bounces ? 0.0 : le * (std::pow(rho, minBounces) - std::pow(rho, bounces + 1)) / (1 - rho);
       double mean = test::meanLuminance(img, 0, 0, 16, 16);
-      if (expected == 0)
-        EXPECT_EQ(mean, 0.0);
-      else
-        EXPECT_NEAR(mean, expected, expected * 0.015) << "expected " << expected;
+      if (expected == 0) EXPECT_EQ(mean, 0.0);
+      else EXPECT_NEAR(mean, expected, expected * 0.015) << "expected " << expected;
     }
   }
 }
@@ -861,10 +859,8 @@ TEST(KnownAnswer, TungstensRaysSkipWhatLiesWithinItsEpsilon) {
     const double mean = meanOver(img, floor, &n);
     ASSERT_EQ(n, 16 * 16) << "the camera sees the floor alone";
     // Robust: only the rare ray that grazes out past the lid's edge, 5 units away.
-    if (offset == RayOffset::Robust)
-      EXPECT_LT(mean, 1e-6) << "no light gets under the lid";
-    else
-      EXPECT_NEAR(mean, 0.6, 0.01);
+    if (offset == RayOffset::Robust) EXPECT_LT(mean, 1e-6) << "no light gets under the lid";
+    else EXPECT_NEAR(mean, 0.6, 0.01);
   }
 }
 
@@ -923,10 +919,8 @@ TEST(KnownAnswer, AnObjectHitFromTheFrontOnlyIsPassedFromBehind) {
     s.camera.target = {2, 0, 1};
     s.camera.up = {0, 0, -1};
     s.camera.verticalFov = radians(20.0f);
-    if (first)
-      r->setScene(s);
-    else
-      r->updateScene(s, kUpdateInstances | kUpdateLights | kUpdateCamera);  // SetObject's, and SetCamera's
+    if (first) r->setScene(s);
+    else r->updateScene(s, kUpdateInstances | kUpdateLights | kUpdateCamera);  // SetObject's, and SetCamera's
     first = false;
     RenderImage img = r->render(req);
     int n;

@@ -113,10 +113,8 @@ TEST(Import, EverySharedSceneOpensTheSameUnderACommaDecimalLocale) {
     ASSERT_TRUE(comma.active()) << comma.error();
     auto inComma = importScene(scenes / name);
     ASSERT_EQ(inComma.ok(), inC.ok()) << (inComma.ok() ? inC.error() : inComma.error());
-    if (inC.ok())
-      EXPECT_TRUE(nativeSceneToString(inComma->scene) == nativeSceneToString(inC->scene));
-    else
-      EXPECT_EQ(inComma.error(), inC.error());
+    if (inC.ok()) EXPECT_TRUE(nativeSceneToString(inComma->scene) == nativeSceneToString(inC->scene));
+    else EXPECT_EQ(inComma.error(), inC.error());
   }
 }
 

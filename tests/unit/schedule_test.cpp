@@ -161,10 +161,8 @@ TEST(Scheduler, SmoothTransitionCapsStaleSumsAndKeepsTheBudget) {
   s.startPass(spiralOrder(g, 0), 2, 1, true, 4);
   FramePlan p = s.nextFrame();
   for (const auto& c : p.chunks) {
-    if (c.tile == 0)
-      EXPECT_TRUE(c.restart) << "the prioritized tile restarts";
-    else
-      EXPECT_EQ(c.capStale, 4) << "the others keep at most 4 stale samples";
+    if (c.tile == 0) EXPECT_TRUE(c.restart) << "the prioritized tile restarts";
+    else EXPECT_EQ(c.capStale, 4) << "the others keep at most 4 stale samples";
   }
   EXPECT_NEAR(s.tileSamples()[1], 4.0 + 2.0, 1e-9);
 }

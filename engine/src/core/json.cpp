@@ -23,18 +23,12 @@ void Value::set(std::string key, Value value) {
 
 const char* typeName(Value::Type t) {
   switch (t) {
-    case Value::Type::kNull:
-      return "null";
-    case Value::Type::kBool:
-      return "a boolean";
-    case Value::Type::kNumber:
-      return "a number";
-    case Value::Type::kString:
-      return "a string";
-    case Value::Type::kArray:
-      return "an array";
-    case Value::Type::kObject:
-      return "an object";
+    case Value::Type::kNull: return "null";
+    case Value::Type::kBool: return "a boolean";
+    case Value::Type::kNumber: return "a number";
+    case Value::Type::kString: return "a string";
+    case Value::Type::kArray: return "an array";
+    case Value::Type::kObject: return "an object";
   }
   return "?";
 }
@@ -245,14 +239,10 @@ class Parser {
     for (int i = 0; i < 4; ++i) {
       char c = s_[pos_++];
       cp <<= 4;
-      if (c >= '0' && c <= '9')
-        cp |= static_cast<std::uint32_t>(c - '0');
-      else if (c >= 'a' && c <= 'f')
-        cp |= static_cast<std::uint32_t>(c - 'a' + 10);
-      else if (c >= 'A' && c <= 'F')
-        cp |= static_cast<std::uint32_t>(c - 'A' + 10);
-      else
-        return setError("bad hex digit in \\u escape");
+      if (c >= '0' && c <= '9') cp |= static_cast<std::uint32_t>(c - '0');
+      else if (c >= 'a' && c <= 'f') cp |= static_cast<std::uint32_t>(c - 'a' + 10);
+      else if (c >= 'A' && c <= 'F') cp |= static_cast<std::uint32_t>(c - 'A' + 10);
+      else return setError("bad hex digit in \\u escape");
     }
     return true;
   }
@@ -270,30 +260,14 @@ class Parser {
       if (pos_ >= s_.size()) break;
       char e = s_[pos_++];
       switch (e) {
-        case '"':
-          out += '"';
-          break;
-        case '\\':
-          out += '\\';
-          break;
-        case '/':
-          out += '/';
-          break;
-        case 'b':
-          out += '\b';
-          break;
-        case 'f':
-          out += '\f';
-          break;
-        case 'n':
-          out += '\n';
-          break;
-        case 'r':
-          out += '\r';
-          break;
-        case 't':
-          out += '\t';
-          break;
+        case '"': out += '"'; break;
+        case '\\': out += '\\'; break;
+        case '/': out += '/'; break;
+        case 'b': out += '\b'; break;
+        case 'f': out += '\f'; break;
+        case 'n': out += '\n'; break;
+        case 'r': out += '\r'; break;
+        case 't': out += '\t'; break;
         case 'u': {
           std::uint32_t cp = 0;  // set by parseHex4 (a TSan build of GCC 12 cannot tell)
           if (!parseHex4(cp)) return false;
@@ -310,8 +284,7 @@ class Parser {
           appendUtf8(out, cp);
           break;
         }
-        default:
-          return setError(cat("unknown escape '\\", printable(e), "'"));
+        default: return setError(cat("unknown escape '\\", printable(e), "'"));
       }
     }
     return setError("unterminated string");
@@ -327,21 +300,11 @@ void writeString(std::string& out, const std::string& s) {
   out += '"';
   for (unsigned char c : s) {
     switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
       default:
         if (c < 0x20) {
           char buf[8];
@@ -370,21 +333,13 @@ void writeValue(std::string& out, const Value& v, bool pretty, int indent) {
     out.append(static_cast<std::size_t>(n) * 2, ' ');
   };
   switch (v.type()) {
-    case Value::Type::kNull:
-      out += "null";
-      break;
-    case Value::Type::kBool:
-      out += v.asBool() ? "true" : "false";
-      break;
+    case Value::Type::kNull: out += "null"; break;
+    case Value::Type::kBool: out += v.asBool() ? "true" : "false"; break;
     case Value::Type::kNumber:
-      if (std::isfinite(v.asNumber()))
-        numbers::append(out, v.asNumber());
-      else
-        out += "null";
+      if (std::isfinite(v.asNumber())) numbers::append(out, v.asNumber());
+      else out += "null";
       break;
-    case Value::Type::kString:
-      writeString(out, v.asString());
-      break;
+    case Value::Type::kString: writeString(out, v.asString()); break;
     case Value::Type::kArray: {
       const Array& a = v.asArray();
       bool flat = isFlat(v);  // short vectors of numbers stay on one line

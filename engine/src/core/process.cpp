@@ -54,29 +54,14 @@ KeepDenormals::~KeepDenormals() {
 std::string signalDescription(int sig) {
   const char* name = "";
   switch (sig) {
-    case SIGSEGV:
-      name = "SIGSEGV";
-      break;
-    case SIGABRT:
-      name = "SIGABRT";
-      break;
-    case SIGBUS:
-      name = "SIGBUS";
-      break;
-    case SIGFPE:
-      name = "SIGFPE";
-      break;
-    case SIGILL:
-      name = "SIGILL";
-      break;
-    case SIGKILL:
-      name = "SIGKILL";
-      break;
-    case SIGXCPU:
-      name = "SIGXCPU";
-      break;
-    default:
-      break;
+    case SIGSEGV: name = "SIGSEGV"; break;
+    case SIGABRT: name = "SIGABRT"; break;
+    case SIGBUS: name = "SIGBUS"; break;
+    case SIGFPE: name = "SIGFPE"; break;
+    case SIGILL: name = "SIGILL"; break;
+    case SIGKILL: name = "SIGKILL"; break;
+    case SIGXCPU: name = "SIGXCPU"; break;
+    default: break;
   }
   const char* what = strsignal(sig);
   return *name ? cat(name, " (", what ? what : "?", ")") : cat("signal ", sig, " (", what ? what : "?", ")");

@@ -53,16 +53,11 @@ Result<MethodSettings> parseMethodLabel(const std::string& label) {
   }
   if (!methodFromName(parts[0], &m.kind)) return R::failure(cat("unknown method '", parts[0], "' in '", label, "'"));
   for (std::size_t i = 1; i < parts.size(); ++i) {
-    if (parts[i] == "smooth")
-      m.smooth = true;
-    else if (parts[i] == "denoise")
-      m.denoise = true;
-    else if (parts[i] == "reuse")
-      m.reuse = true;
-    else if (parts[i] == "focus" && m.kind == MethodKind::Indirection)
-      m.kind = MethodKind::IndirectionFocus;
-    else
-      return R::failure(cat("unknown option '", parts[i], "' in method '", label, "' (smooth, denoise, reuse)"));
+    if (parts[i] == "smooth") m.smooth = true;
+    else if (parts[i] == "denoise") m.denoise = true;
+    else if (parts[i] == "reuse") m.reuse = true;
+    else if (parts[i] == "focus" && m.kind == MethodKind::Indirection) m.kind = MethodKind::IndirectionFocus;
+    else return R::failure(cat("unknown option '", parts[i], "' in method '", label, "' (smooth, denoise, reuse)"));
   }
   if (m.kind == MethodKind::Indirection || m.kind == MethodKind::IndirectionFocus) m.quality = 0;
   if (std::string bad = validateMethodSettings(m); !bad.empty()) return R::failure(cat(label, ": ", bad));
@@ -582,10 +577,8 @@ Summary summarize(const Run& run, double target) {
   for (const FrameScore& fs : run.frames) {
     if (!fs.scored()) continue;
     double e = std::isnan(fs.relRmseAffected) ? fs.relRmse : fs.relRmseAffected;
-    if (!(e <= target))
-      from = nullptr;
-    else if (!from)
-      from = &fs;
+    if (!(e <= target)) from = nullptr;
+    else if (!from) from = &fs;
   }
   if (from) {
     s.framesToTarget = from->frame;

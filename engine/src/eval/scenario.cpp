@@ -184,8 +184,7 @@ Result<StepEdits> stepEdits(const ScenarioStep& step, int frameInStep, const Sce
           (*out.focus)[i].pixel = {(*out.focus)[i].pixel.x * static_cast<float>(scene.settings.width),
                                    (*out.focus)[i].pixel.y * static_cast<float>(scene.settings.height)};
       return out;
-    case K::Wait:
-      return out;
+    case K::Wait: return out;
     case K::Move: {
       const Object* o = step.target.empty() ? scene.object(selection) : objectByName(scene, step.target);
       if (!o)

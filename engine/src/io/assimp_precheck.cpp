@@ -106,10 +106,8 @@ std::vector<std::string> checkObj(const fs::path& file) {
   std::vector<std::string> libraries;
   std::string line;
   while (std::getline(in, line)) {
-    if (startsWithKeyword(line, "mtllib"))
-      libraries.push_back(restOfLine(line, 6));
-    else if (startsWithKeyword(line, "usemtl"))
-      used.insert(restOfLine(line, 6));
+    if (startsWithKeyword(line, "mtllib")) libraries.push_back(restOfLine(line, 6));
+    else if (startsWithKeyword(line, "usemtl")) used.insert(restOfLine(line, 6));
   }
   std::set<std::string, std::less<>> defined;
   for (const auto& lib : libraries) {

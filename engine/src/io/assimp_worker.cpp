@@ -314,20 +314,14 @@ struct Converter {
       l.direction = normalize(world.transformVector({al->mDirection.x, al->mDirection.y, al->mDirection.z}));
       if (length(l.direction) == 0) l.direction = {0, -1, 0};
       switch (al->mType) {
-        case aiLightSource_POINT:
-          l.type = LightType::Point;
-          break;
+        case aiLightSource_POINT: l.type = LightType::Point; break;
         case aiLightSource_SPOT:
           l.type = LightType::Spot;
           l.spotAngle = std::isfinite(al->mAngleOuterCone) ? std::clamp(al->mAngleOuterCone, 0.01f, kPi / 2) : radians(30);
           l.spotBlend = std::isfinite(al->mAngleInnerCone) ? std::clamp(1 - al->mAngleInnerCone / l.spotAngle, 0.0f, 1.0f) : 0.1f;
           break;
-        case aiLightSource_DIRECTIONAL:
-          l.type = LightType::Directional;
-          break;
-        default:
-          warn(cat("light '", l.name, "' is of a type we do not render (area/ambient); skipped"));
-          continue;
+        case aiLightSource_DIRECTIONAL: l.type = LightType::Directional; break;
+        default: warn(cat("light '", l.name, "' is of a type we do not render (area/ambient); skipped")); continue;
       }
       if (!isFinite(l.position) || !isFinite(l.direction)) continue;
       scene.lights.push_back(l);

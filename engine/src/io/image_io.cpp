@@ -199,13 +199,9 @@ Result<TextureImage> loadTexture(const Texture& tex, const fs::path& base, const
     case TextureColorSpace::TungstenGamma:
       if (!dec.isFloat) tungstenGamma(img);
       break;
-    case TextureColorSpace::SRGB:
-      srgb = true;
-      break;
+    case TextureColorSpace::SRGB: srgb = true; break;
     case TextureColorSpace::Linear:
-    case TextureColorSpace::Raw:
-      srgb = false;
-      break;
+    case TextureColorSpace::Raw: srgb = false; break;
     case TextureColorSpace::Auto:
       // Integer data is encoded unless its file says linear: OpenImageIO tags a PPM "Rec709" (the
       // transfer curve of its standard, not linear light), which the sRGB curve decodes closely.

@@ -30,38 +30,27 @@ Value mat4(const Mat4& m) {
 
 const char* colorSpaceName(TextureColorSpace c) {
   switch (c) {
-    case TextureColorSpace::Auto:
-      return "auto";
-    case TextureColorSpace::SRGB:
-      return "srgb";
-    case TextureColorSpace::Linear:
-      return "linear";
-    case TextureColorSpace::Raw:
-      return "raw";
-    case TextureColorSpace::TungstenGamma:
-      return "tungsten_gamma";
+    case TextureColorSpace::Auto: return "auto";
+    case TextureColorSpace::SRGB: return "srgb";
+    case TextureColorSpace::Linear: return "linear";
+    case TextureColorSpace::Raw: return "raw";
+    case TextureColorSpace::TungstenGamma: return "tungsten_gamma";
   }
   return "auto";
 }
 const char* textureKindName(TextureKind k) {
   switch (k) {
-    case TextureKind::File:
-      return "file";
-    case TextureKind::Embedded:
-      return "embedded";
-    case TextureKind::Checker:
-      return "checker";
+    case TextureKind::File: return "file";
+    case TextureKind::Embedded: return "embedded";
+    case TextureKind::Checker: return "checker";
   }
   return "file";
 }
 const char* lightTypeName(LightType t) {
   switch (t) {
-    case LightType::Point:
-      return "point";
-    case LightType::Spot:
-      return "spot";
-    case LightType::Directional:
-      return "directional";
+    case LightType::Point: return "point";
+    case LightType::Spot: return "spot";
+    case LightType::Directional: return "directional";
   }
   return "point";
 }
@@ -378,10 +367,8 @@ template <class E>
 void readConvention(Reader& r, const char* key, const char* ours, E* out) {
   std::string name;
   r.string(key, &name);
-  if (name == "tungsten")
-    *out = E::Tungsten;
-  else if (!name.empty() && name != ours)
-    r.problem(key, cat("unknown ", key, " '", name, "' (", ours, ", tungsten)"));
+  if (name == "tungsten") *out = E::Tungsten;
+  else if (!name.empty() && name != ours) r.problem(key, cat("unknown ", key, " '", name, "' (", ours, ", tungsten)"));
 }
 
 void readSettings(Reader& r, RenderSettings& settings) {
@@ -458,8 +445,7 @@ Texture readTexture(Reader& r, const fs::path& baseDir) {
   r.enumeration("color_space", &t.colorSpace, colorSpaceName, kTextureColorSpaceCount);
   std::string whenMissing;
   r.string("when_missing", &whenMissing);
-  if (whenMissing == "tungsten")
-    t.whenMissing = MissingTexture::Tungsten;
+  if (whenMissing == "tungsten") t.whenMissing = MissingTexture::Tungsten;
   else if (!whenMissing.empty() && whenMissing != "checker")
     r.problem("when_missing", cat("unknown stand-in '", whenMissing, "' (checker, tungsten)"));
   r.boolean("interpolate", &t.interpolate);
@@ -470,12 +456,9 @@ Texture readTexture(Reader& r, const fs::path& baseDir) {
   if (t.kind == TextureKind::File) {
     // Prefer the recorded relative path when it still resolves next to this file.
     std::error_code ec;
-    if (!path.empty() && (fs::path(path).is_absolute() || fs::exists(baseDir / path, ec)))
-      t.path = path;
-    else if (!absolute.empty())
-      t.path = absolute;
-    else
-      t.path = path;
+    if (!path.empty() && (fs::path(path).is_absolute() || fs::exists(baseDir / path, ec))) t.path = path;
+    else if (!absolute.empty()) t.path = absolute;
+    else t.path = path;
   }
   r.string("format", &t.encodedFormat);
   r.blob("data", &t.encoded);
@@ -485,10 +468,8 @@ Texture readTexture(Reader& r, const fs::path& baseDir) {
   r.integer("res_v", &t.checkerResV);
   std::string cells;
   r.string("cells", &cells);
-  if (cells == "tungsten")
-    t.tungstenCells = true;
-  else if (!cells.empty() && cells != "floor")
-    r.problem("cells", cat("unknown cell count '", cells, "' (floor, tungsten)"));
+  if (cells == "tungsten") t.tungstenCells = true;
+  else if (!cells.empty() && cells != "floor") r.problem("cells", cat("unknown cell count '", cells, "' (floor, tungsten)"));
   return t;
 }
 
@@ -502,24 +483,20 @@ Material readMaterial(Reader& r) {
   r.number("roughness", &m.roughness);
   std::string distribution;
   r.string("distribution", &distribution);
-  if (distribution == "beckmann")
-    m.beckmann = true;
+  if (distribution == "beckmann") m.beckmann = true;
   else if (!distribution.empty() && distribution != "ggx")
     r.problem("distribution", cat("unknown distribution '", distribution, "' (ggx, beckmann)"));
   std::string shadowing;
   r.string("shadowing", &shadowing);
-  if (shadowing == "separable")
-    m.separableShadowing = true;
+  if (shadowing == "separable") m.separableShadowing = true;
   else if (!shadowing.empty() && shadowing != "correlated")
     r.problem("shadowing", cat("unknown shadowing '", shadowing, "' (correlated, separable)"));
   r.id("roughness_texture", &m.roughnessTexture);
   r.number("ior", &m.ior);
   std::string glass;
   r.string("glass", &glass);
-  if (glass == "tungsten")
-    m.tungstenGlass = true;
-  else if (!glass.empty() && glass != "physical")
-    r.problem("glass", cat("unknown glass convention '", glass, "' (physical, tungsten)"));
+  if (glass == "tungsten") m.tungstenGlass = true;
+  else if (!glass.empty() && glass != "physical") r.problem("glass", cat("unknown glass convention '", glass, "' (physical, tungsten)"));
   r.vec3("coating_absorption", &m.coatingAbsorption);
   r.number("film_thickness", &m.filmThickness);
   r.number("hair_tilt", &m.hairTilt);

@@ -11,10 +11,8 @@ void TungstenImporter::underAlbedo(Material& p, const TextureRef& albedo, int de
   if (albedo.constant == Vec3{1.0f} && !albedo.isTexture) return;  // nothing changes: shared as it is
   Material copy = *next;
   copied_.insert(next->id);
-  if (depth + 2 < kMaxBlendChain)
-    underAlbedo(copy, albedo, depth + 1);
-  else
-    copy.blendWith = kNoNode;
+  if (depth + 2 < kMaxBlendChain) underAlbedo(copy, albedo, depth + 1);
+  else copy.blendWith = kNoNode;
   copy.id = out_.scene.newId();
   out_.scene.materials.push_back(copy);
   p.blendWith = copy.id;
@@ -495,10 +493,8 @@ std::optional<TungstenImporter::Filling> TungstenImporter::mediumFilling(const V
   float density = 1;
   const Value *a = medium.find("sigma_a"), *sc = medium.find("sigma_s"), *d = medium.find("density");
   const std::string type = string(medium, "type");
-  if (type != "homogeneous")
-    *why = cat("a ", type.empty() ? "medium of no type" : cat(type, " medium"), "; only homogeneous ones are");
-  else if (!exponentialTransmittance(medium.find("transmittance")))
-    *why = "a non-exponential transmittance";
+  if (type != "homogeneous") *why = cat("a ", type.empty() ? "medium of no type" : cat(type, " medium"), "; only homogeneous ones are");
+  else if (!exponentialTransmittance(medium.find("transmittance"))) *why = "a non-exponential transmittance";
   else if (!((!a || json::toVec3(*a, &sigmaA)) && (!sc || json::toVec3(*sc, &sigmaS)) && (!d || json::toFloat(*d, &density))))
     *why = "sigma_a, sigma_s or density is not a number";
   if (!why->empty()) return std::nullopt;

@@ -79,10 +79,8 @@ Result<ImportedScene> TungstenImporter::run() {
       const std::string name = string(medium, "name", "?");
       mediaNamed_.insert(name);
       std::string why;
-      if (auto filling = mediumFilling(medium, name, &why))
-        media_[name] = *filling;
-      else
-        warn(cat("media: '", name, "' is not rendered (", why, "); light travels through it as through a vacuum"));
+      if (auto filling = mediumFilling(medium, name, &why)) media_[name] = *filling;
+      else warn(cat("media: '", name, "' is not rendered (", why, "); light travels through it as through a vacuum"));
     }
   }
   if (const Value* p = root.find("primitives"); p && ok()) {
@@ -269,14 +267,10 @@ Mat4 TungstenImporter::transform(const Value* v, const std::string& where, Vec3*
   }
   // Gram-Schmidt in an order that keeps the explicitly given axes (Tungsten's rules).
   int order[3] = {2, 1, 0};
-  if (given[0] && !given[1] && !given[2])
-    order[0] = 0, order[1] = 2, order[2] = 1;
-  else if (!given[0] && given[1] && !given[2])
-    order[0] = 1, order[1] = 2, order[2] = 0;
-  else if (given[0] && given[1] && !given[2])
-    order[0] = 1, order[1] = 0, order[2] = 2;
-  else if (given[0] && !given[1] && given[2])
-    order[0] = 2, order[1] = 0, order[2] = 1;
+  if (given[0] && !given[1] && !given[2]) order[0] = 0, order[1] = 2, order[2] = 1;
+  else if (!given[0] && given[1] && !given[2]) order[0] = 1, order[1] = 2, order[2] = 0;
+  else if (given[0] && given[1] && !given[2]) order[0] = 1, order[1] = 0, order[2] = 2;
+  else if (given[0] && !given[1] && given[2]) order[0] = 2, order[1] = 0, order[2] = 1;
   Vec3& a = axis[order[0]];
   Vec3& b = axis[order[1]];
   Vec3& c = axis[order[2]];
@@ -288,12 +282,9 @@ Mat4 TungstenImporter::transform(const Value* v, const std::string& where, Vec3*
   c = c - a * dot(a, c) - b * dot(b, c);
   c = length(c) < 1e-6f ? cross(a, b) : normalize(c);
   if (dot(cross(axis[0], axis[1]), axis[2]) < 0) {
-    if (!given[0])
-      axis[0] = -axis[0];
-    else if (!given[1])
-      axis[1] = -axis[1];
-    else
-      axis[2] = -axis[2];
+    if (!given[0]) axis[0] = -axis[0];
+    else if (!given[1]) axis[1] = -axis[1];
+    else axis[2] = -axis[2];
   }
   Mat4 basis;
   for (int col = 0; col < 3; ++col)

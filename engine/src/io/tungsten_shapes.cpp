@@ -88,18 +88,12 @@ std::shared_ptr<const MeshGeometry> TungstenImporter::shape(const std::string& k
   auto it = shapes_.find(kind);
   if (it != shapes_.end()) return it->second;
   std::shared_ptr<const MeshGeometry> g;
-  if (kind == "quad")
-    g = tungstenQuad();
-  else if (kind == "cube")
-    g = tungstenCube();
-  else if (kind == "sphere")
-    g = withArea(tungstenSphere(), 4 * kPi);
-  else if (kind == "disk")
-    g = withArea(tungstenDisk(64), kPi);
-  else if (kind == "cylinder")
-    g = tungstenCylinder(true);
-  else if (kind == "open cylinder")
-    g = tungstenCylinder(false);
+  if (kind == "quad") g = tungstenQuad();
+  else if (kind == "cube") g = tungstenCube();
+  else if (kind == "sphere") g = withArea(tungstenSphere(), 4 * kPi);
+  else if (kind == "disk") g = withArea(tungstenDisk(64), kPi);
+  else if (kind == "cylinder") g = tungstenCylinder(true);
+  else if (kind == "open cylinder") g = tungstenCylinder(false);
   shapes_[kind] = g;
   return g;
 }
@@ -275,24 +269,18 @@ std::vector<TungstenImporter::MeshPart> TungstenImporter::loadMesh(const Value& 
   Result<MeshGeometry> g = Result<MeshGeometry>::failure("");
   std::vector<std::int32_t> materials;  // per triangle, wo3 only
   std::string ext = extensionLower(*path);
-  if (ext == "obj")
-    g = readObjGeometry(*path, &warnings, options_);
-  else if (ext == "wo3")
-    g = readWo3(*path, &materials);
-  else
-    g = Result<MeshGeometry>::failure(cat(path->string(), ": unsupported mesh format '.", ext, "' (obj or wo3)"));
+  if (ext == "obj") g = readObjGeometry(*path, &warnings, options_);
+  else if (ext == "wo3") g = readWo3(*path, &materials);
+  else g = Result<MeshGeometry>::failure(cat(path->string(), ": unsupported mesh format '.", ext, "' (obj or wo3)"));
   for (auto& w : warnings) out_.warnings.push_back(w);
   if (!g) {
     warn(cat(where, ": ", g.error(), "; the primitive is skipped"));
     return {};
   }
   MeshGeometry geom = std::move(g.value());
-  if (!smooth)
-    geom.normals.clear();  // flat shading
-  else if (recompute)
-    creasedNormals(geom);  // across the parts' seams
-  else if (geom.normals.empty())
-    smoothNormals(geom);
+  if (!smooth) geom.normals.clear();         // flat shading
+  else if (recompute) creasedNormals(geom);  // across the parts' seams
+  else if (geom.normals.empty()) smoothNormals(geom);
   const std::string name = fs::path(f).stem().string();
   std::vector<MeshPart> parts;
   if (!split || materials.size() * 3 != geom.indices.size() ||
@@ -450,10 +438,8 @@ void TungstenImporter::sphereCap(const Value& p, const std::string& where, const
   // Tied to a skydome (Tungsten's InfiniteSphereCap::prepareForRender): the cap is the dome's
   // sun, around the dome's +y, whatever the cap's own transform says.
   if (std::string dome = string(p, "skydome"); !dome.empty() && primitives_) {
-    if (std::optional<Mat4> d = transformOfPrimitive(*primitives_, dome))
-      m = *d;
-    else
-      warn(cat(where, ": skydome '", dome, "' names no primitive; the cap keeps its own direction"));
+    if (std::optional<Mat4> d = transformOfPrimitive(*primitives_, dome)) m = *d;
+    else warn(cat(where, ": skydome '", dome, "' names no primitive; the cap keeps its own direction"));
   }
   float cap = 10;
   number(p, "cap_angle", &cap, where);

@@ -190,38 +190,20 @@ std::size_t cutPieces(const std::vector<BuildNode>& bn, std::int32_t n, std::uin
   // Opens node i: its two children, or a failed cut when it is a leaf.
   auto open = [&](std::int32_t i, auto&& then) {
     const BuildNode& b = bn[static_cast<std::size_t>(i)];
-    if (b.left < 0)
-      exists = false;
-    else
-      then(b.left, b.right);
+    if (b.left < 0) exists = false;
+    else then(b.left, b.right);
   };
   open(n, [&](std::int32_t l, std::int32_t r) {
     auto both = [&](std::int32_t a, std::int32_t b) { put(a), put(b); };
     switch (id) {
-      case 0:
-        put(l), put(r);
-        break;
-      case 1:
-        open(l, both), put(r);
-        break;
-      case 2:
-        put(l), open(r, both);
-        break;
-      case 3:
-        open(l, both), open(r, both);
-        break;
-      case 4:
-        open(l, [&](std::int32_t a, std::int32_t b) { open(a, both), put(b); }), put(r);
-        break;
-      case 5:
-        open(l, [&](std::int32_t a, std::int32_t b) { put(a), open(b, both); }), put(r);
-        break;
-      case 6:
-        put(l), open(r, [&](std::int32_t a, std::int32_t b) { open(a, both), put(b); });
-        break;
-      default:
-        put(l), open(r, [&](std::int32_t a, std::int32_t b) { put(a), open(b, both); });
-        break;
+      case 0: put(l), put(r); break;
+      case 1: open(l, both), put(r); break;
+      case 2: put(l), open(r, both); break;
+      case 3: open(l, both), open(r, both); break;
+      case 4: open(l, [&](std::int32_t a, std::int32_t b) { open(a, both), put(b); }), put(r); break;
+      case 5: open(l, [&](std::int32_t a, std::int32_t b) { put(a), open(b, both); }), put(r); break;
+      case 6: put(l), open(r, [&](std::int32_t a, std::int32_t b) { open(a, both), put(b); }); break;
+      default: put(l), open(r, [&](std::int32_t a, std::int32_t b) { put(a), open(b, both); }); break;
     }
   });
   return exists ? count : 0;
@@ -319,10 +301,8 @@ Bvh buildBvh(std::span<const Bounds3> primBounds, const BvhBuildOptions& options
   for (std::size_t k = 0; k < behind.size(); ++k) {
     std::array<std::int32_t, kBvhWidth> kids{};
     std::size_t count = 0;
-    if (k == 0 && plan.leaf[0])
-      kids[count++] = 0;  // the root is a leaf
-    else
-      count = cutPieces(bn, static_cast<std::int32_t>(behind[k]), plan.cut[behind[k]], kids);
+    if (k == 0 && plan.leaf[0]) kids[count++] = 0;  // the root is a leaf
+    else count = cutPieces(bn, static_cast<std::int32_t>(behind[k]), plan.cut[behind[k]], kids);
     auto isLeaf = [&](std::int32_t kid) { return plan.leaf[static_cast<std::size_t>(kid)] != 0; };
     // Inner children first, then leaves (render/bvh.h BvhNode).
     std::stable_partition(kids.begin(), kids.begin() + static_cast<std::ptrdiff_t>(count), [&](std::int32_t kid) { return !isLeaf(kid); });
@@ -497,10 +477,8 @@ std::array<int, kBvhWidth> childRanks(const float (&near)[kBvhWidth]) {
   std::array<int, kBvhWidth> rank{};
   for (int i = 0; i < kBvhWidth; ++i)
     for (int j = i + 1; j < kBvhWidth; ++j) {
-      if (near[j] <= near[i])
-        ++rank[static_cast<std::size_t>(i)];
-      else
-        ++rank[static_cast<std::size_t>(j)];
+      if (near[j] <= near[i]) ++rank[static_cast<std::size_t>(i)];
+      else ++rank[static_cast<std::size_t>(j)];
     }
   return rank;
 }

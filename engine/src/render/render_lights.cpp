@@ -111,10 +111,8 @@ void pushLightGroupShape(std::vector<vec4>& out, const vec4* e, const float* pow
     bounds.grow(w0 + Vec3{t[2].x, t[2].y, t[2].z});
     if (!(power[k] > 0)) continue;
     const Vec3 nrm{t[4].x, t[4].y, t[4].z};
-    if (length(normal) == 0)
-      normal = nrm, onPlane = w0;
-    else if (!(dot(normal, nrm) > 1 - 1e-5f))
-      planar = false;
+    if (length(normal) == 0) normal = nrm, onPlane = w0;
+    else if (!(dot(normal, nrm) > 1 - 1e-5f)) planar = false;
   }
   const float radius = bounds.empty() ? 0.0f : 0.5f * length(bounds.extent());
   Vec3 centre = bounds.empty() ? Vec3{0.0f} : bounds.center();
@@ -128,10 +126,8 @@ void pushLightGroupShape(std::vector<vec4>& out, const vec4* e, const float* pow
       if (!(std::abs(dot(normal, v) - offset) <= slack)) planar = false;
   }
   planar = planar && length(normal) > 0;
-  if (planar)
-    centre = centre - normal * (dot(normal, centre) - offset);  // onto the plane, which the kernel measures from it
-  else
-    normal = Vec3{0.0f};
+  if (planar) centre = centre - normal * (dot(normal, centre) - offset);  // onto the plane, which the kernel measures from it
+  else normal = Vec3{0.0f};
   // What it gives a point at distance d is about its radiance times the solid angle of its area
   // (a plane's seen at the plane's cosine, a solid's a quarter of its area, a convex body's mean
   // projection), over d^2.
@@ -314,12 +310,9 @@ void RenderSceneBuilder::packEmitters(const Scene& scene) {
     data_.deltaLights.push_back(v4(intensity, cosInner));
     data_.deltaLights.push_back({0, 0, 0, 0});
     float lum = luminance(intensity);
-    if (type == gpu::kLightPoint)
-      deltaPower_ += 4 * kPi * lum;
-    else if (type == gpu::kLightSpot)
-      deltaPower_ += 2 * kPi * (1 - 0.5f * (cosInner + cosOuter)) * lum;
-    else
-      deltaPower_ += kPi * radius * radius * lum;
+    if (type == gpu::kLightPoint) deltaPower_ += 4 * kPi * lum;
+    else if (type == gpu::kLightSpot) deltaPower_ += 2 * kPi * (1 - 0.5f * (cosInner + cosOuter)) * lum;
+    else deltaPower_ += kPi * radius * radius * lum;
   }
 }
 

@@ -35,8 +35,7 @@ std::string textureSignature(const Texture& t, const std::filesystem::path& base
       return cat("emb|", t.encoded.size(), "|",
                  fnv1a64(std::string_view(reinterpret_cast<const char*>(t.encoded.data()), t.encoded.size())), "|",
                  static_cast<int>(t.colorSpace));
-    case TextureKind::Checker:
-      return "checker";  // analytic: nothing decoded to cache
+    case TextureKind::Checker: return "checker";  // analytic: nothing decoded to cache
   }
   return {};
 }

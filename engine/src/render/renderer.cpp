@@ -572,10 +572,8 @@ struct Renderer::Impl {
     lastItems = items;
     const bool compose = options.denoise.compose && options.accumulate;
     if (compose) denoiser.prepare(options.denoise);
-    if (options.accumulate && !items.empty())
-      displayCurrent = compose;
-    else if (compose)
-      displayCurrent = true;
+    if (options.accumulate && !items.empty()) displayCurrent = compose;
+    else if (compose) displayCurrent = true;
 
     const std::uint64_t ticket = nextTicket++;
     Slot& slot = slots_[ticket % 2];

@@ -202,10 +202,8 @@ struct RenderSession::Impl {
           }
         }
       tested[ti] = retile::testReuse(fresh, hist, r.width, r.height, falseRejectRate);
-      if (tested[ti].reject())
-        pendingRejects.push_back(t);
-      else
-        kept.push_back(t);
+      if (tested[ti].reject()) pendingRejects.push_back(t);
+      else kept.push_back(t);
     }
     // Changes too small for one tile: each kept tile pooled with its kept neighbours, then all
     // the kept tiles together (a light a few per cent brighter changes every lit tile a little).
@@ -256,14 +254,9 @@ struct RenderSession::Impl {
 
   void execute(const Plan& p) {
     switch (p.kind) {
-      case PlanKind::None:
-        break;
-      case PlanKind::GlobalUpdate:
-        scheduler.globalUpdate();
-        break;
-      case PlanKind::Probe:
-        scheduler.probe();
-        break;
+      case PlanKind::None: break;
+      case PlanKind::GlobalUpdate: scheduler.globalUpdate(); break;
+      case PlanKind::Probe: scheduler.probe(); break;
       case PlanKind::Pass:
         scheduler.startPass(p.order, p.quality, p.prioritized, p.smooth, p.staleCap);
         ++pass;
@@ -307,18 +300,10 @@ struct RenderSession::Impl {
     for (std::size_t t = 0; t < f.source.size(); ++t) {
       std::uint32_t code = kShowStale;
       switch (f.source[t]) {
-        case TileSource::Stale:
-          code = kShowStale;
-          break;
-        case TileSource::Previous:
-          code = kShowPreviousLayer;
-          break;
-        case TileSource::Fresh:
-          code = kShowFresh;
-          break;
-        case TileSource::Region:
-          code = kShowLayer + static_cast<std::uint32_t>(f.region[t]);
-          break;
+        case TileSource::Stale: code = kShowStale; break;
+        case TileSource::Previous: code = kShowPreviousLayer; break;
+        case TileSource::Fresh: code = kShowFresh; break;
+        case TileSource::Region: code = kShowLayer + static_cast<std::uint32_t>(f.region[t]); break;
       }
       if (f.write[t]) code |= kShowWriteLayer;
       if (f.filtered[t]) code |= kShowFiltered;
@@ -625,10 +610,8 @@ void RenderSession::submitFrame(bool readImage) {
   const int block = d.frameBlock(edited, method().reuse);
   d.syncCounting(scene_);
   std::vector<double> samplesBefore;
-  if (method().reuse)
-    samplesBefore = d.scheduler.tileSamples();
-  else
-    d.scheduler.setCredit({});
+  if (method().reuse) samplesBefore = d.scheduler.tileSamples();
+  else d.scheduler.setCredit({});
   FramePlan plan = d.scheduler.nextFrame(block);
   std::vector<TileWork> work;
   work.reserve(plan.chunks.size());

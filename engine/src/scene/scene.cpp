@@ -9,26 +9,19 @@ namespace retile {
 
 const char* environmentTypeName(EnvironmentType t) {
   switch (t) {
-    case EnvironmentType::Constant:
-      return "constant";
-    case EnvironmentType::Map:
-      return "map";
-    case EnvironmentType::Sky:
-      return "sky";
+    case EnvironmentType::Constant: return "constant";
+    case EnvironmentType::Map: return "map";
+    case EnvironmentType::Sky: return "sky";
   }
   return "constant";
 }
 
 const char* pixelFilterName(PixelFilter f) {
   switch (f) {
-    case PixelFilter::Box:
-      return "box";
-    case PixelFilter::Tent:
-      return "tent";
-    case PixelFilter::Gaussian:
-      return "gaussian";
-    case PixelFilter::BlackmanHarris:
-      return "blackman_harris";
+    case PixelFilter::Box: return "box";
+    case PixelFilter::Tent: return "tent";
+    case PixelFilter::Gaussian: return "gaussian";
+    case PixelFilter::BlackmanHarris: return "blackman_harris";
   }
   return "box";
 }
@@ -44,14 +37,10 @@ bool parsePixelFilter(std::string_view name, PixelFilter* out) {
 
 float defaultFilterWidth(PixelFilter f) {
   switch (f) {
-    case PixelFilter::Box:
-      return 1.0f;
-    case PixelFilter::Tent:
-      return 2.0f;
-    case PixelFilter::Gaussian:
-      return 4.0f;
-    case PixelFilter::BlackmanHarris:
-      return 1.5f;
+    case PixelFilter::Box: return 1.0f;
+    case PixelFilter::Tent: return 2.0f;
+    case PixelFilter::Gaussian: return 4.0f;
+    case PixelFilter::BlackmanHarris: return 1.5f;
   }
   return 1.0f;
 }
@@ -63,12 +52,9 @@ std::vector<float> pixelFilterWarp(PixelFilter f, float width, int segments) {
   auto weight = [&](double x) {
     const double t = x / radius;  // -1..1
     switch (f) {
-      case PixelFilter::Box:
-        return 1.0;
-      case PixelFilter::Tent:
-        return std::max(0.0, 1.0 - std::abs(t));
-      case PixelFilter::Gaussian:
-        return std::exp(-0.5 * (3.0 * t) * (3.0 * t));  // +-3 sigma across the width
+      case PixelFilter::Box: return 1.0;
+      case PixelFilter::Tent: return std::max(0.0, 1.0 - std::abs(t));
+      case PixelFilter::Gaussian: return std::exp(-0.5 * (3.0 * t) * (3.0 * t));  // +-3 sigma across the width
       case PixelFilter::BlackmanHarris: {
         const double a = std::numbers::pi * (t + 1.0);  // 0..2 pi across the width
         return std::max(0.0, 0.35875 - 0.48829 * std::cos(a) + 0.14128 * std::cos(2 * a) - 0.01168 * std::cos(3 * a));

@@ -55,15 +55,11 @@ std::shared_ptr<const MeshGeometry> repairGeometry(const MeshGeometry& g, const 
     bool inRange = true, finite = true;
     for (std::size_t k = 0; k < 3; ++k) {
       std::uint32_t i = g.indices[t + k];
-      if (i >= n)
-        inRange = false;
-      else if (!sane(g.positions[i]))
-        finite = false;
+      if (i >= n) inRange = false;
+      else if (!sane(g.positions[i])) finite = false;
     }
-    if (!inRange)
-      ++badIndex;
-    else if (!finite)
-      ++badVertex;
+    if (!inRange) ++badIndex;
+    else if (!finite) ++badVertex;
     else
       kept.insert(kept.end(), g.indices.begin() + static_cast<std::ptrdiff_t>(t), g.indices.begin() + static_cast<std::ptrdiff_t>(t + 3));
   }

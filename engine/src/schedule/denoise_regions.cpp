@@ -30,12 +30,9 @@ DenoiseFrame DenoiseRegions::describe(bool filter, const TileRect& domain, const
   f.write = written_;
   f.filtered.assign(n, 0);
   for (std::size_t t = 0; t < n; ++t) {
-    if (regionOf_[t] >= 0)
-      f.source[t] = TileSource::Region;
-    else if (t < started.size() && started[t])
-      f.source[t] = TileSource::Fresh;
-    else if (layerValid_[t])
-      f.source[t] = TileSource::Previous;
+    if (regionOf_[t] >= 0) f.source[t] = TileSource::Region;
+    else if (t < started.size() && started[t]) f.source[t] = TileSource::Fresh;
+    else if (layerValid_[t]) f.source[t] = TileSource::Previous;
     f.filtered[t] = filter && (whole_ || (t < started.size() && started[t]));
   }
   return f;

@@ -57,12 +57,9 @@ IndirectionPlan indirectionPlan(const TileGrid& grid, const IndirectionCounts& c
     double refl = at(counts.reflection, t), sh = at(counts.shadow, t);
     double c = std::max(refl, sh);
     TileClass k = TileClass::Rest;
-    if (at(counts.direct, t) > 0 || c > third)
-      k = TileClass::High;
-    else if (c > sixth || sh > twelfth)
-      k = TileClass::Middle;
-    else if (c > twelfth)
-      k = TileClass::Low;
+    if (at(counts.direct, t) > 0 || c > third) k = TileClass::High;
+    else if (c > sixth || sh > twelfth) k = TileClass::Middle;
+    else if (c > twelfth) k = TileClass::Low;
     plan.classes[t] = k;
   }
   for (TileClass k : {TileClass::High, TileClass::Middle, TileClass::Low})

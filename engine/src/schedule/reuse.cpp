@@ -12,10 +12,8 @@ double normalQuantileTwoSided(double p) {
   double lo = 0.0, hi = 40.0;
   for (int i = 0; i < 200; ++i) {
     double mid = 0.5 * (lo + hi);
-    if (std::erfc(mid / std::sqrt(2.0)) > p)
-      lo = mid;
-    else
-      hi = mid;
+    if (std::erfc(mid / std::sqrt(2.0)) > p) lo = mid;
+    else hi = mid;
   }
   return 0.5 * (lo + hi);
 }

@@ -7,14 +7,10 @@ namespace retile {
 
 const char* accumModeName(AccumMode m) {
   switch (m) {
-    case AccumMode::GlobalUpdate:
-      return "global-update";
-    case AccumMode::Incremental:
-      return "incremental";
-    case AccumMode::Refinement:
-      return "refinement";
-    case AccumMode::Probe:
-      return "probe";
+    case AccumMode::GlobalUpdate: return "global-update";
+    case AccumMode::Incremental: return "incremental";
+    case AccumMode::Refinement: return "refinement";
+    case AccumMode::Probe: return "probe";
   }
   return "?";
 }
@@ -143,12 +139,9 @@ void TileScheduler::emit(FramePlan& plan, int tile, TileRect rect, int quality, 
   // Sample indices only grow per tile, so no pixel ever sees the same index twice.
   nextIndex_[t] += static_cast<std::uint32_t>(quality);
   double share = wholeTile ? 1.0 : static_cast<double>(rect.pixels()) / static_cast<double>(grid_.rect(tile).pixels());
-  if (restart)
-    samples_[t] = quality * share;
-  else if (cap > 0)
-    samples_[t] = std::min(samples_[t], static_cast<double>(cap)) + quality * share;
-  else
-    samples_[t] += quality * share;
+  if (restart) samples_[t] = quality * share;
+  else if (cap > 0) samples_[t] = std::min(samples_[t], static_cast<double>(cap)) + quality * share;
+  else samples_[t] += quality * share;
   if (plan.servedTiles.empty() || std::find(plan.servedTiles.begin(), plan.servedTiles.end(), tile) == plan.servedTiles.end())
     plan.servedTiles.push_back(tile);
   plan.chunks.push_back(c);
@@ -211,10 +204,8 @@ std::int64_t TileScheduler::waterFill(FramePlan& plan, std::vector<int> order, s
   double lo = have[static_cast<std::size_t>(order.front())], hi = lo + 1e6;
   for (int i = 0; i < 60; ++i) {
     const double mid = 0.5 * (lo + hi);
-    if (cost(mid) <= budget)
-      lo = mid;
-    else
-      hi = mid;
+    if (cost(mid) <= budget) lo = mid;
+    else hi = mid;
   }
   std::int64_t spent = 0;
   for (int t : order) {

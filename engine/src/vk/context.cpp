@@ -15,8 +15,7 @@ namespace retile::vk {
 const char* resultName(VkResult r) {
   switch (r) {
 #define RETILE_VK_CASE(x) \
-  case x:                 \
-    return #x;
+  case x: return #x;
     RETILE_VK_CASE(VK_SUCCESS)
     RETILE_VK_CASE(VK_NOT_READY)
     RETILE_VK_CASE(VK_TIMEOUT)
@@ -40,8 +39,7 @@ const char* resultName(VkResult r) {
     RETILE_VK_CASE(VK_ERROR_INVALID_EXTERNAL_HANDLE)
     RETILE_VK_CASE(VK_ERROR_FRAGMENTATION)
 #undef RETILE_VK_CASE
-    default:
-      return "VK_ERROR_(unnamed)";
+    default: return "VK_ERROR_(unnamed)";
   }
 }
 
@@ -62,16 +60,11 @@ VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBits
 
 int typeRank(VkPhysicalDeviceType t) {
   switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
-      return 0;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
-      return 1;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
-      return 2;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU:
-      return 3;
-    default:
-      return 4;
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
+    default: return 4;
   }
 }
 

@@ -8,14 +8,10 @@ namespace {
 
 VkDescriptorType descriptorType(Binding b) {
   switch (b) {
-    case Binding::Uniform:
-      return VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-    case Binding::Storage:
-      return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    case Binding::UniformTexel:
-      return VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
-    case Binding::StorageTexel:
-      return VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;
+    case Binding::Uniform: return VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    case Binding::Storage: return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    case Binding::UniformTexel: return VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+    case Binding::StorageTexel: return VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;
   }
   return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 }
