@@ -132,7 +132,7 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
     for (int k = 1; k < kMaxBlendChain; ++k) {
       int partner = floatBitsToInt(texelFetch(uMaterials, shaded * kMaterialTexels + 5).w);
       if (partner < 0) break;
-      float ratio = texelFetch(uMaterials, shaded * kMaterialTexels + 6).w;
+      float ratio = RT_MATERIAL_SCALAR(shaded, blendRatio);
       if (hasFeature(kFeatureTextures)) {
         int ratioTex = floatBitsToInt(texelFetch(uMaterials, shaded * kMaterialTexels + 7).x);
         if (ratioTex >= 0) ratio *= dot(sampleTexture(ratioTex, uv).rgb, vec3(1.0 / 3.0));
@@ -389,7 +389,7 @@ vec3 bumped(vec3 ns, int material, vec4 r0, vec4 r1, vec4 r2, vec3 e1, vec3 e2, 
   vec3 q1, q2;
   vec2 duv1, duv2;
   worldEdges(r0, r1, r2, e1, e2, s0, s1, s2, s3, q1, q2, duv1, duv2);
-  return bumpNormal(ns, q1, q2, duv1, duv2, bump.y * textureSlope(bumpTex, uv));
+  return bumpNormal(ns, q1, q2, duv1, duv2, RT_MATERIAL_SCALAR(material, bumpStrength) * textureSlope(bumpTex, uv));
 }
 
 #if RETILE_SHEET && RETILE_ALPHA_TEST

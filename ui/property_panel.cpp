@@ -325,6 +325,31 @@ void PropertyPanel::buildObject(Builder& b, const Object& o) {
    })->setToolTip(tr("Rays pass through the object's back faces, shadow rays too: a wall seen from behind is not there"));
 }
 
+namespace {
+// What decides which of a material's fields the panel shows: an edit that changes it rebuilds it.
+auto fieldsShown(const Material& m) { return std::tuple{m.type, m.coated(), m.filmThickness > 0, m.emissive(), m.blendWith != kNoNode}; }
+}  // namespace
+
+void PropertyPanel::scalarRows(Builder& b, const Material& m, MaterialPlace place) {
+  const NodeId id = m.id;
+  auto edit = nodeEdit<Material, SetMaterial>(id, [](const Scene& sc, NodeId i) { return sc.material(i); });
+  for (const MaterialScalar& f : kMaterialScalars) {
+    if (f.place != place || !f.appliesTo(m.type)) continue;
+    const QString label = tr(f.label);
+    const QString title = *f.unit ? tr("%1 (%2)").arg(label, tr(f.unit)) : label;
+    ScrubField* row = b.number(title, f.member, m.*f.field, f.lo, f.hi, f.fallback, f.decimals,
+                               [this, id, edit, label, field = f.field](double v, int drag) {
+                                 const Material* cur = scene_().material(id);
+                                 if (!cur) return;
+                                 const auto shown = fieldsShown(*cur);
+                                 edit(label, drag, [v, field](Material& x) { x.*field = static_cast<float>(v); });
+                                 const Material* now = scene_().material(id);
+                                 if (now && fieldsShown(*now) != shown) rebuildLater(drag);
+                               });
+    if (*f.tip) row->setToolTip(tr(f.tip));
+  }
+}
+
 void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   const NodeId id = m.id;
   auto edit = nodeEdit<Material, SetMaterial>(id, [](const Scene& sc, NodeId i) { return sc.material(i); });
@@ -381,23 +406,10 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
       b.choice(tr("Shadowing"), "shadowing", {tr("Height-correlated"), tr("Separable (Tungsten)")}, m.separableShadowing ? 1 : 0,
                [edit](int i) { edit(tr("Shadowing"), 0, [i](Material& x) { x.separableShadowing = i == 1; }); });
   }
-  if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic || m.type == MaterialType::Dielectric ||
-      m.type == MaterialType::RoughDielectric || m.type == MaterialType::ThinSheet) {
-    b.number(tr("IOR"), "ior", m.ior, 1.0, 4.0, defaults.ior, 3,
-             [edit](double v, int drag) { edit(tr("IOR"), drag, [v](Material& x) { x.ior = static_cast<float>(v); }); });
-  }
+  scalarRows(b, m, MaterialPlace::Surface);
   if (!isTransmissiveType(m.type)) {
-    // A clear coat over any opaque type; 0 takes it off.
-    b.number(tr("Coat IOR"), "coatIor", m.coatIor, 0.0, 4.0, defaults.coatIor, 3, [this, id, edit](double v, int drag) {
-      const Material* cur = scene_().material(id);
-      const bool was = cur && cur->coated();
-      edit(tr("Coat IOR"), drag, [v](Material& x) { x.coatIor = static_cast<float>(v); });
-      if (was != (v > 1.0)) rebuildLater(drag);  // the coat's absorption shows only with a coat
-    });
     if (m.coated()) {
-      b.number(tr("Coat roughness"), "coatRoughness", m.coatRoughness, 0.0, 1.0, defaults.coatRoughness, 3, [edit](double v, int drag) {
-        edit(tr("Coat roughness"), drag, [v](Material& x) { x.coatRoughness = static_cast<float>(v); });
-      });
+      scalarRows(b, m, MaterialPlace::Coated);
       b.vec3(
           tr("Coat absorption"), "coatAbsorption", m.coatAbsorption, 0.01,
           [edit](int channel, double v, int drag) {
@@ -411,13 +423,6 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     b.medium<Material>(tr("Interior"), "interior", m, &Material::interiorAbsorption, &Material::interiorScattering,
                        &Material::interiorAnisotropy, edit);
   if (m.type == MaterialType::Boundary) return;  // no surface: no texture, emission, alpha or blend applies
-  if (m.type == MaterialType::Phong)
-    b.number(tr("Diffuse ratio"), "diffuseRatio", m.diffuseRatio, 0.0, 1.0, defaults.diffuseRatio, 3,
-             [edit](double v, int drag) { edit(tr("Diffuse ratio"), drag, [v](Material& x) { x.diffuseRatio = static_cast<float>(v); }); });
-  if (m.type == MaterialType::DiffuseTransmission)
-    b.number(tr("Transmittance"), "transmittance", m.transmittance, 0.0, 1.0, defaults.transmittance, 3, [edit](double v, int drag) {
-      edit(tr("Transmittance"), drag, [v](Material& x) { x.transmittance = static_cast<float>(v); });
-    });
   if (isGlassType(m.type))
     b.choice(tr("Glass"), "glassConvention", {tr("Physical"), tr("Tungsten")}, m.tungstenGlass ? 1 : 0,
              [edit](int i) { edit(tr("Glass"), 0, [i](Material& x) { x.tungstenGlass = i == 1; }); });
@@ -437,21 +442,6 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
           tr("Per unit of the fibre's radius. Eumelanin (brown to black) absorbs about 0.42, 0.70, 1.37 per unit of "
              "concentration, pheomelanin (red to blond) 0.19, 0.40, 1.05"));
   }
-  if (m.type == MaterialType::Hair)
-    b.number(tr("Scale tilt (degrees)"), "hairTilt", m.hairTilt, -45.0, 45.0, defaults.hairTilt, 1,
-             [edit](double v, int drag) { edit(tr("Scale tilt"), drag, [v](Material& x) { x.hairTilt = static_cast<float>(v); }); })
-        ->setToolTip(
-            tr("How far the cuticle's scales lean the highlights along the fibre: the white one towards the tip, the coloured one back"));
-  if (m.type == MaterialType::ThinSheet)
-    b.number(tr("Film thickness (nm)"), "filmThickness", m.filmThickness, 0.0, 5000.0, defaults.filmThickness, 1,
-             [this, id, edit](double v, int drag) {
-               const Material* cur = scene_().material(id);
-               const bool was = cur && cur->filmThickness > 0;
-               edit(tr("Film thickness"), drag, [v](Material& x) { x.filmThickness = static_cast<float>(v); });
-               if (was != (v > 0)) rebuildLater(drag);  // the interference's form shows only with a film
-             })
-        ->setToolTip(
-            tr("Thin-film interference over a film this thick: colours that change with the angle, as on a soap bubble; 0 for none"));
   if (m.type == MaterialType::ThinSheet && m.filmThickness > 0)
     b.choice(tr("Interference"), "interferenceConvention", {tr("Physical"), tr("Tungsten")}, m.tungstenGlass ? 1 : 0, [edit](int i) {
        edit(tr("Interference"), 0, [i](Material& x) { x.tungstenGlass = i == 1; });
@@ -489,10 +479,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     });
     const Texture* tex = scene_().texture(m.*slot.field);
     if (tex && tex->kind == TextureKind::File) texturePath(b, *tex, QString("%1Path").arg(slot.name));
-    if (slot.field == &Material::bumpTexture && tex)
-      b.number(tr("Bump strength"), "bumpStrength", m.bumpStrength, -1e4, 1e4, defaults.bumpStrength, 3, [edit](double v, int drag) {
-        edit(tr("Bump strength"), drag, [v](Material& x) { x.bumpStrength = static_cast<float>(v); });
-      });
+    if (slot.field == &Material::bumpTexture && tex) scalarRows(b, m, MaterialPlace::Bumped);
   }
 
   // Shown as a swatch (the colour, normalised: files give radiance above 1) and a strength, the
@@ -522,13 +509,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     });
     if (was != (v > 0)) rebuildLater(drag);  // the cone shows only while it emits
   });
-  if (m.emissive())
-    b.number(tr("Emission cone half angle"), "emissionCone", m.emissionCone, 0.0, 90.0, defaults.emissionCone, 1,
-             [edit](double v, int drag) { edit(tr("Emission cone"), drag, [v](Material& x) { x.emissionCone = static_cast<float>(v); }); })
-        ->setToolTip(tr("The half-angle about the normal within which the front emits: 90 lights the whole hemisphere, less makes a spot "
-                        "with a hard edge"));
-  b.number(tr("Alpha"), "alpha", m.alpha, 0.0, 1.0, 1.0, 3,
-           [edit](double v, int drag) { edit(tr("Alpha"), drag, [v](Material& x) { x.alpha = static_cast<float>(v); }); });
+  if (m.emissive()) scalarRows(b, m, MaterialPlace::Emissive);
 
   // A blend with another material (Tungsten's mixed bsdf): this one's share, the other's the rest.
   b.nodeChoice(

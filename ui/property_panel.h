@@ -74,6 +74,8 @@ class PropertyPanel : public QScrollArea {
   void cancelPreview();
   void buildObject(Builder& b, const Object& o);
   void buildMaterial(Builder& b, const Material& m);
+  // The rows of kMaterialScalars shown at `place` for m's type, each edited as one undoable step.
+  void scalarRows(Builder& b, const Material& m, MaterialPlace place);
   void buildLight(Builder& b, const Light& l);
   void texturePath(Builder& b, const Texture& t, const QString& objectName);
   void buildCamera(Builder& b);

@@ -431,7 +431,7 @@ vec3 hairEval(Material m, vec3 wo, vec3 wi, out float pdf) {
   float thetaO = asin(sinO), thetaI = asin(sinI);
   float cosD = cos(0.5 * (thetaI - thetaO));
   float phi = atan(dot(wi, x), dot(wi, z));
-  float tilt = m.eta.x;
+  float tilt = radians(m.eta.x);  // degrees (Material::hairTilt)
   float betaR = max(0.5 * PI * m.roughness, 0.04);
   float v[3] = float[3](betaR * betaR, 0.25 * betaR * betaR, 4.0 * betaR * betaR);
   float shift[3] = float[3](-2.0 * tilt, tilt, 4.0 * tilt);
@@ -456,7 +456,7 @@ vec3 hairSample(Material m, vec3 wo, vec3 u) {
   hairFrame(m, wo, T, z, x);
   float sinO = clamp(dot(wo, T), -1.0, 1.0), cosO = sqrt(1.0 - sinO * sinO);
   float thetaO = asin(sinO);
-  float tilt = m.eta.x;
+  float tilt = radians(m.eta.x);  // degrees (Material::hairTilt)
   float betaR = max(0.5 * PI * m.roughness, 0.04);
   vec3 weights = hairLobeWeights(m, cosO, m.hairH);
   int p = u.z < weights.x ? 0 : (u.z < weights.x + weights.y ? 1 : 2);

@@ -216,9 +216,8 @@ float emissionConeCos(int material) { return texelFetch(uMaterials, material * k
 
 bool alphaPasses(int instance, int prim, float u, float v, float rayRandom) {
   int material = instanceMaterial(instance);
-  vec4 m1 = texelFetch(uMaterials, material * kMaterialTexels + 1);
   int alphaTex = floatBitsToInt(texelFetch(uMaterials, material * kMaterialTexels + 4).w);
-  float alpha = m1.z;
+  float alpha = RT_MATERIAL_SCALAR(material, alpha);
   if (alphaTex >= 0) alpha *= sampleAlphaTexture(alphaTex, triangleUv(prim, u, v));
   return hitRandom(rayRandom, prim, 2654435761u) < alpha;
 }

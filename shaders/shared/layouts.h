@@ -22,6 +22,17 @@ RT_CONST(int, kInstanceRecordTexels, 6)  // root item, instance, flags, - | worl
 RT_CONST(int, kTriShadeTexels, 4)   // n0.xyz uv0.x | n1.xyz uv0.y | n2.xyz uv1.x | uv1.y uv2.xy hasNormals
 RT_CONST(int, kInstanceTexels, 5)   // shading: world-to-object rows 0..2 | - triOffset material emitterOffset | objectIndex+1 flags
 RT_CONST(int, kMaterialTexels, 10)   // see render/render_scene.h packMaterial
+#ifndef __cplusplus
+// Where packMaterial writes each scalar field material_fields.h places: texel * 4 + component
+// (C++ reads the same rows as kMaterialScalars).
+#define RETILE_MATERIAL_SCALAR(member, key, def, lo, hi, types, texel, component, label, unit, decimals, place, tip) \
+  const int kMaterialSlot_##member = texel * 4 + component;
+#include "shared/material_fields.h"
+#undef RETILE_MATERIAL_SCALAR
+// A scalar field's value, read from its material's texels (`material` an index).
+#define RT_MATERIAL_SCALAR(material, member) \
+  texelFetch(uMaterials, (material) * kMaterialTexels + kMaterialSlot_##member / 4)[kMaterialSlot_##member % 4]
+#endif
 RT_CONST(int, kMaxBlendChain, 4)    // retile::kMaxBlendChain (scene.h)
 RT_CONST(int, kTextureTexels, 3)    // offset w h kind | on.rgb resU | off.rgb resV
 RT_CONST(int, kEmitterTexels, 5)    // v0.xyz area | e1.xyz instance | e2.xyz triangle | radiance.rgb pick pdf | normal.xyz emission texture

@@ -641,6 +641,36 @@ TEST(Editor, ABoundaryShowsItsMediumAndNoSurface) {
   EXPECT_TRUE(w->scene().material(material)->filled());
 }
 
+// The panel's scalar rows come from the material fields' table: each type shows the rows that
+// apply to it, with the row's range and default, and a value typed there reaches the scene.
+TEST(Editor, EachTypeShowsTheScalarFieldsOfItsRowsWithTheirRanges) {
+  auto w = makeWindow();
+  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  const NodeId material = w->scene().object(sphere)->material;
+  for (int t = 0; t < kMaterialTypeCount; ++t) {
+    const auto mt = static_cast<MaterialType>(t);
+    SCOPED_TRACE(materialTypeName(mt));
+    auto* type = w->findChild<QComboBox*>("materialType");  // each rebuild makes the panel anew
+    ASSERT_TRUE(type);
+    type->setCurrentIndex(t);
+    ASSERT_TRUE(QTest::qWaitFor([&] { return w->scene().material(material)->type == mt; }, 2000));
+    QTest::qWait(50);  // the rebuild the type queues
+    for (const MaterialScalar& f : kMaterialScalars) {
+      if (f.place != MaterialPlace::Surface) continue;
+      auto* field = w->findChild<ScrubField*>(f.member);
+      const bool shown = f.appliesTo(mt);
+      ASSERT_EQ(field != nullptr, shown) << f.member;
+      if (!field) continue;
+      EXPECT_FLOAT_EQ(static_cast<float>(field->minimum()), f.lo) << f.member;
+      EXPECT_FLOAT_EQ(static_cast<float>(field->maximum()), f.hi) << f.member;
+      const double v = f.lo + 0.25 * (f.hi - f.lo);
+      field->setValue(v);
+      EXPECT_NEAR(w->scene().material(material)->*f.field, v, 1e-3 * (f.hi - f.lo)) << f.member;
+    }
+  }
+}
+
 TEST(Editor, AMaterialBlendsWithAnotherFromItsPanel) {
   auto w = makeWindow();
   NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");

@@ -115,15 +115,15 @@ TEST(Validate, ValuesOutsideTheirRangesAreClampedOrReset) {
   const Material& r = s.materials[0];
   EXPECT_EQ(r.albedo, Vec3(0.8f));
   EXPECT_EQ(r.emission, Vec3(0.0f));
-  EXPECT_EQ(r.roughness, 0.5f);
+  EXPECT_EQ(r.roughness, Material{}.roughness);
   EXPECT_EQ(r.ior, 1.5f);
   EXPECT_EQ(r.alpha, 1.0f);
   EXPECT_EQ(r.metal, "Cu");
   EXPECT_EQ(r.emissionCone, 90.0f);
   EXPECT_EQ(s.materials[1].emissionCone, 90.0f);
-  EXPECT_TRUE(mentions(warnings, "material 'Cube': emission cone was 200; now 90"));
+  EXPECT_TRUE(mentions(warnings, "material 'Cube': emission_cone was 200; now 90"));
   EXPECT_EQ(r.hairTilt, -45.0f);
-  EXPECT_TRUE(mentions(warnings, "material 'Cube': hair tilt was -60; now -45"));
+  EXPECT_TRUE(mentions(warnings, "material 'Cube': hair_tilt was -60; now -45"));
   ASSERT_EQ(s.lights.size(), 2u);
   EXPECT_EQ(s.lights[0].name, "Spot");
   EXPECT_LE(s.lights[0].spotAngle, 1.5707964f);

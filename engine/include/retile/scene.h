@@ -6,7 +6,9 @@
 // an object edit never copies vertex data.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -148,14 +150,30 @@ constexpr int kMaxBlendChain = 4;
 // the kernel's sums of extinction times distance would overflow to infinity and then NaN.
 constexpr float kMaxExtinction = 1e6f;
 
+// Where the properties panel shows a material's scalar field (shaders/shared/material_fields.h).
+enum class MaterialPlace {
+  Surface,   // with the type's fields, for the types it applies to
+  Coated,    // while the material has a clear coat
+  Emissive,  // while it emits
+  Bumped,    // beside its bump texture
+  Custom,    // drawn by the panel itself
+};
+
+// Expands a row of shaders/shared/material_fields.h for C++.
+#define RT_TYPE(t) (1u << static_cast<int>(MaterialType::t))
+#define RT_ALL_TYPES ((1u << kMaterialTypeCount) - 1u)
+#define RT_PANEL(p) MaterialPlace::p
+
 struct Material {
   NodeId id = kNoNode;
   std::string name;
   MaterialType type = MaterialType::Lambert;
+  // The scalar fields, each described once by its row in material_fields.h.
+#define RETILE_MATERIAL_SCALAR(member, key, def, ...) float member = static_cast<float>(def);
+#include "shared/material_fields.h"
+#undef RETILE_MATERIAL_SCALAR
   Vec3 albedo{0.8f};
   NodeId albedoTexture = kNoNode;
-  float roughness = 0.1f;  // microfacet alpha for rough types; sigma for Oren-Nayar; hair: its cones' width
-  // (Tungsten's roughness: the R lobe's angular deviation is pi / 2 times it, at least 0.04)
   // Rough types: the microfacet distribution. GGX's long tails are the default; Beckmann for
   // files that ask for it (Tungsten's "distribution": "beckmann"), drawn as Tungsten draws it.
   bool beckmann = false;
@@ -167,7 +185,6 @@ struct Material {
   // there it is its thickness (Tungsten's textured thickness), which scales both its absorption
   // (coatingAbsorption) and its film (filmThickness) point by point.
   NodeId roughnessTexture = kNoNode;
-  float ior = 1.5f;  // dielectric index (plastic coating, glass, thin sheet)
   // Glass as Tungsten has it (its dielectric and rough_dielectric): albedo tints the reflection
   // as well as the transmission, and radiance is not scaled by (n_t / n_i)^2 where it crosses
   // the surface. The two agree on light that passes in and out again; they differ where a path
@@ -181,27 +198,12 @@ struct Material {
   // sheet's, light passing through it dimmed by exp(-a / cos t), t the angle inside the sheet.
   // Hair: its pigment's, per unit of the fibre's radius.
   Vec3 coatingAbsorption{0.0f};
-  // Hair: the angle in degrees by which its cuticle's scales tilt the lobes (Tungsten's
-  // scale_angle): R by -2 of it, TT by 1 and TRT by 4.
-  float hairTilt = 2.0f;
-  // Thin sheets: thin-film interference over a film this many nanometres thick (Tungsten's
-  // enable_interference, over its thickness times 500): the sheet's reflectance then varies by
-  // channel (red, green and blue taken at 650, 510 and 475 nm) and with the angle. 0: none.
-  float filmThickness = 0.0f;
-  float transmittance = 0.5f;  // diffuse transmission: the share of albedo passed through
-  float diffuseRatio = 0.2f;   // Phong: the share of albedo reflected as Lambert (Tungsten's default)
   // A clear coat over this material (Tungsten's smooth_coat): a smooth dielectric layer of index
   // coatIor (0: none) that reflects by Fresnel and through which the material is seen with both
   // directions refracted, dimmed inside by exp(-coatAbsorption (1 / cos + 1 / cos)) (sigma_a
   // times thickness). No light bounces between the coat and what it covers, as in Tungsten.
   // Transmissive types take no coat.
-  float coatIor = 0.0f;
   Vec3 coatAbsorption{0.0f};
-  // Above 0, the coat is rough (Tungsten's rough_coat): its reflection a GGX lobe of this alpha
-  // (Smith's G as the product of both G1, as Tungsten has it), and what is below seen as through
-  // the smooth coat times cos wo / cos wo' (wo toward the viewer, wo' inside), Tungsten's form,
-  // which darkens the base at grazing views and is not reciprocal.
-  float coatRoughness = 0.0f;
   // Glass (dielectric, rough dielectric) or a boundary filled with a homogeneous medium
   // (Tungsten's homogeneous int_medium: its sigma_a and sigma_s times density): per unit of
   // length, what fills it absorbs interiorAbsorption and scatters interiorScattering, by Henyey
@@ -211,7 +213,6 @@ struct Material {
   // third level of nesting is not tracked.
   Vec3 interiorAbsorption{0.0f};
   Vec3 interiorScattering{0.0f};
-  float interiorAnisotropy = 0.0f;
   // Glass or a boundary with a medium that absorbs or scatters.
   bool filled() const {
     return holdsMedium(type) && isFinite(interiorAbsorption) && isFinite(interiorScattering) &&
@@ -224,27 +225,19 @@ struct Material {
   // The front's emitted radiance is emission times emissionStrength: the colour, and a strength
   // that at 0 turns the light off and keeps its colour (importers leave the strength at 1).
   Vec3 emission{0.0f};
-  float emissionStrength = 1.0f;
   Vec3 radiance() const { return emission * emissionStrength; }
   NodeId emissionTexture = kNoNode;  // multiplies emission (glTF's emissiveTexture, Tungsten's textured emission)
-  // The half-angle, in degrees about the front's normal, of the cone the front emits into: 90 is
-  // the whole hemisphere; less, a spot with a hard edge (Tungsten's disk cone_angle). Seen from
-  // outside the cone the emitter is dark, and light samples from there find nothing.
-  float emissionCone = 90.0f;
-  float alpha = 1.0f;             // coverage; < 1 or an alpha texture makes a cut-out
-  NodeId alphaTexture = kNoNode;  // its alpha channel, else the mean of its channels
+  NodeId alphaTexture = kNoNode;     // its alpha channel, else the mean of its channels
   // Tilts the shading normal by the slope of this texture's value (the mean of its channels), as
   // Tungsten's bump maps do (BitmapTexture::derivatives: the difference across two texels); the
   // slope is scaled by bumpStrength.
   NodeId bumpTexture = kNoNode;
-  float bumpStrength = 1.0f;
   // A blend of two materials, as Tungsten's `mixed` bsdf: a surface shades as this material with
   // probability blendRatio and as `blendWith` otherwise, chosen again at every hit, which
   // averages to ratio * this + (1 - ratio) * other. Emission, coverage and bump stay this one's.
   // kNoNode: no blend. The other material's own blend is followed in its turn, kMaxBlendChain
   // materials in all at most: blends of blends, as Tungsten files nest them.
   NodeId blendWith = kNoNode;
-  float blendRatio = 1.0f;
   // Multiplies blendRatio, where the surface is hit, by the mean of this texture's channels, read
   // as data (Tungsten's textured `ratio`, its channels averaged). kNoNode: the ratio is constant.
   NodeId blendRatioTexture = kNoNode;
@@ -267,6 +260,48 @@ struct Material {
   bool emissive() const { return type != MaterialType::Boundary && emissionStrength > 0 && maxComponent(emission) > 0; }
   friend bool operator==(const Material&, const Material&) = default;
 };
+
+// One scalar field of Material, as its row in shaders/shared/material_fields.h describes it. The
+// table is constant: any thread may read it.
+struct MaterialScalar {
+  float Material::*field;
+  const char* member;  // the C++ name; the panel's widget takes it as its object name
+  const char* key;     // in native files
+  float fallback, lo, hi;
+  std::uint32_t types;   // bit per MaterialType
+  int texel, component;  // packed there for its types; -1: by code
+  const char* label;
+  const char* unit;
+  int decimals;
+  MaterialPlace place;
+  const char* tip;
+  bool appliesTo(MaterialType t) const { return (types >> static_cast<int>(t)) & 1u; }
+  bool packed() const { return texel >= 0; }
+  float clamp(float v) const { return std::isfinite(v) ? std::clamp(v, lo, hi) : fallback; }
+};
+
+inline constexpr MaterialScalar kMaterialScalars[] = {
+#define RETILE_MATERIAL_SCALAR(member, key, def, lo, hi, types, texel, component, label, unit, decimals, place, tip) \
+  {&Material::member,                                                                                                \
+   #member,                                                                                                          \
+   key,                                                                                                              \
+   static_cast<float>(def),                                                                                          \
+   static_cast<float>(lo),                                                                                           \
+   static_cast<float>(hi),                                                                                           \
+   types,                                                                                                            \
+   texel,                                                                                                            \
+   component,                                                                                                        \
+   label,                                                                                                            \
+   unit,                                                                                                             \
+   decimals,                                                                                                         \
+   place,                                                                                                            \
+   tip},
+#include "shared/material_fields.h"
+#undef RETILE_MATERIAL_SCALAR
+};
+#undef RT_TYPE
+#undef RT_ALL_TYPES
+#undef RT_PANEL
 
 // Named metals with RGB complex indices of refraction (linear sRGB primaries).
 std::vector<std::string> conductorNames();

@@ -278,40 +278,28 @@ Value materialToJson(const Material& m) {
   v.set("id", m.id);
   v.set("name", m.name);
   v.set("type", materialTypeName(m.type));
+  // A scalar at its default is left out: the reader takes the default for what is not there.
+  const Material defaults;
+  for (const MaterialScalar& f : kMaterialScalars)
+    if (m.*f.field != defaults.*f.field) v.set(f.key, m.*f.field);
   v.set("albedo", json::fromVec3(m.albedo));
   v.set("albedo_texture", m.albedoTexture);
-  v.set("roughness", m.roughness);
   if (m.beckmann) v.set("distribution", "beckmann");
   if (m.separableShadowing) v.set("shadowing", "separable");
   v.set("roughness_texture", m.roughnessTexture);
-  v.set("ior", m.ior);
   if (m.tungstenGlass) v.set("glass", "tungsten");
   v.set("coating_absorption", json::fromVec3(m.coatingAbsorption));
-  if (m.filmThickness != 0) v.set("film_thickness", m.filmThickness);
-  if (m.type == MaterialType::Hair) v.set("hair_tilt", m.hairTilt);
-  v.set("transmittance", m.transmittance);
-  v.set("diffuse_ratio", m.diffuseRatio);
   v.set("interior_absorption", json::fromVec3(m.interiorAbsorption));
   v.set("interior_scattering", json::fromVec3(m.interiorScattering));
-  v.set("interior_anisotropy", m.interiorAnisotropy);
-  if (m.coatIor != 0) {
-    v.set("coat_ior", m.coatIor);
-    v.set("coat_absorption", json::fromVec3(m.coatAbsorption));
-    v.set("coat_roughness", m.coatRoughness);
-  }
+  if (m.coatIor != 0) v.set("coat_absorption", json::fromVec3(m.coatAbsorption));
   v.set("metal", m.metal);
   v.set("eta", json::fromVec3(m.eta));
   v.set("k", json::fromVec3(m.k));
   v.set("emission", json::fromVec3(m.emission));
-  if (m.emissionStrength != 1) v.set("emission_strength", m.emissionStrength);
-  v.set("alpha", m.alpha);
   v.set("alpha_texture", m.alphaTexture);
   v.set("bump_texture", m.bumpTexture);
   v.set("emission_texture", m.emissionTexture);
-  if (m.emissionCone != 90) v.set("emission_cone", m.emissionCone);
-  v.set("bump_strength", m.bumpStrength);
   v.set("blend_with", m.blendWith);
-  v.set("blend_ratio", m.blendRatio);
   v.set("blend_ratio_texture", m.blendRatioTexture);
   return v;
 }
@@ -478,9 +466,9 @@ Material readMaterial(Reader& r) {
   r.id("id", &m.id, true);
   r.string("name", &m.name);
   r.enumeration("type", &m.type, materialName, kMaterialTypeCount);
+  for (const MaterialScalar& f : kMaterialScalars) r.number(f.key, &(m.*f.field));
   r.vec3("albedo", &m.albedo);
   r.id("albedo_texture", &m.albedoTexture);
-  r.number("roughness", &m.roughness);
   std::string distribution;
   r.string("distribution", &distribution);
   if (distribution == "beckmann") m.beckmann = true;
@@ -492,35 +480,22 @@ Material readMaterial(Reader& r) {
   else if (!shadowing.empty() && shadowing != "correlated")
     r.problem("shadowing", cat("unknown shadowing '", shadowing, "' (correlated, separable)"));
   r.id("roughness_texture", &m.roughnessTexture);
-  r.number("ior", &m.ior);
   std::string glass;
   r.string("glass", &glass);
   if (glass == "tungsten") m.tungstenGlass = true;
   else if (!glass.empty() && glass != "physical") r.problem("glass", cat("unknown glass convention '", glass, "' (physical, tungsten)"));
   r.vec3("coating_absorption", &m.coatingAbsorption);
-  r.number("film_thickness", &m.filmThickness);
-  r.number("hair_tilt", &m.hairTilt);
-  r.number("transmittance", &m.transmittance);
-  r.number("diffuse_ratio", &m.diffuseRatio);
   r.vec3("interior_absorption", &m.interiorAbsorption);
   r.vec3("interior_scattering", &m.interiorScattering);
-  r.number("interior_anisotropy", &m.interiorAnisotropy);
-  r.number("coat_ior", &m.coatIor);
   r.vec3("coat_absorption", &m.coatAbsorption);
-  r.number("coat_roughness", &m.coatRoughness);
   r.string("metal", &m.metal);
   r.vec3("eta", &m.eta);
   r.vec3("k", &m.k);
   r.vec3("emission", &m.emission);
-  r.number("emission_strength", &m.emissionStrength);
-  r.number("alpha", &m.alpha);
   r.id("alpha_texture", &m.alphaTexture);
   r.id("bump_texture", &m.bumpTexture);
   r.id("emission_texture", &m.emissionTexture);
-  r.number("emission_cone", &m.emissionCone);
-  r.number("bump_strength", &m.bumpStrength);
   r.id("blend_with", &m.blendWith);
-  r.number("blend_ratio", &m.blendRatio);
   r.id("blend_ratio_texture", &m.blendRatioTexture);
   return m;
 }

@@ -19,6 +19,14 @@ inline constexpr std::uint64_t kMaxTexelBytes = static_cast<std::uint64_t>(gpu::
 
 inline vec4 v4(Vec3 v, float w) { return {v.x, v.y, v.z, w}; }
 inline float bitsOf(std::int32_t i) { return std::bit_cast<float>(i); }
+inline float& component(vec4& v, int c) {
+  switch (c) {
+    case 0: return v.x;
+    case 1: return v.y;
+    case 2: return v.z;
+    default: return v.w;
+  }
+}
 inline vec4 ints(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d) { return {bitsOf(a), bitsOf(b), bitsOf(c), bitsOf(d)}; }
 
 // Calls `visit` on `m` and on each material it blends with, as the kernel follows the chain

@@ -60,10 +60,6 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
                                                     int bumpTexture, int emissionTexture, int blendWith, int blendRatioTexture) {
   Vec3 eta = m.eta, k = m.k;
   if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
-  // Hair has no complex index: the slot carries its scales' tilt in radians, and its index is
-  // the fibre's.
-  if (m.type == MaterialType::Hair)
-    eta = Vec3{std::isfinite(m.hairTilt) ? std::clamp(m.hairTilt, -45.0f, 45.0f) * (kPi / 180) : 0.0f, 0.0f, 0.0f};
   const bool rough = isMicrofacet(m.type);
   int type = static_cast<int>(m.type) | (rough && m.beckmann ? gpu::kMatBeckmann : 0) |
              (rough && m.separableShadowing ? gpu::kMatSeparable : 0) |
@@ -72,31 +68,29 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
   if (rough || m.type == MaterialType::Phong) roughness = std::max(roughness, 1e-3f);
   if (m.type == MaterialType::OrenNayar) roughness = std::clamp(m.roughness, 0.0f, kPi / 2);
-  // A thin sheet has no roughness: the slot carries its film's thickness (Material::filmThickness).
-  if (roughnessSlotIsThickness(m.type)) roughness = std::isfinite(m.filmThickness) ? std::clamp(m.filmThickness, 0.0f, 1e5f) : 0.0f;
   float ior = m.type == MaterialType::Hair ? 1.55f : std::clamp(m.ior, 1.0001f, 10.0f);
   const bool coated = coatRendered(m);
   // Diffuse light inside a plastic coating reflects back this fraction at the boundary
   // (Jensen et al.'s polynomial fit of the internal diffuse Fresnel reflectance).
   float fdrInt = -1.4399f / (ior * ior) + 0.7099f / ior + 0.6681f + 0.0636f * ior;
-  // Diffuse transmission and Phong have no coating: the texel carries the transmittance or the
-  // diffuse ratio instead.
-  if (m.type == MaterialType::DiffuseTransmission) fdrInt = std::isfinite(m.transmittance) ? m.transmittance : 0.5f;
-  if (m.type == MaterialType::Phong) fdrInt = std::isfinite(m.diffuseRatio) ? m.diffuseRatio : 0.2f;
-  return {v4(max(m.albedo, Vec3{0.0f}), bitsOf(type)),
-          vec4{roughness, ior, std::clamp(m.alpha, 0.0f, 1.0f), std::clamp(fdrInt, 0.0f, 1.0f)}, v4(eta, bitsOf(albedoTexture)),
-          v4(k, bitsOf(roughnessTexture)), v4(max(m.radiance(), Vec3{0.0f}), bitsOf(alphaTexture)),
-          vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), m.bumpStrength, bitsOf(emissionTexture), bitsOf(blendWith)},
-          v4(max(m.coatingAbsorption, Vec3{0.0f}), std::isfinite(m.blendRatio) ? std::clamp(m.blendRatio, 0.0f, 1.0f) : 1.0f),
-          vec4{bitsOf(blendRatioTexture), coated ? std::min(m.coatIor, 10.0f) : 0.0f, emissionConeCos(m), 0},
-          // The ninth holds the coat or, for glass, which takes no coat, its medium's absorption;
-          // the tenth the medium's scattering and its phase function's asymmetry.
-          v4(coated       ? max(m.coatAbsorption, Vec3{0.0f})
-             : m.filled() ? max(m.interiorAbsorption, Vec3{0.0f})
-                          : Vec3{0.0f},
-             coated && m.coatRoughness > 0 ? std::clamp(m.coatRoughness, 1e-3f, 1.0f) : 0.0f),
-          v4(m.filled() ? max(m.interiorScattering, Vec3{0.0f}) : Vec3{0.0f},
-             std::isfinite(m.interiorAnisotropy) ? std::clamp(m.interiorAnisotropy, -0.99f, 0.99f) : 0.0f)};
+  std::array<vec4, gpu::kMaterialTexels> texels{
+      v4(max(m.albedo, Vec3{0.0f}), bitsOf(type)), vec4{roughness, ior, 0, std::clamp(fdrInt, 0.0f, 1.0f)}, v4(eta, bitsOf(albedoTexture)),
+      v4(k, bitsOf(roughnessTexture)), v4(max(m.radiance(), Vec3{0.0f}), bitsOf(alphaTexture)),
+      vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), 0, bitsOf(emissionTexture), bitsOf(blendWith)},
+      v4(max(m.coatingAbsorption, Vec3{0.0f}), 0),
+      vec4{bitsOf(blendRatioTexture), coated ? std::min(m.coatIor, 10.0f) : 0.0f, emissionConeCos(m), 0},
+      // The ninth holds the coat or, for glass, which takes no coat, its medium's absorption;
+      // the tenth the medium's scattering.
+      v4(coated       ? max(m.coatAbsorption, Vec3{0.0f})
+         : m.filled() ? max(m.interiorAbsorption, Vec3{0.0f})
+                      : Vec3{0.0f},
+         coated && m.coatRoughness > 0 ? std::clamp(m.coatRoughness, 1e-3f, 1.0f) : 0.0f),
+      v4(m.filled() ? max(m.interiorScattering, Vec3{0.0f}) : Vec3{0.0f}, 0)};
+  // The fields material_fields.h places, for the types that have them: after the rest, since a
+  // type-specific field takes a slot another type uses for something else.
+  for (const MaterialScalar& f : kMaterialScalars)
+    if (f.packed() && f.appliesTo(m.type)) component(texels[static_cast<std::size_t>(f.texel)], f.component) = f.clamp(m.*f.field);
+  return texels;
 }
 
 void RenderSceneBuilder::packMaterials(const Scene& scene) {

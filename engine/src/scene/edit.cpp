@@ -30,17 +30,17 @@ std::string checkMedium(Vec3 absorption, Vec3 scattering, float anisotropy) {
 }
 
 std::string checkMaterial(const Scene& s, const Material& m) {
-  if (!isFinite(m.albedo) || !isFinite(m.emission) || !finite(m.emissionStrength) || !isFinite(m.eta) || !isFinite(m.k) ||
-      !isFinite(m.coatingAbsorption) || !isFinite(m.coatAbsorption) || !finite(m.coatIor) || !isFinite(m.interiorAbsorption) ||
-      !isFinite(m.interiorScattering) || !finite(m.interiorAnisotropy) || !finite(m.coatRoughness) || !finite(m.roughness) ||
-      !finite(m.ior) || !finite(m.alpha) || !finite(m.bumpStrength) || !finite(m.blendRatio) || !finite(m.transmittance) ||
-      !finite(m.diffuseRatio) || !finite(m.filmThickness) || !finite(m.emissionCone) || !finite(m.hairTilt))
+  if (!isFinite(m.albedo) || !isFinite(m.emission) || !isFinite(m.eta) || !isFinite(m.k) || !isFinite(m.coatingAbsorption) ||
+      !isFinite(m.coatAbsorption) || !isFinite(m.interiorAbsorption) || !isFinite(m.interiorScattering))
     return cat("material '", m.name, "': a parameter is not a finite number");
+  for (const MaterialScalar& f : kMaterialScalars) {
+    const float v = m.*f.field;
+    if (!finite(v)) return cat("material '", m.name, "': its ", f.key, " is not a finite number");
+    if (v < f.lo || v > f.hi)
+      return cat("material '", m.name, "': its ", f.key, " must be within ", f.lo, "..", f.hi, *f.unit ? " " : "", f.unit);
+  }
   if (auto why = checkMedium(m.interiorAbsorption, m.interiorScattering, m.interiorAnisotropy); !why.empty())
     return cat("material '", m.name, "': ", why);
-  if (m.emissionStrength < 0) return cat("material '", m.name, "': its emission strength must not be negative");
-  if (m.emissionCone < 0 || m.emissionCone > 90) return cat("material '", m.name, "': its emission cone must be within 0..90 degrees");
-  if (std::abs(m.hairTilt) > 45) return cat("material '", m.name, "': its hair tilt must be within -45..45 degrees");
   if (m.blendWith != kNoNode && (m.blendWith == m.id || !s.material(m.blendWith)))
     return cat("material '", m.name, "': it cannot blend with material ", m.blendWith);
   for (NodeId t : m.textures())

@@ -140,27 +140,15 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
 
   for (Material& m : scene.materials) {
     const std::string what = cat("material '", m.name, "'");
+    for (const MaterialScalar& f : kMaterialScalars) clampValue(m.*f.field, f.lo, f.hi, f.fallback, cat(what, ": ", f.key), warnings);
+    // Only Oren-Nayar's sigma goes past 1.
+    if (m.type != MaterialType::OrenNayar) clampValue(m.roughness, 0.0f, 1.0f, 0.1f, what + ": roughness", warnings);
     checkColor(m.albedo, Vec3{0.8f}, what + ": albedo", warnings);
     checkColor(m.emission, Vec3{0.0f}, what + ": emission", warnings);
-    clampValue(m.emissionStrength, 0.0f, 1e6f, 1.0f, what + ": emission strength", warnings);
     checkColor(m.coatingAbsorption, Vec3{0.0f}, what + ": coating absorption", warnings);
-    clampValue(m.roughness, 0.0f, m.type == MaterialType::OrenNayar ? 1.6f : 1.0f, 0.5f, what + ": roughness", warnings);
-    // Below 1 is an interface seen from the denser side (water to air), which scenes do use.
-    clampValue(m.ior, 0.1f, 10.0f, 1.5f, what + ": index of refraction", warnings);
-    clampValue(m.alpha, 0.0f, 1.0f, 1.0f, what + ": coverage", warnings);
-    clampValue(m.bumpStrength, -1e4f, 1e4f, 1.0f, what + ": bump strength", warnings);
-    clampValue(m.blendRatio, 0.0f, 1.0f, 1.0f, what + ": blend ratio", warnings);
-    clampValue(m.transmittance, 0.0f, 1.0f, 0.5f, what + ": transmittance", warnings);
-    clampValue(m.diffuseRatio, 0.0f, 1.0f, 0.2f, what + ": diffuse ratio", warnings);
-    clampValue(m.filmThickness, 0.0f, 1e5f, 0.0f, what + ": film thickness", warnings);
-    clampValue(m.emissionCone, 0.0f, 90.0f, 90.0f, what + ": emission cone", warnings);
-    clampValue(m.hairTilt, -45.0f, 45.0f, 2.0f, what + ": hair tilt", warnings);
-    clampValue(m.coatIor, 0.0f, 10.0f, 0.0f, what + ": coat index of refraction", warnings);
     checkColor(m.coatAbsorption, Vec3{0.0f}, what + ": coat absorption", warnings);
-    clampValue(m.coatRoughness, 0.0f, 1.0f, 0.0f, what + ": coat roughness", warnings);
     checkMedium(m.interiorAbsorption, what + ": interior absorption", warnings);
     checkMedium(m.interiorScattering, what + ": interior scattering", warnings);
-    clampValue(m.interiorAnisotropy, -0.99f, 0.99f, 0.0f, what + ": interior anisotropy", warnings);
     if (!finiteNonNegative(m.eta) || !finiteNonNegative(m.k)) {
       warnings.push_back(cat(what, ": its complex index of refraction is negative or not finite; copper instead"));
       m.metal = "Cu";
