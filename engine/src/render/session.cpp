@@ -11,6 +11,7 @@
 #include "schedule/planner.h"
 #include "schedule/policies.h"
 #include "schedule/reuse.h"
+#include "schedule/reuse_tracker.h"
 #include "schedule/scheduler.h"
 
 namespace retile {
@@ -79,17 +80,9 @@ struct RenderSession::Impl {
   std::shared_ptr<const RenderImage> lastImage;
   std::uint64_t lastImageFrame = 0;  // the frame lastImage shows the accumulation after
   RegionRect region;                 // the render region in pixels (empty: the whole image)
-  // Verified reuse, per tile: its state, the frame of its last restart with reuse (a test of
-  // samples read back before it is about the previous edit and is ignored) and of its rejection;
-  // tiles the last read-back rejected, applied with the next frame.
-  std::vector<TileReuse> reuse;
-  std::vector<std::uint64_t> reuseStarted, reuseRejectedAt;
-  std::vector<int> pendingRejects;
-  std::uint64_t pass = 0;                // counts the passes started (execute)
-  std::vector<std::uint64_t> reusePass;  // per tile: the pass that last started its history
-  std::vector<double> reuseCredit;       // per tile: spp of history it keeps (the scheduler's credit)
-  int previewBlock = 1;                  // setPreview
-  bool previewed = false;                // the last frame was a preview: the next full one plans the edit again
+  ReuseTracker reuse;                // verified reuse's per-tile state, on the scheduler's grid
+  int previewBlock = 1;              // setPreview
+  bool previewed = false;            // the last frame was a preview: the next full one plans the edit again
   Clock::time_point lastEdit{};
 
   // The block size of the next frame: the preview's while edits come (or came a moment ago) and
@@ -107,79 +100,21 @@ struct RenderSession::Impl {
     return 1;
   }
 
-  void resetReuse() {
-    const auto n = static_cast<std::size_t>(scheduler.grid().count());
-    reuse.assign(n, TileReuse::None);
-    reuseStarted.assign(n, 0);
-    reuseRejectedAt.assign(n, 0);
-    reusePass.assign(n, 0);
-    reuseCredit.assign(n, 0.0);
-    pendingRejects.clear();
-  }
-
-  // Restarts of a pass keep their tiles' samples as history; a global update drops every history
-  // (its restarts do, in the accumulate pass); rejections found in the last read-back apply.
+  // The tracker turns the plan's restarts into history starts (a global update drops every
+  // history) and applies the last read-back's rejections; the scheduler counts the kept samples.
   // `before`: the scheduler's samples per tile before this frame's plan (a restart resets them).
-  void planReuse(FramePlan& plan, std::vector<TileWork>& work, FrameOptions& options, std::uint64_t frameNumber,
-                 const std::vector<double>& before) {
-    if (reuse.size() != static_cast<std::size_t>(scheduler.grid().count())) resetReuse();
-    if (plan.mode == AccumMode::GlobalUpdate) {
-      resetReuse();
-      scheduler.setCredit(reuseCredit);
-      return;
-    }
-    const TileGrid& grid = scheduler.grid();
-    std::vector<char> started(reuse.size(), 0);
-    for (std::size_t i = 0; i < plan.chunks.size(); ++i) {
-      const TileChunk& c = plan.chunks[i];
-      auto t = static_cast<std::size_t>(c.tile);
-      // With reuse, the smooth transition's stale tiles keep their verified history instead of
-      // a capped one: their first serve in the pass starts the history like a restart.
-      const double had = t < before.size() ? before[t] : 0.0;
-      double kept = had;  // spp the tile's history will hold
-      if (c.capStale > 0 && !c.restart) {
-        work[i].capStale = 0;
-        if (reusePass[t] == pass) continue;
-        kept = had - std::min(had, static_cast<double>(c.capStale));  // the scheduler counts the cap as fresh
-      } else if (!c.restart) {
-        continue;
-      }
-      // A tile that keeps a history goes back to it: its credit stays.
-      if (reuse[t] != TileReuse::Reusing) reuseCredit[t] = kept + reuseCredit[t];
-      work[i].restart = false;
-      reusePass[t] = pass;
-      options.reuse.push_back({c.rect.x, c.rect.y, c.rect.width, c.rect.height, FrameOptions::Reuse::Start});
-      started[t] = 1;
-      reuse[t] = TileReuse::Reusing;
-      reuseStarted[t] = frameNumber;
-      reuseRejectedAt[t] = 0;
-    }
-    for (int tile : pendingRejects) {
-      auto t = static_cast<std::size_t>(tile);
-      if (started[t] || reuse[t] != TileReuse::Reusing) continue;  // a new edit's history replaces the verdict
-      TileRect r = grid.rect(tile);
-      options.reuse.push_back({r.x, r.y, r.width, r.height, FrameOptions::Reuse::Reject});
-      reuse[t] = TileReuse::Rejected;
-      reuseRejectedAt[t] = frameNumber;
-      reuseCredit[t] = 0.0;
-    }
-    pendingRejects.clear();
-    scheduler.setCredit(reuseCredit);
+  void planReuse(FramePlan& plan, FrameOptions& options, std::uint64_t frameNumber, const std::vector<double>& before) {
+    for (const ReuseOp& op : reuse.planFrame(plan, before, frameNumber))
+      options.reuse.push_back({op.rect.x, op.rect.y, op.rect.width, op.rect.height,
+                               op.kind == ReuseOp::Start ? FrameOptions::Reuse::Start : FrameOptions::Reuse::Reject});
+    scheduler.setCredit(reuse.credit());
   }
 
-  // Tests every tile that reuses its history against the fresh samples the image holds.
+  // Tests every tile that reuses its history against the fresh samples the image holds: the
+  // image keeps the history beside the accumulation, so the fresh sums are the difference.
   void testReuse(const RenderImage& img, std::uint64_t imageFrame, double falseRejectRate) {
     if (img.history.empty() || img.width != width || img.height != height) return;
-    const TileGrid& grid = scheduler.grid();
-    std::vector<LuminanceSums> fresh, hist;
-    std::vector<ReuseTest> tested(static_cast<std::size_t>(grid.count()));
-    std::vector<int> kept;
-    for (int t = 0; t < grid.count(); ++t) {
-      auto ti = static_cast<std::size_t>(t);
-      if (ti >= reuse.size() || reuse[ti] != TileReuse::Reusing || reuseStarted[ti] >= imageFrame + 1) continue;
-      TileRect r = grid.rect(t);
-      fresh.assign(static_cast<std::size_t>(r.pixels()), {});
-      hist.assign(fresh.size(), {});
+    reuse.test(imageFrame, falseRejectRate, [&](const TileRect& r, std::vector<LuminanceSums>& fresh, std::vector<LuminanceSums>& hist) {
       for (int y = 0; y < r.height; ++y)
         for (int x = 0; x < r.width; ++x) {
           const std::size_t p = static_cast<std::size_t>(r.y + y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(r.x + x);
@@ -201,30 +136,7 @@ struct RenderSession::Impl {
             F.rgb[ch] = c[ch] * n - H.rgb[ch];
           }
         }
-      tested[ti] = retile::testReuse(fresh, hist, r.width, r.height, falseRejectRate);
-      if (tested[ti].reject()) pendingRejects.push_back(t);
-      else kept.push_back(t);
-    }
-    // Changes too small for one tile: each kept tile pooled with its kept neighbours, then all
-    // the kept tiles together (a light a few per cent brighter changes every lit tile a little).
-    std::vector<int> more;
-    for (int t : kept) {
-      std::vector<const ReuseTest*> pool;
-      const int cx = t % grid.cols(), cy = t / grid.cols();
-      for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, grid.rows() - 1); ++y)
-        for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, grid.cols() - 1); ++x) {
-          const auto n = static_cast<std::size_t>(y * grid.cols() + x);
-          if (tested[n].pixels > 0 && !tested[n].reject()) pool.push_back(&tested[n]);
-        }
-      if (pool.size() > 1 && testPooled(pool, falseRejectRate).reject()) more.push_back(t);
-    }
-    std::vector<char> found(tested.size(), 0);
-    for (int t : more) found[static_cast<std::size_t>(t)] = 1;
-    std::vector<const ReuseTest*> all;
-    for (int t : kept)
-      if (!found[static_cast<std::size_t>(t)]) all.push_back(&tested[static_cast<std::size_t>(t)]);
-    if (all.size() > 1 && testPooled(all, falseRejectRate).reject()) more = kept;
-    pendingRejects.insert(pendingRejects.end(), more.begin(), more.end());
+    });
   }
 
   explicit Impl(const RendererOptions& o) : renderer(o) {}
@@ -249,7 +161,7 @@ struct RenderSession::Impl {
     planner.setGrid(grid);
     denoise.reset(grid);
     batch.clear();  // measured on the old grid; the reset restarts everything anyway
-    resetReuse();
+    reuse.reset(grid);
   }
 
   void execute(const Plan& p) {
@@ -259,7 +171,7 @@ struct RenderSession::Impl {
       case PlanKind::Probe: scheduler.probe(); break;
       case PlanKind::Pass:
         scheduler.startPass(p.order, p.quality, p.prioritized, p.smooth, p.staleCap);
-        ++pass;
+        reuse.startPass();
         leading.assign(static_cast<std::size_t>(scheduler.grid().count()), 0);
         for (int i = 0; i < p.leading && i < static_cast<int>(p.order.size()); ++i)
           leading[static_cast<std::size_t>(p.order[static_cast<std::size_t>(i)])] = 1;
@@ -396,7 +308,7 @@ std::string RenderSession::setMethod(const MethodSettings& method) {
     impl_->planner.setGrid(grid);
     impl_->denoise.reset(grid);
     impl_->batch.clear();
-    impl_->resetReuse();
+    impl_->reuse.reset(grid);
     impl_->applyRegion();
   }
   return {};
@@ -613,20 +525,20 @@ void RenderSession::submitFrame(bool readImage) {
   if (method().reuse) samplesBefore = d.scheduler.tileSamples();
   else d.scheduler.setCredit({});
   FramePlan plan = d.scheduler.nextFrame(block);
+  FrameOptions options;
+  options.accumulate = plan.mode != AccumMode::Probe;
+  if (method().denoise) options.denoise = d.denoiseWork(plan.mode, d.frame + 1, method());
+  if (method().reuse && options.accumulate) d.planReuse(plan, options, d.frame + 1, samplesBefore);
   std::vector<TileWork> work;
   work.reserve(plan.chunks.size());
   for (const TileChunk& c : plan.chunks)
     work.push_back({c.rect.x, c.rect.y, c.rect.width, c.rect.height, c.quality, c.sampleBase, c.restart, c.capStale, c.block});
-  FrameOptions options;
-  options.accumulate = plan.mode != AccumMode::Probe;
-  if (method().denoise) options.denoise = d.denoiseWork(plan.mode, d.frame + 1, method());
-  if (method().reuse && options.accumulate) d.planReuse(plan, work, options, d.frame + 1, samplesBefore);
   Impl::Pending p;
   p.mode = plan.mode;
   p.counting = d.planner.countThisFrame(plan.mode);
   if (p.counting) options.selectionTileSize = grid.tileSize();
   // Verified reuse tests the samples of every frame while a tile reuses its history.
-  p.readImage = readImage || (method().reuse && std::find(d.reuse.begin(), d.reuse.end(), TileReuse::Reusing) != d.reuse.end());
+  p.readImage = readImage || (method().reuse && d.reuse.anyReusing());
   p.start = start;
 
   FrameRecord& rec = p.rec;
@@ -656,13 +568,13 @@ void RenderSession::submitFrame(bool readImage) {
     for (const DenoiseRegion& r : d.lastRegions)
       rec.denoised.push_back({RegionRect{r.rect.x, r.rect.y, r.rect.width, r.rect.height}, rec.frame - r.frame});
   if (method().reuse) {
-    rec.tileReuse.reserve(d.reuse.size());
-    for (TileReuse r : d.reuse) {
+    rec.tileReuse.reserve(d.reuse.states().size());
+    for (TileReuse r : d.reuse.states()) {
       rec.tileReuse.push_back(static_cast<std::uint8_t>(r));
       rec.reusedTiles += r == TileReuse::Reusing;
       rec.rejectedTiles += r == TileReuse::Rejected;
     }
-    rec.tileRejectedAt = d.reuseRejectedAt;
+    rec.tileRejectedAt = d.reuse.rejectedAt();
   }
   rec.queueLength = d.scheduler.queueLength();
   rec.queueServed = d.scheduler.queueServed();

@@ -1,7 +1,7 @@
 // Verified sample reuse (issue 16): when an edit restarts a tile, its converged samples (the
 // history) are kept beside the fresh ones, and the tile shows and accumulates both for as long as
 // the fresh estimate agrees with the history within noise. This is the test that decides, and the
-// per-tile state the render session keeps. Pure CPU, no Vulkan; owned by the render thread.
+// per-tile states (ReuseTracker, reuse_tracker.h, keeps them). Pure CPU, no Vulkan; any thread.
 //
 // The test, per tile and per aligned 4x4 block of it (pooling finds small changes spread over many
 // pixels, a single block finds a small local one): with each pixel's luminance mean over its fresh
