@@ -81,62 +81,34 @@ RT_CONST(int, kLayoutStarts, 7)     // 12 bits: kStartBits for each of slots 1..
 RT_CONST(int, kStartBits, 4)
 RT_CONST(int, kMaxTraversalTexels, 134217728)  // 2^27: items stay positive; also lavapipe's texel-buffer limit
 
-// What a scene has besides geometry and materials (RenderSceneData::features). The renderer
-// compiles the trace kernel without the code for what a scene lacks (see scene.glsl).
-RT_CONST(int, kFeatureTextures, 1)       // some material reads an albedo or roughness texture
-RT_CONST(int, kFeatureEnvConstant, 2)
-RT_CONST(int, kFeatureEnvMap, 4)
-RT_CONST(int, kFeatureEmitters, 8)       // emissive triangles
-RT_CONST(int, kFeatureDeltaLights, 16)   // point, spot and directional lights
-RT_CONST(int, kFeatureTungstenShading, 32)  // ShadingConvention::Tungsten (scene.h)
-RT_CONST(int, kFeatureBump, 64)          // some material has a bump map
-RT_CONST(int, kFeatureEmissionTextures, 128)  // some emitter's emission is textured
-RT_CONST(int, kFeatureBlend, 256)         // some material blends with another (Material::blendWith)
-// How a sample's offset in its pixel is drawn (exactly one): the filter's tabulated inverse CDF, a
-// tent's exact inverse, Tungsten's table searched as Tungsten searches it (its Gaussian), or
-// Tungsten's tent table, whose steps are found in closed form (render_scene.h).
-RT_CONST(int, kFeatureFilterTable, 512)
-RT_CONST(int, kFeatureFilterTent, 1024)
-RT_CONST(int, kFeatureFilterTungsten, 2048)
-RT_CONST(int, kFeatureSun, 4096)  // some directional light has a disc (Light::angularRadius)
-RT_CONST(int, kFeatureInstanceTransforms, 8192)  // some instance is not in world space as it is
-RT_CONST(int, kFeatureFilterTungstenTent, 16384)
-RT_CONST(int, kFeatureTungstenRoulette, 32768)  // Roulette::Tungsten (scene.h)
-// The instance BVH's leaves are the instances' own top nodes and triangles, copied into its part
-// of the buffer, not instance records: a ray goes from the instance BVH into an instance without
-// a step of its own, and a triangle names its instance in e2.w (kTriInstanceMask, with its
-// kTriSheet, kTriCullBack, kTriBoundary and kTriAlphaTested flags). Only for scenes without instance
-// transforms whose triangles each belong to one instance (render_scene.cpp packInstances);
-// ignored with kFeatureInstanceTransforms.
-RT_CONST(int, kFeatureDirectReferences, 65536)
-// How bitmaps' texels are stored (kTexEightBit): some in 8 bits, some in halves (an environment
-// map is), some 8-bit ones sRGB-encoded. Each way of reading them costs speed wherever a texture
-// lookup is inlined (the traversal loop's cut-out test too), read or not: 45 % on the living room
-// with all three compiled in, where it has only the first. Also macros, for the preprocessor
-// (scene.glsl bitmapTexel).
+// The trace kernel's bindings (trace_bindings.h): kBind<name>.
+#define RETILE_TRACE_BINDING(name, binding, kind) RT_CONST(int, kBind##name, binding)
+#include "shared/trace_bindings.h"
+#undef RETILE_TRACE_BINDING
+
+// The kernel's features (kernel_features.h): kFeature<name>, and kFeatureAll of them all.
+#define RETILE_KERNEL_FEATURE(name, bit, label) RT_CONST(int, kFeature##name, 1 << bit)
+#include "shared/kernel_features.h"
+#undef RETILE_KERNEL_FEATURE
+#ifdef __cplusplus
+constexpr int kFeatureAll = 0
+#else
+const int kFeatureAll = 0
+#endif
+#define RETILE_KERNEL_FEATURE(name, bit, label) | (1 << bit)
+#include "shared/kernel_features.h"
+#undef RETILE_KERNEL_FEATURE
+    ;
+// The texel formats' bits for the preprocessor (scene.glsl bitmapTexel).
 #define RT_FEATURE_BYTE_TEXELS 131072
 #define RT_FEATURE_HALF_TEXELS 262144
 #define RT_FEATURE_SRGB_TEXELS 524288
-RT_CONST(int, kFeatureByteTexels, RT_FEATURE_BYTE_TEXELS)
-RT_CONST(int, kFeatureHalfTexels, RT_FEATURE_HALF_TEXELS)
-RT_CONST(int, kFeatureSrgbTexels, RT_FEATURE_SRGB_TEXELS)
-// RayOffset::Tungsten (scene.h): a ray leaving a surface skips what lies within kTungstenEpsilon
-// of it (scene units), as Tungsten's rays do (its DefaultEpsilon, the same for every primitive).
-RT_CONST(int, kFeatureTungstenEpsilon, 1048576)
+#ifdef __cplusplus
+static_assert(RT_FEATURE_BYTE_TEXELS == kFeatureByteTexels && RT_FEATURE_HALF_TEXELS == kFeatureHalfTexels &&
+              RT_FEATURE_SRGB_TEXELS == kFeatureSrgbTexels);
+#endif
+// RayOffset::Tungsten (kFeatureTungstenEpsilon): what a ray leaving a surface skips, in scene units.
 RT_CONST(float, kTungstenEpsilon, 5e-4)
-// Some visible object is hit from the front only (Object::cullBackFaces, kInstanceCullBack).
-RT_CONST(int, kFeatureCullBack, 2097152)
-// Some emitter emits into a cone narrower than its hemisphere (Material::emissionCone; the cosine
-// in its material's eighth texel, z).
-RT_CONST(int, kFeatureEmissionCone, 4194304)
-// Light that arrives in fewer than FrameUniforms::bounces.x bounces is left out (RenderSettings::minBounces).
-RT_CONST(int, kFeatureMinBounces, 8388608)
-// Light samples choose among the emissive instances (light groups) by what each would give the
-// shading point (lights.glsl lightGroupWeight), then a triangle of the chosen one by power;
-// without it, a triangle of all of them by power. For 2 to kMaxLightGroups groups
-// (FrameUniforms::bounces.y).
-RT_CONST(int, kFeatureLightGroups, 16777216)
-RT_CONST(int, kFeatureAll, 33554431)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceBoundary, 2)  // its material is a boundary (kMatBoundary), which shadow rays cross

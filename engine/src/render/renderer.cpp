@@ -27,26 +27,21 @@ namespace {
 constexpr VkBufferUsageFlags kTexelUsage = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
 constexpr VkBufferUsageFlags kStorageUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
 
-// Binding numbers of trace.comp (shaders/common/scene.glsl and trace.comp).
-enum TraceBinding : std::uint32_t {
-  kBindFrame = 0,
-  kBindWork = 1,
-  kBindTraversal = 2,
-  kBindTriShade = 3,
-  kBindInstances = 4,
-  kBindMaterials = 5,
-  kBindTexInfo = 6,
-  kBindTexels = 7,
-  kBindEmitters = 8,
-  kBindAlias = 9,
-  kBindDelta = 10,
-  kBindEnvCdf = 11,
-  kBindSamples = 12,
-  kBindAux = 13,
-  kBindStats = 14,
-  kBindSelection = 15,
-  kBindFilterWarp = 16,
-};
+// The trace kernel's bindings as its pipeline layout takes them, in binding order.
+std::vector<Binding> traceBindings() {
+  struct Row {
+    int binding;
+    Binding kind;
+  };
+  static constexpr Row kRows[] = {
+#define RETILE_TRACE_BINDING(name, binding, kind) {binding, Binding::kind},
+#include "shared/trace_bindings.h"
+#undef RETILE_TRACE_BINDING
+  };
+  std::vector<Binding> out(std::size(kRows));
+  for (const Row& r : kRows) out.at(static_cast<std::size_t>(r.binding)) = r.kind;
+  return out;
+}
 
 std::uint32_t groupsFor(std::uint64_t invocations, std::uint32_t local, std::uint32_t* groupsY) {
   std::uint64_t groups = (invocations + local - 1) / local;
@@ -232,16 +227,10 @@ struct Renderer::Impl {
   vk::ComputePipeline* traceVariant(bool alpha, std::uint32_t materialTypes, std::uint32_t features) {
     auto& slot = traceVariants[{alpha, materialTypes, features}];
     if (!slot) {
-      slot = std::make_unique<vk::ComputePipeline>(
-          ctx, "trace.comp",
-          std::vector<Binding>{Binding::Storage, Binding::Storage, Binding::StorageTexel, Binding::UniformTexel, Binding::UniformTexel,
-                               Binding::UniformTexel, Binding::UniformTexel, Binding::StorageTexel, Binding::UniformTexel,
-                               Binding::UniformTexel, Binding::UniformTexel, Binding::UniformTexel, Binding::Storage, Binding::Storage,
-                               Binding::Storage, Binding::Storage, Binding::UniformTexel},
-          static_cast<std::uint32_t>(sizeof(gpu::TracePush)),
-          std::vector<vk::ShaderDefine>{{"RETILE_ALPHA_TEST", alpha ? "1" : "0"},
-                                        {"RETILE_MATERIALS", std::to_string(materialTypes)},
-                                        {"RETILE_FEATURES", std::to_string(features)}});
+      slot = std::make_unique<vk::ComputePipeline>(ctx, "trace.comp", traceBindings(), static_cast<std::uint32_t>(sizeof(gpu::TracePush)),
+                                                   std::vector<vk::ShaderDefine>{{"RETILE_ALPHA_TEST", alpha ? "1" : "0"},
+                                                                                 {"RETILE_MATERIALS", std::to_string(materialTypes)},
+                                                                                 {"RETILE_FEATURES", std::to_string(features)}});
     }
     return slot.get();
   }
@@ -252,24 +241,24 @@ struct Renderer::Impl {
   }
 
   void bindTrace(vk::ComputePipeline& t) {
-    t.bind(kBindFrame, frameUbo);
-    t.bind(kBindWork, work);
-    t.bind(kBindTraversal, traversal, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(kBindTriShade, triShade, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(kBindInstances, instances, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(kBindMaterials, materials, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(kBindTexInfo, texInfo, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(kBindTexels, texels, VK_FORMAT_R32G32_UINT);  // pairs of words (layouts.h kTexEightBit)
-    t.bind(kBindEmitters, emitters, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(kBindAlias, alias, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(kBindDelta, delta, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(kBindEnvCdf, envCdf, VK_FORMAT_R32_SFLOAT);
-    t.bind(kBindStats, stats);
-    t.bind(kBindSelection, selection);
-    t.bind(kBindFilterWarp, filterWarp, VK_FORMAT_R32_SFLOAT);
+    t.bind(gpu::kBindFrame, frameUbo);
+    t.bind(gpu::kBindWork, work);
+    t.bind(gpu::kBindTraversal, traversal, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindTriShade, triShade, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindInstances, instances, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindMaterials, materials, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindTexInfo, texInfo, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindTexels, texels, VK_FORMAT_R32G32_UINT);  // pairs of words (layouts.h kTexEightBit)
+    t.bind(gpu::kBindEmitters, emitters, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindAlias, alias, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindDelta, delta, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindEnvCdf, envCdf, VK_FORMAT_R32_SFLOAT);
+    t.bind(gpu::kBindStats, stats);
+    t.bind(gpu::kBindSelection, selection);
+    t.bind(gpu::kBindFilterWarp, filterWarp, VK_FORMAT_R32_SFLOAT);
     if (samples.valid()) {
-      t.bind(kBindSamples, samples);
-      t.bind(kBindAux, aux);
+      t.bind(gpu::kBindSamples, samples);
+      t.bind(gpu::kBindAux, aux);
     }
   }
 
@@ -876,30 +865,17 @@ std::vector<std::string> Renderer::kernelFeatures() const {
   if (d.cutOuts) out.push_back("alpha test");
   if (d.sheetShadows) out.push_back("shadow rays through thin sheets");
   const std::uint32_t f = d.features();
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureTextures)) out.push_back("textures");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureEnvConstant)) out.push_back("constant environment");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureEnvMap)) out.push_back("environment map");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureEmitters)) out.push_back("emissive triangles");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureDeltaLights)) out.push_back("delta lights");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureTungstenShading)) out.push_back("Tungsten's shading normals");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureBump)) out.push_back("bump maps");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureEmissionTextures)) out.push_back("emission textures");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureBlend)) out.push_back("blends");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureSun)) out.push_back("suns with a disc");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureInstanceTransforms)) out.push_back("instance transforms");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureDirectReferences)) out.push_back("direct references");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTent)) out.push_back("exact tent filter");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTungsten)) out.push_back("Tungsten's filter table");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureFilterTungstenTent)) out.push_back("Tungsten's tent");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureTungstenRoulette)) out.push_back("Tungsten's roulette");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureTungstenEpsilon)) out.push_back("Tungsten's ray epsilon");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureCullBack)) out.push_back("back faces culled");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureEmissionCone)) out.push_back("emission cones");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureMinBounces)) out.push_back("min bounces");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureLightGroups)) out.push_back("light groups");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureByteTexels)) out.push_back("8-bit texels");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureHalfTexels)) out.push_back("half-float texels");
-  if (f & static_cast<std::uint32_t>(gpu::kFeatureSrgbTexels)) out.push_back("sRGB texels");
+  struct Named {
+    std::uint32_t bit;
+    const char* label;
+  };
+  static constexpr Named kNames[] = {
+#define RETILE_KERNEL_FEATURE(name, bit, label) {1u << bit, label},
+#include "shared/kernel_features.h"
+#undef RETILE_KERNEL_FEATURE
+  };
+  for (const Named& n : kNames)
+    if (f & n.bit) out.push_back(n.label);
   return out;
 }
 double Renderer::lastBlasSeconds() const { return impl_->builder.lastTiming().blas; }
