@@ -116,10 +116,18 @@ void MainWindow::opened(const std::filesystem::path& file, const std::vector<std
                            .arg(QString::fromStdString(file.filename().string()));
   view_->showNotice(text, 8000);
   statusBar()->showMessage(text, 15000);
-  if (auto* logDock = findChild<QDockWidget*>("log")) {
-    logDock->show();
-    logDock->raise();
+  auto* logDock = findChild<QDockWidget*>("log");
+  if (!logDock) return;
+  // Beside the node graph, not over it: a tab raised in front of the graph would hide it until
+  // the user went back to it.
+  auto* graphDock = findChild<QDockWidget*>("nodeGraphDock");
+  // (splitDockWidget would add it to the graph's tabs again: it is taken out of them first.)
+  if (graphDock && graphDock->isVisible() && tabifiedDockWidgets(graphDock).contains(logDock)) {
+    removeDockWidget(logDock);
+    addDockWidget(Qt::BottomDockWidgetArea, logDock, Qt::Horizontal);
   }
+  logDock->show();
+  logDock->raise();
 }
 
 bool MainWindow::maybeSave() {

@@ -400,6 +400,26 @@ TEST_F(Bsdfs, LosslessMaterialsKeepAllEnergy) {
   }
 }
 
+// Glass less dense than what surrounds it (an air bubble in ice: its ior the ratio, below 1)
+// reflects everything past its critical angle, asin(ior), and before it reflects F and refracts
+// the rest, radiance expanded by 1 / ior^2 on the less dense side.
+TEST_F(Bsdfs, GlassLessDenseThanItsSurroundingsReflectsTotallyPastItsCriticalAngle) {
+  const double eta = 0.763;
+  const Material bubble = material(MaterialType::Dielectric, 1.0f, 0.3f, static_cast<float>(eta));
+  const Vec3 grazing = direction(0.3f, 0.3f);  // sin 0.95, past asin(0.763)
+  std::vector<BsdfQuery> q;
+  for (int i = 0; i < 64; ++i) q.push_back(BsdfQuery{bubble, grazing, grazing, {(i + 0.5f) / 64, 0.5f, 0.5f}});
+  for (const BsdfAnswer& a : run(q)) {
+    EXPECT_FALSE(a.transmitted);
+    EXPECT_NEAR(a.weight.y, 1.0, 1e-5);
+    EXPECT_NEAR(a.sampledWi.z, grazing.z, 1e-5);
+  }
+  for (float cosO : {0.9f, 0.8f}) {
+    const Vec3 wo = direction(cosO, 0.3f);
+    EXPECT_NEAR(sampledAlbedo(bubble, wo).first, fresnel(cosO, eta) + (1 - fresnel(cosO, eta)) / (eta * eta), 0.003) << "cos " << cosO;
+  }
+}
+
 // Tungsten's glass (Material::tungstenGlass): its albedo tints both lobes, and radiance is not
 // scaled by eta^2 through the surface, so that white glass returns exactly everything from either
 // side, where the physical form returns F + (1 - F) / eta^2 from outside. The rough one's

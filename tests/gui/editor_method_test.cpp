@@ -444,8 +444,10 @@ TEST(EditorMethod, OpenedFilesAreRecentWarningsAreSeenAndPanelsComeBack) {
   EXPECT_TRUE(w->viewport()->notice().contains("warning")) << w->viewport()->notice().toStdString();
   EXPECT_TRUE(w->statusBar()->currentMessage().contains("warning"));
   EXPECT_FALSE(logDock->visibleRegion().isEmpty()) << "the Log is raised";
-
   auto* graphDock = w->findChild<QDockWidget*>("nodeGraphDock");
+  EXPECT_TRUE(QTest::qWaitFor([&] { return !graphDock->visibleRegion().isEmpty(); }, 2000)) << "the node graph stays in view beside it";
+  EXPECT_FALSE(logDock->visibleRegion().isEmpty());
+
   graphDock->close();
   QMenu* windows = w->menuBar()->findChild<QMenu*>("windowMenu");
   ASSERT_TRUE(windows);

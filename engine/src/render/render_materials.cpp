@@ -68,7 +68,11 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
   if (rough || m.type == MaterialType::Phong) roughness = std::max(roughness, 1e-3f);
   if (m.type == MaterialType::OrenNayar) roughness = std::clamp(m.roughness, 0.0f, kPi / 2);
-  float ior = m.type == MaterialType::Hair ? 1.55f : std::clamp(m.ior, 1.0001f, 10.0f);
+  // Glass and sheets may be less dense than what is around them (an air bubble in ice: its ior
+  // the ratio, below 1); a coating may not. An index of 1, where a rough interface's half vector
+  // is undefined, is kept a hair away from.
+  const bool lessDense = (isGlassType(m.type) || m.type == MaterialType::ThinSheet) && m.ior < 1.0f;
+  float ior = m.type == MaterialType::Hair ? 1.55f : lessDense ? std::clamp(m.ior, 0.1f, 0.9999f) : std::clamp(m.ior, 1.0001f, 10.0f);
   const bool coated = coatRendered(m);
   // Diffuse light inside a plastic coating reflects back this fraction at the boundary
   // (Jensen et al.'s polynomial fit of the internal diffuse Fresnel reflectance).
