@@ -39,13 +39,222 @@ struct EditOptions {
   bool noSoftBorders = false, noImages = false;
 };
 
+using SteadyClock = std::chrono::steady_clock;
+
+double elapsedSince(SteadyClock::time_point t0) { return std::chrono::duration<double>(SteadyClock::now() - t0).count(); }
+
+// The display-referred copy of a linear image, what PSNR, SSIM and PSNR-HVS-M compare: the image
+// as a viewer sees it.
+std::vector<float> displayReferred(const ColorConfig& colors, const std::vector<float>& linear) {
+  std::vector<float> out(linear.size());
+  colors.toDisplayFloat(linear.data(), linear.size() / 3, DisplaySettings{}, out.data());
+  for (float& v : out) v = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+  return out;
+}
+
+// What --reference scores the frames against: the fresh render of the final state, and the
+// pixels the script changed (and the others). Empty without --reference.
+struct Reference {
+  std::shared_ptr<const ColorConfig> colors;
+  std::vector<float> linear, display;
+  std::vector<std::uint8_t> affected, rest;
+  std::size_t affectedCount = 0;
+};
+
+// Each state from its own renderer and seed, at `spp`; reference.exr is the final state's.
+Reference renderReferences(const Scene& start, const Scene& finalScene, int spp, const std::filesystem::path& outDir) {
+  Reference out;
+  out.colors = ColorConfig::get();
+  Renderer r;
+  auto render = [&](const Scene& state, const char* what) {
+    r.setScene(state);
+    RenderRequest req;
+    req.width = start.settings.width;
+    req.height = start.settings.height;
+    req.samplesPerPixel = spp;
+    req.seed = 0x5eed;
+    auto t0 = SteadyClock::now();
+    return r.render(req, [&](int done, int total) {
+      progressBar(what, done, total, elapsedSince(t0));
+      return true;
+    });
+  };
+  RenderImage img = render(finalScene, "reference");
+  out.linear = img.color;
+  out.display = displayReferred(*out.colors, out.linear);
+  writeRenderImage(img, outDir / "reference.exr");
+  // The starting state's reference too: where the two differ beyond their noise is the region
+  // the edits affected, scored apart from the rest.
+  RenderImage before = render(start, "reference before");
+  out.affected = affectedPixels(before, img);
+  out.rest.resize(out.affected.size());
+  for (std::size_t i = 0; i < out.affected.size(); ++i) out.affectedCount += out.affected[i], out.rest[i] = !out.affected[i];
+  std::fprintf(stderr, "affected region: %zu of %zu pixels\n", out.affectedCount, out.affected.size());
+  return out;
+}
+
+// frames.csv's scores of what a frame shows against the reference: PSNR, SSIM, PSNR-HVS-M, and
+// RMSE and PSNR of the affected region and of the rest; empty fields without a reference.
+std::string frameScores(const Reference& ref, const FrameRecord& rec, int w, int h) {
+  if (ref.display.empty() || !rec.image) return ",,,,,,";
+  const std::vector<float> shown = displayReferred(*ref.colors, rec.image->shown());
+  const MetricImage a{shown.data(), w, h}, r{ref.display.data(), w, h};
+  char q[192];
+  if (ref.affectedCount > 0)
+    std::snprintf(q, sizeof q, "%.3f,%.5f,%.3f,%.5f,%.5f,%.3f,%.3f", psnr(a, r), ssim(a, r), psnrHvsM(a, r),
+                  rootMeanSquaredError(a, r, ref.affected.data()), rootMeanSquaredError(a, r, ref.rest.data()),
+                  psnr(a, r, ref.affected.data()), psnr(a, r, ref.rest.data()));
+  else  // nothing changed: no affected scores, the rest is the whole image
+    std::snprintf(q, sizeof q, "%.3f,%.5f,%.3f,,%.5f,,%.3f", psnr(a, r), ssim(a, r), psnrHvsM(a, r), rootMeanSquaredError(a, r),
+                  psnr(a, r));
+  return q;
+}
+
+// Applies the selection and focus steps at the head of the script, which hold while the scene
+// converges, as an artist selects before editing: the indirection counters are gathered then.
+// Returns the first step after them.
+Result<std::size_t> applyLeadingSteps(RenderSession& session, const Scenario& scenario, const std::string& scriptFile) {
+  std::size_t firstStep = 0;
+  for (; firstStep < scenario.steps.size(); ++firstStep) {
+    const ScenarioStep& step = scenario.steps[firstStep];
+    if (step.kind != ScenarioStep::Kind::Select && step.kind != ScenarioStep::Kind::Focus) break;
+    auto e = stepEdits(step, 0, session.scene(), session.selection());
+    if (!e) return Result<std::size_t>::failure(cat(scriptFile, ": steps[", firstStep, "]: ", e.error()));
+    if (e->select) session.select(*e->select);
+    if (e->focus) session.setFocus(*e->focus);
+  }
+  return firstStep;
+}
+
+// Plays the script's steps after the leading ones and writes frames.csv and the frames. Frames
+// are pipelined: frame n+1 is submitted (its edits applied first) before frame n is read back
+// and written, so the device traces while this thread writes.
+class EditPlayer {
+ public:
+  // The frames are width x height; `total` of them.
+  EditPlayer(RenderSession& session, const EditOptions& o, const Reference& ref, const std::filesystem::path& outDir, int width, int height,
+             int total)
+      : session_(session), o_(o), ref_(ref), outDir_(outDir), w_(width), h_(height), total_(total), csv_(outDir / "frames.csv") {
+    csv_ << "frame,step,method,mode,samples,tiles_served,queue_left,quality,ms,schedule_ms,trace_ms,rel_rmse,"
+            "denoise_regions,denoise_width,denoise_height,psnr,ssim,psnr_hvs_m,rmse_affected,rmse_rest,psnr_affected,"
+            "psnr_rest,reused_tiles,rejected_tiles\n";
+  }
+
+  // Returns false on an error, said on stderr.
+  bool play(const Scenario& scenario, std::size_t firstStep) {
+    t0_ = SteadyClock::now();
+    const bool images = !o_.noImages;
+    for (std::size_t si = firstStep; si < scenario.steps.size(); ++si) {
+      const ScenarioStep& step = scenario.steps[si];
+      bool instant = step.kind == ScenarioStep::Kind::Select || step.kind == ScenarioStep::Kind::Focus;
+      for (int f = 0; f < (instant ? 1 : step.frames); ++f) {
+        auto e = stepEdits(step, f, session_.scene(), session_.selection());
+        if (!e) return std::fprintf(stderr, "\nerror: %s: steps[%zu]: %s\n", o_.script.c_str(), si, e.error().c_str()), false;
+        if (e->select) session_.select(*e->select);
+        if (e->focus) session_.setFocus(*e->focus);
+        for (const Edit& edit : e->edits) {
+          auto r = session_.applyEdit(edit);
+          if (!r) return std::fprintf(stderr, "\nerror: steps[%zu]: %s\n", si, r.error().c_str()), false;
+        }
+        if (instant) break;
+        session_.submitFrame(images || !ref_.linear.empty());
+        submitted_.push_back({si, !e->edits.empty()});
+        if (session_.framesInFlight() > 1 && !finishOne()) return false;
+      }
+    }
+    while (session_.framesInFlight() > 0)
+      if (!finishOne()) return false;
+    wallMs_ = elapsedSince(t0_) * 1e3;
+    csv_.close();
+    return true;
+  }
+
+  // The summary on stdout, after play; the exit status: 1 when a frame missed the budget.
+  int report(const MethodSettings& method, int converge) const {
+    const int frame = frame_;
+    std::printf("method         %s, T=%d, Q=%s\n", methodLabel(method).c_str(), method.tileSize,
+                method.quality ? std::to_string(method.quality).c_str() : "auto");
+    std::printf("frames         %d after %d converging; every frame traced %s %dx%d samples\n", frame, converge, exact_ ? "exactly" : "NOT",
+                w_, h_);
+    std::printf("frame rate     %.1f frames/s (%.1f ms a frame, wall clock, frames pipelined)\n", wallMs_ > 0 ? frame * 1e3 / wallMs_ : 0.0,
+                frame ? wallMs_ / frame : 0.0);
+    std::printf("scheduling     %.2f %% of frame time (%.3f ms a frame)\n", wallMs_ > 0 ? 100.0 * sumScheduleMs_ / wallMs_ : 0.0,
+                frame ? sumScheduleMs_ / frame : 0.0);
+    if (!ref_.linear.empty()) {
+      if (settledFrame_ > 0)
+        std::printf("settled        %d frames after the last edit (relative RMSE of %dx%d blocks below %.3g from then on)\n",
+                    settledFrame_ - lastEditFrame_, o_.block, o_.block, o_.threshold);
+      else
+        std::printf("settled        not within the script (relative RMSE of %dx%d blocks stayed above %.3g)\n", o_.block, o_.block,
+                    o_.threshold);
+    }
+    std::printf("wrote          %s\n", (outDir_ / "frames.csv").string().c_str());
+    return exact_ ? 0 : 1;
+  }
+
+ private:
+  struct Submitted {
+    std::size_t step;
+    bool edited;
+  };
+
+  // Reads back the oldest frame in flight, scores it, and writes its line and image.
+  bool finishOne() {
+    FrameRecord rec = session_.finishFrame();
+    Submitted sub = submitted_.front();
+    submitted_.pop_front();
+    ++frame_;
+    if (sub.edited) {
+      lastEditFrame_ = frame_;
+      settledFrame_ = -1;
+    }
+    exact_ = exact_ && rec.samples == static_cast<std::uint64_t>(w_) * static_cast<std::uint64_t>(h_);
+    // The error of what the method shows (denoised, when it denoises).
+    const std::vector<float>& ref = ref_.linear;
+    double err = !ref.empty() && rec.image ? relativeRmse(rec.image->shown(), ref, w_, h_, o_.block) : NAN;
+    if (!ref.empty() && frame_ > lastEditFrame_ && settledFrame_ < 0 && err < o_.threshold) settledFrame_ = frame_;
+    if (!ref.empty() && err >= o_.threshold) settledFrame_ = -1;  // settled means: stays under
+    sumScheduleMs_ += rec.scheduleMs;
+    char line[768];
+    const RegionRect outer = rec.denoised.empty() ? RegionRect{} : rec.denoised.back().rect;
+    const std::string scores = frameScores(ref_, rec, w_, h_);
+    std::snprintf(line, sizeof line, "%d,%zu,%s,%s,%llu,%zu,%zu,%d,%.3f,%.4f,%.3f,%s,%zu,%d,%d,%s,%d,%d\n", frame_, sub.step,
+                  rec.method.c_str(), rec.mode.c_str(), static_cast<unsigned long long>(rec.samples), rec.servedTiles.size(),
+                  rec.queueLength - rec.queueServed, rec.quality, rec.frameMs, rec.scheduleMs, rec.traceMs,
+                  std::isnan(err) ? "" : std::to_string(err).c_str(), rec.denoised.size(), outer.width, outer.height, scores.c_str(),
+                  rec.reusedTiles, rec.rejectedTiles);
+    csv_ << line;
+    if (!o_.noImages && rec.image) {
+      char name[64];
+      std::snprintf(name, sizeof name, "frame_%05d.exr", frame_);
+      auto written = writeRenderImage(*rec.image, outDir_ / name);
+      if (!written) {
+        std::fprintf(stderr, "\nerror: %s\n", written.error().c_str());
+        return false;
+      }
+    }
+    progressBar(rec.method, frame_, total_, elapsedSince(t0_));
+    return true;
+  }
+
+  RenderSession& session_;
+  const EditOptions& o_;
+  const Reference& ref_;
+  const std::filesystem::path outDir_;
+  const int w_, h_, total_;
+  std::ofstream csv_;
+  std::deque<Submitted> submitted_;
+  SteadyClock::time_point t0_;
+  int frame_ = 0, lastEditFrame_ = 0, settledFrame_ = -1;
+  double sumScheduleMs_ = 0, wallMs_ = 0;
+  bool exact_ = true;
+};
+
 int runEdit(EditOptions o) {
   MethodSettings& method = o.method;
   methodFromName(o.methodName, &method.kind);  // checked by the option
   method.softBorders = !o.noSoftBorders;
   if (std::string bad = validateMethodSettings(method); !bad.empty()) throw CLI::ValidationError(bad);
-  const int reference = o.reference.value_or(0), block = o.block;
-  const double threshold = o.threshold;
 
   auto loaded = loadScene(o.scene);
   if (!loaded) return std::fprintf(stderr, "error: %s\n", loaded.error().c_str()), 1;
@@ -65,173 +274,23 @@ int runEdit(EditOptions o) {
   std::error_code ec;
   std::filesystem::create_directories(outDir, ec);
   if (ec) return std::fprintf(stderr, "error: cannot create %s: %s\n", outDir.string().c_str(), ec.message().c_str()), 1;
-  const bool images = !o.noImages;
-  const int w = scene.settings.width, h = scene.settings.height;
-
-  // The fresh render of the final state, from its own renderer and seed. The display-referred
-  // copies are what PSNR, SSIM and PSNR-HVS-M compare: the image as a viewer sees it.
-  std::vector<float> ref, refDisplay;
-  const std::shared_ptr<const ColorConfig> colors = reference > 0 ? ColorConfig::get() : nullptr;
-  auto displayed = [&](const std::vector<float>& linear) {
-    std::vector<float> out(linear.size());
-    colors->toDisplayFloat(linear.data(), linear.size() / 3, DisplaySettings{}, out.data());
-    for (float& v : out) v = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
-    return out;
-  };
-  std::vector<std::uint8_t> affected, rest;  // the pixels the script changed, and the others
-  std::size_t affectedCount = 0;
-  if (reference > 0) {
-    Renderer r;
-    auto renderReference = [&](const Scene& state, const char* what) {
-      r.setScene(state);
-      RenderRequest req;
-      req.width = w;
-      req.height = h;
-      req.samplesPerPixel = reference;
-      req.seed = 0x5eed;
-      auto t0 = std::chrono::steady_clock::now();
-      return r.render(req, [&](int done, int total) {
-        progressBar(what, done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-        return true;
-      });
-    };
-    RenderImage img = renderReference(finalScene, "reference");
-    ref = img.color;
-    refDisplay = displayed(ref);
-    writeRenderImage(img, outDir / "reference.exr");
-    // The starting state's reference too: where the two differ beyond their noise is the region
-    // the edits affected, scored apart from the rest.
-    RenderImage start = renderReference(scene, "reference before");
-    affected = affectedPixels(start, img);
-    rest.resize(affected.size());
-    for (std::size_t i = 0; i < affected.size(); ++i) affectedCount += affected[i], rest[i] = !affected[i];
-    std::fprintf(stderr, "affected region: %zu of %zu pixels\n", affectedCount, affected.size());
-  }
+  const int reference = o.reference.value_or(0);
+  const Reference ref = reference > 0 ? renderReferences(scene, finalScene, reference, outDir) : Reference{};
 
   RenderSession session(scene, method);
   std::fprintf(stderr, "device: %s\n", session.deviceName().c_str());
   printRenderWarnings(session.sceneWarnings(), loaded->warnings);
-  // Selection and focus steps at the head of the script hold while the scene converges, as an
-  // artist selects before editing: the indirection counters are gathered then.
-  std::size_t firstStep = 0;
-  for (; firstStep < scenario->steps.size(); ++firstStep) {
-    const ScenarioStep& step = scenario->steps[firstStep];
-    if (step.kind != ScenarioStep::Kind::Select && step.kind != ScenarioStep::Kind::Focus) break;
-    auto e = stepEdits(step, 0, session.scene(), session.selection());
-    if (!e) return std::fprintf(stderr, "error: %s: steps[%zu]: %s\n", o.script.c_str(), firstStep, e.error().c_str()), 1;
-    if (e->select) session.select(*e->select);
-    if (e->focus) session.setFocus(*e->focus);
-  }
-  auto t0 = std::chrono::steady_clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  auto firstStep = applyLeadingSteps(session, scenario.value(), o.script);
+  if (!firstStep) return std::fprintf(stderr, "error: %s\n", firstStep.error().c_str()), 1;
+  const auto t0 = SteadyClock::now();
   for (int f = 0; f < converge; ++f) {
     session.renderFrame(false);
-    progressBar("converging", f + 1, converge, elapsed());
+    progressBar("converging", f + 1, converge, elapsedSince(t0));
   }
 
-  std::ofstream csv(outDir / "frames.csv");
-  csv << "frame,step,method,mode,samples,tiles_served,queue_left,quality,ms,schedule_ms,trace_ms,rel_rmse,"
-         "denoise_regions,denoise_width,denoise_height,psnr,ssim,psnr_hvs_m,rmse_affected,rmse_rest,psnr_affected,"
-         "psnr_rest,reused_tiles,rejected_tiles\n";
-  const int total = scenario->totalFrames();
-  int frame = 0, lastEditFrame = 0, settledFrame = -1;
-  double sumScheduleMs = 0;
-  bool exact = true;
-  // Frames are pipelined: frame n+1 is submitted (its edits applied first) before frame n is
-  // read back and written, so the device traces while this thread writes.
-  struct Submitted {
-    std::size_t step;
-    bool edited;
-  };
-  std::deque<Submitted> submitted;
-  auto finishOne = [&]() -> bool {
-    FrameRecord rec = session.finishFrame();
-    Submitted sub = submitted.front();
-    submitted.pop_front();
-    ++frame;
-    if (sub.edited) {
-      lastEditFrame = frame;
-      settledFrame = -1;
-    }
-    exact = exact && rec.samples == static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
-    // The error of what the method shows (denoised, when it denoises).
-    double err = !ref.empty() && rec.image ? relativeRmse(rec.image->shown(), ref, w, h, block) : NAN;
-    if (!ref.empty() && frame > lastEditFrame && settledFrame < 0 && err < threshold) settledFrame = frame;
-    if (!ref.empty() && err >= threshold) settledFrame = -1;  // settled means: stays under
-    sumScheduleMs += rec.scheduleMs;
-    char line[768];
-    const RegionRect outer = rec.denoised.empty() ? RegionRect{} : rec.denoised.back().rect;
-    std::string scores = ",,,,,,";
-    if (!refDisplay.empty() && rec.image) {
-      const std::vector<float> shown = displayed(rec.image->shown());
-      const MetricImage a{shown.data(), w, h}, r{refDisplay.data(), w, h};
-      char q[192];
-      if (affectedCount > 0)
-        std::snprintf(q, sizeof q, "%.3f,%.5f,%.3f,%.5f,%.5f,%.3f,%.3f", psnr(a, r), ssim(a, r), psnrHvsM(a, r),
-                      rootMeanSquaredError(a, r, affected.data()), rootMeanSquaredError(a, r, rest.data()), psnr(a, r, affected.data()),
-                      psnr(a, r, rest.data()));
-      else  // nothing changed: no affected scores, the rest is the whole image
-        std::snprintf(q, sizeof q, "%.3f,%.5f,%.3f,,%.5f,,%.3f", psnr(a, r), ssim(a, r), psnrHvsM(a, r), rootMeanSquaredError(a, r),
-                      psnr(a, r));
-      scores = q;
-    }
-    std::snprintf(line, sizeof line, "%d,%zu,%s,%s,%llu,%zu,%zu,%d,%.3f,%.4f,%.3f,%s,%zu,%d,%d,%s,%d,%d\n", frame, sub.step,
-                  rec.method.c_str(), rec.mode.c_str(), static_cast<unsigned long long>(rec.samples), rec.servedTiles.size(),
-                  rec.queueLength - rec.queueServed, rec.quality, rec.frameMs, rec.scheduleMs, rec.traceMs,
-                  std::isnan(err) ? "" : std::to_string(err).c_str(), rec.denoised.size(), outer.width, outer.height, scores.c_str(),
-                  rec.reusedTiles, rec.rejectedTiles);
-    csv << line;
-    if (images && rec.image) {
-      char name[64];
-      std::snprintf(name, sizeof name, "frame_%05d.exr", frame);
-      auto written = writeRenderImage(*rec.image, outDir / name);
-      if (!written) {
-        std::fprintf(stderr, "\nerror: %s\n", written.error().c_str());
-        return false;
-      }
-    }
-    progressBar(rec.method, frame, total, elapsed());
-    return true;
-  };
-  t0 = std::chrono::steady_clock::now();
-  for (std::size_t si = firstStep; si < scenario->steps.size(); ++si) {
-    const ScenarioStep& step = scenario->steps[si];
-    bool instant = step.kind == ScenarioStep::Kind::Select || step.kind == ScenarioStep::Kind::Focus;
-    for (int f = 0; f < (instant ? 1 : step.frames); ++f) {
-      auto e = stepEdits(step, f, session.scene(), session.selection());
-      if (!e) return std::fprintf(stderr, "\nerror: %s: steps[%zu]: %s\n", o.script.c_str(), si, e.error().c_str()), 1;
-      if (e->select) session.select(*e->select);
-      if (e->focus) session.setFocus(*e->focus);
-      for (const Edit& edit : e->edits) {
-        auto r = session.applyEdit(edit);
-        if (!r) return std::fprintf(stderr, "\nerror: steps[%zu]: %s\n", si, r.error().c_str()), 1;
-      }
-      if (instant) break;
-      session.submitFrame(images || !ref.empty());
-      submitted.push_back({si, !e->edits.empty()});
-      if (session.framesInFlight() > 1 && !finishOne()) return 1;
-    }
-  }
-  while (session.framesInFlight() > 0)
-    if (!finishOne()) return 1;
-  const double wallMs = elapsed() * 1e3;
-  csv.close();
-  std::printf("method         %s, T=%d, Q=%s\n", methodLabel(method).c_str(), method.tileSize,
-              method.quality ? std::to_string(method.quality).c_str() : "auto");
-  std::printf("frames         %d after %d converging; every frame traced %s %dx%d samples\n", frame, converge, exact ? "exactly" : "NOT", w,
-              h);
-  std::printf("frame rate     %.1f frames/s (%.1f ms a frame, wall clock, frames pipelined)\n", wallMs > 0 ? frame * 1e3 / wallMs : 0.0,
-              frame ? wallMs / frame : 0.0);
-  std::printf("scheduling     %.2f %% of frame time (%.3f ms a frame)\n", wallMs > 0 ? 100.0 * sumScheduleMs / wallMs : 0.0,
-              frame ? sumScheduleMs / frame : 0.0);
-  if (!ref.empty()) {
-    if (settledFrame > 0)
-      std::printf("settled        %d frames after the last edit (relative RMSE of %dx%d blocks below %.3g from then on)\n",
-                  settledFrame - lastEditFrame, block, block, threshold);
-    else std::printf("settled        not within the script (relative RMSE of %dx%d blocks stayed above %.3g)\n", block, block, threshold);
-  }
-  std::printf("wrote          %s\n", (outDir / "frames.csv").string().c_str());
-  return exact ? 0 : 1;
+  EditPlayer player(session, o, ref, outDir, scene.settings.width, scene.settings.height, scenario->totalFrames());
+  if (!player.play(scenario.value(), firstStep.value())) return 1;
+  return player.report(method, converge);
 }
 
 }  // namespace

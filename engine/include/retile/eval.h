@@ -4,9 +4,10 @@
 // The pieces: built-in scenarios that fit any scene (the paper's Fig. 6 move, a material, a light
 // and a camera edit, a continuous drag); a plan that plays a scenario on a copy of the scene and
 // says which frames are scored and against which state; references of those states cached on disk
-// by content; one method's run; the summary. The report (charts, strips, HTML) is drawn by the
-// app with Qt (ui/eval_report.h). Planning and summaries are pure; References and runMethod use
-// the GPU and block the calling thread. One thread at a time per object.
+// by content; one method's run; the summary; the report (CSV and HTML here, its charts and
+// strips drawn with Qt by the program that runs it, through ReportHost). Planning and summaries
+// are pure; References, runMethod and the reports use the GPU and block the calling thread. One
+// thread at a time per object.
 #pragma once
 
 #include <cstdint>
@@ -18,6 +19,7 @@
 
 #include "retile/error.h"
 #include "retile/image.h"
+#include "retile/io.h"
 #include "retile/method.h"
 #include "retile/scenario.h"
 #include "retile/scene.h"
@@ -212,5 +214,63 @@ struct StabilityResult {
 std::vector<std::string> stabilityCaseNames();
 Result<StabilityResult> runStabilityCase(const std::string& name, const Scene& scene, const StabilityOptions& options, References& refs,
                                          const std::function<void(const std::string& what)>& progress = {});
+
+// ---- The reports: what `retile eval` writes in its output directory ----
+//
+// The engine neither reads scenes by the command line's names, nor owns the terminal, nor links
+// Qt, which draws the charts and strips (ui/eval_report.h): the program that runs a report does
+// those for it.
+struct ReportLine {  // a method's PSNR against time
+  std::string name;
+  std::vector<std::pair<double, double>> points;
+};
+struct ReportPoint {  // a method's speed against accuracy
+  std::string label;
+  double x = 0, y = 0;
+  // false: x is a bound (the run's length), not a time measured (ui::ChartPoint::reached).
+  bool reached = true;
+};
+
+class ReportHost {
+ public:
+  virtual ~ReportHost() = default;
+  // The scene `name` names on the command line ("default": the built-in one).
+  virtual Result<ImportedScene> loadScene(const std::string& name) = 0;
+  virtual void progress(const std::string& what, int done, int total, double seconds) = 0;
+  // Text for the terminal: results on standard output, anything else on standard error.
+  virtual void out(const std::string& text) = 0;
+  virtual void err(const std::string& text) = 0;
+  // The pictures. A strip's cells are drawn as its frames are played (a frame record does not
+  // outlive its run): keepStripFrame adds one to row `row` of strip `strip`, which writeStrip
+  // writes, its rows labelled `rows` and its columns captioned `captions`.
+  virtual void keepStripFrame(std::size_t strip, std::size_t row, const FrameRecord& frame, int scale) = 0;
+  virtual Result<bool> writeStrip(std::size_t strip, const std::filesystem::path& file, const std::vector<std::string>& captions,
+                                  const std::vector<std::string>& rows) = 0;
+  // `base`.png and `base`.svg.
+  virtual Result<bool> writeLineChart(const std::filesystem::path& base, const std::string& title, const std::string& xTitle,
+                                      const std::string& yTitle, const std::vector<ReportLine>& lines, bool logX) = 0;
+  virtual Result<bool> writePointChart(const std::filesystem::path& base, const std::string& title, const std::string& xTitle,
+                                       const std::string& yTitle, const std::vector<ReportPoint>& points) = 0;
+};
+
+struct ReportRequest {
+  Options options;
+  std::vector<std::string> scenes;     // as the command line names them
+  std::vector<std::string> methods;    // labels (parseMethodLabel), already checked
+  std::vector<std::string> scenarios;  // built-in ones; empty: all, or none when there are scripts
+  std::vector<Scenario> scripts;
+  std::filesystem::path out;
+};
+
+// Every method through every scenario of every scene: metrics.csv (written as runs end),
+// summary.csv, three charts and a strip of frames per scenario, and index.html tying them
+// together, readable offline; the summary table on host.out. Returns the command's exit status:
+// 0, or 1 when the report could not be made (said on host.err).
+int runReport(const ReportRequest& request, ReportHost& host);
+// The stability suite's cases on each scene: stability.csv and stability.html, the figures on
+// host.out. Returns 1 when an invariant broke or a case could not run (a method failing a case
+// is a finding, not a defect), else 0.
+int runStabilityReport(const std::vector<std::string>& scenes, const std::vector<std::string>& cases, const StabilityOptions& options,
+                       const std::filesystem::path& out, ReportHost& host);
 
 }  // namespace retile::eval

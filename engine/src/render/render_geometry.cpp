@@ -433,49 +433,61 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
 
 static_assert(gpu::kMaxBlendChain == kMaxBlendChain, "the kernel follows as many blends as the scene allows");
 
-bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
-  struct Candidate {
-    const Object* object;
-    const MeshEntry* mesh;
-    Mat4 transform;  // from the mesh's packed space to world space
-    Bounds3 bounds;
-    bool visible;
-  };
-  // Hidden objects are instances too, with no reference in the instance BVH: so an instance's
-  // number does not change when another is hidden or shown, and with direct references (below)
-  // the triangles that carry it need not be uploaded again.
-  std::vector<Candidate> cands;
-  std::size_t visible = 0;
-  for (const Object& o : scene.objects) {
-    const MeshEntry* mesh = entryOf(o);
-    if (!mesh) continue;
-    const Mat4 t = placement(o.transform, *mesh);
-    Bounds3 b = transformBounds(t, mesh->bvh.bounds);
-    if (b.empty()) continue;
-    cands.push_back({&o, mesh, t, b, o.visible});
-    visible += o.visible ? 1 : 0;
-  }
+// An object with a mesh whose box is not empty: an instance, visible or not.
+struct RenderSceneBuilder::InstanceCandidate {
+  const Object* object;
+  const MeshEntry* mesh;
+  Mat4 transform;  // from the mesh's packed space to world space
+  Bounds3 bounds;
+  bool visible;
+};
+
+// The instances' flags (layouts.h kInstance...) and inverse transforms, as their records hold
+// them; the instance BVH's records repeat them.
+struct RenderSceneBuilder::InstanceRecords {
+  std::vector<int> flags;
+  std::vector<Mat4> inverse;
+};
+
+// A reference of the instance BVH: a subtree of an instance's BVH, entered like an instance.
+struct RenderSceneBuilder::BraidRef {
+  std::uint32_t cand;
+  std::int32_t item;           // where traversal enters the instance's BVH
+  std::int32_t node;           // that BVH's node index when item is an inner node, else -1
+  Bounds3 bounds;              // world space
+  std::int32_t triangles = 0;  // a leaf's, when item is one
+};
+
+// An instance BVH and the top part of the traversal buffer packed from it.
+struct RenderSceneBuilder::TopPacking {
+  std::vector<BraidRef> refs;
+  Bvh tlas;
+  std::vector<vec4> top;
+};
+
+// The instance BVHs that the candidates allow, opened to a braid factor, and their packings above
+// `mesh`, the traversal buffer's part that the meshes fill.
+class RenderSceneBuilder::TopLevel {
+ public:
+  TopLevel(const std::vector<InstanceCandidate>& cands, std::size_t visible, const InstanceRecords& records, const std::vector<vec4>& mesh)
+      : cands_(cands), visible_(visible), records_(records), mesh_(mesh), base_(static_cast<std::int64_t>(mesh.size())) {}
+
+  std::int32_t root() const { return traversalItem(base_, gpu::kItemNode); }
 
   // Where instances overlap, a ray inside their union is inside every one of their boxes and
   // must enter each. So the instance BVH is built over references to subtrees of the instances'
   // BVHs (partial re-braiding, after Benthin et al. 2017): starting from each instance's root,
   // the reference with the largest box is replaced by its children (up to four) until there are
-  // `factor` references per instance. A reference is entered like an instance, at its subtree.
-  // Where instances do not overlap, opening them gains nothing, so the factor is chosen by the
-  // steps it costs sample rays (below), and kept across small edits (when, below), so that a
-  // move builds one instance BVH, whose size stays proportional to the number of objects.
-  struct Ref {
-    std::uint32_t cand;
-    std::int32_t item;           // where traversal enters the instance's BVH
-    std::int32_t node;           // that BVH's node index when item is an inner node, else -1
-    Bounds3 bounds;              // world space
-    std::int32_t triangles = 0;  // a leaf's, when item is one
-  };
-  auto braid = [&](std::size_t budget) {
-    std::vector<Ref> refs;
+  // `budget` references. A reference is entered like an instance, at its subtree. Where
+  // instances do not overlap, opening them gains nothing, so the factor is chosen by the steps
+  // it costs sample rays (chooseBraidFactors), and kept across small edits (resetBraidIfStale),
+  // so that a move builds one instance BVH, whose size stays proportional to the number of
+  // objects.
+  std::vector<BraidRef> braid(std::size_t budget) const {
+    std::vector<BraidRef> refs;
     refs.reserve(budget);
-    for (std::uint32_t c = 0; c < cands.size(); ++c)
-      if (cands[c].visible) refs.push_back({c, cands[c].mesh->rootItem, 0, cands[c].bounds});
+    for (std::uint32_t c = 0; c < cands_.size(); ++c)
+      if (cands_[c].visible) refs.push_back({c, cands_[c].mesh->rootItem, 0, cands_[c].bounds});
     auto smaller = [&](std::size_t a, std::size_t b) { return refs[a].bounds.area() < refs[b].bounds.area(); };
     std::vector<std::size_t> open(refs.size());  // a max-heap by area of the references that can still be opened
     std::iota(open.begin(), open.end(), std::size_t{0});
@@ -484,20 +496,7 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
       std::pop_heap(open.begin(), open.end(), smaller);
       const std::size_t r = open.back();
       open.pop_back();
-      const Candidate& c = cands[refs[r].cand];
-      const BvhNode& n = c.mesh->bvh.nodes[static_cast<std::size_t>(refs[r].node)];
-      const std::int64_t nodes = c.mesh->rootItem >> gpu::kItemOffsetShift;
-      std::vector<Ref> children;
-      for (std::size_t k = 0; k < kBvhWidth; ++k) {
-        const std::int32_t index = n.index[k], count = n.count[k];
-        if (count < 0) continue;
-        const Bounds3 world = transformBounds(c.transform, n.box[k]);
-        if (count == 0)
-          children.push_back({refs[r].cand, traversalItem(nodes + std::int64_t{index} * gpu::kNodeTexels, gpu::kItemNode), index, world});
-        else
-          children.push_back({refs[r].cand, traversalItem((std::int64_t{c.mesh->triOffset} + index) * gpu::kTriTexels, gpu::kItemTriangles),
-                              -1, world, count});
-      }
+      const std::vector<BraidRef> children = childrenOf(refs[r]);
       if (children.size() < 2) continue;  // a leaf root: nothing to open
       const std::size_t first = refs.size();
       refs[r] = children[0];
@@ -511,38 +510,155 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
       for (std::size_t i = first; i < refs.size(); ++i) reopen(i);
     }
     return refs;
-  };
-  // Direct references (layouts.h kFeatureDirectReferences) need every instance in world space as
-  // packed, and each triangle in one instance only, as it names it.
-  bool transforms = false, shared = false;
-  {
-    std::unordered_set<const MeshEntry*> seen;
-    for (const Candidate& c : cands) {
-      if (!c.visible) continue;
-      transforms = transforms || !(c.transform == Mat4::identity());
-      shared = shared || !seen.insert(c.mesh).second;
-    }
   }
-  // A triangle names its instance in kTriInstanceMask's bits.
-  const bool direct = directReferences_ && !transforms && !shared && cands.size() <= static_cast<std::size_t>(gpu::kTriInstanceMask);
-  BvhBuildOptions opt;
-  opt.maxLeafSize = 1;  // a TLAS leaf is one reference: traversal enters its subtree directly
-  auto build = [&](std::size_t factor, bool packDirect, std::vector<Ref>* refs) {
-    *refs = braid(std::max(visible, std::min(visible * factor, kMaxBraidReferences)));
+
+  // The instance BVH over the references of `factor` per visible instance (kMaxBraidReferences
+  // at most), into *refs.
+  Bvh build(std::size_t factor, bool packDirect, std::vector<BraidRef>* refs) const {
+    *refs = braid(std::max(visible_, std::min(visible_ * factor, kMaxBraidReferences)));
     std::vector<Bounds3> boxes;
     boxes.reserve(refs->size());
-    for (const Ref& r : *refs) boxes.push_back(r.bounds);
+    for (const BraidRef& r : *refs) boxes.push_back(r.bounds);
+    BvhBuildOptions opt;
+    opt.maxLeafSize = 1;  // a TLAS leaf is one reference: traversal enters its subtree directly
     // Entering a reference is one step, unless packed direct, then its subtree's.
     const float enter = packDirect ? 0.0f : 1.0f;
-    opt.primCost = [&, enter](std::uint32_t i) {
-      const Ref& r = (*refs)[i];
-      if (r.node >= 0) return enter + cands[r.cand].mesh->steps[static_cast<std::size_t>(r.node)];
+    opt.primCost = [this, refs, enter](std::uint32_t i) {
+      const BraidRef& r = (*refs)[i];
+      if (r.node >= 0) return enter + cands_[r.cand].mesh->steps[static_cast<std::size_t>(r.node)];
       return enter + static_cast<float>(r.triangles);  // a leaf: its triangles
     };
     return buildBvh(boxes, opt);
-  };
+  }
 
-  // The instances' records, flags and numbers first: the instance BVH's packing needs them.
+  // The top part of the traversal buffer: the instance BVH, then one record per reference (in
+  // the BVH's packed order), or, direct, what the references name (copied after the numbering,
+  // so that copies of triangles carry it too).
+  std::vector<vec4> pack(const Bvh& tlas, const std::vector<BraidRef>& refs, bool packDirect) const {
+    std::vector<vec4> top;
+    if (packDirect) {
+      appendDirectTop(
+          top, base_, tlas.nodes,
+          [&](std::int32_t p) {
+            const BraidRef& r = refs[tlas.primOrder[static_cast<std::size_t>(p)]];
+            return DirectRef{r.item >> gpu::kItemOffsetShift, r.node >= 0, r.triangles};
+          },
+          mesh_);
+      return top;
+    }
+    const auto records = base_ + static_cast<std::int64_t>(tlas.nodes.size()) * gpu::kNodeTexels;
+    appendNodes(top, tlas.nodes, base_, records, true);
+    for (std::uint32_t p : tlas.primOrder) {
+      const BraidRef& r = refs[p];
+      const Mat4& inv = records_.inverse[r.cand];
+      top.push_back(ints(r.item, static_cast<std::int32_t>(r.cand), records_.flags[r.cand], 0));
+      for (int row = 0; row < 3; ++row) top.push_back({inv.m[row][0], inv.m[row][1], inv.m[row][2], inv.m[row][3]});
+      top.insert(top.end(), gpu::kInstanceRecordTexels - 4, vec4{});
+    }
+    RETILE_ASSERT(
+        records + static_cast<std::int64_t>(refs.size()) * gpu::kInstanceRecordTexels == base_ + static_cast<std::int64_t>(top.size()),
+        "instance records out of place");
+    return top;
+  }
+
+  TopPacking packing(std::size_t factor, bool packDirect) const {
+    TopPacking p;
+    p.tlas = build(factor, packDirect, &p.refs);
+    p.top = pack(p.tlas, p.refs, packDirect);
+    return p;
+  }
+
+  // Traversal steps of `rays` through a packing, as the kernel counts them (tracePacked).
+  std::uint64_t steps(const std::vector<SampleRay>& rays, const std::vector<vec4>& top, bool packDirect) const {
+    std::uint64_t steps = 0;
+    for (const SampleRay& r : rays) steps += tracePacked(mesh_, top, root(), packDirect, r.origin, r.direction, kRayFar).steps;
+    return steps;
+  }
+
+  // The factor for packing `packDirect` whose packing costs `rays` the fewest steps, from
+  // *best, the packing of factor 1, which becomes the chosen one. A factor must save 1 % of the
+  // steps to be taken: more references cost memory and build time.
+  std::size_t bestFactor(const std::vector<SampleRay>& rays, bool packDirect, TopPacking* best) const {
+    std::uint64_t fewest = steps(rays, best->top, packDirect);
+    std::size_t factor = 1, previous = best->refs.size();
+    for (std::size_t f = 2; f <= kMaxBraidFactor && !rays.empty(); f *= 2) {
+      std::vector<BraidRef> tried;
+      Bvh bvh = build(f, packDirect, &tried);
+      const bool opened = tried.size() > previous;
+      previous = tried.size();
+      if (!opened) break;  // nothing left to open, or the cap reached
+      std::vector<vec4> packed = pack(bvh, tried, packDirect);
+      const std::uint64_t n = steps(rays, packed, packDirect);
+      if (static_cast<double>(n) < 0.99 * static_cast<double>(fewest)) {
+        fewest = n;
+        factor = f;
+        best->refs = std::move(tried);
+        best->tlas = std::move(bvh);
+        best->top = std::move(packed);
+      }
+    }
+    return factor;
+  }
+
+ private:
+  // A reference's children, each a reference of the same instance.
+  std::vector<BraidRef> childrenOf(const BraidRef& ref) const {
+    const InstanceCandidate& c = cands_[ref.cand];
+    const BvhNode& n = c.mesh->bvh.nodes[static_cast<std::size_t>(ref.node)];
+    const std::int64_t nodes = c.mesh->rootItem >> gpu::kItemOffsetShift;
+    std::vector<BraidRef> children;
+    for (std::size_t k = 0; k < kBvhWidth; ++k) {
+      const std::int32_t index = n.index[k], count = n.count[k];
+      if (count < 0) continue;
+      const Bounds3 world = transformBounds(c.transform, n.box[k]);
+      if (count == 0)
+        children.push_back({ref.cand, traversalItem(nodes + std::int64_t{index} * gpu::kNodeTexels, gpu::kItemNode), index, world});
+      else
+        children.push_back(
+            {ref.cand, traversalItem((std::int64_t{c.mesh->triOffset} + index) * gpu::kTriTexels, gpu::kItemTriangles), -1, world, count});
+    }
+    return children;
+  }
+
+  const std::vector<InstanceCandidate>& cands_;
+  std::size_t visible_;
+  const InstanceRecords& records_;
+  const std::vector<vec4>& mesh_;
+  std::int64_t base_;  // the top part's first texel
+};
+
+// Hidden objects are instances too, with no reference in the instance BVH: so an instance's
+// number does not change when another is hidden or shown, and with direct references the
+// triangles that carry it need not be uploaded again.
+std::vector<RenderSceneBuilder::InstanceCandidate> RenderSceneBuilder::instanceCandidates(const Scene& scene) const {
+  std::vector<InstanceCandidate> cands;
+  for (const Object& o : scene.objects) {
+    const MeshEntry* mesh = entryOf(o);
+    if (!mesh) continue;
+    const Mat4 t = placement(o.transform, *mesh);
+    Bounds3 b = transformBounds(t, mesh->bvh.bounds);
+    if (b.empty()) continue;
+    cands.push_back({&o, mesh, t, b, o.visible});
+  }
+  return cands;
+}
+
+int RenderSceneBuilder::instanceFlags(const Scene& scene, const InstanceCandidate& c) const {
+  const Material* mat = scene.material(c.object->material);
+  int flags = 0;
+  // A boundary is crossed whole (its medium must not be left at random).
+  if (mat && mat->type != MaterialType::Boundary && (mat->alpha < 1.0f || textureIndex(mat->alphaTexture) >= 0))
+    flags |= gpu::kInstanceAlphaTested;
+  if (mat && sheetInBlend(scene, *mat)) flags |= gpu::kInstanceSheet;
+  if (mat && mat->emissive()) flags |= gpu::kInstanceEmissive;
+  if (mat && mat->type == MaterialType::Boundary) flags |= gpu::kInstanceBoundary;
+  if (c.object->cullBackFaces) flags |= gpu::kInstanceCullBack;
+  return flags;
+}
+
+// The instances' records, flags and numbers come first: the instance BVH's packing needs them.
+RenderSceneBuilder::InstanceRecords RenderSceneBuilder::packInstanceRecords(const Scene& scene, const std::vector<InstanceCandidate>& cands,
+                                                                            bool direct, bool transforms) {
   data_.directReferences = direct;
   data_.instances.clear();
   data_.instanceObject.clear();
@@ -550,107 +666,61 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
   data_.cutOuts = data_.sheetShadows = false;
   data_.cullBack = false;
   data_.instanceTransforms = transforms;
-  std::vector<int> flagsOf(cands.size(), 0);
-  std::vector<Mat4> inverseOf(cands.size());
+  InstanceRecords records{std::vector<int>(cands.size(), 0), std::vector<Mat4>(cands.size())};
   for (std::size_t i = 0; i < cands.size(); ++i) {
-    const Candidate& c = cands[i];
-    const Material* mat = scene.material(c.object->material);
-    int flags = 0;
-    // A boundary is crossed whole (its medium must not be left at random).
-    if (mat && mat->type != MaterialType::Boundary && (mat->alpha < 1.0f || textureIndex(mat->alphaTexture) >= 0))
-      flags |= gpu::kInstanceAlphaTested;
-    if (mat && sheetInBlend(scene, *mat)) flags |= gpu::kInstanceSheet;
-    if (mat && mat->emissive()) flags |= gpu::kInstanceEmissive;
-    if (mat && mat->type == MaterialType::Boundary) flags |= gpu::kInstanceBoundary;
-    if (c.object->cullBackFaces) flags |= gpu::kInstanceCullBack;
+    const InstanceCandidate& c = cands[i];
+    const int flags = instanceFlags(scene, c);
     if (c.visible && (flags & gpu::kInstanceAlphaTested)) data_.cutOuts = true;
     // A sheet's pause is the cut-outs' (RETILE_ALPHA_TEST).
     if (c.visible && (flags & gpu::kInstanceSheet)) data_.sheetShadows = true;
     if (c.visible && (flags & gpu::kInstanceCullBack)) data_.cullBack = true;
-    flagsOf[i] = flags;
-    inverseOf[i] = c.transform.inverse();
-    const Mat4& inv = inverseOf[i];
+    records.flags[i] = flags;
+    records.inverse[i] = c.transform.inverse();
+    const Mat4& inv = records.inverse[i];
     for (int r = 0; r < 3; ++r) data_.instances.push_back({inv.m[r][0], inv.m[r][1], inv.m[r][2], inv.m[r][3]});
     data_.instances.push_back(ints(0, static_cast<std::int32_t>(c.mesh->triOffset), materialIndex(c.object->material), -1));
     data_.instances.push_back(ints(static_cast<std::int32_t>(i) + 1, flags, 0, 0));
     data_.instanceObject.push_back(c.object->id);
     if (c.visible) data_.instancedTriangles += c.mesh->bvh.primOrder.size();
   }
-  // Direct, each triangle names its instance: a visible object's, or where none uses its mesh
-  // a hidden one's, so that showing it later changes nothing. The names change when objects are
-  // added or removed (or a cut-out's or culling flag changes), and then the meshes' part is
-  // uploaded again; a mesh whose triangles already name the right instance is not touched.
+  return records;
+}
+
+// Direct, each triangle names its instance: a visible object's, or where none uses its mesh
+// a hidden one's, so that showing it later changes nothing. The names change when objects are
+// added or removed (or a cut-out's or culling flag changes), and then the meshes' part is
+// uploaded again; a mesh whose triangles already name the right instance is not touched.
+// Returns whether any triangle was renamed.
+bool RenderSceneBuilder::nameTriangles(const std::vector<InstanceCandidate>& cands, const std::vector<int>& flagsOf) {
   bool renamed = false;
-  if (direct) {
-    std::unordered_map<const MeshEntry*, std::size_t> namer;
-    for (std::size_t i = 0; i < cands.size(); ++i)
-      if (cands[i].visible) namer[cands[i].mesh] = i;
-    for (std::size_t i = 0; i < cands.size(); ++i)
-      if (!cands[i].visible) namer.try_emplace(cands[i].mesh, i);
-    for (const auto& [mesh, i] : namer) {
-      const std::uint32_t name = static_cast<std::uint32_t>(i) | ((flagsOf[i] & gpu::kInstanceAlphaTested) ? gpu::kTriAlphaTested : 0u) |
-                                 ((flagsOf[i] & gpu::kInstanceBoundary) ? gpu::kTriBoundary : 0u) |
-                                 ((flagsOf[i] & gpu::kInstanceCullBack) ? gpu::kTriCullBack : 0u) |
-                                 ((flagsOf[i] & gpu::kInstanceSheet) ? gpu::kTriSheet : 0u);
-      if (mesh->named == name) continue;
-      mesh->named = name;
-      renamed = true;
-      const std::size_t from = mesh->triOffset, to = from + mesh->bvh.primOrder.size();
-      for (std::size_t p = from; p < to; ++p) data_.meshTraversal[p * gpu::kTriTexels + 2].w = std::bit_cast<float>(name);
-    }
+  std::unordered_map<const MeshEntry*, std::size_t> namer;
+  for (std::size_t i = 0; i < cands.size(); ++i)
+    if (cands[i].visible) namer[cands[i].mesh] = i;
+  for (std::size_t i = 0; i < cands.size(); ++i)
+    if (!cands[i].visible) namer.try_emplace(cands[i].mesh, i);
+  for (const auto& [mesh, i] : namer) {
+    const std::uint32_t name = static_cast<std::uint32_t>(i) | ((flagsOf[i] & gpu::kInstanceAlphaTested) ? gpu::kTriAlphaTested : 0u) |
+                               ((flagsOf[i] & gpu::kInstanceBoundary) ? gpu::kTriBoundary : 0u) |
+                               ((flagsOf[i] & gpu::kInstanceCullBack) ? gpu::kTriCullBack : 0u) |
+                               ((flagsOf[i] & gpu::kInstanceSheet) ? gpu::kTriSheet : 0u);
+    if (mesh->named == name) continue;
+    mesh->named = name;
+    renamed = true;
+    const std::size_t from = mesh->triOffset, to = from + mesh->bvh.primOrder.size();
+    for (std::size_t p = from; p < to; ++p) data_.meshTraversal[p * gpu::kTriTexels + 2].w = std::bit_cast<float>(name);
   }
+  return renamed;
+}
 
-  // The top part of the traversal buffer: the instance BVH, then one record per reference (in
-  // the BVH's packed order), or, direct, what the references name (copied after the numbering,
-  // so that copies of triangles carry it too).
-  const auto base = static_cast<std::int64_t>(data_.meshTraversal.size());
-  auto pack = [&](const Bvh& tlas, const std::vector<Ref>& refs, bool packDirect) {
-    std::vector<vec4> top;
-    if (packDirect) {
-      appendDirectTop(
-          top, base, tlas.nodes,
-          [&](std::int32_t p) {
-            const Ref& r = refs[tlas.primOrder[static_cast<std::size_t>(p)]];
-            return DirectRef{r.item >> gpu::kItemOffsetShift, r.node >= 0, r.triangles};
-          },
-          data_.meshTraversal);
-      return top;
-    }
-    const auto records = base + static_cast<std::int64_t>(tlas.nodes.size()) * gpu::kNodeTexels;
-    appendNodes(top, tlas.nodes, base, records, true);
-    for (std::uint32_t p : tlas.primOrder) {
-      const Ref& r = refs[p];
-      const Mat4& inv = inverseOf[r.cand];
-      top.push_back(ints(r.item, static_cast<std::int32_t>(r.cand), flagsOf[r.cand], 0));
-      for (int row = 0; row < 3; ++row) top.push_back({inv.m[row][0], inv.m[row][1], inv.m[row][2], inv.m[row][3]});
-      top.insert(top.end(), gpu::kInstanceRecordTexels - 4, vec4{});
-    }
-    RETILE_ASSERT(
-        records + static_cast<std::int64_t>(refs.size()) * gpu::kInstanceRecordTexels == base + static_cast<std::int64_t>(top.size()),
-        "instance records out of place");
-    return top;
-  };
-  data_.tlasRoot = traversalItem(base, gpu::kItemNode);
-
-  // How far instances are opened: the factor whose packing costs sample rays the fewest
-  // traversal steps, counted as the kernel counts them (tracePacked). The surface area
-  // heuristic, used before, assumes rays come from outside every box; a path's rays start on
-  // surfaces, inside the boxes of the instances around them, and the heuristic kept the living
-  // room's objects whole where 16 references each take 10 % fewer loop iterations a path. A
-  // factor must save 1 % of the steps to be taken: more references cost memory and build time.
-  // The rays leave the camera as it is when the factor is chosen.
-  //
-  // Choosing costs tens of milliseconds (the spaceship 30, a room of a million triangles 60), so
-  // it is done when meshes change, or when the visible objects differ from those of the last
-  // choice by more than an eighth of those (and by more than two), not for each object shown,
-  // hidden, added or removed, which would delay the editor's next frame by as much. Direct, a
-  // reference costs no step of its own, so the factor for records differs: a scene packed direct
-  // chooses it too, from the same rays, so that the first move (which turns direct off) need not
-  // choose. A scene packed with records that turns direct (its transforms undone, a duplicate
-  // removed) chooses the direct factor then.
+// Choosing the braid factors costs tens of milliseconds (the spaceship 30, a room of a million
+// triangles 60), so it is done when meshes change (chooseBraid), or when the visible objects
+// differ from those of the last choice by more than an eighth of those (and by more than two),
+// not for each object shown, hidden, added or removed, which would delay the editor's next frame
+// by as much. Forgets the factors chosen when it is time to choose again.
+void RenderSceneBuilder::resetBraidIfStale(const std::vector<InstanceCandidate>& cands, std::size_t visible, bool chooseBraid) {
   std::vector<NodeId> visibleIds;
   visibleIds.reserve(visible);
-  for (const Candidate& c : cands)
+  for (const InstanceCandidate& c : cands)
     if (c.visible) visibleIds.push_back(c.object->id);
   std::sort(visibleIds.begin(), visibleIds.end());
   std::vector<NodeId> differ;  // objects visible now or then but not both
@@ -660,76 +730,67 @@ bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
     braidVisible_ = std::move(visibleIds);
     braidFactor_ = {0, 0};
   }
-  std::vector<Ref> refs;
-  Bvh tlas;
-  std::vector<vec4> top;
-  if (braidFactor_[direct] == 0) {
-    ++braidChoices_;
-    std::vector<Ref> probeRefs;  // the rays are traced through the packing of factor 1
-    Bvh probe = build(1, direct, &probeRefs);
-    std::vector<vec4> probeTop = pack(probe, probeRefs, direct);
-    std::vector<SampleSurface> surfaces;
-    for (std::size_t i = 0; i < cands.size(); ++i)
-      if (cands[i].visible)
-        surfaces.push_back({cands[i].mesh->triOffset, static_cast<std::uint32_t>(cands[i].mesh->bvh.primOrder.size()), &cands[i].transform,
-                            &inverseOf[i]});
-    const std::vector<SampleRay> rays =
-        sampleRays(scene, data_.meshTraversal, probeTop, data_.tlasRoot, direct, surfaces,
-                   [&](std::int32_t instance) -> const Mat4& { return inverseOf[static_cast<std::size_t>(instance)]; });
-    auto stepsOf = [&](const std::vector<vec4>& packed, bool packDirect) {
-      std::uint64_t steps = 0;
-      for (const SampleRay& r : rays)
-        steps += tracePacked(data_.meshTraversal, packed, data_.tlasRoot, packDirect, r.origin, r.direction, kRayFar).steps;
-      return steps;
-    };
-    // The factor for packing `packDirect`, and with `keep` its instance BVH and packing. Factor 1
-    // in the current packing is the probe's.
-    auto choose = [&](bool packDirect, bool keep) {
-      std::vector<Ref> bestRefs;
-      Bvh bestTlas;
-      std::vector<vec4> bestTop;
-      if (packDirect == direct) {
-        bestRefs = std::move(probeRefs);
-        bestTlas = std::move(probe);
-        bestTop = std::move(probeTop);
-      } else {
-        bestTlas = build(1, packDirect, &bestRefs);
-        bestTop = pack(bestTlas, bestRefs, packDirect);
-      }
-      std::uint64_t best = stepsOf(bestTop, packDirect);
-      std::size_t factor = 1, previous = bestRefs.size();
-      for (std::size_t f = 2; f <= kMaxBraidFactor && !rays.empty(); f *= 2) {
-        std::vector<Ref> tried;
-        Bvh bvh = build(f, packDirect, &tried);
-        const bool opened = tried.size() > previous;
-        previous = tried.size();
-        if (!opened) break;  // nothing left to open, or the cap reached
-        std::vector<vec4> packed = pack(bvh, tried, packDirect);
-        const std::uint64_t steps = stepsOf(packed, packDirect);
-        if (static_cast<double>(steps) < 0.99 * static_cast<double>(best)) {
-          best = steps;
-          factor = f;
-          bestRefs = std::move(tried);
-          bestTlas = std::move(bvh);
-          bestTop = std::move(packed);
-        }
-      }
-      if (keep) {
-        refs = std::move(bestRefs);
-        tlas = std::move(bestTlas);
-        top = std::move(bestTop);
-      }
-      braidFactor_[packDirect] = factor;
-    };
-    choose(direct, true);
-    if (direct && braidFactor_[false] == 0) choose(false, false);
-  } else {
-    tlas = build(braidFactor_[direct], direct, &refs);
-    top = pack(tlas, refs, direct);
+}
+
+// How far instances are opened: the factor whose packing costs sample rays the fewest
+// traversal steps, counted as the kernel counts them (tracePacked). The surface area
+// heuristic assumes rays come from outside every box; a path's rays start on surfaces, inside
+// the boxes of the instances around them, and the heuristic keeps the living room's objects
+// whole where 16 references each take 10 % fewer loop iterations a path. The rays leave the
+// camera as it is when the factor is chosen.
+//
+// Direct, a reference costs no step of its own, so the factor for records differs: a scene
+// packed direct chooses it too, from the same rays, so that the first move (which turns direct
+// off) need not choose. A scene packed with records that turns direct (its transforms undone, a
+// duplicate removed) chooses the direct factor then. Returns the packing chosen for `direct`.
+RenderSceneBuilder::TopPacking RenderSceneBuilder::chooseBraidFactors(const Scene& scene, const TopLevel& top,
+                                                                      const std::vector<InstanceCandidate>& cands,
+                                                                      const InstanceRecords& records, bool direct) {
+  ++braidChoices_;
+  TopPacking chosen = top.packing(1, direct);  // the rays are traced through the packing of factor 1
+  std::vector<SampleSurface> surfaces;
+  for (std::size_t i = 0; i < cands.size(); ++i)
+    if (cands[i].visible)
+      surfaces.push_back({cands[i].mesh->triOffset, static_cast<std::uint32_t>(cands[i].mesh->bvh.primOrder.size()), &cands[i].transform,
+                          &records.inverse[i]});
+  const std::vector<SampleRay> rays =
+      sampleRays(scene, data_.meshTraversal, chosen.top, top.root(), direct, surfaces,
+                 [&](std::int32_t instance) -> const Mat4& { return records.inverse[static_cast<std::size_t>(instance)]; });
+  braidFactor_[direct] = top.bestFactor(rays, direct, &chosen);
+  if (direct && braidFactor_[false] == 0) {
+    TopPacking withRecords = top.packing(1, false);
+    braidFactor_[false] = top.bestFactor(rays, false, &withRecords);
   }
-  data_.bounds = tlas.bounds;
-  data_.topTraversal = std::move(top);
-  data_.instanceReferences = refs.size();
+  return chosen;
+}
+
+bool RenderSceneBuilder::packInstances(const Scene& scene, bool chooseBraid) {
+  const std::vector<InstanceCandidate> cands = instanceCandidates(scene);
+  const auto visible = static_cast<std::size_t>(std::count_if(cands.begin(), cands.end(), [](const auto& c) { return c.visible; }));
+  // Direct references (layouts.h kFeatureDirectReferences) need every instance in world space as
+  // packed, and each triangle in one instance only, as it names it.
+  bool transforms = false, shared = false;
+  {
+    std::unordered_set<const MeshEntry*> seen;
+    for (const InstanceCandidate& c : cands) {
+      if (!c.visible) continue;
+      transforms = transforms || !(c.transform == Mat4::identity());
+      shared = shared || !seen.insert(c.mesh).second;
+    }
+  }
+  // A triangle names its instance in kTriInstanceMask's bits.
+  const bool direct = directReferences_ && !transforms && !shared && cands.size() <= static_cast<std::size_t>(gpu::kTriInstanceMask);
+  const InstanceRecords records = packInstanceRecords(scene, cands, direct, transforms);
+  const bool renamed = direct && nameTriangles(cands, records.flags);
+
+  const TopLevel top(cands, visible, records, data_.meshTraversal);
+  data_.tlasRoot = top.root();
+  resetBraidIfStale(cands, visible, chooseBraid);
+  TopPacking chosen =
+      braidFactor_[direct] == 0 ? chooseBraidFactors(scene, top, cands, records, direct) : top.packing(braidFactor_[direct], direct);
+  data_.bounds = chosen.tlas.bounds;
+  data_.topTraversal = std::move(chosen.top);
+  data_.instanceReferences = chosen.refs.size();
   return renamed;
 }
 

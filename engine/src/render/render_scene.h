@@ -225,6 +225,19 @@ class RenderSceneBuilder {
   // chooseBraid: choose how far instances are opened (packInstances), as when meshes change.
   // Returns whether triangles were renamed (kDirtyTriangleNames).
   bool packInstances(const Scene& scene, bool chooseBraid);
+  // packInstances' steps and what they hand on (render_geometry.cpp).
+  struct InstanceCandidate;
+  struct InstanceRecords;
+  struct BraidRef;
+  struct TopPacking;
+  class TopLevel;
+  std::vector<InstanceCandidate> instanceCandidates(const Scene& scene) const;
+  int instanceFlags(const Scene& scene, const InstanceCandidate& c) const;
+  InstanceRecords packInstanceRecords(const Scene& scene, const std::vector<InstanceCandidate>& cands, bool direct, bool transforms);
+  bool nameTriangles(const std::vector<InstanceCandidate>& cands, const std::vector<int>& flagsOf);
+  void resetBraidIfStale(const std::vector<InstanceCandidate>& cands, std::size_t visible, bool chooseBraid);
+  TopPacking chooseBraidFactors(const Scene& scene, const TopLevel& top, const std::vector<InstanceCandidate>& cands,
+                                const InstanceRecords& records, bool direct);
   void packMaterials(const Scene& scene);
   void packTextures(const Scene& scene, std::vector<std::string>* warnings);
   void packEmitters(const Scene& scene);
