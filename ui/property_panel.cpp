@@ -350,6 +350,71 @@ void PropertyPanel::scalarRows(Builder& b, const Material& m, MaterialPlace plac
   }
 }
 
+void PropertyPanel::roughnessRows(Builder& b, const Material& m) {
+  const NodeId id = m.id;
+  auto edit = nodeEdit<Material, SetMaterial>(id, [](const Scene& sc, NodeId i) { return sc.material(i); });
+  const Material defaults;
+  // A slider as well as the field: the gesture look-dev artists use most.
+  auto* row = new QWidget(body_);
+  auto* l = new QHBoxLayout(row);
+  l->setContentsMargins(0, 0, 0, 0);
+  auto* slider = new QSlider(Qt::Horizontal, row);
+  slider->setObjectName("roughnessSlider");
+  slider->setRange(0, 1000);
+  slider->setValue(static_cast<int>(std::lround(m.roughness * 1000)));
+  auto* field = new ScrubField(m.roughness, 0.0, 1.0, defaults.roughness, 3, row);
+  field->setObjectName("roughness");
+  field->setSizePolicy(QSizePolicy::Fixed, QSizePolicy::Fixed);
+  field->setFixedWidth(72);
+  l->addWidget(slider, 1);
+  l->addWidget(field);
+  QObject::connect(slider, &QSlider::valueChanged, slider, [this, slider, field, edit](int v) {
+    QSignalBlocker block(field);
+    field->setValue(v / 1000.0);
+    edit(tr("Roughness"), slider->isSliderDown() ? drag_ : 0, [v](Material& x) { x.roughness = std::max(0.001f, v / 1000.0f); });
+  });
+  QObject::connect(slider, &QSlider::sliderReleased, slider, [this] { ++drag_; });
+  b.connectField(field, [slider, edit](double v, int drag) {
+    QSignalBlocker block(slider);
+    slider->setValue(static_cast<int>(std::lround(v * 1000)));
+    edit(tr("Roughness"), drag, [v](Material& x) { x.roughness = std::max(0.001f, static_cast<float>(v)); });
+  });
+  form_->addRow(tr("Roughness"), row);
+  if (isMicrofacet(m.type))
+    b.choice(tr("Distribution"), "distribution", {tr("GGX"), tr("Beckmann")}, m.beckmann ? 1 : 0,
+             [edit](int i) { edit(tr("Distribution"), 0, [i](Material& x) { x.beckmann = i == 1; }); });
+  if (isMicrofacet(m.type))
+    b.choice(tr("Shadowing"), "shadowing", {tr("Height-correlated"), tr("Separable (Tungsten)")}, m.separableShadowing ? 1 : 0,
+             [edit](int i) { edit(tr("Shadowing"), 0, [i](Material& x) { x.separableShadowing = i == 1; }); });
+}
+
+void PropertyPanel::textureRows(Builder& b, const Material& m) {
+  auto edit = nodeEdit<Material, SetMaterial>(m.id, [](const Scene& sc, NodeId i) { return sc.material(i); });
+  // Texture slots: which texture feeds each input, and for file textures the file itself.
+  struct Slot {
+    const char* label;
+    const char* name;
+    NodeId Material::*field;
+  };
+  for (const Slot& slot :
+       {Slot{"Albedo texture", "albedoTexture", &Material::albedoTexture},
+        Slot{"Roughness texture", "roughnessTexture", &Material::roughnessTexture},
+        Slot{"Alpha texture", "alphaTexture", &Material::alphaTexture}, Slot{"Bump texture", "bumpTexture", &Material::bumpTexture},
+        Slot{"Emission texture", "emissionTexture", &Material::emissionTexture}}) {
+    if (slot.field == &Material::roughnessTexture && !readsRoughnessSlot(m.type)) continue;
+    if (slot.field == &Material::albedoTexture && m.type == MaterialType::Hair) continue;
+    auto field = slot.field;
+    const char* label = field == &Material::roughnessTexture && roughnessSlotIsThickness(m.type) ? "Thickness texture" : slot.label;
+    b.nodeChoice(tr(label), slot.name, scene_().textures, m.*field, [this, edit, field](NodeId t) {
+      edit(tr("Assign texture"), 0, [t, field](Material& x) { x.*field = t; });
+      rebuildLater();
+    });
+    const Texture* tex = scene_().texture(m.*slot.field);
+    if (tex && tex->kind == TextureKind::File) texturePath(b, *tex, QString("%1Path").arg(slot.name));
+    if (slot.field == &Material::bumpTexture && tex) scalarRows(b, m, MaterialPlace::Bumped);
+  }
+}
+
 void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   const NodeId id = m.id;
   auto edit = nodeEdit<Material, SetMaterial>(id, [](const Scene& sc, NodeId i) { return sc.material(i); });
@@ -371,41 +436,7 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
   if (m.type != MaterialType::Boundary && m.type != MaterialType::Hair)
     b.color(tr("Albedo"), "albedo", m.albedo, defaults.albedo,
             [edit](Vec3 c, int drag) { edit(tr("Albedo"), drag, [c](Material& x) { x.albedo = c; }); });
-  const bool rough = hasRoughness(m.type);
-  if (rough) {  // smooth types ignore roughness: no field that does nothing
-    // A slider as well as the field: the gesture look-dev artists use most.
-    auto* row = new QWidget(body_);
-    auto* l = new QHBoxLayout(row);
-    l->setContentsMargins(0, 0, 0, 0);
-    auto* slider = new QSlider(Qt::Horizontal, row);
-    slider->setObjectName("roughnessSlider");
-    slider->setRange(0, 1000);
-    slider->setValue(static_cast<int>(std::lround(m.roughness * 1000)));
-    auto* field = new ScrubField(m.roughness, 0.0, 1.0, defaults.roughness, 3, row);
-    field->setObjectName("roughness");
-    field->setSizePolicy(QSizePolicy::Fixed, QSizePolicy::Fixed);
-    field->setFixedWidth(72);
-    l->addWidget(slider, 1);
-    l->addWidget(field);
-    QObject::connect(slider, &QSlider::valueChanged, slider, [this, slider, field, edit](int v) {
-      QSignalBlocker block(field);
-      field->setValue(v / 1000.0);
-      edit(tr("Roughness"), slider->isSliderDown() ? drag_ : 0, [v](Material& x) { x.roughness = std::max(0.001f, v / 1000.0f); });
-    });
-    QObject::connect(slider, &QSlider::sliderReleased, slider, [this] { ++drag_; });
-    b.connectField(field, [slider, edit](double v, int drag) {
-      QSignalBlocker block(slider);
-      slider->setValue(static_cast<int>(std::lround(v * 1000)));
-      edit(tr("Roughness"), drag, [v](Material& x) { x.roughness = std::max(0.001f, static_cast<float>(v)); });
-    });
-    form_->addRow(tr("Roughness"), row);
-    if (isMicrofacet(m.type))
-      b.choice(tr("Distribution"), "distribution", {tr("GGX"), tr("Beckmann")}, m.beckmann ? 1 : 0,
-               [edit](int i) { edit(tr("Distribution"), 0, [i](Material& x) { x.beckmann = i == 1; }); });
-    if (isMicrofacet(m.type))
-      b.choice(tr("Shadowing"), "shadowing", {tr("Height-correlated"), tr("Separable (Tungsten)")}, m.separableShadowing ? 1 : 0,
-               [edit](int i) { edit(tr("Shadowing"), 0, [i](Material& x) { x.separableShadowing = i == 1; }); });
-  }
+  if (hasRoughness(m.type)) roughnessRows(b, m);  // smooth types ignore roughness: no field that does nothing
   scalarRows(b, m, MaterialPlace::Surface);
   if (!isTransmissiveType(m.type)) {
     if (m.coated()) {
@@ -458,29 +489,14 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
                });
              });
   }
-  // Texture slots: which texture feeds each input, and for file textures the file itself.
-  struct Slot {
-    const char* label;
-    const char* name;
-    NodeId Material::*field;
-  };
-  for (const Slot& slot :
-       {Slot{"Albedo texture", "albedoTexture", &Material::albedoTexture},
-        Slot{"Roughness texture", "roughnessTexture", &Material::roughnessTexture},
-        Slot{"Alpha texture", "alphaTexture", &Material::alphaTexture}, Slot{"Bump texture", "bumpTexture", &Material::bumpTexture},
-        Slot{"Emission texture", "emissionTexture", &Material::emissionTexture}}) {
-    if (slot.field == &Material::roughnessTexture && !readsRoughnessSlot(m.type)) continue;
-    if (slot.field == &Material::albedoTexture && m.type == MaterialType::Hair) continue;
-    auto field = slot.field;
-    const char* label = field == &Material::roughnessTexture && roughnessSlotIsThickness(m.type) ? "Thickness texture" : slot.label;
-    b.nodeChoice(tr(label), slot.name, scene_().textures, m.*field, [this, edit, field](NodeId t) {
-      edit(tr("Assign texture"), 0, [t, field](Material& x) { x.*field = t; });
-      rebuildLater();
-    });
-    const Texture* tex = scene_().texture(m.*slot.field);
-    if (tex && tex->kind == TextureKind::File) texturePath(b, *tex, QString("%1Path").arg(slot.name));
-    if (slot.field == &Material::bumpTexture && tex) scalarRows(b, m, MaterialPlace::Bumped);
-  }
+  textureRows(b, m);
+  emissionRows(b, m);
+  blendRows(b, m);
+}
+
+void PropertyPanel::emissionRows(Builder& b, const Material& m) {
+  const NodeId id = m.id;
+  auto edit = nodeEdit<Material, SetMaterial>(id, [](const Scene& sc, NodeId i) { return sc.material(i); });
 
   // Shown as a swatch (the colour, normalised: files give radiance above 1) and a strength, the
   // peak of the radiance; each edit keeps the other, a strength of 0 included.
@@ -510,6 +526,11 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     if (was != (v > 0)) rebuildLater(drag);  // the cone shows only while it emits
   });
   if (m.emissive()) scalarRows(b, m, MaterialPlace::Emissive);
+}
+
+void PropertyPanel::blendRows(Builder& b, const Material& m) {
+  const NodeId id = m.id;
+  auto edit = nodeEdit<Material, SetMaterial>(id, [](const Scene& sc, NodeId i) { return sc.material(i); });
 
   // A blend with another material (Tungsten's mixed bsdf): this one's share, the other's the rest.
   b.nodeChoice(

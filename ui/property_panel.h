@@ -76,6 +76,11 @@ class PropertyPanel : public QScrollArea {
   void buildMaterial(Builder& b, const Material& m);
   // The rows of kMaterialScalars shown at `place` for m's type, each edited as one undoable step.
   void scalarRows(Builder& b, const Material& m, MaterialPlace place);
+  // The rest of a material's rows, by what they set.
+  void roughnessRows(Builder& b, const Material& m);
+  void textureRows(Builder& b, const Material& m);
+  void emissionRows(Builder& b, const Material& m);
+  void blendRows(Builder& b, const Material& m);
   void buildLight(Builder& b, const Light& l);
   void texturePath(Builder& b, const Texture& t, const QString& objectName);
   void buildCamera(Builder& b);
