@@ -77,6 +77,16 @@ std::vector<int> sortedTiles(std::vector<int> v) {
   return v;
 }
 
+// Every tile of `g` reusing a 40-sample history, and the fresh samples of `tile` twice its
+// history's mean tested: its rejection pending.
+void rejectOneTile(ReuseTracker& r, const TileGrid& g, int tile) {
+  r.reset(g);
+  startEveryTile(r, g, 1, 40);
+  NoisyTiles img{g, std::vector<double>(static_cast<std::size_t>(g.count()), 1.0)};
+  img.freshMean[static_cast<std::size_t>(tile)] = 2.0;
+  r.test(1, 1e-4, img.sums());
+}
+
 TEST(ReuseTracker, ARestartStartsAHistoryCreditedWithTheSamplesTheTileHad) {
   const TileGrid g(64, 32, kTile);  // 4 x 2 tiles
   ReuseTracker r;
@@ -153,11 +163,7 @@ TEST(ReuseTracker, AStaleTileOfASmoothPassStartsItsHistoryOncePerPass) {
 TEST(ReuseTracker, AGlobalUpdateDropsEveryHistoryCreditAndVerdict) {
   const TileGrid g(64, 32, kTile);
   ReuseTracker r;
-  r.reset(g);
-  startEveryTile(r, g, 1, 40);
-  NoisyTiles img{g, std::vector<double>(8, 1.0)};
-  img.freshMean[4] = 2.0;
-  r.test(1, 1e-4, img.sums());
+  rejectOneTile(r, g, 4);
   ASSERT_EQ(r.pendingRejects(), std::vector<int>{4});
 
   FramePlan global;
@@ -176,11 +182,7 @@ TEST(ReuseTracker, AGlobalUpdateDropsEveryHistoryCreditAndVerdict) {
 TEST(ReuseTracker, APendingRejectionDropsTheHistoryAndItsCreditWithTheNextFrame) {
   const TileGrid g(64, 32, kTile);
   ReuseTracker r;
-  r.reset(g);
-  startEveryTile(r, g, 1, 40);
-  NoisyTiles img{g, std::vector<double>(8, 1.0)};
-  img.freshMean[6] = 2.0;
-  r.test(1, 1e-4, img.sums());
+  rejectOneTile(r, g, 6);
   EXPECT_EQ(r.states()[6], TileReuse::Reusing) << "until the next frame";
 
   FramePlan p = incrementalFrame({wholeTile(g, 6, false)});
@@ -201,11 +203,7 @@ TEST(ReuseTracker, APendingRejectionDropsTheHistoryAndItsCreditWithTheNextFrame)
 TEST(ReuseTracker, ANewEditRestartingARejectedTileInTheSameFrameKeepsItsNewHistory) {
   const TileGrid g(64, 32, kTile);
   ReuseTracker r;
-  r.reset(g);
-  startEveryTile(r, g, 1, 40);
-  NoisyTiles img{g, std::vector<double>(8, 1.0)};
-  img.freshMean[6] = 2.0;
-  r.test(1, 1e-4, img.sums());
+  rejectOneTile(r, g, 6);
   ASSERT_EQ(r.pendingRejects(), std::vector<int>{6});
 
   r.startPass();
