@@ -233,14 +233,17 @@ TEST(Cli, RefusesBadValuesNamingTheOption) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
-// `retile eval --quick` as a reviewer runs it: every default method through three scenarios, a
-// report that opens offline, and references that a second run takes from disk.
+// `retile eval --quick` as a reviewer runs it, with one method of each policy and the denoiser
+// (every method runs in the stability suite): three scenarios, a report that opens offline, and
+// references that a second run takes from disk.
 TEST(Cli, EvalQuickWritesTheReportAndCachesReferences) {
   const std::filesystem::path out = test::tempDir() / "eval";
   ChildLimits limits;
   limits.timeout = std::chrono::minutes(10);
-  ChildResult run =
-      runChild(RETILE_CLI_PATH, {"eval", "default", "--quick", "--scenarios", "fig6,material,light", "--out-dir", out.string()}, limits);
+  ChildResult run = runChild(RETILE_CLI_PATH,
+                             {"eval", "default", "--quick", "--methods", "global,spiral,focus,indirection,global+denoise", "--scenarios",
+                              "fig6,material,light", "--out-dir", out.string()},
+                             limits);
   ASSERT_EQ(run.exitCode, 0) << run.err;
   for (const char* f : {"index.html", "metrics.csv", "summary.csv"}) EXPECT_TRUE(std::filesystem::exists(out / f)) << f;
 
