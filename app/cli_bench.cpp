@@ -108,8 +108,8 @@ struct RoomOptions {
   std::string roulette = "standard";
 };
 
-// --roulette: the rule by name (standard, tungsten).
-Roulette rouletteNamed(const std::string& name) { return name == "tungsten" ? Roulette::Tungsten : Roulette::Standard; }
+// --roulette: the rule by name (standard, low_throughput; tungsten, as Tungsten plays it, is the second).
+Roulette rouletteNamed(const std::string& name) { return name == "standard" ? Roulette::Standard : Roulette::LowThroughput; }
 
 // "100k,1M,4M" -> counts; k and M multiply by a thousand and a million.
 std::vector<std::uint64_t> parseCounts(const std::string& text) {
@@ -447,9 +447,10 @@ void addBench(CLI::App& app, int* status) {
       ->type_name("P");
   addInt(*cmd, "--spp-per-frame", &throughput->sppPerFrame, 1, 1024, "samples per pixel in each frame",
          "as retile render: about 2^18 samples a frame");
-  cmd->add_option("--roulette", throughput->roulette, "Russian roulette: standard or tungsten (default: the scene's)")
+  cmd->add_option("--roulette", throughput->roulette,
+                  "Russian roulette: standard, or low_throughput (also called tungsten) (default: the scene's)")
       ->type_name("RULE")
-      ->check(oneOf("roulette", {"standard", "tungsten"}));
+      ->check(oneOf("roulette", {"standard", "low_throughput", "tungsten"}));
   cmd->callback([throughput, status] { *status = benchThroughput(*throughput); });
 
   cmd = bench->add_subcommand("bvh", "BVH build time for a tessellated surface of N triangles");
@@ -489,9 +490,9 @@ void addBench(CLI::App& app, int* status) {
          "as retile render: about 2^18 samples a frame");
   addInt(*cmd, "--max-bounces", &room->maxBounces, 0, 1024, "bounce limit");
   cmd->add_option("--write-scene", room->writeScene, "also save the first room as a native scene (.retile)")->type_name("FILE");
-  cmd->add_option("--roulette", room->roulette, "Russian roulette: standard or tungsten (default: standard)")
+  cmd->add_option("--roulette", room->roulette, "Russian roulette: standard, or low_throughput (also called tungsten) (default: standard)")
       ->type_name("RULE")
-      ->check(oneOf("roulette", {"standard", "tungsten"}));
+      ->check(oneOf("roulette", {"standard", "low_throughput", "tungsten"}));
   cmd->callback([room, status] { *status = benchRoom(*room); });
 
   cmd = bench->add_subcommand("scale", "Samples/s and memory against triangle count (16 k to 2 M)");

@@ -42,59 +42,60 @@ layout(set = 0, binding = kBindFilterWarp) uniform samplerBuffer uFilterWarp;
 
 float warpSlot(int i) { return texelFetch(uFilterWarp, i).x; }
 
-// Tungsten's table (FilterSampling::Tungsten) at step i = 0..30: slot i - 1 holds it, step 0's is 0.
-float tungstenCdf(int i) { return i <= 0 ? 0.0 : warpSlot(i - 1); }
+// The stepped table's CDF (FilterSampling::SteppedTable) at step i = 0..30: slot i - 1 holds it, step 0's is 0.
+float steppedCdf(int i) { return i <= 0 ? 0.0 : warpSlot(i - 1); }
 
-// Tungsten's tent table at step i = 0..31 in closed form: the weights 1 - k/31 of steps k = 0..30
+// The stepped tent table at step i = 0..31 in closed form: the weights 1 - k/31 of steps k = 0..30
 // sum to 16, so the sum of those below step i, normalised, is (i - i (i - 1) / 62) / 16.
-float tungstenTentCdf(int i) {
+float steppedTentCdf(int i) {
   float f = float(i);
   return (f - f * (f - 1.0) / 62.0) / 16.0;
 }
 
 // A sample's offset from the pixel centre along one axis for u in [0, 1): the filter's inverse
-// CDF, linear between its 33 tabulated points (layouts.h), or exact for a tent, or as Tungsten
-// draws it (ReconstructionFilter::sample: the first step whose CDF exceeds the draw, searched from
-// step 1, so the draw lands one step further out than the weight it was drawn with).
+// CDF, linear between its 33 tabulated points (layouts.h), or exact for a tent, or from the
+// stepped table (as Tungsten's ReconstructionFilter::sample draws: the first step whose CDF
+// exceeds the draw, searched from step 1, so the draw lands one step further out than the weight
+// it was drawn with).
 // Only the way the scene's filter is drawn is compiled in (kFeatureFilter...): every lane runs
 // this for every segment, whether it starts a path or not.
 float filterOffset(float u) {
   float tent = frame.filterWarp[8].w;
   if (hasFeature(kFeatureFilterTent) && tent > 0.0) return tent * (u < 0.5 ? sqrt(2.0 * u) - 1.0 : 1.0 - sqrt(2.0 - 2.0 * u));
-  if (hasFeature(kFeatureFilterTungstenTent) && tent < 0.0 && frame.filterWarp[8].z > 0.0) {
+  if (hasFeature(kFeatureFilterSteppedTent) && tent < 0.0 && frame.filterWarp[8].z > 0.0) {
     // As below, with the step found without the table: its search (seven reads a side, each a
     // call over the eight lanes, in every lane of every pass) cost the spaceship about 5 % of its
-    // samples/s. The CDF is tungstenTentCdf's, equal to the table's up to
+    // samples/s. The CDF is steppedTentCdf's, equal to the table's up to
     // its float sums' rounding.
     bool negative = u < 0.5;
     float xi = negative ? 2.0 * u : 2.0 * u - 1.0;
-    float x = 0.5 * (63.0 - sqrt(max(3969.0 - 3968.0 * xi, 0.0)));  // tungstenTentCdf(x) = xi
+    float x = 0.5 * (63.0 - sqrt(max(3969.0 - 3968.0 * xi, 0.0)));  // steppedTentCdf(x) = xi
     int lo = clamp(int(x) + 1, 1, 30);
-    float c0 = tungstenTentCdf(lo - 1), c1 = tungstenTentCdf(lo);
+    float c0 = steppedTentCdf(lo - 1), c1 = steppedTentCdf(lo);
     // The root's rounding can put it a step off: the step is the first whose CDF exceeds xi.
     if (xi < c0 && lo > 1) {
       lo--;
       c1 = c0;
-      c0 = tungstenTentCdf(lo - 1);
+      c0 = steppedTentCdf(lo - 1);
     } else if (xi >= c1 && lo < 30) {
       lo++;
       c0 = c1;
-      c1 = tungstenTentCdf(lo);
+      c1 = steppedTentCdf(lo);
     }
     float offset = -tent * (float(lo) + (xi - c0) / max(c1 - c0, 1e-9)) / 31.0;
     return negative ? -offset : offset;
   }
-  if (hasFeature(kFeatureFilterTungsten) && tent < 0.0) {
+  if (hasFeature(kFeatureFilterStepped) && tent < 0.0) {
     bool negative = u < 0.5;
     float xi = negative ? 2.0 * u : 2.0 * u - 1.0;
     int lo = 1, hi = 30;  // the first step in 1..29 with CDF > xi, else 30
     for (int k = 0; k < 5; ++k) {
       int mid = (lo + hi) >> 1;
-      bool below = mid >= 30 || xi < tungstenCdf(mid);
+      bool below = mid >= 30 || xi < steppedCdf(mid);
       hi = below ? mid : hi;
       lo = below ? lo : mid + 1;
     }
-    float c0 = tungstenCdf(lo - 1), c1 = tungstenCdf(lo);
+    float c0 = steppedCdf(lo - 1), c1 = steppedCdf(lo);
     float offset = -tent * (float(lo) + (xi - c0) / max(c1 - c0, 1e-9)) / 31.0;
     return negative ? -offset : offset;
   }
@@ -188,11 +189,11 @@ vec3 offsetRay(vec3 p, vec3 n) {
               abs(p.z) < origin ? p.z + floatScale * n.z : pi.z);
 }
 
-// How far along a ray that leaves a surface it starts: Tungsten's rays skip what lies within its
-// epsilon (RayOffset::Tungsten), so light leaks through cracks narrower than that and contact
-// shadows closer than that vanish, in Tungsten and then here too. The skipped piece of a medium
+// How far along a ray that leaves a surface it starts: with RayOffset::FixedEpsilon it skips what
+// lies within kFixedRayEpsilon, so light leaks through cracks narrower than that and contact
+// shadows closer than that vanish, as in Tungsten. The skipped piece of a medium
 // is not counted on a path's own segment (at most 5e-4 of its optical depth per unit extinction).
-float surfaceSkip() { return hasFeature(kFeatureTungstenEpsilon) ? kTungstenEpsilon : 0.0; }
+float surfaceSkip() { return hasFeature(kFeatureFixedEpsilon) ? kFixedRayEpsilon : 0.0; }
 
 // The work item that holds `slot`. Every lane runs it in every pass, for a slot of its own or
 // any, with the same number of iterations (enough for the longest search), so that the lanes'
@@ -421,7 +422,7 @@ bool sheetPasses(inout Trace tr) {
     vec3 n = r0.xyz * nObj.x + r1.xyz * nObj.y + r2.xyz * nObj.z;
     if (dot(n, n) > 0.0) {
       ns = normalize(n);
-      if (!hasFeature(kFeatureTungstenShading) && dot(ns, ng) < 0.0) ns = -ns;
+      if (!hasFeature(kFeatureUncheckedShading) && dot(ns, ng) < 0.0) ns = -ns;
     }
   }
   ns = bumped(ns, material, r0, r1, r2, e1, e2, s0, s1, s2, s3, uv);
@@ -514,7 +515,7 @@ void resolveShadow(inout Path path, inout Shadow shadow, Trace tr) {
 bool survivesRoulette(inout Path path, inout Shadow shadow) {
   if (path.depth > 3) {
     float m = maxComponent(path.beta * path.etaScale);
-    float q = hasFeature(kFeatureTungstenRoulette) ? (m < 0.1 ? 1.0 - m : 0.0) : max(0.05, 1.0 - m);
+    float q = hasFeature(kFeatureLowThroughputRoulette) ? (m < 0.1 ? 1.0 - m : 0.0) : max(0.05, 1.0 - m);
     if (rand(path.rng) < q) return endPath(path, shadow);
     path.beta /= 1.0 - q;
   }
@@ -715,8 +716,8 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
     if (dot(n, n) > 0.0) {
       ns = normalize(n);
       // Shading normals from files may disagree with the winding; the winding decides the front
-      // (in Tungsten's convention the shading normal is taken as it is).
-      if (!hasFeature(kFeatureTungstenShading) && dot(ns, ng) < 0.0) ns = -ns;
+      // (unchecked, the shading normal is taken as it is).
+      if (!hasFeature(kFeatureUncheckedShading) && dot(ns, ng) < 0.0) ns = -ns;
     }
   }
   ns = bumped(ns, floatBitsToInt(info.z), r0, r1, r2, e1, e2, s0, s1, s2, s3, uv);
@@ -775,16 +776,16 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   if (path.depth >= maxBounces) return false;
 
   // Shading frame. Opaque materials are two-sided: flip to the viewer's side, of the true surface
-  // (consistent) or of the shading normal (Tungsten's convention).
-  const bool tungstenShading = hasFeature(kFeatureTungstenShading);
+  // (consistent) or of the shading normal (unchecked).
+  const bool uncheckedShading = hasFeature(kFeatureUncheckedShading);
   bool transmissive = isTransmissive(m);
   vec3 ngs = ng, nss = ns;
   if (!transmissive && !frontFace) ngs = -ng;
-  if (!transmissive && (tungstenShading ? dot(ns, wo) < 0.0 : !frontFace)) nss = -ns;
+  if (!transmissive && (uncheckedShading ? dot(ns, wo) < 0.0 : !frontFace)) nss = -ns;
   vec3 t, b;
   makeFrame(nss, t, b);
   vec3 woL = toLocal(wo, t, b, nss);
-  if (!tungstenShading && !transmissive && woL.z <= 0.0) {
+  if (!uncheckedShading && !transmissive && woL.z <= 0.0) {
     // The interpolated normal faces away from the viewer: shade with the geometric one.
     nss = ngs;
     makeFrame(nss, t, b);
@@ -812,7 +813,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
     if (ls.pdf > 0.0 && maxComponent(ls.radiance) > 0.0) {
       float sideL = dot(ls.dir, ngs);
       bool sameSide = sideL > 0.0;
-      if (sameSide || transmissive || tungstenShading) {
+      if (sameSide || transmissive || uncheckedShading) {
         float bsdfPdf;
         vec3 f = bsdfEval(m, woL, toLocal(ls.dir, t, b, nss), bsdfPdf);
         if (maxComponent(f) > 0.0) {
@@ -842,10 +843,11 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   // one on the other side; otherwise the shading normal lied and the path would leak. The
   // viewer's side, not the normal's: inside glass it is the back (comparing with the normal
   // alone ended every path leaving glass, and every reflection inside it: black glass).
-  // Tungsten's convention has no such check (its enable_consistency_checks is off by default).
+  // The unchecked convention has no such check (nor has Tungsten: its enable_consistency_checks
+  // is off by default).
   // A fibre scatters to every side of its surface: the tube's far side, culled, lets the path
   // through (Material::Hair).
-  if (!tungstenShading && !isMat(m.type, kMatHair) && (bs.transmitted ? sideI * sideO >= 0.0 : sideI * sideO <= 0.0))
+  if (!uncheckedShading && !isMat(m.type, kMatHair) && (bs.transmitted ? sideI * sideO >= 0.0 : sideI * sideO <= 0.0))
     return endPath(path, shadow);
   path.beta *= bs.weight;
 #if RETILE_SHEET
@@ -865,7 +867,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   if (bs.transmitted && (isMat(m.type, kMatDielectric) || isMat(m.type, kMatRoughDielectric))) crossMedium(path, m, frontFace);
 #endif
   // Roulette must not see the 1/eta^2 radiance scaling inside glass as lost energy.
-  if (bs.transmitted && !m.tungstenGlass && !isMat(m.type, kMatThinSheet) && !isMat(m.type, kMatDiffuseTransmission)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
+  if (bs.transmitted && !m.tintsReflection && !isMat(m.type, kMatThinSheet) && !isMat(m.type, kMatDiffuseTransmission)) path.etaScale *= woL.z > 0.0 ? m.ior * m.ior : 1.0 / (m.ior * m.ior);
   path.specular = bs.delta;
   path.prevPdf = bs.pdf;
   path.prevPos = pos;

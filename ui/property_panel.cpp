@@ -455,8 +455,8 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
                        &Material::interiorAnisotropy, edit);
   if (m.type == MaterialType::Boundary) return;  // no surface: no texture, emission, alpha or blend applies
   if (isGlassType(m.type))
-    b.choice(tr("Glass"), "glassConvention", {tr("Physical"), tr("Tungsten")}, m.tungstenGlass ? 1 : 0,
-             [edit](int i) { edit(tr("Glass"), 0, [i](Material& x) { x.tungstenGlass = i == 1; }); });
+    b.choice(tr("Glass"), "glassConvention", {tr("Physical"), tr("Tinted reflection (Tungsten)")}, m.tintsReflection ? 1 : 0,
+             [edit](int i) { edit(tr("Glass"), 0, [i](Material& x) { x.tintsReflection = i == 1; }); });
   if (m.type == MaterialType::Plastic || m.type == MaterialType::RoughPlastic || m.type == MaterialType::ThinSheet ||
       m.type == MaterialType::Hair) {
     const QString label = m.type == MaterialType::ThinSheet ? tr("Absorption")
@@ -474,9 +474,9 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
              "concentration, pheomelanin (red to blond) 0.19, 0.40, 1.05"));
   }
   if (m.type == MaterialType::ThinSheet && m.filmThickness > 0)
-    b.choice(tr("Interference"), "interferenceConvention", {tr("Physical"), tr("Tungsten")}, m.tungstenGlass ? 1 : 0, [edit](int i) {
-       edit(tr("Interference"), 0, [i](Material& x) { x.tungstenGlass = i == 1; });
-     })->setToolTip(tr("Tungsten's form, for scenes made for it, shows a few per cent of the physical colours"));
+    b.choice(tr("Interference"), "interferenceConvention", {tr("Physical"), tr("Squared (Tungsten)")}, m.tintsReflection ? 1 : 0,
+             [edit](int i) { edit(tr("Interference"), 0, [i](Material& x) { x.tintsReflection = i == 1; }); })
+        ->setToolTip(tr("Tungsten's form, for scenes made for it, shows a few per cent of the physical colours"));
   if (m.type == MaterialType::Conductor || m.type == MaterialType::RoughConductor) {
     QStringList metals;
     for (const auto& n : conductorNames()) metals << QString::fromStdString(n);
@@ -721,23 +721,24 @@ void PropertyPanel::buildRender(Builder& b) {
       [edit](double v, int drag) { edit(tr("Filter width"), drag, [v](RenderSettings& x) { x.filterWidth = static_cast<float>(v); }); });
   // Tungsten scene files come with Tungsten's way of drawing its tent and Gaussian, so they converge
   // to the picture their author saw; any scene may switch.
-  b.choice(tr("Filter sampling"), "filterSampling", {tr("Exact"), tr("As Tungsten draws it")}, static_cast<int>(r.filterSampling),
+  b.choice(tr("Filter sampling"), "filterSampling", {tr("Exact"), tr("Stepped table (Tungsten)")}, static_cast<int>(r.filterSampling),
            [edit](int i) {
              if (i < 0 || i > 1) return;
              edit(tr("Filter sampling"), 0, [i](RenderSettings& x) { x.filterSampling = static_cast<FilterSampling>(i); });
            });
   // Tungsten scene files come with its shading-normal convention too (see ShadingConvention).
-  b.choice(tr("Shading normals"), "shading", {tr("Consistent"), tr("As Tungsten shades them")}, static_cast<int>(r.shading), [edit](int i) {
+  b.choice(tr("Shading normals"), "shading", {tr("Consistent"), tr("Unchecked (Tungsten)")}, static_cast<int>(r.shading), [edit](int i) {
     if (i < 0 || i > 1) return;
     edit(tr("Shading normals"), 0, [i](RenderSettings& x) { x.shading = static_cast<ShadingConvention>(i); });
   });
   // And with its Russian roulette, so that a sample is the same work as in Tungsten (see Roulette).
-  b.choice(tr("Russian roulette"), "roulette", {tr("Standard"), tr("As Tungsten plays it")}, static_cast<int>(r.roulette), [edit](int i) {
-    if (i < 0 || i > 1) return;
-    edit(tr("Russian roulette"), 0, [i](RenderSettings& x) { x.roulette = static_cast<Roulette>(i); });
-  });
+  b.choice(tr("Russian roulette"), "roulette", {tr("Standard"), tr("Low throughput (Tungsten)")}, static_cast<int>(r.roulette),
+           [edit](int i) {
+             if (i < 0 || i > 1) return;
+             edit(tr("Russian roulette"), 0, [i](RenderSettings& x) { x.roulette = static_cast<Roulette>(i); });
+           });
   // And with where its rays leave a surface, which decides what leaks through cracks (see RayOffset).
-  b.choice(tr("Ray offset"), "rayOffset", {tr("Robust"), tr("As Tungsten's (skip 0.0005 units)")}, static_cast<int>(r.rayOffset),
+  b.choice(tr("Ray offset"), "rayOffset", {tr("Robust"), tr("Skip 0.0005 units (Tungsten)")}, static_cast<int>(r.rayOffset),
            [edit](int i) {
              if (i < 0 || i > 1) return;
              edit(tr("Ray offset"), 0, [i](RenderSettings& x) { x.rayOffset = static_cast<RayOffset>(i); });

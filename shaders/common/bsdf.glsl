@@ -39,7 +39,7 @@ struct Material {
                      // sheet's film thickness in nm (0: no interference; Material::filmThickness)
   bool beckmann;     // rough types: Beckmann's distribution instead of GGX
   bool separable;    // rough types: G = G1(wo) G1(wi) instead of height-correlated
-  bool tungstenGlass;  // glass: albedo tints reflection too, no (n_t / n_i)^2 across (Material::tungstenGlass)
+  bool tintsReflection;  // glass: albedo tints reflection too, no (n_t / n_i)^2 across (Material::tintsReflection)
   float ior;
   float fdrInt;      // plastic: internal diffuse Fresnel reflectance of the coating; diffuse
                      // transmission: the transmittance; Phong: the diffuse ratio (packMaterial)
@@ -66,7 +66,7 @@ Material unpackMaterial(vec4 t0, vec4 t1, vec4 t2, vec4 t3, vec4 t4, vec4 t6, ve
   m.type = type & kMatTypeBits;
   m.beckmann = kBeckmannUsed && (type & kMatBeckmann) != 0;
   m.separable = (type & kMatSeparable) != 0;
-  m.tungstenGlass = (type & kMatTungstenGlass) != 0;
+  m.tintsReflection = (type & kMatTintsReflection) != 0;
   m.albedo = t0.rgb;
   m.roughness = t1.x;
   m.ior = t1.y;
@@ -151,7 +151,7 @@ float fresnelDielectric(float cosI, float eta) {
 // thickness m.roughness nm the waves interfere, phi the phase the film's two faces put between
 // them at 650, 510 and 475 nm: each polarisation passes (1 - R)^2 / (1 + R^2 - 2 R cos phi) of
 // what reaches it (Airy's, whose mean over the phase is the plain sheet's), or, as Tungsten draws
-// it (m.tungstenGlass; Fresnel::thinFilmReflectanceInterference),
+// it (m.tintsReflection; Fresnel::thinFilmReflectanceInterference),
 // (1 - R)^2 / sqrt(1 + R^4 - 2 R^2 cos phi), whose colours are a few per cent of Airy's.
 // cosT: the angle's inside the sheet.
 vec3 thinSheetReflectances(Material m, float cosI, out float cosT) {
@@ -162,9 +162,9 @@ vec3 thinSheetReflectances(Material m, float cosI, out float cosT) {
   vec3 half2 = sin(2.0 * PI * m.ior * m.roughness * cosT / vec3(650.0, 510.0, 475.0));
   half2 *= half2;
   vec2 t2 = (1.0 - r) * (1.0 - r);
-  vec2 a = m.tungstenGlass ? r * r : r;  // Tungsten squares the reflectances once more
+  vec2 a = m.tintsReflection ? r * r : r;  // Tungsten squares the reflectances once more
   vec3 ds = (1.0 - a.x) * (1.0 - a.x) + 4.0 * a.x * half2, dp = (1.0 - a.y) * (1.0 - a.y) + 4.0 * a.y * half2;
-  if (m.tungstenGlass) {
+  if (m.tintsReflection) {
     ds = sqrt(ds);
     dp = sqrt(dp);
   }
@@ -539,13 +539,13 @@ vec3 baseEval(Material m, vec3 wo, vec3 wi, out float pdf) {
     pdf = (1.0 - F) * mf.normalPdf * jac;
     float f = abs(ih) * oh / (o.z * abs(i.z)) * (1.0 - F) * mf.D * mf.G2 / (denom * denom);
     // Tungsten's form is the adjoint's: radiance not compressed by 1 / eta^2 (eta = n_i / n_o).
-    if (m.tungstenGlass) f *= eta * eta;
+    if (m.tintsReflection) f *= eta * eta;
     return m.albedo * (f * abs(i.z));
   }
   float reflectionPdf = mf.normalPdf / (4.0 * max(oh, 1e-12));
   if (roughDielectric) {
     pdf = F * reflectionPdf;
-    return (m.tungstenGlass ? m.albedo : vec3(1.0)) * (F * mf.D * mf.G2 / (4.0 * o.z));
+    return (m.tintsReflection ? m.albedo : vec3(1.0)) * (F * mf.D * mf.G2 / (4.0 * o.z));
   }
   if (roughConductor) {
     pdf = reflectionPdf;
@@ -602,13 +602,13 @@ BsdfSample baseSample(Material m, vec3 wo, vec3 u) {
       }
     } else if (u.x < F) {
       s.wi = vec3(-wo.x, -wo.y, wo.z);
-      s.weight = m.tungstenGlass ? m.albedo : vec3(1.0);
+      s.weight = m.tintsReflection ? m.albedo : vec3(1.0);
       s.pdf = F;
     } else {
       float inv = 1.0 / eta;
       s.wi = normalize(vec3(-wo.x * inv, -wo.y * inv, entering ? -cosT : cosT));
       // Radiance is compressed by 1/eta^2 on entering and expanded on leaving (not in Tungsten).
-      s.weight = m.tungstenGlass ? m.albedo : m.albedo * (inv * inv);
+      s.weight = m.tintsReflection ? m.albedo : m.albedo * (inv * inv);
       s.pdf = 1.0 - F;
       s.transmitted = true;
     }

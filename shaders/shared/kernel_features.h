@@ -12,20 +12,20 @@ RETILE_KERNEL_FEATURE(EnvConstant, 1, "constant environment")
 RETILE_KERNEL_FEATURE(EnvMap, 2, "environment map")
 RETILE_KERNEL_FEATURE(Emitters, 3, "emissive triangles")
 RETILE_KERNEL_FEATURE(DeltaLights, 4, "delta lights")  // point, spot and directional lights
-RETILE_KERNEL_FEATURE(TungstenShading, 5, "Tungsten's shading normals")  // ShadingConvention::Tungsten (scene.h)
+RETILE_KERNEL_FEATURE(UncheckedShading, 5, "unchecked shading normals")  // ShadingConvention::Unchecked (scene.h)
 RETILE_KERNEL_FEATURE(Bump, 6, "bump maps")  // some material has a bump map
 RETILE_KERNEL_FEATURE(EmissionTextures, 7, "emission textures")  // some emitter's emission is textured
 RETILE_KERNEL_FEATURE(Blend, 8, "blends")  // some material blends with another (Material::blendWith)
 // How a sample's offset in its pixel is drawn (exactly one): the filter's tabulated inverse CDF, a
-// tent's exact inverse, Tungsten's table searched as Tungsten searches it (its Gaussian), or
-// Tungsten's tent table, whose steps are found in closed form (render_scene.h).
+// tent's exact inverse, the stepped table searched step by step (a Gaussian), or the stepped tent,
+// whose steps are found in closed form (FilterSampling::SteppedTable, render_scene.h).
 RETILE_KERNEL_FEATURE(FilterTable, 9, "filter table")
 RETILE_KERNEL_FEATURE(FilterTent, 10, "exact tent filter")
-RETILE_KERNEL_FEATURE(FilterTungsten, 11, "Tungsten's filter table")
+RETILE_KERNEL_FEATURE(FilterStepped, 11, "stepped filter table")
 RETILE_KERNEL_FEATURE(Sun, 12, "suns with a disc")  // some directional light has a disc (Light::angularRadius)
 RETILE_KERNEL_FEATURE(InstanceTransforms, 13, "instance transforms")  // some instance is not in world space as it is
-RETILE_KERNEL_FEATURE(FilterTungstenTent, 14, "Tungsten's tent")
-RETILE_KERNEL_FEATURE(TungstenRoulette, 15, "Tungsten's roulette")  // Roulette::Tungsten (scene.h)
+RETILE_KERNEL_FEATURE(FilterSteppedTent, 14, "stepped tent")
+RETILE_KERNEL_FEATURE(LowThroughputRoulette, 15, "low-throughput roulette")  // Roulette::LowThroughput (scene.h)
 // The instance BVH's leaves are the instances' own top nodes and triangles, copied into its part
 // of the buffer, not instance records: a ray goes from the instance BVH into an instance without
 // a step of its own, and a triangle names its instance in e2.w (kTriInstanceMask, with its
@@ -41,9 +41,9 @@ RETILE_KERNEL_FEATURE(DirectReferences, 16, "direct references")
 RETILE_KERNEL_FEATURE(ByteTexels, 17, "8-bit texels")
 RETILE_KERNEL_FEATURE(HalfTexels, 18, "half-float texels")
 RETILE_KERNEL_FEATURE(SrgbTexels, 19, "sRGB texels")
-// RayOffset::Tungsten (scene.h): a ray leaving a surface skips what lies within kTungstenEpsilon
-// of it (scene units), as Tungsten's rays do (its DefaultEpsilon, the same for every primitive).
-RETILE_KERNEL_FEATURE(TungstenEpsilon, 20, "Tungsten's ray epsilon")
+// RayOffset::FixedEpsilon (scene.h): a ray leaving a surface skips what lies within
+// kFixedRayEpsilon of it (scene units), the same for every primitive.
+RETILE_KERNEL_FEATURE(FixedEpsilon, 20, "fixed ray epsilon")
 // Some visible object is hit from the front only (Object::cullBackFaces, kInstanceCullBack).
 RETILE_KERNEL_FEATURE(CullBack, 21, "back faces culled")
 // Some emitter emits into a cone narrower than its hemisphere (Material::emissionCone; the cosine

@@ -107,8 +107,8 @@ const int kFeatureAll = 0
 static_assert(RT_FEATURE_BYTE_TEXELS == kFeatureByteTexels && RT_FEATURE_HALF_TEXELS == kFeatureHalfTexels &&
               RT_FEATURE_SRGB_TEXELS == kFeatureSrgbTexels);
 #endif
-// RayOffset::Tungsten (kFeatureTungstenEpsilon): what a ray leaving a surface skips, in scene units.
-RT_CONST(float, kTungstenEpsilon, 5e-4)
+// RayOffset::FixedEpsilon (kFeatureFixedEpsilon): what a ray leaving a surface skips, in scene units.
+RT_CONST(float, kFixedRayEpsilon, 5e-4)
 
 RT_CONST(int, kInstanceAlphaTested, 1)
 RT_CONST(int, kInstanceBoundary, 2)  // its material is a boundary (kMatBoundary), which shadow rays cross
@@ -146,8 +146,8 @@ RT_CONST(int, kMaskScattering, 18)
 // Packed with a rough type: Smith's G as the product G1(wo) G1(wi) (Material::separableShadowing).
 // A multiply more per evaluation, so no kernel variant.
 RT_CONST(int, kMatSeparable, 512)
-// Packed with a glass type: Tungsten's glass (Material::tungstenGlass). A multiply more, no variant.
-RT_CONST(int, kMatTungstenGlass, 1024)
+// Packed with a glass type or a thin sheet: Material::tintsReflection. A multiply more, no variant.
+RT_CONST(int, kMatTintsReflection, 1024)
 RT_CONST(int, kMatTypeBits, 255)
 
 RT_CONST(int, kTexBitmap, 0)
@@ -163,8 +163,8 @@ RT_CONST(int, kTexSrgb, 64)
 // texels held beyond [0, 1] instead of repeating (Texture::clampToEdge).
 RT_CONST(int, kTexNearest, 128)
 RT_CONST(int, kTexClamp, 32768)
-// A checker's cells as Tungsten counts them: uv times cells truncated toward zero, not floored
-// (Texture::tungstenCells).
+// A checker's cells counted as uv times cells truncated toward zero, not floored
+// (Texture::truncatedCells).
 RT_CONST(int, kTexTruncate, 65536)
 // And a half-float bitmap's colour is stored divided by 2^k, k in these bits, so that values
 // beyond a half's range (a sun in a sky map) keep their light.
@@ -223,9 +223,9 @@ struct FrameUniforms {
   // A sample's offset from the pixel centre along each axis, in pixels, for u = i / 32: the
   // inverse CDF of the scene's pixel filter (filter importance sampling), 33 values, packed; the
   // last slot (filterWarp[8].w): a tent's radius, inverted exactly instead (0: use the table);
-  // negative: minus the radius of a filter drawn as Tungsten draws it, whose table's CDF at steps
-  // 1..30 then fills the first 30 slots (retile/scene.h, FilterSampling); filterWarp[8].z is then
-  // 1 for Tungsten's tent, whose CDF the shader computes instead, and 0 for its Gaussian.
+  // negative: minus the radius of a filter drawn from the stepped table, whose CDF at steps 1..30
+  // then fills the first 30 slots (retile/scene.h, FilterSampling::SteppedTable); filterWarp[8].z
+  // is then 1 for a tent, whose CDF the shader computes instead, and 0 for a Gaussian.
   vec4 filterWarp[9];
   // The medium the camera is in (render_scene.h mediaAround: inside glass or a boundary that holds
   // one, else the world's): its absorption xyz, 1 when it is glass's (else 0); its scattering xyz

@@ -53,8 +53,8 @@ Material separable(Material m) {
   return m;
 }
 
-Material tungstenGlass(Material m) {
-  m.tungstenGlass = true;
+Material tintsReflection(Material m) {
+  m.tintsReflection = true;
   return m;
 }
 
@@ -113,7 +113,7 @@ std::vector<Case> smoothLobed() {
           {"rough_dielectric_beckmann", beckmann(material(MaterialType::RoughDielectric, 1.0f, 0.3f))},
           {"rough_conductor_separable", separable(material(MaterialType::RoughConductor, 1.0f, 0.3f))},
           {"rough_dielectric_separable", separable(material(MaterialType::RoughDielectric, 1.0f, 0.3f))},
-          {"rough_dielectric_tungsten", tungstenGlass(material(MaterialType::RoughDielectric, 0.8f, 0.3f))},
+          {"rough_dielectric_tungsten", tintsReflection(material(MaterialType::RoughDielectric, 0.8f, 0.3f))},
           {"rough_plastic_beckmann_separable", separable(beckmann(material(MaterialType::RoughPlastic, 0.8f, 0.4f)))},
           {"plastic_absorbing", coated(material(MaterialType::Plastic, 0.8f), 0.3f)},
           {"rough_plastic_absorbing", coated(material(MaterialType::RoughPlastic, 0.8f, 0.3f), 0.3f)},
@@ -420,7 +420,7 @@ TEST_F(Bsdfs, GlassLessDenseThanItsSurroundingsReflectsTotallyPastItsCriticalAng
   }
 }
 
-// Tungsten's glass (Material::tungstenGlass): its albedo tints both lobes, and radiance is not
+// Tungsten's glass (Material::tintsReflection): its albedo tints both lobes, and radiance is not
 // scaled by eta^2 through the surface, so that white glass returns exactly everything from either
 // side, where the physical form returns F + (1 - F) / eta^2 from outside. The rough one's
 // transmission is the physical one's times eta^2 (eta = n_i / n_o: the index wi is in over
@@ -431,14 +431,14 @@ TEST_F(Bsdfs, TungstensGlassTintsBothLobesAndKeepsRadiance) {
     for (float side : {1.0f, -1.0f}) {
       SCOPED_TRACE(testing::Message() << "cos " << cosO << (side > 0 ? " outside" : " inside"));
       Vec3 wo = direction(side * cosO, 0.3f);
-      EXPECT_NEAR(sampledAlbedo(tungstenGlass(material(MaterialType::Dielectric, 1.0f)), wo).first, 1.0, 1e-5);
-      EXPECT_NEAR(sampledAlbedo(tungstenGlass(material(MaterialType::Dielectric, 0.6f)), wo).first, 0.6, 1e-5);
+      EXPECT_NEAR(sampledAlbedo(tintsReflection(material(MaterialType::Dielectric, 1.0f)), wo).first, 1.0, 1e-5);
+      EXPECT_NEAR(sampledAlbedo(tintsReflection(material(MaterialType::Dielectric, 0.6f)), wo).first, 0.6, 1e-5);
       if (side > 0) {
         EXPECT_NEAR(sampledAlbedo(material(MaterialType::Dielectric, 0.6f), wo).first,
                     fresnel(cosO, eta) + 0.6 * (1 - fresnel(cosO, eta)) / (eta * eta), 0.003);
       }
     }
-  const Material physical = material(MaterialType::RoughDielectric, 0.6f, 0.3f), tungsten = tungstenGlass(physical);
+  const Material physical = material(MaterialType::RoughDielectric, 0.6f, 0.3f), tungsten = tintsReflection(physical);
   struct Pair {
     Vec3 wo, wi;
     double ratio;
@@ -491,7 +491,7 @@ TEST_F(Bsdfs, AThinFilmReflectsEachChannelByItsPhase) {
         Material m = coated(material(MaterialType::ThinSheet, 1.0f), 60.0f);
         m.ior = static_cast<float>(eta);
         m.filmThickness = film;
-        m.tungstenGlass = tungsten;
+        m.tintsReflection = tungsten;
         const Vec3 wo = direction(cosO, 0.3f);
         std::vector<BsdfQuery> q;
         std::mt19937 rng(3);

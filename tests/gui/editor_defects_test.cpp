@@ -684,8 +684,8 @@ TEST(EditorDefects, ThePixelFilterIsARenderSettingWithUndo) {
   auto* sampling = w->findChild<QComboBox*>("filterSampling");
   ASSERT_TRUE(sampling);
   EXPECT_EQ(sampling->currentIndex(), static_cast<int>(FilterSampling::Exact));
-  sampling->setCurrentIndex(static_cast<int>(FilterSampling::Tungsten));
-  EXPECT_EQ(w->scene().settings.filterSampling, FilterSampling::Tungsten);
+  sampling->setCurrentIndex(static_cast<int>(FilterSampling::SteppedTable));
+  EXPECT_EQ(w->scene().settings.filterSampling, FilterSampling::SteppedTable);
   w->undoStack()->undo();
   EXPECT_EQ(w->scene().settings.filterSampling, FilterSampling::Exact);
   // So are the other conventions Tungsten files bring: its shading normals, its Russian roulette

@@ -509,7 +509,7 @@ TEST(Editor, AThinSheetTakesItsFilmThicknessFromItsPanel) {
   auto* form = w->findChild<QComboBox*>("interferenceConvention");
   ASSERT_TRUE(form) << "a film shows its interference's form";
   form->setCurrentIndex(1);
-  EXPECT_TRUE(w->scene().material(material)->tungstenGlass) << "Tungsten's";
+  EXPECT_TRUE(w->scene().material(material)->tintsReflection) << "Tungsten's";
   const std::uint64_t version = w->documentVersion();
   ASSERT_TRUE(waitForFrame(*w, [&](const FrameRecord& f) { return f.documentVersion == version; })) << "the edit reached the engine";
 }
@@ -591,7 +591,7 @@ TEST(Editor, GlassTakesAScatteringMediumFromItsPanel) {
   auto* glass = w->findChild<QComboBox*>("glassConvention");
   ASSERT_TRUE(glass);
   glass->setCurrentIndex(1);
-  EXPECT_TRUE(w->scene().material(material)->tungstenGlass);
+  EXPECT_TRUE(w->scene().material(material)->tintsReflection);
   type = w->findChild<QComboBox*>("materialType");
   type->setCurrentIndex(static_cast<int>(MaterialType::ThinSheet));
   ASSERT_TRUE(QTest::qWaitFor([&] { return w->findChild<ScrubField*>("coatingAbsorption2") != nullptr; }, 2000));

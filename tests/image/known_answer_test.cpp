@@ -350,7 +350,7 @@ TEST(KnownAnswer, GlassFilledWithAnAbsorbingMediumDimsByBeersLaw) {
 
 // An emitter of radiance 1 inside a slab of glass of index 1.5, seen head on through its face.
 // Radiance is 1.5^2 times as dense inside glass as outside, so the physical form shows it as
-// (1 - F) / 1.5^2 = 0.4267 (F = 0.04 head on); Tungsten's glass (Material::tungstenGlass) does
+// (1 - F) / 1.5^2 = 0.4267 (F = 0.04 head on); Tungsten's glass (Material::tintsReflection) does
 // not scale radiance across the surface and shows 1 - F = 0.96, as Tungsten renders a lamp's
 // bulb. The sky is black and the emitter's albedo 0: nothing else reaches the camera.
 TEST(KnownAnswer, ALampInsideGlassShinesThroughAsItsConventionSays) {
@@ -358,7 +358,7 @@ TEST(KnownAnswer, ALampInsideGlassShinesThroughAsItsConventionSays) {
   for (bool tungsten : {false, true}) {
     Material glass = filledGlass(Vec3{0.0f});
     glass.ior = 1.5f;
-    glass.tungstenGlass = tungsten;
+    glass.tintsReflection = tungsten;
     Scene s = slabBeforeTheSky(glass, 30, 8);
     s.environment.color = Vec3{0.0f};
     Material lamp = grey(0.0f);
@@ -555,7 +555,7 @@ TEST(KnownAnswer, GlassInFogLeavesThePathInTheFog) {
   test::addMeshObject(s, "glass", makeCube(), test::addMaterial(s, filledGlass(Vec3{0.0f})),
                       Mat4::translate({0, 0, -5}) * Mat4::scale({30, 30, 1}));
   // Four crossings: Tungsten's roulette spares paths this bright, so the pixels carry no noise.
-  s.settings.roulette = Roulette::Tungsten;
+  s.settings.roulette = Roulette::LowThroughput;
   RenderImage img = renderScene(*r, s, 16);
   for (int y = 14; y < 18; ++y)
     for (int x = 14; x < 18; ++x)
@@ -736,8 +736,8 @@ TEST(KnownAnswer, ClosedFurnaceWithBounceLimit) {
   RETILE_RENDERER_OR_SKIP(r);
   const float rho = 0.5f, le = 1.0f;
   const int bounces = 6;
-  for (Roulette roulette : {Roulette::Standard, Roulette::Tungsten}) {
-    SCOPED_TRACE(roulette == Roulette::Tungsten ? "Tungsten's roulette" : "standard roulette");
+  for (Roulette roulette : {Roulette::Standard, Roulette::LowThroughput}) {
+    SCOPED_TRACE(roulette == Roulette::LowThroughput ? "Tungsten's roulette" : "standard roulette");
     Scene s = closedFurnace(rho, le, bounces);
     s.settings.roulette = roulette;
     RenderImage img = renderScene(*r, s, 256);
@@ -838,8 +838,8 @@ TEST(KnownAnswer, DiffusePlaneUnderUniformSky) {
 TEST(KnownAnswer, TungstensRaysSkipWhatLiesWithinItsEpsilon) {
   RETILE_RENDERER_OR_SKIP(r);
   const float floorY = 0.04f, lidAbove = 2.5e-4f;
-  for (RayOffset offset : {RayOffset::Robust, RayOffset::Tungsten}) {
-    SCOPED_TRACE(offset == RayOffset::Tungsten ? "Tungsten's offset" : "robust offset");
+  for (RayOffset offset : {RayOffset::Robust, RayOffset::FixedEpsilon}) {
+    SCOPED_TRACE(offset == RayOffset::FixedEpsilon ? "Tungsten's offset" : "robust offset");
     Scene s = test::emptyScene(16, 16);
     // Looking down at (2, 1), away from the quads' diagonals: rounding leaves a crack along a
     // shared edge, wider the larger the triangles.
@@ -1144,7 +1144,7 @@ TEST(KnownAnswer, EightBitTexturesReadAsTheirDecodedValues) {
   const std::vector<Case> cases = {
       {addColumnTexture(s, dir, "half-first", 3, 1, [](int) { return 0.5f; }), 0.5, "a half-float texture of 3 texels"},
       {addByteRow(s, dir, "srgb", std::vector<int>(3, 200), TextureColorSpace::SRGB), srgb200, "8-bit sRGB, 3 texels"},
-      {addByteRow(s, dir, "tungsten", std::vector<int>(5, 100), TextureColorSpace::TungstenGamma), tungsten100,
+      {addByteRow(s, dir, "tungsten", std::vector<int>(5, 100), TextureColorSpace::Gamma22), tungsten100,
        "8-bit with Tungsten's gamma, 5 texels"},
       {addColumnTexture(s, dir, "half-after", 3, 1, [](int) { return 0.25f; }), 0.25, "a half-float texture after 8-bit ones"},
       {addByteRow(s, dir, "linear", std::vector<int>(1, 64), TextureColorSpace::Linear), 64.0 / 255.0, "8-bit linear, 1 texel"},
@@ -1249,7 +1249,7 @@ TEST(KnownAnswer, ATungstenCheckerCountsItsCellsTowardZero) {
   const RenderImage floored = renderScene(*r, s, 32);
   EXPECT_LT(columns(floored, outerLeft[0], outerLeft[1]), 0.02) << "floored";
   EXPECT_GT(columns(floored, innerLeft[0], innerLeft[1]), 0.98);
-  s.texture(checker.id)->tungstenCells = true;
+  s.texture(checker.id)->truncatedCells = true;
   const RenderImage truncated = renderScene(*r, s, 32);
   EXPECT_GT(columns(truncated, outerLeft[0], outerLeft[1]), 0.98) << "truncated";
   EXPECT_LT(columns(truncated, innerLeft[0], innerLeft[1]), 0.02);
@@ -1337,9 +1337,9 @@ TEST(KnownAnswer, PixelFiltersSpreadAnEdgeAsTheyShould) {
   };
   for (auto [filter, sampling, inner, across] :
        {std::tuple{PixelFilter::Box, FilterSampling::Exact, 1.0, 0.0}, std::tuple{PixelFilter::Tent, FilterSampling::Exact, 0.875, 0.125},
-        std::tuple{PixelFilter::Tent, FilterSampling::Tungsten, 0.8543, 0.1457},
-        std::tuple{PixelFilter::Box, FilterSampling::Tungsten, 1.0, 0.0}}) {
-    SCOPED_TRACE(std::string(pixelFilterName(filter)) + (sampling == FilterSampling::Tungsten ? " as Tungsten draws it" : ""));
+        std::tuple{PixelFilter::Tent, FilterSampling::SteppedTable, 0.8543, 0.1457},
+        std::tuple{PixelFilter::Box, FilterSampling::SteppedTable, 1.0, 0.0}}) {
+    SCOPED_TRACE(std::string(pixelFilterName(filter)) + (sampling == FilterSampling::SteppedTable ? " as Tungsten draws it" : ""));
     s.settings.pixelFilter = filter;
     s.settings.filterWidth = defaultFilterWidth(filter);
     s.settings.filterSampling = sampling;
@@ -1397,7 +1397,7 @@ TEST(KnownAnswer, ShadingConventionsDisagreeWhereTheShadingNormalLies) {
   const double expected = 10.0 / kPi * dot(ns, toLight) / std::sqrt(d2) / d2;
 
   double consistent = meanOver(renderScene(*r, s, 64), plane);
-  s.settings.shading = ShadingConvention::Tungsten;
+  s.settings.shading = ShadingConvention::Unchecked;
   double tungsten = meanOver(renderScene(*r, s, 64), plane);
   EXPECT_LT(consistent, 1e-6) << "light from behind the true surface";
   EXPECT_NEAR(tungsten, expected, 0.03 * expected);

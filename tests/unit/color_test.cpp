@@ -28,7 +28,7 @@ TEST(Color, SrgbTextureDecodesToLinear) {
   EXPECT_NEAR(px[5], 0.5f, 1e-4f);
 }
 
-// Tungsten's "gamma_correct" (TungstenGamma): floor(255 (v/255)^2.2) / 255, its decoding table,
+// Tungsten's "gamma_correct" (Gamma22): floor(255 (v/255)^2.2) / 255, its decoding table,
 // against entries of that table; sRGB gives other values (64 -> 13, not 12; 21 -> 1.9, not 1).
 TEST(Color, TungstenGammaTexturesDecodeWithTungstensTable) {
   const auto file = test::tempDir() / "ramp.ppm";
@@ -40,7 +40,7 @@ TEST(Color, TungstenGammaTexturesDecodeWithTungstensTable) {
   Texture t;
   t.kind = TextureKind::File;
   t.path = file;
-  t.colorSpace = TextureColorSpace::TungstenGamma;
+  t.colorSpace = TextureColorSpace::Gamma22;
   // As linear floats, decoded the way the shader decodes them.
   auto linear = [&] {
     auto texture = loadTexture(t, file.parent_path());
@@ -98,7 +98,7 @@ TEST(Color, EightBitTexturesKeepTheirBytes) {
     EXPECT_NEAR(linear.rgba[i], config[i], 2.5e-4f * config[i] + 1e-9f) << "texel " << i / 4 << ", channel " << i % 4;
   }
 
-  t.colorSpace = TextureColorSpace::TungstenGamma;
+  t.colorSpace = TextureColorSpace::Gamma22;
   auto tungsten = loadTexture(t, file.parent_path());
   ASSERT_TRUE(tungsten.ok() && tungsten->eightBit());
   EXPECT_EQ(tungsten->curve, TextureImage::Curve::Linear);

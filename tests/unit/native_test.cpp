@@ -73,30 +73,53 @@ TEST(Native, TungstenTextureHandlingRoundTrips) {
   Texture t;
   t.id = s.newId();
   t.path = "wood.jpg";
-  t.colorSpace = TextureColorSpace::TungstenGamma;
-  t.whenMissing = MissingTexture::Tungsten;
+  t.colorSpace = TextureColorSpace::Gamma22;
+  t.whenMissing = MissingTexture::BlackAndWhite;
   s.textures.push_back(t);
   auto file = test::tempDir() / "scene.retile";
   ASSERT_TRUE(saveNativeScene(s, file).ok());
   auto back = loadNativeScene(file);
   ASSERT_TRUE(back.ok()) << back.error();
-  EXPECT_EQ(back->scene.textures.back().colorSpace, TextureColorSpace::TungstenGamma);
-  EXPECT_EQ(back->scene.textures.back().whenMissing, MissingTexture::Tungsten);
+  EXPECT_EQ(back->scene.textures.back().colorSpace, TextureColorSpace::Gamma22);
+  EXPECT_EQ(back->scene.textures.back().whenMissing, MissingTexture::BlackAndWhite);
+}
+
+// Files saved while the second way of each convention was called "tungsten" (and Gamma22
+// "tungsten_gamma") read as they were saved.
+TEST(Native, FilesThatNamedTheConventionsTungstenReadAsSaved) {
+  const auto file = test::tempDir() / "old.retile";
+  std::ofstream(file) << R"({"format": "retile-scene", "version": 1,
+    "settings": {"filter_sampling": "tungsten", "shading": "tungsten", "roulette": "tungsten", "ray_offset": "tungsten"},
+    "textures": [{"id": 1, "kind": "checker", "color_space": "tungsten_gamma", "when_missing": "tungsten", "cells": "tungsten"}],
+    "materials": [{"id": 2, "type": "dielectric", "glass": "tungsten"}]})";
+  auto r = loadNativeScene(file);
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Scene& s = r->scene;
+  EXPECT_EQ(s.settings.filterSampling, FilterSampling::SteppedTable);
+  EXPECT_EQ(s.settings.shading, ShadingConvention::Unchecked);
+  EXPECT_EQ(s.settings.roulette, Roulette::LowThroughput);
+  EXPECT_EQ(s.settings.rayOffset, RayOffset::FixedEpsilon);
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(s.textures[0].colorSpace, TextureColorSpace::Gamma22);
+  EXPECT_EQ(s.textures[0].whenMissing, MissingTexture::BlackAndWhite);
+  EXPECT_TRUE(s.textures[0].truncatedCells);
+  ASSERT_EQ(s.materials.size(), 1u);
+  EXPECT_TRUE(s.materials[0].tintsReflection);
 }
 
 TEST(Native, DefaultSceneRoundTripsLosslessly) {
   Scene s = makeDefaultScene();
   s.settings.pixelFilter = PixelFilter::BlackmanHarris;
   s.settings.filterWidth = 1.75f;
-  s.settings.filterSampling = FilterSampling::Tungsten;
-  s.settings.shading = ShadingConvention::Tungsten;
-  s.settings.roulette = Roulette::Tungsten;
-  s.settings.rayOffset = RayOffset::Tungsten;
+  s.settings.filterSampling = FilterSampling::SteppedTable;
+  s.settings.shading = ShadingConvention::Unchecked;
+  s.settings.roulette = Roulette::LowThroughput;
+  s.settings.rayOffset = RayOffset::FixedEpsilon;
   s.settings.minBounces = 2;
   s.settings.lightSampling = false;
   s.settings.view = "Filmic";
   s.materials[0].separableShadowing = true;
-  s.materials[0].tungstenGlass = true;
+  s.materials[0].tintsReflection = true;
   ASSERT_FALSE(s.textures.empty());
   s.textures[0].interpolate = false;
   s.textures[0].clampToEdge = true;
@@ -136,17 +159,17 @@ TEST(Native, DefaultSceneRoundTripsLosslessly) {
   EXPECT_EQ(back->scene.lights[0].intensity, 3.5f);
   EXPECT_EQ(back->scene.settings.pixelFilter, PixelFilter::BlackmanHarris);
   EXPECT_EQ(back->scene.settings.filterWidth, 1.75f);
-  EXPECT_EQ(back->scene.settings.filterSampling, FilterSampling::Tungsten);
-  EXPECT_EQ(back->scene.settings.shading, ShadingConvention::Tungsten);
-  EXPECT_EQ(back->scene.settings.roulette, Roulette::Tungsten);
-  EXPECT_EQ(back->scene.settings.rayOffset, RayOffset::Tungsten);
+  EXPECT_EQ(back->scene.settings.filterSampling, FilterSampling::SteppedTable);
+  EXPECT_EQ(back->scene.settings.shading, ShadingConvention::Unchecked);
+  EXPECT_EQ(back->scene.settings.roulette, Roulette::LowThroughput);
+  EXPECT_EQ(back->scene.settings.rayOffset, RayOffset::FixedEpsilon);
   EXPECT_EQ(back->scene.settings.minBounces, 2);
   EXPECT_FALSE(back->scene.settings.lightSampling);
   EXPECT_EQ(back->scene.settings.view, "Filmic");
   EXPECT_FALSE(back->scene.textures[0].interpolate);
   EXPECT_TRUE(back->scene.textures[0].clampToEdge);
   EXPECT_TRUE(back->scene.materials[0].separableShadowing);
-  EXPECT_TRUE(back->scene.materials[0].tungstenGlass);
+  EXPECT_TRUE(back->scene.materials[0].tintsReflection);
   EXPECT_EQ(back->scene.materials[0].bumpTexture, s.textures[0].id);
   EXPECT_EQ(back->scene.materials[0].bumpStrength, -2.5f);
   EXPECT_EQ(back->scene.materials[0].emissionTexture, s.textures[0].id);
@@ -305,7 +328,7 @@ TEST(Native, BrokenFilesGiveClearErrors) {
       {"{\"format\": \"retile-scene\", \"version\": 1, \"meshes\": [{\"id\": 1}, {\"id\": 1}]}", "not unique"},
       {"{\"format\": \"retile-scene\", \"version\": 1, \"settings\": {\"width\": 1e9}}", "outside 1..16384"},
       {"{\"format\": \"retile-scene\", \"version\": 1, \"settings\": {\"ray_offset\": \"sideways\"}}",
-       "settings.ray_offset: unknown ray_offset 'sideways' (robust, tungsten)"},
+       "settings.ray_offset: unknown ray_offset 'sideways' (robust, fixed_epsilon)"},
   };
   int i = 0;
   for (const Case& c : cases) {

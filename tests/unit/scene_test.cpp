@@ -72,11 +72,11 @@ TEST(PixelFilter, WarpsAreInverseCdfs) {
 // is (i - i (i - 1) / 62) / 16; the Gaussian's is exp(-2 x^2) - exp(-8) over 2 px, most of it near
 // the centre.
 TEST(PixelFilters, TungstenTableIsTungstens) {
-  const std::vector<float> tent = tungstenFilterCdf(PixelFilter::Tent);
-  ASSERT_EQ(tent.size(), static_cast<std::size_t>(kTungstenFilterSteps) - 1);
-  for (int i = 1; i < kTungstenFilterSteps; ++i)
+  const std::vector<float> tent = steppedFilterCdf(PixelFilter::Tent);
+  ASSERT_EQ(tent.size(), static_cast<std::size_t>(kSteppedFilterSteps) - 1);
+  for (int i = 1; i < kSteppedFilterSteps; ++i)
     EXPECT_NEAR(tent[static_cast<std::size_t>(i) - 1], (i - i * (i - 1) / 62.0) / 16.0, 1e-5) << i;
-  const std::vector<float> gauss = tungstenFilterCdf(PixelFilter::Gaussian);
+  const std::vector<float> gauss = steppedFilterCdf(PixelFilter::Gaussian);
   for (std::size_t i = 1; i < gauss.size(); ++i) EXPECT_GT(gauss[i], gauss[i - 1]) << "monotone";
   EXPECT_GT(gauss[14], 0.9f) << "weight at 1 px: exp(-2), at 2 px: none";
   EXPECT_LT(gauss.back(), 1.0f);

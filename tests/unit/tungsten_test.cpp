@@ -36,10 +36,10 @@ TEST(Tungsten, CornellBoxMatchesTheObjVersion) {
   EXPECT_NEAR(degrees(s.camera.verticalFov), 19.5f, 1e-3f);  // square image: horizontal == vertical
   EXPECT_EQ(s.settings.pixelFilter, PixelFilter::Tent) << "the scene's reconstruction_filter";
   EXPECT_EQ(s.settings.filterWidth, 2.0f) << "Tungsten's tent reaches one pixel each way";
-  EXPECT_EQ(s.settings.filterSampling, FilterSampling::Tungsten) << "drawn as the scene's author saw it";
-  EXPECT_EQ(s.settings.shading, ShadingConvention::Tungsten) << "Tungsten's defaults: two-sided, no consistency checks";
-  EXPECT_EQ(s.settings.roulette, Roulette::Tungsten) << "a sample is the same work as in Tungsten";
-  EXPECT_EQ(s.settings.rayOffset, RayOffset::Tungsten) << "what leaks through cracks, as in Tungsten";
+  EXPECT_EQ(s.settings.filterSampling, FilterSampling::SteppedTable) << "drawn as the scene's author saw it";
+  EXPECT_EQ(s.settings.shading, ShadingConvention::Unchecked) << "Tungsten's defaults: two-sided, no consistency checks";
+  EXPECT_EQ(s.settings.roulette, Roulette::LowThroughput) << "a sample is the same work as in Tungsten";
+  EXPECT_EQ(s.settings.rayOffset, RayOffset::FixedEpsilon) << "what leaks through cracks, as in Tungsten";
 
   // The light: a downward-facing quad 2 cm below the ceiling, corners as in cornell-box.obj.
   const Object* light = objectWithMaterial(s, "Light");
@@ -92,9 +92,9 @@ TEST(Tungsten, LivingRoomOpensWithSubstitutesForMissingFiles) {
       // transparent), not an opaque surface.
       const Texture* alpha = s.texture(m.alphaTexture);
       ASSERT_TRUE(alpha);
-      EXPECT_EQ(alpha->whenMissing, MissingTexture::Tungsten);
+      EXPECT_EQ(alpha->whenMissing, MissingTexture::BlackAndWhite);
       ASSERT_TRUE(s.texture(m.albedoTexture));
-      EXPECT_EQ(s.texture(m.albedoTexture)->whenMissing, MissingTexture::Tungsten);
+      EXPECT_EQ(s.texture(m.albedoTexture)->whenMissing, MissingTexture::BlackAndWhite);
     }
     if (m.name == "PlantPot") {
       EXPECT_NEAR(m.roughness, 1.0f / std::sqrt(2.0f), 1e-6f);
@@ -104,7 +104,7 @@ TEST(Tungsten, LivingRoomOpensWithSubstitutesForMissingFiles) {
       EXPECT_FLOAT_EQ(m.roughness, 0.05f);
       const Texture* wood = s.texture(m.albedoTexture);
       ASSERT_TRUE(wood);
-      EXPECT_EQ(wood->colorSpace, TextureColorSpace::TungstenGamma) << "decoded as Tungsten decodes it";
+      EXPECT_EQ(wood->colorSpace, TextureColorSpace::Gamma22) << "decoded as Tungsten decodes it";
     }
   }
   EXPECT_GE(textured, 3);
@@ -948,7 +948,7 @@ TEST(Tungsten, ADielectricWithoutRefractionIsAFresnelReflectorOnly) {
   EXPECT_EQ(frosted->roughness, 0.3f);
   EXPECT_EQ(frosted->eta, Vec3(1.5f));
   EXPECT_EQ(s.material(s.objects[2].material)->type, MaterialType::Dielectric);
-  EXPECT_TRUE(s.material(s.objects[2].material)->tungstenGlass);
+  EXPECT_TRUE(s.material(s.objects[2].material)->tintsReflection);
   EXPECT_TRUE(r->warnings.empty()) << r->warnings.front();
 }
 
@@ -972,7 +972,7 @@ TEST(Tungsten, AThinSheetAbsorbsAlongTwiceItsThicknessAndHasNoAlbedo) {
   EXPECT_EQ(s.material(s.objects[1].material)->coatingAbsorption, Vec3(0.0f)) << "sigma_a defaults to 0";
   EXPECT_EQ(film->filmThickness, 0.0f) << "no interference unless asked";
   EXPECT_EQ(s.material(s.objects[1].material)->filmThickness, 250.0f);
-  EXPECT_TRUE(s.material(s.objects[1].material)->tungstenGlass) << "its interference drawn as Tungsten draws it";
+  EXPECT_TRUE(s.material(s.objects[1].material)->tintsReflection) << "its interference drawn as Tungsten draws it";
   EXPECT_EQ(s.material(s.objects[2].material)->filmThickness, 125.0f);
   EXPECT_TRUE(r->warnings.empty()) << r->warnings.front();
 
@@ -983,7 +983,7 @@ TEST(Tungsten, AThinSheetAbsorbsAlongTwiceItsThicknessAndHasNoAlbedo) {
   EXPECT_EQ(back->scene.material(back->scene.objects[0].material)->coatingAbsorption, Vec3(0.5f, 1.0f, 1.5f));
   EXPECT_TRUE(back->scene.material(back->scene.objects[0].material)->albedo == Vec3(1.0f));
   EXPECT_EQ(back->scene.material(back->scene.objects[1].material)->filmThickness, 250.0f);
-  EXPECT_TRUE(back->scene.material(back->scene.objects[1].material)->tungstenGlass);
+  EXPECT_TRUE(back->scene.material(back->scene.objects[1].material)->tintsReflection);
 
   // A textured albedo, which the sheet does not render, leaves no texture behind to be decoded
   // and packed; a texture something uses stays. A textured thickness is the sheet's roughness
@@ -1004,12 +1004,12 @@ TEST(Tungsten, AThinSheetAbsorbsAlongTwiceItsThicknessAndHasNoAlbedo) {
   EXPECT_EQ(textured->scene.texture(sheet.roughnessTexture)->checkerResU, 3);
   EXPECT_EQ(sheet.coatingAbsorption, Vec3{1.0f});
   EXPECT_EQ(sheet.filmThickness, 500.0f);
-  EXPECT_TRUE(textured->scene.textures[0].tungstenCells) << "a Tungsten checker counts its cells as Tungsten does";
+  EXPECT_TRUE(textured->scene.textures[0].truncatedCells) << "a Tungsten checker counts its cells as Tungsten does";
   ASSERT_TRUE(saveNativeScene(textured->scene, file).ok());
   auto checkerBack = loadNativeScene(file);
   ASSERT_TRUE(checkerBack.ok()) << checkerBack.error();
   ASSERT_EQ(checkerBack->scene.textures.size(), 2u);
-  EXPECT_TRUE(checkerBack->scene.textures[0].tungstenCells) << "and keeps counting so when saved natively";
+  EXPECT_TRUE(checkerBack->scene.textures[0].truncatedCells) << "and keeps counting so when saved natively";
 }
 
 // The spaceship's leathers ask for Beckmann: rendered with it (no warning); a Phong distribution

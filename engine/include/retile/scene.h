@@ -43,18 +43,18 @@ struct Mesh {
 enum class TextureKind { File, Embedded, Checker };
 // How texel values are turned into linear scene values. Auto: 8-bit formats are sRGB-encoded,
 // floating-point formats (EXR, HDR) are linear. Raw: no conversion (roughness, alpha masks).
-// TungstenGamma: Tungsten's "gamma_correct" (its files' default), so their textures keep the
-// values their author saw: 8-bit values v become floor(255 (v/255)^2.2) / 255, its decoding
-// table (darker than sRGB in the shadows: 5 % less blue in the living room's wood floor);
-// floating-point formats stay linear.
-enum class TextureColorSpace { Auto, SRGB, Linear, Raw, TungstenGamma };
+// Gamma22: 8-bit values v become floor(255 (v/255)^2.2) / 255, a decoding table darker than sRGB
+// in the shadows (5 % less blue in the living room's wood floor); floating-point formats stay
+// linear. Tungsten's "gamma_correct" (its files' default) is this, so their textures keep the
+// values their author saw.
+enum class TextureColorSpace { Auto, SRGB, Linear, Raw, Gamma22 };
 constexpr int kTextureColorSpaceCount = 5;
 
 // What stands in for a file that cannot be read. Checker: magenta and black squares nobody takes
-// for the real texture. Tungsten: what Tungsten draws instead (a 2x2 checker of 1 and 0 over the
-// uv square, as colour and as alpha), so its scene files converge to its pictures with a file
-// missing too; the warning still names the file.
-enum class MissingTexture { Checker, Tungsten };
+// for the real texture. BlackAndWhite: a 2x2 checker of 1 and 0 over the uv square, as colour and
+// as alpha, what Tungsten draws instead, so that its scene files converge to its pictures with a
+// file missing too. Either way the warning names the file.
+enum class MissingTexture { Checker, BlackAndWhite };
 
 struct Texture {
   NodeId id = kNoNode;
@@ -71,10 +71,10 @@ struct Texture {
   bool clampToEdge = false;
   Vec3 checkerOn{0.8f}, checkerOff{0.2f};  // Checker: colours and squares per unit of uv
   int checkerResU = 8, checkerResV = 8;
-  // Checker: its cells counted as Tungsten counts them (CheckerTexture: uv times cells truncated
-  // toward zero), so that where uvs go below 0 the cells about 0 are twice as wide and the pattern
-  // mirrors; else floored, a pattern that repeats everywhere.
-  bool tungstenCells = false;
+  // Checker: its cells counted by truncating uv times cells toward zero (as Tungsten's
+  // CheckerTexture does), so that where uvs go below 0 the cells about 0 are twice as wide and the
+  // pattern mirrors; else floored, a pattern that repeats everywhere.
+  bool truncatedCells = false;
   friend bool operator==(const Texture&, const Texture&) = default;
 };
 
@@ -185,14 +185,14 @@ struct Material {
   // there it is its thickness (Tungsten's textured thickness), which scales both its absorption
   // (coatingAbsorption) and its film (filmThickness) point by point.
   NodeId roughnessTexture = kNoNode;
-  // Glass as Tungsten has it (its dielectric and rough_dielectric): albedo tints the reflection
-  // as well as the transmission, and radiance is not scaled by (n_t / n_i)^2 where it crosses
-  // the surface. The two agree on light that passes in and out again; they differ where a path
-  // ends inside, on an emitter within the glass (a lamp's bulb, say): 1 / ior^2 as bright here
-  // without this. Otherwise albedo tints the transmission alone, the physical form. For a thin
-  // sheet with a film (filmThickness): its interference as Tungsten draws it, much fainter than
-  // the physical (Airy) form's, which is otherwise drawn.
-  bool tungstenGlass = false;
+  // Glass: albedo tints the reflection as well as the transmission, and radiance is not scaled by
+  // (n_t / n_i)^2 where it crosses the surface (Tungsten's dielectric and rough_dielectric). The
+  // two forms agree on light that passes in and out again; they differ where a path ends inside,
+  // on an emitter within the glass (a lamp's bulb, say): 1 / ior^2 as bright without this.
+  // Otherwise albedo tints the transmission alone, the physical form. A thin sheet with a film
+  // (filmThickness): its reflectances squared once more before they interfere (Tungsten's film),
+  // much fainter colours than the physical (Airy) form's, which is otherwise drawn.
+  bool tintsReflection = false;
   // Plastics: the coating's absorption, its sigma_a times its thickness (Tungsten's plastic):
   // the diffuse base shows through dimmed by exp(-a (1 / cos wi + 1 / cos wo)). Thin sheets: the
   // sheet's, light passing through it dimmed by exp(-a / cos t), t the angle inside the sheet.
@@ -400,40 +400,40 @@ float defaultFilterWidth(PixelFilter f);  // box 1, tent 2 (Tungsten's), Gaussia
 // from the pixel centre in pixels. Separable filters: x and y are drawn independently.
 std::vector<float> pixelFilterWarp(PixelFilter f, float width, int segments);
 
-// How the filter's offsets are drawn. Exact: from the filter itself (pixelFilterWarp). Tungsten:
-// as Tungsten draws them, so its scene files converge to the picture their author saw: the
-// filter's weight at k/31 of its radius, k = 0..30, makes a 31-step table, and a draw that falls
-// in step k lands one step further out, in (k+1)/31..(k+2)/31 of the radius. The tent comes out
-// about 1/31 px wider than the true tent, and the edges of bright lights differ by up to 10 %
-// without it. Tungsten's Gaussian is exp(-2 x^2) - exp(-8) over a radius of 2 px; its box is
-// drawn exactly; other filters are drawn exactly either way.
-enum class FilterSampling { Exact, Tungsten };
+// How the filter's offsets are drawn. Exact: from the filter itself (pixelFilterWarp).
+// SteppedTable: the filter's weight at k/31 of its radius, k = 0..30, makes a 31-step table, and
+// a draw that falls in step k lands one step further out, in (k+1)/31..(k+2)/31 of the radius;
+// the Gaussian is then exp(-2 x^2) - exp(-8) over a radius of 2 px. The tent comes out about
+// 1/31 px wider than the true tent. Tungsten draws its tent and Gaussian so, and its scene files
+// ask for it, so that they converge to the picture their author saw (the edges of bright lights
+// differ by up to 10 % without it). A box and the other filters are drawn exactly either way.
+enum class FilterSampling { Exact, SteppedTable };
 
 // How paths use a mesh's interpolated shading normals. Consistent: the winding decides which side
 // faces the viewer; a viewer behind the shading normal is shaded with the geometric one; a path
 // whose next direction would cross the true surface ends, so light cannot leak through a mesh.
-// Tungsten: as Tungsten's path tracer with the defaults its scene files are made with (two-sided
-// shading, consistency checks off): the shading normal, turned toward the viewer, alone decides,
-// and paths may cross the true surface. Smooth meshes then shade differently where the shading
-// normal and the true surface disagree, mostly at their rims.
-enum class ShadingConvention { Consistent, Tungsten };
+// Unchecked: the shading normal, turned toward the viewer, alone decides, and paths may cross the
+// true surface (two-sided shading, consistency checks off: Tungsten's defaults, which its scene
+// files are made with). Smooth meshes then shade differently where the shading normal and the
+// true surface disagree, mostly at their rims.
+enum class ShadingConvention { Consistent, Unchecked };
 // When a path may end early (Russian roulette), keeping the expected value. Standard: after three
-// bounces, each bounce survives with its throughput's largest channel, at most 0.95. Tungsten's:
-// after three bounces, only a throughput below 0.1 plays, and survives with that. Tungsten's ends
-// fewer paths, so a sample costs more and varies less; Tungsten files use
-// it so that a sample is the same work and the same estimate as in Tungsten.
-enum class Roulette { Standard, Tungsten };
+// bounces, each bounce survives with its throughput's largest channel, at most 0.95. LowThroughput:
+// after three bounces, only a throughput below 0.1 plays, and survives with that. It ends fewer
+// paths, so a sample costs more and varies less; Tungsten plays it, and its files use it here so
+// that a sample is the same work and the same estimate as in Tungsten.
+enum class Roulette { Standard, LowThroughput };
 // Where a ray that leaves a surface starts. Robust: a few float ulps off the surface, and never on
-// the triangle it leaves, so it hits whatever lies beyond, however close. Tungsten: as Tungsten's
-// rays, which skip everything within 5e-4 scene units of the surface (its DefaultEpsilon). Light
-// then leaks through cracks narrower than that, such as where a skirting board dips into the
-// floor, and the contact shadows of surfaces closer than that vanish: Tungsten files use it so
-// that they converge to the picture their author saw (the living room's darkest corners differ by
-// 8 to 18 % without it).
-enum class RayOffset { Robust, Tungsten };
-constexpr int kTungstenFilterSteps = 31;
-// The Tungsten table's CDF at steps 1..30 (step 0's is 0, step 31's is 1), for tent and Gaussian.
-std::vector<float> tungstenFilterCdf(PixelFilter f);
+// the triangle it leaves, so it hits whatever lies beyond, however close. FixedEpsilon: it skips
+// everything within 5e-4 scene units of the surface (Tungsten's DefaultEpsilon). Light then leaks
+// through cracks narrower than that, such as where a skirting board dips into the floor, and the
+// contact shadows of surfaces closer than that vanish: Tungsten files use it so that they
+// converge to the picture their author saw (the living room's darkest corners differ by 8 to 18 %
+// without it).
+enum class RayOffset { Robust, FixedEpsilon };
+constexpr int kSteppedFilterSteps = 31;
+// FilterSampling::SteppedTable's CDF at steps 1..30 (step 0's is 0, step 31's is 1), for tent and Gaussian.
+std::vector<float> steppedFilterCdf(PixelFilter f);
 
 // The largest image side anything accepts (files, edits, the command line, the renderer).
 constexpr int kMaxImageSide = 16384;
@@ -454,10 +454,11 @@ struct RenderSettings {
   // New scenes (the built-in one, glTF/OBJ/FBX imports): Blackman-Harris 1.5 px, as Blender.
   PixelFilter pixelFilter = PixelFilter::BlackmanHarris;
   float filterWidth = 1.5f;
-  FilterSampling filterSampling = FilterSampling::Exact;      // Tungsten scene files: Tungsten
-  ShadingConvention shading = ShadingConvention::Consistent;  // Tungsten files: what their integrator asks
-  Roulette roulette = Roulette::Standard;                     // Tungsten files: Tungsten's
-  RayOffset rayOffset = RayOffset::Robust;                    // Tungsten files: Tungsten's
+  // Tungsten files ask for the second value of each (their importer sets them).
+  FilterSampling filterSampling = FilterSampling::Exact;
+  ShadingConvention shading = ShadingConvention::Consistent;
+  Roulette roulette = Roulette::Standard;
+  RayOffset rayOffset = RayOffset::Robust;
   // The OCIO view the scene's author looked at it through (a Tungsten camera's tonemap), which
   // the editor and `retile render` show it with until told otherwise; empty: the application's
   // default, Standard. Display only: the render is the same whatever it says.

@@ -27,7 +27,7 @@ struct Decoded {
 
 // Tungsten's LDR decoding (ImageIO::loadLdr with gamma correction): a 256-entry table of
 // floor(255 (v/255)^2.2), kept in 8 bits; colour only, alpha stays as stored.
-const std::array<std::uint8_t, 256>& tungstenGammaTable() {
+const std::array<std::uint8_t, 256>& gamma22Table() {
   static const std::array<std::uint8_t, 256> table = [] {
     std::array<std::uint8_t, 256> t{};
     for (int v = 0; v < 256; ++v)
@@ -37,8 +37,8 @@ const std::array<std::uint8_t, 256>& tungstenGammaTable() {
   return table;
 }
 
-void tungstenGamma(TextureImage& image) {
-  const auto& table = tungstenGammaTable();
+void decodeGamma22(TextureImage& image) {
+  const auto& table = gamma22Table();
   if (image.eightBit()) {
     for (std::size_t i = 0; i < image.rgba8.size(); ++i)
       if (i % 4 != 3) image.rgba8[i] = table[image.rgba8[i]];
@@ -196,8 +196,8 @@ Result<TextureImage> loadTexture(const Texture& tex, const fs::path& base, const
   TextureImage& img = dec.image;
   bool srgb = false;
   switch (tex.colorSpace) {
-    case TextureColorSpace::TungstenGamma:
-      if (!dec.isFloat) tungstenGamma(img);
+    case TextureColorSpace::Gamma22:
+      if (!dec.isFloat) decodeGamma22(img);
       break;
     case TextureColorSpace::SRGB: srgb = true; break;
     case TextureColorSpace::Linear:

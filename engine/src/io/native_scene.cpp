@@ -34,7 +34,7 @@ const char* colorSpaceName(TextureColorSpace c) {
     case TextureColorSpace::SRGB: return "srgb";
     case TextureColorSpace::Linear: return "linear";
     case TextureColorSpace::Raw: return "raw";
-    case TextureColorSpace::TungstenGamma: return "tungsten_gamma";
+    case TextureColorSpace::Gamma22: return "gamma22";
   }
   return "auto";
 }
@@ -194,11 +194,11 @@ Value settingsToJson(const RenderSettings& r) {
   settings.set("seed", r.seed);
   settings.set("pixel_filter", pixelFilterName(r.pixelFilter));
   settings.set("filter_width", r.filterWidth);
-  // Only scenes that came from Tungsten files say it; everything else draws the filter exactly.
-  if (r.filterSampling == FilterSampling::Tungsten) settings.set("filter_sampling", "tungsten");
-  if (r.shading == ShadingConvention::Tungsten) settings.set("shading", "tungsten");
-  if (r.roulette == Roulette::Tungsten) settings.set("roulette", "tungsten");
-  if (r.rayOffset == RayOffset::Tungsten) settings.set("ray_offset", "tungsten");
+  // Only scenes that came from Tungsten files say them; everything else has the first ways.
+  if (r.filterSampling == FilterSampling::SteppedTable) settings.set("filter_sampling", "stepped_table");
+  if (r.shading == ShadingConvention::Unchecked) settings.set("shading", "unchecked");
+  if (r.roulette == Roulette::LowThroughput) settings.set("roulette", "low_throughput");
+  if (r.rayOffset == RayOffset::FixedEpsilon) settings.set("ray_offset", "fixed_epsilon");
   if (!r.view.empty()) settings.set("view", r.view);
   return settings;
 }
@@ -252,7 +252,7 @@ Value textureToJson(const Texture& t, const fs::path& baseDirectory) {
   v.set("name", t.name);
   v.set("kind", textureKindName(t.kind));
   v.set("color_space", colorSpaceName(t.colorSpace));
-  if (t.whenMissing == MissingTexture::Tungsten) v.set("when_missing", "tungsten");
+  if (t.whenMissing == MissingTexture::BlackAndWhite) v.set("when_missing", "black_and_white");
   if (!t.interpolate) v.set("interpolate", false);
   if (t.clampToEdge) v.set("clamp", true);
   if (t.kind == TextureKind::File) {
@@ -268,7 +268,7 @@ Value textureToJson(const Texture& t, const fs::path& baseDirectory) {
     v.set("off", json::fromVec3(t.checkerOff));
     v.set("res_u", t.checkerResU);
     v.set("res_v", t.checkerResV);
-    if (t.tungstenCells) v.set("cells", "tungsten");
+    if (t.truncatedCells) v.set("cells", "truncated");
   }
   return v;
 }
@@ -287,7 +287,7 @@ Value materialToJson(const Material& m) {
   if (m.beckmann) v.set("distribution", "beckmann");
   if (m.separableShadowing) v.set("shadowing", "separable");
   v.set("roughness_texture", m.roughnessTexture);
-  if (m.tungstenGlass) v.set("glass", "tungsten");
+  if (m.tintsReflection) v.set("glass", "tinted");
   v.set("coating_absorption", json::fromVec3(m.coatingAbsorption));
   v.set("interior_absorption", json::fromVec3(m.interiorAbsorption));
   v.set("interior_scattering", json::fromVec3(m.interiorScattering));
@@ -349,14 +349,15 @@ Value nativeSceneToJson(const Scene& s) {
   return root;
 }
 
-// A setting that is either Retile's own way (`ours`, the enum's first value, also when the file
-// says nothing) or Tungsten's ("tungsten", its second): the conventions Tungsten files bring.
+// A setting or field that is one of two ways, by name: `first` (the enum's first value, or false;
+// also when the file says nothing) or `second`. Files saved before these names said what the ways
+// do called every second way "tungsten"; they read as they did.
 template <class E>
-void readConvention(Reader& r, const char* key, const char* ours, E* out) {
+void readEither(Reader& r, const char* key, const char* first, const char* second, E* out) {
   std::string name;
   r.string(key, &name);
-  if (name == "tungsten") *out = E::Tungsten;
-  else if (!name.empty() && name != ours) r.problem(key, cat("unknown ", key, " '", name, "' (", ours, ", tungsten)"));
+  if (name == second || name == "tungsten") *out = static_cast<E>(1);
+  else if (!name.empty() && name != first) r.problem(key, cat("unknown ", key, " '", name, "' (", first, ", ", second, ")"));
 }
 
 void readSettings(Reader& r, RenderSettings& settings) {
@@ -379,10 +380,10 @@ void readSettings(Reader& r, RenderSettings& settings) {
   r.number("filter_width", &settings.filterWidth);
   if (!(settings.filterWidth > 0.0f && settings.filterWidth <= 16.0f))
     r.problem("filter_width", "expected a width in pixels within (0, 16]");
-  readConvention(r, "filter_sampling", "exact", &settings.filterSampling);
-  readConvention(r, "shading", "consistent", &settings.shading);
-  readConvention(r, "roulette", "standard", &settings.roulette);
-  readConvention(r, "ray_offset", "robust", &settings.rayOffset);
+  readEither(r, "filter_sampling", "exact", "stepped_table", &settings.filterSampling);
+  readEither(r, "shading", "consistent", "unchecked", &settings.shading);
+  readEither(r, "roulette", "standard", "low_throughput", &settings.roulette);
+  readEither(r, "ray_offset", "robust", "fixed_epsilon", &settings.rayOffset);
   r.string("view", &settings.view);
 }
 
@@ -430,12 +431,11 @@ Texture readTexture(Reader& r, const fs::path& baseDir) {
   r.id("id", &t.id, true);
   r.string("name", &t.name);
   r.enumeration("kind", &t.kind, textureKindName, 3);
-  r.enumeration("color_space", &t.colorSpace, colorSpaceName, kTextureColorSpaceCount);
-  std::string whenMissing;
-  r.string("when_missing", &whenMissing);
-  if (whenMissing == "tungsten") t.whenMissing = MissingTexture::Tungsten;
-  else if (!whenMissing.empty() && whenMissing != "checker")
-    r.problem("when_missing", cat("unknown stand-in '", whenMissing, "' (checker, tungsten)"));
+  std::string colorSpace;
+  r.string("color_space", &colorSpace);
+  if (colorSpace == "tungsten_gamma") t.colorSpace = TextureColorSpace::Gamma22;  // its name before "gamma22"
+  else r.enumeration("color_space", &t.colorSpace, colorSpaceName, kTextureColorSpaceCount);
+  readEither(r, "when_missing", "checker", "black_and_white", &t.whenMissing);
   r.boolean("interpolate", &t.interpolate);
   r.boolean("clamp", &t.clampToEdge);
   std::string path, absolute;
@@ -454,10 +454,7 @@ Texture readTexture(Reader& r, const fs::path& baseDir) {
   r.vec3("off", &t.checkerOff);
   r.integer("res_u", &t.checkerResU);
   r.integer("res_v", &t.checkerResV);
-  std::string cells;
-  r.string("cells", &cells);
-  if (cells == "tungsten") t.tungstenCells = true;
-  else if (!cells.empty() && cells != "floor") r.problem("cells", cat("unknown cell count '", cells, "' (floor, tungsten)"));
+  readEither(r, "cells", "floor", "truncated", &t.truncatedCells);
   return t;
 }
 
@@ -480,10 +477,7 @@ Material readMaterial(Reader& r) {
   else if (!shadowing.empty() && shadowing != "correlated")
     r.problem("shadowing", cat("unknown shadowing '", shadowing, "' (correlated, separable)"));
   r.id("roughness_texture", &m.roughnessTexture);
-  std::string glass;
-  r.string("glass", &glass);
-  if (glass == "tungsten") m.tungstenGlass = true;
-  else if (!glass.empty() && glass != "physical") r.problem("glass", cat("unknown glass convention '", glass, "' (physical, tungsten)"));
+  readEither(r, "glass", "physical", "tinted", &m.tintsReflection);
   r.vec3("coating_absorption", &m.coatingAbsorption);
   r.vec3("interior_absorption", &m.interiorAbsorption);
   r.vec3("interior_scattering", &m.interiorScattering);

@@ -51,7 +51,7 @@ NodeId TungstenImporter::fileTexture(const std::string& ref, TextureColorSpace c
   t.path = ref;
   t.name = fs::path(ref).filename().string();
   t.colorSpace = cs;
-  t.whenMissing = MissingTexture::Tungsten;
+  t.whenMissing = MissingTexture::BlackAndWhite;
   t.interpolate = interpolate;
   t.clampToEdge = clampToEdge;
   // One warning per missing file, however many materials use it; the environment says its own.
@@ -70,7 +70,7 @@ TextureRef TungstenImporter::texture(const Value& v, const std::string& where, b
   if (v.isString()) {
     r.isTexture = true;
     r.constant = Vec3{1.0f};
-    r.texture = fileTexture(v.asString(), data ? TextureColorSpace::Raw : TextureColorSpace::TungstenGamma);
+    r.texture = fileTexture(v.asString(), data ? TextureColorSpace::Raw : TextureColorSpace::Gamma22);
     return r;
   }
   if (!v.isObject()) {
@@ -99,7 +99,7 @@ TextureRef TungstenImporter::texture(const Value& v, const std::string& where, b
     r.constant = Vec3{scale};
     r.texture = fileTexture(f,
                             data    ? TextureColorSpace::Raw
-                            : gamma ? TextureColorSpace::TungstenGamma
+                            : gamma ? TextureColorSpace::Gamma22
                                     : TextureColorSpace::Linear,
                             interpolate, clampToEdge);
     return r;
@@ -118,7 +118,7 @@ TextureRef TungstenImporter::texture(const Value& v, const std::string& where, b
     number(v, "res_v", &rv, where);
     t.checkerResU = std::clamp(static_cast<int>(ru), 1, 100000);
     t.checkerResV = std::clamp(static_cast<int>(rv), 1, 100000);
-    t.tungstenCells = true;
+    t.truncatedCells = true;
     out_.scene.textures.push_back(t);
     r.isTexture = true;
     r.texture = t.id;
@@ -362,7 +362,7 @@ Material TungstenImporter::typedBsdf(const Value& v, const std::string& type, co
   } else if (type == "dielectric" || type == "rough_dielectric") {
     const bool rough = type == "rough_dielectric";
     m.type = rough ? MaterialType::RoughDielectric : MaterialType::Dielectric;
-    m.tungstenGlass = true;
+    m.tintsReflection = true;
     if (rough) roughness(0.1f);
     if (const Value* e = v.find("enable_refraction"); e && e->isBool() && !e->asBool()) {
       // Tungsten's dielectric without refraction reflects F times its albedo and transmits
@@ -373,7 +373,7 @@ Material TungstenImporter::typedBsdf(const Value& v, const std::string& type, co
       m.metal = "custom";
       m.eta = Vec3{std::clamp(m.ior, 1.0001f, 10.0f)};
       m.k = Vec3{0.0f};
-      m.tungstenGlass = false;
+      m.tintsReflection = false;
     }
   } else if (type == "thinsheet") {
     m.type = MaterialType::ThinSheet;
@@ -399,7 +399,7 @@ Material TungstenImporter::typedBsdf(const Value& v, const std::string& type, co
     // drawn as Tungsten draws it.
     if (const Value* e = v.find("enable_interference"); e && e->isBool() && e->asBool())
       m.filmThickness = std::max(500.0f * thickness, 0.0f);
-    m.tungstenGlass = true;
+    m.tintsReflection = true;
   } else if (type == "null") {
     m.type = MaterialType::Null;
   } else if (type == "phong") {

@@ -47,9 +47,9 @@ Result<ImportedScene> TungstenImporter::run() {
     if (const Value* v = in->find("enable_consistency_checks"); v && v->isBool()) consistency = v->asBool();
     if (const Value* v = in->find("enable_two_sided_shading"); v && v->isBool()) twoSided = v->asBool();
   }
-  s.settings.shading = !consistency && twoSided ? ShadingConvention::Tungsten : ShadingConvention::Consistent;
-  s.settings.roulette = Roulette::Tungsten;
-  s.settings.rayOffset = RayOffset::Tungsten;
+  s.settings.shading = !consistency && twoSided ? ShadingConvention::Unchecked : ShadingConvention::Consistent;
+  s.settings.roulette = Roulette::LowThroughput;
+  s.settings.rayOffset = RayOffset::FixedEpsilon;
   if (!twoSided) warn("integrator: one-sided shading (enable_two_sided_shading: false) is rendered two-sided");
   if (const Value* in = integrator) {
     // Tungsten counts bounces as scattering events, as RenderSettings::minBounces does (unlike
@@ -353,7 +353,7 @@ void TungstenImporter::camera(const Value& c) {
     }
   }
   s.settings.filterWidth = defaultFilterWidth(s.settings.pixelFilter);  // Tungsten's widths
-  s.settings.filterSampling = FilterSampling::Tungsten;
+  s.settings.filterSampling = FilterSampling::SteppedTable;
   float fov = 60;
   number(c, "fov", &fov, where);
   if (!(fov > 0 && fov < 180)) return problem(where, "fov must be between 0 and 180 degrees");

@@ -63,7 +63,7 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   const bool rough = isMicrofacet(m.type);
   int type = static_cast<int>(m.type) | (rough && m.beckmann ? gpu::kMatBeckmann : 0) |
              (rough && m.separableShadowing ? gpu::kMatSeparable : 0) |
-             ((isGlassType(m.type) || m.type == MaterialType::ThinSheet) && m.tungstenGlass ? gpu::kMatTungstenGlass : 0);
+             ((isGlassType(m.type) || m.type == MaterialType::ThinSheet) && m.tintsReflection ? gpu::kMatTintsReflection : 0);
   // Keep roughness away from zero, where GGX turns into a delta the rough code cannot sample.
   float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
   if (rough || m.type == MaterialType::Phong) roughness = std::max(roughness, 1e-3f);
@@ -246,7 +246,7 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
     int index = static_cast<int>(data_.textureInfo.size() / gpu::kTextureTexels);
     textureIndex_[t.id] = index;
     if (t.kind == TextureKind::Checker) {
-      textureMean_[t.id] = appendChecker(t.checkerOn, t.checkerOff, t.checkerResU, t.checkerResV, t.tungstenCells);
+      textureMean_[t.id] = appendChecker(t.checkerOn, t.checkerOff, t.checkerResU, t.checkerResV, t.truncatedCells);
       continue;
     }
     const std::size_t at = data_.texels.size();
@@ -274,7 +274,7 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
           d.flags |= scale << gpu::kTexScaleShift;
         }
       } else if (warnings) {
-        warnings->push_back(cat(img.error(), t.whenMissing == MissingTexture::Tungsten
+        warnings->push_back(cat(img.error(), t.whenMissing == MissingTexture::BlackAndWhite
                                                  ? "; shown as Tungsten shows it (a black and white checker)"
                                                  : "; shown as a magenta checker"));
       }
@@ -299,7 +299,7 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
       data_.textureInfo.push_back({0, 0, 0, 0});
       data_.textureInfo.push_back({0, 0, 0, 0});
       textureMean_[t.id] = d.mean;
-    } else if (t.whenMissing == MissingTexture::Tungsten) {
+    } else if (t.whenMissing == MissingTexture::BlackAndWhite) {
       // Tungsten's 2x2 stand-in, its texel (0, 0) white, at the top left.
       textureMean_[t.id] = appendChecker({1, 1, 1}, {0, 0, 0}, 2, 2);
     } else {

@@ -80,8 +80,8 @@ std::uint64_t RenderSceneData::deviceBytes() const {
 }
 
 int filterFeature(const RenderSettings& s) {
-  if (s.filterSampling == FilterSampling::Tungsten && s.pixelFilter == PixelFilter::Tent) return gpu::kFeatureFilterTungstenTent;
-  if (s.filterSampling == FilterSampling::Tungsten && s.pixelFilter == PixelFilter::Gaussian) return gpu::kFeatureFilterTungsten;
+  if (s.filterSampling == FilterSampling::SteppedTable && s.pixelFilter == PixelFilter::Tent) return gpu::kFeatureFilterSteppedTent;
+  if (s.filterSampling == FilterSampling::SteppedTable && s.pixelFilter == PixelFilter::Gaussian) return gpu::kFeatureFilterStepped;
   return s.pixelFilter == PixelFilter::Tent ? gpu::kFeatureFilterTent : gpu::kFeatureFilterTable;
 }
 
@@ -93,9 +93,9 @@ std::uint32_t RenderSceneData::features() const {
   if (!emitters.empty()) f |= gpu::kFeatureEmitters;
   if (!deltaLights.empty()) f |= gpu::kFeatureDeltaLights;
   if (suns > 0) f |= gpu::kFeatureSun;
-  if (tungstenShading) f |= gpu::kFeatureTungstenShading;
-  if (tungstenRoulette) f |= gpu::kFeatureTungstenRoulette;
-  if (tungstenEpsilon) f |= gpu::kFeatureTungstenEpsilon;
+  if (uncheckedShading) f |= gpu::kFeatureUncheckedShading;
+  if (lowThroughputRoulette) f |= gpu::kFeatureLowThroughputRoulette;
+  if (fixedEpsilon) f |= gpu::kFeatureFixedEpsilon;
   if (cullBack) f |= gpu::kFeatureCullBack;
   if (minBounces > 0) f |= gpu::kFeatureMinBounces;
   if (lightGroups > 0) f |= gpu::kFeatureLightGroups;
@@ -124,9 +124,9 @@ int RenderSceneBuilder::materialIndex(NodeId id) const {
 std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags, std::vector<std::string>* warnings) {
   if (first_) flags = kUpdateAll;
   first_ = false;
-  data_.tungstenShading = scene.settings.shading == ShadingConvention::Tungsten;                            // a kernel variant, no array
-  data_.tungstenRoulette = scene.settings.roulette == Roulette::Tungsten;                                   // likewise
-  data_.tungstenEpsilon = scene.settings.rayOffset == RayOffset::Tungsten;                                  // likewise
+  data_.uncheckedShading = scene.settings.shading == ShadingConvention::Unchecked;                          // a kernel variant, no array
+  data_.lowThroughputRoulette = scene.settings.roulette == Roulette::LowThroughput;                         // likewise
+  data_.fixedEpsilon = scene.settings.rayOffset == RayOffset::FixedEpsilon;                                 // likewise
   data_.filterFeature = filterFeature(scene.settings);                                                      // likewise
   data_.minBounces = std::clamp(scene.settings.minBounces, 0, std::max(scene.settings.maxBounces, 0) + 1);  // likewise
   const bool lightSamplingChanged = data_.lightSampling != scene.settings.lightSampling;

@@ -47,7 +47,7 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
 float emissionConeCos(const Material& m);
 
 // How the trace kernel draws a sample's offset in its pixel for these settings: one of the
-// gpu::kFeatureFilter... bits (Tungsten draws its tent and Gaussian from a table of its own).
+// gpu::kFeatureFilter... bits (FilterSampling::SteppedTable has two of its own).
 int filterFeature(const RenderSettings& s);
 
 // How much lower, about, a light sample's second moment is where it chooses one of the light
@@ -145,9 +145,9 @@ struct RenderSceneData {
   bool instanceTransforms = false;  // some instance's transform is not the identity
   bool directReferences = false;    // the instance BVH is packed direct (layouts.h kFeatureDirectReferences)
 
-  bool tungstenShading = false;                  // RenderSettings::shading is Tungsten's
-  bool tungstenRoulette = false;                 // RenderSettings::roulette is Tungsten's
-  bool tungstenEpsilon = false;                  // RenderSettings::rayOffset is Tungsten's
+  bool uncheckedShading = false;                 // RenderSettings::shading is ShadingConvention::Unchecked
+  bool lowThroughputRoulette = false;            // RenderSettings::roulette is Roulette::LowThroughput
+  bool fixedEpsilon = false;                     // RenderSettings::rayOffset is RayOffset::FixedEpsilon
   int filterFeature = gpu::kFeatureFilterTable;  // filterFeature(RenderSettings)
   std::uint32_t features() const;                // kFeature... (layouts.h) of what the arrays hold
 

@@ -118,7 +118,7 @@ struct Renderer::Impl {
   std::vector<float> warp;
   PixelFilter warpFilter = PixelFilter::Box;
   float warpWidth = 0.0f;
-  bool warpTungsten = false;
+  bool warpStepped = false;
   bool hasScene = false;
   NodeId selectedObject = kNoNode;
   std::vector<NodeId> countedGroup;      // counted beside the selection: every object of its material
@@ -495,14 +495,14 @@ struct Renderer::Impl {
     const bool counting = countTile > 0 && counters > 0;
     u.work = {itemCount, static_cast<std::uint32_t>(slots), counting ? counters + 1 : 0u,
               counting ? static_cast<std::uint32_t>(countTile) : 0u};
-    // Tungsten draws its box exactly, and has no other filter the table could stand for.
+    // The stepped table is drawn for a tent and a Gaussian only; a box is drawn exactly either way.
     const int drawn = d.filterFeature;  // the compiled kernel's
-    const bool tungsten = drawn == gpu::kFeatureFilterTungsten || drawn == gpu::kFeatureFilterTungstenTent;
-    if (warpFilter != sceneSettings.pixelFilter || warpWidth != sceneSettings.filterWidth || warpTungsten != tungsten || warp.empty()) {
+    const bool stepped = drawn == gpu::kFeatureFilterStepped || drawn == gpu::kFeatureFilterSteppedTent;
+    if (warpFilter != sceneSettings.pixelFilter || warpWidth != sceneSettings.filterWidth || warpStepped != stepped || warp.empty()) {
       warpFilter = sceneSettings.pixelFilter;
       warpWidth = sceneSettings.filterWidth;
-      warpTungsten = tungsten;
-      warp = tungsten ? tungstenFilterCdf(warpFilter) : pixelFilterWarp(warpFilter, warpWidth, gpu::kFilterWarpSegments);
+      warpStepped = stepped;
+      warp = stepped ? steppedFilterCdf(warpFilter) : pixelFilterWarp(warpFilter, warpWidth, gpu::kFilterWarpSegments);
     }
     for (std::size_t i = 0; i < warp.size(); ++i) {
       gpu::vec4& v = u.filterWarp[i / 4];
@@ -511,9 +511,9 @@ struct Renderer::Impl {
     // The tent's inverse CDF has an infinite slope at its ends, where the table's straight pieces
     // put too many samples: the shader inverts it exactly when this (its radius) is set.
     const float radius = 0.5f * std::clamp(warpWidth, 0.01f, 16.0f);
-    u.filterWarp[8].w = tungsten ? -radius : drawn == gpu::kFeatureFilterTent ? radius : 0.0f;
-    // Which of Tungsten's two (a kernel compiled with every feature has the code for both).
-    u.filterWarp[8].z = drawn == gpu::kFeatureFilterTungstenTent ? 1.0f : 0.0f;
+    u.filterWarp[8].w = stepped ? -radius : drawn == gpu::kFeatureFilterTent ? radius : 0.0f;
+    // Which of the two stepped ones (a kernel compiled with every feature has the code for both).
+    u.filterWarp[8].z = drawn == gpu::kFeatureFilterSteppedTent ? 1.0f : 0.0f;
     frameUbo.upload(&u, sizeof u);
     filterWarp.upload(u.filterWarp, sizeof u.filterWarp);  // host-visible: a copy of 144 bytes
   }

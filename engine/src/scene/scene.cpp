@@ -83,20 +83,20 @@ std::vector<float> pixelFilterWarp(PixelFilter f, float width, int segments) {
   return warp;
 }
 
-std::vector<float> tungstenFilterCdf(PixelFilter f) {
+std::vector<float> steppedFilterCdf(PixelFilter f) {
   // Tungsten's ReconstructionFilter::precompute: the weights at the steps' inner ends, in float
   // as there, normalised by their sum.
   auto weight = [&](float t) {  // t: 0..1 of the radius
     if (f == PixelFilter::Gaussian) return std::max(std::exp(-2.0f * (2 * t) * (2 * t)) - std::exp(-8.0f), 0.0f);
     return 1.0f - t;  // the tent (and anything else asked for)
   };
-  std::vector<float> w(kTungstenFilterSteps);
+  std::vector<float> w(kSteppedFilterSteps);
   float sum = 0;
-  for (int i = 0; i < kTungstenFilterSteps; ++i)
-    sum += (w[static_cast<std::size_t>(i)] = weight(static_cast<float>(i) / kTungstenFilterSteps));
-  std::vector<float> cdf(kTungstenFilterSteps - 1);
+  for (int i = 0; i < kSteppedFilterSteps; ++i)
+    sum += (w[static_cast<std::size_t>(i)] = weight(static_cast<float>(i) / kSteppedFilterSteps));
+  std::vector<float> cdf(kSteppedFilterSteps - 1);
   float c = 0;
-  for (int i = 1; i < kTungstenFilterSteps; ++i) cdf[static_cast<std::size_t>(i) - 1] = (c += w[static_cast<std::size_t>(i) - 1] / sum);
+  for (int i = 1; i < kSteppedFilterSteps; ++i) cdf[static_cast<std::size_t>(i) - 1] = (c += w[static_cast<std::size_t>(i) - 1] / sum);
   return cdf;
 }
 
