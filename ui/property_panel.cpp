@@ -738,11 +738,10 @@ void PropertyPanel::buildRender(Builder& b) {
              edit(tr("Russian roulette"), 0, [i](RenderSettings& x) { x.roulette = static_cast<Roulette>(i); });
            });
   // And with where its rays leave a surface, which decides what leaks through cracks (see RayOffset).
-  b.choice(tr("Ray offset"), "rayOffset", {tr("Robust"), tr("Skip 0.0005 units (Tungsten)")}, static_cast<int>(r.rayOffset),
-           [edit](int i) {
-             if (i < 0 || i > 1) return;
-             edit(tr("Ray offset"), 0, [i](RenderSettings& x) { x.rayOffset = static_cast<RayOffset>(i); });
-           });
+  b.choice(tr("Ray offset"), "rayOffset", {tr("Robust"), tr("Skip 0.0005 units (Tungsten)")}, static_cast<int>(r.rayOffset), [edit](int i) {
+    if (i < 0 || i > 1) return;
+    edit(tr("Ray offset"), 0, [i](RenderSettings& x) { x.rayOffset = static_cast<RayOffset>(i); });
+  });
   // The scene's own image: what `retile render` renders and the framing the viewport can show.
   b.number(tr("Width (px)"), "resolutionWidth", r.width, 1, kMaxImageSide, RenderSettings{}.width, 0,
            [edit](double v, int drag) { edit(tr("Resolution"), drag, [v](RenderSettings& x) { x.width = static_cast<int>(v); }); });

@@ -1,8 +1,11 @@
 #include "vk/context.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdlib>
 #include <cstring>
+#include <map>
+#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -78,12 +81,47 @@ bool hasLayer(const char* name) {
 
 }  // namespace
 
-Context::Context(const DeviceChoice& choiceIn) {
-  flushDenormals();  // lavapipe's threads, created with the device, inherit it (core/process.h)
-  DeviceChoice choice = choiceIn;
-  if (const char* env = std::getenv("RETILE_DEVICE"); env && *env) choice.preferred = env;
-  if (const char* env = std::getenv("RETILE_VALIDATION"); env && *env) choice.validation = std::strcmp(env, "0") != 0;
+// The instance and device every Context of the process shares, and the programs compiled on it.
+class Device {
+ public:
+  explicit Device(const DeviceChoice& choice);
+  ~Device();
+  Device(const Device&) = delete;
+  Device& operator=(const Device&) = delete;
 
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  std::uint32_t queueFamily_ = 0;
+  VkPhysicalDeviceProperties props_{};
+  VkPhysicalDeviceMemoryProperties memProps_{};
+  std::string name_;
+
+  std::mutex queueLock;  // vkQueueSubmit's queue is externally synchronised
+  std::mutex programsLock;
+  std::map<std::string, Context::Program> programs_;
+  std::atomic<bool> lost{false};
+};
+
+namespace {
+
+// The devices made so far, by the choice they were made for; never destroyed (see context.h),
+// as a process that rendered once renders again, and a lavapipe device torn down by static
+// destructors at exit may outlive the driver's own state.
+std::shared_ptr<Device> sharedDevice(const DeviceChoice& choice) {
+  static std::mutex lock;
+  static auto* devices = new std::map<std::pair<std::string, bool>, std::shared_ptr<Device>>;
+  std::lock_guard<std::mutex> guard(lock);
+  std::shared_ptr<Device>& d = (*devices)[{choice.preferred, choice.validation}];
+  if (!d || d->lost) d = std::make_shared<Device>(choice);
+  return d;
+}
+
+}  // namespace
+
+Device::Device(const DeviceChoice& choice) {
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "Retile";
   app.pEngineName = "Retile";
@@ -185,20 +223,17 @@ Context::Context(const DeviceChoice& choiceIn) {
   checkVk(vkCreateDevice(physical_, &dci, nullptr, &device_), "creating the device");
   vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
 
-  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  pci.queueFamilyIndex = queueFamily_;
-  checkVk(vkCreateCommandPool(device_, &pci, nullptr, &pool_), "creating a command pool");
-  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  checkVk(vkCreateFence(device_, &fci, nullptr, &fence_), "creating a fence");
   logInfo("Vulkan device: ", name_);
 }
 
-Context::~Context() {
+Device::~Device() {
   if (device_) {
     vkDeviceWaitIdle(device_);
-    if (fence_) vkDestroyFence(device_, fence_, nullptr);
-    if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
+    for (auto& [key, p] : programs_) {
+      vkDestroyPipeline(device_, p.pipeline, nullptr);
+      vkDestroyPipelineLayout(device_, p.layout, nullptr);
+      vkDestroyDescriptorSetLayout(device_, p.setLayout, nullptr);
+    }
     vkDestroyDevice(device_, nullptr);
   }
   if (messenger_) {
@@ -209,21 +244,71 @@ Context::~Context() {
   if (instance_) vkDestroyInstance(instance_, nullptr);
 }
 
+Context::Context(const DeviceChoice& choiceIn) {
+  flushDenormals();  // lavapipe's threads, created with the device, inherit it (core/process.h)
+  DeviceChoice choice = choiceIn;
+  if (const char* env = std::getenv("RETILE_DEVICE"); env && *env) choice.preferred = env;
+  if (const char* env = std::getenv("RETILE_VALIDATION"); env && *env) choice.validation = std::strcmp(env, "0") != 0;
+  shared_ = sharedDevice(choice);
+  VkDevice d = shared_->device_;
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pci.queueFamilyIndex = shared_->queueFamily_;
+  checkVk(vkCreateCommandPool(d, &pci, nullptr, &pool_), "creating a command pool");
+  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  checkVk(vkCreateFence(d, &fci, nullptr, &fence_), "creating a fence");
+}
+
+Context::~Context() {
+  VkDevice d = shared_->device_;
+  if (pending_) {
+    vkWaitForFences(d, 1, &fence_, VK_TRUE, UINT64_MAX);
+    vkFreeCommandBuffers(d, pool_, 1, &pending_);
+  }
+  if (fence_) vkDestroyFence(d, fence_, nullptr);
+  if (pool_) vkDestroyCommandPool(d, pool_, nullptr);
+}
+
+VkInstance Context::instance() const { return shared_->instance_; }
+VkPhysicalDevice Context::physicalDevice() const { return shared_->physical_; }
+VkDevice Context::device() const { return shared_->device_; }
+std::uint32_t Context::queueFamily() const { return shared_->queueFamily_; }
+const VkPhysicalDeviceProperties& Context::properties() const { return shared_->props_; }
+const std::string& Context::deviceName() const { return shared_->name_; }
+
+const Context::Program& Context::program(const std::string& key, const std::function<Program()>& make) {
+  std::lock_guard<std::mutex> guard(shared_->programsLock);
+  auto it = shared_->programs_.find(key);
+  if (it == shared_->programs_.end()) it = shared_->programs_.emplace(key, make()).first;
+  return it->second;
+}
+
+template <class F>
+void Context::noticingLoss(F&& call) {
+  try {
+    call();
+  } catch (const DeviceLost&) {
+    shared_->lost = true;
+    throw;
+  }
+}
+
 std::uint32_t Context::memoryType(std::uint32_t bits, VkMemoryPropertyFlags wanted, VkMemoryPropertyFlags fallback) const {
   for (VkMemoryPropertyFlags flags : {wanted, fallback})
-    for (std::uint32_t i = 0; i < memProps_.memoryTypeCount; ++i)
-      if ((bits & (1u << i)) && (memProps_.memoryTypes[i].propertyFlags & flags) == flags) return i;
+    for (std::uint32_t i = 0; i < shared_->memProps_.memoryTypeCount; ++i)
+      if ((bits & (1u << i)) && (shared_->memProps_.memoryTypes[i].propertyFlags & flags) == flags) return i;
   throw Error("Vulkan: no suitable memory type for a buffer");
 }
 
 void Context::submit(const std::function<void(VkCommandBuffer)>& record) {
   wait();  // one submission in flight at a time: its fence and command buffer are reused
+  VkDevice d = shared_->device_;
   VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   ai.commandPool = pool_;
   ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   ai.commandBufferCount = 1;
   VkCommandBuffer cb;
-  checkVk(vkAllocateCommandBuffers(device_, &ai, &cb), "allocating a command buffer");
+  checkVk(vkAllocateCommandBuffers(d, &ai, &cb), "allocating a command buffer");
   try {
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -233,10 +318,13 @@ void Context::submit(const std::function<void(VkCommandBuffer)>& record) {
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     si.commandBufferCount = 1;
     si.pCommandBuffers = &cb;
-    checkVk(vkResetFences(device_, 1, &fence_), "resetting a fence");
-    checkVk(vkQueueSubmit(queue_, 1, &si, fence_), "submitting work");
+    checkVk(vkResetFences(d, 1, &fence_), "resetting a fence");
+    noticingLoss([&] {
+      std::lock_guard<std::mutex> guard(shared_->queueLock);
+      checkVk(vkQueueSubmit(shared_->queue_, 1, &si, fence_), "submitting work");
+    });
   } catch (...) {
-    vkFreeCommandBuffers(device_, pool_, 1, &cb);
+    vkFreeCommandBuffers(d, pool_, 1, &cb);
     throw;
   }
   pending_ = cb;
@@ -244,10 +332,11 @@ void Context::submit(const std::function<void(VkCommandBuffer)>& record) {
 
 void Context::wait() {
   if (pending_ == VK_NULL_HANDLE) return;
+  VkDevice d = shared_->device_;
   VkCommandBuffer cb = std::exchange(pending_, VK_NULL_HANDLE);
-  VkResult r = vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX);
-  vkFreeCommandBuffers(device_, pool_, 1, &cb);
-  checkVk(r, "waiting for the device");
+  VkResult r = vkWaitForFences(d, 1, &fence_, VK_TRUE, UINT64_MAX);
+  vkFreeCommandBuffers(d, pool_, 1, &cb);
+  noticingLoss([&] { checkVk(r, "waiting for the device"); });
 }
 
 void Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record) {

@@ -1,11 +1,18 @@
-// The engine's own headless Vulkan instance and device (no surface, no Qt). One Context per
-// renderer. Threads: created and used by the thread that owns the renderer (the render thread
-// in the editor); nothing here is thread-safe on its own.
+// The engine's own headless Vulkan (no surface, no Qt). One Context per renderer, each with its
+// own command pool and fence; the instance, the device and the compiled compute programs behind
+// them are the process's (Device, context.cpp), made by the first Context that asks for a device
+// and kept until the process exits, so that the next renderer starts without compiling anything
+// again (lavapipe takes 0.3 to 0.7 s to create a trace kernel's pipeline even with its disk cache
+// warm, and the eval and the tests make a renderer per method and case). A device that was lost is
+// given to no new Context. Threads: a Context is created and used by the thread that owns its
+// renderer (the render thread in the editor); Contexts on different threads may share the device
+// (its queue and program cache are locked).
 #pragma once
 
 #include <vulkan/vulkan.h>
 
 #include <functional>
+#include <memory>
 #include <string>
 
 namespace retile::vk {
@@ -17,6 +24,8 @@ struct DeviceChoice {
   bool validation = false;  // request VK_LAYER_KHRONOS_validation if installed
 };
 
+class Device;
+
 class Context {
  public:
   explicit Context(const DeviceChoice& choice = {});
@@ -24,18 +33,27 @@ class Context {
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
 
-  VkInstance instance() const { return instance_; }
-  VkPhysicalDevice physicalDevice() const { return physical_; }
-  VkDevice device() const { return device_; }
-  VkQueue queue() const { return queue_; }
-  std::uint32_t queueFamily() const { return queueFamily_; }
-  const VkPhysicalDeviceProperties& properties() const { return props_; }
-  const std::string& deviceName() const { return name_; }
-  bool isCpuDevice() const { return props_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
+  VkInstance instance() const;
+  VkPhysicalDevice physicalDevice() const;
+  VkDevice device() const;
+  std::uint32_t queueFamily() const;
+  const VkPhysicalDeviceProperties& properties() const;
+  const std::string& deviceName() const;
+  bool isCpuDevice() const { return properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
 
   // Memory type for `bits` with `wanted` flags; falls back to any type in `bits` with
   // `fallback` flags. Throws when none fits.
   std::uint32_t memoryType(std::uint32_t bits, VkMemoryPropertyFlags wanted, VkMemoryPropertyFlags fallback) const;
+
+  // A compute program: what every pipeline of one shader, defines and bindings shares.
+  struct Program {
+    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+  };
+  // The device's program for `key`, made by make() the first time any Context of the device asks
+  // for it (while others wait) and destroyed with the device.
+  const Program& program(const std::string& key, const std::function<Program()>& make);
 
   // Records commands into a one-time command buffer and submits it; returns while the device
   // works. At most one submission is in flight: a second submit waits for the first.
@@ -48,18 +66,14 @@ class Context {
   void submitAndWait(const std::function<void(VkCommandBuffer)>& record);
 
  private:
-  VkInstance instance_ = VK_NULL_HANDLE;
-  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
-  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
-  VkDevice device_ = VK_NULL_HANDLE;
-  VkQueue queue_ = VK_NULL_HANDLE;
-  std::uint32_t queueFamily_ = 0;
+  // Marks the device lost (no new Context gets it) when `call` throws DeviceLost.
+  template <class F>
+  void noticingLoss(F&& call);
+
+  std::shared_ptr<Device> shared_;
   VkCommandPool pool_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
   VkCommandBuffer pending_ = VK_NULL_HANDLE;  // the submission in flight
-  VkPhysicalDeviceProperties props_{};
-  VkPhysicalDeviceMemoryProperties memProps_{};
-  std::string name_;
 };
 
 }  // namespace retile::vk

@@ -24,6 +24,7 @@ ComputePipeline::ComputePipeline(Context& ctx, const std::string& entry, const s
   VkDevice d = ctx.device();
   std::vector<VkDescriptorSetLayoutBinding> lb;
   std::vector<VkDescriptorPoolSize> sizes;
+  std::string key = cat(entry, " push ", pushConstantBytes, " bindings");
   for (std::uint32_t i = 0; i < bindings.size(); ++i) {
     VkDescriptorSetLayoutBinding b{};
     b.binding = i;
@@ -32,35 +33,49 @@ ComputePipeline::ComputePipeline(Context& ctx, const std::string& entry, const s
     b.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
     lb.push_back(b);
     sizes.push_back({b.descriptorType, 1});
+    key += cat(" ", static_cast<int>(b.descriptorType));
   }
-  VkDescriptorSetLayoutCreateInfo dlci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  dlci.bindingCount = static_cast<std::uint32_t>(lb.size());
-  dlci.pBindings = lb.data();
-  checkVk(vkCreateDescriptorSetLayout(d, &dlci, nullptr, &setLayout_), "creating a descriptor set layout");
+  for (const ShaderDefine& def : defines) key += cat(" -D", def.name, "=", def.value);
 
-  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushConstantBytes};
-  VkPipelineLayoutCreateInfo plci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  plci.setLayoutCount = 1;
-  plci.pSetLayouts = &setLayout_;
-  plci.pushConstantRangeCount = pushConstantBytes ? 1 : 0;
-  plci.pPushConstantRanges = &range;
-  checkVk(vkCreatePipelineLayout(d, &plci, nullptr, &layout_), "creating a pipeline layout");
+  const Context::Program& program = ctx.program(key, [&] {
+    Context::Program p;
+    VkDescriptorSetLayoutCreateInfo dlci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    dlci.bindingCount = static_cast<std::uint32_t>(lb.size());
+    dlci.pBindings = lb.data();
+    checkVk(vkCreateDescriptorSetLayout(d, &dlci, nullptr, &p.setLayout), "creating a descriptor set layout");
 
-  std::vector<std::uint32_t> spirv = compileComputeShader(entry, defines);
-  VkShaderModuleCreateInfo smci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  smci.codeSize = spirv.size() * 4;
-  smci.pCode = spirv.data();
-  VkShaderModule module;
-  checkVk(vkCreateShaderModule(d, &smci, nullptr, &module), cat("creating shader module ", entry).c_str());
-  VkComputePipelineCreateInfo cpci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-  cpci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-  cpci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-  cpci.stage.module = module;
-  cpci.stage.pName = "main";
-  cpci.layout = layout_;
-  VkResult r = vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &cpci, nullptr, &pipeline_);
-  vkDestroyShaderModule(d, module, nullptr);
-  checkVk(r, cat("creating compute pipeline ", entry).c_str());
+    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushConstantBytes};
+    VkPipelineLayoutCreateInfo plci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    plci.setLayoutCount = 1;
+    plci.pSetLayouts = &p.setLayout;
+    plci.pushConstantRangeCount = pushConstantBytes ? 1 : 0;
+    plci.pPushConstantRanges = &range;
+    checkVk(vkCreatePipelineLayout(d, &plci, nullptr, &p.layout), "creating a pipeline layout");
+
+    std::vector<std::uint32_t> spirv = compileComputeShader(entry, defines);
+    VkShaderModuleCreateInfo smci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    smci.codeSize = spirv.size() * 4;
+    smci.pCode = spirv.data();
+    VkShaderModule module;
+    checkVk(vkCreateShaderModule(d, &smci, nullptr, &module), cat("creating shader module ", entry).c_str());
+    VkComputePipelineCreateInfo cpci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    cpci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    cpci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    cpci.stage.module = module;
+    cpci.stage.pName = "main";
+    cpci.layout = p.layout;
+    VkResult r = vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &cpci, nullptr, &p.pipeline);
+    vkDestroyShaderModule(d, module, nullptr);
+    if (r != VK_SUCCESS) {
+      vkDestroyPipelineLayout(d, p.layout, nullptr);
+      vkDestroyDescriptorSetLayout(d, p.setLayout, nullptr);
+    }
+    checkVk(r, cat("creating compute pipeline ", entry).c_str());
+    return p;
+  });
+  setLayout_ = program.setLayout;
+  layout_ = program.layout;
+  pipeline_ = program.pipeline;
 
   VkDescriptorPoolCreateInfo dpci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   dpci.maxSets = 1;
@@ -75,11 +90,7 @@ ComputePipeline::ComputePipeline(Context& ctx, const std::string& entry, const s
 }
 
 ComputePipeline::~ComputePipeline() {
-  VkDevice d = ctx_.device();
-  if (pool_) vkDestroyDescriptorPool(d, pool_, nullptr);
-  if (pipeline_) vkDestroyPipeline(d, pipeline_, nullptr);
-  if (layout_) vkDestroyPipelineLayout(d, layout_, nullptr);
-  if (setLayout_) vkDestroyDescriptorSetLayout(d, setLayout_, nullptr);
+  if (pool_) vkDestroyDescriptorPool(ctx_.device(), pool_, nullptr);  // the program is the device's
 }
 
 void ComputePipeline::bind(std::uint32_t index, Buffer& buffer, VkFormat format) {

@@ -1,5 +1,7 @@
 // A compute pipeline with one descriptor set. Owned by a render pass object; used on the
-// thread that owns the Context.
+// thread that owns the Context. Its program (layouts and pipeline) is the device's, compiled by
+// the first pipeline of the same shader, defines and bindings (Context::program); the descriptor
+// set, which binds this pass's buffers, is its own.
 #pragma once
 
 #include <vulkan/vulkan.h>
