@@ -8,10 +8,13 @@
 #include <span>
 
 #include "gpu_support.h"
+#include "render/bsdf_probe.h"
 #include "render/bvh.h"
 #include "retile/edit.h"
 #include "scene/primitives.h"
 #include "test_support.h"
+#include "vk/context.h"
+#include "vk/pipeline.h"
 
 namespace retile {
 namespace {
@@ -30,6 +33,45 @@ Scene wallScene(int w, int h, Vec3 emission) {
   // The quad faces +y; turn it to face the camera (+z) and push it back.
   test::addMeshObject(s, "wall", makeQuad(), mat, Mat4::translate({0, 0, -5}) * Mat4::rotateX(kPi / 2) * Mat4::scale({100, 1, 100}));
   return s;
+}
+
+// Renderers made one after another, or side by side, share the device and compile each program
+// once (vk/context.h): the device outlives them, and a second pipeline of the same shader, defines
+// and bindings is made without compiling, while one that differs in any of them is compiled anew.
+TEST(VulkanContext, RenderersShareTheDeviceAndCompileEachProgramOnce) {
+  RETILE_RENDERER_OR_SKIP(probe);
+  probe.reset();
+  VkDevice first = VK_NULL_HANDLE;
+  {
+    vk::Context a;
+    first = a.device();
+  }
+  vk::Context b, c;
+  EXPECT_EQ(b.device(), first) << "kept after its last Context";
+  EXPECT_EQ(c.device(), first);
+  const std::vector<vk::Binding> bindings{vk::Binding::Storage, vk::Binding::Storage};
+  vk::ComputePipeline p1(b, "bsdf_probe.comp", bindings, 4);
+  int made = 0;
+  const std::string key = "RenderersShareTheDevice test";
+  auto make = [&] {
+    ++made;
+    return vk::Context::Program{};
+  };
+  b.program(key, make);
+  c.program(key, make);
+  EXPECT_EQ(made, 1);
+  c.program(key + " differs", make);
+  EXPECT_EQ(made, 2);
+  // The same program behind pipelines of two Contexts, each with its own descriptor set: both
+  // dispatch (BsdfProbe's shader, through the probe each Context makes).
+  BsdfProbe probeB(b), probeC(c);
+  Material lambert;
+  lambert.type = MaterialType::Lambert;
+  lambert.albedo = Vec3{0.5f};
+  const std::vector<BsdfQuery> q{{lambert, {0, 0, 1}, {0, 0, 1}, Vec3{0.5f}}};
+  const BsdfAnswer ab = probeB.run(q).at(0), ac = probeC.run(q).at(0);
+  EXPECT_NEAR(ab.f.x, 0.5f / kPi, 1e-5f);
+  EXPECT_EQ(ab.f.x, ac.f.x);
 }
 
 TEST(AccumulatePass, MergesAnyQualityExactly) {

@@ -6,6 +6,7 @@
 #include <exception>
 
 #include "retile/log.h"
+#include "vk/check.h"
 
 namespace retile {
 
@@ -222,14 +223,17 @@ void Engine::run() {
       }
     } catch (const std::exception& e) {
       // A failed frame (device lost, out of memory) takes the session's GPU state with it, not its
-      // scene, which holds every edit applied so far: rendering starts again on a new device with
-      // it (the accumulation restarts). The document, on the GUI thread, is never touched.
+      // scene, which holds every edit applied so far: rendering starts again with it in a new
+      // session (the accumulation restarts), on a new device when the device was lost
+      // (vk::Context gives a lost device to no one). The document, on the GUI thread, is never
+      // touched.
       constexpr int kMaxRestarts = 3;
       if (++restarts > kMaxRestarts) {
-        report(cat("rendering stopped: ", e.what(), " (", kMaxRestarts, " new devices failed in a row)"));
+        report(cat("rendering stopped: ", e.what(), " (", kMaxRestarts, " restarts failed in a row)"));
         break;
       }
-      report(cat("the device failed: ", e.what(), "; rendering starts again on a new device"));
+      report(cat("the device failed: ", e.what(), "; rendering starts again",
+                 dynamic_cast<const vk::DeviceLost*>(&e) ? " on a new device" : ""));
       try {
         Scene scene = session->scene();
         MethodSettings method = session->method();
