@@ -1315,6 +1315,50 @@ TEST(KnownAnswer, ACutOutLetsThroughWhatItsAlphaLeavesOut) {
   EXPECT_NEAR(imageMean(renderScene(*r, s, 64)), std::pow(0.9, 20), 0.015) << "ten cut-outs";
 }
 
+// A ray that passes a cut-out leaves it as Tungsten's rays leave a surface (RayOffset): with
+// Tungsten's offset it skips what lies within 5e-4 beyond it, and goes on from the next thing it
+// meets past that. So a thin shell of cut-outs (the kitchen's blinds: two faces 0.25 mm apart)
+// lets through 1 - alpha where the faces lie within 5e-4 of each other along the ray, not
+// (1 - alpha)^2. A white floor under a sky of 1, and above it n black cut-outs of alpha 0.3, h
+// apart, seen from above: a camera ray (within 10 degrees of the normal: the leading factors
+// below) and the floor's light from a direction at cos theta = c meet the layers spaced h / c
+// along the ray. Two layers,
+// h = 2.5e-4: the second is skipped where c >= h / 5e-4 = 0.5, a share 1 - 0.5^2 = 0.75 of the
+// floor's cosine-weighted sky: 0.7 (0.7 0.75 + 0.49 0.25) = 0.45325. Three, h = 3e-4: the
+// second is skipped wherever c >= 0.6 (0.64 of the sky) and the third, 6e-4 past the first, is
+// met there: 0.49 (0.49 0.64 + 0.343 0.36) = 0.214; one that skipped whatever lay within 5e-4 of
+// any passed layer would skip the third behind a passed second. The robust offset meets every
+// layer: 0.7^(2n). Bounces enough that a pass counted as one (Tungsten's forward event) would
+// change nothing: light reaches the floor's paths once.
+TEST(KnownAnswer, APassedCutOutIsLeftAsTheRaysOffsetSays) {
+  RETILE_RENDERER_OR_SKIP(r);
+  auto imageMean = [](const RenderImage& img) {
+    double sum = 0;
+    for (std::size_t i = 0; i < img.color.size() / 3; ++i) sum += img.color[i * 3 + 1];
+    return sum / static_cast<double>(img.color.size() / 3);
+  };
+  for (RayOffset offset : {RayOffset::Robust, RayOffset::Tungsten}) {
+    for (int layers : {2, 3}) {
+      SCOPED_TRACE(std::string(offset == RayOffset::Tungsten ? "Tungsten's offset, " : "robust offset, ") + std::to_string(layers) +
+                   " layers");
+      Scene s = underUnitSky(16, 16, 20);
+      s.settings.maxBounces = 16;
+      s.settings.rayOffset = offset;
+      test::addMeshObject(s, "white", makeQuad(), test::addMaterial(s, grey(1.0f)), Mat4::scale({1000, 1, 1000}));
+      Material cut = grey(0.0f);
+      cut.alpha = 0.3f;
+      const NodeId cutMaterial = test::addMaterial(s, cut);
+      const float h = layers == 2 ? 2.5e-4f : 3e-4f;
+      for (int i = 0; i < layers; ++i)
+        test::addMeshObject(s, "layer", makeQuad(), cutMaterial,
+                            Mat4::translate({0, 1 + h * static_cast<float>(i), 0}) * Mat4::scale({1000, 1, 1000}));
+      double expected = std::pow(0.7, 2 * layers);
+      if (offset == RayOffset::Tungsten) expected = layers == 2 ? 0.7 * (0.7 * 0.75 + 0.49 * 0.25) : 0.49 * (0.49 * 0.64 + 0.343 * 0.36);
+      EXPECT_NEAR(imageMean(renderScene(*r, s, 128)), expected, 0.012);
+    }
+  }
+}
+
 // The pixel filter (filter importance sampling): a light's straight edge on a pixel boundary.
 // With a box each pixel sees only its own square; with Tungsten's tent (one pixel each way) the
 // pixel on either side of the edge takes 1/8 from across it (the tent's mass beyond half a pixel);

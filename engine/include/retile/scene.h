@@ -425,7 +425,8 @@ enum class ShadingConvention { Consistent, Tungsten };
 enum class Roulette { Standard, Tungsten };
 // Where a ray that leaves a surface starts. Robust: a few float ulps off the surface, and never on
 // the triangle it leaves, so it hits whatever lies beyond, however close. Tungsten: as Tungsten's
-// rays, which skip everything within 5e-4 scene units of the surface (its DefaultEpsilon). Light
+// rays, which skip everything within 5e-4 scene units of the surface (its DefaultEpsilon), also
+// when they pass a cut-out (a forward event; a shadow ray: a cut-out or a thin sheet). Light
 // then leaks through cracks narrower than that, such as where a skirting board dips into the
 // floor, and the contact shadows of surfaces closer than that vanish: Tungsten files use it so
 // that they converge to the picture their author saw (the living room's darkest corners differ by
