@@ -465,6 +465,9 @@ void resolveForward(inout Trace tr, bool solid, int root) {
   }
   tr.hitForward = false;
   tr.forwardT = kInfinity;
+#if RETILE_BOUNDARY
+  tr.forwardCrossing = 0;
+#endif
   tr.item = root;
   tr.stackSize = 0;
   tr.o = tr.origin;
@@ -1059,6 +1062,15 @@ void main() {
         if (solid && tr.onShadow && (flags & kInstanceSheet) != 0) solid = !sheetPasses(tr);
 #else
         bool solid = alphaPasses(tr.pendingInstance, tr.pendingPrim, tr.pendingU, tr.pendingV, tr.rayRandom);
+#endif
+#if RETILE_BOUNDARY
+        if (tr.forwardCrossing != 0) {
+          // A boundary (Trace::forwardCrossing): crossed, counted below (countCrossings).
+          solid = false;
+          tr.crossingInstance[tr.crossings] = tr.forwardCrossing;
+          tr.crossingT[tr.crossings] = tr.forwardT;
+          tr.crossings++;
+        }
 #endif
         if (hasFeature(kFeatureTungstenEpsilon)) resolveForward(tr, solid, root);
         else tr.alphaDecision = solid ? 1 : -1;

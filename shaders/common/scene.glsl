@@ -316,11 +316,16 @@ struct Trace {
   // as in Tungsten, not two. What a ray skips depends on the order it meets things in, which the
   // traversal does not follow, so then nothing is decided in the loop: the ray's segment finds
   // its nearest cut-out (an extension ray its closest hit, flagged hitForward; a shadow ray the
-  // nearest cut-out or sheet, at forwardT, with its opaque blockers as any hit up to there),
+  // nearest cut-out, sheet or boundary, at forwardT, with its opaque blockers as any hit up to there),
   // pauses on it once the segment is traced (alphaPending), and once decided (trace.comp
   // resolveForward) either stops there or is traced again from tNear = past it + the epsilon.
   bool hitForward;
   float forwardT, tNear;
+#if RETILE_BOUNDARY
+  // A boundary a shadow ray crosses is a forward event too, counted once the ray passes it: when
+  // the nearest is one, its crossing (as Trace::crossingInstance holds one), else 0.
+  int forwardCrossing;
+#endif
 #endif
 };
 
@@ -375,6 +380,9 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, i
   tr.hitForward = false;
   tr.forwardT = kInfinity;
   tr.tNear = 0.0;
+#if RETILE_BOUNDARY
+  tr.forwardCrossing = 0;
+#endif
 #endif
 #if RETILE_SHEET
   tr.shadowWeight = vec3(1.0);
@@ -573,6 +581,9 @@ void traceStep(inout Trace tr, int below, int root) {
         tr.pendingInstance = instance;
         tr.pendingU = uu;
         tr.pendingV = vv;
+#if RETILE_BOUNDARY
+        tr.forwardCrossing = 0;
+#endif
         found = false;
       }
     } else {
@@ -593,7 +604,22 @@ void traceStep(inout Trace tr, int below, int root) {
     // A boundary is no surface: the shadow ray goes on, into the medium on its other side, which
     // countCrossings counts. (A boundary is never a cut-out: packInstances.)
     bool boundary = direct ? (floatBitsToInt(r2.w) & kTriBoundary) != 0 : (tr.instFlags & kInstanceBoundary) != 0;
-    if (found && tr.onShadow && boundary) {
+    bool crosses = found && tr.onShadow && boundary;
+#if RETILE_ALPHA_TEST
+    if (forwardEvents && crosses) {
+      // With Tungsten's offset, the nearest so far (Trace::forwardCrossing): crossed, and counted,
+      // once the segment is traced, so that one the ray skips past a cut-out is not counted.
+      tr.forwardT = tt;
+      tr.pendingPrim = p;
+      tr.pendingInstance = instance;
+      tr.pendingU = uu;
+      tr.pendingV = vv;
+      tr.forwardCrossing = det > 0.0 ? instance + 1 : -(instance + 1);
+      found = false;
+      crosses = false;
+    }
+#endif
+    if (crosses) {
       if (tr.crossings == 4) {
         // Pause here, the item unchanged, so that the step is taken again once they are counted.
         tr.crossingPending = true;

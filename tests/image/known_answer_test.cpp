@@ -605,7 +605,10 @@ TEST(KnownAnswer, ALightOutsideABoundaryLightsTheMediumInside) {
 // it must pause until they are counted (Trace::crossings), so the count goes on across rounds of
 // the traversal loop. The plane reads albedo / pi E exp(-5 sigma), in each channel. Packed direct
 // (triangles name their instance and its boundary flag) and with instance records. Each crossing
-// is a bounce, as for a path (and in Tungsten): at ten bounces the light is out of reach.
+// is a bounce, as for a path (and in Tungsten): at ten bounces the light is out of reach. The
+// same with Tungsten's ray offset and cut-outs that let everything through, below the slabs and
+// inside two of them: the shadow ray, traced again past each (resolveForward), counts each
+// crossing once, also the far side of a slab it met before the cut-out inside.
 TEST(KnownAnswer, AShadowRayCountsEveryBoundaryItCrosses) {
   RETILE_RENDERER_OR_SKIP(direct);
   std::string why;
@@ -633,6 +636,23 @@ TEST(KnownAnswer, AShadowRayCountsEveryBoundaryItCrosses) {
   }
   s.settings.maxBounces = 10;
   EXPECT_EQ(meanOver(renderScene(*direct, s, 4), plane), 0.0) << "ten crossings at ten bounces";
+  s.settings.maxBounces = 11;
+  s.settings.rayOffset = RayOffset::Tungsten;
+  Material clear = grey(0.0f);
+  clear.alpha = 0.0f;
+  const NodeId clearMaterial = test::addMaterial(s, clear);
+  for (float y : {1.0f, 2.5f, 6.5f})
+    test::addMeshObject(s, "clear", makeQuad(), clearMaterial, Mat4::translate({0, y, 0}) * Mat4::scale({40, 1, 40}));
+  lookStraightDown(s, 0.5f, 2);
+  for (Renderer* r : {direct.get(), records.get()}) {
+    RenderImage img = renderScene(*r, s, 4);
+    for (int c = 0; c < 3; ++c) {
+      const double mean = meanOver(img, plane, nullptr, c);
+      const double expected = 0.5 / kPi * 2.0 * std::exp(-5.0 * static_cast<double>(sigma[c]));
+      EXPECT_NEAR(mean, expected, 1e-3 * expected)
+          << "Tungsten's offset, cut-outs, " << (r == direct.get() ? "direct" : "records") << ", channel " << c;
+    }
+  }
 }
 
 TEST(KnownAnswer, TheWorldsMediumDimsWhatTheCameraSeesAndHidesTheSky) {
