@@ -433,6 +433,53 @@ bool sheetPasses(inout Trace tr) {
 }
 #endif
 
+#if RETILE_ALPHA_TEST
+// With the fixed ray offset (RayOffset::FixedEpsilon): the cut-out (or, for a shadow ray, thin
+// sheet) a lane's ray segment paused on at its end (Trace::hitForward), decided `solid` or
+// passed. Solid, the ray ends there (a shadow ray blocked), as traceStep ends one; passed, it is
+// a forward event, as in Tungsten: the ray is traced again from the root, from tNear,
+// kFixedRayEpsilon past the point it passed, as a ray leaves a surface; so it skips what lies
+// within that of it (the blinds' second face) and meets what lies beyond in turn. Past the
+// traversal loop, once a round.
+void resolveForward(inout Trace tr, bool solid, int root) {
+  if (solid && tr.onShadow) tr.blocker = tr.pendingInstance;
+  if (solid && (tr.onShadow || !tr.second)) {
+    tr.done = true;
+    tr.onShadow = true;
+    tr.tMax2 = -1.0;
+  } else if (solid) {
+    // The extension ray's hit stands: its shadow ray follows, from its own origin.
+    tr.onShadow = true;
+    tr.origin = tr.origin2;
+    tr.dir = tr.dir2;
+    tr.invDir = tr.invDir2;
+    tr.rayRandom = tr.random2;
+    tr.from = tr.from2;
+    tr.tNear = 0.0;
+  } else {
+    tr.tNear = (tr.onShadow ? tr.forwardT : tr.hit.t) + kFixedRayEpsilon;
+    if (!tr.onShadow) {
+      // The extension ray looks for its closest hit again, past that.
+      tr.hit.t = kInfinity;
+      tr.hit.prim = -1;
+      tr.hit.instance = -1;
+    }
+  }
+  tr.hitForward = false;
+  tr.forwardT = kInfinity;
+#if RETILE_BOUNDARY
+  tr.forwardCrossing = 0;
+#endif
+  tr.item = root;
+  tr.stackSize = 0;
+  tr.o = tr.origin;
+  tr.d = tr.dir;
+  tr.invD = tr.invDir;
+  tr.instance = -1;
+  tr.instanceSp = -1;
+}
+#endif
+
 // Surfaces whose reflection or refraction shows other objects' edges: mirrors, smooth glass and
 // metal, and their nearly smooth rough kinds. The denoiser's guides look through them.
 bool guideLooksThrough(Material m) {
@@ -1019,7 +1066,17 @@ void main() {
 #else
         bool solid = alphaPasses(tr.pendingInstance, tr.pendingPrim, tr.pendingU, tr.pendingV, tr.rayRandom);
 #endif
-        tr.alphaDecision = solid ? 1 : -1;
+#if RETILE_BOUNDARY
+        if (tr.forwardCrossing != 0) {
+          // A boundary (Trace::forwardCrossing): crossed, counted below (countCrossings).
+          solid = false;
+          tr.crossingInstance[tr.crossings] = tr.forwardCrossing;
+          tr.crossingT[tr.crossings] = tr.forwardT;
+          tr.crossings++;
+        }
+#endif
+        if (hasFeature(kFeatureFixedEpsilon)) resolveForward(tr, solid, root);
+        else tr.alphaDecision = solid ? 1 : -1;
         tr.alphaPending = false;
       }
 #endif

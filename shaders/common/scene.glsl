@@ -310,6 +310,22 @@ struct Trace {
   int alphaDecision;
   int pendingPrim, pendingInstance;
   float pendingU, pendingV;
+  // With the fixed ray offset (kFeatureFixedEpsilon) a pass is a forward event, as Tungsten's: the
+  // ray goes on from the point it passed, skipping what lies within kFixedRayEpsilon beyond it, so
+  // that a shell of cut-outs thinner than that (a blind's two faces 0.25 mm apart) is one layer,
+  // as in Tungsten, not two. What a ray skips depends on the order it meets things in, which the
+  // traversal does not follow, so then nothing is decided in the loop: the ray's segment finds
+  // its nearest cut-out (an extension ray its closest hit, flagged hitForward; a shadow ray the
+  // nearest cut-out, sheet or boundary, at forwardT, with its opaque blockers as any hit up to there),
+  // pauses on it once the segment is traced (alphaPending), and once decided (trace.comp
+  // resolveForward) either stops there or is traced again from tNear = past it + the epsilon.
+  bool hitForward;
+  float forwardT, tNear;
+#if RETILE_BOUNDARY
+  // A boundary a shadow ray crosses is a forward event too, counted once the ray passes it: when
+  // the nearest is one, its crossing (as Trace::crossingInstance holds one), else 0.
+  int forwardCrossing;
+#endif
 #endif
 };
 
@@ -361,6 +377,12 @@ void beginTrace(inout Trace tr, int root, bool first, vec3 origin1, vec3 dir1, i
 #if RETILE_ALPHA_TEST
   tr.alphaPending = false;
   tr.alphaDecision = 0;
+  tr.hitForward = false;
+  tr.forwardT = kInfinity;
+  tr.tNear = 0.0;
+#if RETILE_BOUNDARY
+  tr.forwardCrossing = 0;
+#endif
 #endif
 #if RETILE_SHEET
   tr.shadowWeight = vec3(1.0);
@@ -431,6 +453,16 @@ void traceStep(inout Trace tr, int below, int root) {
   vec3 rayInvD = transforms ? tr.invD : tr.invDir;
   // How far the current ray looks: a shadow ray to its light, an extension ray to its hit so far.
   float tLimit = tr.onShadow ? tr.tMax2 : tr.hit.t;
+  // And from where: past what a ray that passed a cut-out skips (Trace::hitForward).
+  float tMin = 0.0;
+#if RETILE_ALPHA_TEST
+  const bool forwardEvents = hasFeature(kFeatureFixedEpsilon);
+  if (forwardEvents) {
+    tMin = tr.tNear;
+    // A shadow ray's segment ends at the nearest cut-out it has met (it is traced on from there).
+    if (tr.onShadow) tLimit = min(tLimit, tr.forwardT);
+  }
+#endif
   int item = tr.item;
   int at = item >> kItemOffsetShift;
   int kind = item & 3;
@@ -463,7 +495,8 @@ void traceStep(inout Trace tr, int below, int root) {
     // lavapipe gives those NaN semantics at three instructions each. tNear is never NaN (a
     // distance only replaces a smaller one), so the ranks below are a strict order.
     vec4 tNear = base.x + vec4((uvec4(inX) >> bytes) & 255u) * scaled.x;
-    tNear = mix(vec4(0.0), tNear, greaterThan(tNear, vec4(0.0)));
+    // From tMin on (0 but for a ray traced again past a cut-out): boxes left behind are not entered.
+    tNear = mix(vec4(tMin), tNear, greaterThan(tNear, vec4(tMin)));
     vec4 tFar = base.x + vec4((uvec4(outX) >> bytes) & 255u) * scaled.x;
     vec4 t = base.y + vec4((uvec4(inY) >> bytes) & 255u) * scaled.y;
     tNear = mix(tNear, t, greaterThan(t, tNear));
@@ -521,7 +554,7 @@ void traceStep(inout Trace tr, int below, int root) {
     float tt = dot(r2.xyz, q) * inv;
     int p = floatBitsToInt(r0.w);
     int instance = direct ? floatBitsToInt(r2.w) & kTriInstanceMask : tr.instance;
-    bool found = det != 0.0 && uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < tLimit &&
+    bool found = det != 0.0 && uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > tMin && tt < tLimit &&
                  (p != tr.from.x || instance != tr.from.y);
     if (hasFeature(kFeatureCullBack)) {
       // det is -dot(d, the triangle's normal): negative where the ray meets its back, which an
@@ -531,29 +564,62 @@ void traceStep(inout Trace tr, int below, int root) {
       bool culls = direct ? (floatBitsToInt(r2.w) & kTriCullBack) != 0 : (tr.instFlags & kInstanceCullBack) != 0;
       found = found && !(culls && det < 0.0);
     }
+    bool forwardHit = false;
 #if RETILE_ALPHA_TEST
     bool alphaTested = direct ? (floatBitsToInt(r2.w) & kTriAlphaTested) != 0 : (tr.instFlags & kInstanceAlphaTested) != 0;
 #if RETILE_SHEET
     // A thin sheet pauses shadow rays alone: an extension ray hits it.
     alphaTested = alphaTested || (tr.onShadow && (direct ? (floatBitsToInt(r2.w) & kTriSheet) != 0 : (tr.instFlags & kInstanceSheet) != 0));
 #endif
-    if (found && alphaTested && tr.alphaDecision == 0) {
-      // Pause here, the item unchanged, so that the step is taken again with the answer.
-      tr.alphaPending = true;
-      tr.pendingPrim = p;
-      tr.pendingInstance = instance;
-      tr.pendingU = uu;
-      tr.pendingV = vv;
-      return;
+    if (forwardEvents) {
+      // Decided once the segment is traced: an extension ray's hit like any other, flagged; a
+      // shadow ray's the nearest so far (tLimit is the nearest before it).
+      forwardHit = alphaTested;
+      if (found && alphaTested && tr.onShadow) {
+        tr.forwardT = tt;
+        tr.pendingPrim = p;
+        tr.pendingInstance = instance;
+        tr.pendingU = uu;
+        tr.pendingV = vv;
+#if RETILE_BOUNDARY
+        tr.forwardCrossing = 0;
+#endif
+        found = false;
+      }
+    } else {
+      if (found && alphaTested && tr.alphaDecision == 0) {
+        // Pause here, the item unchanged, so that the step is taken again with the answer.
+        tr.alphaPending = true;
+        tr.pendingPrim = p;
+        tr.pendingInstance = instance;
+        tr.pendingU = uu;
+        tr.pendingV = vv;
+        return;
+      }
+      if (found && alphaTested) found = tr.alphaDecision > 0;
+      tr.alphaDecision = 0;
     }
-    if (found && alphaTested) found = tr.alphaDecision > 0;
-    tr.alphaDecision = 0;
 #endif
 #if RETILE_BOUNDARY
     // A boundary is no surface: the shadow ray goes on, into the medium on its other side, which
     // countCrossings counts. (A boundary is never a cut-out: packInstances.)
     bool boundary = direct ? (floatBitsToInt(r2.w) & kTriBoundary) != 0 : (tr.instFlags & kInstanceBoundary) != 0;
-    if (found && tr.onShadow && boundary) {
+    bool crosses = found && tr.onShadow && boundary;
+#if RETILE_ALPHA_TEST
+    if (forwardEvents && crosses) {
+      // With the fixed offset, the nearest so far (Trace::forwardCrossing): crossed, and counted,
+      // once the segment is traced, so that one the ray skips past a cut-out is not counted.
+      tr.forwardT = tt;
+      tr.pendingPrim = p;
+      tr.pendingInstance = instance;
+      tr.pendingU = uu;
+      tr.pendingV = vv;
+      tr.forwardCrossing = det > 0.0 ? instance + 1 : -(instance + 1);
+      found = false;
+      crosses = false;
+    }
+#endif
+    if (crosses) {
       if (tr.crossings == 4) {
         // Pause here, the item unchanged, so that the step is taken again once they are counted.
         tr.crossingPending = true;
@@ -576,6 +642,9 @@ void traceStep(inout Trace tr, int below, int root) {
       tr.hit.v = vv;
       tr.hit.prim = p;
       tr.hit.instance = instance;
+#if RETILE_ALPHA_TEST
+      tr.hitForward = forwardHit;
+#endif
     }
     // The rest of the leaf: one triangle further on, until the run's last.
     if (r1.w == 0.0) next = item + (kTriTexels << kItemOffsetShift);
@@ -600,6 +669,19 @@ void traceStep(inout Trace tr, int below, int root) {
       tr.stackSize--;
     }
   }
+#if RETILE_ALPHA_TEST
+  if (forwardEvents && finished && (tr.onShadow ? tr.blocker < 0 && tr.forwardT < kInfinity : tr.hitForward)) {
+    // The segment ends at a cut-out (Trace::hitForward): wait for it to be decided.
+    if (!tr.onShadow) {
+      tr.pendingPrim = tr.hit.prim;
+      tr.pendingInstance = tr.hit.instance;
+      tr.pendingU = tr.hit.u;
+      tr.pendingV = tr.hit.v;
+    }
+    tr.alphaPending = true;
+    return;
+  }
+#endif
   if (finished && (tr.onShadow || !tr.second)) {
     // Both rays done. The lane stays in the loop until it ends, visiting the root with a ray
     // that enters nothing (a negative limit): a lane that left the loop made every iteration's
@@ -618,6 +700,9 @@ void traceStep(inout Trace tr, int below, int root) {
     tr.rayRandom = tr.random2;
     tr.from = tr.from2;
     tr.stackSize = 0;
+#if RETILE_ALPHA_TEST
+    tr.tNear = 0.0;
+#endif
     next = root;
   }
   if (tr.stackSize < tr.instanceSp || finished) {

@@ -42,7 +42,8 @@ RETILE_KERNEL_FEATURE(ByteTexels, 17, "8-bit texels")
 RETILE_KERNEL_FEATURE(HalfTexels, 18, "half-float texels")
 RETILE_KERNEL_FEATURE(SrgbTexels, 19, "sRGB texels")
 // RayOffset::FixedEpsilon (scene.h): a ray leaving a surface skips what lies within
-// kFixedRayEpsilon of it (scene units), the same for every primitive.
+// kFixedRayEpsilon of it (scene units), the same for every primitive; so does one passing a
+// cut-out (scene.glsl Trace::hitForward).
 RETILE_KERNEL_FEATURE(FixedEpsilon, 20, "fixed ray epsilon")
 // Some visible object is hit from the front only (Object::cullBackFaces, kInstanceCullBack).
 RETILE_KERNEL_FEATURE(CullBack, 21, "back faces culled")

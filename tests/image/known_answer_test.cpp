@@ -605,7 +605,10 @@ TEST(KnownAnswer, ALightOutsideABoundaryLightsTheMediumInside) {
 // it must pause until they are counted (Trace::crossings), so the count goes on across rounds of
 // the traversal loop. The plane reads albedo / pi E exp(-5 sigma), in each channel. Packed direct
 // (triangles name their instance and its boundary flag) and with instance records. Each crossing
-// is a bounce, as for a path (and in Tungsten): at ten bounces the light is out of reach.
+// is a bounce, as for a path (and in Tungsten): at ten bounces the light is out of reach. The
+// same with Tungsten's ray offset and cut-outs that let everything through, below the slabs and
+// inside two of them: the shadow ray, traced again past each (resolveForward), counts each
+// crossing once, also the far side of a slab it met before the cut-out inside.
 TEST(KnownAnswer, AShadowRayCountsEveryBoundaryItCrosses) {
   RETILE_RENDERER_OR_SKIP(direct);
   std::string why;
@@ -633,6 +636,23 @@ TEST(KnownAnswer, AShadowRayCountsEveryBoundaryItCrosses) {
   }
   s.settings.maxBounces = 10;
   EXPECT_EQ(meanOver(renderScene(*direct, s, 4), plane), 0.0) << "ten crossings at ten bounces";
+  s.settings.maxBounces = 11;
+  s.settings.rayOffset = RayOffset::FixedEpsilon;
+  Material clear = grey(0.0f);
+  clear.alpha = 0.0f;
+  const NodeId clearMaterial = test::addMaterial(s, clear);
+  for (float y : {1.0f, 2.5f, 6.5f})
+    test::addMeshObject(s, "clear", makeQuad(), clearMaterial, Mat4::translate({0, y, 0}) * Mat4::scale({40, 1, 40}));
+  lookStraightDown(s, 0.5f, 2);
+  for (Renderer* r : {direct.get(), records.get()}) {
+    RenderImage img = renderScene(*r, s, 4);
+    for (int c = 0; c < 3; ++c) {
+      const double mean = meanOver(img, plane, nullptr, c);
+      const double expected = 0.5 / kPi * 2.0 * std::exp(-5.0 * static_cast<double>(sigma[c]));
+      EXPECT_NEAR(mean, expected, 1e-3 * expected)
+          << "Tungsten's offset, cut-outs, " << (r == direct.get() ? "direct" : "records") << ", channel " << c;
+    }
+  }
 }
 
 TEST(KnownAnswer, TheWorldsMediumDimsWhatTheCameraSeesAndHidesTheSky) {
@@ -1313,6 +1333,51 @@ TEST(KnownAnswer, ACutOutLetsThroughWhatItsAlphaLeavesOut) {
   for (int i = 1; i < 10; ++i)
     test::addMeshObject(s, "cut-out", makeQuad(), cutMaterial, Mat4::translate({0, 1 + 0.1f * i, 0}) * Mat4::scale({1000, 1, 1000}));
   EXPECT_NEAR(imageMean(renderScene(*r, s, 64)), std::pow(0.9, 20), 0.015) << "ten cut-outs";
+}
+
+// A ray that passes a cut-out leaves it as Tungsten's rays leave a surface (RayOffset): with
+// Tungsten's offset it skips what lies within 5e-4 beyond it, and goes on from the next thing it
+// meets past that. So a thin shell of cut-outs (the kitchen's blinds: two faces 0.25 mm apart)
+// lets through 1 - alpha where the faces lie within 5e-4 of each other along the ray, not
+// (1 - alpha)^2. A white floor under a sky of 1, and above it n black cut-outs of alpha 0.3, h
+// apart, seen from above: a camera ray (within 10 degrees of the normal: the leading factors
+// below) and the floor's light from a direction at cos theta = c meet the layers spaced h / c
+// along the ray. Two layers,
+// h = 2.5e-4: the second is skipped where c >= h / 5e-4 = 0.5, a share 1 - 0.5^2 = 0.75 of the
+// floor's cosine-weighted sky: 0.7 (0.7 0.75 + 0.49 0.25) = 0.45325. Three, h = 3e-4: the
+// second is skipped wherever c >= 0.6 (0.64 of the sky) and the third, 6e-4 past the first, is
+// met there: 0.49 (0.49 0.64 + 0.343 0.36) = 0.214; one that skipped whatever lay within 5e-4 of
+// any passed layer would skip the third behind a passed second. The robust offset meets every
+// layer: 0.7^(2n). Bounces enough that a pass counted as one (Tungsten's forward event) would
+// change nothing: light reaches the floor's paths once.
+TEST(KnownAnswer, APassedCutOutIsLeftAsTheRaysOffsetSays) {
+  RETILE_RENDERER_OR_SKIP(r);
+  auto imageMean = [](const RenderImage& img) {
+    double sum = 0;
+    for (std::size_t i = 0; i < img.color.size() / 3; ++i) sum += img.color[i * 3 + 1];
+    return sum / static_cast<double>(img.color.size() / 3);
+  };
+  for (RayOffset offset : {RayOffset::Robust, RayOffset::FixedEpsilon}) {
+    for (int layers : {2, 3}) {
+      SCOPED_TRACE(std::string(offset == RayOffset::FixedEpsilon ? "fixed offset, " : "robust offset, ") + std::to_string(layers) +
+                   " layers");
+      Scene s = underUnitSky(16, 16, 20);
+      s.settings.maxBounces = 16;
+      s.settings.rayOffset = offset;
+      test::addMeshObject(s, "white", makeQuad(), test::addMaterial(s, grey(1.0f)), Mat4::scale({1000, 1, 1000}));
+      Material cut = grey(0.0f);
+      cut.alpha = 0.3f;
+      const NodeId cutMaterial = test::addMaterial(s, cut);
+      const float h = layers == 2 ? 2.5e-4f : 3e-4f;
+      for (int i = 0; i < layers; ++i)
+        test::addMeshObject(s, "layer", makeQuad(), cutMaterial,
+                            Mat4::translate({0, 1 + h * static_cast<float>(i), 0}) * Mat4::scale({1000, 1, 1000}));
+      double expected = std::pow(0.7, 2 * layers);
+      if (offset == RayOffset::FixedEpsilon)
+        expected = layers == 2 ? 0.7 * (0.7 * 0.75 + 0.49 * 0.25) : 0.49 * (0.49 * 0.64 + 0.343 * 0.36);
+      EXPECT_NEAR(imageMean(renderScene(*r, s, 128)), expected, 0.012);
+    }
+  }
 }
 
 // The pixel filter (filter importance sampling): a light's straight edge on a pixel boundary.
