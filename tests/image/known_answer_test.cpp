@@ -1298,6 +1298,13 @@ TEST(KnownAnswer, ASkyBrighterThanAHalfFloatKeepsItsLight) {
   EXPECT_NEAR(meanOver(renderScene(*r, s, 16), plane), 1e6, 1e4);
 }
 
+// The image's mean of the green channel (grey scenes: their radiance).
+double imageMean(const RenderImage& img) {
+  double sum = 0;
+  for (std::size_t i = 0; i < img.color.size() / 3; ++i) sum += img.color[i * 3 + 1];
+  return sum / static_cast<double>(img.color.size() / 3);
+}
+
 // A cut-out (alpha below 1) lets a ray through with probability 1 - alpha, camera rays and
 // shadow rays alike: a black plane of alpha 0.3 one unit above a white one, under a sky of 1 with
 // one bounce, shows the white plane in 0.7 of the samples, lit through the cut-out by 0.7 of the
@@ -1306,11 +1313,6 @@ TEST(KnownAnswer, ASkyBrighterThanAHalfFloatKeepsItsLight) {
 // candidate after another.
 TEST(KnownAnswer, ACutOutLetsThroughWhatItsAlphaLeavesOut) {
   RETILE_RENDERER_OR_SKIP(r);
-  auto imageMean = [](const RenderImage& img) {
-    double sum = 0;
-    for (std::size_t i = 0; i < img.color.size() / 3; ++i) sum += img.color[i * 3 + 1];
-    return sum / static_cast<double>(img.color.size() / 3);
-  };
   Scene s = underUnitSky(16, 16, 20);
   test::addMeshObject(s, "white", makeQuad(), test::addMaterial(s, grey(1.0f)), Mat4::scale({1000, 1, 1000}));
   Material cut = grey(0.0f);
@@ -1352,11 +1354,6 @@ TEST(KnownAnswer, ACutOutLetsThroughWhatItsAlphaLeavesOut) {
 // change nothing: light reaches the floor's paths once.
 TEST(KnownAnswer, APassedCutOutIsLeftAsTheRaysOffsetSays) {
   RETILE_RENDERER_OR_SKIP(r);
-  auto imageMean = [](const RenderImage& img) {
-    double sum = 0;
-    for (std::size_t i = 0; i < img.color.size() / 3; ++i) sum += img.color[i * 3 + 1];
-    return sum / static_cast<double>(img.color.size() / 3);
-  };
   for (RayOffset offset : {RayOffset::Robust, RayOffset::FixedEpsilon}) {
     for (int layers : {2, 3}) {
       SCOPED_TRACE(std::string(offset == RayOffset::FixedEpsilon ? "fixed offset, " : "robust offset, ") + std::to_string(layers) +
