@@ -9,18 +9,18 @@
 
 layout(local_size_x = kAccumulateWorkgroup) in;
 
-layout(set = 0, binding = 0, std140) uniform Frame { FrameUniforms frame; };
-layout(set = 0, binding = 1, std430) readonly buffer Work { WorkItem items[]; };
-layout(set = 0, binding = 2, std430) readonly buffer Samples { vec4 samples[]; };
-layout(set = 0, binding = 3, std430) readonly buffer Aux { vec4 aux[]; };
+layout(set = 0, binding = kBindAccumulateFrame, std140) uniform Frame { FrameUniforms frame; };
+layout(set = 0, binding = kBindAccumulateWork, std430) readonly buffer Work { WorkItem items[]; };
+layout(set = 0, binding = kBindAccumulateSamples, std430) readonly buffer Samples { vec4 samples[]; };
+layout(set = 0, binding = kBindAccumulateAux, std430) readonly buffer Aux { vec4 aux[]; };
 // Per pixel: [0] colour sum.rgb, sample count; [1] compensation.rgb, sum of squared luminances
 // (the second moment, so the denoiser has every pixel's variance whatever tiles restarted).
-layout(set = 0, binding = 4, std430) buffer Accum { vec4 accum[]; };
+layout(set = 0, binding = kBindAccumulateAccum, std430) buffer Accum { vec4 accum[]; };
 // Per pixel (kAuxVec4s): [0] albedo sum.rgb, depth; [1] normal sum.xyz, instance id; [2] emission sum.rgb, -.
-layout(set = 0, binding = 5, std430) buffer AccumAux { vec4 accumAux[]; };
+layout(set = 0, binding = kBindAccumulateAccumAux, std430) buffer AccumAux { vec4 accumAux[]; };
 // Verified reuse (reuse.comp): the part of the accumulation that is history; bound only when
 // push.hasHistory is set.
-layout(set = 0, binding = 6, std430) buffer History { vec4 history[]; };
+layout(set = 0, binding = kBindAccumulateHistory, std430) buffer History { vec4 history[]; };
 
 layout(push_constant) uniform Push { AccumulatePush push; };
 

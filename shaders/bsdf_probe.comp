@@ -10,10 +10,10 @@ layout(local_size_x = 64) in;
 
 // Per query: the material's kMaterialTexels texels, then wo (and in w a hair's h), wi and the
 // sample's random numbers.
-layout(set = 0, binding = 0, std430) readonly buffer Queries { vec4 queries[]; };
+layout(set = 0, binding = kBindBsdfProbeQueries, std430) readonly buffer Queries { vec4 queries[]; };
 // Per query: eval(wo, wi) (f * |cos wi|, pdf); the sample's wi and pdf; its weight and flags
 // (1: delta, 2: transmitted); eval at the sampled wi (f * |cos|, pdf).
-layout(set = 0, binding = 1, std430) writeonly buffer Answers { vec4 answers[]; };
+layout(set = 0, binding = kBindBsdfProbeAnswers, std430) writeonly buffer Answers { vec4 answers[]; };
 
 layout(push_constant) uniform Push { uint count; } push;
 

@@ -18,10 +18,10 @@ layout(push_constant) uniform Push { DenoisePush push; };
 
 #include "common/denoise.glsl"
 
-layout(set = 0, binding = 0) uniform samplerBuffer uAccum;
-layout(set = 0, binding = 1) uniform samplerBuffer uLayer;
-layout(set = 0, binding = 2, std430) readonly buffer Tiles { uint tileCodes[]; };
-layout(set = 0, binding = 3, std430) writeonly buffer Display { vec4 display[]; };
+layout(set = 0, binding = kBindComposeAccum) uniform samplerBuffer uAccum;
+layout(set = 0, binding = kBindComposeLayer) uniform samplerBuffer uLayer;
+layout(set = 0, binding = kBindComposeTiles, std430) readonly buffer Tiles { uint tileCodes[]; };
+layout(set = 0, binding = kBindComposeDisplay, std430) writeonly buffer Display { vec4 display[]; };
 
 uint codeAt(ivec2 tile) { return tileCodes[uint(tile.y) * push.tiles.y + uint(tile.x)] & kTileKindMask; }
 

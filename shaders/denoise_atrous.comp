@@ -19,10 +19,10 @@
 layout(local_size_x = kDenoiseTile, local_size_y = kDenoiseTile) in;
 layout(push_constant) uniform Push { DenoisePush push; };
 
-layout(set = 0, binding = 0) uniform samplerBuffer uIn;        // RGBA16F: demodulated colour, std. dev. of the mean
-layout(set = 0, binding = 1) uniform samplerBuffer uSurface;   // normal, depth
-layout(set = 0, binding = 2) uniform samplerBuffer uGradient;  // |depth gradient| per pixel
-layout(set = 0, binding = 3, std430) writeonly buffer Out { uvec2 outColors[]; };
+layout(set = 0, binding = kBindDenoiseAtrousIn) uniform samplerBuffer uIn;        // RGBA16F: demodulated colour, std. dev. of the mean
+layout(set = 0, binding = kBindDenoiseAtrousSurface) uniform samplerBuffer uSurface;   // normal, depth
+layout(set = 0, binding = kBindDenoiseAtrousGradient) uniform samplerBuffer uGradient;  // |depth gradient| per pixel
+layout(set = 0, binding = kBindDenoiseAtrousOut, std430) writeonly buffer Out { uvec2 outColors[]; };
 
 #include "common/denoise.glsl"
 

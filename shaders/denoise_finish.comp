@@ -11,11 +11,11 @@
 layout(local_size_x = kDenoiseTile, local_size_y = kDenoiseTile) in;
 layout(push_constant) uniform Push { DenoisePush push; };
 
-layout(set = 0, binding = 0) uniform samplerBuffer uColors;    // RGBA16F: the filtered demodulated colour
-layout(set = 0, binding = 1) uniform samplerBuffer uAccum;
-layout(set = 0, binding = 2) uniform samplerBuffer uAccumAux;
-layout(set = 0, binding = 3, std430) readonly buffer Tiles { uint tileCodes[]; };
-layout(set = 0, binding = 4, std430) buffer Layer { vec4 layer[]; };
+layout(set = 0, binding = kBindDenoiseFinishColors) uniform samplerBuffer uColors;    // RGBA16F: the filtered demodulated colour
+layout(set = 0, binding = kBindDenoiseFinishAccum) uniform samplerBuffer uAccum;
+layout(set = 0, binding = kBindDenoiseFinishAccumAux) uniform samplerBuffer uAccumAux;
+layout(set = 0, binding = kBindDenoiseFinishTiles, std430) readonly buffer Tiles { uint tileCodes[]; };
+layout(set = 0, binding = kBindDenoiseFinishLayer, std430) buffer Layer { vec4 layer[]; };
 
 #include "common/denoise.glsl"
 

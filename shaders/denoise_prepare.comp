@@ -11,15 +11,15 @@
 layout(local_size_x = kDenoiseTile, local_size_y = kDenoiseTile) in;
 layout(push_constant) uniform Push { DenoisePush push; };
 
-layout(set = 0, binding = 0) uniform samplerBuffer uAccum;     // [2p] sum, count; [2p+1] compensation, squares
-layout(set = 0, binding = 1) uniform samplerBuffer uAccumAux;  // kAuxVec4s per pixel
+layout(set = 0, binding = kBindDenoisePrepareAccum) uniform samplerBuffer uAccum;     // [2p] sum, count; [2p+1] compensation, squares
+layout(set = 0, binding = kBindDenoisePrepareAccumAux) uniform samplerBuffer uAccumAux;  // kAuxVec4s per pixel
 
 #define DENOISE_READS_ACCUMULATION
 #include "common/denoise.glsl"
-layout(set = 0, binding = 2, std430) writeonly buffer Colors { uvec2 colors[]; };    // packColor, variance 0 for now
-layout(set = 0, binding = 3, std430) writeonly buffer Surface { vec4 surface[]; };  // normal, depth
-layout(set = 0, binding = 4, std430) writeonly buffer Moments { vec4 moments[]; };  // luminance, mean square, samples, -
-layout(set = 0, binding = 5, std430) readonly buffer Tiles { uint tileCodes[]; };
+layout(set = 0, binding = kBindDenoisePrepareColors, std430) writeonly buffer Colors { uvec2 colors[]; };    // packColor, variance 0 for now
+layout(set = 0, binding = kBindDenoisePrepareSurface, std430) writeonly buffer Surface { vec4 surface[]; };  // normal, depth
+layout(set = 0, binding = kBindDenoisePrepareMoments, std430) writeonly buffer Moments { vec4 moments[]; };  // luminance, mean square, samples, -
+layout(set = 0, binding = kBindDenoisePrepareTiles, std430) readonly buffer Tiles { uint tileCodes[]; };
 
 void main() {
   uint p;

@@ -16,11 +16,11 @@ layout(push_constant) uniform Push { DenoisePush push; };
 
 #include "common/denoise.glsl"
 
-layout(set = 0, binding = 0) uniform samplerBuffer uColors;   // RGBA16F view of packColor
-layout(set = 0, binding = 1) uniform samplerBuffer uSurface;  // normal, depth
-layout(set = 0, binding = 2) uniform samplerBuffer uMoments;
-layout(set = 0, binding = 3, std430) writeonly buffer Out { uvec2 outColors[]; };
-layout(set = 0, binding = 4, std430) writeonly buffer Gradient { float gradients[]; };  // |depth gradient| per pixel
+layout(set = 0, binding = kBindDenoiseVarianceColors) uniform samplerBuffer uColors;   // RGBA16F view of packColor
+layout(set = 0, binding = kBindDenoiseVarianceSurface) uniform samplerBuffer uSurface;  // normal, depth
+layout(set = 0, binding = kBindDenoiseVarianceMoments) uniform samplerBuffer uMoments;
+layout(set = 0, binding = kBindDenoiseVarianceOut, std430) writeonly buffer Out { uvec2 outColors[]; };
+layout(set = 0, binding = kBindDenoiseVarianceGradient, std430) writeonly buffer Gradient { float gradients[]; };  // |depth gradient| per pixel
 
 void main() {
   uint p;

@@ -11,11 +11,11 @@
 
 layout(local_size_x = kAccumulateWorkgroup) in;
 
-layout(set = 0, binding = 0, std140) uniform Frame { FrameUniforms frame; };
-layout(set = 0, binding = 1, std430) readonly buffer Items { ReuseItem items[]; };
-layout(set = 0, binding = 2, std430) buffer Accum { vec4 accum[]; };
-layout(set = 0, binding = 3, std430) buffer History { vec4 history[]; };
-layout(set = 0, binding = 4, std430) buffer AccumAux { vec4 accumAux[]; };
+layout(set = 0, binding = kBindReuseFrame, std140) uniform Frame { FrameUniforms frame; };
+layout(set = 0, binding = kBindReuseItems, std430) readonly buffer Items { ReuseItem items[]; };
+layout(set = 0, binding = kBindReuseAccum, std430) buffer Accum { vec4 accum[]; };
+layout(set = 0, binding = kBindReuseHistory, std430) buffer History { vec4 history[]; };
+layout(set = 0, binding = kBindReuseAccumAux, std430) buffer AccumAux { vec4 accumAux[]; };
 
 layout(push_constant) uniform Push { ReusePush push; };
 

@@ -14,12 +14,12 @@
 
 layout(local_size_x = kTraceWorkgroup) in;
 
-layout(set = 0, binding = kBindWork, std430) readonly buffer Work { WorkItem items[]; };
-layout(set = 0, binding = kBindSamples, std430) writeonly buffer Samples { vec4 samples[]; };
-layout(set = 0, binding = kBindAux, std430) writeonly buffer Aux { vec4 aux[]; };
+layout(set = 0, binding = kBindTraceWork, std430) readonly buffer Work { WorkItem items[]; };
+layout(set = 0, binding = kBindTraceSamples, std430) writeonly buffer Samples { vec4 samples[]; };
+layout(set = 0, binding = kBindTraceAux, std430) writeonly buffer Aux { vec4 aux[]; };
 // primary, bounce, shadow rays; the most loop iterations of one invocation; paths cut short;
 // loop iterations of all invocations, in kLoopIterationUnit; the most of one path segment.
-layout(set = 0, binding = kBindStats, std430) buffer Stats { uint rayCounts[kStatsCount]; };
+layout(set = 0, binding = kBindTraceStats, std430) buffer Stats { uint rayCounts[kStatsCount]; };
 
 // kLoopBudget (layouts.h): paths stop before the eight lock-stepped invocations could reach
 // lavapipe's loop limit (see scene.glsl). That limit is 65535 of lavapipe's own counts, and it
@@ -31,14 +31,14 @@ layout(set = 0, binding = kBindStats, std430) buffer Stats { uint rayCounts[kSta
 
 // What the tracer sees of the selected object and of its group, per tile (the indirection-aware
 // policy): the instances' set words, then the counters (layouts.h, kSelectionCounters).
-layout(set = 0, binding = kBindSelection, std430) buffer Selection { uint selectionCounts[]; };
+layout(set = 0, binding = kBindTraceSelection, std430) buffer Selection { uint selectionCounts[]; };
 
 layout(push_constant) uniform Push { TracePush push; };
 
 // The pixel filter's table (frame.filterWarp's 36 values) in a texel buffer: each lane reads its
 // own slot, and a storage buffer read at a different index in each lane is a loop over the eight
 // lanes on lavapipe (the table's 16 such reads a segment cost the spaceship 10 %).
-layout(set = 0, binding = kBindFilterWarp) uniform samplerBuffer uFilterWarp;
+layout(set = 0, binding = kBindTraceFilterWarp) uniform samplerBuffer uFilterWarp;
 
 float warpSlot(int i) { return texelFetch(uFilterWarp, i).x; }
 

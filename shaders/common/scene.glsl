@@ -13,7 +13,7 @@
 // A storage buffer, not a uniform buffer: lavapipe (Mesa 22.3) "inlines" uniform-buffer values that
 // decide branches into a fresh copy of the shader at every bind, and never frees the copies (the
 // process grew by 1.9 MB a frame, whatever the image size).
-layout(set = 0, binding = kBindFrame, std430) readonly buffer Frame { FrameUniforms frameBuffer; };
+layout(set = 0, binding = kBindTraceFrame, std430) readonly buffer Frame { FrameUniforms frameBuffer; };
 // frameBuffer, copied by main before anything else: inside a loop or a branch, a storage buffer
 // read is a loop over the lanes on lavapipe even at a uniform address, and the shading code
 // reads the frame's constants in many places (the copy made the spaceship 6 % faster).
@@ -21,18 +21,18 @@ FrameUniforms frame;
 // Triangles, BVH nodes and instance records, addressed by items (layouts.h).
 // A storage texel buffer, read with imageLoad, which lavapipe inlines (a texelFetch is a call per
 // read): three reads a traversal step.
-layout(set = 0, binding = kBindTraversal, rgba32f) uniform readonly imageBuffer uTraversal;
-layout(set = 0, binding = kBindTriShade) uniform samplerBuffer uTriShade;
-layout(set = 0, binding = kBindInstances) uniform samplerBuffer uInstances;
-layout(set = 0, binding = kBindMaterials) uniform samplerBuffer uMaterials;
-layout(set = 0, binding = kBindTexInfo) uniform samplerBuffer uTexInfo;
+layout(set = 0, binding = kBindTraceTraversal, rgba32f) uniform readonly imageBuffer uTraversal;
+layout(set = 0, binding = kBindTraceTriShade) uniform samplerBuffer uTriShade;
+layout(set = 0, binding = kBindTraceInstances) uniform samplerBuffer uInstances;
+layout(set = 0, binding = kBindTraceMaterials) uniform samplerBuffer uMaterials;
+layout(set = 0, binding = kBindTraceTexInfo) uniform samplerBuffer uTexInfo;
 // Every bitmap's texels, as pairs of words: 8-bit RGBA a word each, or RGBA16F two words each
 // (layouts.h kTexEightBit). A storage texel buffer, as uTraversal, for imageLoad.
-layout(set = 0, binding = kBindTexels, rg32ui) uniform readonly uimageBuffer uTexels;
-layout(set = 0, binding = kBindEmitters) uniform samplerBuffer uEmitters;
-layout(set = 0, binding = kBindAlias) uniform samplerBuffer uEmitterAlias;
-layout(set = 0, binding = kBindDelta) uniform samplerBuffer uDeltaLights;
-layout(set = 0, binding = kBindEnvCdf) uniform samplerBuffer uEnvCdf;
+layout(set = 0, binding = kBindTraceTexels, rg32ui) uniform readonly uimageBuffer uTexels;
+layout(set = 0, binding = kBindTraceEmitters) uniform samplerBuffer uEmitters;
+layout(set = 0, binding = kBindTraceAlias) uniform samplerBuffer uEmitterAlias;
+layout(set = 0, binding = kBindTraceDelta) uniform samplerBuffer uDeltaLights;
+layout(set = 0, binding = kBindTraceEnvCdf) uniform samplerBuffer uEnvCdf;
 
 // Traversal stack entries, over both levels of BVH. The builder keeps a level's depth within 40
 // plus log2 of its primitives (SAH, then median splits past depth 40): at most 65 levels, so 64

@@ -81,10 +81,12 @@ RT_CONST(int, kLayoutStarts, 7)     // 12 bits: kStartBits for each of slots 1..
 RT_CONST(int, kStartBits, 4)
 RT_CONST(int, kMaxTraversalTexels, 134217728)  // 2^27: items stay positive; also lavapipe's texel-buffer limit
 
-// The trace kernel's bindings (trace_bindings.h): kBind<name>.
-#define RETILE_TRACE_BINDING(name, binding, kind) RT_CONST(int, kBind##name, binding)
-#include "shared/trace_bindings.h"
-#undef RETILE_TRACE_BINDING
+// Every kernel's bindings (bindings.h): kBind<pass><name>.
+#define RETILE_PASS(pass, shader)
+#define RETILE_BINDING(pass, name, binding, kind) RT_CONST(int, kBind##pass##name, binding)
+#include "shared/bindings.h"
+#undef RETILE_BINDING
+#undef RETILE_PASS
 
 // The kernel's features (kernel_features.h): kFeature<name>, and kFeatureAll of them all.
 #define RETILE_KERNEL_FEATURE(name, bit, label) RT_CONST(int, kFeature##name, 1 << bit)

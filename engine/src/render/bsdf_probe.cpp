@@ -3,6 +3,7 @@
 #include <array>
 #include <cstring>
 
+#include "render/passes.h"
 #include "render/render_scene.h"
 #include "vk/buffer.h"
 #include "vk/pipeline.h"
@@ -10,10 +11,7 @@
 namespace retile {
 
 BsdfProbe::BsdfProbe(vk::Context& ctx)
-    : ctx_(ctx),
-      pipeline_(std::make_unique<vk::ComputePipeline>(ctx, "bsdf_probe.comp",
-                                                      std::vector<vk::Binding>{vk::Binding::Storage, vk::Binding::Storage},
-                                                      static_cast<std::uint32_t>(sizeof(std::uint32_t)))) {}
+    : ctx_(ctx), pipeline_(makePass(ctx, Pass::BsdfProbe, static_cast<std::uint32_t>(sizeof(std::uint32_t)))) {}
 
 BsdfProbe::~BsdfProbe() = default;
 
@@ -39,8 +37,8 @@ std::vector<BsdfAnswer> BsdfProbe::run(const std::vector<BsdfQuery>& queries) {
   vk::Buffer outBuf(ctx, static_cast<VkDeviceSize>(count) * 4 * sizeof(vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true,
                     "bsdf probe answers");
   inBuf.upload(in.data(), in.size() * sizeof(vec4));
-  pipeline_->bind(0, inBuf);
-  pipeline_->bind(1, outBuf);
+  pipeline_->bind(gpu::kBindBsdfProbeQueries, inBuf);
+  pipeline_->bind(gpu::kBindBsdfProbeAnswers, outBuf);
   ctx.submitAndWait([&](VkCommandBuffer cb) { pipeline_->dispatch(cb, (count + 63) / 64, 1, &count, sizeof(count)); });
   std::vector<vec4> out(static_cast<std::size_t>(count) * 4);
   outBuf.download(out.data(), out.size() * sizeof(vec4));

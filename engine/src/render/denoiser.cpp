@@ -3,13 +3,13 @@
 #include <algorithm>
 #include <tuple>
 
+#include "render/passes.h"
 #include "retile/log.h"
 #include "vk/check.h"
 #include "shared/layouts.h"
 
 namespace retile {
 
-using vk::Binding;
 
 static_assert(kShowStale == gpu::kTileStale && kShowFresh == gpu::kTileFresh && kShowLayer == gpu::kTileLayer &&
                   kShowPreviousLayer == gpu::kTilePreviousLayer && kShowFiltered == gpu::kTileFiltered &&
@@ -59,20 +59,12 @@ void Denoiser::resize(int width, int height, vk::Buffer& accum, vk::Buffer& accu
 void Denoiser::allocate() {
   if (!prepare_) {
     auto push = static_cast<std::uint32_t>(sizeof(gpu::DenoisePush));
-    using B = Binding;
-    prepare_ = std::make_unique<vk::ComputePipeline>(
-        ctx_, "denoise_prepare.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::Storage, B::Storage, B::Storage, B::Storage},
-        push);
-    variance_ = std::make_unique<vk::ComputePipeline>(
-        ctx_, "denoise_variance.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
+    prepare_ = makePass(ctx_, Pass::DenoisePrepare, push);
+    variance_ = makePass(ctx_, Pass::DenoiseVariance, push);
     // The a-trous iterations ping-pong between two buffers: one pipeline (and descriptor set) each way.
-    for (auto* p : {&atrousAB_, &atrousBA_})
-      *p = std::make_unique<vk::ComputePipeline>(ctx_, "denoise_atrous.comp",
-                                                 std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage}, push);
-    finish_ = std::make_unique<vk::ComputePipeline>(
-        ctx_, "denoise_finish.comp", std::vector<B>{B::UniformTexel, B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
-    compose_ = std::make_unique<vk::ComputePipeline>(ctx_, "compose.comp",
-                                                     std::vector<B>{B::UniformTexel, B::UniformTexel, B::Storage, B::Storage}, push);
+    for (auto* p : {&atrousAB_, &atrousBA_}) *p = makePass(ctx_, Pass::DenoiseAtrous, push);
+    finish_ = makePass(ctx_, Pass::DenoiseFinish, push);
+    compose_ = makePass(ctx_, Pass::Compose, push);
   }
   const VkDeviceSize pixels = static_cast<VkDeviceSize>(width_) * static_cast<VkDeviceSize>(height_);
   const VkDeviceSize px = pixels * sizeof(gpu::vec4);
@@ -85,30 +77,30 @@ void Denoiser::allocate() {
   display_ = vk::Buffer(ctx_, px, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, "displayed image");
   ctx_.submitAndWait([&](VkCommandBuffer cb) { vkCmdFillBuffer(cb, layer_.handle(), 0, VK_WHOLE_SIZE, 0); });
 
-  prepare_->bind(0, *accum_, kRgba32);
-  prepare_->bind(1, *accumAux_, kRgba32);
-  prepare_->bind(2, a_);
-  prepare_->bind(3, surface_);
-  prepare_->bind(4, moments_);
-  variance_->bind(0, a_, kHalf4);
-  variance_->bind(1, surface_, kRgba32);
-  variance_->bind(2, moments_, kRgba32);
-  variance_->bind(3, b_);
-  variance_->bind(4, gradient_);
+  prepare_->bind(gpu::kBindDenoisePrepareAccum, *accum_, kRgba32);
+  prepare_->bind(gpu::kBindDenoisePrepareAccumAux, *accumAux_, kRgba32);
+  prepare_->bind(gpu::kBindDenoisePrepareColors, a_);
+  prepare_->bind(gpu::kBindDenoisePrepareSurface, surface_);
+  prepare_->bind(gpu::kBindDenoisePrepareMoments, moments_);
+  variance_->bind(gpu::kBindDenoiseVarianceColors, a_, kHalf4);
+  variance_->bind(gpu::kBindDenoiseVarianceSurface, surface_, kRgba32);
+  variance_->bind(gpu::kBindDenoiseVarianceMoments, moments_, kRgba32);
+  variance_->bind(gpu::kBindDenoiseVarianceOut, b_);
+  variance_->bind(gpu::kBindDenoiseVarianceGradient, gradient_);
   for (auto [pipe, from, to] : {std::tuple{atrousBA_.get(), &b_, &a_}, std::tuple{atrousAB_.get(), &a_, &b_}}) {
-    pipe->bind(0, *from, kHalf4);
-    pipe->bind(1, surface_, kRgba32);
-    pipe->bind(2, gradient_, VK_FORMAT_R32_SFLOAT);
-    pipe->bind(3, *to);
+    pipe->bind(gpu::kBindDenoiseAtrousIn, *from, kHalf4);
+    pipe->bind(gpu::kBindDenoiseAtrousSurface, surface_, kRgba32);
+    pipe->bind(gpu::kBindDenoiseAtrousGradient, gradient_, VK_FORMAT_R32_SFLOAT);
+    pipe->bind(gpu::kBindDenoiseAtrousOut, *to);
   }
   // The variance pass writes b; the iterations go b->a, a->b, ...; the last one's output is finished.
-  finish_->bind(0, gpu::kDenoiseIterations % 2 == 1 ? a_ : b_, kHalf4);
-  finish_->bind(1, *accum_, kRgba32);
-  finish_->bind(2, *accumAux_, kRgba32);
-  finish_->bind(4, layer_);
-  compose_->bind(0, *accum_, kRgba32);
-  compose_->bind(1, layer_, kRgba32);
-  compose_->bind(3, display_);
+  finish_->bind(gpu::kBindDenoiseFinishColors, gpu::kDenoiseIterations % 2 == 1 ? a_ : b_, kHalf4);
+  finish_->bind(gpu::kBindDenoiseFinishAccum, *accum_, kRgba32);
+  finish_->bind(gpu::kBindDenoiseFinishAccumAux, *accumAux_, kRgba32);
+  finish_->bind(gpu::kBindDenoiseFinishLayer, layer_);
+  compose_->bind(gpu::kBindComposeAccum, *accum_, kRgba32);
+  compose_->bind(gpu::kBindComposeLayer, layer_, kRgba32);
+  compose_->bind(gpu::kBindComposeDisplay, display_);
   allocated_ = true;
 }
 
@@ -122,9 +114,9 @@ void Denoiser::prepare(const DenoiseWork& work) {
   VkDeviceSize bytes = std::max<VkDeviceSize>(count * sizeof(std::uint32_t), 16);
   if (!tiles_.valid() || tiles_.size() < bytes) {
     tiles_ = vk::Buffer(ctx_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "tile codes");
-    prepare_->bind(5, tiles_);
-    finish_->bind(3, tiles_);
-    compose_->bind(2, tiles_);
+    prepare_->bind(gpu::kBindDenoisePrepareTiles, tiles_);
+    finish_->bind(gpu::kBindDenoiseFinishTiles, tiles_);
+    compose_->bind(gpu::kBindComposeTiles, tiles_);
   }
   tiles_.upload(work.tileCodes.data(), count * sizeof(std::uint32_t));
 }

@@ -9,6 +9,7 @@
 
 #include "core/process.h"
 #include "render/denoiser.h"
+#include "render/passes.h"
 #include "render/render_scene.h"
 #include "retile/log.h"
 #include "shared/layouts.h"
@@ -19,29 +20,12 @@
 
 namespace retile {
 
-using vk::Binding;
 using vk::Buffer;
 
 namespace {
 
 constexpr VkBufferUsageFlags kTexelUsage = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
 constexpr VkBufferUsageFlags kStorageUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-
-// The trace kernel's bindings as its pipeline layout takes them, in binding order.
-std::vector<Binding> traceBindings() {
-  struct Row {
-    int binding;
-    Binding kind;
-  };
-  static constexpr Row kRows[] = {
-#define RETILE_TRACE_BINDING(name, binding, kind) {binding, Binding::kind},
-#include "shared/trace_bindings.h"
-#undef RETILE_TRACE_BINDING
-  };
-  std::vector<Binding> out(std::size(kRows));
-  for (const Row& r : kRows) out.at(static_cast<std::size_t>(r.binding)) = r.kind;
-  return out;
-}
 
 std::uint32_t groupsFor(std::uint64_t invocations, std::uint32_t local, std::uint32_t* groupsY) {
   std::uint64_t groups = (invocations + local - 1) / local;
@@ -147,11 +131,7 @@ struct Renderer::Impl {
   std::uint64_t inFlight = 0;  // ticket of the submitted frame not yet completed (0: none)
 
   explicit Impl(const RendererOptions& o) : ctx(vk::DeviceChoice{o.device, o.validation || kDebugValidation}) {
-    accumulate =
-        std::make_unique<vk::ComputePipeline>(ctx, "accumulate.comp",
-                                              std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::Storage, Binding::Storage,
-                                                                   Binding::Storage, Binding::Storage, Binding::Storage},
-                                              static_cast<std::uint32_t>(sizeof(gpu::AccumulatePush)));
+    accumulate = makePass(ctx, Pass::Accumulate, static_cast<std::uint32_t>(sizeof(gpu::AccumulatePush)));
     directReferences = o.directReferences;
     builder.setDirectReferences(directReferences);
     frameUbo = Buffer(ctx, sizeof(gpu::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true,
@@ -227,10 +207,10 @@ struct Renderer::Impl {
   vk::ComputePipeline* traceVariant(bool alpha, std::uint32_t materialTypes, std::uint32_t features) {
     auto& slot = traceVariants[{alpha, materialTypes, features}];
     if (!slot) {
-      slot = std::make_unique<vk::ComputePipeline>(ctx, "trace.comp", traceBindings(), static_cast<std::uint32_t>(sizeof(gpu::TracePush)),
-                                                   std::vector<vk::ShaderDefine>{{"RETILE_ALPHA_TEST", alpha ? "1" : "0"},
-                                                                                 {"RETILE_MATERIALS", std::to_string(materialTypes)},
-                                                                                 {"RETILE_FEATURES", std::to_string(features)}});
+      slot = makePass(ctx, Pass::Trace, static_cast<std::uint32_t>(sizeof(gpu::TracePush)),
+                      {{"RETILE_ALPHA_TEST", alpha ? "1" : "0"},
+                       {"RETILE_MATERIALS", std::to_string(materialTypes)},
+                       {"RETILE_FEATURES", std::to_string(features)}});
     }
     return slot.get();
   }
@@ -241,46 +221,46 @@ struct Renderer::Impl {
   }
 
   void bindTrace(vk::ComputePipeline& t) {
-    t.bind(gpu::kBindFrame, frameUbo);
-    t.bind(gpu::kBindWork, work);
-    t.bind(gpu::kBindTraversal, traversal, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(gpu::kBindTriShade, triShade, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(gpu::kBindInstances, instances, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(gpu::kBindMaterials, materials, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(gpu::kBindTexInfo, texInfo, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(gpu::kBindTexels, texels, VK_FORMAT_R32G32_UINT);  // pairs of words (layouts.h kTexEightBit)
-    t.bind(gpu::kBindEmitters, emitters, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(gpu::kBindAlias, alias, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(gpu::kBindDelta, delta, VK_FORMAT_R32G32B32A32_SFLOAT);
-    t.bind(gpu::kBindEnvCdf, envCdf, VK_FORMAT_R32_SFLOAT);
-    t.bind(gpu::kBindStats, stats);
-    t.bind(gpu::kBindSelection, selection);
-    t.bind(gpu::kBindFilterWarp, filterWarp, VK_FORMAT_R32_SFLOAT);
+    t.bind(gpu::kBindTraceFrame, frameUbo);
+    t.bind(gpu::kBindTraceWork, work);
+    t.bind(gpu::kBindTraceTraversal, traversal, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindTraceTriShade, triShade, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindTraceInstances, instances, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindTraceMaterials, materials, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindTraceTexInfo, texInfo, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindTraceTexels, texels, VK_FORMAT_R32G32_UINT);  // pairs of words (layouts.h kTexEightBit)
+    t.bind(gpu::kBindTraceEmitters, emitters, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindTraceAlias, alias, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindTraceDelta, delta, VK_FORMAT_R32G32B32A32_SFLOAT);
+    t.bind(gpu::kBindTraceEnvCdf, envCdf, VK_FORMAT_R32_SFLOAT);
+    t.bind(gpu::kBindTraceStats, stats);
+    t.bind(gpu::kBindTraceSelection, selection);
+    t.bind(gpu::kBindTraceFilterWarp, filterWarp, VK_FORMAT_R32_SFLOAT);
     if (samples.valid()) {
-      t.bind(gpu::kBindSamples, samples);
-      t.bind(gpu::kBindAux, aux);
+      t.bind(gpu::kBindTraceSamples, samples);
+      t.bind(gpu::kBindTraceAux, aux);
     }
   }
 
   void bindAccumulate(vk::ComputePipeline& a) {
-    a.bind(0, frameUbo);
-    a.bind(1, work);
+    a.bind(gpu::kBindAccumulateFrame, frameUbo);
+    a.bind(gpu::kBindAccumulateWork, work);
     if (samples.valid()) {
-      a.bind(2, samples);
-      a.bind(3, aux);
+      a.bind(gpu::kBindAccumulateSamples, samples);
+      a.bind(gpu::kBindAccumulateAux, aux);
     }
     if (accum.valid()) {
-      a.bind(4, accum);
-      a.bind(5, accumAux);
-      // Without a history the shader never reads binding 6; it still needs a buffer.
-      a.bind(6, history.valid() ? history : accum);
+      a.bind(gpu::kBindAccumulateAccum, accum);
+      a.bind(gpu::kBindAccumulateAccumAux, accumAux);
+      // Without a history the shader never reads it; it still needs a buffer.
+      a.bind(gpu::kBindAccumulateHistory, history.valid() ? history : accum);
     }
     if (reusePass && history.valid()) {
-      reusePass->bind(0, frameUbo);
-      reusePass->bind(1, reuseItems);
-      reusePass->bind(2, accum);
-      reusePass->bind(3, history);
-      reusePass->bind(4, accumAux);
+      reusePass->bind(gpu::kBindReuseFrame, frameUbo);
+      reusePass->bind(gpu::kBindReuseItems, reuseItems);
+      reusePass->bind(gpu::kBindReuseAccum, accum);
+      reusePass->bind(gpu::kBindReuseHistory, history);
+      reusePass->bind(gpu::kBindReuseAccumAux, accumAux);
     }
   }
 
@@ -304,11 +284,7 @@ struct Renderer::Impl {
       const VkDeviceSize bytes = static_cast<VkDeviceSize>(width) * static_cast<VkDeviceSize>(height) * 2 * sizeof(gpu::vec4);
       history = Buffer(ctx, bytes, kStorageUsage, false, "reuse history");
       ctx.submitAndWait([&](VkCommandBuffer cb) { vkCmdFillBuffer(cb, history.handle(), 0, VK_WHOLE_SIZE, 0); });
-      if (!reusePass)
-        reusePass = std::make_unique<vk::ComputePipeline>(
-            ctx, "reuse.comp",
-            std::vector<Binding>{Binding::Uniform, Binding::Storage, Binding::Storage, Binding::Storage, Binding::Storage},
-            static_cast<std::uint32_t>(sizeof(gpu::ReusePush)));
+      if (!reusePass) reusePass = makePass(ctx, Pass::Reuse, static_cast<std::uint32_t>(sizeof(gpu::ReusePush)));
       rebind = true;
     }
     const VkDeviceSize bytes = items.size() * sizeof(gpu::ReuseItem);
