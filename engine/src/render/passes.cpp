@@ -1,7 +1,5 @@
 #include "render/passes.h"
 
-#include <iterator>
-
 #include "retile/error.h"
 #include "retile/log.h"
 
