@@ -10,7 +10,6 @@
 
 namespace retile {
 
-
 static_assert(kShowStale == gpu::kTileStale && kShowFresh == gpu::kTileFresh && kShowLayer == gpu::kTileLayer &&
                   kShowPreviousLayer == gpu::kTilePreviousLayer && kShowFiltered == gpu::kTileFiltered &&
                   kShowWriteLayer == gpu::kTileWrite,
