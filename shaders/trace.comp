@@ -135,7 +135,7 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
       if (partner < 0) break;
       float ratio = RT_MATERIAL_SCALAR(shaded, blendRatio);
       if (hasFeature(kFeatureTextures)) {
-        int ratioTex = floatBitsToInt(texelFetch(uMaterials, shaded * kMaterialTexels + 7).x);
+        int ratioTex = RT_MATERIAL_TEXTURE(shaded, blendRatioTexture);
         if (ratioTex >= 0) ratio *= dot(sampleTexture(ratioTex, uv).rgb, vec3(1.0 / 3.0));
       }
       if (u < ratio) break;
@@ -154,7 +154,7 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
                               kCoatUsed ? texelFetch(uMaterials, base + 7) : vec4(0.0),
                               kCoatUsed || kMediumUsed ? texelFetch(uMaterials, base + 8) : vec4(0.0));
   if (kScatteringUsed) m.scattering = texelFetch(uMaterials, base + 9);
-  int albedoTex = floatBitsToInt(t2.w), roughTex = floatBitsToInt(t3.w);
+  int albedoTex = RT_MATERIAL_TEXTURE(shaded, albedoTexture), roughTex = RT_MATERIAL_TEXTURE(shaded, roughnessTexture);
   if (hasFeature(kFeatureTextures) && albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
   if (hasFeature(kFeatureTextures) && roughTex >= 0) {
     float scale = dot(sampleTexture(roughTex, uv).rgb, vec3(1.0 / 3.0));
@@ -170,7 +170,7 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
   }
   if (hasFeature(kFeatureBlend)) m.emission = texelFetch(uMaterials, index * kMaterialTexels + 4).rgb;
   if (hasFeature(kFeatureEmissionTextures)) {
-    int emissionTex = floatBitsToInt(texelFetch(uMaterials, index * kMaterialTexels + 5).z);
+    int emissionTex = RT_MATERIAL_TEXTURE(index, emissionTexture);
     if (emissionTex >= 0) m.emission *= sampleTexture(emissionTex, uv).rgb;
   }
   return m;
@@ -384,8 +384,7 @@ void worldEdges(vec4 r0, vec4 r1, vec4 r2, vec3 e1, vec3 e2, vec4 s0, vec4 s1, v
 
 vec3 bumped(vec3 ns, int material, vec4 r0, vec4 r1, vec4 r2, vec3 e1, vec3 e2, vec4 s0, vec4 s1, vec4 s2, vec4 s3, vec2 uv) {
   if (!hasFeature(kFeatureBump)) return ns;
-  vec4 bump = texelFetch(uMaterials, material * kMaterialTexels + 5);
-  int bumpTex = floatBitsToInt(bump.x);
+  int bumpTex = RT_MATERIAL_TEXTURE(material, bumpTexture);
   if (bumpTex < 0) return ns;
   vec3 q1, q2;
   vec2 duv1, duv2;

@@ -10,15 +10,11 @@
 namespace retile::ui {
 namespace {
 
-struct TextureInput {
-  const char* name;
-  NodeId Material::*field;
-};
-constexpr TextureInput kTextureInputs[] = {{"albedo", &Material::albedoTexture},     {"roughness", &Material::roughnessTexture},
-                                           {"alpha", &Material::alphaTexture},       {"bump", &Material::bumpTexture},
-                                           {"emission", &Material::emissionTexture}, {"blend ratio", &Material::blendRatioTexture}};
-
 constexpr qreal kEndDotR = kSocketR - 2;  // inside the socket's ring, which stays visible around it
+
+// A material's texture inputs are its texture rows (material_fields.h), named by their labels
+// without " texture": "albedo", "blend ratio".
+QString inputName(const MaterialTexture& t) { return QString::fromLatin1(t.label).toLower().remove(QStringLiteral(" texture")); }
 
 }  // namespace
 
@@ -55,7 +51,7 @@ QColor displayColor(const Vec3& linear) {
 const QStringList& textureInputs() {
   static const QStringList inputs = [] {
     QStringList l;
-    for (const TextureInput& t : kTextureInputs) l << QLatin1String(t.name);
+    for (const MaterialTexture& t : kMaterialTextures) l << inputName(t);
     return l;
   }();
   return inputs;
@@ -64,8 +60,8 @@ const QStringList& textureInputs() {
 bool isTextureInput(const QString& s) { return textureInputs().contains(s); }
 
 NodeId Material::*textureSlot(const QString& input) {
-  for (const TextureInput& t : kTextureInputs)
-    if (input == QLatin1String(t.name)) return t.field;
+  for (const MaterialTexture& t : kMaterialTextures)
+    if (input == inputName(t)) return t.field;
   return nullptr;
 }
 

@@ -330,7 +330,7 @@ namespace {
 auto fieldsShown(const Material& m) { return std::tuple{m.type, m.coated(), m.filmThickness > 0, m.emissive(), m.blendWith != kNoNode}; }
 }  // namespace
 
-void PropertyPanel::scalarRows(Builder& b, const Material& m, MaterialPlace place) {
+void PropertyPanel::fieldRows(Builder& b, const Material& m, MaterialPlace place) {
   const NodeId id = m.id;
   auto edit = nodeEdit<Material, SetMaterial>(id, [](const Scene& sc, NodeId i) { return sc.material(i); });
   for (const MaterialScalar& f : kMaterialScalars) {
@@ -347,6 +347,31 @@ void PropertyPanel::scalarRows(Builder& b, const Material& m, MaterialPlace plac
                                  if (now && fieldsShown(*now) != shown) rebuildLater(drag);
                                });
     if (*f.tip) row->setToolTip(tr(f.tip));
+  }
+  for (const MaterialColor& f : kMaterialColors) {
+    if (f.place != place || !f.appliesTo(m.type)) continue;
+    const QString label = tr(f.label);
+    const auto field = f.field;
+    QWidget* row = f.widget == ColorWidget::Swatch
+                       ? b.color(label, f.member, m.*field, f.fallback,
+                                 [edit, label, field](Vec3 c, int drag) { edit(label, drag, [c, field](Material& x) { x.*field = c; }); })
+                       : b.vec3(
+                             label, f.member, m.*field, 0.01,
+                             [edit, label, field](int channel, double v, int drag) {
+                               edit(label, drag, [channel, v, field](Material& x) {
+                                 axisOf(x.*field, channel) = std::max(0.0f, static_cast<float>(v));
+                               });
+                             },
+                             true);
+    if (*f.tip && row) row->setToolTip(tr(f.tip));
+  }
+  for (const MaterialChoice& f : kMaterialChoices) {
+    if (f.place != place || !f.appliesTo(m.type)) continue;
+    const QString label = tr(f.label);
+    const auto field = f.field;
+    QWidget* row = b.choice(label, f.key, {tr(f.offLabel), tr(f.onLabel)}, m.*field ? 1 : 0,
+                            [edit, label, field](int i) { edit(label, 0, [i, field](Material& x) { x.*field = i == 1; }); });
+    if (*f.tip && row) row->setToolTip(tr(f.tip));
   }
 }
 
@@ -380,38 +405,23 @@ void PropertyPanel::roughnessRows(Builder& b, const Material& m) {
     edit(tr("Roughness"), drag, [v](Material& x) { x.roughness = std::max(0.001f, static_cast<float>(v)); });
   });
   form_->addRow(tr("Roughness"), row);
-  if (isMicrofacet(m.type))
-    b.choice(tr("Distribution"), "distribution", {tr("GGX"), tr("Beckmann")}, m.beckmann ? 1 : 0,
-             [edit](int i) { edit(tr("Distribution"), 0, [i](Material& x) { x.beckmann = i == 1; }); });
-  if (isMicrofacet(m.type))
-    b.choice(tr("Shadowing"), "shadowing", {tr("Height-correlated"), tr("Separable (Tungsten)")}, m.separableShadowing ? 1 : 0,
-             [edit](int i) { edit(tr("Shadowing"), 0, [i](Material& x) { x.separableShadowing = i == 1; }); });
+  fieldRows(b, m, MaterialPlace::Rough);
 }
 
 void PropertyPanel::textureRows(Builder& b, const Material& m) {
   auto edit = nodeEdit<Material, SetMaterial>(m.id, [](const Scene& sc, NodeId i) { return sc.material(i); });
   // Texture slots: which texture feeds each input, and for file textures the file itself.
-  struct Slot {
-    const char* label;
-    const char* name;
-    NodeId Material::*field;
-  };
-  for (const Slot& slot :
-       {Slot{"Albedo texture", "albedoTexture", &Material::albedoTexture},
-        Slot{"Roughness texture", "roughnessTexture", &Material::roughnessTexture},
-        Slot{"Alpha texture", "alphaTexture", &Material::alphaTexture}, Slot{"Bump texture", "bumpTexture", &Material::bumpTexture},
-        Slot{"Emission texture", "emissionTexture", &Material::emissionTexture}}) {
-    if (slot.field == &Material::roughnessTexture && !readsRoughnessSlot(m.type)) continue;
-    if (slot.field == &Material::albedoTexture && m.type == MaterialType::Hair) continue;
-    auto field = slot.field;
-    const char* label = field == &Material::roughnessTexture && roughnessSlotIsThickness(m.type) ? "Thickness texture" : slot.label;
-    b.nodeChoice(tr(label), slot.name, scene_().textures, m.*field, [this, edit, field](NodeId t) {
+  for (const MaterialTexture& f : kMaterialTextures) {
+    if (f.place != MaterialPlace::Surface || !f.appliesTo(m.type)) continue;
+    const auto field = f.field;
+    const char* label = field == &Material::roughnessTexture && roughnessSlotIsThickness(m.type) ? "Thickness texture" : f.label;
+    b.nodeChoice(tr(label), f.member, scene_().textures, m.*field, [this, edit, field](NodeId t) {
       edit(tr("Assign texture"), 0, [t, field](Material& x) { x.*field = t; });
       rebuildLater();
     });
-    const Texture* tex = scene_().texture(m.*slot.field);
-    if (tex && tex->kind == TextureKind::File) texturePath(b, *tex, QString("%1Path").arg(slot.name));
-    if (slot.field == &Material::bumpTexture && tex) scalarRows(b, m, MaterialPlace::Bumped);
+    const Texture* tex = scene_().texture(m.*field);
+    if (tex && tex->kind == TextureKind::File) texturePath(b, *tex, QString("%1Path").arg(f.member));
+    if (field == &Material::bumpTexture && tex) fieldRows(b, m, MaterialPlace::Bumped);
   }
 }
 
@@ -437,17 +447,10 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     b.color(tr("Albedo"), "albedo", m.albedo, defaults.albedo,
             [edit](Vec3 c, int drag) { edit(tr("Albedo"), drag, [c](Material& x) { x.albedo = c; }); });
   if (hasRoughness(m.type)) roughnessRows(b, m);  // smooth types ignore roughness: no field that does nothing
-  scalarRows(b, m, MaterialPlace::Surface);
+  fieldRows(b, m, MaterialPlace::Surface);
   if (!isTransmissiveType(m.type)) {
     if (m.coated()) {
-      scalarRows(b, m, MaterialPlace::Coated);
-      b.vec3(
-          tr("Coat absorption"), "coatAbsorption", m.coatAbsorption, 0.01,
-          [edit](int channel, double v, int drag) {
-            edit(tr("Coat absorption"), drag,
-                 [channel, v](Material& x) { axisOf(x.coatAbsorption, channel) = std::max(0.0f, static_cast<float>(v)); });
-          },
-          true);
+      fieldRows(b, m, MaterialPlace::Coated);
     }
   }
   if (holdsMedium(m.type))
@@ -525,7 +528,7 @@ void PropertyPanel::emissionRows(Builder& b, const Material& m) {
     });
     if (was != (v > 0)) rebuildLater(drag);  // the cone shows only while it emits
   });
-  if (m.emissive()) scalarRows(b, m, MaterialPlace::Emissive);
+  if (m.emissive()) fieldRows(b, m, MaterialPlace::Emissive);
 }
 
 void PropertyPanel::blendRows(Builder& b, const Material& m) {

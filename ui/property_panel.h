@@ -74,8 +74,9 @@ class PropertyPanel : public QScrollArea {
   void cancelPreview();
   void buildObject(Builder& b, const Object& o);
   void buildMaterial(Builder& b, const Material& m);
-  // The rows of kMaterialScalars shown at `place` for m's type, each edited as one undoable step.
-  void scalarRows(Builder& b, const Material& m, MaterialPlace place);
+  // The rows of material_fields.h (scalars, colours, choices) shown at `place` for m's type, each
+  // edited as one undoable step.
+  void fieldRows(Builder& b, const Material& m, MaterialPlace place);
   // The rest of a material's rows, by what they set.
   void roughnessRows(Builder& b, const Material& m);
   void textureRows(Builder& b, const Material& m);

@@ -216,7 +216,7 @@ float emissionConeCos(int material) { return texelFetch(uMaterials, material * k
 
 bool alphaPasses(int instance, int prim, float u, float v, float rayRandom) {
   int material = instanceMaterial(instance);
-  int alphaTex = floatBitsToInt(texelFetch(uMaterials, material * kMaterialTexels + 4).w);
+  int alphaTex = RT_MATERIAL_TEXTURE(material, alphaTexture);
   float alpha = RT_MATERIAL_SCALAR(material, alpha);
   if (alphaTex >= 0) alpha *= sampleAlphaTexture(alphaTex, triangleUv(prim, u, v));
   return hitRandom(rayRandom, prim, 2654435761u) < alpha;

@@ -23,15 +23,25 @@ RT_CONST(int, kTriShadeTexels, 4)   // n0.xyz uv0.x | n1.xyz uv0.y | n2.xyz uv1.
 RT_CONST(int, kInstanceTexels, 5)   // shading: world-to-object rows 0..2 | - triOffset material emitterOffset | objectIndex+1 flags
 RT_CONST(int, kMaterialTexels, 10)   // see render/render_scene.h packMaterial
 #ifndef __cplusplus
-// Where packMaterial writes each scalar field material_fields.h places: texel * 4 + component
-// (C++ reads the same rows as kMaterialScalars).
+// Where packMaterial writes each field material_fields.h places (C++ reads the same rows as
+// kMaterialScalars and on): a scalar's or a texture's slot, texel * 4 + component; a colour's texel.
 #define RETILE_MATERIAL_SCALAR(member, key, def, lo, hi, types, texel, component, label, unit, decimals, place, tip) \
   const int kMaterialSlot_##member = texel * 4 + component;
+#define RETILE_MATERIAL_COLOR(member, key, r, g, b, hi, types, texel, label, widget, place, tip) \
+  const int kMaterialTexel_##member = texel;
+#define RETILE_MATERIAL_TEXTURE(member, key, types, texel, component, label, place) \
+  const int kMaterialSlot_##member = texel * 4 + component;
+#define RETILE_MATERIAL_CHOICE(member, key, off, on, types, flag, label, offLabel, onLabel, place, tip)
 #include "shared/material_fields.h"
 #undef RETILE_MATERIAL_SCALAR
-// A scalar field's value, read from its material's texels (`material` an index).
+#undef RETILE_MATERIAL_COLOR
+#undef RETILE_MATERIAL_TEXTURE
+#undef RETILE_MATERIAL_CHOICE
+// A scalar field's value, and a texture field's index (-1: none), read from the texels of
+// material `material` (an index).
 #define RT_MATERIAL_SCALAR(material, member) \
   texelFetch(uMaterials, (material) * kMaterialTexels + kMaterialSlot_##member / 4)[kMaterialSlot_##member % 4]
+#define RT_MATERIAL_TEXTURE(material, member) floatBitsToInt(RT_MATERIAL_SCALAR(material, member))
 #endif
 RT_CONST(int, kMaxBlendChain, 4)    // retile::kMaxBlendChain (scene.h)
 RT_CONST(int, kTextureTexels, 3)    // offset w h kind | on.rgb resU | off.rgb resV

@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <numeric>
+#include <string>
 
 #include "frame_view.h"
 #include "main_window.h"
@@ -29,6 +30,14 @@ inline bool waitForFrame(MainWindow& w, const std::function<bool(const FrameReco
 }
 
 using retile::test::objectNamed;
+
+// Selects the object named `name`, which shows it and its material in the properties panel, and
+// returns the material.
+inline NodeId selectWithMaterial(MainWindow& w, const std::string& name) {
+  const NodeId object = objectNamed(w.scene(), name);
+  w.select(object);
+  return w.scene().object(object)->material;
+}
 
 // The mean of a frame's samples per tile.
 inline double meanSamples(const FrameRecord& f) {

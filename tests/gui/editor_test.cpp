@@ -41,6 +41,7 @@ using test::makeWindow;
 using test::meanSamples;
 using test::objectNamed;
 using test::pointShowing;
+using test::selectWithMaterial;
 using test::waitForFrame;
 
 TEST(Editor, EditFromThePropertiesReRendersAroundTheObjectAndUndoes) {
@@ -444,13 +445,42 @@ TEST(Editor, AnObjectIsHitFromTheFrontOnlyFromItsPanel) {
   EXPECT_FALSE(again->isChecked()) << "the box follows the undo";
 }
 
+// The panel draws a material's rows from material_fields.h for its type: a rough type's choices
+// beside its roughness, each an undoable edit; the coat's absorption while it has a coat.
+TEST(Editor, TheMaterialPanelShowsTheRowsOfItsType) {
+  auto w = makeWindow();
+  const NodeId material = selectWithMaterial(*w, "Glossy Sphere");
+  auto* type = w->findChild<QComboBox*>("materialType");
+  ASSERT_TRUE(type);
+  type->setCurrentIndex(type->findText(materialTypeName(MaterialType::RoughConductor)));
+  ASSERT_EQ(w->scene().material(material)->type, MaterialType::RoughConductor);
+  QTest::qWait(50);
+  auto* distribution = w->findChild<QComboBox*>("distribution");
+  ASSERT_TRUE(distribution);
+  EXPECT_TRUE(w->findChild<QComboBox*>("shadowing"));
+  EXPECT_FALSE(w->findChild<QWidget*>("coatAbsorption0")) << "no coat, no coat absorption";
+  distribution->setCurrentIndex(1);
+  EXPECT_TRUE(w->scene().material(material)->beckmann);
+  w->undoStack()->undo();
+  EXPECT_FALSE(w->scene().material(material)->beckmann);
+  Material coated = *w->scene().material(material);
+  coated.coatIor = 1.5f;
+  w->edit(SetMaterial{*w->scene().material(material)}, SetMaterial{coated}, "coat");
+  QTest::qWait(50);
+  EXPECT_TRUE(w->findChild<QWidget*>("coatAbsorption0"));
+  type = w->findChild<QComboBox*>("materialType");
+  ASSERT_TRUE(type);
+  type->setCurrentIndex(type->findText(materialTypeName(MaterialType::Lambert)));
+  QTest::qWait(50);
+  EXPECT_FALSE(w->findChild<QComboBox*>("distribution")) << "a smooth type has no distribution";
+  EXPECT_FALSE(w->findChild<QComboBox*>("shadowing"));
+}
+
 // A roughness texture does not become a sheet's thickness (nor a thickness a roughness) when
 // the type changes; undo gives it back with the type.
 TEST(Editor, SwitchingToOrFromASheetDropsItsRoughnessOrThicknessTexture) {
   auto w = makeWindow();
-  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
-  w->select(sphere);
-  const NodeId material = w->scene().object(sphere)->material;
+  const NodeId material = selectWithMaterial(*w, "Glossy Sphere");
   auto* rough = w->findChild<QComboBox*>("roughnessTexture");
   ASSERT_TRUE(rough) << materialTypeName(w->scene().material(material)->type);
   ASSERT_GT(rough->count(), 1) << "a texture to choose";
@@ -623,9 +653,7 @@ TEST(Editor, TheMaterialPanelFitsANarrowDock) {
 
 TEST(Editor, ABoundaryShowsItsMediumAndNoSurface) {
   auto w = makeWindow();
-  NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
-  w->select(sphere);
-  const NodeId material = w->scene().object(sphere)->material;
+  const NodeId material = selectWithMaterial(*w, "Glossy Sphere");
   auto* type = w->findChild<QComboBox*>("materialType");
   ASSERT_TRUE(type);
   ASSERT_TRUE(w->findChild<QWidget*>("albedo"));

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <random>
@@ -373,6 +374,32 @@ TEST(RenderScene, OverlappingInstancesAreEnteredAtSubtrees) {
   moved->transform = Mat4::translate({0.1f, 0, 0}) * moved->transform;
   EXPECT_NE(builder.update(s, kUpdateInstances, nullptr) & kDirtyInstances, 0u);
   EXPECT_EQ(builder.data().instanceReferences, references);
+}
+
+// Where each mesh's triangles are packed follows the scene, not where the meshes happen to live
+// in memory: a triangle's index seeds its cut-out's coin, so an order by address changed the
+// image from one build to the next.
+TEST(RenderScene, ThePackedBuffersDoNotDependOnWhereTheMeshesLiveInMemory) {
+  // The scene's meshes in one array, in the scene's order or the reverse: their addresses are in
+  // one order or the other.
+  auto packed = [](bool backwards) {
+    constexpr std::size_t kRods = 6;
+    auto store = std::make_shared<std::vector<MeshGeometry>>(kRods);
+    auto at = [&](std::size_t i) { return backwards ? kRods - 1 - i : i; };
+    for (std::size_t i = 0; i < kRods; ++i)
+      (*store)[at(i)] = *diagonalRod({1, 1, 1}, 50 + static_cast<std::uint32_t>(i) * 7, static_cast<std::uint32_t>(i));
+    Scene s = test::emptyScene(8, 8);
+    const NodeId mat = test::addMaterial(s, Material{});
+    for (std::size_t i = 0; i < kRods; ++i)
+      test::addMeshObject(s, "rod", std::shared_ptr<const MeshGeometry>(store, &(*store)[at(i)]), mat,
+                          Mat4::translate({static_cast<float>(i), 0, 0}));
+    RenderSceneBuilder builder;
+    builder.update(s, kUpdateAll, nullptr);
+    return builder.data().meshTraversal;
+  };
+  const auto forwards = packed(false), backwards = packed(true);
+  ASSERT_EQ(forwards.size(), backwards.size());
+  EXPECT_EQ(std::memcmp(forwards.data(), backwards.data(), forwards.size() * sizeof(forwards[0])), 0);
 }
 
 // The kernel's traversal mirrored on the CPU (tracePacked) finds what brute force finds, over an

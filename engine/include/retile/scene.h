@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "retile/math.h"
+#include "shared/layouts.h"  // the kernel's flags a choice sets (MaterialChoice::flag)
 
 namespace retile {
 
@@ -156,91 +157,53 @@ enum class MaterialPlace {
   Coated,    // while the material has a clear coat
   Emissive,  // while it emits
   Bumped,    // beside its bump texture
+  Rough,     // beside the roughness, for the types it applies to
   Custom,    // drawn by the panel itself
 };
+// How the panel edits a colour field: a colour picker, or three fields for values beyond 1.
+enum class ColorWidget { Swatch, Channels };
 
 // Expands a row of shaders/shared/material_fields.h for C++.
 #define RT_TYPE(t) (1u << static_cast<int>(MaterialType::t))
 #define RT_ALL_TYPES ((1u << kMaterialTypeCount) - 1u)
 #define RT_PANEL(p) MaterialPlace::p
+#define RT_WIDGET(w) ColorWidget::w
+
+// Every row of shaders/shared/material_fields.h expanded into nothing: an includer defines the
+// kinds it reads, these the rest.
+#define RETILE_IGNORE_SCALAR(member, key, def, lo, hi, types, texel, component, label, unit, decimals, place, tip)
+#define RETILE_IGNORE_COLOR(member, key, r, g, b, hi, types, texel, label, widget, place, tip)
+#define RETILE_IGNORE_TEXTURE(member, key, types, texel, component, label, place)
+#define RETILE_IGNORE_CHOICE(member, key, off, on, types, flag, label, offLabel, onLabel, place, tip)
 
 struct Material {
   NodeId id = kNoNode;
   std::string name;
   MaterialType type = MaterialType::Lambert;
-  // The scalar fields, each described once by its row in material_fields.h.
+  // The fields, each described once by its row in material_fields.h.
 #define RETILE_MATERIAL_SCALAR(member, key, def, ...) float member = static_cast<float>(def);
+#define RETILE_MATERIAL_COLOR(member, key, r, g, b, ...) Vec3 member{static_cast<float>(r), static_cast<float>(g), static_cast<float>(b)};
+#define RETILE_MATERIAL_TEXTURE(member, ...) NodeId member = kNoNode;
+#define RETILE_MATERIAL_CHOICE(member, ...) bool member = false;
 #include "shared/material_fields.h"
 #undef RETILE_MATERIAL_SCALAR
-  Vec3 albedo{0.8f};
-  NodeId albedoTexture = kNoNode;
-  // Rough types: the microfacet distribution. GGX's long tails are the default; Beckmann for
-  // files that ask for it (Tungsten's "distribution": "beckmann"), drawn as Tungsten draws it.
-  bool beckmann = false;
-  // Rough types: Smith's masking and shadowing as the product G1(wo) G1(wi), as Tungsten and
-  // Mitsuba 0.5 have it, instead of the height-correlated form (Heitz 2014), which is the more
-  // accurate and a little brighter at grazing angles. Tungsten files ask for the product.
-  bool separableShadowing = false;
-  // Scales roughness by the mean of its channels, as Tungsten's. A thin sheet has no roughness:
-  // there it is its thickness (Tungsten's textured thickness), which scales both its absorption
-  // (coatingAbsorption) and its film (filmThickness) point by point.
-  NodeId roughnessTexture = kNoNode;
-  // Glass: albedo tints the reflection as well as the transmission, and radiance is not scaled by
-  // (n_t / n_i)^2 where it crosses the surface (Tungsten's dielectric and rough_dielectric). The
-  // two forms agree on light that passes in and out again; they differ where a path ends inside,
-  // on an emitter within the glass (a lamp's bulb, say): 1 / ior^2 as bright without this.
-  // Otherwise albedo tints the transmission alone, the physical form. A thin sheet with a film
-  // (filmThickness): its reflectances squared once more before they interfere (Tungsten's film),
-  // much fainter colours than the physical (Airy) form's, which is otherwise drawn.
-  bool tintsReflection = false;
-  // Plastics: the coating's absorption, its sigma_a times its thickness (Tungsten's plastic):
-  // the diffuse base shows through dimmed by exp(-a (1 / cos wi + 1 / cos wo)). Thin sheets: the
-  // sheet's, light passing through it dimmed by exp(-a / cos t), t the angle inside the sheet.
-  // Hair: its pigment's, per unit of the fibre's radius.
-  Vec3 coatingAbsorption{0.0f};
-  // A clear coat over this material (Tungsten's smooth_coat): a smooth dielectric layer of index
-  // coatIor (0: none) that reflects by Fresnel and through which the material is seen with both
-  // directions refracted, dimmed inside by exp(-coatAbsorption (1 / cos + 1 / cos)) (sigma_a
-  // times thickness). No light bounces between the coat and what it covers, as in Tungsten.
-  // Transmissive types take no coat.
-  Vec3 coatAbsorption{0.0f};
-  // Glass (dielectric, rough dielectric) or a boundary filled with a homogeneous medium
-  // (Tungsten's homogeneous int_medium: its sigma_a and sigma_s times density): per unit of
-  // length, what fills it absorbs interiorAbsorption and scatters interiorScattering, by Henyey
-  // and Greenstein's phase function of asymmetry interiorAnisotropy (-1 back, 0 even, 1 forward).
-  // Light that only crosses it is dimmed by exp(-(absorption + scattering) distance). A path
-  // remembers one medium outside the one it is in: glass in fog leaves the fog around it, but a
-  // third level of nesting is not tracked.
-  Vec3 interiorAbsorption{0.0f};
-  Vec3 interiorScattering{0.0f};
+#undef RETILE_MATERIAL_COLOR
+#undef RETILE_MATERIAL_TEXTURE
+#undef RETILE_MATERIAL_CHOICE
+  Vec3 radiance() const { return emission * emissionStrength; }
   // Glass or a boundary with a medium that absorbs or scatters.
   bool filled() const {
     return holdsMedium(type) && isFinite(interiorAbsorption) && isFinite(interiorScattering) &&
            (maxComponent(interiorAbsorption) > 0 || maxComponent(interiorScattering) > 0);
   }
   bool coated() const { return coatIor > 1.0f; }
-  std::string metal = "Cu";     // conductors: a named metal (see conductorNames) or "custom"
-  Vec3 eta{0.2f, 0.92f, 1.1f};  // conductors with metal == "custom"
-  Vec3 k{3.9f, 2.45f, 2.14f};
-  // The front's emitted radiance is emission times emissionStrength: the colour, and a strength
-  // that at 0 turns the light off and keeps its colour (importers leave the strength at 1).
-  Vec3 emission{0.0f};
-  Vec3 radiance() const { return emission * emissionStrength; }
-  NodeId emissionTexture = kNoNode;  // multiplies emission (glTF's emissiveTexture, Tungsten's textured emission)
-  NodeId alphaTexture = kNoNode;     // its alpha channel, else the mean of its channels
-  // Tilts the shading normal by the slope of this texture's value (the mean of its channels), as
-  // Tungsten's bump maps do (BitmapTexture::derivatives: the difference across two texels); the
-  // slope is scaled by bumpStrength.
-  NodeId bumpTexture = kNoNode;
+  std::string metal = "Cu";  // conductors: a named metal (see conductorNames) or "custom" (eta, k)
   // A blend of two materials, as Tungsten's `mixed` bsdf: a surface shades as this material with
   // probability blendRatio and as `blendWith` otherwise, chosen again at every hit, which
   // averages to ratio * this + (1 - ratio) * other. Emission, coverage and bump stay this one's.
   // kNoNode: no blend. The other material's own blend is followed in its turn, kMaxBlendChain
   // materials in all at most: blends of blends, as Tungsten files nest them.
   NodeId blendWith = kNoNode;
-  // Multiplies blendRatio, where the surface is hit, by the mean of this texture's channels, read
-  // as data (Tungsten's textured `ratio`, its channels averaged). kNoNode: the ratio is constant.
-  NodeId blendRatioTexture = kNoNode;
   // Blends with `other` (kNoNode: no more); a ratio of 1, which would show nothing of it, becomes
   // half and half.
   void setBlendWith(NodeId other) {
@@ -249,59 +212,137 @@ struct Material {
   }
 
   // Every texture reference, for code that visits them all (deletion, validation, copies).
-  std::array<NodeId, 6> textures() const {
-    return {albedoTexture, roughnessTexture, alphaTexture, bumpTexture, emissionTexture, blendRatioTexture};
+  static constexpr std::size_t kTextureCount = 0
+#define RETILE_MATERIAL_TEXTURE(...) +1
+#define RETILE_MATERIAL_SCALAR RETILE_IGNORE_SCALAR
+#define RETILE_MATERIAL_COLOR RETILE_IGNORE_COLOR
+#define RETILE_MATERIAL_CHOICE RETILE_IGNORE_CHOICE
+#include "shared/material_fields.h"
+#undef RETILE_MATERIAL_TEXTURE
+      ;
+  std::array<NodeId, kTextureCount> textures() const {
+    return {
+#define RETILE_MATERIAL_TEXTURE(member, ...) member,
+#include "shared/material_fields.h"
+#undef RETILE_MATERIAL_TEXTURE
+    };
   }
-  std::array<NodeId*, 6> textureSlots() {
-    return {&albedoTexture, &roughnessTexture, &alphaTexture, &bumpTexture, &emissionTexture, &blendRatioTexture};
+  std::array<NodeId*, kTextureCount> textureSlots() {
+    return {
+#define RETILE_MATERIAL_TEXTURE(member, ...) &member,
+#include "shared/material_fields.h"
+#undef RETILE_MATERIAL_TEXTURE
+    };
   }
+#undef RETILE_MATERIAL_SCALAR
+#undef RETILE_MATERIAL_COLOR
+#undef RETILE_MATERIAL_CHOICE
 
   // A boundary is no surface, so nothing on it shines.
   bool emissive() const { return type != MaterialType::Boundary && emissionStrength > 0 && maxComponent(emission) > 0; }
   friend bool operator==(const Material&, const Material&) = default;
 };
 
-// One scalar field of Material, as its row in shaders/shared/material_fields.h describes it. The
-// table is constant: any thread may read it.
-struct MaterialScalar {
+// One field of Material of each kind, as its row in shaders/shared/material_fields.h describes
+// it. The tables are constant: any thread may read them.
+struct MaterialRow {
+  const char* member;   // the C++ name; the panel's widget takes it as its object name
+  const char* key;      // in native files
+  std::uint32_t types;  // the types it applies to, a bit per MaterialType
+  const char* label;    // the panel's
+  MaterialPlace place;  // where the panel shows it
+  const char* tip;      // the panel row's tooltip ("" none)
+  bool appliesTo(MaterialType t) const { return (types >> static_cast<int>(t)) & 1u; }
+};
+
+struct MaterialScalar : MaterialRow {
   float Material::*field;
-  const char* member;  // the C++ name; the panel's widget takes it as its object name
-  const char* key;     // in native files
   float fallback, lo, hi;
-  std::uint32_t types;   // bit per MaterialType
   int texel, component;  // packed there for its types; -1: by code
-  const char* label;
   const char* unit;
   int decimals;
-  MaterialPlace place;
-  const char* tip;
-  bool appliesTo(MaterialType t) const { return (types >> static_cast<int>(t)) & 1u; }
   bool packed() const { return texel >= 0; }
   float clamp(float v) const { return std::isfinite(v) ? std::clamp(v, lo, hi) : fallback; }
 };
 
+struct MaterialColor : MaterialRow {
+  Vec3 Material::*field;
+  Vec3 fallback;
+  float hi;   // each channel is finite and within 0..hi
+  int texel;  // its xyz, for its types; -1: by code
+  ColorWidget widget;
+  bool packed() const { return texel >= 0; }
+  bool inRange(Vec3 c) const { return isFinite(c) && minComponent(c) >= 0 && maxComponent(c) <= hi; }
+  Vec3 clamp(Vec3 c) const { return isFinite(c) ? min(max(c, Vec3{0.0f}), Vec3{hi}) : fallback; }
+};
+
+struct MaterialTexture : MaterialRow {
+  NodeId Material::*field;
+  int texel, component;  // where its index is packed, for its types
+};
+
+struct MaterialChoice : MaterialRow {
+  bool Material::*field;
+  const char* off;  // the values in native files
+  const char* on;
+  int flag;              // kMat<flag> (shared/layouts.h), set in the packed type word for its types
+  const char* offLabel;  // the panel's
+  const char* onLabel;
+};
+
+#define RETILE_MATERIAL_COLOR RETILE_IGNORE_COLOR
+#define RETILE_MATERIAL_TEXTURE RETILE_IGNORE_TEXTURE
+#define RETILE_MATERIAL_CHOICE RETILE_IGNORE_CHOICE
 inline constexpr MaterialScalar kMaterialScalars[] = {
 #define RETILE_MATERIAL_SCALAR(member, key, def, lo, hi, types, texel, component, label, unit, decimals, place, tip) \
-  {&Material::member,                                                                                                \
-   #member,                                                                                                          \
-   key,                                                                                                              \
+  {{#member, key, types, label, place, tip},                                                                         \
+   &Material::member,                                                                                                \
    static_cast<float>(def),                                                                                          \
    static_cast<float>(lo),                                                                                           \
    static_cast<float>(hi),                                                                                           \
-   types,                                                                                                            \
    texel,                                                                                                            \
    component,                                                                                                        \
-   label,                                                                                                            \
    unit,                                                                                                             \
-   decimals,                                                                                                         \
-   place,                                                                                                            \
-   tip},
+   decimals},
 #include "shared/material_fields.h"
 #undef RETILE_MATERIAL_SCALAR
 };
+#undef RETILE_MATERIAL_COLOR
+#define RETILE_MATERIAL_SCALAR RETILE_IGNORE_SCALAR
+inline constexpr MaterialColor kMaterialColors[] = {
+#define RETILE_MATERIAL_COLOR(member, key, r, g, b, hi, types, texel, label, widget, place, tip) \
+  {{#member, key, types, label, place, tip},                                                     \
+   &Material::member,                                                                            \
+   Vec3{static_cast<float>(r), static_cast<float>(g), static_cast<float>(b)},                    \
+   static_cast<float>(hi),                                                                       \
+   texel,                                                                                        \
+   widget},
+#include "shared/material_fields.h"
+#undef RETILE_MATERIAL_COLOR
+};
+#define RETILE_MATERIAL_COLOR RETILE_IGNORE_COLOR
+#undef RETILE_MATERIAL_TEXTURE
+inline constexpr MaterialTexture kMaterialTextures[] = {
+#define RETILE_MATERIAL_TEXTURE(member, key, types, texel, component, label, place) \
+  {{#member, key, types, label, place, ""}, &Material::member, texel, component},
+#include "shared/material_fields.h"
+#undef RETILE_MATERIAL_TEXTURE
+};
+#define RETILE_MATERIAL_TEXTURE RETILE_IGNORE_TEXTURE
+#undef RETILE_MATERIAL_CHOICE
+inline constexpr MaterialChoice kMaterialChoices[] = {
+#define RETILE_MATERIAL_CHOICE(member, key, off, on, types, flag, label, offLabel, onLabel, place, tip) \
+  {{#member, key, types, label, place, tip}, &Material::member, off, on, gpu::kMat##flag, offLabel, onLabel},
+#include "shared/material_fields.h"
+#undef RETILE_MATERIAL_CHOICE
+};
+#undef RETILE_MATERIAL_SCALAR
+#undef RETILE_MATERIAL_COLOR
+#undef RETILE_MATERIAL_TEXTURE
 #undef RT_TYPE
 #undef RT_ALL_TYPES
 #undef RT_PANEL
+#undef RT_WIDGET
 
 // Named metals with RGB complex indices of refraction (linear sRGB primaries).
 std::vector<std::string> conductorNames();

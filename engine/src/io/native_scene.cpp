@@ -278,29 +278,18 @@ Value materialToJson(const Material& m) {
   v.set("id", m.id);
   v.set("name", m.name);
   v.set("type", materialTypeName(m.type));
-  // A scalar at its default is left out: the reader takes the default for what is not there.
+  // A field at its default is left out: the reader takes the default for what is not there.
   const Material defaults;
   for (const MaterialScalar& f : kMaterialScalars)
     if (m.*f.field != defaults.*f.field) v.set(f.key, m.*f.field);
-  v.set("albedo", json::fromVec3(m.albedo));
-  v.set("albedo_texture", m.albedoTexture);
-  if (m.beckmann) v.set("distribution", "beckmann");
-  if (m.separableShadowing) v.set("shadowing", "separable");
-  v.set("roughness_texture", m.roughnessTexture);
-  if (m.tintsReflection) v.set("glass", "tinted");
-  v.set("coating_absorption", json::fromVec3(m.coatingAbsorption));
-  v.set("interior_absorption", json::fromVec3(m.interiorAbsorption));
-  v.set("interior_scattering", json::fromVec3(m.interiorScattering));
-  if (m.coatIor != 0) v.set("coat_absorption", json::fromVec3(m.coatAbsorption));
+  for (const MaterialColor& f : kMaterialColors)
+    if (m.*f.field != defaults.*f.field) v.set(f.key, json::fromVec3(m.*f.field));
+  for (const MaterialTexture& f : kMaterialTextures)
+    if (m.*f.field != kNoNode) v.set(f.key, m.*f.field);
+  for (const MaterialChoice& f : kMaterialChoices)
+    if (m.*f.field) v.set(f.key, f.on);
   v.set("metal", m.metal);
-  v.set("eta", json::fromVec3(m.eta));
-  v.set("k", json::fromVec3(m.k));
-  v.set("emission", json::fromVec3(m.emission));
-  v.set("alpha_texture", m.alphaTexture);
-  v.set("bump_texture", m.bumpTexture);
-  v.set("emission_texture", m.emissionTexture);
-  v.set("blend_with", m.blendWith);
-  v.set("blend_ratio_texture", m.blendRatioTexture);
+  if (m.blendWith != kNoNode) v.set("blend_with", m.blendWith);
   return v;
 }
 
@@ -464,33 +453,11 @@ Material readMaterial(Reader& r) {
   r.string("name", &m.name);
   r.enumeration("type", &m.type, materialName, kMaterialTypeCount);
   for (const MaterialScalar& f : kMaterialScalars) r.number(f.key, &(m.*f.field));
-  r.vec3("albedo", &m.albedo);
-  r.id("albedo_texture", &m.albedoTexture);
-  std::string distribution;
-  r.string("distribution", &distribution);
-  if (distribution == "beckmann") m.beckmann = true;
-  else if (!distribution.empty() && distribution != "ggx")
-    r.problem("distribution", cat("unknown distribution '", distribution, "' (ggx, beckmann)"));
-  std::string shadowing;
-  r.string("shadowing", &shadowing);
-  if (shadowing == "separable") m.separableShadowing = true;
-  else if (!shadowing.empty() && shadowing != "correlated")
-    r.problem("shadowing", cat("unknown shadowing '", shadowing, "' (correlated, separable)"));
-  r.id("roughness_texture", &m.roughnessTexture);
-  readEither(r, "glass", "physical", "tinted", &m.tintsReflection);
-  r.vec3("coating_absorption", &m.coatingAbsorption);
-  r.vec3("interior_absorption", &m.interiorAbsorption);
-  r.vec3("interior_scattering", &m.interiorScattering);
-  r.vec3("coat_absorption", &m.coatAbsorption);
+  for (const MaterialColor& f : kMaterialColors) r.vec3(f.key, &(m.*f.field));
+  for (const MaterialTexture& f : kMaterialTextures) r.id(f.key, &(m.*f.field));
+  for (const MaterialChoice& f : kMaterialChoices) readEither(r, f.key, f.off, f.on, &(m.*f.field));
   r.string("metal", &m.metal);
-  r.vec3("eta", &m.eta);
-  r.vec3("k", &m.k);
-  r.vec3("emission", &m.emission);
-  r.id("alpha_texture", &m.alphaTexture);
-  r.id("bump_texture", &m.bumpTexture);
-  r.id("emission_texture", &m.emissionTexture);
   r.id("blend_with", &m.blendWith);
-  r.id("blend_ratio_texture", &m.blendRatioTexture);
   return m;
 }
 

@@ -371,11 +371,19 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
       copied += m->geometry->triangleCount();
     }
   }
+  // The entries in the scene's order, which decides where each mesh's triangles are packed: a
+  // triangle's index seeds its cut-out's coin (scene.glsl hitRandom), so an order of the map's
+  // keys (addresses) would change the image from one build to the next.
+  std::vector<MeshEntry*> order;
+  auto use = [&](MeshEntry& e) {
+    if (!e.used) order.push_back(&e);
+    e.used = true;
+  };
   for (const Mesh& m : scene.meshes) {
     if (!m.geometry || m.geometry->indices.empty()) continue;
     auto [it, inserted] = meshes_.try_emplace({m.geometry.get(), kNoNode});
     MeshEntry& e = it->second;
-    e.used = true;
+    use(e);
     meshOf_[m.id] = &e;
     if (!inserted) continue;
     e.geometry = m.geometry;
@@ -387,7 +395,7 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
       const Mesh* m = scene.mesh(o->mesh);
       auto [it, inserted] = meshes_.try_emplace({m->geometry.get(), o->id});
       MeshEntry& e = it->second;
-      e.used = true;
+      use(e);
       copyOf_[o->id] = &e;
       if (!inserted) continue;
       e.geometry = m->geometry;
@@ -401,14 +409,15 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
   // triangles live in one place only: a new mesh's in its entry until they are placed here, a
   // kept mesh's in the arrays of the last update, from which they are copied.
   std::size_t triangles = 0, nodes = 0;
-  for (const auto& [key, e] : meshes_) {
-    triangles += e.bvh.primOrder.size();
-    nodes += e.bvh.nodes.size();
+  for (const MeshEntry* e : order) {
+    triangles += e->bvh.primOrder.size();
+    nodes += e->bvh.nodes.size();
   }
   std::vector<vec4> traversal, shading;
   traversal.reserve(triangles * gpu::kTriTexels + nodes * gpu::kNodeTexels);
   shading.reserve(triangles * gpu::kTriShadeTexels);
-  for (auto& [key, e] : meshes_) {
+  for (MeshEntry* entry : order) {
+    MeshEntry& e = *entry;
     const std::size_t n = e.bvh.primOrder.size();
     const auto offset = static_cast<std::uint32_t>(traversal.size() / gpu::kTriTexels);
     const bool fresh = !e.triangles.empty();
@@ -424,10 +433,10 @@ void RenderSceneBuilder::packGeometry(const Scene& scene) {
   data_.meshTraversal = std::move(traversal);
   data_.triangleShading = std::move(shading);
   data_.triangleCount = triangles;
-  for (auto& [key, e] : meshes_) {
+  for (MeshEntry* e : order) {
     auto base = static_cast<std::int64_t>(data_.meshTraversal.size());
-    e.rootItem = traversalItem(base, gpu::kItemNode);
-    appendNodes(data_.meshTraversal, e.bvh.nodes, 0, std::int64_t{e.triOffset} * gpu::kTriTexels, false);
+    e->rootItem = traversalItem(base, gpu::kItemNode);
+    appendNodes(data_.meshTraversal, e->bvh.nodes, 0, std::int64_t{e->triOffset} * gpu::kTriTexels, false);
   }
 }
 

@@ -56,15 +56,14 @@ float emissionConeCos(const Material& m) {
   return m.emissionCone < 90 ? std::cos(std::max(m.emissionCone, 0.0f) * (kPi / 180)) : 0.0f;  // NaN: the hemisphere
 }
 
-std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture, int roughnessTexture, int alphaTexture,
-                                                    int bumpTexture, int emissionTexture, int blendWith, int blendRatioTexture) {
+std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, const std::function<int(NodeId)>& textureIndex, int blendWith) {
   Vec3 eta = m.eta, k = m.k;
   if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
-  const bool rough = isMicrofacet(m.type);
-  int type = static_cast<int>(m.type) | (rough && m.beckmann ? gpu::kMatBeckmann : 0) |
-             (rough && m.separableShadowing ? gpu::kMatSeparable : 0) |
-             ((isGlassType(m.type) || m.type == MaterialType::ThinSheet) && m.tintsReflection ? gpu::kMatTintsReflection : 0);
+  int type = static_cast<int>(m.type);
+  for (const MaterialChoice& c : kMaterialChoices)
+    if (m.*c.field && c.appliesTo(m.type)) type |= c.flag;
   // Keep roughness away from zero, where GGX turns into a delta the rough code cannot sample.
+  const bool rough = isMicrofacet(m.type);
   float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
   if (rough || m.type == MaterialType::Phong) roughness = std::max(roughness, 1e-3f);
   if (m.type == MaterialType::OrenNayar) roughness = std::clamp(m.roughness, 0.0f, kPi / 2);
@@ -77,23 +76,36 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albed
   // Diffuse light inside a plastic coating reflects back this fraction at the boundary
   // (Jensen et al.'s polynomial fit of the internal diffuse Fresnel reflectance).
   float fdrInt = -1.4399f / (ior * ior) + 0.7099f / ior + 0.6681f + 0.0636f * ior;
-  std::array<vec4, gpu::kMaterialTexels> texels{
-      v4(max(m.albedo, Vec3{0.0f}), bitsOf(type)), vec4{roughness, ior, 0, std::clamp(fdrInt, 0.0f, 1.0f)}, v4(eta, bitsOf(albedoTexture)),
-      v4(k, bitsOf(roughnessTexture)), v4(max(m.radiance(), Vec3{0.0f}), bitsOf(alphaTexture)),
-      vec4{bitsOf(m.bumpStrength != 0 ? bumpTexture : -1), 0, bitsOf(emissionTexture), bitsOf(blendWith)},
-      v4(max(m.coatingAbsorption, Vec3{0.0f}), 0),
-      vec4{bitsOf(blendRatioTexture), coated ? std::min(m.coatIor, 10.0f) : 0.0f, emissionConeCos(m), 0},
-      // The ninth holds the coat or, for glass, which takes no coat, its medium's absorption;
-      // the tenth the medium's scattering.
-      v4(coated       ? max(m.coatAbsorption, Vec3{0.0f})
-         : m.filled() ? max(m.interiorAbsorption, Vec3{0.0f})
-                      : Vec3{0.0f},
-         coated && m.coatRoughness > 0 ? std::clamp(m.coatRoughness, 1e-3f, 1.0f) : 0.0f),
-      v4(m.filled() ? max(m.interiorScattering, Vec3{0.0f}) : Vec3{0.0f}, 0)};
+  const vec4 none{0, 0, 0, 0};
+  std::array<vec4, gpu::kMaterialTexels> texels{v4(Vec3{0.0f}, bitsOf(type)), vec4{roughness, ior, 0, std::clamp(fdrInt, 0.0f, 1.0f)},
+                                                v4(eta, 0), v4(k, 0), v4(max(m.radiance(), Vec3{0.0f}), 0),
+                                                vec4{0, 0, 0, bitsOf(blendWith)}, none,
+                                                vec4{0, coated ? std::min(m.coatIor, 10.0f) : 0.0f, emissionConeCos(m), 0},
+                                                // The ninth holds the coat or, for glass, which takes no coat, its medium's absorption;
+                                                // the tenth the medium's scattering.
+                                                v4(coated       ? max(m.coatAbsorption, Vec3{0.0f})
+                                                   : m.filled() ? max(m.interiorAbsorption, Vec3{0.0f})
+                                                                : Vec3{0.0f},
+                                                   coated && m.coatRoughness > 0 ? std::clamp(m.coatRoughness, 1e-3f, 1.0f) : 0.0f),
+                                                v4(m.filled() ? max(m.interiorScattering, Vec3{0.0f}) : Vec3{0.0f}, 0)};
   // The fields material_fields.h places, for the types that have them: after the rest, since a
   // type-specific field takes a slot another type uses for something else.
   for (const MaterialScalar& f : kMaterialScalars)
     if (f.packed() && f.appliesTo(m.type)) component(texels[static_cast<std::size_t>(f.texel)], f.component) = f.clamp(m.*f.field);
+  for (const MaterialColor& c : kMaterialColors) {
+    if (!c.packed() || !c.appliesTo(m.type)) continue;
+    const Vec3 v = c.clamp(m.*c.field);
+    vec4& t = texels[static_cast<std::size_t>(c.texel)];
+    t.x = v.x, t.y = v.y, t.z = v.z;
+  }
+  for (const MaterialTexture& f : kMaterialTextures) {
+    const NodeId id = m.*f.field;
+    int index = f.appliesTo(m.type) && id != kNoNode && textureIndex ? textureIndex(id) : -1;
+    // A bump of strength 0 and a ratio without a blend do nothing: the kernel skips them.
+    if ((f.field == &Material::bumpTexture && m.bumpStrength == 0) || (f.field == &Material::blendRatioTexture && blendWith < 0))
+      index = -1;
+    component(texels[static_cast<std::size_t>(f.texel)], f.component) = bitsOf(index);
+  }
   return texels;
 }
 
@@ -115,14 +127,14 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     if (coatRendered(m)) data_.materialTypes |= 1u << gpu::kMaskCoat;
     if (m.filled()) data_.materialTypes |= 1u << gpu::kMaskMedium;
     if (m.filled() && maxComponent(m.interiorScattering) > 0) data_.materialTypes |= 1u << gpu::kMaskScattering;
-    // A type without roughness reads no roughness texture: the kernel would scale what the slot
-    // holds for it (hair's tilt) by the texture's mean.
+    // A type without roughness reads no roughness texture (packMaterial leaves it out): the
+    // kernel would scale what the slot holds for it (hair's tilt) by the texture's mean.
     const int roughnessTexture = readsRoughnessSlot(m.type) ? textureIndex(m.roughnessTexture) : -1;
     if (textureIndex(m.albedoTexture) >= 0 || roughnessTexture >= 0) data_.materialTextures = true;
     if (textureIndex(m.bumpTexture) >= 0 && m.bumpStrength != 0) data_.materialBump = true;
     if (textureIndex(m.emissionTexture) >= 0 && m.emissive()) data_.emissionTextures = true;
     if (emissionConeCos(m) != 0 && m.emissive()) data_.emissionCones = true;
-    int blendWith = -1, ratioTexture = -1;
+    int blendWith = -1;
     const bool texturedRatio = textureIndex(m.blendRatioTexture) >= 0;
     // A boundary blends with nothing and nothing with it: the traversal takes an instance's own
     // material for whether its shadow rays pass, and a surface that were partly a boundary would
@@ -134,13 +146,10 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     if (!boundary && it != materialIndex_.end() && m.blendWith != m.id && (m.blendRatio < 1.0f || texturedRatio)) {
       blendWith = it->second;
       data_.materialBlend = true;
-      if (texturedRatio) {
-        ratioTexture = textureIndex(m.blendRatioTexture);
-        data_.materialTextures = true;
-      }
+      if (texturedRatio) data_.materialTextures = true;
     }
-    auto texels = packMaterial(m, textureIndex(m.albedoTexture), roughnessTexture, textureIndex(m.alphaTexture),
-                               textureIndex(m.bumpTexture), textureIndex(m.emissionTexture), blendWith, ratioTexture);
+    auto texels = packMaterial(
+        m, [this](NodeId t) { return textureIndex(t); }, blendWith);
     data_.materials.insert(data_.materials.end(), texels.begin(), texels.end());
   };
   for (const Material& m : scene.materials) pack(m);

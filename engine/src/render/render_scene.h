@@ -13,6 +13,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -30,17 +31,14 @@ namespace retile {
 
 using gpu::vec4;
 
-// A material as the shaders read it (kMaterialTexels texels: the first five, the seventh, the
-// eighth and the ninth unpacked by unpackMaterial in shaders/common/bsdf.glsl; the sixth, bump
-// map, emission texture and the material blended with, the seventh's w, the blend's ratio, the
-// eighth's x, the texture that scales it, the eighth's z, the emission cone's cosine, and the
-// tenth, the glass's scattering medium, read by trace.comp; the eighth's y and the ninth hold the
-// coat, or for glass its medium's absorption),
-// with its textures' and blend partner's indices (-1: none). Roughness and IOR are clamped to
-// what the BSDF code can sample.
-std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, int albedoTexture = -1, int roughnessTexture = -1,
-                                                    int alphaTexture = -1, int bumpTexture = -1, int emissionTexture = -1,
-                                                    int blendWith = -1, int blendRatioTexture = -1);
+// A material as the shaders read it: kMaterialTexels texels, each field of material_fields.h
+// that has a slot written there for its types (the kernel reads it by name), the rest where
+// packMaterial's code puts them (unpackMaterial in shaders/common/bsdf.glsl and trace.comp read
+// those by position). textureIndex gives a texture's index in the texture buffer (-1: none, and
+// every texture when it is empty); blendWith the partner's material index (-1: no blend).
+// Roughness and IOR are clamped to what the BSDF code can sample.
+std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, const std::function<int(NodeId)>& textureIndex = {},
+                                                    int blendWith = -1);
 
 // The cosine of Material::emissionCone, 0 for the hemisphere (or a cone that is not a number):
 // the front emits toward directions whose cosine with its normal is above it.

@@ -30,17 +30,14 @@ std::string checkMedium(Vec3 absorption, Vec3 scattering, float anisotropy) {
 }
 
 std::string checkMaterial(const Scene& s, const Material& m) {
-  if (!isFinite(m.albedo) || !isFinite(m.emission) || !isFinite(m.eta) || !isFinite(m.k) || !isFinite(m.coatingAbsorption) ||
-      !isFinite(m.coatAbsorption) || !isFinite(m.interiorAbsorption) || !isFinite(m.interiorScattering))
-    return cat("material '", m.name, "': a parameter is not a finite number");
+  for (const MaterialColor& f : kMaterialColors)
+    if (!f.inRange(m.*f.field)) return cat("material '", m.name, "': its ", f.key, " must be finite and within 0..", f.hi);
   for (const MaterialScalar& f : kMaterialScalars) {
     const float v = m.*f.field;
     if (!finite(v)) return cat("material '", m.name, "': its ", f.key, " is not a finite number");
     if (v < f.lo || v > f.hi)
       return cat("material '", m.name, "': its ", f.key, " must be within ", f.lo, "..", f.hi, *f.unit ? " " : "", f.unit);
   }
-  if (auto why = checkMedium(m.interiorAbsorption, m.interiorScattering, m.interiorAnisotropy); !why.empty())
-    return cat("material '", m.name, "': ", why);
   if (m.blendWith != kNoNode && (m.blendWith == m.id || !s.material(m.blendWith)))
     return cat("material '", m.name, "': it cannot blend with material ", m.blendWith);
   for (NodeId t : m.textures())

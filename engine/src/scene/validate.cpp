@@ -143,16 +143,13 @@ Result<bool> validateScene(Scene& scene, std::vector<std::string>& warnings) {
     for (const MaterialScalar& f : kMaterialScalars) clampValue(m.*f.field, f.lo, f.hi, f.fallback, cat(what, ": ", f.key), warnings);
     // Only Oren-Nayar's sigma goes past 1.
     if (m.type != MaterialType::OrenNayar) clampValue(m.roughness, 0.0f, 1.0f, 0.1f, what + ": roughness", warnings);
-    checkColor(m.albedo, Vec3{0.8f}, what + ": albedo", warnings);
-    checkColor(m.emission, Vec3{0.0f}, what + ": emission", warnings);
-    checkColor(m.coatingAbsorption, Vec3{0.0f}, what + ": coating absorption", warnings);
-    checkColor(m.coatAbsorption, Vec3{0.0f}, what + ": coat absorption", warnings);
-    checkMedium(m.interiorAbsorption, what + ": interior absorption", warnings);
-    checkMedium(m.interiorScattering, what + ": interior scattering", warnings);
-    if (!finiteNonNegative(m.eta) || !finiteNonNegative(m.k)) {
-      warnings.push_back(cat(what, ": its complex index of refraction is negative or not finite; copper instead"));
-      m.metal = "Cu";
-      conductorIor("Cu", &m.eta, &m.k);
+    for (const MaterialColor& f : kMaterialColors) {
+      Vec3& c = m.*f.field;
+      if (f.inRange(c)) continue;
+      const Vec3 before = c;
+      c = f.clamp(c);
+      warnings.push_back(cat(what, ": ", f.key, " (", before.x, ", ", before.y, ", ", before.z, ") is negative, above ", f.hi,
+                             " or not a number; now (", c.x, ", ", c.y, ", ", c.z, ")"));
     }
   }
 
