@@ -154,7 +154,9 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
                               kCoatUsed ? texelFetch(uMaterials, base + 7) : vec4(0.0),
                               kCoatUsed || kMediumUsed ? texelFetch(uMaterials, base + 8) : vec4(0.0));
   if (kScatteringUsed) m.scattering = texelFetch(uMaterials, base + 9);
-  int albedoTex = RT_MATERIAL_TEXTURE(shaded, albedoTexture), roughTex = RT_MATERIAL_TEXTURE(shaded, roughnessTexture);
+  // The albedo and roughness textures' slots lie in t2 and t3, fetched above for eta and k
+  // (render_materials.cpp asserts it): no second fetch.
+  int albedoTex = floatBitsToInt(t2[kMaterialSlot_albedoTexture % 4]), roughTex = floatBitsToInt(t3[kMaterialSlot_roughnessTexture % 4]);
   if (hasFeature(kFeatureTextures) && albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
   if (hasFeature(kFeatureTextures) && roughTex >= 0) {
     float scale = dot(sampleTexture(roughTex, uv).rgb, vec3(1.0 / 3.0));

@@ -56,6 +56,16 @@ float emissionConeCos(const Material& m) {
   return m.emissionCone < 90 ? std::cos(std::max(m.emissionCone, 0.0f) * (kPi / 180)) : 0.0f;  // NaN: the hemisphere
 }
 
+namespace {
+constexpr int texelOf(NodeId Material::*field) {
+  for (const MaterialTexture& t : kMaterialTextures)
+    if (t.field == field) return t.texel;
+  return -1;
+}
+}  // namespace
+// trace.comp's fetchMaterial reads these two from the texels it has fetched for eta and k.
+static_assert(texelOf(&Material::albedoTexture) == 2 && texelOf(&Material::roughnessTexture) == 3);
+
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, const std::function<int(NodeId)>& textureIndex, int blendWith) {
   Vec3 eta = m.eta, k = m.k;
   if (m.metal != "custom" && !conductorIor(m.metal, &eta, &k)) conductorIor("Cu", &eta, &k);
