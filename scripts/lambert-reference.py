@@ -77,8 +77,9 @@ def load_scene(path):
             if np.linalg.norm(n) == 0:
                 continue
             v0.append(world[a]); e1.append(ea); e2.append(eb); normal.append(n / np.linalg.norm(n))
-            albedo.append(mat["albedo"] if mat["type"] == "lambert" else [0, 0, 0])
-            emission.append(mat["emission"])
+            # A native file leaves out a colour at its default (material_fields.h).
+            albedo.append(mat.get("albedo", [0.8, 0.8, 0.8]) if mat["type"] == "lambert" else [0, 0, 0])
+            emission.append(mat.get("emission", [0, 0, 0]))
     geo = {k: np.array(v) for k, v in
            dict(v0=v0, e1=e1, e2=e2, albedo=albedo, emission=emission, normal=normal).items()}
     geo["emitters"] = np.where(geo["emission"].max(1) > 0)[0]

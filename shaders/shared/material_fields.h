@@ -1,10 +1,11 @@
 // A material's fields, one row each, and every user of a field reads it from its row:
 // retile/scene.h declares the member, the native reader and writer, validation, edits and the
 // properties panel iterate the rows (kMaterialScalars, kMaterialColors, kMaterialTextures,
-// kMaterialChoices), packMaterial writes the value to its slot and the kernel reads it there by
-// name (kMaterialSlot_<member>, kMaterialTexel_<member>). A new field is a row here, the GLSL
-// that reads it and a test. Included by C++ (retile/scene.h, render_materials.cpp) and GLSL
-// (shared/layouts.h), each defining all four RETILE_MATERIAL_* first: no include guard.
+// kMaterialChoices) and packMaterial writes the value to its slot. The kernel reads a scalar or a
+// texture there by name (kMaterialSlot_<member>); a colour through the texels unpackMaterial
+// takes (render_materials.cpp asserts the packed ones' texels). A new field is a row here, the
+// GLSL that reads it and a test. Included by C++ (retile/scene.h) and GLSL (shared/layouts.h),
+// each defining all four RETILE_MATERIAL_* first: no include guard.
 //
 // RETILE_MATERIAL_SCALAR(member, key, default, lo, hi, types, texel, component, label, unit, decimals, place, tip)
 //   member            Material's float member
@@ -34,7 +35,8 @@
 //
 // RETILE_MATERIAL_TEXTURE(member, key, types, texel, component, label, place)
 //   A texture that feeds an input (kNoNode: none). packMaterial writes its index (-1 none) to the
-//   slot for its types, -1 for the others; the kernel reads it as RT_MATERIAL_TEXTURE(m, member).
+//   slot for its types and -1 for the others: the slot is the texture's for every type. The
+//   kernel reads it as RT_MATERIAL_TEXTURE(m, member).
 //
 // RETILE_MATERIAL_CHOICE(member, key, off, on, types, flag, label, offLabel, onLabel, place, tip)
 //   A bool member, written to files as `key: on` when set (`off` or no key: not set). For its

@@ -94,6 +94,10 @@ TEST(MaterialFields, TheColourTextureAndChoiceRowsAreConsistent) {
     EXPECT_TRUE(keys.insert(f.key).second) << "a key names one field";
     EXPECT_EQ(Material{}.*f.field, f.fallback) << "a new material holds the default";
     EXPECT_TRUE(f.inRange(f.fallback));
+    // A medium's rows cap it where the kernel's sums of extinction stay finite.
+    if (f.field == &Material::interiorAbsorption || f.field == &Material::interiorScattering) {
+      EXPECT_EQ(f.hi, kMaxExtinction);
+    }
     EXPECT_NE(f.types, 0u);
     EXPECT_LT(f.texel, gpu::kMaterialTexels);
   }
@@ -121,10 +125,10 @@ TEST(MaterialFields, TwoFieldsShareASlotOnlyForDifferentTypes) {
         EXPECT_EQ(a.types & b.types, 0u) << a.member << " and " << b.member;
       }
     }
+    // packMaterial writes -1 to a texture's slot for the types it does not apply to: the slot is
+    // the texture's alone.
     for (const MaterialTexture& t : kMaterialTextures)
-      if (a.packed() && a.texel == t.texel && a.component == t.component) {
-        EXPECT_EQ(a.types & t.types, 0u) << a.member << " and " << t.member;
-      }
+      EXPECT_FALSE(a.packed() && a.texel == t.texel && a.component == t.component) << a.member << " and " << t.member;
     for (const MaterialColor& c : kMaterialColors)
       if (a.packed() && a.texel == c.texel && a.component < 3) {
         EXPECT_EQ(a.types & c.types, 0u) << a.member << " and " << c.member;
@@ -135,6 +139,9 @@ TEST(MaterialFields, TwoFieldsShareASlotOnlyForDifferentTypes) {
       if (&a != &b) {
         EXPECT_FALSE(a.texel == b.texel && a.component == b.component) << a.member << " and " << b.member;
       }
+  for (const MaterialTexture& t : kMaterialTextures)
+    for (const MaterialColor& c : kMaterialColors)
+      EXPECT_FALSE(c.packed() && c.texel == t.texel && t.component < 3) << c.member << " and " << t.member;
 }
 
 TEST(MaterialFields, EveryFieldIsWrittenAndReadBack) {

@@ -151,7 +151,7 @@ constexpr int kMaxBlendChain = 4;
 // the kernel's sums of extinction times distance would overflow to infinity and then NaN.
 constexpr float kMaxExtinction = 1e6f;
 
-// Where the properties panel shows a material's scalar field (shaders/shared/material_fields.h).
+// Where the properties panel shows a material's field (shaders/shared/material_fields.h).
 enum class MaterialPlace {
   Surface,   // with the type's fields, for the types it applies to
   Coated,    // while the material has a clear coat
@@ -343,6 +343,10 @@ inline constexpr MaterialChoice kMaterialChoices[] = {
 #undef RT_ALL_TYPES
 #undef RT_PANEL
 #undef RT_WIDGET
+#undef RETILE_IGNORE_SCALAR
+#undef RETILE_IGNORE_COLOR
+#undef RETILE_IGNORE_TEXTURE
+#undef RETILE_IGNORE_CHOICE
 
 // Named metals with RGB complex indices of refraction (linear sRGB primaries).
 std::vector<std::string> conductorNames();

@@ -455,7 +455,15 @@ Material readMaterial(Reader& r) {
   for (const MaterialScalar& f : kMaterialScalars) r.number(f.key, &(m.*f.field));
   for (const MaterialColor& f : kMaterialColors) r.vec3(f.key, &(m.*f.field));
   for (const MaterialTexture& f : kMaterialTextures) r.id(f.key, &(m.*f.field));
-  for (const MaterialChoice& f : kMaterialChoices) readEither(r, f.key, f.off, f.on, &(m.*f.field));
+  for (const MaterialChoice& f : kMaterialChoices) {
+    std::string value;
+    r.string(f.key, &value);
+    // Files written before the conventions were named for their effect said "tungsten" for the
+    // tinted glass.
+    const bool legacy = f.field == &Material::tintsReflection && value == "tungsten";
+    if (value == f.on || legacy) m.*f.field = true;
+    else if (!value.empty() && value != f.off) r.problem(f.key, cat("unknown ", f.key, " '", value, "' (", f.off, ", ", f.on, ")"));
+  }
   r.string("metal", &m.metal);
   r.id("blend_with", &m.blendWith);
   return m;

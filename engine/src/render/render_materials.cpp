@@ -62,9 +62,24 @@ constexpr int texelOf(NodeId Material::*field) {
     if (t.field == field) return t.texel;
   return -1;
 }
+constexpr int texelOf(Vec3 Material::*field) {
+  for (const MaterialColor& c : kMaterialColors)
+    if (c.field == field) return c.texel;
+  return -1;
+}
 }  // namespace
 // trace.comp's fetchMaterial reads these two from the texels it has fetched for eta and k.
 static_assert(texelOf(&Material::albedoTexture) == 2 && texelOf(&Material::roughnessTexture) == 3);
+// unpackMaterial (common/bsdf.glsl) reads the packed colours by position: albedo from texel 0,
+// the coating's absorption from texel 6.
+static_assert(texelOf(&Material::albedo) == 0 && texelOf(&Material::coatingAbsorption) == 6);
+static_assert(
+    [] {
+      for (const MaterialColor& c : kMaterialColors)
+        if (c.texel >= 0 && c.field != &Material::albedo && c.field != &Material::coatingAbsorption) return false;
+      return true;
+    }(),
+    "a colour packed by its row needs its texel read in unpackMaterial, and asserted here");
 
 std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, const std::function<int(NodeId)>& textureIndex, int blendWith) {
   Vec3 eta = m.eta, k = m.k;
