@@ -60,9 +60,9 @@ const QStringList& textureInputs() {
 bool isTextureInput(const QString& s) { return textureInputs().contains(s); }
 
 NodeId Material::*textureSlot(const QString& input) {
-  for (const MaterialTexture& t : kMaterialTextures)
-    if (input == inputName(t)) return t.field;
-  return nullptr;
+  // textureInputs() lists the rows' names in the rows' order.
+  const qsizetype i = textureInputs().indexOf(input);
+  return i < 0 ? nullptr : kMaterialTextures[static_cast<std::size_t>(i)].field;
 }
 
 GraphNodeItem::GraphNodeItem(NodeId nodeId, NodeKind nodeKind) : id(nodeId), kind(nodeKind) {

@@ -142,8 +142,6 @@ constexpr bool hasRoughness(MaterialType t) {
 // is its film's thickness, Tungsten's textured thinsheet. The kernel, the panel's label and the
 // node graph's all ask this, so that the slot means one thing everywhere.
 constexpr bool roughnessSlotIsThickness(MaterialType t) { return t == MaterialType::ThinSheet; }
-// The types that read the texture in their roughness slot, as roughness or as thickness.
-constexpr bool readsRoughnessSlot(MaterialType t) { return hasRoughness(t) || roughnessSlotIsThickness(t); }
 
 // Materials a hit follows through blends, the first included (Material::blendWith).
 constexpr int kMaxBlendChain = 4;

@@ -57,22 +57,23 @@ float emissionConeCos(const Material& m) {
 }
 
 namespace {
-constexpr int texelOf(NodeId Material::*field) {
+// A field's row (every field named here has one).
+constexpr const MaterialTexture& textureRow(NodeId Material::*field) {
   for (const MaterialTexture& t : kMaterialTextures)
-    if (t.field == field) return t.texel;
-  return -1;
+    if (t.field == field) return t;
+  return kMaterialTextures[0];
 }
-constexpr int texelOf(Vec3 Material::*field) {
+constexpr const MaterialColor& colorRow(Vec3 Material::*field) {
   for (const MaterialColor& c : kMaterialColors)
-    if (c.field == field) return c.texel;
-  return -1;
+    if (c.field == field) return c;
+  return kMaterialColors[0];
 }
 }  // namespace
 // trace.comp's fetchMaterial reads these two from the texels it has fetched for eta and k.
-static_assert(texelOf(&Material::albedoTexture) == 2 && texelOf(&Material::roughnessTexture) == 3);
+static_assert(textureRow(&Material::albedoTexture).texel == 2 && textureRow(&Material::roughnessTexture).texel == 3);
 // unpackMaterial (common/bsdf.glsl) reads the packed colours by position: albedo from texel 0,
 // the coating's absorption from texel 6.
-static_assert(texelOf(&Material::albedo) == 0 && texelOf(&Material::coatingAbsorption) == 6);
+static_assert(colorRow(&Material::albedo).texel == 0 && colorRow(&Material::coatingAbsorption).texel == 6);
 static_assert(
     [] {
       for (const MaterialColor& c : kMaterialColors)
@@ -101,10 +102,9 @@ std::array<vec4, gpu::kMaterialTexels> packMaterial(const Material& m, const std
   // Diffuse light inside a plastic coating reflects back this fraction at the boundary
   // (Jensen et al.'s polynomial fit of the internal diffuse Fresnel reflectance).
   float fdrInt = -1.4399f / (ior * ior) + 0.7099f / ior + 0.6681f + 0.0636f * ior;
-  const vec4 none{0, 0, 0, 0};
   std::array<vec4, gpu::kMaterialTexels> texels{v4(Vec3{0.0f}, bitsOf(type)), vec4{roughness, ior, 0, std::clamp(fdrInt, 0.0f, 1.0f)},
                                                 v4(eta, 0), v4(k, 0), v4(max(m.radiance(), Vec3{0.0f}), 0),
-                                                vec4{0, 0, 0, bitsOf(blendWith)}, none,
+                                                vec4{0, 0, 0, bitsOf(blendWith)}, vec4{0, 0, 0, 0},
                                                 vec4{0, coated ? std::min(m.coatIor, 10.0f) : 0.0f, emissionConeCos(m), 0},
                                                 // The ninth holds the coat or, for glass, which takes no coat, its medium's absorption;
                                                 // the tenth the medium's scattering.
@@ -152,12 +152,6 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     if (coatRendered(m)) data_.materialTypes |= 1u << gpu::kMaskCoat;
     if (m.filled()) data_.materialTypes |= 1u << gpu::kMaskMedium;
     if (m.filled() && maxComponent(m.interiorScattering) > 0) data_.materialTypes |= 1u << gpu::kMaskScattering;
-    // A type without roughness reads no roughness texture (packMaterial leaves it out): the
-    // kernel would scale what the slot holds for it (hair's tilt) by the texture's mean.
-    const int roughnessTexture = readsRoughnessSlot(m.type) ? textureIndex(m.roughnessTexture) : -1;
-    if (textureIndex(m.albedoTexture) >= 0 || roughnessTexture >= 0) data_.materialTextures = true;
-    if (textureIndex(m.bumpTexture) >= 0 && m.bumpStrength != 0) data_.materialBump = true;
-    if (textureIndex(m.emissionTexture) >= 0 && m.emissive()) data_.emissionTextures = true;
     if (emissionConeCos(m) != 0 && m.emissive()) data_.emissionCones = true;
     int blendWith = -1;
     const bool texturedRatio = textureIndex(m.blendRatioTexture) >= 0;
@@ -171,10 +165,18 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     if (!boundary && it != materialIndex_.end() && m.blendWith != m.id && (m.blendRatio < 1.0f || texturedRatio)) {
       blendWith = it->second;
       data_.materialBlend = true;
-      if (texturedRatio) data_.materialTextures = true;
     }
     auto texels = packMaterial(
         m, [this](NodeId t) { return textureIndex(t); }, blendWith);
+    // The kernel's texture code, for the textures packMaterial kept (those its type reads).
+    auto packed = [&texels](NodeId Material::*field) {
+      const MaterialTexture& t = textureRow(field);
+      return std::bit_cast<std::int32_t>(component(texels[static_cast<std::size_t>(t.texel)], t.component)) >= 0;
+    };
+    if (packed(&Material::albedoTexture) || packed(&Material::roughnessTexture) || packed(&Material::blendRatioTexture))
+      data_.materialTextures = true;
+    if (packed(&Material::bumpTexture)) data_.materialBump = true;
+    if (packed(&Material::emissionTexture) && m.emissive()) data_.emissionTextures = true;
     data_.materials.insert(data_.materials.end(), texels.begin(), texels.end());
   };
   for (const Material& m : scene.materials) pack(m);
