@@ -340,12 +340,12 @@ Value nativeSceneToJson(const Scene& s) {
 
 // A setting or field that is one of two ways, by name: `first` (the enum's first value, or false;
 // also when the file says nothing) or `second`. Files saved before these names said what the ways
-// do called every second way "tungsten"; they read as they did.
+// do called the second way "tungsten" (`wasTungsten`); they read as they did.
 template <class E>
-void readEither(Reader& r, const char* key, const char* first, const char* second, E* out) {
+void readEither(Reader& r, const char* key, const char* first, const char* second, E* out, bool wasTungsten = true) {
   std::string name;
   r.string(key, &name);
-  if (name == second || name == "tungsten") *out = static_cast<E>(1);
+  if (name == second || (wasTungsten && name == "tungsten")) *out = static_cast<E>(1);
   else if (!name.empty() && name != first) r.problem(key, cat("unknown ", key, " '", name, "' (", first, ", ", second, ")"));
 }
 
@@ -455,15 +455,8 @@ Material readMaterial(Reader& r) {
   for (const MaterialScalar& f : kMaterialScalars) r.number(f.key, &(m.*f.field));
   for (const MaterialColor& f : kMaterialColors) r.vec3(f.key, &(m.*f.field));
   for (const MaterialTexture& f : kMaterialTextures) r.id(f.key, &(m.*f.field));
-  for (const MaterialChoice& f : kMaterialChoices) {
-    std::string value;
-    r.string(f.key, &value);
-    // Files written before the conventions were named for their effect said "tungsten" for the
-    // tinted glass.
-    const bool legacy = f.field == &Material::tintsReflection && value == "tungsten";
-    if (value == f.on || legacy) m.*f.field = true;
-    else if (!value.empty() && value != f.off) r.problem(f.key, cat("unknown ", f.key, " '", value, "' (", f.off, ", ", f.on, ")"));
-  }
+  // Of the choices only the glass convention was ever written "tungsten".
+  for (const MaterialChoice& f : kMaterialChoices) readEither(r, f.key, f.off, f.on, &(m.*f.field), f.field == &Material::tintsReflection);
   r.string("metal", &m.metal);
   r.id("blend_with", &m.blendWith);
   return m;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <numeric>
+#include <stdexcept>
 #include <functional>
 #include <iterator>
 #include <map>
@@ -57,16 +58,16 @@ float emissionConeCos(const Material& m) {
 }
 
 namespace {
-// A field's row (every field named here has one).
+// A field's row; a field without one fails to compile where evaluated at compile time.
 constexpr const MaterialTexture& textureRow(NodeId Material::*field) {
   for (const MaterialTexture& t : kMaterialTextures)
     if (t.field == field) return t;
-  return kMaterialTextures[0];
+  throw std::logic_error("no texture row for this field");
 }
 constexpr const MaterialColor& colorRow(Vec3 Material::*field) {
   for (const MaterialColor& c : kMaterialColors)
     if (c.field == field) return c;
-  return kMaterialColors[0];
+  throw std::logic_error("no colour row for this field");
 }
 }  // namespace
 // trace.comp's fetchMaterial reads these two from the texels it has fetched for eta and k.
@@ -169,14 +170,17 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     auto texels = packMaterial(
         m, [this](NodeId t) { return textureIndex(t); }, blendWith);
     // The kernel's texture code, for the textures packMaterial kept (those its type reads).
-    auto packed = [&texels](NodeId Material::*field) {
-      const MaterialTexture& t = textureRow(field);
+    auto packed = [&texels](const MaterialTexture& t) {
       return std::bit_cast<std::int32_t>(component(texels[static_cast<std::size_t>(t.texel)], t.component)) >= 0;
     };
-    if (packed(&Material::albedoTexture) || packed(&Material::roughnessTexture) || packed(&Material::blendRatioTexture))
-      data_.materialTextures = true;
-    if (packed(&Material::bumpTexture)) data_.materialBump = true;
-    if (packed(&Material::emissionTexture) && m.emissive()) data_.emissionTextures = true;
+    static constexpr const MaterialTexture& albedo = textureRow(&Material::albedoTexture);
+    static constexpr const MaterialTexture& roughness = textureRow(&Material::roughnessTexture);
+    static constexpr const MaterialTexture& ratio = textureRow(&Material::blendRatioTexture);
+    static constexpr const MaterialTexture& bump = textureRow(&Material::bumpTexture);
+    static constexpr const MaterialTexture& emission = textureRow(&Material::emissionTexture);
+    if (packed(albedo) || packed(roughness) || packed(ratio)) data_.materialTextures = true;
+    if (packed(bump)) data_.materialBump = true;
+    if (packed(emission) && m.emissive()) data_.emissionTextures = true;
     data_.materials.insert(data_.materials.end(), texels.begin(), texels.end());
   };
   for (const Material& m : scene.materials) pack(m);
