@@ -224,9 +224,13 @@ int benchThroughput(const ThroughputOptions& o) {
       "loop iterations %u at most in one invocation (paths stop at %u; lavapipe's limit is near 32767); "
       "%llu paths cut short; %u at most in one path segment\n",
       sum.maxLoopIterations, kTraceLoopBudget, static_cast<unsigned long long>(sum.cutPaths), sum.maxSegmentIterations);
-  std::printf("paths          %.1f loop iterations each, %.0f per invocation (last frame)\n",
+  // Per ray and per iteration, so that two scenes' costs split into how long their paths are, how
+  // far their rays search, and what a step costs.
+  const double rays = static_cast<double>(std::max<std::uint64_t>(sum.primaryRays + sum.bounceRays + sum.shadowRays, 1));
+  const double iterations = static_cast<double>(std::max<std::uint64_t>(sum.loopIterations, 1));
+  std::printf("paths          %.1f loop iterations each, %.0f per invocation (last frame); %.1f a ray, %.1f ns of device time each\n",
               static_cast<double>(sum.loopIterations) / static_cast<double>(std::max<std::uint64_t>(sum.samples, 1)),
-              sum.pathsPerInvocation);
+              sum.pathsPerInvocation, static_cast<double>(sum.loopIterations) / rays, sec / iterations * 1e9);
   std::printf("device memory  %.3f MiB scene data, %.1f bytes per triangle\n", static_cast<double>(renderer.sceneDeviceBytes()) / (1 << 20),
               tris ? static_cast<double>(renderer.sceneDeviceBytes()) / static_cast<double>(tris) : 0.0);
   return 0;
