@@ -893,15 +893,19 @@ TEST(KnownAnswer, DiffusePlaneUnderUniformSky) {
 
 // Where rays leave a surface (RayOffset). A floor of albedo 0.8 under a black lid h = 2.5e-4
 // above it, under a sky of 1, seen from between the two. Robust rays from the floor all meet the
-// lid: the floor reads 0. Tungsten's start 5e-4 along their direction, so those within 60 degrees
-// of the normal (cos > h / 5e-4) start past the lid and see the sky: 0.8 (1 - 0.5^2) = 0.6, by
-// light samples and BSDF samples alike. Away from the origin: there the robust offset is ulps of
-// the position (~1e-6 here), near it a fixed 1.5e-5, which would blur the answer.
+// lid: the floor reads 0. Tungsten's start at the point they leave and skip 5e-4 along their
+// direction, so those within 60 degrees of the normal (cos > h / 5e-4) pass the lid and see the
+// sky: 0.8 (1 - 0.5^2) = 0.6, by light samples and BSDF samples alike. Away from the origin: there
+// the robust offset is ulps of the position, near it a fixed 1.5e-5, which would blur the answer.
+// At y = 0.04 those ulps are 1e-6; at y = 4, 1.2e-4, half the gap: a ray lifted by them as well
+// passes the lid for cos > 0.26 and reads 0.75, so Tungsten's rays must not be lifted.
 TEST(KnownAnswer, TungstensRaysSkipWhatLiesWithinItsEpsilon) {
   RETILE_RENDERER_OR_SKIP(r);
-  const float floorY = 0.04f, lidAbove = 2.5e-4f;
-  for (RayOffset offset : {RayOffset::Robust, RayOffset::FixedEpsilon}) {
-    SCOPED_TRACE(offset == RayOffset::FixedEpsilon ? "Tungsten's offset" : "robust offset");
+  const float lidAbove = 2.5e-4f;
+  for (auto [offset, floorY] : {std::pair{RayOffset::Robust, 0.04f}, std::pair{RayOffset::FixedEpsilon, 0.04f},
+                                std::pair{RayOffset::Robust, 4.0f}, std::pair{RayOffset::FixedEpsilon, 4.0f}}) {
+    SCOPED_TRACE(std::string(offset == RayOffset::FixedEpsilon ? "Tungsten's offset" : "robust offset") + ", the floor at y " +
+                 std::to_string(floorY));
     Scene s = test::emptyScene(16, 16);
     // Looking down at (2, 1), away from the quads' diagonals: rounding leaves a crack along a
     // shared edge, wider the larger the triangles.
