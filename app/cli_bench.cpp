@@ -231,6 +231,18 @@ int benchThroughput(const ThroughputOptions& o) {
   std::printf("paths          %.1f loop iterations each, %.0f per invocation (last frame); %.1f a ray, %.1f ns of device time each\n",
               static_cast<double>(sum.loopIterations) / static_cast<double>(std::max<std::uint64_t>(sum.samples, 1)),
               sum.pathsPerInvocation, static_cast<double>(sum.loopIterations) / rays, sec / iterations * 1e9);
+  // Where the paths' time goes when they are long: how they end.
+  const double samples = static_cast<double>(std::max<std::uint64_t>(sum.samples, 1));
+  std::uint64_t ended = 0;
+  for (std::uint64_t n : sum.pathEnds) ended += n;
+  std::printf(
+      "path ends      %.1f %% left the scene, %.1f %% met an emitter that does not reflect, %.1f %% at the bounce limit, "
+      "%.1f %% by roulette, %.1f %% otherwise (absorbed, or cut short)\n",
+      100.0 * static_cast<double>(sum.pathEnds[FrameStats::LeftTheScene]) / samples,
+      100.0 * static_cast<double>(sum.pathEnds[FrameStats::AtEmitter]) / samples,
+      100.0 * static_cast<double>(sum.pathEnds[FrameStats::AtBounceLimit]) / samples,
+      100.0 * static_cast<double>(sum.pathEnds[FrameStats::ByRoulette]) / samples,
+      100.0 * static_cast<double>(sum.samples - std::min(ended, sum.samples)) / samples);
   std::printf("device memory  %.3f MiB scene data, %.1f bytes per triangle\n", static_cast<double>(renderer.sceneDeviceBytes()) / (1 << 20),
               tris ? static_cast<double>(renderer.sceneDeviceBytes()) / static_cast<double>(tris) : 0.0);
   return 0;

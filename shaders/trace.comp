@@ -288,6 +288,9 @@ struct Shadow {
 const int kPickedNothing = 0x7fffffff;
 
 uint primaryRays = 0u, bounceRays = 0u, shadowRays = 0u;
+// The paths that ended each way (FrameStats::PathEnd): they left the scene, met an emitter that
+// does not reflect, reached the bounce limit, lost at roulette.
+uint pathsLeft = 0u, pathsAtEmitters = 0u, pathsAtLimit = 0u, pathsByRoulette = 0u;
 
 // `found`: findItem(slot).
 Path startPath(uint slot, int found) {
@@ -569,7 +572,10 @@ bool survivesRoulette(inout Path path, inout Shadow shadow) {
   if (path.depth > 3) {
     float m = maxComponent(path.beta * path.etaScale);
     float q = hasFeature(kFeatureLowThroughputRoulette) ? (m < 0.1 ? 1.0 - m : 0.0) : max(0.05, 1.0 - m);
-    if (rand(path.rng) < q) return endPath(path, shadow);
+    if (rand(path.rng) < q) {
+      pathsByRoulette++;
+      return endPath(path, shadow);
+    }
     path.beta /= 1.0 - q;
   }
   return true;
@@ -654,7 +660,11 @@ bool scatterInMedium(inout Path path, inout Shadow shadow, float flight, float h
     path.auxDepth = path.travelled;
   }
   path.beta *= pdf > 0.0 ? path.scattering.rgb * crossed / pdf : vec3(0.0);
-  if (path.depth >= int(frame.image.w) || !(maxComponent(path.beta) > 0.0)) return false;
+  if (path.depth >= int(frame.image.w)) {
+    pathsAtLimit++;
+    return false;
+  }
+  if (!(maxComponent(path.beta) > 0.0)) return false;
   // Kept short of the surface, so that rounding cannot put the point on its far side.
   vec3 pos = path.ro + min(flight, hitT * 0.99999) * path.rd;
   float g = path.scattering.w;
@@ -727,6 +737,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   // min_bounces): the sky and the emitters this segment finds, the light samples of vertices before.
   bool counts = !hasFeature(kFeatureMinBounces) || path.depth >= frame.bounces.x;
   if (hit.prim < 0) {
+    pathsLeft++;
     if (!counts) return false;
     vec3 Le = envRadiance(rd);
     vec3 added = path.beta * Le;
@@ -799,7 +810,10 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
     // MIS's), except that the crossing counts as a bounce, as in Tungsten (TraceBase). Nothing
     // changes its weight, so no roulette here: it would only add noise. One that holds no medium
     // leaves the path in the one it is in (Tungsten's selectMedium keeps it too).
-    if (path.depth >= maxBounces) return false;
+    if (path.depth >= maxBounces) {
+      pathsAtLimit++;
+      return false;
+    }
     if (path.auxInstance <= 0) path.auxInstance = -floatBitsToInt(info2.x);
 #if RETILE_MEDIUM
     if (maxComponent(m.interior + m.scattering.rgb) > 0.0) crossMedium(path, m, frontFace);
@@ -824,9 +838,15 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
     }
   }
 
-  if (nullMaterial) return false;  // an emitter that does not reflect: the path ends here
+  if (nullMaterial) {
+    pathsAtEmitters++;
+    return false;  // an emitter that does not reflect: the path ends here
+  }
 
-  if (path.depth >= maxBounces) return false;
+  if (path.depth >= maxBounces) {
+    pathsAtLimit++;
+    return false;
+  }
 
   // Shading frame. Opaque materials are two-sided: flip to the viewer's side, of the true surface
   // (consistent) or of the shading normal (unchecked).
@@ -1105,4 +1125,8 @@ void main() {
   if (invocation < push.invocations) atomicAdd(rayCounts[5], (loopIterations + kLoopIterationUnit / 2u) / kLoopIterationUnit);
   if (cutPaths > 0u) atomicAdd(rayCounts[4], cutPaths);
   atomicMax(rayCounts[6], maxSegment);
+  atomicAdd(rayCounts[kStatsPathEnds], pathsLeft);
+  atomicAdd(rayCounts[kStatsPathEnds + 1], pathsAtEmitters);
+  atomicAdd(rayCounts[kStatsPathEnds + 2], pathsAtLimit);
+  atomicAdd(rayCounts[kStatsPathEnds + 3], pathsByRoulette);
 }

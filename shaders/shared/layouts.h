@@ -200,7 +200,9 @@ RT_CONST(int, kTraceWorkgroup, 64)
 // The traversal loop ends when this many lanes of every eight have their rays done (scene.glsl
 // traverse): the ones done are shaded while the rest wait, their rays half traced.
 RT_CONST(int, kTraceReadyLanes, 6)
-RT_CONST(int, kStatsCount, 8)  // counters the trace pass writes (see trace.comp)
+RT_CONST(int, kStatsCount, 11)  // counters the trace pass writes (see trace.comp)
+// Where the counters of the paths that ended each way start, in FrameStats::PathEnd's order.
+RT_CONST(int, kStatsPathEnds, 7)
 // The trace pass stops its paths once its loop-iteration count passes this (see trace.comp).
 RT_CONST(uint, kLoopBudget, 30000u)
 // Below lavapipe's limit (it stopped an invocation when the count read 32659): paths also stop

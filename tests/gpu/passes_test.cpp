@@ -675,6 +675,46 @@ TEST(TracePass, PathsPerInvocationDoNotChangeAnySample) {
   EXPECT_EQ(a.normal, b.normal);
 }
 
+// The trace pass counts how each path ended (FrameStats::pathEnds), every path once: in a scene
+// with nothing in it every path leaves; facing an emitter of the null type every path ends on it;
+// inside a closed white box with a bounce limit of 2 (roulette starts past 3) every path reaches
+// the limit, and with no limit to speak of nearly every path ends by roulette and none leaves.
+TEST(TracePass, CountsHowEveryPathEnds) {
+  RETILE_RENDERER_OR_SKIP(r);
+  const int w = 16, h = 16, spp = 4;
+  const auto samples = static_cast<std::uint64_t>(w * h * spp);
+  auto ends = [&](const Scene& s) {
+    r->setScene(s);
+    r->resize(w, h);
+    FrameStats stats = r->renderFrame({{0, 0, w, h, spp, 0, true}});
+    EXPECT_EQ(stats.samples, samples);
+    EXPECT_EQ(stats.cutPaths, 0u);
+    return stats.pathEnds;
+  };
+  using Ends = std::array<std::uint64_t, FrameStats::kPathEnds>;
+  EXPECT_EQ(ends(test::emptyScene(w, h)), (Ends{samples, 0, 0, 0})) << "nothing to hit";
+
+  Scene emitter = wallScene(w, h, Vec3{1.0f});
+  emitter.settings.maxBounces = 8;
+  emitter.materials[0].type = MaterialType::Null;
+  EXPECT_EQ(ends(emitter), (Ends{0, samples, 0, 0})) << "an emitter of the null type fills the view";
+
+  Scene box = test::emptyScene(w, h);
+  box.camera = test::frontCamera(60);
+  Material white;
+  white.name = "white";
+  white.albedo = Vec3{0.5f};
+  test::addMeshObject(box, "box", makeCube(), test::addMaterial(box, white), Mat4::scale({10, 10, 10}));
+  box.settings.maxBounces = 2;
+  EXPECT_EQ(ends(box), (Ends{0, 0, samples, 0})) << "a closed box, two bounces";
+  box.settings.maxBounces = 1000;
+  const Ends long_ = ends(box);
+  EXPECT_EQ(long_[FrameStats::LeftTheScene], 0u);
+  EXPECT_EQ(long_[FrameStats::AtEmitter], 0u);
+  EXPECT_EQ(long_[FrameStats::AtBounceLimit] + long_[FrameStats::ByRoulette], samples) << "lambert never absorbs a path";
+  EXPECT_GT(long_[FrameStats::ByRoulette], samples * 9 / 10) << long_[FrameStats::AtBounceLimit] << " at the limit";
+}
+
 // A pixel's samples may be traced in one frame or in several: the trace pass and the accumulate
 // pass must agree on which slot holds which pixel's which sample (layouts.h WorkItem), and a
 // sample's value depends only on its pixel and index.

@@ -1247,6 +1247,30 @@ TEST(KnownAnswer, EightBitTexturesReadAsTheirDecodedValues) {
   EXPECT_NEAR(meanOver(renderScene(*r, s, 16), plane), tungsten100, 0.004) << "under a sky map";
 }
 
+// An sRGB byte decodes to the sRGB curve to 1e-4 of its value, tighter than the EightBit test's
+// lambert under a sky can say (a cheaper curve in the kernel must keep to it): seen directly with
+// no bounce, an emitter of 1 textured by a uniform sRGB texture shows the texture's decoded value
+// in every pixel. The bytes straddle the curve's linear foot (10 and 11 about 0.04045) and span
+// the rest.
+TEST(KnownAnswer, SrgbBytesDecodeToTheirCurve) {
+  RETILE_RENDERER_OR_SKIP(r);
+  auto dir = test::tempDir();
+  Scene s = underUnitSky(8, 8, 16);  // the unit quad fills the frame
+  s.settings.maxBounces = 0;
+  Material light = grey(0.0f);
+  light.emission = Vec3{1.0f};
+  const NodeId material = test::addMaterial(s, light);
+  const NodeId plane = test::addMeshObject(s, "plane", makeQuad(), material, Mat4::identity());
+  for (int byte : {0, 1, 10, 11, 12, 30, 64, 100, 128, 180, 230, 254, 255}) {
+    SCOPED_TRACE("byte " + std::to_string(byte));
+    const double c = byte / 255.0;
+    const double expected = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+    s.material(material)->emissionTexture =
+        addByteRow(s, dir, "b" + std::to_string(byte), std::vector<int>(3, byte), TextureColorSpace::SRGB);
+    EXPECT_NEAR(meanOver(renderScene(*r, s, 1), plane), expected, 1e-4 * expected + 1e-7);
+  }
+}
+
 // A texture of two texels, 1 and 0, across the unit quad that fills the frame (the frame spans u
 // from a to 1 - a). Read at the nearest texel (Texture::interpolate off), the left half is 1 and
 // the right 0 but for the column the pixel filter straddles; held at its edges (clampToEdge), the

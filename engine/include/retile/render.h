@@ -6,6 +6,7 @@
 // passed in is read during the call only.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -122,6 +123,10 @@ struct FrameStats {
   // stop when the count passes kTraceLoopBudget, so this must stay below the ~2700 left to the limit.
   std::uint32_t maxSegmentIterations = 0;
   double pathsPerInvocation = 0;  // each invocation traces this many paths one after another
+  // How paths ended: the rest of `samples` were absorbed (no direction to go on in, no weight
+  // left), cut short, or never started (cutPaths).
+  enum PathEnd { LeftTheScene, AtEmitter, AtBounceLimit, ByRoulette, kPathEnds };  // AtEmitter: one that does not reflect
+  std::array<std::uint64_t, kPathEnds> pathEnds{};
   // With DenoiseWork::timePasses: the device's time for each denoiser pass, in record order.
   struct PassTime {
     const char* name;

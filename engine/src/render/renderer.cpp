@@ -47,6 +47,7 @@ std::uint32_t groupsFor(std::uint64_t invocations, std::uint32_t local, std::uin
 // by side, so an invocation traces whole pixels) the busiest ran 1.31 times the mean in the
 // living room, 15634 loop iterations against the budget's 30000.
 static_assert(kTraceLoopBudget == gpu::kLoopBudget, "render.h and shaders/shared/layouts.h disagree");
+static_assert(gpu::kStatsPathEnds + FrameStats::kPathEnds <= gpu::kStatsCount, "the path ends' counters lie past the buffer");
 
 // `fixedPaths` > 0 overrides the choice (FrameOptions::pathsPerInvocation).
 std::uint64_t traceInvocations(std::uint64_t slots, double iterationsPerPath, int fixedPaths) {
@@ -628,6 +629,7 @@ struct Renderer::Impl {
     fs.maxLoopIterations = counts[3];
     fs.cutPaths = counts[4];
     fs.maxSegmentIterations = counts[6];
+    for (std::size_t i = 0; i < fs.pathEnds.size(); ++i) fs.pathEnds[i] = counts[gpu::kStatsPathEnds + i];
     fs.loopIterations = static_cast<std::uint64_t>(counts[5]) * gpu::kLoopIterationUnit;
     fs.pathsPerInvocation = static_cast<double>(fs.samples) / static_cast<double>(std::max<std::uint64_t>(slot.invocations, 1));
     iterationsPerPath = static_cast<double>(fs.loopIterations) / static_cast<double>(fs.samples);
@@ -814,6 +816,7 @@ void FrameStats::add(const FrameStats& later) {
   loopIterations += later.loopIterations;
   maxSegmentIterations = std::max(maxSegmentIterations, later.maxSegmentIterations);
   pathsPerInvocation = later.pathsPerInvocation;
+  for (std::size_t i = 0; i < pathEnds.size(); ++i) pathEnds[i] += later.pathEnds[i];
 }
 
 void Renderer::prepareMoves() {
