@@ -67,6 +67,30 @@ render() {
   echo '```'
   "$bin" bench room --triangles 100k,1M 2>/dev/null
   echo '```'
+  echo
+  echo "## What a path costs: the kitchen against a synthetic room of its size"
+  echo
+  echo "\`retile bench throughput SCENE --size 320x180 --frames 4 --max-bounces 15\`, the synthetic room of 1 M"
+  echo "triangles written by \`retile bench room --triangles 1M --roulette low_throughput --write-scene\` (the"
+  echo "kitchen's roulette). Where paths end: the share that left the scene, met an emitter that does not"
+  echo "reflect, reached the bounce limit, ended by roulette, or otherwise (absorbed, cut short)."
+  echo
+  echo "| scene | M samples/s | rays a sample | loop iterations a path | a ray | ns an iteration | left | at a null emitter | at the limit | roulette | otherwise |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|"
+  "$bin" bench room --triangles 1M --frames 1 --roulette low_throughput --write-scene "$work/room.retile" >/dev/null 2>&1
+  for scene in "$shared/scenes/kitchen/scene.json" "$work/room.retile"; do
+    [ -f "$scene" ] || continue
+    "$bin" bench throughput "$scene" --size 320x180 --frames 4 --max-bounces 15 2>/dev/null | awk -v name="$(basename "$(dirname "$scene")")" '
+      $1 == "scene" && $2 != "upload" { tris = $3; sub(/^\(/, "", tris) }
+      $1 == "samples/s" { rate = $2 }
+      $1 == "rays/sample" { rays = $2 }
+      $1 == "paths" { perPath = $2; perRay = $11; ns = $14 }
+      $1 == "path" && $2 == "ends" { left = $3; emitter = $8; limit = $17; roulette = $23; other = $27 }
+      END {
+        if (name == "kitchen") label = "kitchen"; else label = "synthetic room (" tris " triangles)"
+        printf "| %s | %s | %s | %s | %s | %s | %s %% | %s %% | %s %% | %s %% | %s %% |\n", label, rate, rays, perPath, perRay, ns, left, emitter, limit, roulette, other
+      }'
+  done
   if [ -n "$ci_log" ]; then
     echo
     echo "## CI by stage"
