@@ -15,6 +15,10 @@
 # separated a 5 % difference the sequential rounds could not (their per-round ratios spread
 # 0.8 to 1.2). It needs two cores and taskset.
 #
+# Each round also prints both binaries' loop iterations per path: they do not depend on the
+# machine's moment, so a ratio that moves with them is a change in work, and one that moves
+# without them a change in the cost of each step (or noise).
+#
 # usage: scripts/ab-throughput.sh [--side-by-side] BIN_A BIN_B ROUNDS SCENE [retile bench throughput options]
 # e.g.   scripts/ab-throughput.sh /tmp/retile-before build/bin/retile 8 \
 #          ../shared/scenes/spaceship/scene.json --size 320x180 --frames 16
@@ -25,7 +29,7 @@ if [ "${1:-}" = --side-by-side ]; then
   shift
 fi
 if [ $# -lt 4 ]; then
-  sed -n 2,20p "$0" | sed 's/^# \{0,1\}//'
+  sed -n 2,24p "$0" | sed 's/^# \{0,1\}//'
   exit 2
 fi
 a="$1" b="$2" rounds="$3"
@@ -47,7 +51,7 @@ measure() {
 
 if ((side)); then
   command -v taskset >/dev/null || { echo "error: --side-by-side needs taskset (util-linux)" >&2; exit 2; }
-  printf '%5s %6s %10s %10s %8s\n' round "A core" "A M/s" "B M/s" "B/A"
+  printf '%5s %6s %10s %10s %8s   %s\n' round "A core" "A M/s" "B M/s" "B/A" "loop iterations per path (A, B)"
   results=""
   for ((i = 1; i <= rounds; i++)); do
     ca=$(((i + 1) % 2)) cb=$((i % 2))
@@ -57,10 +61,10 @@ if ((side)); then
     LP_NUM_THREADS=1 taskset -c "$cb" bash -c "$(declare -f measure); measure \"\$@\"" _ "$b" "$@" >"$outb" &
     pb=$!
     wait "$pa" && wait "$pb" || { rm -f "$outa" "$outb"; exit 1; }
-    read -r ra _ <"$outa"
-    read -r rb _ <"$outb"
+    read -r ra ia <"$outa"
+    read -r rb ib <"$outb"
     rm -f "$outa" "$outb"
-    printf '%5d %6d %10s %10s %8.4f\n' "$i" "$ca" "$ra" "$rb" "$(awk -v x="$ra" -v y="$rb" 'BEGIN {print y / x}')"
+    printf '%5d %6d %10s %10s %8.4f   %s, %s\n' "$i" "$ca" "$ra" "$rb" "$(awk -v x="$ra" -v y="$rb" 'BEGIN {print y / x}')" "$ia" "$ib"
     results+="$ra $rb"$'\n'
   done
   echo "$results" | awk 'NF == 2 {r[++n] = $2 / $1}
