@@ -10,7 +10,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path sourceRoot() { return fs::path(RETILE_TEST_DATA_DIR).parent_path().parent_path(); }
+fs::path sourceRoot() { return fs::path(RETILE_SOURCE_DIR); }
 
 struct Include {
   std::string where;  // file:line

@@ -9,9 +9,7 @@
 namespace retile {
 namespace {
 
-std::filesystem::path scripts() {
-  return std::filesystem::path(RETILE_TEST_DATA_DIR).parent_path().parent_path() / "resources" / "scripts";
-}
+std::filesystem::path scripts() { return std::filesystem::path(RETILE_SOURCE_DIR) / "resources" / "scripts"; }
 
 TEST(Scenario, ShippedScriptsPlayOnTheDefaultScene) {
   int found = 0;
