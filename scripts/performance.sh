@@ -104,7 +104,11 @@ pathCost() {
   echo "| scene | M samples/s | rays a sample | loop iterations a path | a ray | ns an iteration | left | at a null emitter | at the limit | roulette | otherwise |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|"
   "$bin" bench room --triangles 1M --frames 1 --roulette low_throughput --write-scene "$work/room.retile" >/dev/null 2>&1
-  sed 's/"type": "dielectric"/"type": "lambert"/' "$here/scenes/glass-ice/scene.json" >"$work/glass-ice-lambert.json"
+  sed -E 's/"type"[[:space:]]*:[[:space:]]*"dielectric"/"type": "lambert"/' "$here/scenes/glass-ice/scene.json" >"$work/glass-ice-lambert.json"
+  if grep -q '"dielectric"' "$work/glass-ice-lambert.json"; then
+    echo "error: the lambert twin of scenes/glass-ice/scene.json still has a dielectric" >&2
+    exit 1
+  fi
   pathCost kitchen "$shared/scenes/kitchen/scene.json" --max-bounces 15
   pathCost "synthetic room" "$work/room.retile" --max-bounces 15
   pathCost "glass and ice" "$here/scenes/glass-ice/scene.json"

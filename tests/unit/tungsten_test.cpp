@@ -5,12 +5,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
 
 #include "retile/io.h"
 #include "retile/log.h"
+#include "render/bvh.h"
 #include "test_support.h"
 
 namespace retile {
@@ -1409,20 +1411,11 @@ TEST(Tungsten, PowerBecomesRadianceByArea) {
 // How many times the ray from p along d crosses `o`'s triangles, in the world.
 int crossings(const Scene& s, const Object& o, Vec3 p, Vec3 d) {
   const MeshGeometry& g = *s.mesh(o.mesh)->geometry;
+  const auto world = [&](std::size_t i) { return o.transform.transformPoint(g.positions[g.indices[i]]); };
   int n = 0;
-  for (std::size_t t = 0; t < g.indices.size(); t += 3) {
-    Vec3 a = o.transform.transformPoint(g.positions[g.indices[t]]);
-    Vec3 e1 = o.transform.transformPoint(g.positions[g.indices[t + 1]]) - a;
-    Vec3 e2 = o.transform.transformPoint(g.positions[g.indices[t + 2]]) - a;
-    Vec3 q = cross(d, e2);
-    float det = dot(e1, q);
-    if (std::abs(det) < 1e-12f) continue;
-    Vec3 f = p - a;
-    float u = dot(f, q) / det;
-    Vec3 r = cross(f, e1);
-    float v = dot(d, r) / det;
-    n += u >= 0.0f && v >= 0.0f && u + v <= 1.0f && dot(e2, r) / det > 0.0f;
-  }
+  float t, u, v;
+  for (std::size_t i = 0; i < g.indices.size(); i += 3)
+    n += intersectTriangle(p, d, world(i), world(i + 1), world(i + 2), std::numeric_limits<float>::infinity(), &t, &u, &v);
   return n;
 }
 
