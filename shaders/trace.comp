@@ -952,14 +952,32 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   return survivesRoulette(path, shadow);
 }
 
+// How many slots the invocation `i` owns: i, i + invocations, ... below the dispatch's count.
+uint ownSlots(uint i) { return i < push.invocations && i < push.slotCount ? (push.slotCount - i + push.invocations - 1u) / push.invocations : 0u; }
+
 void main() {
   frame = frameBuffer;  // see scene.glsl
   uint invocation = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * uint(kTraceWorkgroup) + gl_LocalInvocationID.x;
-  // This invocation's slots are invocation, invocation + invocations, ...: neighbouring lanes
-  // start on neighbouring slots, a pixel's samples or neighbouring pixels. Invocations past the
-  // end take part in the loop with no slots, so that every lane of the eight sees every iteration
-  // and loopIterations stays exact.
-  uint next = invocation < push.invocations ? invocation : push.slotCount;
+  // Invocation i is given slots i, i + invocations, ...: neighbouring lanes start on neighbouring
+  // slots, a pixel's samples or neighbouring pixels. The lanes of a subgroup (lavapipe's eight in
+  // lock-step) share theirs: the subgroup's m-th path is the (m / lanes)-th slot of its lane
+  // m % lanes, started by whichever lane is free first. Kept each to its own slots, a lane that
+  // drew short paths idled at the end until the one with the longest was through (a tenth of the
+  // traversal loop's lane steps in the living room, 7 % in the kitchen). Which lane traces a
+  // slot changes nothing in its sample. Sharing needs the subgroup's invocations consecutive, as
+  // in one-dimensional workgroups on lavapipe and the GPUs we know; elsewhere each lane keeps to
+  // its own. Lanes past the last invocation have no slots of their own but take part, in the
+  // loop and in the sharing, so that every lane of the eight sees every iteration and
+  // loopIterations stays exact.
+  const uint lane = gl_SubgroupInvocationID;
+  const bool sharedSlots = subgroupAll(invocation - lane == subgroupBroadcastFirst(invocation - lane)) &&
+                           subgroupMax(invocation) - subgroupMin(invocation) == gl_SubgroupSize - 1u;
+  const uint firstLane = sharedSlots ? invocation - lane : invocation;
+  // Lanes of the subgroup with slots of their own (none past the last invocation).
+  const uint slotLanes = firstLane < push.invocations ? min(sharedSlots ? gl_SubgroupSize : 1u, push.invocations - firstLane) : 0u;
+  // Paths the subgroup (or, not shared, the lane) has taken from its slots so far: the same in
+  // every lane when shared.
+  uint taken = 0u;
   // Until its first path starts, a lane's slot is the spare one past the frame's last (it writes none).
   Path path;
   path.slot = frame.work.y;
@@ -1014,7 +1032,11 @@ void main() {
         cutPaths++;
         writeSample(path, true);
       }
-      if (next < push.slotCount) cutPaths += (push.slotCount - next + push.invocations - 1u) / push.invocations;
+      // The slots not started: each lane counts its own, less those taken (all counted once,
+      // in the first lane, when shared).
+      uint own = lane < slotLanes || !sharedSlots ? ownSlots(firstLane + (sharedSlots ? lane : 0u)) : 0u;
+      uint all = sharedSlots ? subgroupAdd(own) : own;
+      if (!sharedSlots || subgroupElect()) cutPaths += all - min(taken, all);
       break;
     }
     // The lanes whose rays are done take their hits, shade, and set off their next rays; the
@@ -1041,12 +1063,21 @@ void main() {
     // it was to keep lavapipe's per-lane store branches predictable, the four stores, each a loop
     // over the lanes and over the components, took a tenth of the time.)
     if (ended) writeSample(path, true);
-    bool starts = ready && !alive && next < push.slotCount;
+    bool wants = ready && !alive;
+    uint m = taken;
+    if (sharedSlots) {
+      uvec4 asking = subgroupBallot(wants);
+      m += subgroupBallotExclusiveBitCount(asking);
+      taken += subgroupBallotBitCount(asking);
+    } else if (wants) {
+      taken++;
+    }
+    uint slot = slotLanes == 0u ? push.slotCount : firstLane + m % slotLanes + (m / slotLanes) * push.invocations;
+    bool starts = wants && slot < push.slotCount;
     // Every lane searches, outside any branch, so that every lane counts the search's iterations.
-    int found = findItem(push.slotOffset + (starts ? next : 0u));
+    int found = findItem(push.slotOffset + (starts ? slot : 0u));
     if (starts) {
-      path = startPath(push.slotOffset + next, found);
-      next += push.invocations;
+      path = startPath(push.slotOffset + slot, found);
       alive = true;
     }
     if (ready)
@@ -1122,7 +1153,8 @@ void main() {
   atomicAdd(rayCounts[1], bounceRays);
   atomicAdd(rayCounts[2], shadowRays);
   atomicMax(rayCounts[3], loopIterations);
-  if (invocation < push.invocations) atomicAdd(rayCounts[5], (loopIterations + kLoopIterationUnit / 2u) / kLoopIterationUnit);
+  // Every lane of a subgroup with slots counts: those past the last invocation trace its paths too.
+  if (slotLanes > 0u) atomicAdd(rayCounts[5], (loopIterations + kLoopIterationUnit / 2u) / kLoopIterationUnit);
   if (cutPaths > 0u) atomicAdd(rayCounts[4], cutPaths);
   atomicMax(rayCounts[6], maxSegment);
   atomicAdd(rayCounts[kStatsPathEnds], pathsLeft);

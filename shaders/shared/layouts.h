@@ -288,7 +288,7 @@ RT_CONST(int, kInstancesPerSetWord, 16)
 struct TracePush {
   uint slotOffset;   // first slot of this dispatch (dispatches are split by size)
   uint slotCount;    // slots in this dispatch
-  uint invocations;  // invocations launched; each traces slots i, i + invocations, ...
+  uint invocations;  // invocations launched; invocation i is given slots i, i + invocations, ... (trace.comp shares them among a subgroup's lanes)
   uint pad0;
 };
 

@@ -801,8 +801,9 @@ TracedComparison compareTraced(const RenderImage& reference, const RenderImage& 
 }
 
 // lavapipe silently ends the loops of eight lock-stepped invocations after 65535 iterations.
-// One invocation given every path of the frame must stop itself first: the paths it finished are
-// exactly right, the rest are weighted 0, and it says how many it cut.
+// One invocation given every path of the frame (which the eight lanes of its subgroup share,
+// trace.comp) must stop itself first: the paths finished are exactly right, the rest are weighted
+// 0, and it says how many it cut.
 TEST(TracePass, AnInvocationOutOfLoopBudgetStopsCleanly) {
   RETILE_RENDERER_OR_SKIP(r);
   const int w = 192, h = 108, n = w * h;
@@ -819,11 +820,13 @@ TEST(TracePass, AnInvocationOutOfLoopBudgetStopsCleanly) {
   auto [traced, untraced, differing] = compareTraced(a, b);
   EXPECT_GT(traced, 100);
   EXPECT_GT(untraced, 0);
-  // Cut: the slots never started, and the path in flight (if any) when the budget ran out, which
-  // ends as it stands. Every other path is exact.
+  // Cut: the slots never started, and the paths in flight when the budget ran out, one a lane of
+  // the eight that share the slots (more than one: they do share), which end as they stand. Those
+  // differ, and so may a lane's ended path whose last shadow ray was still to trace (see the next
+  // test). Every other path is exact.
   auto inFlight = static_cast<int>(all.cutPaths) - untraced;
-  EXPECT_TRUE(inFlight == 0 || inFlight == 1) << all.cutPaths << " cut, " << untraced << " untraced";
-  EXPECT_LE(differing, inFlight);
+  EXPECT_TRUE(inFlight > 1 && inFlight <= 8) << all.cutPaths << " cut, " << untraced << " untraced";
+  EXPECT_LE(differing, inFlight + 8);
 }
 
 // The same with eight lanes in lock-step, each with many paths, over 1344 tiles: only the lanes
