@@ -54,6 +54,7 @@ std::string commandPath(const CLI::App& app) {
 
 int main(int argc, char** argv) {
   // Before any thread starts: Qt's Vulkan window creates its own lavapipe device in this thread.
+  retile::preferWideCpuVectors();
   retile::flushDenormals();
   std::vector<std::string> args(argv + 1, argv + argc);
   if (const char* v = std::getenv("RETILE_LOG"); v && std::strcmp(v, "debug") == 0) retile::setLogLevel(retile::LogLevel::Debug);

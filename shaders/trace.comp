@@ -21,11 +21,11 @@ layout(set = 0, binding = kBindTraceAux, std430) writeonly buffer Aux { vec4 aux
 // loop iterations of all invocations, in kLoopIterationUnit; the most of one path segment.
 layout(set = 0, binding = kBindTraceStats, std430) buffer Stats { uint rayCounts[kStatsCount]; };
 
-// kLoopBudget (layouts.h): paths stop before the eight lock-stepped invocations could reach
+// kLoopBudget (layouts.h): paths stop before a subgroup's lock-stepped invocations could reach
 // lavapipe's loop limit (see scene.glsl). That limit is 65535 of lavapipe's own counts, and it
 // counts each of our iterations twice (measured: an invocation given 20736 paths was stopped by
-// lavapipe when loopIterations read 32659). One more segment of the eight paths, with their
-// shadow rays, cost at most 465 of our iterations in the scenes measured (the living room;
+// lavapipe when loopIterations read 32659). One more segment of a subgroup's paths, with their
+// shadow rays, cost at most 465 of our iterations in the scenes measured (the living room, eight lanes;
 // `retile bench throughput` prints it); should a scene's segments be longer, the paths stop
 // earlier, when twice the longest segment so far would pass kLoopLimit.
 
@@ -959,15 +959,15 @@ void main() {
   frame = frameBuffer;  // see scene.glsl
   uint invocation = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * uint(kTraceWorkgroup) + gl_LocalInvocationID.x;
   // Invocation i is given slots i, i + invocations, ...: neighbouring lanes start on neighbouring
-  // slots, a pixel's samples or neighbouring pixels. The lanes of a subgroup (lavapipe's eight in
-  // lock-step) share theirs: the subgroup's m-th path is the (m / lanes)-th slot of its lane
+  // slots, a pixel's samples or neighbouring pixels. The lanes of a subgroup (lavapipe's eight or
+  // sixteen in lock-step) share theirs: the subgroup's m-th path is the (m / lanes)-th slot of its lane
   // m % lanes, started by whichever lane is free first. Kept each to its own slots, a lane that
   // drew short paths idled at the end until the one with the longest was through (a tenth of the
   // traversal loop's lane steps in the living room, 7 % in the kitchen). Which lane traces a
   // slot changes nothing in its sample. Sharing needs the subgroup's invocations consecutive, as
   // in one-dimensional workgroups on lavapipe and the GPUs we know; elsewhere each lane keeps to
   // its own. Lanes past the last invocation have no slots of their own but take part, in the
-  // loop and in the sharing, so that every lane of the eight sees every iteration and
+  // loop and in the sharing, so that every lane of the subgroup sees every iteration and
   // loopIterations stays exact.
   const uint lane = gl_SubgroupInvocationID;
   const bool sharedSlots = subgroupAll(invocation - lane == subgroupBroadcastFirst(invocation - lane)) &&
@@ -1020,7 +1020,7 @@ void main() {
   const uint readyLanes = uint(gl_SubgroupSize) * uint(kTraceReadyLanes) / 8u;
   uint cutPaths = 0u;
   uint maxSegment = 0u;
-  // Every lane's count is the eight's here: the last synchronisation of an iteration (after the
+  // Every lane's count is the subgroup's here: the last synchronisation of an iteration (after the
   // traversal) is also the first of the next.
   for (;;) {
     loopIterations++;
@@ -1089,7 +1089,7 @@ void main() {
     if (idleLanes == gl_SubgroupSize) break;
     uint busyAtExit = idleLanes + readyLanes >= gl_SubgroupSize ? 0u : gl_SubgroupSize - readyLanes - idleLanes;
     uint segmentStart = loopIterations;
-    // Trace until enough of the eight are done (kTraceReadyLanes of every eight): lavapipe runs a
+    // Trace until enough of the lanes are done (kTraceReadyLanes of every eight): lavapipe runs a
     // loop as long as its slowest lane, and waiting for all eight left a lane idle more than half
     // the time. The lanes that are done leave with their hits for the shading code above and come
     // back with new rays; the others go on where they stopped. Lanes given nothing (Trace::idle)

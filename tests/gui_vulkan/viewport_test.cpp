@@ -13,6 +13,7 @@
 
 #include <cmath>
 
+#include "core/process.h"
 #include "editor_support.h"
 #include "main_window.h"
 #include "vulkan_viewport.h"
@@ -129,6 +130,7 @@ TEST(VulkanViewport, AFailedPresentationFallsBackToTheWidget) {
 }  // namespace retile::ui
 
 int main(int argc, char** argv) {
+  retile::preferWideCpuVectors();  // as the editor does, before Qt's Vulkan instance
   qputenv("RETILE_NO_PROMPTS", "1");
   QTemporaryDir recovery;
   qputenv("RETILE_RECOVERY_DIR", recovery.path().toUtf8());

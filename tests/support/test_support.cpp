@@ -1,5 +1,7 @@
 #include "test_support.h"
 
+#include "core/process.h"
+
 #include <atomic>
 #include <cstdio>
 #include <mutex>
@@ -13,6 +15,12 @@
 namespace fs = std::filesystem;
 
 namespace retile::test {
+
+namespace {
+// Every suite drives lavapipe as retile does (core/process.h). Before main, while the process
+// has one thread, as setenv needs.
+[[maybe_unused]] const bool kWideCpuVectors = (preferWideCpuVectors(), true);
+}  // namespace
 
 fs::path sharedDir() {
   if (const char* env = std::getenv("RETILE_SHARED"); env && *env) return env;

@@ -160,6 +160,7 @@ class Renderer {
 
   std::string deviceName() const;
   bool cpuDevice() const;
+  std::uint32_t subgroupSize() const;  // invocations the device runs in lock-step
 
   // Uploads the whole scene. Returns warnings (missing textures and their substitutes).
   std::vector<std::string> setScene(const Scene& scene);

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 
 #if defined(__SSE__)
@@ -35,6 +36,16 @@ constexpr unsigned kFlushToZero = 0x8000, kDenormalsAreZero = 0x0040;
 void flushDenormals() {
 #if defined(__SSE__)
   _mm_setcsr(_mm_getcsr() | kFlushToZero | kDenormalsAreZero);
+#endif
+}
+
+void preferWideCpuVectors() {
+  if (std::getenv("LP_NATIVE_VECTOR_WIDTH")) return;
+#if defined(__x86_64__)
+  // The subsets LLVM's 512-bit code generation uses beyond the foundation.
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw") &&
+      __builtin_cpu_supports("avx512dq"))
+    setenv("LP_NATIVE_VECTOR_WIDTH", "512", 0);
 #endif
 }
 

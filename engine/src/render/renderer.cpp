@@ -745,6 +745,7 @@ Renderer::~Renderer() = default;
 
 std::string Renderer::deviceName() const { return impl_->ctx.deviceName(); }
 bool Renderer::cpuDevice() const { return impl_->ctx.isCpuDevice(); }
+std::uint32_t Renderer::subgroupSize() const { return impl_->ctx.subgroupSize(); }
 
 std::vector<std::string> Renderer::setScene(const Scene& scene) {
   impl_->builder = RenderSceneBuilder{};

@@ -96,6 +96,7 @@ class Device {
   VkQueue queue_ = VK_NULL_HANDLE;
   std::uint32_t queueFamily_ = 0;
   VkPhysicalDeviceProperties props_{};
+  std::uint32_t subgroupSize_ = 1;
   VkPhysicalDeviceMemoryProperties memProps_{};
   std::string name_;
 
@@ -210,6 +211,11 @@ Device::Device(const DeviceChoice& choice) {
   props_ = chosen->props;
   queueFamily_ = chosen->family;
   name_ = props_.deviceName;
+  VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  props2.pNext = &subgroup;
+  vkGetPhysicalDeviceProperties2(physical_, &props2);
+  subgroupSize_ = std::max(subgroup.subgroupSize, 1u);
   vkGetPhysicalDeviceMemoryProperties(physical_, &memProps_);
 
   float priority = 1.0f;
@@ -275,6 +281,7 @@ VkDevice Context::device() const { return shared_->device_; }
 std::uint32_t Context::queueFamily() const { return shared_->queueFamily_; }
 const VkPhysicalDeviceProperties& Context::properties() const { return shared_->props_; }
 const std::string& Context::deviceName() const { return shared_->name_; }
+std::uint32_t Context::subgroupSize() const { return shared_->subgroupSize_; }
 
 const Context::Program& Context::program(const std::string& key, const std::function<Program()>& make) {
   std::lock_guard<std::mutex> guard(shared_->programsLock);

@@ -39,6 +39,8 @@ class Context {
   std::uint32_t queueFamily() const;
   const VkPhysicalDeviceProperties& properties() const;
   const std::string& deviceName() const;
+  // Invocations in lock-step: lavapipe's are 8 or, with 512-bit vectors, 16 (core/process.h).
+  std::uint32_t subgroupSize() const;
   bool isCpuDevice() const { return properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
 
   // Memory type for `bits` with `wanted` flags; falls back to any type in `bits` with
