@@ -1017,7 +1017,7 @@ void main() {
   // The last slot takes the spill of a full stack.
   // It is main's own: as a global, the same array cost 8 % of the spaceship's samples/s.
   int stackBelow[kStackSize];
-  const uint readyLanes = uint(gl_SubgroupSize) * uint(kTraceReadyLanes) / 8u;
+  const uint readyLanes = uint(gl_SubgroupSize) * uint(kTraceReadyLanes) / 16u;
   uint cutPaths = 0u;
   uint maxSegment = 0u;
   // Every lane's count is the subgroup's here: the last synchronisation of an iteration (after the
@@ -1089,7 +1089,7 @@ void main() {
     if (idleLanes == gl_SubgroupSize) break;
     uint busyAtExit = idleLanes + readyLanes >= gl_SubgroupSize ? 0u : gl_SubgroupSize - readyLanes - idleLanes;
     uint segmentStart = loopIterations;
-    // Trace until enough of the lanes are done (kTraceReadyLanes of every eight): lavapipe runs a
+    // Trace until enough of the lanes are done (kTraceReadyLanes of every sixteen): lavapipe runs a
     // loop as long as its slowest lane, and waiting for all eight left a lane idle more than half
     // the time. The lanes that are done leave with their hits for the shading code above and come
     // back with new rays; the others go on where they stopped. Lanes given nothing (Trace::idle)
