@@ -57,10 +57,16 @@ pathCost() {
     }'
 }
 
+# The device as retile sets it up (its vector width is retile's choice: core/process.h), not as
+# another Vulkan program sees it.
+device() {
+  "$bin" render default --size 8x8 --spp 1 --out "$work/device.png" 2>&1 | sed -n 's/^device: //p' | grep . || echo 'the Vulkan device found'
+}
+
 {
   echo "# Performance"
   echo
-  echo "Today's figures, written by \`scripts/performance.sh\` on $(nproc) cores with $(vulkaninfo --summary 2>/dev/null | grep -m1 deviceName | sed 's/.*= //' || echo 'the Vulkan device found')."
+  echo "Today's figures, written by \`scripts/performance.sh\` on $(nproc) cores with $(device)."
   echo "Regenerate them rather than editing this page."
   echo
   echo "## Throughput against Tungsten"
