@@ -38,9 +38,9 @@ layout(push_constant) uniform Push { TracePush push; };
 // The pixel filter's table (frame.filterWarp's 36 values) in a texel buffer: each lane reads its
 // own slot, and a storage buffer read at a different index in each lane is a loop over the eight
 // lanes on lavapipe (the table's 16 such reads a segment cost the spaceship 10 %).
-layout(set = 0, binding = kBindTraceFilterWarp) uniform samplerBuffer uFilterWarp;
+layout(set = 0, binding = kBindTraceFilterWarp, r32f) uniform readonly imageBuffer uFilterWarp;
 
-float warpSlot(int i) { return texelFetch(uFilterWarp, i).x; }
+float warpSlot(int i) { return imageLoad(uFilterWarp, i).x; }
 
 // The stepped table's CDF (FilterSampling::SteppedTable) at step i = 0..30: slot i - 1 holds it, step 0's is 0.
 float steppedCdf(int i) { return i <= 0 ? 0.0 : warpSlot(i - 1); }
@@ -131,7 +131,7 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
   if (hasFeature(kFeatureBlend)) {
     float u = blendRandom;
     for (int k = 1; k < kMaxBlendChain; ++k) {
-      int partner = floatBitsToInt(texelFetch(uMaterials, shaded * kMaterialTexels + 5).w);
+      int partner = floatBitsToInt(imageLoad(uMaterials, shaded * kMaterialTexels + 5).w);
       if (partner < 0) break;
       float ratio = RT_MATERIAL_SCALAR(shaded, blendRatio);
       if (hasFeature(kFeatureTextures)) {
@@ -145,15 +145,15 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
     }
   }
   int base = shaded * kMaterialTexels;
-  vec4 t2 = texelFetch(uMaterials, base + 2), t3 = texelFetch(uMaterials, base + 3);
+  vec4 t2 = imageLoad(uMaterials, base + 2), t3 = imageLoad(uMaterials, base + 3);
   // The coating's absorption (a plastic's, a thin sheet's, a hair's pigment) is read only when
   // the scene has one of them.
   const bool plastics = (kMaterialMask & ((1 << kMatPlastic) | (1 << kMatRoughPlastic) | (1 << kMatThinSheet) | (1 << kMatHair))) != 0;
-  Material m = unpackMaterial(texelFetch(uMaterials, base), texelFetch(uMaterials, base + 1), t2, t3,
-                              texelFetch(uMaterials, base + 4), plastics ? texelFetch(uMaterials, base + 6) : vec4(0.0),
-                              kCoatUsed ? texelFetch(uMaterials, base + 7) : vec4(0.0),
-                              kCoatUsed || kMediumUsed ? texelFetch(uMaterials, base + 8) : vec4(0.0));
-  if (kScatteringUsed) m.scattering = texelFetch(uMaterials, base + 9);
+  Material m = unpackMaterial(imageLoad(uMaterials, base), imageLoad(uMaterials, base + 1), t2, t3,
+                              imageLoad(uMaterials, base + 4), plastics ? imageLoad(uMaterials, base + 6) : vec4(0.0),
+                              kCoatUsed ? imageLoad(uMaterials, base + 7) : vec4(0.0),
+                              kCoatUsed || kMediumUsed ? imageLoad(uMaterials, base + 8) : vec4(0.0));
+  if (kScatteringUsed) m.scattering = imageLoad(uMaterials, base + 9);
   // The albedo and roughness textures' slots lie in t2 and t3, fetched above for eta and k
   // (render_materials.cpp asserts it): no second fetch.
   int albedoTex = floatBitsToInt(t2[kMaterialSlot_albedoTexture % 4]), roughTex = floatBitsToInt(t3[kMaterialSlot_roughnessTexture % 4]);
@@ -170,7 +170,7 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
       m.roughness = max(m.roughness * scale, 1e-3);
     }
   }
-  if (hasFeature(kFeatureBlend)) m.emission = texelFetch(uMaterials, index * kMaterialTexels + 4).rgb;
+  if (hasFeature(kFeatureBlend)) m.emission = imageLoad(uMaterials, index * kMaterialTexels + 4).rgb;
   if (hasFeature(kFeatureEmissionTextures)) {
     int emissionTex = RT_MATERIAL_TEXTURE(index, emissionTexture);
     if (emissionTex >= 0) m.emission *= sampleTexture(emissionTex, uv).rgb;
@@ -413,16 +413,16 @@ bool sheetPasses(inout Trace tr) {
   int ibase = tr.pendingInstance * kInstanceTexels;
   int prim = tr.pendingPrim;
   float u = tr.pendingU, v = tr.pendingV, w = 1.0 - u - v;
-  int material = floatBitsToInt(texelFetch(uInstances, ibase + 3).z);
-  vec4 s0 = texelFetch(uTriShade, prim * kTriShadeTexels), s1 = texelFetch(uTriShade, prim * kTriShadeTexels + 1);
-  vec4 s2 = texelFetch(uTriShade, prim * kTriShadeTexels + 2), s3 = texelFetch(uTriShade, prim * kTriShadeTexels + 3);
+  int material = floatBitsToInt(imageLoad(uInstances, ibase + 3).z);
+  vec4 s0 = imageLoad(uTriShade, prim * kTriShadeTexels), s1 = imageLoad(uTriShade, prim * kTriShadeTexels + 1);
+  vec4 s2 = imageLoad(uTriShade, prim * kTriShadeTexels + 2), s3 = imageLoad(uTriShade, prim * kTriShadeTexels + 3);
   vec2 uv = w * vec2(s0.w, s1.w) + u * vec2(s2.w, s3.x) + v * s3.yz;
   // A number of each sheet's own for a blend's choice, as a path draws one at each hit: one for
   // every sheet along the ray would make the same choice at each.
   Material m = fetchMaterial(material, uv, hitRandom(tr.rayRandom, prim, 2246822519u));
   if (!isMat(m.type, kMatThinSheet)) return false;
   // The normal as shadeSegment shades with: interpolated, bumped.
-  vec4 r0 = texelFetch(uInstances, ibase), r1 = texelFetch(uInstances, ibase + 1), r2 = texelFetch(uInstances, ibase + 2);
+  vec4 r0 = imageLoad(uInstances, ibase), r1 = imageLoad(uInstances, ibase + 1), r2 = imageLoad(uInstances, ibase + 2);
   vec3 e1 = imageLoad(uTraversal, prim * kTriTexels + 1).xyz, e2 = imageLoad(uTraversal, prim * kTriTexels + 2).xyz;
   vec3 nObj = cross(e1, e2);
   vec3 ng = normalize(r0.xyz * nObj.x + r1.xyz * nObj.y + r2.xyz * nObj.z), ns = ng;
@@ -753,12 +753,12 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   // Without instance transforms every instance's rows are the identity's: three reads fewer.
   vec4 r0 = vec4(1.0, 0.0, 0.0, 0.0), r1 = vec4(0.0, 1.0, 0.0, 0.0), r2 = vec4(0.0, 0.0, 1.0, 0.0);
   if (hasFeature(kFeatureInstanceTransforms)) {
-    r0 = texelFetch(uInstances, ibase);
-    r1 = texelFetch(uInstances, ibase + 1);
-    r2 = texelFetch(uInstances, ibase + 2);
+    r0 = imageLoad(uInstances, ibase);
+    r1 = imageLoad(uInstances, ibase + 1);
+    r2 = imageLoad(uInstances, ibase + 2);
   }
-  vec4 info = texelFetch(uInstances, ibase + 3);
-  vec4 info2 = texelFetch(uInstances, ibase + 4);
+  vec4 info = imageLoad(uInstances, ibase + 3);
+  vec4 info2 = imageLoad(uInstances, ibase + 4);
   int instFlags = floatBitsToInt(info2.y);
   vec3 pos = ro + hit.t * rd;
 
@@ -767,10 +767,10 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   vec3 e2 = imageLoad(uTraversal, hit.prim * kTriTexels + 2).xyz;
   vec3 ngObj = cross(e1, e2);
   vec3 ng = normalize(r0.xyz * ngObj.x + r1.xyz * ngObj.y + r2.xyz * ngObj.z);
-  vec4 s0 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 0);
-  vec4 s1 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 1);
-  vec4 s2 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 2);
-  vec4 s3 = texelFetch(uTriShade, hit.prim * kTriShadeTexels + 3);
+  vec4 s0 = imageLoad(uTriShade, hit.prim * kTriShadeTexels + 0);
+  vec4 s1 = imageLoad(uTriShade, hit.prim * kTriShadeTexels + 1);
+  vec4 s2 = imageLoad(uTriShade, hit.prim * kTriShadeTexels + 2);
+  vec4 s3 = imageLoad(uTriShade, hit.prim * kTriShadeTexels + 3);
   float bw = 1.0 - hit.u - hit.v;
   vec2 uv = bw * vec2(s0.w, s1.w) + hit.u * vec2(s2.w, s3.x) + hit.v * s3.yz;
   vec3 ns = ng;
@@ -1117,7 +1117,7 @@ void main() {
       if (tr.alphaPending) {
 #if RETILE_SHEET
         // Paused on a cut-out, or (a shadow ray) on a thin sheet, or both.
-        int flags = floatBitsToInt(texelFetch(uInstances, tr.pendingInstance * kInstanceTexels + 4).y);
+        int flags = floatBitsToInt(imageLoad(uInstances, tr.pendingInstance * kInstanceTexels + 4).y);
         bool solid = (flags & kInstanceAlphaTested) == 0 || alphaPasses(tr.pendingInstance, tr.pendingPrim, tr.pendingU, tr.pendingV, tr.rayRandom);
         if (solid && tr.onShadow && (flags & kInstanceSheet) != 0) solid = !sheetPasses(tr);
 #else

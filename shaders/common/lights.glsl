@@ -58,12 +58,12 @@ float envPdf(vec3 d) {
   if (!hasFeature(kFeatureEnvMap) || type != kEnvMap) return 0.0;
   vec2 uv = directionToEnvUv(d);
   ivec2 t = envTexel(uv);
-  float norm = texelFetch(uEnvCdf, 0).x;
+  float norm = imageLoad(uEnvCdf, 0).x;
   float up = envToMap(d).y;
   float sinActual = sqrt(max(0.0, 1.0 - up * up));
   if (norm <= 0.0 || sinActual <= 1e-6) return 0.0;
   float sinRow = sin(PI * (float(t.y) + 0.5) / float(frame.environment.w));
-  vec4 info = texelFetch(uTexInfo, frame.environment.y * kTextureTexels);
+  vec4 info = imageLoad(uTexInfo, frame.environment.y * kTextureTexels);
   vec3 c = bitmapTexel(floatBitsToInt(info.x), t.y * frame.environment.z + t.x, floatBitsToInt(info.w)).rgb;
   return max(luminance(c), 0.0) * sinRow / (norm * 2.0 * PI * PI * sinActual);
 }
@@ -74,7 +74,7 @@ int searchCdf(int base, int n, float u) {
   while (hi - lo > 1) {
     loopIterations++;
     int mid = (lo + hi) >> 1;
-    if (texelFetch(uEnvCdf, base + mid).x <= u) lo = mid; else hi = mid;
+    if (imageLoad(uEnvCdf, base + mid).x <= u) lo = mid; else hi = mid;
   }
   syncLoopIterations();
   return lo;
@@ -90,11 +90,11 @@ vec3 sampleEnvironment(vec2 u, out vec3 radiance, out float pdf) {
   int w = frame.environment.z, h = frame.environment.w;
   int marginal = 1;
   int row = searchCdf(marginal, h, u.y);
-  float r0 = texelFetch(uEnvCdf, marginal + row).x, r1 = texelFetch(uEnvCdf, marginal + row + 1).x;
+  float r0 = imageLoad(uEnvCdf, marginal + row).x, r1 = imageLoad(uEnvCdf, marginal + row + 1).x;
   float fy = r1 > r0 ? (u.y - r0) / (r1 - r0) : 0.5;
   int condBase = 1 + (h + 1) + row * (w + 1);
   int col = searchCdf(condBase, w, u.x);
-  float c0 = texelFetch(uEnvCdf, condBase + col).x, c1 = texelFetch(uEnvCdf, condBase + col + 1).x;
+  float c0 = imageLoad(uEnvCdf, condBase + col).x, c1 = imageLoad(uEnvCdf, condBase + col + 1).x;
   float fx = c1 > c0 ? (u.x - c0) / (c1 - c0) : 0.5;
   vec2 uv = vec2((float(col) + clamp(fx, 0.0, 0.999)) / float(w), (float(row) + clamp(fy, 0.0, 0.999)) / float(h));
   vec3 d = envUvToDirection(uv);
@@ -184,18 +184,18 @@ LightSample sampleLight(vec3 p, vec3 u) {
       // What is left of u.z below pe is again uniform.
       int g = chooseLightGroup(p, u.z / pe, groupProbability);
       if (g < 0) return ls;
-      vec4 r = texelFetch(uEmitterAlias, frame.scene.z + g * kLightGroupTexels);
+      vec4 r = imageLoad(uEmitterAlias, frame.scene.z + g * kLightGroupTexels);
       first = floatBitsToInt(r.x);
       n = floatBitsToInt(r.y);
     }
     float scaled = u.x * float(n);
     int i = min(int(scaled), n - 1);
     float frac = scaled - float(i);
-    vec4 alias = texelFetch(uEmitterAlias, first + i);
+    vec4 alias = imageLoad(uEmitterAlias, first + i);
     int e = frac < alias.x ? first + i : floatBitsToInt(alias.y);
     int base = e * kEmitterTexels;
-    vec4 t0 = texelFetch(uEmitters, base), t1 = texelFetch(uEmitters, base + 1), t2 = texelFetch(uEmitters, base + 2);
-    vec4 t3 = texelFetch(uEmitters, base + 3), t4 = texelFetch(uEmitters, base + 4);
+    vec4 t0 = imageLoad(uEmitters, base), t1 = imageLoad(uEmitters, base + 1), t2 = imageLoad(uEmitters, base + 2);
+    vec4 t3 = imageLoad(uEmitters, base + 3), t4 = imageLoad(uEmitters, base + 4);
     // The fraction left over from the alias choice is again uniform: reuse it for the point.
     float reuse = frac < alias.x ? frac / max(alias.x, 1e-7) : (frac - alias.x) / max(1.0 - alias.x, 1e-7);
     vec2 b = sampleTriangle(vec2(clamp(reuse, 0.0, 0.9999999), u.y));
@@ -225,9 +225,9 @@ LightSample sampleLight(vec3 p, vec3 u) {
   if (!hasFeature(kFeatureDeltaLights) || n == 0) return ls;
   float scaled = u.x * float(n);
   int i = min(int(scaled), n - 1);
-  vec4 a = texelFetch(uDeltaLights, i * kDeltaLightTexels);
-  vec4 b = texelFetch(uDeltaLights, i * kDeltaLightTexels + 1);
-  vec4 c = texelFetch(uDeltaLights, i * kDeltaLightTexels + 2);
+  vec4 a = imageLoad(uDeltaLights, i * kDeltaLightTexels);
+  vec4 b = imageLoad(uDeltaLights, i * kDeltaLightTexels + 1);
+  vec4 c = imageLoad(uDeltaLights, i * kDeltaLightTexels + 2);
   int type = floatBitsToInt(a.w);
   ls.delta = true;
   ls.pdf = frame.lightPick.z / float(n);
@@ -269,8 +269,8 @@ vec3 sunsSeen(vec3 d, bool specular, float bsdfPdf) {
   int n = frame.scene.w;
   // Its iterations are counted in trace.comp's main, in every lane (see loopIterations).
   for (int i = 0; i < int(frame.lightPick.w); ++i) {
-    vec4 b = texelFetch(uDeltaLights, i * kDeltaLightTexels + 1);
-    vec4 c = texelFetch(uDeltaLights, i * kDeltaLightTexels + 2);
+    vec4 b = imageLoad(uDeltaLights, i * kDeltaLightTexels + 1);
+    vec4 c = imageLoad(uDeltaLights, i * kDeltaLightTexels + 2);
     bool inside = 1.0 + dot(d, b.xyz) <= b.w;
     float w = specular ? 1.0 : powerHeuristic(bsdfPdf, frame.lightPick.z / (float(n) * c.w));
     seen += inside ? c.rgb * w : vec3(0.0);
@@ -281,14 +281,14 @@ vec3 sunsSeen(vec3 d, bool specular, float bsdfPdf) {
 // pdf with which sampleLight would have chosen the emitter point hit by a BSDF ray; groupTotal
 // is lightGroupTotal of the light sample at `from` (below 0: not known).
 float emitterPdf(int emitter, vec3 from, vec3 hitPos, float cosL, float groupTotal) {
-  vec4 t0 = texelFetch(uEmitters, emitter * kEmitterTexels);
-  vec4 t3 = texelFetch(uEmitters, emitter * kEmitterTexels + 3);
+  vec4 t0 = imageLoad(uEmitters, emitter * kEmitterTexels);
+  vec4 t3 = imageLoad(uEmitters, emitter * kEmitterTexels + 3);
   vec3 d = hitPos - from;
   if (cosL <= 0.0 || t0.w <= 0.0) return 0.0;
   float pick = frame.lightPick.x * t3.w;
   if (hasFeature(kFeatureLightGroups)) {
     float total = groupTotal >= 0.0 ? groupTotal : lightGroupTotalAt(from);
-    pick *= total > 0.0 ? lightGroupWeight(floatBitsToInt(texelFetch(uEmitterAlias, emitter).z), from) / total : 0.0;
+    pick *= total > 0.0 ? lightGroupWeight(floatBitsToInt(imageLoad(uEmitterAlias, emitter).z), from) / total : 0.0;
   }
   return pick * dot(d, d) / (cosL * t0.w);
 }

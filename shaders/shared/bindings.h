@@ -11,20 +11,20 @@ RETILE_PASS(Trace, "trace.comp")
 RETILE_BINDING(Trace, Frame, 0, Storage)          // FrameUniforms
 RETILE_BINDING(Trace, Work, 1, Storage)           // WorkItem per item
 RETILE_BINDING(Trace, Traversal, 2, StorageTexel) // nodes, triangles, instance records (rgba32f)
-RETILE_BINDING(Trace, TriShade, 3, UniformTexel)  // kTriShadeTexels per triangle
-RETILE_BINDING(Trace, Instances, 4, UniformTexel) // kInstanceTexels per instance
-RETILE_BINDING(Trace, Materials, 5, UniformTexel) // kMaterialTexels per material
-RETILE_BINDING(Trace, TexInfo, 6, UniformTexel)   // kTextureTexels per texture
+RETILE_BINDING(Trace, TriShade, 3, StorageTexel)  // kTriShadeTexels per triangle
+RETILE_BINDING(Trace, Instances, 4, StorageTexel) // kInstanceTexels per instance
+RETILE_BINDING(Trace, Materials, 5, StorageTexel) // kMaterialTexels per material
+RETILE_BINDING(Trace, TexInfo, 6, StorageTexel)   // kTextureTexels per texture
 RETILE_BINDING(Trace, Texels, 7, StorageTexel)    // bitmaps' texels, pairs of words (rg32ui)
-RETILE_BINDING(Trace, Emitters, 8, UniformTexel)  // kEmitterTexels per emissive triangle
-RETILE_BINDING(Trace, Alias, 9, UniformTexel)     // the emitters' alias table, then light groups
-RETILE_BINDING(Trace, Delta, 10, UniformTexel)    // kDeltaLightTexels per light
-RETILE_BINDING(Trace, EnvCdf, 11, UniformTexel)   // the environment map's CDF
+RETILE_BINDING(Trace, Emitters, 8, StorageTexel)  // kEmitterTexels per emissive triangle
+RETILE_BINDING(Trace, Alias, 9, StorageTexel)     // the emitters' alias table, then light groups
+RETILE_BINDING(Trace, Delta, 10, StorageTexel)    // kDeltaLightTexels per light
+RETILE_BINDING(Trace, EnvCdf, 11, StorageTexel)   // the environment map's CDF
 RETILE_BINDING(Trace, Samples, 12, Storage)       // a vec4 per sample slot
 RETILE_BINDING(Trace, Aux, 13, Storage)           // kAuxVec4s per sample slot
 RETILE_BINDING(Trace, Stats, 14, Storage)         // kStatsCount counters
 RETILE_BINDING(Trace, Selection, 15, Storage)     // the selection's sets and counters
-RETILE_BINDING(Trace, FilterWarp, 16, UniformTexel)  // the pixel filter's table
+RETILE_BINDING(Trace, FilterWarp, 16, StorageTexel)  // the pixel filter's table
 
 RETILE_PASS(Accumulate, "accumulate.comp")
 RETILE_BINDING(Accumulate, Frame, 0, Uniform)     // FrameUniforms

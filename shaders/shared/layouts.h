@@ -40,7 +40,7 @@ RT_CONST(int, kMaterialTexels, 10)   // see render/render_scene.h packMaterial
 // A scalar field's value, and a texture field's index (-1: none), read from the texels of
 // material `material` (an index).
 #define RT_MATERIAL_SCALAR(material, member) \
-  texelFetch(uMaterials, (material) * kMaterialTexels + kMaterialSlot_##member / 4)[kMaterialSlot_##member % 4]
+  imageLoad(uMaterials, (material) * kMaterialTexels + kMaterialSlot_##member / 4)[kMaterialSlot_##member % 4]
 #define RT_MATERIAL_TEXTURE(material, member) floatBitsToInt(RT_MATERIAL_SCALAR(material, member))
 #endif
 RT_CONST(int, kMaxBlendChain, 4)    // retile::kMaxBlendChain (scene.h)

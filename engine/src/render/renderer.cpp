@@ -25,6 +25,9 @@ using vk::Buffer;
 namespace {
 
 constexpr VkBufferUsageFlags kTexelUsage = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+// What the trace kernel reads of the scene: storage texel buffers, read with imageLoad, which
+// lavapipe inlines (a texelFetch is a call, scene.glsl).
+constexpr VkBufferUsageFlags kSceneUsage = VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT;
 constexpr VkBufferUsageFlags kStorageUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
 
 std::uint32_t groupsFor(std::uint64_t invocations, std::uint32_t local, std::uint32_t* groupsY) {
@@ -140,7 +143,7 @@ struct Renderer::Impl {
     stats = Buffer(ctx, gpu::kStatsCount * sizeof(std::uint32_t), kStorageUsage, true, "ray statistics");
     selection = Buffer(ctx, 16, kStorageUsage, true, "selection counters");
     work = Buffer(ctx, sizeof(gpu::WorkItem) * 64, kStorageUsage, true, "work items");
-    filterWarp = Buffer(ctx, sizeof(gpu::FrameUniforms::filterWarp), kTexelUsage, true, "pixel filter table");
+    filterWarp = Buffer(ctx, sizeof(gpu::FrameUniforms::filterWarp), kSceneUsage, true, "pixel filter table");
   }
 
 #ifdef RETILE_VULKAN_VALIDATION
@@ -150,9 +153,9 @@ struct Renderer::Impl {
 #endif
 
   template <class T>
-  void uploadArray(Buffer& b, const std::vector<T>& data, const char* what, VkBufferUsageFlags usage = kTexelUsage) {
+  void uploadArray(Buffer& b, const std::vector<T>& data, const char* what) {
     VkDeviceSize bytes = data.size() * sizeof(T);
-    if (!b.valid() || b.size() < bytes || (b.size() > 2 * bytes + 65536)) b = Buffer(ctx, bytes, usage, false, what);
+    if (!b.valid() || b.size() < bytes || (b.size() > 2 * bytes + 65536)) b = Buffer(ctx, bytes, kSceneUsage, false, what);
     b.upload(data.data(), bytes);
   }
 
@@ -169,7 +172,7 @@ struct Renderer::Impl {
         const VkDeviceSize room = std::min<VkDeviceSize>(meshBytes + (2 * d.topTraversal.size() + 256) * sizeof(gpu::vec4),
                                                          gpu::kMaxTraversalTexels * sizeof(gpu::vec4));
         if (!traversal.valid() || traversal.size() < need || traversal.size() > 2 * room + 65536)
-          traversal = Buffer(ctx, std::max(room, need), kTexelUsage | VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT, false, "BVH and triangles");
+          traversal = Buffer(ctx, std::max(room, need), kSceneUsage, false, "BVH and triangles");
         traversal.upload(d.meshTraversal.data(), meshBytes, 0);
         traversal.upload(d.topTraversal.data(), need - meshBytes, meshBytes);
       } else {
@@ -186,7 +189,7 @@ struct Renderer::Impl {
     if (dirty & kDirtyMaterials) uploadArray(materials, d.materials, "materials");
     if (dirty & kDirtyTextures) {
       uploadArray(texInfo, d.textureInfo, "texture table");
-      uploadArray(texels, d.texels, "texels", kTexelUsage | VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT);
+      uploadArray(texels, d.texels, "texels");
     }
     if (dirty & kDirtyEnvironment) uploadArray(envCdf, d.environmentCdf, "environment distribution");
     if (dirty & kDirtyEmitters) {
