@@ -42,6 +42,7 @@ void flushDenormals() {
 void preferWideCpuVectors() {
   if (std::getenv("LP_NATIVE_VECTOR_WIDTH")) return;
 #if defined(__x86_64__)
+  __builtin_cpu_init();  // the test suites call this from a static initializer, maybe before libgcc's
   // The subsets LLVM's 512-bit code generation uses beyond the foundation.
   if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw") &&
       __builtin_cpu_supports("avx512dq"))
