@@ -37,8 +37,8 @@ std::uint32_t groupsFor(std::uint64_t invocations, std::uint32_t local, std::uin
   return x;
 }
 
-// Each trace invocation runs several paths one after another (trace.comp), so its eight
-// lock-stepped lanes rarely wait for the longest path: on the Cornell box 128 paths per
+// Each trace invocation runs several paths one after another (trace.comp), so the lock-stepped
+// lanes of its subgroup rarely wait for the longest path: on the Cornell box 128 paths per
 // invocation trace about 1.5 times as many samples per second as one. The count is chosen from
 // the last frame's mean loop iterations per path, to stay clear of lavapipe's loop limit: the
 // mean invocation aims at 0.4 of the budget, because the busiest ran 1.2 to 1.3 times the mean
