@@ -54,7 +54,6 @@ std::string commandPath(const CLI::App& app) {
 
 int main(int argc, char** argv) {
   // Before any thread starts: Qt's Vulkan window creates its own lavapipe device in this thread.
-  retile::preferWideCpuVectors();
   retile::flushDenormals();
   std::vector<std::string> args(argv + 1, argv + argc);
   if (const char* v = std::getenv("RETILE_LOG"); v && std::strcmp(v, "debug") == 0) retile::setLogLevel(retile::LogLevel::Debug);
@@ -84,6 +83,8 @@ int main(int argc, char** argv) {
     if (args.empty() || (args.size() == 1 && args[0].rfind("-", 0) != 0 && !findCommand(app, args[0])))
       return retile::cli::runEditor(argc, argv, args.empty() ? std::string() : args[0]);
     if (unknownCommand(app, args)) return 2;
+    // The commands only: the editor stays at lavapipe's default (core/process.h).
+    retile::preferWideCpuVectors();
     app.parse(argc, argv);
     return status;
   } catch (const CLI::ParseError& e) {

@@ -13,7 +13,6 @@
 
 #include <cmath>
 
-#include "core/process.h"
 #include "editor_support.h"
 #include "main_window.h"
 #include "vulkan_viewport.h"
@@ -130,7 +129,6 @@ TEST(VulkanViewport, AFailedPresentationFallsBackToTheWidget) {
 }  // namespace retile::ui
 
 int main(int argc, char** argv) {
-  retile::preferWideCpuVectors();  // as the editor does, before Qt's Vulkan instance
   qputenv("RETILE_NO_PROMPTS", "1");
   QTemporaryDir recovery;
   qputenv("RETILE_RECOVERY_DIR", recovery.path().toUtf8());

@@ -17,8 +17,9 @@ namespace fs = std::filesystem;
 namespace retile::test {
 
 namespace {
-// Every suite drives lavapipe as retile does (core/process.h). Before main, while the process
-// has one thread, as setenv needs.
+// The suites drive lavapipe as retile's command line does (core/process.h); gui_vulkan_tests, which
+// shows a Qt Vulkan window, does not link this and stays at the editor's width. Before main,
+// while the process has one thread, as setenv needs.
 [[maybe_unused]] const bool kWideCpuVectors = (preferWideCpuVectors(), true);
 }  // namespace
 

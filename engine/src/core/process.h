@@ -55,9 +55,12 @@ void flushDenormals();
 // the spaceship 1.11x, our glass and ice 1.15x and the Cornell box 1.03x as many samples a second,
 // with the images identical to the bit (which lane traces a path changes nothing in it). lavapipe
 // reads LP_NATIVE_VECTOR_WIDTH once, when a process makes its first lavapipe device, so call this
-// at the start of main, before any thread starts (setenv is not thread-safe) and before anything,
-// Qt's Vulkan window included, makes a Vulkan instance. A width the user set is kept. Other
-// drivers do not read it.
+// early in main, before any thread starts (setenv is not thread-safe) and before any Vulkan
+// instance is made. A width the user set is kept. Other drivers do not read it.
+// Not in the editor: with 512 bits, lavapipe crashed compiling the graphics pipeline that shows
+// the viewport in a Qt Vulkan window whenever Mesa's shader cache was cold (gui_vulkan_tests,
+// three runs of three with ~/.cache/mesa_shader_cache removed; none at 256 bits). The compute
+// kernels, the command line's whole use of the device, compile and run correctly at 512.
 void preferWideCpuVectors();
 
 // Undoes flushDenormals for the calling thread while it lives, and puts the flags back as they
