@@ -8,6 +8,7 @@
 #extension GL_KHR_shader_subgroup_vote : require
 #extension GL_KHR_shader_subgroup_ballot : require
 
+#include "common/integer.glsl"
 #include "common/rng.glsl"
 #include "common/bsdf.glsl"
 #include "common/lights.glsl"
@@ -110,8 +111,8 @@ float filterOffset(float u) {
 int selectionBase(int px, int py) {
   uint t = frame.work.w;
   if (t == 0u || frame.work.z == 0u) return -1;
-  uint cols = (frame.image.x + t - 1u) / t;
-  return int(frame.work.z - 1u + ((uint(py) / t) * cols + uint(px) / t) * uint(kSelectionCounters));
+  uint cols = quotient(frame.image.x + t - 1u, t);
+  return int(frame.work.z - 1u + (quotient(uint(py), t) * cols + quotient(uint(px), t)) * uint(kSelectionCounters));
 }
 
 // The counted sets an instance belongs to (bit 0: the selected object, bit 1: its group). Read only
@@ -296,12 +297,12 @@ uint pathsLeft = 0u, pathsAtEmitters = 0u, pathsAtLimit = 0u, pathsByRoulette = 
 Path startPath(uint slot, int found) {
   WorkItem item = items[found];
   uint inItem = slot - item.info.y;
-  uint p = inItem / item.info.x;  // a pixel's (a block's) q samples are neighbours (layouts.h WorkItem)
+  uint p = quotient(inItem, item.info.x);  // a pixel's (a block's) q samples are neighbours (layouts.h WorkItem)
   uint rep = inItem - p * item.info.x;
   uint block = max(item.pixels.z, 1u);
-  uint cols = (uint(item.rect.z) + block - 1u) / block;
-  int px = item.rect.x + int((p % cols) * block);
-  int py = item.rect.y + int((p / cols) * block);
+  uint cols = quotient(uint(item.rect.z) + block - 1u, block), row = quotient(p, cols);
+  int px = item.rect.x + int((p - row * cols) * block);
+  int py = item.rect.y + int(row * block);
   uint width = frame.image.x, height = frame.image.y;
   Path path;
   path.slot = slot;
@@ -953,7 +954,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
 }
 
 // How many slots the invocation `i` owns: i, i + invocations, ... below the dispatch's count.
-uint ownSlots(uint i) { return i < push.invocations && i < push.slotCount ? (push.slotCount - i + push.invocations - 1u) / push.invocations : 0u; }
+uint ownSlots(uint i) { return i < push.invocations && i < push.slotCount ? quotient(push.slotCount - i + push.invocations - 1u, push.invocations) : 0u; }
 
 void main() {
   frame = frameBuffer;  // see scene.glsl
@@ -1072,7 +1073,8 @@ void main() {
     } else if (wants) {
       taken++;
     }
-    uint slot = slotLanes == 0u ? push.slotCount : firstLane + m % slotLanes + (m / slotLanes) * push.invocations;
+    uint round = quotient(m, max(slotLanes, 1u));
+    uint slot = slotLanes == 0u ? push.slotCount : firstLane + (m - round * slotLanes) + round * push.invocations;
     bool starts = wants && slot < push.slotCount;
     // Every lane searches, outside any branch, so that every lane counts the search's iterations.
     int found = findItem(push.slotOffset + (starts ? slot : 0u));

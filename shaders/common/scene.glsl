@@ -169,9 +169,13 @@ vec2 textureSlope(int index, vec2 uv) {
   vec2 p = wrapped * vec2(w, h) - 0.5;
   vec2 f = p - floor(p);
   ivec2 i = ivec2(floor(p));
-  // Columns i - 1 .. i + 2 and rows likewise, wrapped.
-  ivec4 xs = (ivec4(i.x) + ivec4(-1, 0, 1, 2) + 2 * w) % w;
-  ivec4 ys = ((ivec4(i.y) + ivec4(-1, 0, 1, 2) + 2 * h) % h) * w;
+  // Columns i - 1 .. i + 2 and rows likewise, wrapped. Not by %: lavapipe divides integers one
+  // lane at a time. i is from -1 to w - 1 (h - 1), so two steps each way wrap any size.
+  ivec4 xs = ivec4(i.x) + ivec4(-1, 0, 1, 2), ys = ivec4(i.y) + ivec4(-1, 0, 1, 2);
+  xs += (ivec4(lessThan(xs, ivec4(0))) - ivec4(greaterThanEqual(xs, ivec4(w)))) * w;
+  xs += (ivec4(lessThan(xs, ivec4(0))) - ivec4(greaterThanEqual(xs, ivec4(w)))) * w;
+  ys += (ivec4(lessThan(ys, ivec4(0))) - ivec4(greaterThanEqual(ys, ivec4(h)))) * h;
+  ys = (ys + (ivec4(lessThan(ys, ivec4(0))) - ivec4(greaterThanEqual(ys, ivec4(h)))) * h) * w;
   const vec3 mean = vec3(1.0 / 3.0);
 #define RETILE_TEXEL(x, y) dot(bitmapTexel(offset, ys[y] + xs[x], flags).rgb, mean)
   float a01 = RETILE_TEXEL(1, 0), a02 = RETILE_TEXEL(2, 0);

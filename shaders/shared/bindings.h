@@ -79,3 +79,7 @@ RETILE_BINDING(Compose, Display, 3, Storage)              // the displayed image
 RETILE_PASS(BsdfProbe, "bsdf_probe.comp")
 RETILE_BINDING(BsdfProbe, Queries, 0, Storage)
 RETILE_BINDING(BsdfProbe, Answers, 1, Storage)
+
+RETILE_PASS(IntegerProbe, "integer_probe.comp")
+RETILE_BINDING(IntegerProbe, Queries, 0, Storage)
+RETILE_BINDING(IntegerProbe, Answers, 1, Storage)
