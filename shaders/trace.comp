@@ -159,7 +159,7 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
   // (render_materials.cpp asserts it): no second fetch.
   int albedoTex = floatBitsToInt(t2[kMaterialSlot_albedoTexture % 4]), roughTex = floatBitsToInt(t3[kMaterialSlot_roughnessTexture % 4]);
   if (hasFeature(kFeatureTextures) && albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
-  if (hasFeature(kFeatureTextures) && roughTex >= 0) {
+  if (hasFeature(kFeatureRoughnessTextures) && roughTex >= 0) {
     float scale = dot(sampleTexture(roughTex, uv).rgb, vec3(1.0 / 3.0));
     if (isMat(m.type, kMatThinSheet)) {
       // A thin sheet's texture is its thickness (Material::roughnessTexture): its absorption

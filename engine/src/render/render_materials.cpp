@@ -139,6 +139,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
   data_.materials.clear();
   data_.materialTypes = 0;
   data_.materialTextures = false;
+  data_.roughnessTextures = false;
   data_.materialBump = false;
   data_.emissionTextures = false;
   data_.emissionCones = false;
@@ -178,7 +179,8 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     static constexpr const MaterialTexture& ratio = textureRow(&Material::blendRatioTexture);
     static constexpr const MaterialTexture& bump = textureRow(&Material::bumpTexture);
     static constexpr const MaterialTexture& emission = textureRow(&Material::emissionTexture);
-    if (packed(albedo) || packed(roughness) || packed(ratio)) data_.materialTextures = true;
+    if (packed(albedo) || packed(ratio)) data_.materialTextures = true;
+    if (packed(roughness)) data_.roughnessTextures = true;
     if (packed(bump)) data_.materialBump = true;
     if (packed(emission) && m.emissive()) data_.emissionTextures = true;
     data_.materials.insert(data_.materials.end(), texels.begin(), texels.end());

@@ -88,6 +88,7 @@ int filterFeature(const RenderSettings& s) {
 std::uint32_t RenderSceneData::features() const {
   std::uint32_t f = 0;
   if (materialTextures) f |= gpu::kFeatureTextures;
+  if (roughnessTextures) f |= gpu::kFeatureRoughnessTextures;
   if (environmentType == gpu::kEnvConstant) f |= gpu::kFeatureEnvConstant;
   if (environmentType == gpu::kEnvMap) f |= gpu::kFeatureEnvMap;
   if (!emitters.empty()) f |= gpu::kFeatureEmitters;

@@ -130,7 +130,8 @@ struct RenderSceneData {
   bool alphaTested() const { return cutOuts || sheetShadows; }
   bool cullBack = false;            // some visible instance is hit from the front only
   std::uint32_t materialTypes = 0;  // bit kMat... of each material type present
-  bool materialTextures = false;    // some material reads an albedo or roughness texture
+  bool materialTextures = false;    // some material reads an albedo or blend-ratio texture
+  bool roughnessTextures = false;   // some material reads a roughness texture
   bool materialBump = false;        // some material has a bump map
   bool emissionTextures = false;    // some emissive material has an emission texture
   bool emissionCones = false;       // some emissive material emits into a cone (Material::emissionCone)

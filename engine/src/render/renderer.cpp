@@ -520,7 +520,8 @@ struct Renderer::Impl {
       pixels += static_cast<std::uint64_t>(x1 - x0) * static_cast<std::uint64_t>(y1 - y0);
       items.push_back(w);
     }
-    RETILE_ASSERT(slots < (1ull << 32), cat("a frame of ", slots, " samples"));
+    // The trace kernel divides by its invocations, at most the slots, in floats (integer.glsl quotient).
+    RETILE_ASSERT(slots < (1ull << 30), cat("a frame of ", slots, " samples"));
     std::uint64_t invocations = 0;
     if (!items.empty()) {
       ensureSampleCapacity(slots + 1);  // the trace pass's spare slot (trace.comp)
