@@ -126,8 +126,9 @@ uint countedSets(int instance) {
 // The material a hit on material `index` shades with: itself or, for a blend (Material::blendWith),
 // its partner when `blendRandom` falls past the ratio (times its texture's channel mean at uv,
 // where it has one), and so on along the partner's own blend, kMaxBlendChain materials at most;
-// emission stays the hit material's.
-Material fetchMaterial(int index, vec2 uv, float blendRandom) {
+// emission stays the hit material's. Without `textured` (a constant) the albedo and roughness are
+// the untextured values, and their lookups' code is left out.
+Material fetchMaterial(int index, vec2 uv, float blendRandom, bool textured) {
   int shaded = index;
   if (hasFeature(kFeatureBlend)) {
     float u = blendRandom;
@@ -158,8 +159,8 @@ Material fetchMaterial(int index, vec2 uv, float blendRandom) {
   // The albedo and roughness textures' slots lie in t2 and t3, fetched above for eta and k
   // (render_materials.cpp asserts it): no second fetch.
   int albedoTex = floatBitsToInt(t2[kMaterialSlot_albedoTexture % 4]), roughTex = floatBitsToInt(t3[kMaterialSlot_roughnessTexture % 4]);
-  if (hasFeature(kFeatureTextures) && albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
-  if (hasFeature(kFeatureRoughnessTextures) && roughTex >= 0) {
+  if (textured && hasFeature(kFeatureTextures) && albedoTex >= 0) m.albedo *= sampleTexture(albedoTex, uv).rgb;
+  if (textured && hasFeature(kFeatureRoughnessTextures) && roughTex >= 0) {
     float scale = dot(sampleTexture(roughTex, uv).rgb, vec3(1.0 / 3.0));
     if (isMat(m.type, kMatThinSheet)) {
       // A thin sheet's texture is its thickness (Material::roughnessTexture): its absorption
@@ -420,7 +421,7 @@ bool sheetPasses(inout Trace tr) {
   vec2 uv = w * vec2(s0.w, s1.w) + u * vec2(s2.w, s3.x) + v * s3.yz;
   // A number of each sheet's own for a blend's choice, as a path draws one at each hit: one for
   // every sheet along the ray would make the same choice at each.
-  Material m = fetchMaterial(material, uv, hitRandom(tr.rayRandom, prim, 2246822519u));
+  Material m = fetchMaterial(material, uv, hitRandom(tr.rayRandom, prim, 2246822519u), hasFeature(kFeatureSheetTextures));
   if (!isMat(m.type, kMatThinSheet)) return false;
   // The normal as shadeSegment shades with: interpolated, bumped.
   vec4 r0 = imageLoad(uInstances, ibase), r1 = imageLoad(uInstances, ibase + 1), r2 = imageLoad(uInstances, ibase + 2);
@@ -435,7 +436,7 @@ bool sheetPasses(inout Trace tr) {
       if (!hasFeature(kFeatureUncheckedShading) && dot(ns, ng) < 0.0) ns = -ns;
     }
   }
-  ns = bumped(ns, material, r0, r1, r2, e1, e2, s0, s1, s2, s3, uv);
+  if (hasFeature(kFeatureSheetTextures)) ns = bumped(ns, material, r0, r1, r2, e1, e2, s0, s1, s2, s3, uv);
   vec3 R;
   tr.shadowWeight *= thinSheetTransmittance(m, abs(dot(ns, tr.dir)), R);
   tr.passed++;
@@ -787,7 +788,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
   }
   ns = bumped(ns, floatBitsToInt(info.z), r0, r1, r2, e1, e2, s0, s1, s2, s3, uv);
 
-  Material m = fetchMaterial(floatBitsToInt(info.z), uv, hasFeature(kFeatureBlend) ? rand(path.rng) : 0.0);
+  Material m = fetchMaterial(floatBitsToInt(info.z), uv, hasFeature(kFeatureBlend) ? rand(path.rng) : 0.0, true);
   vec3 wo = -rd;
   bool frontFace = dot(ng, wo) > 0.0;
 

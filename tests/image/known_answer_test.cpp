@@ -286,6 +286,17 @@ TEST(KnownAnswer, ShadowRaysPassAThinSheetDimmed) {
   EXPECT_GT(open, 0.1);
   EXPECT_NEAR(through / open, sheetTransmittance(0, a), 0.003) << "the point light through the sheet";
   s.objects.back().visible = true;
+  // A thickness texture of 0.5 (a checker with both cells so) halves the absorption along the
+  // shadow rays too: they look up what the sheet's shading does (kFeatureSheetTextures).
+  Texture half;
+  half.id = s.newId();
+  half.name = "thickness";
+  half.kind = TextureKind::Checker;
+  half.checkerOn = half.checkerOff = Vec3{0.5f};
+  s.textures.push_back(half);
+  s.material(s.objects.back().material)->roughnessTexture = half.id;
+  EXPECT_NEAR(floorMean(16) / open, sheetTransmittance(0, 0.5 * a), 0.003) << "the point light through a sheet half as thick";
+  s.material(s.objects.back().material)->roughnessTexture = kNoNode;
   s.settings.maxBounces = 1;
   EXPECT_LT(floorMean(16), 1e-6) << "one bounce: the sheet is a second";
 

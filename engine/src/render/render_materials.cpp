@@ -140,6 +140,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
   data_.materialTypes = 0;
   data_.materialTextures = false;
   data_.roughnessTextures = false;
+  data_.sheetTextures = false;
   data_.materialBump = false;
   data_.emissionTextures = false;
   data_.emissionCones = false;
@@ -181,6 +182,7 @@ void RenderSceneBuilder::packMaterials(const Scene& scene) {
     static constexpr const MaterialTexture& emission = textureRow(&Material::emissionTexture);
     if (packed(albedo) || packed(ratio)) data_.materialTextures = true;
     if (packed(roughness)) data_.roughnessTextures = true;
+    if (m.type == MaterialType::ThinSheet && (packed(albedo) || packed(roughness) || packed(bump))) data_.sheetTextures = true;
     if (packed(bump)) data_.materialBump = true;
     if (packed(emission) && m.emissive()) data_.emissionTextures = true;
     data_.materials.insert(data_.materials.end(), texels.begin(), texels.end());

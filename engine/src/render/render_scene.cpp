@@ -89,6 +89,7 @@ std::uint32_t RenderSceneData::features() const {
   std::uint32_t f = 0;
   if (materialTextures) f |= gpu::kFeatureTextures;
   if (roughnessTextures) f |= gpu::kFeatureRoughnessTextures;
+  if (sheetTextures) f |= gpu::kFeatureSheetTextures;
   if (environmentType == gpu::kEnvConstant) f |= gpu::kFeatureEnvConstant;
   if (environmentType == gpu::kEnvMap) f |= gpu::kFeatureEnvMap;
   if (!emitters.empty()) f |= gpu::kFeatureEmitters;

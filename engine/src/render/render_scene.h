@@ -132,6 +132,7 @@ struct RenderSceneData {
   std::uint32_t materialTypes = 0;  // bit kMat... of each material type present
   bool materialTextures = false;    // some material reads an albedo or blend-ratio texture
   bool roughnessTextures = false;   // some material reads a roughness texture
+  bool sheetTextures = false;       // some thin sheet reads an albedo, roughness or bump texture
   bool materialBump = false;        // some material has a bump map
   bool emissionTextures = false;    // some emissive material has an emission texture
   bool emissionCones = false;       // some emissive material emits into a cone (Material::emissionCone)
