@@ -37,8 +37,8 @@ layout(set = 0, binding = kBindTraceSelection, std430) buffer Selection { uint s
 layout(push_constant) uniform Push { TracePush push; };
 
 // The pixel filter's table (frame.filterWarp's 36 values) in a texel buffer: each lane reads its
-// own slot, and a storage buffer read at a different index in each lane is a loop over the eight
-// lanes on lavapipe (the table's 16 such reads a segment cost the spaceship 10 %).
+// own slot, and a storage buffer read at a different index in each lane is a loop over the
+// subgroup's lanes on lavapipe (the table's 16 such reads a segment cost the spaceship 10 %).
 layout(set = 0, binding = kBindTraceFilterWarp, r32f) uniform readonly imageBuffer uFilterWarp;
 
 float warpSlot(int i) { return imageLoad(uFilterWarp, i).x; }
@@ -65,7 +65,7 @@ float filterOffset(float u) {
   if (hasFeature(kFeatureFilterTent) && tent > 0.0) return tent * (u < 0.5 ? sqrt(2.0 * u) - 1.0 : 1.0 - sqrt(2.0 - 2.0 * u));
   if (hasFeature(kFeatureFilterSteppedTent) && tent < 0.0 && frame.filterWarp[8].z > 0.0) {
     // As below, with the step found without the table: its search (seven reads a side, each a
-    // call over the eight lanes, in every lane of every pass) cost the spaceship about 5 % of its
+    // call over the subgroup's lanes, in every lane of every pass) cost the spaceship about 5 % of its
     // samples/s. The CDF is steppedTentCdf's, equal to the table's up to
     // its float sums' rounding.
     bool negative = u < 0.5;
@@ -223,9 +223,9 @@ int findItem(uint slot) {
 }
 
 // One path's state between segments. An invocation carries one path at a time and starts the
-// next of its slots as soon as the current path ends (path regeneration): lavapipe runs eight
-// invocations in lock-step, and without regeneration the lanes whose paths ended early would
-// idle until the longest of the eight had finished (a third of the lanes in the Cornell box).
+// next of its slots as soon as the current path ends (path regeneration): lavapipe runs a
+// subgroup's invocations in lock-step, and without regeneration the lanes whose paths ended early would
+// idle until the longest of them had finished (a third of the lanes in the Cornell box).
 struct Path {
   uint slot;
   Rng rng;
@@ -263,7 +263,7 @@ struct Path {
 // The shadow ray of a path vertex's next-event estimation. It is traced with the next segment's
 // extension ray, in one loop (Trace): the path's own next segment, or, when the path ended at
 // that vertex, the first segment of the path the invocation starts next, so that no segment is
-// spent on it alone (a segment costs the shading code for all eight lanes).
+// spent on it alone (a segment costs the shading code for all of a subgroup's lanes).
 struct Shadow {
   bool pending;
   vec3 origin, dir;
@@ -1008,7 +1008,7 @@ void main() {
   Trace tr;
   beginTrace(tr, root, false, vec3(0.0), vec3(0.0, 0.0, 1.0), ivec2(-1), 0.0, false, vec3(0.0), vec3(0.0, 0.0, 1.0), ivec2(-1), 0.0, 0.0);
   // The traversal stack: its top entry in Trace::top, the ones below it in this array. lavapipe
-  // turns an access to a per-invocation array at a varying index into a loop over the eight lanes
+  // turns an access to a per-invocation array at a varying index into a loop over the subgroup's lanes
   // with a branch per lane on the lane's mask. So each iteration reads and writes the array once,
   // outside any branch, whatever the step: it reads the entry a pop would bring to the top and
   // writes the top to the slot a push would move it to. That write is harmless when nothing is

@@ -17,10 +17,13 @@ namespace fs = std::filesystem;
 namespace retile::test {
 
 namespace {
-// The suites drive lavapipe as retile's command line does (core/process.h); gui_vulkan_tests, which
-// shows a Qt Vulkan window, does not link this and stays at the editor's width. Before main,
-// while the process has one thread, as setenv needs.
+// The suites drive lavapipe as retile's command line does (core/process.h), but for the editor's
+// (RETILE_TEST_EDITOR_LANES: gui_tests; gui_vulkan_tests does not link this), which stay at the
+// width the editor runs at, so that its kernels' subgroup size is tested too. Before main, while
+// the process has one thread, as setenv needs.
+#ifndef RETILE_TEST_EDITOR_LANES
 [[maybe_unused]] const bool kWideCpuVectors = (preferWideCpuVectors(), true);
+#endif
 }  // namespace
 
 fs::path sharedDir() {
