@@ -154,40 +154,39 @@ vec4 sampleTexture(int index, vec2 uv) {
   return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
 }
 
+// Texel i of slopes packed from pair `offset` on, two halves a word (render_materials.cpp
+// appendSlopes).
+vec2 slopeTexel(int offset, int i) {
+  uvec2 pair = imageLoad(uTexels, offset + (i >> 1)).xy;
+  return unpackHalf2x16((i & 1) != 0 ? pair.y : pair.x);
+}
+
 // The slope of a texture's value (the mean of its colour channels) at uv, as Tungsten's bump
 // maps take it (BitmapTexture::derivatives): differences across two texels, along u and down the
 // image's rows, interpolated between the four texels about uv. Not divided by the texel size:
-// the slope of a bump map depends on its resolution, as in Tungsten. Checkers are flat.
+// the slope of a bump map depends on its resolution, as in Tungsten. Each texel's differences
+// are packed after its colour, so that this reads four words instead of twelve texels. Checkers
+// are flat, as is a bitmap packed without slopes (offset -1: packTextures gives slopes to every
+// texture a material bumps by, so none should be met).
 vec2 textureSlope(int index, vec2 uv) {
   vec4 info = imageLoad(uTexInfo, index * kTextureTexels);
-  int flags = floatBitsToInt(info.w);
-  if ((flags & 15) == kTexChecker) return vec2(0.0);
-  int offset = floatBitsToInt(info.x);
+  int offset = floatBitsToInt(imageLoad(uTexInfo, index * kTextureTexels + 1).x);
+  if ((floatBitsToInt(info.w) & 15) == kTexChecker || offset < 0) return vec2(0.0);
+  offset = max(offset, 0);  // the lanes that returned still run what follows, on lavapipe
   int w = max(floatBitsToInt(info.y), 1), h = max(floatBitsToInt(info.z), 1);
   vec2 wrapped = vec2(uv.x, 1.0 - uv.y);
   wrapped = any(isnan(wrapped)) || any(isinf(wrapped)) ? vec2(0.0) : wrapped - floor(wrapped);
   vec2 p = wrapped * vec2(w, h) - 0.5;
   vec2 f = p - floor(p);
-  ivec2 i = ivec2(floor(p));
-  // Columns i - 1 .. i + 2 and rows likewise, wrapped. Not by %: lavapipe divides integers one
-  // lane at a time. i is from -1 to w - 1 (h - 1), so two steps each way wrap any size.
-  ivec4 xs = ivec4(i.x) + ivec4(-1, 0, 1, 2), ys = ivec4(i.y) + ivec4(-1, 0, 1, 2);
-  xs += (ivec4(lessThan(xs, ivec4(0))) - ivec4(greaterThanEqual(xs, ivec4(w)))) * w;
-  xs += (ivec4(lessThan(xs, ivec4(0))) - ivec4(greaterThanEqual(xs, ivec4(w)))) * w;
-  ys += (ivec4(lessThan(ys, ivec4(0))) - ivec4(greaterThanEqual(ys, ivec4(h)))) * h;
-  ys = (ys + (ivec4(lessThan(ys, ivec4(0))) - ivec4(greaterThanEqual(ys, ivec4(h)))) * h) * w;
-  const vec3 mean = vec3(1.0 / 3.0);
-#define RETILE_TEXEL(x, y) dot(bitmapTexel(offset, ys[y] + xs[x], flags).rgb, mean)
-  float a01 = RETILE_TEXEL(1, 0), a02 = RETILE_TEXEL(2, 0);
-  float a10 = RETILE_TEXEL(0, 1), a11 = RETILE_TEXEL(1, 1), a12 = RETILE_TEXEL(2, 1), a13 = RETILE_TEXEL(3, 1);
-  float a20 = RETILE_TEXEL(0, 2), a21 = RETILE_TEXEL(1, 2), a22 = RETILE_TEXEL(2, 2), a23 = RETILE_TEXEL(3, 2);
-  float a31 = RETILE_TEXEL(1, 3), a32 = RETILE_TEXEL(2, 3);
-#undef RETILE_TEXEL
-  // Differences about the texels (1, 1), (2, 1), (1, 2) and (2, 2), in that order.
-  vec4 du = vec4(a12 - a10, a13 - a11, a22 - a20, a23 - a21);
-  vec4 dv = vec4(a21 - a01, a22 - a02, a31 - a11, a32 - a12);
-  vec4 weight = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
-  return vec2(dot(du, weight), dot(dv, weight));
+  // Columns i and i + 1, rows likewise, wrapped: i is from -1 to w - 1 (h - 1). Not by %:
+  // lavapipe divides integers one lane at a time.
+  ivec2 i0 = ivec2(floor(p));
+  ivec2 i1 = i0 + 1;
+  i0 += ivec2(lessThan(i0, ivec2(0))) * ivec2(w, h);
+  i1 -= ivec2(greaterThanEqual(i1, ivec2(w, h))) * ivec2(w, h);
+  vec2 s00 = slopeTexel(offset, i0.y * w + i0.x), s01 = slopeTexel(offset, i0.y * w + i1.x);
+  vec2 s10 = slopeTexel(offset, i1.y * w + i0.x), s11 = slopeTexel(offset, i1.y * w + i1.x);
+  return mix(mix(s00, s01, f.x), mix(s10, s11, f.x), f.y);
 }
 
 float sampleAlphaTexture(int index, vec2 uv) {

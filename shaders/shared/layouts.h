@@ -44,7 +44,7 @@ RT_CONST(int, kMaterialTexels, 10)   // see render/render_scene.h packMaterial
 #define RT_MATERIAL_TEXTURE(material, member) floatBitsToInt(RT_MATERIAL_SCALAR(material, member))
 #endif
 RT_CONST(int, kMaxBlendChain, 4)    // retile::kMaxBlendChain (scene.h)
-RT_CONST(int, kTextureTexels, 3)    // offset w h kind | on.rgb resU | off.rgb resV
+RT_CONST(int, kTextureTexels, 3)    // a bitmap: offset w h kind | slopes (offset, -1: none) - - - | -; a checker: - - - kind | on.rgb resU | off.rgb resV
 RT_CONST(int, kEmitterTexels, 5)    // v0.xyz area | e1.xyz instance | e2.xyz triangle | radiance.rgb pick pdf | normal.xyz emission texture
 // position.xyz type | direction.xyz cosOuter | intensity.rgb cosInner | -; a sun (kLightSun):
 // - type | direction.xyz 1 - cos(angular radius) | radiance.rgb solid angle | -
@@ -167,7 +167,8 @@ RT_CONST(int, kTexChecker, 1)
 // A bitmap's flags, beside its kind (the low four bits): its file had alpha (else an alpha
 // texture reads its channels' mean); its texels are 8-bit RGBA, a word each, instead of RGBA16F, two words
 // each; their colour is sRGB-encoded (else linear). The texel buffer is read in pairs of words
-// (R32G32_UINT), and a bitmap's offset counts pairs, so an 8-bit bitmap takes whole pairs.
+// (R32G32_UINT), and a bitmap's offset counts pairs, so an 8-bit bitmap takes whole pairs. A bump
+// map's slopes follow its colour, a word a texel of two halves (scene.glsl textureSlope).
 RT_CONST(int, kTexAlpha, 16)
 RT_CONST(int, kTexEightBit, 32)
 RT_CONST(int, kTexSrgb, 64)

@@ -958,6 +958,61 @@ TEST(RenderScene, TexturesKeepTheirTexelsWhenOthersComeAndGo) {
       static_cast<std::uint32_t>(gpu::kFeatureByteTexels | gpu::kFeatureSrgbTexels));
 }
 
+// A texture a material bumps by is packed with its slopes after its colour (scene.glsl
+// textureSlope reads them): for each texel, the channels' mean across the two texels beside it,
+// along a row and down the rows, wrapped. Whichever edit makes it a bump map or no longer one,
+// a material's alone, the packing is a fresh packing's, and the colour stays where it was.
+TEST(RenderScene, BumpTexturesArePackedWithTheirSlopes) {
+  Scene s = test::emptyScene(8, 8);
+  const auto file = test::tempDir() / "bumps.ppm";
+  // Grey rows: 0, 0.2, 0.6 | 1, 1, 1 | 0.4, 0.4, 0.4.
+  const std::vector<std::uint8_t> greys = {0, 51, 153, 255, 255, 255, 102, 102, 102};
+  std::vector<std::uint8_t> rgb;
+  for (std::uint8_t g : greys) rgb.insert(rgb.end(), {g, g, g});
+  test::writePpm(file, 3, 3, rgb);
+  const NodeId texture = test::addFileTexture(s, file, TextureColorSpace::Linear);
+  Material m;
+  m.albedoTexture = texture;
+  const NodeId material = test::addMaterial(s, m);
+  RenderSceneBuilder builder;
+  builder.update(s, kUpdateAll, nullptr);
+  const RenderSceneData& d = builder.data();
+  auto slopes = [&] { return std::bit_cast<std::int32_t>(d.textureInfo[1].x); };
+  EXPECT_EQ(slopes(), -1) << "an albedo has none";
+  const std::vector<std::uint32_t> colour = d.texels;
+  ASSERT_EQ(colour.size(), 10u) << "nine words and a pad";
+
+  s.material(material)->bumpTexture = texture;
+  s.material(material)->bumpStrength = 2;
+  EXPECT_NE(builder.update(s, kUpdateMaterials, nullptr) & kDirtyTextures, 0u) << "a material's edit packs the slopes";
+  ASSERT_EQ(slopes(), 5) << "after the colour's five pairs";
+  ASSERT_EQ(d.texels.size(), 20u);
+  EXPECT_TRUE(std::equal(colour.begin(), colour.end(), d.texels.begin()));
+  const float g[3][3] = {{0.0f, 0.2f, 0.6f}, {1, 1, 1}, {0.4f, 0.4f, 0.4f}};
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 3; ++x) {
+      const std::uint32_t word = d.texels[static_cast<std::size_t>(10 + y * 3 + x)];
+      EXPECT_NEAR(halfToFloat(static_cast<std::uint16_t>(word & 0xffffu)), g[y][(x + 1) % 3] - g[y][(x + 2) % 3], 1e-3) << x << ", " << y;
+      EXPECT_NEAR(halfToFloat(static_cast<std::uint16_t>(word >> 16)), g[(y + 1) % 3][x] - g[(y + 2) % 3][x], 1e-3) << x << ", " << y;
+    }
+  const std::vector<std::uint32_t> withSlopes = d.texels;
+  RenderSceneBuilder fresh;
+  fresh.update(s, kUpdateAll, nullptr);
+  EXPECT_EQ(fresh.data().texels, withSlopes);
+  ASSERT_EQ(fresh.data().textureInfo.size(), d.textureInfo.size());
+  EXPECT_EQ(std::memcmp(fresh.data().textureInfo.data(), d.textureInfo.data(), d.textureInfo.size() * sizeof(vec4)), 0);
+  builder.update(s, kUpdateTextures, nullptr);
+  EXPECT_EQ(d.texels, withSlopes) << "copied from the last packing";
+
+  s.material(material)->bumpStrength = 0;
+  EXPECT_NE(builder.update(s, kUpdateMaterials, nullptr) & kDirtyTextures, 0u) << "a bump of strength 0 reads none";
+  EXPECT_EQ(slopes(), -1);
+  EXPECT_EQ(d.texels, colour);
+  s.material(material)->bumpStrength = 2;
+  builder.update(s, kUpdateMaterials, nullptr);
+  EXPECT_EQ(d.texels, withSlopes) << "made again from the colour";
+}
+
 // Sets the scene's environment to a map of two texels, 1 then 3, written as EXR to `file`.
 void setTwoTexelSky(Scene& s, const std::filesystem::path& file) {
   RenderImage sky;

@@ -362,7 +362,7 @@ std::uint32_t RenderSceneBuilder::packEnvironment(const Scene& scene, std::vecto
       appendHalves(data_.texels, baked.rgba, &scale);
       data_.textureInfo.push_back(
           ints(static_cast<std::int32_t>(at / 2), baked.width, baked.height, gpu::kTexBitmap | scale << gpu::kTexScaleShift));
-      data_.textureInfo.push_back({0, 0, 0, 0});
+      data_.textureInfo.push_back(ints(-1, 0, 0, 0));  // no slopes: nothing bumps by a sky
       data_.textureInfo.push_back({0, 0, 0, 0});
       data_.halfTexels = true;
       packedSky_ = source = sky;

@@ -269,7 +269,41 @@ Vec3 appendBytes(std::vector<std::uint32_t>& out, const TextureImage& image) {
   return Vec3{static_cast<float>(sum[0] / n), static_cast<float>(sum[1] / n), static_cast<float>(sum[2] / n)};
 }
 
+// Appends the slopes of the bitmap just packed at texels[firstWord...] (w x h texels, `flags`),
+// a word a texel as two halves, padded to whole pairs of words: what scene.glsl textureSlope
+// interpolates. A texel's slope is Tungsten's (BitmapTexture::derivatives): the difference of the
+// channels' mean across the two texels beside it, along u and down the image's rows, wrapped.
+// Four lookups a bump then read these instead of twelve of the colour.
+void appendSlopes(std::vector<std::uint32_t>& texels, std::size_t firstWord, int w, int h, int flags) {
+  const auto width = static_cast<std::size_t>(w), height = static_cast<std::size_t>(h);
+  std::vector<float> mean(width * height);
+  for (std::size_t i = 0; i < mean.size(); ++i) {
+    const Vec3 c = packedTexel(texels, firstWord, i, flags);
+    mean[i] = (c.x + c.y + c.z) * (1.0f / 3.0f);
+  }
+  // A slope beyond a half's range (only of half-float texels far beyond it) is held at its edge.
+  auto half = [](float v) { return std::uint32_t{floatToHalf(std::clamp(v, -65504.0f, 65504.0f))}; };
+  texels.reserve(texels.size() + mean.size() + 1);
+  for (std::size_t y = 0; y < height; ++y)
+    for (std::size_t x = 0; x < width; ++x) {
+      const float du = mean[y * width + (x + 1) % width] - mean[y * width + (x + width - 1) % width];
+      const float dv = mean[(y + 1) % height * width + x] - mean[(y + height - 1) % height * width + x];
+      texels.push_back(half(du) | half(dv) << 16);
+    }
+  if (texels.size() % 2) texels.push_back(0);
+}
+
 }  // namespace
+
+std::vector<NodeId> bumpTextures(const Scene& scene) {
+  static constexpr const MaterialTexture& bump = textureRow(&Material::bumpTexture);
+  std::vector<NodeId> ids;
+  for (const Material& m : scene.materials)
+    if (m.bumpTexture != kNoNode && m.bumpStrength != 0 && bump.appliesTo(m.type)) ids.push_back(m.bumpTexture);
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  return ids;
+}
 
 void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::string>* warnings) {
   auto& cache = decoded_;
@@ -280,6 +314,7 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
   data_.byteTexels = data_.halfTexels = data_.srgbTexels = false;
   textureIndex_.clear();
   textureMean_.clear();
+  slopeTextures_ = bumpTextures(scene);
   auto appendChecker = [&](Vec3 on, Vec3 off, int ru, int rv, bool truncate = false) {
     data_.textureInfo.push_back(ints(0, 0, 0, gpu::kTexChecker | (truncate ? gpu::kTexTruncate : 0)));
     data_.textureInfo.push_back(v4(on, static_cast<float>(std::max(ru, 1))));
@@ -294,11 +329,15 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
       continue;
     }
     const std::size_t at = data_.texels.size();
+    const bool slopes = std::binary_search(slopeTextures_.begin(), slopeTextures_.end(), t.id);
     std::string sig = textureSignature(t, scene.baseDirectory);
     Decoded& d = cache[t.id];
-    if (d.signature == sig && d.ok && d.offset + d.words <= last.size()) {
-      data_.texels.insert(data_.texels.end(), last.begin() + static_cast<std::ptrdiff_t>(d.offset),
-                          last.begin() + static_cast<std::ptrdiff_t>(d.offset + d.words));
+    // The slopes the last packing left after the colour, copied again if they are still wanted.
+    auto lastSlopes = last.end();
+    if (d.signature == sig && d.ok && d.offset + d.words + d.slopeWords <= last.size()) {
+      const auto colour = last.begin() + static_cast<std::ptrdiff_t>(d.offset);
+      data_.texels.insert(data_.texels.end(), colour, colour + static_cast<std::ptrdiff_t>(d.words));
+      if (d.slopeWords) lastSlopes = colour + static_cast<std::ptrdiff_t>(d.words);
     } else if (d.signature != sig || d.ok) {
       d = Decoded{};
       d.signature = sig;
@@ -325,8 +364,15 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
     }
     d.offset = at;
     d.words = data_.texels.size() - at;
+    if (d.ok && slopes) {
+      if (lastSlopes != last.end())
+        data_.texels.insert(data_.texels.end(), lastSlopes, lastSlopes + static_cast<std::ptrdiff_t>(d.slopeWords));
+      else appendSlopes(data_.texels, at, d.width, d.height, d.flags);
+    }
+    d.slopeWords = data_.texels.size() - at - d.words;
     if (d.ok && data_.texels.size() / 2 > static_cast<std::size_t>(gpu::kMaxTexelPairs)) {
       data_.texels.resize(at);
+      d.slopeWords = 0;
       d.ok = false;
       d.signature.clear();  // tried again at the next update, when others may have left
       if (warnings)
@@ -340,7 +386,7 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
       data_.srgbTexels |= (d.flags & gpu::kTexSrgb) != 0;
       const int sampling = (t.interpolate ? 0 : gpu::kTexNearest) | (t.clampToEdge ? gpu::kTexClamp : 0);
       data_.textureInfo.push_back(ints(static_cast<std::int32_t>(at / 2), d.width, d.height, d.flags | sampling));
-      data_.textureInfo.push_back({0, 0, 0, 0});
+      data_.textureInfo.push_back(ints(d.slopeWords ? static_cast<std::int32_t>((at + d.words) / 2) : -1, 0, 0, 0));
       data_.textureInfo.push_back({0, 0, 0, 0});
       textureMean_[t.id] = d.mean;
     } else if (t.whenMissing == MissingTexture::BlackAndWhite) {

@@ -135,6 +135,8 @@ std::uint32_t RenderSceneBuilder::update(const Scene& scene, std::uint32_t flags
   data_.lightSampling = scene.settings.lightSampling;
   timing_ = {};
   std::uint32_t dirty = 0;
+  // A texture that a material starts or stops bumping by gains or loses its slopes.
+  if ((flags & kUpdateMaterials) && !(flags & kUpdateTextures) && bumpTextures(scene) != slopeTextures_) flags |= kUpdateTextures;
   if (flags & kUpdateTextures || flags & kUpdateEnvironment) {
     auto t = Clock::now();
     // The world's medium is compiled into the kernel as a material's is, and hides the suns.

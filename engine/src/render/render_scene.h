@@ -167,6 +167,10 @@ struct MediaAround {
 };
 MediaAround mediaAround(const RenderSceneData& d, Vec3 point);
 
+// The textures some material bumps by, as packMaterial keeps them (a strength, a type that
+// reads it), sorted: these are packed with their slopes.
+std::vector<NodeId> bumpTextures(const Scene& scene);
+
 class RenderSceneBuilder {
  public:
   // Applies `flags` (from edit.h) by refreshing the affected arrays; returns DirtyArrays.
@@ -216,7 +220,8 @@ class RenderSceneBuilder {
   struct Decoded {
     std::string signature;
     bool ok = false;
-    std::size_t offset = 0, words = 0;  // in data_.texels as last packed
+    std::size_t offset = 0, words = 0;  // its colour in data_.texels as last packed
+    std::size_t slopeWords = 0;         // its slopes' words after the colour's (0: none packed)
     int width = 0, height = 0, flags = 0;
     Vec3 mean{0.0f};
   };
@@ -257,6 +262,8 @@ class RenderSceneBuilder {
   // By geometry, with the object a copy is for (kNoNode: the entry every other object shares).
   std::map<std::pair<const MeshGeometry*, NodeId>, MeshEntry> meshes_;
   std::unordered_map<NodeId, Decoded> decoded_;
+  // The textures packed with their slopes (bumpTextures at the last packTextures), sorted.
+  std::vector<NodeId> slopeTextures_;
   std::unordered_map<NodeId, int> textureIndex_;
   // Each texture's mean RGB as packed: a textured emitter's share of the light samples.
   std::unordered_map<NodeId, Vec3> textureMean_;
