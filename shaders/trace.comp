@@ -1026,28 +1026,31 @@ void main() {
   // traversal) is also the first of the next.
   for (;;) {
     loopIterations++;
-    if (loopIterations > kLoopBudget || loopIterations + 2u * maxSegment > kLoopLimit) {
-      // Out of loop budget (the same decision in every lane): paths end as they stand, their rays
-      // in flight or not (a shadow ray still to trace is dropped, from an ended path too), and
-      // slots not yet started keep the weight 0 the renderer cleared them to.
-      if (alive) {
-        cutPaths++;
-        writeSample(path, true);
-      }
+    // Out of loop budget (the same decision in every lane): paths end as they stand, their rays
+    // in flight or not (a shadow ray still to trace is dropped, from an ended path too), and
+    // slots not yet started keep the weight 0 the renderer cleared them to.
+    bool outOfBudget = loopIterations > kLoopBudget || loopIterations + 2u * maxSegment > kLoopLimit;
+    // The lanes whose rays are done take their hits, shade, and set off their next rays; the
+    // others' rays are still in flight (the traversal loop below).
+    bool ready = tr.done && !outOfBudget, ended = false;
+    if (ready && !tr.idle) {
+      resolveShadow(path, shadow, tr);
+      ended = alive && !shadeSegment(path, shadow, tr.hit);
+      alive = alive && !ended;
+    }
+    // A path's sample is written once, when it ends or is cut short, from this one call: lavapipe
+    // runs a branch's code whether or not a lane takes it, and each of the four stores is a loop
+    // over the lanes and over the components. (Written by every lane every iteration, as it was
+    // to keep lavapipe's per-lane store branches predictable, they took a tenth of the time.)
+    if (ended || (outOfBudget && alive)) writeSample(path, true);
+    if (outOfBudget) {
+      if (alive) cutPaths++;
       // The slots not started: each lane counts its own, less those taken (all counted once,
       // in the first lane, when shared).
       uint own = lane < slotLanes || !sharedSlots ? ownSlots(firstLane + (sharedSlots ? lane : 0u)) : 0u;
       uint all = sharedSlots ? subgroupAdd(own) : own;
       if (!sharedSlots || subgroupElect()) cutPaths += all - min(taken, all);
       break;
-    }
-    // The lanes whose rays are done take their hits, shade, and set off their next rays; the
-    // others' rays are still in flight (the traversal loop below).
-    bool ready = tr.done, ended = false;
-    if (ready && !tr.idle) {
-      resolveShadow(path, shadow, tr);
-      ended = alive && !shadeSegment(path, shadow, tr.hit);
-      alive = alive && !ended;
     }
     // Loops only some lanes ran while shading (see loopIterations in scene.glsl). The sky map's
     // searches, in the lanes that sampled it: every lane takes the count. The suns' loop, one
@@ -1061,10 +1064,6 @@ void main() {
     // Likewise the light groups' loops, a group an iteration, in the lanes that shaded: at most
     // one light sample's choice and one emitter's pdf without its total.
     if (hasFeature(kFeatureLightGroups)) loopIterations += 2u * uint(frame.bounces.y);
-    // A path's sample is written once, when it ends. (Written by every lane every iteration, as
-    // it was to keep lavapipe's per-lane store branches predictable, the four stores, each a loop
-    // over the lanes and over the components, took a tenth of the time.)
-    if (ended) writeSample(path, true);
     bool wants = ready && !alive;
     uint m = taken;
     if (sharedSlots) {
