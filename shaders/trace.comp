@@ -1022,6 +1022,7 @@ void main() {
   const uint readyLanes = uint(gl_SubgroupSize) * uint(kTraceReadyLanes) / 16u;
   uint cutPaths = 0u;
   uint maxSegment = 0u;
+  bool outOfBudget = false;
   // Every lane's count is the subgroup's here: the last synchronisation of an iteration (after the
   // traversal) is also the first of the next.
   for (;;) {
@@ -1029,7 +1030,7 @@ void main() {
     // Out of loop budget (the same decision in every lane): paths end as they stand, their rays
     // in flight or not (a shadow ray still to trace is dropped, from an ended path too), and
     // slots not yet started keep the weight 0 the renderer cleared them to.
-    bool outOfBudget = loopIterations > kLoopBudget || loopIterations + 2u * maxSegment > kLoopLimit;
+    outOfBudget = loopIterations > kLoopBudget || loopIterations + 2u * maxSegment > kLoopLimit;
     // The lanes whose rays are done take their hits, shade, and set off their next rays; the
     // others' rays are still in flight (the traversal loop below).
     bool ready = tr.done && !outOfBudget, ended = false;
@@ -1045,11 +1046,6 @@ void main() {
     if (ended || (outOfBudget && alive)) writeSample(path, true);
     if (outOfBudget) {
       if (alive) cutPaths++;
-      // The slots not started: each lane counts its own, less those taken (all counted once,
-      // in the first lane, when shared).
-      uint own = lane < slotLanes || !sharedSlots ? ownSlots(firstLane + (sharedSlots ? lane : 0u)) : 0u;
-      uint all = sharedSlots ? subgroupAdd(own) : own;
-      if (!sharedSlots || subgroupElect()) cutPaths += all - min(taken, all);
       break;
     }
     // Loops only some lanes ran while shading (see loopIterations in scene.glsl). The sky map's
@@ -1150,6 +1146,14 @@ void main() {
     // Every lane ran every iteration of that loop (its exit is the same in all), so the counts,
     // equal before it, still are.
     maxSegment = max(maxSegment, loopIterations - segmentStart);
+  }
+  if (outOfBudget) {
+    // Cut short: the slots not started count too, each lane its own less those taken (all
+    // counted once, in the first lane, when shared). Here, after the loop, this costs once an
+    // invocation; in it, it cost every round (lavapipe runs a branch no lane takes).
+    uint own = lane < slotLanes || !sharedSlots ? ownSlots(firstLane + (sharedSlots ? lane : 0u)) : 0u;
+    uint all = sharedSlots ? subgroupAdd(own) : own;
+    if (!sharedSlots || subgroupElect()) cutPaths += all - min(taken, all);
   }
   atomicAdd(rayCounts[0], primaryRays);
   atomicAdd(rayCounts[1], bounceRays);
