@@ -352,7 +352,7 @@ Path startPath(uint slot, int found) {
   path.prevPos = path.ro;
   path.prevGroupTotal = -1.0;
   path.depth = 0;
-  path.selBase = selectionBase(px, py);
+  path.selBase = hasFeature(kFeatureSelectionCounts) ? selectionBase(px, py) : -1;
   path.auxAlbedo = vec3(0.0);
   path.auxNormal = vec3(0.0);
   path.auxEmission = vec3(0.0);
@@ -524,7 +524,7 @@ void resolveShadow(inout Path path, inout Shadow shadow, Trace tr) {
   int blocker = tr.blocker;
   if (!shadow.pending) return;
   shadowRays++;
-  if (shadow.selBase >= 0 && blocker >= 0) {
+  if (hasFeature(kFeatureSelectionCounts) && shadow.selBase >= 0 && blocker >= 0) {
     uint sets = countedSets(blocker);
     for (int k = 0; k < kCountedSets; ++k)
       if ((sets & (1u << k)) != 0u) atomicAdd(selectionCounts[shadow.selBase + 3 * k + 2], 1u);
@@ -724,7 +724,7 @@ bool shadeSegment(inout Path path, inout Shadow shadow, Hit hit) {
     path.beta *= transmittance(path.absorption, hit.t);
   }
 #endif
-  if (path.selBase >= 0 && hit.prim >= 0) {
+  if (hasFeature(kFeatureSelectionCounts) && path.selBase >= 0 && hit.prim >= 0) {
     // Direct hits (through boundaries too: nothing is picked yet), then reflections weighted
     // (maxBounces + 1) / depth: 4, 2, 1 at 3 bounces.
     uint sets = countedSets(hit.instance);

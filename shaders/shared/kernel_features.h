@@ -65,3 +65,9 @@ RETILE_KERNEL_FEATURE(RoughnessTextures, 25, "roughness textures")
 // (trace.comp sheetPasses) then look them up as its shading does. Without it they take its
 // untextured values, which are all it has (the kitchen 1.05x the samples/s).
 RETILE_KERNEL_FEATURE(SheetTextures, 26, "textured thin sheets")
+// The tracer counts what it sees of the selection per tile (Renderer::setSelection), for the
+// planner's indirection-aware policy: compiled in only for the frames that count
+// (FrameOptions::selectionTileSize), since lavapipe runs the counting's atomics, each a loop over
+// the lanes, at every shading point whether or not a lane counts (the Cornell box 1.08x the
+// samples/s without).
+RETILE_KERNEL_FEATURE(SelectionCounts, 27, "selection counts")

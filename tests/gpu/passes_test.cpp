@@ -328,9 +328,14 @@ TEST(TracePass, SelectionCountersSeeDirectHitsReflectionsAndShadows) {
   r->setScene(s);
   r->resize(w, h);
   r->setSelection(box, {box, other});
+  // A frame that does not count runs the scene's kernel, which lacks the counting code; the
+  // first frame that counts compiles the kernel with it, once.
+  r->renderFrame({{0, 0, w, h, 1, 0, true}}, FrameOptions{});
+  const std::size_t kernels = r->kernelsCompiled();
   FrameOptions count;
   count.selectionTileSize = tile;
   for (int f = 0; f < 4; ++f) r->renderFrame({{0, 0, w, h, 4, static_cast<std::uint32_t>(f * 4), f == 0}}, count);
+  EXPECT_EQ(r->kernelsCompiled(), kernels + 1);
   SelectionCounts c = r->takeSelectionCounts();
   ASSERT_EQ(c.tileSize, tile);
   ASSERT_EQ(c.object.direct.size(), 8u);  // 4 x 2 tiles
@@ -351,6 +356,8 @@ TEST(TracePass, SelectionCountersSeeDirectHitsReflectionsAndShadows) {
   for (std::size_t t : {0u, 1u, 4u, 5u}) EXPECT_EQ(c.group.direct[t], c.object.direct[t]) << "tile " << t;
   SelectionCounts again = r->takeSelectionCounts();
   EXPECT_EQ(again.object.direct[1] + again.object.direct[5], 0u) << "taking the counts clears them";
+  r->renderFrame({{0, 0, w, h, 1, 100, false}}, FrameOptions{});
+  EXPECT_EQ(r->kernelsCompiled(), kernels + 1) << "each kernel kept";
   // Nothing selected: nothing counted.
   r->setSelection(kNoNode);
   r->renderFrame({{0, 0, w, h, 1, 100, false}}, count);

@@ -70,6 +70,10 @@ struct Renderer::Impl {
   // code it lacks.
   std::map<std::tuple<bool, std::uint32_t, std::uint32_t>, std::unique_ptr<vk::ComputePipeline>> traceVariants;
   vk::ComputePipeline* trace = nullptr;
+  // The same with the selection's counting (kFeatureSelectionCounts), for the frames that count
+  // (FrameOptions::selectionTileSize): looked up at the first of them after selectTrace.
+  vk::ComputePipeline* traceCounting = nullptr;
+  std::tuple<bool, std::uint32_t, std::uint32_t> traceKey{false, 0u, 0u};  // trace's
   std::unique_ptr<vk::ComputePipeline> accumulate;
   std::unique_ptr<vk::ComputePipeline> reusePass;  // created with the history, on first use
   Denoiser denoiser{ctx};
@@ -203,7 +207,21 @@ struct Renderer::Impl {
 
   // Picks the trace kernel the scene needs.
   void selectTrace(bool alpha, std::uint32_t materialTypes, std::uint32_t features) {
+    traceKey = {alpha, materialTypes, features};
     trace = traceVariant(alpha, materialTypes, features);
+    traceCounting = nullptr;
+  }
+
+  // The kernel a frame runs: the scene's, or the one that also counts the selection.
+  vk::ComputePipeline* frameTrace(bool counting) {
+    if (!counting) return trace;
+    if (!traceCounting) {
+      auto [alpha, types, features] = traceKey;
+      traceCounting = traceVariant(alpha, types, features | static_cast<std::uint32_t>(gpu::kFeatureSelectionCounts));
+      ctx.wait();  // a frame in flight may have run this variant before selectTrace and still hold its descriptors
+      bindTrace(*traceCounting);
+    }
+    return traceCounting;
   }
 
   // A trace kernel variant, compiled on first use (about 0.3 s on lavapipe, on the render thread;
@@ -221,6 +239,7 @@ struct Renderer::Impl {
 
   void bindAll() {
     if (trace) bindTrace(*trace);
+    if (traceCounting) bindTrace(*traceCounting);
     bindAccumulate(*accumulate);
   }
 
@@ -523,6 +542,7 @@ struct Renderer::Impl {
     // The trace kernel divides by its invocations, at most the slots, in floats (integer.glsl quotient).
     RETILE_ASSERT(slots < (1ull << 30), cat("a frame of ", slots, " samples"));
     std::uint64_t invocations = 0;
+    vk::ComputePipeline* tracer = nullptr;
     if (!items.empty()) {
       ensureSampleCapacity(slots + 1);  // the trace pass's spare slot (trace.comp)
       VkDeviceSize workBytes = items.size() * sizeof(gpu::WorkItem);
@@ -536,6 +556,7 @@ struct Renderer::Impl {
       std::uint32_t zero[gpu::kStatsCount] = {};
       stats.upload(zero, sizeof zero);
       invocations = traceInvocations(slots, iterationsPerPath, options.pathsPerInvocation);
+      tracer = frameTrace(options.selectionTileSize > 0);
     }
     std::vector<gpu::ReuseItem> reuse;
     const std::uint64_t reusePixels = options.accumulate ? prepareReuse(options.reuse, reuse) : 0;
@@ -585,7 +606,7 @@ struct Renderer::Impl {
         gpu::TracePush tp{0, static_cast<std::uint32_t>(slots), static_cast<std::uint32_t>(invocations), 0};
         std::uint32_t gy;
         std::uint32_t gx = groupsFor(invocations, gpu::kTraceWorkgroup, &gy);
-        trace->dispatch(cb, gx, gy, &tp, sizeof tp);
+        tracer->dispatch(cb, gx, gy, &tp, sizeof tp);
         vk::computeBarrier(cb);
         gpu::AccumulatePush ap{0, static_cast<std::uint32_t>(pixels), static_cast<std::uint32_t>(items.size()), history.valid() ? 1u : 0u};
         gx = groupsFor(pixels, gpu::kAccumulateWorkgroup, &gy);
