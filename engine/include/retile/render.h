@@ -78,7 +78,8 @@ int offlineSamplesPerFrame(int width, int height);
 struct FrameOptions {
   bool accumulate = true;  // false: trace only (a probe); readbackFrameLuminance() gives the result
   // > 0: count what the tracer sees of the selection per tile of this size, with a kernel that has
-  // the counting (compiled at the first such frame after a scene change, about 0.3 s on lavapipe)
+  // the counting (compiled at the first such frame of each scene variant, about 0.3 s on
+  // lavapipe, and kept; the other frames run without that code)
   int selectionTileSize = 0;
   // Paths each trace invocation runs one after another; 0 chooses from the last frame's cost.
   // Fixed by tests and benchmarks: which invocation traces a sample never changes its value.
