@@ -6,12 +6,13 @@
 #
 # Why a script: the protocol (sizes, spp, the living room's plants left out) is easy to get
 # wrong by hand, and one pair's floor scatters with the seeds, so it is worth rerunning with
-# others. At the references' spp the three scenes take about 20 minutes on this machine's
+# others. At the references' spp the four scenes take about 25 minutes on this machine's
 # lavapipe; a lower SPP gives a quick, noisier check (the ratios stay meaningful: both sides'
 # noise is measured).
 #
 # usage: scripts/refs-compare.sh [--bin RETILE] [--spp N] [--seeds A,B] [--out DIR] [SCENE_NAME ...]
-#   SCENE_NAME: cornell-box, living-room, spaceship (default: all three)
+#   SCENE_NAME: a scene of ../shared/scenes with a reference in ../shared/refs (cornell-box,
+#   kitchen, living-room, spaceship); by default every one that has one
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 bin="$here/build/bin/retile"
@@ -37,7 +38,15 @@ case "$seedA$seedB" in '' | *[!0-9]*) echo "error: --seeds must be two integers,
 [ "$seedA" != "$seedB" ] || { echo "error: the two seeds must differ" >&2; exit 2; }
 shared="$here/../shared"
 [ -d "$shared/refs" ] || { echo "error: $shared/refs not found (../shared beside the repository)" >&2; exit 2; }
-[ ${#names[@]} -gt 0 ] || names=(cornell-box living-room spaceship)
+if [ ${#names[@]} -eq 0 ]; then
+  # Every reference names its scene: NAME_WxH_Nspp.exr.
+  for ref in "$shared"/refs/*_*x*_*spp.exr; do
+    [ -e "$ref" ] || continue
+    name="$(basename "$ref" | sed -E 's/_[0-9]+x[0-9]+_[0-9]+spp\.exr$//')"
+    [ -f "$shared/scenes/$name/scene.json" ] && names+=("$name")
+  done
+  [ ${#names[@]} -gt 0 ] || { echo "error: no reference in $shared/refs names a scene of $shared/scenes" >&2; exit 2; }
+fi
 mkdir -p "$out"
 
 for name in "${names[@]}"; do
