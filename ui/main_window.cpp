@@ -703,11 +703,11 @@ void MainWindow::onFrame() {
                                           : std::accumulate(frame->tileSamples.begin(), frame->tileSamples.end(), 0.0) /
                                                 static_cast<double>(frame->tileSamples.size());
   const QString mode = QString::fromStdString(frame->mode) + (frame->block > 1 ? tr(", preview 1/%1").arg(frame->block) : QString());
-  status_->setText(tr("%1 fps | %2 spp | queue %3/%4 | %5 (%6) | %7x%8 | %9")
+  const QString queue = frame->queueLength == 0 ? tr("whole image") : tr("queue %1/%2").arg(frame->queueServed).arg(frame->queueLength);
+  status_->setText(tr("%1 fps | %2 spp | %3 | %4 (%5) | %6x%7 | %8")
                        .arg(fps_, 0, 'f', 1)
                        .arg(spp, 0, 'f', 0)
-                       .arg(frame->queueServed)
-                       .arg(frame->queueLength)
+                       .arg(queue)
                        .arg(QString::fromStdString(frame->method), mode)
                        .arg(frame->width)
                        .arg(frame->height)

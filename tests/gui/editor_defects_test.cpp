@@ -234,8 +234,12 @@ TEST(EditorDefects, TheLegendExplainsWhatIsDrawnAndNothingElse) {
   FrameView* v = w->viewport();
   auto refining = std::make_shared<FrameRecord>(*v->frame());
   refining->mode = "refinement";
+  refining->queueLength = 0;  // outside a pass there is no queue
+  refining->queueServed = 0;
   auto inPass = std::make_shared<FrameRecord>(*refining);
   inPass->mode = "incremental";
+  inPass->queueLength = 40;
+  inPass->queueServed = 12;
   OverlaySettings o;
   o.priority = false;
   o.legend = true;
@@ -255,9 +259,12 @@ TEST(EditorDefects, TheLegendExplainsWhatIsDrawnAndNothingElse) {
   v->setOverlays(o);
   box = v->legendRect();
   EXPECT_GT(saturatedPixels(v->composed(), box), 50) << "the ramp with it";
+  auto lastLine = [&] { return v->legendItems().back().text; };
+  EXPECT_TRUE(lastLine().endsWith("incremental: 12 of 40 tiles")) << lastLine().toStdString();
   v->showFrame(refining);
   EXPECT_FALSE(v->heatMapShown()) << "no heat map outside a pass";
   EXPECT_EQ(saturatedPixels(v->composed(), v->legendRect()), 0);
+  EXPECT_TRUE(lastLine().endsWith("refinement: the whole image")) << "not \"0 of 0 tiles\": " << lastLine().toStdString();
 
   // Indirection with counters: the classes' row is in the legend's one box, inside the image.
   MethodSettings m;
