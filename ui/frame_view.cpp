@@ -413,10 +413,14 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
     }
   }
   if (overlays_.markers) {
-    QPointF poc(r.x() + f.pointOfChange.x * sx, r.y() + f.pointOfChange.y * sy);
-    p.setPen(QPen(kChangeColor, 2.5));
-    p.drawLine(poc + QPointF(-10, 0), poc + QPointF(10, 0));
-    p.drawLine(poc + QPointF(0, -10), poc + QPointF(0, 10));
+    // Before the first edit (and after a resize) nothing has changed: a cross at the image's
+    // centre would name a point of change that is not there.
+    if (!f.pointsOfChange.empty()) {
+      QPointF poc(r.x() + f.pointOfChange.x * sx, r.y() + f.pointOfChange.y * sy);
+      p.setPen(QPen(kChangeColor, 2.5));
+      p.drawLine(poc + QPointF(-10, 0), poc + QPointF(10, 0));
+      p.drawLine(poc + QPointF(0, -10), poc + QPointF(0, 10));
+    }
     p.setPen(QPen(kFocusColor, 2.5));
     for (const Vec2& fp : f.focus) p.drawEllipse(QPointF(r.x() + fp.x * sx, r.y() + fp.y * sy), 9, 9);
   }
@@ -448,7 +452,7 @@ std::vector<FrameView::LegendItem> FrameView::legendItems(bool everything) const
   if (overlays_.served && (everything || (!f.servedTiles.empty() && static_cast<int>(f.servedTiles.size()) < tiles)))
     items.push_back({K::Outline, kServedColor, tr("traced this frame")});
   if (overlays_.markers) {
-    items.push_back({K::Cross, kChangeColor, tr("point of change")});
+    if (everything || !f.pointsOfChange.empty()) items.push_back({K::Cross, kChangeColor, tr("point of change")});
     if (everything || !f.focus.empty()) items.push_back({K::Circle, kFocusColor, tr("focus point")});
   }
   if (overlays_.classes && (everything || !f.tileClass.empty())) {

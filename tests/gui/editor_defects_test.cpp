@@ -266,6 +266,31 @@ TEST(EditorDefects, TheLegendExplainsWhatIsDrawnAndNothingElse) {
   EXPECT_EQ(saturatedPixels(v->composed(), v->legendRect()), 0);
   EXPECT_TRUE(lastLine().endsWith("refinement: the whole image")) << "not \"0 of 0 tiles\": " << lastLine().toStdString();
 
+  // No point of change before the first edit: neither its cross (drawn at the image's centre,
+  // where nothing changed) nor its key. After one, both. The cross's colour around the point,
+  // where the built-in scene shows grey glass.
+  ASSERT_TRUE(refining->pointsOfChange.empty()) << "the first frames follow no edit";
+  o.markers = true;
+  v->setOverlays(o);
+  auto crossPixels = [&](const FrameRecord& f) {
+    const QImage img = v->composed();
+    const QRectF r = v->imageRect();
+    const QPointF at(r.x() + f.pointOfChange.x * r.width() / f.width, r.y() + f.pointOfChange.y * r.height() / f.height);
+    int n = 0;
+    for (int y = static_cast<int>(at.y()) - 12; y <= static_cast<int>(at.y()) + 12; ++y)
+      for (int x = static_cast<int>(at.x()) - 12; x <= static_cast<int>(at.x()) + 12; ++x)
+        n += img.rect().contains(x, y) && img.pixelColor(x, y) == FrameView::kChangeColor;
+    return n;
+  };
+  EXPECT_FALSE(keyed(Key::Cross));
+  EXPECT_EQ(crossPixels(*refining), 0) << "no cross where nothing changed";
+  auto edited = std::make_shared<FrameRecord>(*refining);
+  edited->pointsOfChange = {edited->pointOfChange};
+  v->showFrame(edited);
+  EXPECT_TRUE(keyed(Key::Cross));
+  EXPECT_GT(crossPixels(*edited), 20) << "the cross at the point of change";
+  v->showFrame(refining);
+
   // Indirection with counters: the classes' row is in the legend's one box, inside the image.
   MethodSettings m;
   m.kind = MethodKind::Indirection;
