@@ -474,9 +474,9 @@ std::vector<FrameView::LegendItem> FrameView::legendItems(bool everything) const
   // longest label stands in for it.
   const QString method = everything ? QStringLiteral("indirection+focus+smooth+denoise+reuse") : QString::fromStdString(f.method);
   const QString mode = everything ? QStringLiteral("global-update") : QString::fromStdString(f.mode);
-  // Outside a pass (refinement) there is no queue: the whole image takes the frame's samples,
-  // and "0 of 0 tiles" read as if nothing were being traced.
-  if (!everything && f.queueLength == 0) items.push_back({K::None, QColor(200, 200, 200), tr("%1, %2: the whole image").arg(method, mode)});
+  // Outside a pass the whole image takes the frame's samples: "0 of 0 tiles" read as if nothing
+  // were traced, and the finished pass's "170 of 170 tiles" as if it were still the plan.
+  if (!everything && !f.inPass()) items.push_back({K::None, QColor(200, 200, 200), tr("%1, %2: the whole image").arg(method, mode)});
   else
     items.push_back({K::None, QColor(200, 200, 200),
                      tr("%1, %2: %3 of %4 tiles")

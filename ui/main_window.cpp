@@ -703,7 +703,7 @@ void MainWindow::onFrame() {
                                           : std::accumulate(frame->tileSamples.begin(), frame->tileSamples.end(), 0.0) /
                                                 static_cast<double>(frame->tileSamples.size());
   const QString mode = QString::fromStdString(frame->mode) + (frame->block > 1 ? tr(", preview 1/%1").arg(frame->block) : QString());
-  const QString queue = frame->queueLength == 0 ? tr("whole image") : tr("queue %1/%2").arg(frame->queueServed).arg(frame->queueLength);
+  const QString queue = frame->inPass() ? tr("queue %1/%2").arg(frame->queueServed).arg(frame->queueLength) : tr("whole image");
   status_->setText(tr("%1 fps | %2 spp | %3 | %4 (%5) | %6x%7 | %8")
                        .arg(fps_, 0, 'f', 1)
                        .arg(spp, 0, 'f', 0)

@@ -265,6 +265,11 @@ TEST(EditorDefects, TheLegendExplainsWhatIsDrawnAndNothingElse) {
   EXPECT_FALSE(v->heatMapShown()) << "no heat map outside a pass";
   EXPECT_EQ(saturatedPixels(v->composed(), v->legendRect()), 0);
   EXPECT_TRUE(lastLine().endsWith("refinement: the whole image")) << "not \"0 of 0 tiles\": " << lastLine().toStdString();
+  auto afterPass = std::make_shared<FrameRecord>(*refining);
+  afterPass->queueLength = afterPass->queueServed = 40;  // the pass finished, its queue kept
+  v->showFrame(afterPass);
+  EXPECT_TRUE(lastLine().endsWith("refinement: the whole image")) << "not \"40 of 40 tiles\": " << lastLine().toStdString();
+  v->showFrame(refining);
 
   // No point of change before the first edit: neither its cross (drawn at the image's centre,
   // where nothing changed) nor its key. After one, both. The cross's colour around the point,

@@ -60,12 +60,16 @@ struct FrameRecord {
   std::vector<std::uint8_t> tileReuse;
   std::vector<std::uint64_t> tileRejectedAt;
   int reusedTiles = 0, rejectedTiles = 0;
-  std::size_t queueLength = 0;  // tiles in the current pass
+  std::size_t queueLength = 0;  // tiles in the current pass (or the last, once it is finished)
   std::size_t queueServed = 0;  // tiles of the pass finished
   std::uint64_t samples = 0;    // samples traced this frame: width x height, a preview's fewer
   int block = 1;                // > 1: a preview while edits come, a sample per block x block pixels
   double scheduleMs = 0, traceMs = 0, readbackMs = 0, frameMs = 0;
   std::shared_ptr<const RenderImage> image;  // the accumulated image after this frame (may be null)
+
+  // A pass is re-rendering its queue's tiles; otherwise (refinement, a global update) the whole
+  // image takes the frame's samples.
+  bool inPass() const { return queueLength > 0 && mode != "refinement"; }
 };
 
 // Image position (pixels, y down) of a world point seen by `camera` in a width x height image,
