@@ -347,11 +347,15 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
     }
   }
   const TileLabels labels = tileLabels(tileRect(0));
-  p.setFont(labels.font);
   const QFontMetricsF metrics(labels.font);
-  auto label = [&](const QRectF& box, Qt::Alignment align, const QString& text) {
-    // A label that does not fit its share of the tile is left out rather than overprinted.
-    if (metrics.horizontalAdvance(text) <= box.width()) p.drawText(box, align, text);
+  // `box` is the label's place in a whole tile, moved to `tile`: an edge tile that the image's
+  // border cuts short keeps only the part inside it. A label that does not fit is left out rather
+  // than overprinted (or printed past the image).
+  auto label = [&](const QRectF& box, const QRectF& tile, Qt::Alignment align, const QString& text) {
+    const QRectF inside = box.intersected(tile);
+    if (metrics.horizontalAdvance(text) > inside.width() || labels.font.pixelSize() > inside.height()) return;
+    p.setFont(labels.font);  // the denoised regions' labels, drawn between, set their own
+    p.drawText(inside, align, text);
   };
   if (overlays_.order && static_cast<int>(f.tilePriority.size()) == tiles && f.queueLength > 1) {
     p.setPen(Qt::white);
@@ -359,13 +363,13 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
       float pr = f.tilePriority[static_cast<std::size_t>(t)];
       if (pr < 0) continue;
       int rank = static_cast<int>(std::lround((1.0f - pr) * static_cast<float>(f.queueLength - 1))) + 1;
-      label(labels.order.translated(tileRect(t).topLeft() - tileRect(0).topLeft()), labels.orderAlign, QString::number(rank));
+      label(labels.order.translated(tileRect(t).topLeft() - tileRect(0).topLeft()), tileRect(t), labels.orderAlign, QString::number(rank));
     }
   }
   if (overlays_.samples && static_cast<int>(f.tileSamples.size()) == tiles) {
     p.setPen(QColor(180, 255, 180));
     for (int t = 0; t < tiles; ++t)
-      label(labels.samples.translated(tileRect(t).topLeft() - tileRect(0).topLeft()), labels.samplesAlign,
+      label(labels.samples.translated(tileRect(t).topLeft() - tileRect(0).topLeft()), tileRect(t), labels.samplesAlign,
             QString::number(static_cast<int>(f.tileSamples[static_cast<std::size_t>(t)])));
   }
   if (overlays_.served && static_cast<int>(f.servedTiles.size()) < tiles) {
@@ -408,7 +412,7 @@ void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
         p.setBrush(Qt::NoBrush);
         p.drawRect(box.adjusted(1, 1, -1, -1));
         const std::uint64_t at = t < static_cast<int>(f.tileRejectedAt.size()) ? f.tileRejectedAt[static_cast<std::size_t>(t)] : 0;
-        if (at > 0 && f.frame >= at) label(box.adjusted(2, 1, -2, -1), Qt::AlignLeft | Qt::AlignBottom, QString::number(f.frame - at));
+        if (at > 0 && f.frame >= at) label(box.adjusted(2, 1, -2, -1), box, Qt::AlignLeft | Qt::AlignBottom, QString::number(f.frame - at));
       }
     }
   }

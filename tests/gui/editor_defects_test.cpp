@@ -333,6 +333,48 @@ TEST(EditorDefects, OrderNumbersAndSampleCountsDoNotOverlap) {
   }
 }
 
+// Where the image's size is not a multiple of the tile's, the last row and column of tiles are
+// cut short: their numbers were placed as in a whole tile, below and beside the image.
+TEST(EditorDefects, TileNumbersStayInsideTheImage) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  FrameView* v = w->viewport();
+  auto f = std::make_shared<FrameRecord>(*v->frame());
+  // A tile size that leaves a thin last row and column.
+  f->tileSize = 1;
+  for (int t = 4; t <= 64; ++t)
+    if (f->height % t > 0 && f->height % t < t / 4 && f->width % t > 0) {
+      f->tileSize = t;
+      break;
+    }
+  ASSERT_GT(f->tileSize, 1) << f->width << "x" << f->height;
+  f->cols = (f->width + f->tileSize - 1) / f->tileSize;
+  f->rows = (f->height + f->tileSize - 1) / f->tileSize;
+  f->tileSamples.assign(static_cast<std::size_t>(f->cols * f->rows), 558.0f);
+  f->tilePriority.assign(f->tileSamples.size(), 0.5f);
+  f->queueLength = 2;
+  f->mode = "incremental";
+  v->showFrame(f);
+  OverlaySettings o;
+  // No legend: its strip grows with the numbers' keys, which would move the image.
+  o.priority = o.served = o.markers = o.denoised = o.reuse = o.legend = false;
+  v->setOverlays(o);
+  const QImage bare = v->composed();
+  o.samples = o.order = true;
+  v->setOverlays(o);
+  const QImage numbered = v->composed();
+  ASSERT_EQ(bare.size(), numbered.size());
+  const QRect image = v->imageRect().toAlignedRect();
+  int outside = 0, inside = 0;
+  for (int y = 0; y < bare.height(); ++y)
+    for (int x = 0; x < bare.width(); ++x) {
+      if (bare.pixel(x, y) == numbered.pixel(x, y)) continue;
+      (image.contains(x, y) ? inside : outside)++;
+    }
+  EXPECT_GT(inside, 100) << "the numbers are drawn";
+  EXPECT_EQ(outside, 0) << "none past the image's border (tile " << f->tileSize << ", image " << f->width << "x" << f->height << ")";
+}
+
 // 10. At 1280x800 and 1600x1000 drop-downs and number fields lost their arrows; Q's "auto" was
 // found only by stepping below 1; a typed Q applied at every digit.
 TEST(EditorDefects, TheRenderSettingsFitAndQHasAnAutoSwitch) {
