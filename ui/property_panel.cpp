@@ -443,9 +443,14 @@ void PropertyPanel::buildMaterial(Builder& b, const Material& m) {
     rebuildLater();  // the type decides which fields apply
   });
   // A boundary has no surface, and hair's colour is its pigment's absorption.
-  if (m.type != MaterialType::Boundary && m.type != MaterialType::Hair)
-    b.color(tr("Albedo"), "albedo", m.albedo, defaults.albedo,
-            [edit](Vec3 c, int drag) { edit(tr("Albedo"), drag, [c](Material& x) { x.albedo = c; }); });
+  if (m.type != MaterialType::Boundary && m.type != MaterialType::Hair) {
+    // With a texture the colour multiplies it (trace.comp fetchMaterial): a white swatch beside a
+    // wood texture read as the surface's colour.
+    const bool textured = m.albedoTexture != kNoNode;
+    ColorField* albedo = b.color(textured ? tr("Albedo \u00d7 texture") : tr("Albedo"), "albedo", m.albedo, defaults.albedo,
+                                 [edit](Vec3 c, int drag) { edit(tr("Albedo"), drag, [c](Material& x) { x.albedo = c; }); });
+    if (textured) albedo->setToolTip(tr("Multiplies the albedo texture (below) pixel by pixel"));
+  }
   if (hasRoughness(m.type)) roughnessRows(b, m);  // smooth types ignore roughness: no field that does nothing
   fieldRows(b, m, MaterialPlace::Surface);
   if (!isTransmissiveType(m.type)) {

@@ -8,6 +8,7 @@
 #include <QComboBox>
 #include <QDockWidget>
 #include <QFileDialog>
+#include <QFormLayout>
 #include <QFontMetricsF>
 #include <QLabel>
 #include <QLineEdit>
@@ -173,6 +174,26 @@ TEST(EditorDefects, TheColourDialogKeepsItsOwnColours) {
     }
   EXPECT_LT(limePixels, shot.width() * shot.height() / 10) << "only the colour's own preview is lime";
   dialog->reject();
+}
+
+// A textured albedo showed its colour as "Albedo": a white swatch above a wood texture read as the
+// surface's colour, where the kernel multiplies the two.
+TEST(EditorDefects, ATexturedAlbedoSaysItsColourMultipliesTheTexture) {
+  auto w = makeWindow();
+  auto albedoLabel = [&](const char* object) {
+    w->select(objectNamed(w->scene(), object));
+    QTest::qWait(50);  // the panel rebuilds
+    auto* field = w->findChild<ColorField*>("albedo");
+    if (!field) return QString("(no albedo field)");
+    auto* form = qobject_cast<QFormLayout*>(field->parentWidget()->layout());
+    auto* label = form ? qobject_cast<QLabel*>(form->labelForField(field)) : nullptr;
+    return label ? label->text() : QString("(no label)");
+  };
+  const Material* checkered = w->scene().material(w->scene().object(objectNamed(w->scene(), "Checkered Box"))->material);
+  ASSERT_NE(checkered->albedoTexture, kNoNode) << "the built-in scene's box is textured";
+  EXPECT_EQ(albedoLabel("Checkered Box"), QString::fromUtf8("Albedo \u00d7 texture"));
+  EXPECT_FALSE(w->findChild<ColorField*>("albedo")->toolTip().isEmpty());
+  EXPECT_EQ(albedoLabel("Glossy Sphere"), QString("Albedo"));
 }
 
 // 6. Cancelling the colour dialog left an empty undo step and cleared Redo.
