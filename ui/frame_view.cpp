@@ -527,8 +527,9 @@ QRectF FrameView::legendRect() const {
 }
 
 bool FrameView::heatMapShown() const {
-  // Outside a pass every tile has the same standing: a heat map would only tint the picture.
-  return overlays_.priority && frame_ && frame_->mode != "refinement";
+  // Outside a pass (refining, or a global update restarting every tile) every tile has the same
+  // standing: a heat map would only tint the picture, and its key would name tiles still to come.
+  return overlays_.priority && frame_ && frame_->inPass();
 }
 
 bool FrameView::heatMapOn(int tile) const {

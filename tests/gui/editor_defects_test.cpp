@@ -290,6 +290,13 @@ TEST(EditorDefects, TheLegendExplainsWhatIsDrawnAndNothingElse) {
   afterPass->queueLength = afterPass->queueServed = 40;  // the pass finished, its queue kept
   v->showFrame(afterPass);
   EXPECT_TRUE(lastLine().endsWith("refinement: the whole image")) << "not \"40 of 40 tiles\": " << lastLine().toStdString();
+  // A global update (a camera or settings change) restarts every tile with no queue: no ramp.
+  auto global = std::make_shared<FrameRecord>(*refining);
+  global->mode = "global-update";
+  v->showFrame(global);
+  EXPECT_FALSE(v->heatMapShown()) << "no heat map in a global update";
+  EXPECT_FALSE(keyed(Key::Ramp)) << "its key names tiles still to come, and there are none";
+  EXPECT_EQ(saturatedPixels(v->composed(), v->legendRect()), 0);
   v->showFrame(refining);
 
   // No point of change before the first edit: neither its cross (drawn at the image's centre,
