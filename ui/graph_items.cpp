@@ -57,12 +57,15 @@ const QStringList& textureInputs() {
   return inputs;
 }
 
-bool isTextureInput(const QString& s) { return textureInputs().contains(s); }
-
 NodeId Material::*textureSlot(const QString& input) {
   // textureInputs() lists the rows' names in the rows' order.
   const qsizetype i = textureInputs().indexOf(input);
   return i < 0 ? nullptr : kMaterialTextures[static_cast<std::size_t>(i)].field;
+}
+
+bool textureInputApplies(const QString& input, MaterialType t) {
+  const qsizetype i = textureInputs().indexOf(input);
+  return i >= 0 && kMaterialTextures[static_cast<std::size_t>(i)].appliesTo(t);
 }
 
 GraphNodeItem::GraphNodeItem(NodeId nodeId, NodeKind nodeKind) : id(nodeId), kind(nodeKind) {

@@ -43,8 +43,10 @@ QColor displayColor(const Vec3& linear);
 inline const QString kBlendInput = QStringLiteral("blend");
 // A material node's texture inputs, top to bottom ("albedo", "roughness", ...).
 const QStringList& textureInputs();
-bool isTextureInput(const QString& s);
 NodeId Material::*textureSlot(const QString& input);  // null for a name that is not a texture input
+// Whether a texture in `input` changes how a material of type `t` renders (its row's types): a
+// lambert has no roughness for a texture to scale.
+bool textureInputApplies(const QString& input, MaterialType t);
 
 // One node: a rounded box with a coloured header, a subtitle line and one row per socket (inputs on
 // the left, the output on the right of the first row). Plain data; the view lays it out and rebuilds it.

@@ -238,9 +238,12 @@ std::vector<GraphNodeItem*> NodeGraphView::addNodes() {
     QString sub = QString::fromLatin1(materialTypeName(m.type));
     if (m.emissive()) sub += tr(", emissive");
     GraphNodeItem* n = add(m.id, NodeKind::Material, m.name, sub);
-    // A boundary is no surface: no texture or blend would change what it renders.
+    // A boundary is no surface: no texture or blend would change what it renders. Other types
+    // show the inputs their type reads, and any other that still holds a texture (the type was
+    // changed), so that its link can be seen and taken off.
     if (m.type != MaterialType::Boundary) {
-      n->inputs = textureInputs();
+      for (const QString& input : textureInputs())
+        if (textureInputApplies(input, m.type) || m.*textureSlot(input) != kNoNode) n->inputs << input;
       n->inputs << kBlendInput;
       if (roughnessSlotIsThickness(m.type)) {
         n->labels.resize(n->inputs.size());
@@ -454,7 +457,7 @@ bool NodeGraphView::accepts(NodeId from, NodeId to, const QString& input) const 
   const Material* m = scene_.material(to);
   if (!m || m->type == MaterialType::Boundary) return false;  // a boundary has no inputs
   if (input == kBlendInput) return from != to && scene_.material(from);
-  return isTextureInput(input) && scene_.texture(from);
+  return textureInputApplies(input, m->type) && scene_.texture(from);
 }
 
 const NodeGraphView::Link* NodeGraphView::insertTarget() const {

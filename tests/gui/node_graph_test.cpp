@@ -257,6 +257,37 @@ TEST_F(NodeGraph, ABoundaryHasNoInputs) {
   EXPECT_TRUE(edits.empty());
 }
 
+// A material node offers the inputs its type reads: a lambert has no roughness for a texture to
+// scale, so no socket for one, and no link is taken there. One its type stopped reading but that
+// still holds a texture stays, so the link can be seen and taken off.
+TEST_F(NodeGraph, AMaterialShowsTheInputsItsTypeReads) {
+  const NodeId lambert = named(scene().materials, "Checkered");
+  const NodeId rough = named(scene().materials, "Ground");
+  const NodeId checker = named(scene().textures, "Checker");
+  ASSERT_EQ(scene().material(lambert)->type, MaterialType::Lambert);
+  ASSERT_EQ(scene().material(rough)->type, MaterialType::RoughPlastic);
+  auto hasSocket = [&](NodeId id, const char* input) { return view.socketScenePos(id, input, false) != view.nodePosition(id); };
+  EXPECT_FALSE(hasSocket(lambert, "roughness"));
+  EXPECT_TRUE(hasSocket(lambert, "albedo"));
+  EXPECT_TRUE(hasSocket(lambert, "bump"));
+  EXPECT_TRUE(hasSocket(lambert, "blend"));
+  EXPECT_FALSE(view.link(checker, lambert, "roughness"));
+  EXPECT_TRUE(edits.empty());
+
+  EXPECT_TRUE(hasSocket(rough, "roughness"));
+  ASSERT_TRUE(view.link(checker, rough, "roughness"));
+  Material changed = *scene().material(rough);
+  changed.type = MaterialType::Lambert;
+  ASSERT_TRUE(doc.apply(SetMaterial{changed}).ok());
+  view.setDocument(doc.scene());
+  EXPECT_TRUE(hasSocket(rough, "roughness")) << "its texture is still there";
+  EXPECT_EQ(view.linkSource(rough, "roughness"), checker);
+  ASSERT_TRUE(view.unlink(rough, "roughness"));
+  EXPECT_EQ(scene().material(rough)->roughnessTexture, kNoNode);
+  EXPECT_FALSE(hasSocket(rough, "roughness"));
+  EXPECT_FALSE(view.link(checker, rough, "roughness"));
+}
+
 // A sheet has no roughness; its "roughness" texture is read as its thickness, and the node says
 // so, while the socket keeps its name (links, the API).
 TEST_F(NodeGraph, ASheetsRoughnessInputIsShownAsItsThickness) {
@@ -429,6 +460,7 @@ TEST_F(NodeGraph, MarqueeSelectsAndFAndAFrame) {
   const QPoint centre = at(p + QPointF(95, 30));
   EXPECT_LT((centre - vp()->rect().center()).manhattanLength(), 20) << "around it";
 
+  view.resize(1400, 1000);  // room for the whole graph at a legible zoom (else A keeps the selection in view)
   QTest::keyClick(&view, Qt::Key_A);
   const QRectF visible = view.mapToScene(vp()->rect()).boundingRect();
   for (const Object& o : scene().objects) EXPECT_TRUE(visible.contains(view.nodePosition(o.id))) << o.name;
