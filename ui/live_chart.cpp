@@ -65,7 +65,7 @@ LiveChart::LiveChart(QWidget* parent) : QWidget(parent) {
   chart->addSeries(frameMs_);
   timeAxis_ = new QValueAxis(chart);
   timeAxis_->setLabelFormat("%.0f s");
-  timeAxis_->setRange(-kWindowSeconds, 0);
+  timeAxis_->setRange(0, kWindowSeconds);
   rateAxis_ = new QValueAxis(chart);
   msAxis_ = new QValueAxis(chart);
   chart->addAxis(timeAxis_, Qt::AlignBottom);
@@ -84,7 +84,7 @@ LiveChart::LiveChart(QWidget* parent) : QWidget(parent) {
   error_->setName(tr("relative RMSE against the reference (4x4 blocks)"));
   errChart->addSeries(error_);
   errTimeAxis_ = new QValueAxis(errChart);
-  errTimeAxis_->setRange(-kWindowSeconds, 0);
+  errTimeAxis_->setRange(0, kWindowSeconds);
   errTimeAxis_->setLabelFormat("%.0f s");
   errAxis_ = new QValueAxis(errChart);
   errAxis_->setLabelFormat("%.3f");
@@ -135,8 +135,11 @@ void LiveChart::trim(double now) {
     while (drop < s->count() && s->at(drop).x() < now - kWindowSeconds) ++drop;
     if (drop > 0) s->removePoints(0, drop);
   }
-  timeAxis_->setRange(now - kWindowSeconds, now);
-  errTimeAxis_->setRange(now - kWindowSeconds, now);
+  // Seconds since the editor opened; in the first minute the window starts at 0 and fills, so
+  // that no time before the editor opened is shown.
+  const double from = std::max(0.0, now - kWindowSeconds);
+  timeAxis_->setRange(from, from + kWindowSeconds);
+  errTimeAxis_->setRange(from, from + kWindowSeconds);
 }
 
 void LiveChart::addFrame(const FrameRecord& frame) {

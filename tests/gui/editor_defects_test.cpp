@@ -19,6 +19,7 @@
 #include <QTest>
 #include <QTimer>
 #include <QTreeWidget>
+#include <QValueAxis>
 
 #include <gtest/gtest.h>
 
@@ -521,6 +522,18 @@ TEST(EditorDefects, TheLiveChartHasRoomForItsPlotsAndLabels) {
     EXPECT_GE(c->plotArea().height(), 80) << "the plot";
     for (QAbstractAxis* a : c->axes()) EXPECT_FALSE(a->labelsTruncated()) << "no label is cut to ...";
   }
+  // Its time axis counts from the editor's opening: in the first minute it starts at 0 (it showed
+  // "-9 s" to "51 s", times before the editor opened), and spans the minute the legend names.
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 3; }));
+  QTest::qWait(100);
+  ASSERT_GT(chart->throughputPoints(), 0);
+  for (QChart* c : chart->charts())
+    for (QAbstractAxis* a : c->axes(Qt::Horizontal)) {
+      auto* time = qobject_cast<QValueAxis*>(a);
+      ASSERT_TRUE(time);
+      EXPECT_EQ(time->min(), 0.0);
+      EXPECT_EQ(time->max(), 60.0);
+    }
 }
 
 // 16. The log did not follow new entries, and a missing file was reported twice.
