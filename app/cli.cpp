@@ -23,13 +23,8 @@ Result<ImportedScene> loadScene(const std::string& name) {
 }
 
 void printRenderWarnings(const std::vector<std::string>& renderWarnings, const std::vector<std::string>& importWarnings) {
-  for (const auto& w : renderWarnings) {
-    // "FILE: problem": the importer has already reported a missing file; say the rest.
-    std::string file = std::filesystem::path(w.substr(0, w.find(": "))).filename().string();
-    bool known = !file.empty() && std::any_of(importWarnings.begin(), importWarnings.end(),
-                                              [&](const std::string& i) { return i.find(file) != std::string::npos; });
-    if (!known) std::fprintf(stderr, "warning: %s\n", w.c_str());
-  }
+  for (const auto& w : renderWarnings)
+    if (!importReported(w, importWarnings)) std::fprintf(stderr, "warning: %s\n", w.c_str());
 }
 
 void progressBar(const std::string& label, int done, int total, double seconds) {

@@ -687,7 +687,12 @@ void MainWindow::startEngine(Scene scene) {
 void MainWindow::onFrame() {
   if (!engine_) return;
   auto frame = engine_->latestFrame();
-  for (const auto& e : engine_->takeErrors()) log(QString::fromStdString(e));
+  for (const auto& e : engine_->takeErrors()) {
+    // A missing file the import reported comes back from the scene's upload in other words.
+    const std::string warning = "warning: ";
+    if (e.starts_with(warning) && importReported(e.substr(warning.size()), importWarnings_)) continue;
+    log(QString::fromStdString(e));
+  }
   if (!frame) return;
   view_->showFrame(frame);
   updateGizmo();
@@ -715,7 +720,7 @@ void MainWindow::onFrame() {
 }
 
 void MainWindow::log(const QString& line) {
-  // The same warning from the importer and again from the renderer is one warning.
+  // A warning said again (the scene uploaded again, a device replaced) is logged once.
   if (line.startsWith("warning: ")) {
     if (loggedWarnings_.contains(line)) return;
     loggedWarnings_.insert(line);
@@ -983,6 +988,7 @@ void MainWindow::replaceDocument(Scene scene, const std::filesystem::path& file)
   methodPanel_->setFocus({});
   updateTitle();
   loggedWarnings_.clear();
+  importWarnings_.clear();
   startEngine(doc_.scene());
   applySceneView();
   rebuildOutliner();

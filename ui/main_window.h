@@ -178,8 +178,9 @@ class MainWindow : public QMainWindow {
   QElapsedTimer focusTimer_;
   QComboBox* displayView_ = nullptr;  // the viewport's OCIO view
   QPlainTextEdit* log_ = nullptr;
-  PropertyPanel* panelEdit_ = nullptr;  // the panel whose own edit is being applied (it shows it already)
-  QSet<QString> loggedWarnings_;        // of the current document: each is logged once
+  PropertyPanel* panelEdit_ = nullptr;       // the panel whose own edit is being applied (it shows it already)
+  QSet<QString> loggedWarnings_;             // of the current document: each is logged once
+  std::vector<std::string> importWarnings_;  // the current document's import's
   QLabel* status_ = nullptr;
   QLabel* toolLabel_ = nullptr;
   QMenu* recentMenu_ = nullptr;

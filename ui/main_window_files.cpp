@@ -111,6 +111,7 @@ void MainWindow::opened(const std::filesystem::path& file, const std::vector<std
   log(tr("opened %1").arg(QString::fromStdString(file.string())));
   rememberRecent(file);
   for (const auto& w : warnings) log(tr("warning: %1").arg(QString::fromStdString(w)));
+  importWarnings_ = warnings;
   if (warnings.empty()) return;
   const QString text = tr("%n warning(s) opening %1: see the Log", nullptr, static_cast<int>(warnings.size()))
                            .arg(QString::fromStdString(file.filename().string()));

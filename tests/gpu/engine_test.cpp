@@ -10,6 +10,7 @@
 
 #include "gpu_support.h"
 #include "retile/engine.h"
+#include "retile/io.h"
 #include "retile/session.h"
 #include "scene/synthetic.h"
 #include "test_support.h"
@@ -159,6 +160,39 @@ TEST(Engine, SceneMemoryPartsAddUp) {
   EXPECT_EQ(m.triangles, r->sceneTriangles() * 48);
   EXPECT_EQ(m.shading, r->sceneTriangles() * 64);
   EXPECT_GT(m.bvh, r->sceneTriangles() * 8) << "a node per few triangles";
+}
+
+// A sky map that cannot be read is said once, as what stands in for it (a constant sky), not as
+// a texture shown as a checker; said with its file's name first, so that a warning the import
+// gave already is recognised (importReported). The same file as a material's texture is the
+// material's checker.
+TEST(Engine, AMissingSkyMapIsReportedOnceAsTheConstantSkyItBecomes) {
+  RETILE_RENDERER_OR_SKIP(r);
+  Scene s = test::emptyScene(8, 8);
+  const NodeId sky = test::addFileTexture(s, "no-such-sky.exr", TextureColorSpace::Auto);
+  s.environment.type = EnvironmentType::Map;
+  s.environment.map = sky;
+  s.environment.color = Vec3{1.0f};
+  auto naming = [](const std::vector<std::string>& warnings) {
+    std::vector<std::string> out;
+    for (const auto& w : warnings)
+      if (w.find("no-such-sky.exr") != std::string::npos) out.push_back(w);
+    return out;
+  };
+  const auto once = naming(r->setScene(s));
+  ASSERT_EQ(once.size(), 1u);
+  EXPECT_NE(once[0].find("constant"), std::string::npos) << once[0];
+  EXPECT_EQ(once[0].find("checker"), std::string::npos) << once[0];
+  EXPECT_TRUE(importReported(once[0], {"scene.json: environment map 'no-such-sky.exr' is missing"}));
+  EXPECT_FALSE(importReported(once[0], {"scene.json: texture 'leaf.png' not found"}));
+
+  Material m;
+  m.albedoTexture = sky;
+  test::addMaterial(s, m);
+  const auto twice = naming(r->setScene(s));
+  ASSERT_EQ(twice.size(), 2u);
+  EXPECT_NE(twice[0].find("checker"), std::string::npos) << twice[0];
+  EXPECT_NE(twice[1].find("constant"), std::string::npos) << twice[1];
 }
 
 TEST(Engine, FramesFlowAndEditsArriveWithTheirVersion) {

@@ -33,6 +33,11 @@ struct ImportedScene {
 // (.json), everything else through Assimp in a child process.
 Result<ImportedScene> importScene(const std::filesystem::path& file, const ImportOptions& options = {});
 
+// Whether a renderer's warning about a scene's file ("FILE: problem", Renderer::setScene) names a
+// file that one of `importWarnings`, the same scene's import warnings, already named: the import
+// said what stands in for it, so the renderer's is the same news again. Any thread.
+bool importReported(const std::string& renderWarning, const std::vector<std::string>& importWarnings);
+
 Result<ImportedScene> importTungsten(const std::filesystem::path& file, const ImportOptions& options = {});
 Result<ImportedScene> importAssimp(const std::filesystem::path& file, const ImportOptions& options = {});
 Result<ImportedScene> loadNativeScene(const std::filesystem::path& file, const ImportOptions& options = {});

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 
@@ -112,6 +113,12 @@ Result<ImportedScene> importByFormat(const fs::path& file, const ImportOptions& 
 }
 
 }  // namespace
+
+bool importReported(const std::string& renderWarning, const std::vector<std::string>& importWarnings) {
+  const std::string file = fs::path(renderWarning.substr(0, renderWarning.find(": "))).filename().string();
+  return !file.empty() &&
+         std::any_of(importWarnings.begin(), importWarnings.end(), [&](const std::string& i) { return i.find(file) != std::string::npos; });
+}
 
 Result<ImportedScene> importScene(const fs::path& file, const ImportOptions& options) {
   auto imported = importByFormat(file, options);

@@ -335,9 +335,15 @@ std::uint32_t RenderSceneBuilder::packEnvironment(const Scene& scene, std::vecto
     if (map >= 0 &&
         (std::bit_cast<std::int32_t>(data_.textureInfo[static_cast<std::size_t>(map) * gpu::kTextureTexels].w) & 15) != gpu::kTexBitmap)
       map = -1;  // it could not be read (packTextures said why) and stands in as a checker
-    if (map < 0 && warnings)
-      warnings->push_back(cat("environment: ", t ? cat("the map '", t->name, "' could not be read") : std::string("no map texture is set"),
-                              "; lighting with a constant sky of radiance ", luminance(tint), " instead"));
+    if (map < 0 && warnings) {
+      // A file that could not be read leads with its path and why (as a texture's warning does,
+      // so that one the import already reported is recognised: importReported).
+      const auto read = t ? decoded_.find(t->id) : decoded_.end();
+      const std::string why = read != decoded_.end() && !read->second.error.empty() ? read->second.error
+                              : t ? cat("environment: the map '", t->name, "' could not be read")
+                                  : std::string("environment: no map texture is set");
+      warnings->push_back(cat(why, "; the sky is a constant of radiance ", luminance(tint), " instead of the map"));
+    }
     if (map >= 0) source = environmentSource(e, t, decoded_[t->id].signature);
   }
   // A sky packed after the scene's textures stays while it is the same sky.

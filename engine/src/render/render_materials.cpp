@@ -321,6 +321,13 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
     data_.textureInfo.push_back(v4(off, static_cast<float>(std::max(rv, 1))));
     return (on + off) * 0.5f;
   };
+  auto environmentOnly = [&](NodeId id) {
+    if (scene.environment.type != EnvironmentType::Map || scene.environment.map != id) return false;
+    return std::none_of(scene.materials.begin(), scene.materials.end(), [id](const Material& m) {
+      const auto used = m.textures();
+      return std::find(used.begin(), used.end(), id) != used.end();
+    });
+  };
   for (const Texture& t : scene.textures) {
     int index = static_cast<int>(data_.textureInfo.size() / gpu::kTextureTexels);
     textureIndex_[t.id] = index;
@@ -343,6 +350,7 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
       d.signature = sig;
       auto img = loadTexture(t, scene.baseDirectory);
       d.ok = img.ok();
+      if (!img.ok()) d.error = img.error();
       if (img.ok()) {
         const TextureImage& im = img.value();
         d.width = im.width;
@@ -356,7 +364,8 @@ void RenderSceneBuilder::packTextures(const Scene& scene, std::vector<std::strin
           d.mean = appendHalves(data_.texels, im.rgba, &scale);
           d.flags |= scale << gpu::kTexScaleShift;
         }
-      } else if (warnings) {
+      } else if (warnings && !environmentOnly(t.id)) {
+        // (What a sky map that cannot be read stands in for, the environment's warning says.)
         warnings->push_back(cat(img.error(), t.whenMissing == MissingTexture::BlackAndWhite
                                                  ? "; shown as Tungsten shows it (a black and white checker)"
                                                  : "; shown as a magenta checker"));

@@ -224,6 +224,7 @@ class RenderSceneBuilder {
     std::size_t slopeWords = 0;         // its slopes' words after the colour's (0: none packed)
     int width = 0, height = 0, flags = 0;
     Vec3 mean{0.0f};
+    std::string error;  // why it could not be read ("" when it was)
   };
 
   void packGeometry(const Scene& scene);
