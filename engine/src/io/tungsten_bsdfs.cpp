@@ -54,11 +54,11 @@ NodeId TungstenImporter::fileTexture(const std::string& ref, TextureColorSpace c
   t.whenMissing = MissingTexture::BlackAndWhite;
   t.interpolate = interpolate;
   t.clampToEdge = clampToEdge;
-  // One warning per missing file, however many materials use it; the environment says its own.
+  // One warning per missing file, however many materials use it and in whichever role (the checker
+  // stands in as a colour, an alpha or a bump alike); the environment says its own.
   if (!resolveScenePath(base_, ref) && !quietMissingTexture_ && missingWarned_.insert(ref).second)
     warn(cat("texture '", ref,
-             "' not found; until the file is there it renders as Tungsten renders a missing texture, a black and white checker (as colour "
-             "and as alpha)"));
+             "' not found; until the file is there it renders as Tungsten renders a missing texture, a black and white checker"));
   out_.scene.textures.push_back(t);
   textures_[key] = t.id;
   return t.id;
