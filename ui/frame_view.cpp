@@ -303,8 +303,9 @@ void FrameView::compose(QPainter& p, const QRect& area) const {
 void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {
   if (!frame_) return;
   const FrameRecord& f = *frame_;
-  if (selection_.size() > 1 && f.image) {
-    // Outlined pixel by pixel from the frame's object ids: which objects a move will take along.
+  if (!selection_.empty() && f.image) {
+    // Outlined pixel by pixel from the frame's object ids: what was picked (the gizmo sits at its
+    // pivot, which may lie outside it), and which objects a move will take along.
     if (outlineOf_ != f.image.get()) {
       outlineOf_ = f.image.get();
       const auto& ids = f.image->objectId;

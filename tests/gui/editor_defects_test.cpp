@@ -786,6 +786,35 @@ TEST(EditorDefects, CtrlClickSelectsSeveralObjectsAndADragMovesThemTogether) {
   EXPECT_EQ(w->selectedObjects(), std::vector<NodeId>{sphere});
 }
 
+// A single pick is outlined too: only the gizmo showed, at the object's pivot, which in a scene
+// of meshes modelled in world space (the kitchen's) lies far from what was picked.
+TEST(EditorDefects, ThePickedObjectIsOutlined) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  FrameView* v = w->viewport();
+  OverlaySettings o;  // only the outline: the denoised regions' dashes are orange too
+  o.priority = o.served = o.markers = o.denoised = o.reuse = o.legend = false;
+  v->setOverlays(o);
+  auto outlined = [&] {
+    const QImage img = v->composed();
+    int n = 0;
+    for (int y = 0; y < img.height(); ++y)
+      for (int x = 0; x < img.width(); ++x) {
+        const QColor c = img.pixelColor(x, y);  // qRgb(255, 160, 40), blended where it is scaled
+        n += c.red() > 215 && std::abs(c.green() - 160) < 40 && c.blue() < 90;
+      }
+    return n;
+  };
+  EXPECT_EQ(outlined(), 0) << "nothing picked";
+  const NodeId sphere = objectNamed(w->scene(), "Glossy Sphere");
+  w->select(sphere);
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 4; }));
+  const int one = outlined();
+  EXPECT_GT(one, 40) << "the sphere's silhouette";
+  w->select(kNoNode);
+  EXPECT_EQ(outlined(), 0);
+}
+
 // The pixel filter, how it is drawn and Tungsten's other conventions are render settings:
 // chosen in Properties, each reaches the engine as one undo step and restarts the accumulation.
 TEST(EditorDefects, ThePixelFilterIsARenderSettingWithUndo) {
