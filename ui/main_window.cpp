@@ -275,6 +275,7 @@ void MainWindow::buildMenus() {
   });
   // Spelled out: QKeySequence::SaveAs is empty on desktops without a key theme.
   file->addAction(tr("Save &As..."), QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_S), this, [this] { saveAs(); });
+  file->addAction(tr("Save &Image..."), QKeySequence(Qt::CTRL | Qt::Key_E), this, [this] { saveImage(); });
   file->addSeparator();
   file->addAction(tr("&Quit"), QKeySequence::Quit, this, &QWidget::close);
 

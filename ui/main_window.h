@@ -71,6 +71,12 @@ class MainWindow : public QMainWindow {
   void log(const QString& line);
   // Asks for a .retile file (the "saveAsDialog") and saves there.
   bool saveAs();
+  // The picture the viewport shows (the denoised view where it is denoised; no overlays), at its
+  // render resolution: EXR linear with the raw accumulation and the guide channels, PNG through
+  // the viewport's view, exposure and gamma. Atomic; an error is shown. saveImage asks for the
+  // file (the "saveImageDialog").
+  bool saveImageTo(const std::filesystem::path& file);
+  bool saveImage();
 
   const Scene& scene() const { return doc_.scene(); }
   std::uint64_t documentVersion() const { return doc_.version(); }

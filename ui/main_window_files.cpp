@@ -1,5 +1,8 @@
 // The window's document on disk: opening, saving, the autosave and its recovery, recent files,
 // files dropped on the window. GUI thread only, like the rest of MainWindow.
+#include <algorithm>
+#include <cctype>
+
 #include <QCloseEvent>
 #include <QDateTime>
 #include <QDir>
@@ -18,6 +21,7 @@
 
 #include "frame_view.h"
 #include "main_window.h"
+#include "retile/image.h"
 #include "retile/io.h"
 
 namespace retile::ui {
@@ -153,6 +157,36 @@ bool MainWindow::saveAs() {
   dialog.setDefaultSuffix("retile");
   if (dialog.exec() != QDialog::Accepted || dialog.selectedFiles().isEmpty()) return false;
   return saveTo(dialog.selectedFiles().front().toStdString());
+}
+
+bool MainWindow::saveImage() {
+  QFileDialog dialog(this, tr("Save image"), QString(), tr("OpenEXR, linear (*.exr);;PNG, as shown (*.png)"));
+  dialog.setObjectName("saveImageDialog");
+  dialog.setAcceptMode(QFileDialog::AcceptSave);
+  dialog.setDefaultSuffix("exr");
+  if (dialog.exec() != QDialog::Accepted || dialog.selectedFiles().isEmpty()) return false;
+  return saveImageTo(dialog.selectedFiles().front().toStdString());
+}
+
+bool MainWindow::saveImageTo(const std::filesystem::path& file) {
+  const auto& frame = view_->frame();
+  if (!frame || !frame->image) {
+    showError(tr("Cannot save the image"), tr("%1: nothing is rendered yet").arg(QString::fromStdString(file.string())));
+    return false;
+  }
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext != ".exr" && ext != ".png") {
+    showError(tr("Cannot save the image"), tr("%1: the name must end in .exr or .png").arg(QString::fromStdString(file.string())));
+    return false;
+  }
+  auto r = writeRenderImage(*frame->image, file, view_->display());
+  if (!r) {
+    showError(tr("Cannot save the image"), QString::fromStdString(r.error()));
+    return false;
+  }
+  notify(tr("saved the image (%1x%2) to %3").arg(frame->image->width).arg(frame->image->height).arg(QString::fromStdString(file.string())));
+  return true;
 }
 
 void MainWindow::updateTitle() {

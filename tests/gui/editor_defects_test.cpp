@@ -23,6 +23,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <set>
 #include <string>
 
@@ -813,6 +815,42 @@ TEST(EditorDefects, ThePickedObjectIsOutlined) {
   EXPECT_GT(one, 40) << "the sphere's silhouette";
   w->select(kNoNode);
   EXPECT_EQ(outlined(), 0);
+}
+
+// File > Save Image writes what the viewport shows: an artist had no way to keep a picture from
+// the editor. PNG through the viewport's view and exposure, EXR linear; a bad name is an error.
+TEST(EditorDefects, TheViewportsPictureSavesAsAnImage) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 3 && f.image; }));
+  QTemporaryDir dir;
+  ASSERT_TRUE(dir.isValid());
+  const std::filesystem::path base = dir.path().toStdString();
+  auto meanOf = [](const QImage& img) {
+    double sum = 0;
+    for (int y = 0; y < img.height(); ++y)
+      for (int x = 0; x < img.width(); ++x) sum += qGray(img.pixel(x, y));
+    return sum / std::max(1, img.width() * img.height());
+  };
+  ASSERT_TRUE(w->saveImageTo(base / "shown.png")) << w->lastError().toStdString();
+  const QImage shown(QString::fromStdString((base / "shown.png").string()));
+  ASSERT_FALSE(shown.isNull());
+  const FrameRecord& f = *w->viewport()->frame();
+  EXPECT_EQ(shown.width(), f.image->width);
+  EXPECT_EQ(shown.height(), f.image->height);
+  EXPECT_GT(meanOf(shown), 20.0) << "the lit scene";
+  DisplaySettings darker = w->viewport()->display();
+  darker.exposure -= 2;
+  w->viewport()->setDisplay(darker);
+  ASSERT_TRUE(w->saveImageTo(base / "darker.png"));
+  EXPECT_LT(meanOf(QImage(QString::fromStdString((base / "darker.png").string()))), 0.75 * meanOf(shown)) << "as the viewport shows it";
+
+  ASSERT_TRUE(w->saveImageTo(base / "linear.exr"));
+  std::ifstream exr(base / "linear.exr", std::ios::binary);
+  char magic[4] = {};
+  exr.read(magic, 4);
+  EXPECT_EQ(std::string(magic, 4), std::string("\x76\x2f\x31\x01", 4)) << "an OpenEXR file";
+  EXPECT_FALSE(w->saveImageTo(base / "picture.tiff"));
+  EXPECT_TRUE(w->lastError().contains(".exr or .png")) << w->lastError().toStdString();
 }
 
 // The pixel filter, how it is drawn and Tungsten's other conventions are render settings:
