@@ -132,6 +132,15 @@ void MainWindow::connectViewport() {
                      .arg(c.x(), 0, 'f', 4)
                      .arg(c.y(), 0, 'f', 4)
                      .arg(c.z(), 0, 'f', 4);
+    // What the pixel shows and how many samples it holds: where a pass stands, pixel by pixel.
+    if (const auto& f = view_->frame();
+        f && f->image && px.x() >= 0 && px.y() >= 0 && px.x() < f->image->width && px.y() < f->image->height) {
+      const auto i = static_cast<std::size_t>(px.y()) * static_cast<std::size_t>(f->image->width) + static_cast<std::size_t>(px.x());
+      const RenderImage& img = *f->image;
+      const Object* o = i < img.objectId.size() ? doc_.scene().object(img.objectId[i]) : nullptr;
+      const QString what = o ? QString::fromStdString(o->name) : tr("background");
+      if (i < img.sampleCount.size()) pixelText_ += tr("\n%1, %2 samples").arg(what).arg(img.sampleCount[i], 0, 'f', 0);
+    }
     inspector_->setText(pixelText_ + (regionText_.isEmpty() ? QString() : "\n\n" + regionText_));
     // An eye-tracker stand-in: the focus point follows the cursor, at most ten times a second.
     if (methodPanel_->focusMode() == MethodPanel::FocusMode::Cursor && focusTimer_.elapsed() > 100) {

@@ -853,6 +853,24 @@ TEST(EditorDefects, TheViewportsPictureSavesAsAnImage) {
   EXPECT_TRUE(w->lastError().contains(".exr or .png")) << w->lastError().toStdString();
 }
 
+// The pixel inspector names what a pixel shows and the samples it holds (a teacher pointing at a
+// tile in a pass, an artist at a noisy spot).
+TEST(EditorDefects, TheInspectorSaysWhatAPixelShowsAndItsSamples) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 3 && f.image; }));
+  FrameView* v = w->viewport();
+  auto* inspector = w->findChild<QLabel*>("inspector");
+  ASSERT_TRUE(inspector);
+  const QPoint onSphere = pointShowing(*v, objectNamed(w->scene(), "Glossy Sphere"));
+  ASSERT_GE(onSphere.x(), 0);
+  QTest::mouseMove(v, onSphere);
+  const QStringList lines = inspector->text().split('\n');
+  ASSERT_GE(lines.size(), 2) << inspector->text().toStdString();
+  EXPECT_TRUE(lines[1].startsWith("Glossy Sphere, ")) << lines[1].toStdString();
+  EXPECT_TRUE(lines[1].endsWith(" samples")) << lines[1].toStdString();
+  EXPECT_GE(lines[1].section(", ", 1).section(' ', 0, 0).toInt(), 1) << lines[1].toStdString();
+}
+
 // The pixel filter, how it is drawn and Tungsten's other conventions are render settings:
 // chosen in Properties, each reaches the engine as one undo step and restarts the accumulation.
 TEST(EditorDefects, ThePixelFilterIsARenderSettingWithUndo) {
