@@ -1,8 +1,5 @@
 // The window's document on disk: opening, saving, the autosave and its recovery, recent files,
 // files dropped on the window. GUI thread only, like the rest of MainWindow.
-#include <algorithm>
-#include <cctype>
-
 #include <QCloseEvent>
 #include <QDateTime>
 #include <QDir>
@@ -174,12 +171,7 @@ bool MainWindow::saveImageTo(const std::filesystem::path& file) {
     showError(tr("Cannot save the image"), tr("%1: nothing is rendered yet").arg(QString::fromStdString(file.string())));
     return false;
   }
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (ext != ".exr" && ext != ".png") {
-    showError(tr("Cannot save the image"), tr("%1: the name must end in .exr or .png").arg(QString::fromStdString(file.string())));
-    return false;
-  }
+  // writeRenderImage refuses a name not ending in .exr or .png, saying so.
   auto r = writeRenderImage(*frame->image, file, view_->display());
   if (!r) {
     showError(tr("Cannot save the image"), QString::fromStdString(r.error()));
