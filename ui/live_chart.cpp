@@ -43,9 +43,12 @@ QChartView* makeView(QChart* chart, QWidget* parent) {
   return v;
 }
 
-void fitY(QLineSeries* s, QValueAxis* axis, double floor) {
+// `skip`: points the axis is not fitted to (they run off the top).
+void fitY(QLineSeries* s, QValueAxis* axis, double floor, const std::deque<bool>& skip = {}) {
   double hi = floor;
-  for (const QPointF& p : s->points()) hi = std::max(hi, p.y());
+  const QList<QPointF> points = s->points();
+  for (qsizetype i = 0; i < points.size(); ++i)
+    if (static_cast<std::size_t>(i) >= skip.size() || !skip[static_cast<std::size_t>(i)]) hi = std::max(hi, points[i].y());
   axis->setRange(0, hi * 1.15);
 }
 
@@ -134,6 +137,7 @@ void LiveChart::trim(double now) {
     int drop = 0;
     while (drop < s->count() && s->at(drop).x() < now - kWindowSeconds) ++drop;
     if (drop > 0) s->removePoints(0, drop);
+    if (s == frameMs_) msCompiled_.erase(msCompiled_.begin(), msCompiled_.begin() + drop);
   }
   // Seconds since the editor opened; in the first minute the window starts at 0 and fills, so
   // that no time before the editor opened is shown.
@@ -147,6 +151,7 @@ void LiveChart::addFrame(const FrameRecord& frame) {
   if (frame.frameMs > 0 && frame.samples > 0) {
     samplesPerSecond_->append(now, static_cast<double>(frame.samples) / (frame.frameMs * 1000.0));
     frameMs_->append(now, frame.frameMs);
+    msCompiled_.push_back(frame.compiledKernel);
   }
   if (!reference_.empty() && frame.image && frame.documentVersion == refVersion_ && frame.width == refWidth_ &&
       frame.height == refHeight_) {
@@ -159,7 +164,9 @@ void LiveChart::addFrame(const FrameRecord& frame) {
   }
   trim(now);
   fitY(samplesPerSecond_, rateAxis_, 0.01);
-  fitY(frameMs_, msAxis_, 1.0);
+  // A frame that compiled a kernel (about a second on lavapipe) would flatten the minute's
+  // frame times to the axis's floor.
+  fitY(frameMs_, msAxis_, 1.0, msCompiled_);
   fitY(error_, errAxis_, 0.01);
 }
 

@@ -10,6 +10,7 @@
 #include <QWidget>
 
 #include <atomic>
+#include <deque>
 #include <memory>
 #include <thread>
 #include <vector>
@@ -54,6 +55,7 @@ class LiveChart : public QWidget {
 
   QLineSeries* samplesPerSecond_ = nullptr;
   QLineSeries* frameMs_ = nullptr;
+  std::deque<bool> msCompiled_;  // per frameMs_ point: its frame compiled a kernel
   QLineSeries* error_ = nullptr;
   QValueAxis* timeAxis_ = nullptr;
   QValueAxis* rateAxis_ = nullptr;

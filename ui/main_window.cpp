@@ -139,7 +139,10 @@ void MainWindow::connectViewport() {
       const RenderImage& img = *f->image;
       const Object* o = i < img.objectId.size() ? doc_.scene().object(img.objectId[i]) : nullptr;
       const QString what = o ? QString::fromStdString(o->name) : tr("background");
-      if (i < img.sampleCount.size()) pixelText_ += tr("\n%1, %2 samples").arg(what).arg(img.sampleCount[i], 0, 'f', 0);
+      if (i < img.sampleCount.size()) {
+        const double n = std::round(img.sampleCount[i]);
+        pixelText_ += n == 1 ? tr("\n%1, 1 sample").arg(what) : tr("\n%1, %2 samples").arg(what).arg(n, 0, 'f', 0);
+      }
     }
     inspector_->setText(pixelText_ + (regionText_.isEmpty() ? QString() : "\n\n" + regionText_));
     // An eye-tracker stand-in: the focus point follows the cursor, at most ten times a second.

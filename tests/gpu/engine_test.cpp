@@ -91,6 +91,19 @@ TEST(Session, MemoryStaysFlatFrameAfterFrame) {
   }
 }
 
+// The live chart leaves a frame that waited for a compile (about a second) out of its frame-time
+// axis.
+TEST(Session, AFrameSaysWhetherItCompiledTheTraceKernel) {
+  RETILE_RENDERER_OR_SKIP(probe);
+  probe.reset();
+  RenderSession s(smallDefault(), MethodSettings{});
+  EXPECT_FALSE(s.renderFrame(false).compiledKernel) << "the scene's kernel is compiled with its upload";
+  s.submitFrame(false);
+  s.prepareMoves();  // as the engine does with its first frame in flight
+  EXPECT_TRUE(s.finishFrame().compiledKernel);
+  EXPECT_FALSE(s.renderFrame(false).compiledKernel);
+}
+
 // Plays the same frames with edits through renderFrame (waiting for each) and pipelined (frame
 // n+1 submitted before n is finished, the edits for n+1 applied in between), and compares.
 TEST(Session, PipelinedFramesEqualFramesWaitedFor) {

@@ -538,6 +538,29 @@ TEST(EditorDefects, TheLiveChartHasRoomForItsPlotsAndLabels) {
     }
 }
 
+// The frame-time axis was fitted to the first frame, which waits about a second for the trace
+// kernel to compile: for a minute every other frame lay flat along the bottom.
+TEST(EditorDefects, TheLiveChartsFrameTimesAreNotFlattenedByAKernelCompile) {
+  auto msAxisMax = [](bool flagged) {
+    LiveChart chart;
+    FrameRecord f;
+    f.samples = 1000;
+    f.frameMs = 1100;
+    f.compiledKernel = flagged;
+    chart.addFrame(f);
+    f.compiledKernel = false;
+    for (double ms : {40.0, 55.0, 45.0}) {
+      f.frameMs = ms;
+      chart.addFrame(f);
+    }
+    for (QAbstractAxis* a : chart.charts().front()->axes(Qt::Vertical))
+      if (a->alignment() == Qt::AlignRight) return qobject_cast<QValueAxis*>(a)->max();
+    return -1.0;
+  };
+  EXPECT_NEAR(msAxisMax(true), 55 * 1.15, 1e-6) << "fitted to the frames after the compile";
+  EXPECT_NEAR(msAxisMax(false), 1100 * 1.15, 1e-6) << "a slow frame of its own still shows";
+}
+
 // 16. The log did not follow new entries, and a missing file was reported twice.
 TEST(EditorDefects, TheLogFollowsNewEntriesAndSaysEachWarningOnce) {
   RETILE_SHARED_OR_SKIP(room, "scenes/living-room/scene.json");

@@ -64,6 +64,7 @@ struct FrameRecord {
   std::size_t queueServed = 0;  // tiles of the pass finished
   std::uint64_t samples = 0;    // samples traced this frame: width x height, a preview's fewer
   int block = 1;                // > 1: a preview while edits come, a sample per block x block pixels
+  bool compiledKernel = false;  // a trace kernel was compiled while the frame was in flight: it waited
   double scheduleMs = 0, traceMs = 0, readbackMs = 0, frameMs = 0;
   std::shared_ptr<const RenderImage> image;  // the accumulated image after this frame (may be null)
 

@@ -75,6 +75,7 @@ struct RenderSession::Impl {
     bool completed = false;  // the device is done and counters and probe are taken
     FrameStats stats;
     Clock::time_point start;
+    std::size_t kernels = 0;  // trace kernels compiled before it was submitted
   };
   std::deque<Pending> pending;
   std::shared_ptr<const RenderImage> lastImage;
@@ -580,6 +581,7 @@ void RenderSession::submitFrame(bool readImage) {
   rec.queueServed = d.scheduler.queueServed();
   rec.scheduleMs = msSince(start);
 
+  p.kernels = d.renderer.kernelsCompiled();
   p.ticket = d.renderer.submitFrame(work, options, p.readImage);
   d.pending.push_back(std::move(p));
 }
@@ -602,6 +604,8 @@ FrameRecord RenderSession::finishFrame() {
   }
   rec.readbackMs = msSince(readStart);
   rec.frameMs = msSince(p.start);
+  // Compiled for it, or while it was in flight (prepareMoves): its time is mostly the compile's.
+  rec.compiledKernel = d.renderer.kernelsCompiled() != p.kernels;
   return rec;
 }
 
