@@ -287,7 +287,8 @@ void MainWindow::buildMenus() {
   });
   // Spelled out: QKeySequence::SaveAs is empty on desktops without a key theme.
   file->addAction(tr("Save &As..."), QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_S), this, [this] { saveAs(); });
-  file->addAction(tr("Save &Image..."), QKeySequence(Qt::CTRL | Qt::Key_E), this, [this] { saveImage(); });
+  // Not Ctrl+E: on X11 a focused text field takes it (end of line).
+  file->addAction(tr("Save &Image..."), QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_E), this, [this] { saveImage(); });
   file->addSeparator();
   file->addAction(tr("&Quit"), QKeySequence::Quit, this, &QWidget::close);
 

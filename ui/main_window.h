@@ -152,6 +152,7 @@ class MainWindow : public QMainWindow {
   EditorOptions options_;
   Document doc_;
   std::filesystem::path file_;
+  std::filesystem::path imageFolder_;  // of the last image saved (saveImage's dialog starts there)
   std::unique_ptr<Engine> engine_;
   QUndoStack undo_;
   NodeId selection_ = kNoNode;

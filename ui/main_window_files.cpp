@@ -148,7 +148,7 @@ bool MainWindow::maybeSave() {
 }
 
 bool MainWindow::saveAs() {
-  QFileDialog dialog(this, tr("Save scene as"), QString(), tr("Retile scenes (*.retile)"));
+  QFileDialog dialog(this, tr("Save scene as"), QString::fromStdString(file_.parent_path().string()), tr("Retile scenes (*.retile)"));
   dialog.setObjectName("saveAsDialog");
   dialog.setAcceptMode(QFileDialog::AcceptSave);
   dialog.setDefaultSuffix("retile");
@@ -157,10 +157,14 @@ bool MainWindow::saveAs() {
 }
 
 bool MainWindow::saveImage() {
-  QFileDialog dialog(this, tr("Save image"), QString(), tr("OpenEXR, linear (*.exr);;PNG, as shown (*.png)"));
+  // In the folder of the last image saved, else the scene's, named after the scene.
+  const std::filesystem::path folder = !imageFolder_.empty() ? imageFolder_ : file_.parent_path();
+  const std::string stem = file_.empty() ? "retile" : file_.stem().string();
+  QFileDialog dialog(this, tr("Save image"), QString::fromStdString(folder.string()), tr("OpenEXR, linear (*.exr);;PNG, as shown (*.png)"));
   dialog.setObjectName("saveImageDialog");
   dialog.setAcceptMode(QFileDialog::AcceptSave);
   dialog.setDefaultSuffix("exr");
+  dialog.selectFile(QString::fromStdString(stem + ".exr"));
   if (dialog.exec() != QDialog::Accepted || dialog.selectedFiles().isEmpty()) return false;
   return saveImageTo(dialog.selectedFiles().front().toStdString());
 }
@@ -177,6 +181,7 @@ bool MainWindow::saveImageTo(const std::filesystem::path& file) {
     showError(tr("Cannot save the image"), QString::fromStdString(r.error()));
     return false;
   }
+  imageFolder_ = file.parent_path();
   notify(tr("saved the image (%1x%2) to %3").arg(frame->image->width).arg(frame->image->height).arg(QString::fromStdString(file.string())));
   return true;
 }

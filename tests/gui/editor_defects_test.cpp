@@ -7,7 +7,9 @@
 #include <QColorDialog>
 #include <QComboBox>
 #include <QDockWidget>
+#include <QDir>
 #include <QFileDialog>
+#include <QFileInfo>
 #include <QFormLayout>
 #include <QFontMetricsF>
 #include <QLabel>
@@ -874,6 +876,28 @@ TEST(EditorDefects, TheViewportsPictureSavesAsAnImage) {
   EXPECT_EQ(std::string(magic, 4), std::string("\x76\x2f\x31\x01", 4)) << "an OpenEXR file";
   EXPECT_FALSE(w->saveImageTo(base / "picture.tiff"));
   EXPECT_TRUE(w->lastError().contains(".exr or .png")) << w->lastError().toStdString();
+
+  // Save Image asks, in the folder of the last image saved (the working directory before),
+  // with a name to take. The dialog is read and rejected; one that stays is rejected later, so
+  // a failure cannot hang the suite.
+  QString folder, name;
+  QTimer poll;
+  int polls = 0;
+  QObject::connect(&poll, &QTimer::timeout, [&] {
+    auto* dialog = qobject_cast<QFileDialog*>(QApplication::activeModalWidget());
+    if (dialog && dialog->objectName() == "saveImageDialog" && folder.isEmpty()) {
+      folder = dialog->directory().absolutePath();
+      if (!dialog->selectedFiles().isEmpty()) name = QFileInfo(dialog->selectedFiles().front()).fileName();
+      dialog->reject();
+    } else if (dialog && ++polls > 100) {
+      dialog->reject();
+    }
+  });
+  poll.start(50);
+  EXPECT_FALSE(w->saveImage()) << "rejected";
+  poll.stop();
+  EXPECT_EQ(folder, QDir(dir.path()).absolutePath()) << "the last image's folder";
+  EXPECT_EQ(name, "retile.exr") << "the built-in scene's picture";
 }
 
 // The pixel inspector names what a pixel shows and the samples it holds (a teacher pointing at a
