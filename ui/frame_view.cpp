@@ -296,7 +296,7 @@ void FrameView::compose(QPainter& p, const QRect& area) const {
     p.setPen(QPen(QColor(255, 190, 40), 4));
     p.drawRect(r.adjusted(2, 2, -2, -2));
     p.setFont(QFont(font().family(), 14, QFont::Bold));
-    p.drawText(r.adjusted(10, 8, -10, -8), Qt::AlignTop | Qt::AlignRight, tr("PAUSED (Esc resumes)"));
+    p.drawText(r.adjusted(10, 8, -10, -8), Qt::AlignTop | Qt::AlignRight, tr("PAUSED (Esc resumes, . steps a frame)"));
   }
 }
 

@@ -407,6 +407,16 @@ void MainWindow::buildMenus() {
     view_->setPaused(paused_);
     log(paused_ ? tr("paused: the accumulated samples are kept") : tr("resumed"));
   });
+  // A pass followed frame by frame: which tiles come next and how the denoised region grows.
+  QAction* step = render->addAction(tr("&Step one frame (pauses)"));
+  step->setObjectName("stepAction");
+  step->setShortcut(Qt::Key_Period);
+  connect(step, &QAction::triggered, this, [this] {
+    if (!paused_) log(tr("paused: the accumulated samples are kept"));
+    paused_ = true;
+    engine_->submit(StepCommand{1});
+    view_->setPaused(true);
+  });
 
   // Every panel, so that a closed one comes back (the docks exist by now).
   QMenu* windows = menuBar()->addMenu(tr("&Window"));

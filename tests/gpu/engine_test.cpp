@@ -257,6 +257,37 @@ TEST(Engine, FramesFlowAndEditsArriveWithTheirVersion) {
   EXPECT_GT(called.load(), 3);
 }
 
+// A step renders that many frames and leaves the engine paused, from running or paused, steps
+// sent together each counted: a teacher follows a pass frame by frame.
+TEST(Engine, AStepRendersItsFramesAndStaysPaused) {
+  RETILE_RENDERER_OR_SKIP(probe);
+  probe.reset();
+  Engine engine(smallDefault(), MethodSettings{});
+  engine.start();
+  ASSERT_TRUE(waitFor(engine, [](const FrameRecord& f) { return f.frame >= 2; }));
+  auto settled = [&] {
+    std::uint64_t n = engine.framesRendered();
+    for (int i = 0; i < 20; ++i) {
+      std::this_thread::sleep_for(100ms);
+      if (engine.framesRendered() == n) return n;
+      n = engine.framesRendered();
+    }
+    return n;
+  };
+  engine.submit(StepCommand{1});  // from running: pauses
+  const std::uint64_t paused = settled();
+  std::this_thread::sleep_for(300ms);
+  EXPECT_EQ(engine.framesRendered(), paused) << "paused after the step";
+  engine.submit(StepCommand{1});
+  engine.submit(StepCommand{1});
+  engine.submit(StepCommand{2});
+  EXPECT_EQ(settled(), paused + 4) << "four frames stepped";
+  EXPECT_EQ(engine.latestFrame()->frame, paused + 4);
+  engine.submit(PauseCommand{false});
+  ASSERT_TRUE(waitFor(engine, [&](const FrameRecord& f) { return f.frame > paused + 6; })) << "resumed";
+  engine.stop();
+}
+
 TEST(Engine, StopsWhileRendering) {
   RETILE_RENDERER_OR_SKIP(probe);
   probe.reset();

@@ -143,6 +143,36 @@ TEST(EditorMethod, AtTheDefaultsTheDenoisedRegionGrowsNestedAndLabelled) {
   }
 }
 
+// A teacher follows a pass frame by frame: Render > Step one frame (.) pauses and shows one
+// frame more each time, the tiles it served among them.
+TEST(EditorMethod, StepShowsAPassOneFrameAtATime) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 3; }));
+  auto* step = w->findChild<QAction*>("stepAction");
+  ASSERT_TRUE(step);
+  const NodeId cup = objectNamed(w->scene(), "Cup");
+  const Object o = *w->scene().object(cup);
+  Object moved = o;
+  moved.transform = Mat4::translate({0, 0.05f, 0}) * o.transform;
+  step->trigger();  // paused
+  QTest::qWait(500);
+  w->edit(SetObject{o}, SetObject{moved}, "move");
+  const std::uint64_t before = w->viewport()->frame()->frame;
+  QTest::qWait(400);  // past the preview's linger: the steps are the pass's full frames
+  EXPECT_EQ(w->viewport()->frame()->frame, before) << "the edit alone renders nothing while paused";
+  for (std::uint64_t k = 1; k <= 3; ++k) {
+    step->trigger();
+    ASSERT_TRUE(waitForFrame(
+        *w, [&](const FrameRecord& f) { return f.frame == before + k; }, 20000))
+        << "step " << k;
+    QTest::qWait(300);
+    const auto f = w->viewport()->frame();
+    EXPECT_EQ(f->frame, before + k) << "one frame a step";
+    EXPECT_EQ(f->mode, "incremental");
+    EXPECT_FALSE(f->servedTiles.empty());
+  }
+}
+
 // 3. The legend was cut off ("...") and keyed every class in one orange; letterboxed, it covered
 // a third of the image.
 TEST(EditorMethod, TheLegendNamesEveryMarkInItsOwnColourAndCoversNothing) {

@@ -45,7 +45,12 @@ struct PauseCommand {
 struct RegionCommand {
   RegionRect region;
 };  // a render region; empty: the whole image
-using Command = std::variant<Edit, SelectCommand, FocusCommand, MethodCommand, ResizeCommand, PauseCommand, RegionCommand>;
+// Pauses (if running) and renders `frames` more frames, then stays paused: a pass followed frame
+// by frame. Each is counted (never coalesced with another step).
+struct StepCommand {
+  int frames = 1;
+};
+using Command = std::variant<Edit, SelectCommand, FocusCommand, MethodCommand, ResizeCommand, PauseCommand, RegionCommand, StepCommand>;
 
 // Commands in arrival order. A command of the same kind and target as one still queued replaces
 // it (a slider drag becomes its newest value), unless an add or remove was queued after it.

@@ -21,6 +21,7 @@ std::uint64_t commandKey(const Command& c) {
       return 0;  // structural: never coalesced
     return editCoalesceKey(*e);
   }
+  if (std::holds_alternative<StepCommand>(c)) return 0;  // each step counts
   return 0xff00000000000000ull + c.index();
 }
 
@@ -149,6 +150,7 @@ void Engine::run() {
     return;
   }
   bool paused = false;
+  int steps = 0;  // frames still to render while paused (StepCommand)
   std::shared_ptr<const FrameRecord> last;
   // What a new session needs beyond the old one's scene when a device fails.
   std::uint64_t version = options_.documentVersion;
@@ -179,6 +181,10 @@ void Engine::run() {
                 session->resize(c.width, c.height);
               } else if constexpr (std::is_same_v<T, PauseCommand>) {
                 paused = c.paused;
+                steps = 0;
+              } else if constexpr (std::is_same_v<T, StepCommand>) {
+                paused = true;
+                steps += std::max(c.frames, 0);
               } else if constexpr (std::is_same_v<T, RegionCommand>) {
                 session->setRegion(c.region);
               }
@@ -205,7 +211,7 @@ void Engine::run() {
     bool converged = options_.maxSamplesPerPixel > 0 && last && !changed && last->mode == "refinement" && !last->tileSamples.empty() &&
                      regionConverged(*last, options_.maxSamplesPerPixel);
     try {
-      if (paused || converged) {
+      if ((paused || converged) && steps == 0) {
         // Show the frame still unfinished before resting.
         while (session->framesInFlight() > 0) publish(session->finishFrame());
         queue_.waitForWork(std::chrono::milliseconds(100));
@@ -215,6 +221,7 @@ void Engine::run() {
       if (++submitted == static_cast<std::uint64_t>(options_.failFrame))
         throw Error("the device was lost (injected by EngineOptions::failFrame)");
       session->submitFrame(true);
+      if (steps > 0) --steps;
       if (session->framesInFlight() > 1) publish(session->finishFrame());
       // Once the first picture is out, before the first drag can ask for it.
       if (!movesPrepared && last) {
