@@ -1,5 +1,6 @@
 #include "frame_view.h"
 
+#include <QFontMetricsF>
 #include <QDateTime>
 #include <QMouseEvent>
 #include <QPainter>
@@ -296,7 +297,11 @@ void FrameView::compose(QPainter& p, const QRect& area) const {
     p.setPen(QPen(QColor(255, 190, 40), 4));
     p.drawRect(r.adjusted(2, 2, -2, -2));
     p.setFont(QFont(font().family(), 14, QFont::Bold));
-    p.drawText(r.adjusted(10, 8, -10, -8), Qt::AlignTop | Qt::AlignRight, tr("PAUSED (Esc resumes, . steps a frame)"));
+    // Above the image where the letterbox leaves room, so that it hides no tile's numbers while
+    // a pass is stepped through; else over the image's top edge.
+    const double line = QFontMetricsF(p.font()).height() + 8;
+    const QRectF band = r.top() - area.top() >= line ? QRectF(r.left(), r.top() - line, r.width(), line) : r.adjusted(10, 8, -10, -8);
+    p.drawText(band, Qt::AlignTop | Qt::AlignRight, tr("PAUSED (Esc resumes, . steps a frame)"));
   }
 }
 

@@ -171,6 +171,23 @@ TEST(EditorMethod, StepShowsAPassOneFrameAtATime) {
     EXPECT_EQ(f->mode, "incremental");
     EXPECT_FALSE(f->servedTiles.empty());
   }
+  // The paused banner sits in the letterbox above the image, hiding no tile's numbers: its
+  // amber text is there, and none lies inside the image below its border.
+  FrameView* v = w->viewport();
+  const QImage pic = v->composed();
+  const QRect r = v->imageRect().toRect();
+  auto amber = [&](int top, int bottom) {
+    int n = 0;
+    for (int y = std::max(0, top); y < std::min(pic.height(), bottom); ++y)
+      for (int x = r.left() + 8; x < r.right() - 8; ++x) {
+        const QColor c = pic.pixelColor(x, y);
+        n += c.red() > 200 && c.green() > 140 && c.green() < 220 && c.blue() < 90;
+      }
+    return n;
+  };
+  ASSERT_GT(r.top(), 40) << "letterboxed";
+  EXPECT_GT(amber(r.top() - 30, r.top() - 4), 20) << "the banner above the image";
+  EXPECT_EQ(amber(r.top() + 8, r.top() + 30), 0) << "nothing of it over the image";
 }
 
 // 3. The legend was cut off ("...") and keyed every class in one orange; letterboxed, it covered
