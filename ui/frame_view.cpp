@@ -1,7 +1,7 @@
 #include "frame_view.h"
 
-#include <QFontMetricsF>
 #include <QDateTime>
+#include <QFontMetricsF>
 #include <QMouseEvent>
 #include <QPainter>
 #include <QTimer>
@@ -788,12 +788,23 @@ void FrameView::mouseReleaseEvent(QMouseEvent* e) {
   drag_ = Drag::None;
 }
 
+std::optional<std::size_t> FrameView::pixelIndex(QPoint imagePixel) const {
+  if (!frame_ || !frame_->image || imagePixel.x() < 0 || imagePixel.y() < 0 || imagePixel.x() >= frame_->image->width ||
+      imagePixel.y() >= frame_->image->height)
+    return std::nullopt;
+  return static_cast<std::size_t>(imagePixel.y()) * static_cast<std::size_t>(frame_->image->width) +
+         static_cast<std::size_t>(imagePixel.x());
+}
+
 quint64 FrameView::objectAt(QPoint imagePixel) const {
-  if (!frame_ || !frame_->image || imagePixel.x() < 0 || imagePixel.y() < 0) return 0;
-  const auto& ids = frame_->image->objectId;
-  const std::size_t i =
-      static_cast<std::size_t>(imagePixel.y()) * static_cast<std::size_t>(frame_->width) + static_cast<std::size_t>(imagePixel.x());
-  return i < ids.size() ? static_cast<quint64>(ids[i]) : 0;
+  const auto i = pixelIndex(imagePixel);
+  return i && *i < frame_->image->objectId.size() ? static_cast<quint64>(frame_->image->objectId[*i]) : 0;
+}
+
+std::optional<double> FrameView::samplesAt(QPoint imagePixel) const {
+  const auto i = pixelIndex(imagePixel);
+  if (!i || *i >= frame_->image->sampleCount.size()) return std::nullopt;
+  return frame_->image->sampleCount[*i];
 }
 
 void FrameView::setSelection(std::vector<quint64> objects, quint64 primary) {

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <optional>
 
 #include "retile/image.h"
 #include "retile/session.h"
@@ -84,6 +85,10 @@ class FrameView : public QWidget {
   static constexpr double kRingRadiusX = 34, kRingRadiusY = 12;  // the rotate tool's ring, widget pixels
   // A point in the widget over an image position (the inverse of picking's mapping).
   QPointF widgetPoint(QPointF imagePixel) const { return toWidget(imagePixel); }
+  // The shown frame at an image pixel: the object of its first hit (0: none) and the samples it
+  // holds (none outside the image).
+  quint64 objectAt(QPoint imagePixel) const;
+  std::optional<double> samplesAt(QPoint imagePixel) const;
 
   // The presenting Vulkan window, or nullptr when this widget paints (and why, for the log).
   VulkanViewport* vulkanWindow() const { return vulkan_; }
@@ -173,7 +178,7 @@ class FrameView : public QWidget {
   QImage toDisplay(const RenderImage& img) const;
   const std::vector<float>& inspected(const RenderImage& img) const { return inspect_ == Inspect::Raw ? img.color : img.shown(); }
   QPoint imagePixel(QPointF widgetPos) const;
-  quint64 objectAt(QPoint imagePixel) const;  // the object of the shown frame's first hit there; 0: none
+  std::optional<std::size_t> pixelIndex(QPoint imagePixel) const;  // into the shown frame's image; none outside it
   void inspectRegion();
 
   std::shared_ptr<const FrameRecord> frame_;

@@ -133,16 +133,11 @@ void MainWindow::connectViewport() {
                      .arg(c.y(), 0, 'f', 4)
                      .arg(c.z(), 0, 'f', 4);
     // What the pixel shows and how many samples it holds: where a pass stands, pixel by pixel.
-    if (const auto& f = view_->frame();
-        f && f->image && px.x() >= 0 && px.y() >= 0 && px.x() < f->image->width && px.y() < f->image->height) {
-      const auto i = static_cast<std::size_t>(px.y()) * static_cast<std::size_t>(f->image->width) + static_cast<std::size_t>(px.x());
-      const RenderImage& img = *f->image;
-      const Object* o = i < img.objectId.size() ? doc_.scene().object(img.objectId[i]) : nullptr;
+    if (const auto samples = view_->samplesAt(px)) {
+      const Object* o = doc_.scene().object(view_->objectAt(px));
       const QString what = o ? QString::fromStdString(o->name) : tr("background");
-      if (i < img.sampleCount.size()) {
-        const double n = std::round(img.sampleCount[i]);
-        pixelText_ += n == 1 ? tr("\n%1, 1 sample").arg(what) : tr("\n%1, %2 samples").arg(what).arg(n, 0, 'f', 0);
-      }
+      const double n = std::round(*samples);
+      pixelText_ += n == 1 ? tr("\n%1, 1 sample").arg(what) : tr("\n%1, %2 samples").arg(what).arg(n, 0, 'f', 0);
     }
     inspector_->setText(pixelText_ + (regionText_.isEmpty() ? QString() : "\n\n" + regionText_));
     // An eye-tracker stand-in: the focus point follows the cursor, at most ten times a second.
@@ -263,6 +258,13 @@ void MainWindow::connectDrags() {
 
 MainWindow::~MainWindow() {
   if (engine_) engine_->stop();  // before any member the callback might touch goes away
+}
+
+void MainWindow::setRenderPaused(bool paused) {
+  paused_ = paused;
+  engine_->submit(PauseCommand{paused});
+  view_->setPaused(paused);
+  log(paused ? tr("paused: the accumulated samples are kept") : tr("resumed"));
 }
 
 void MainWindow::buildMenus() {
@@ -401,21 +403,14 @@ void MainWindow::buildMenus() {
   QAction* pause = render->addAction(tr("&Pause / resume"));
   pause->setObjectName("pauseAction");
   pause->setShortcut(Qt::Key_Escape);
-  connect(pause, &QAction::triggered, this, [this] {
-    paused_ = !paused_;
-    engine_->submit(PauseCommand{paused_});
-    view_->setPaused(paused_);
-    log(paused_ ? tr("paused: the accumulated samples are kept") : tr("resumed"));
-  });
+  connect(pause, &QAction::triggered, this, [this] { setRenderPaused(!paused_); });
   // A pass followed frame by frame: which tiles come next and how the denoised region grows.
   QAction* step = render->addAction(tr("&Step one frame (pauses)"));
   step->setObjectName("stepAction");
   step->setShortcut(Qt::Key_Period);
   connect(step, &QAction::triggered, this, [this] {
-    if (!paused_) log(tr("paused: the accumulated samples are kept"));
-    paused_ = true;
+    if (!paused_) setRenderPaused(true);
     engine_->submit(StepCommand{1});
-    view_->setPaused(true);
   });
 
   // Every panel, so that a closed one comes back (the docks exist by now).

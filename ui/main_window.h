@@ -165,6 +165,7 @@ class MainWindow : public QMainWindow {
   }
   class MethodPanel* methodPanel_ = nullptr;  // owns the method the engine renders with
   bool paused_ = false;
+  void setRenderPaused(bool paused);  // the engine, the viewport's banner and the log
   int dragCounter_ = 0;
   QString lastError_;
   QSize renderSize_;
