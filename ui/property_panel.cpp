@@ -346,6 +346,7 @@ void PropertyPanel::fieldRows(Builder& b, const Material& m, MaterialPlace place
                                  const Material* now = scene_().material(id);
                                  if (now && fieldsShown(*now) != shown) rebuildLater(drag);
                                });
+    if (*f.atLo) row->setSpecialValueText(tr(f.atLo));
     if (*f.tip) row->setToolTip(tr(f.tip));
   }
   for (const MaterialColor& f : kMaterialColors) {

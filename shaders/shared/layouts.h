@@ -25,7 +25,7 @@ RT_CONST(int, kMaterialTexels, 10)   // see render/render_scene.h packMaterial
 #ifndef __cplusplus
 // Where packMaterial writes each field material_fields.h places (C++ reads the same rows as
 // kMaterialScalars and on): a scalar's or a texture's slot, texel * 4 + component; a colour's texel.
-#define RETILE_MATERIAL_SCALAR(member, key, def, lo, hi, types, texel, component, label, unit, decimals, place, tip) \
+#define RETILE_MATERIAL_SCALAR(member, key, def, lo, hi, types, texel, component, label, unit, decimals, atLo, place, tip) \
   const int kMaterialSlot_##member = texel * 4 + component;
 #define RETILE_MATERIAL_COLOR(member, key, r, g, b, hi, types, texel, label, widget, place, tip) \
   const int kMaterialTexel_##member = texel;

@@ -12,6 +12,7 @@
 #include <QSpinBox>
 #include <QLabel>
 #include <QLineEdit>
+#include <QLocale>
 #include <QPushButton>
 #include <QElapsedTimer>
 #include <QTest>
@@ -474,6 +475,36 @@ TEST(Editor, TheMaterialPanelShowsTheRowsOfItsType) {
   QTest::qWait(50);
   EXPECT_FALSE(w->findChild<QComboBox*>("distribution")) << "a smooth type has no distribution";
   EXPECT_FALSE(w->findChild<QComboBox*>("shadowing"));
+}
+
+// A field whose lowest value means none of its effect says so: an uncoated material's coat reads
+// "none", not an index (which would read as a coat), and one step up is a coat, whose rows appear.
+TEST(Editor, AnUncoatedMaterialsCoatReadsNone) {
+  auto w = makeWindow();
+  const NodeId material = selectWithMaterial(*w, "Glossy Sphere");
+  auto* type = w->findChild<QComboBox*>("materialType");
+  ASSERT_TRUE(type);
+  type->setCurrentIndex(type->findText(materialTypeName(MaterialType::Lambert)));
+  ASSERT_FALSE(w->scene().material(material)->coated());
+  QTest::qWait(50);
+  auto* coat = w->findChild<ScrubField*>("coatIor");
+  ASSERT_TRUE(coat);
+  EXPECT_EQ(coat->text(), "none");
+  EXPECT_FALSE(w->findChild<QWidget*>("coatRoughness")) << "no coat, no coat roughness";
+  coat->stepUp();
+  EXPECT_TRUE(w->scene().material(material)->coated()) << w->scene().material(material)->coatIor;
+  QTest::qWait(50);
+  coat = w->findChild<ScrubField*>("coatIor");
+  ASSERT_TRUE(coat);
+  EXPECT_EQ(coat->text(), QLocale().toString(1.01, 'f', 3));
+  EXPECT_TRUE(w->findChild<QWidget*>("coatRoughness"));
+  // A thin sheet's film, absent at 0, says so too.
+  type = w->findChild<QComboBox*>("materialType");
+  type->setCurrentIndex(type->findText(materialTypeName(MaterialType::ThinSheet)));
+  QTest::qWait(50);
+  auto* film = w->findChild<ScrubField*>("filmThickness");
+  ASSERT_TRUE(film);
+  EXPECT_EQ(film->text(), "none");
 }
 
 // A roughness texture does not become a sheet's thickness (nor a thickness a roughness) when

@@ -169,7 +169,7 @@ enum class ColorWidget { Swatch, Channels };
 
 // Every row of shaders/shared/material_fields.h expanded into nothing: an includer defines the
 // kinds it reads, these the rest.
-#define RETILE_IGNORE_SCALAR(member, key, def, lo, hi, types, texel, component, label, unit, decimals, place, tip)
+#define RETILE_IGNORE_SCALAR(member, key, def, lo, hi, types, texel, component, label, unit, decimals, atLo, place, tip)
 #define RETILE_IGNORE_COLOR(member, key, r, g, b, hi, types, texel, label, widget, place, tip)
 #define RETILE_IGNORE_TEXTURE(member, key, types, texel, component, label, place)
 #define RETILE_IGNORE_CHOICE(member, key, off, on, types, flag, label, offLabel, onLabel, place, tip)
@@ -259,6 +259,7 @@ struct MaterialScalar : MaterialRow {
   int texel, component;  // packed there for its types; -1: by code
   const char* unit;
   int decimals;
+  const char* atLo;  // the panel's text at lo, where lo means none of the field's effect ("" the number)
   bool packed() const { return texel >= 0; }
   float clamp(float v) const { return std::isfinite(v) ? std::clamp(v, lo, hi) : fallback; }
 };
@@ -292,16 +293,17 @@ struct MaterialChoice : MaterialRow {
 #define RETILE_MATERIAL_TEXTURE RETILE_IGNORE_TEXTURE
 #define RETILE_MATERIAL_CHOICE RETILE_IGNORE_CHOICE
 inline constexpr MaterialScalar kMaterialScalars[] = {
-#define RETILE_MATERIAL_SCALAR(member, key, def, lo, hi, types, texel, component, label, unit, decimals, place, tip) \
-  {{#member, key, types, label, place, tip},                                                                         \
-   &Material::member,                                                                                                \
-   static_cast<float>(def),                                                                                          \
-   static_cast<float>(lo),                                                                                           \
-   static_cast<float>(hi),                                                                                           \
-   texel,                                                                                                            \
-   component,                                                                                                        \
-   unit,                                                                                                             \
-   decimals},
+#define RETILE_MATERIAL_SCALAR(member, key, def, lo, hi, types, texel, component, label, unit, decimals, atLo, place, tip) \
+  {{#member, key, types, label, place, tip},                                                                               \
+   &Material::member,                                                                                                      \
+   static_cast<float>(def),                                                                                                \
+   static_cast<float>(lo),                                                                                                 \
+   static_cast<float>(hi),                                                                                                 \
+   texel,                                                                                                                  \
+   component,                                                                                                              \
+   unit,                                                                                                                   \
+   decimals,                                                                                                               \
+   atLo},
 #include "shared/material_fields.h"
 #undef RETILE_MATERIAL_SCALAR
 };
