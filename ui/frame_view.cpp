@@ -470,6 +470,9 @@ std::vector<FrameView::LegendItem> FrameView::legendItems(bool everything) const
     for (int c = 0; c < 3; ++c)
       if (everything || std::find(f.tileClass.begin(), f.tileClass.end(), c) != f.tileClass.end())
         items.push_back({K::Hatch, kClassColor[c], what[c]});
+    // The tiles of no class are the rest, served last: without a key they read as unclassified.
+    if (everything || std::find(f.tileClass.begin(), f.tileClass.end(), 3) != f.tileClass.end())
+      items.push_back({K::None, QColor(200, 200, 200), tr("unhatched: the object does not reach it")});
   }
   if (overlays_.order && (everything || f.queueLength > 1)) items.push_back({K::None, Qt::white, tr("numbers: place in the queue")});
   if (overlays_.samples) items.push_back({K::None, QColor(180, 255, 180), tr("numbers: samples per pixel")});

@@ -224,6 +224,16 @@ TEST(EditorMethod, TheLegendNamesEveryMarkInItsOwnColourAndCoversNothing) {
   EXPECT_EQ(classes[2], FrameView::kClassColor[2]);
   EXPECT_TRUE(focusKeyed) << "the focus point keyed in the colour it is drawn in";
   EXPECT_TRUE(denoiseKeyed);
+  auto restKeyed = [&] {
+    const auto items = v->legendItems();
+    return std::any_of(items.begin(), items.end(), [](const auto& i) { return i.text.startsWith("unhatched"); });
+  };
+  EXPECT_TRUE(restKeyed()) << "the tiles of no class, served last, are keyed too";
+  auto allClassed = std::make_shared<FrameRecord>(*f);
+  for (std::size_t t = 0; t < allClassed->tileClass.size(); ++t) allClassed->tileClass[t] = static_cast<std::uint8_t>(t % 3);
+  v->showFrame(allClassed);
+  EXPECT_FALSE(restKeyed()) << "and only when there are such tiles";
+  v->showFrame(f);
   // The focus point as drawn has the colour its key has.
   const QImage pic = v->composed();
   const QPointF at = v->widgetPoint(QPointF(10, 10)) + QPointF(9, 0);  // on its ring
