@@ -92,6 +92,25 @@ TEST(Cli, APngIsShownThroughTheScenesViewUnlessToldOtherwise) {
   EXPECT_NE(byScene, standard);
 }
 
+// A render whose paths ran into the loop limit says so (they lack light: the image is biased), and
+// one that did not says nothing. All of a frame's paths in one invocation run past the limit.
+TEST(Cli, ARenderSaysWhenPathsWereCutAtTheLoopLimit) {
+  const auto dir = test::tempDir();
+  ChildLimits limits;
+  limits.timeout = std::chrono::minutes(5);
+  auto render = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {"render", "default", "--size", "192x108", "--spp", "1", "--out", (dir / "cut.png").string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return runChild(RETILE_CLI_PATH, args, limits);
+  };
+  ChildResult cut = render({"--paths", std::to_string(192 * 108)});
+  ASSERT_EQ(cut.exitCode, 0) << cut.err;
+  EXPECT_NE(cut.err.find("were cut short, or never started, at the trace kernel's loop limit"), std::string::npos) << cut.err;
+  ChildResult whole = render({});
+  ASSERT_EQ(whole.exitCode, 0) << whole.err;
+  EXPECT_EQ(whole.err.find("cut short"), std::string::npos) << whole.err;
+}
+
 // `retile compare` with a noise image lists the ratio by block size: noise averages away as blocks
 // grow, a bias does not. Three synthetic images: the reference flat; ours at two seeds, each with
 // its own noise and both 3 % brighter on the left half (the bias our renderer would have).

@@ -151,7 +151,8 @@ struct RenderRequest {
   int samplesPerPixel = 0;    // 0: the scene's settings
   int maxBounces = -1;        // -1: the scene's settings
   std::uint32_t seed = 0;
-  bool denoise = false;  // the result's display is the whole frame denoised
+  bool denoise = false;        // the result's display is the whole frame denoised
+  int pathsPerInvocation = 0;  // as FrameOptions' (0: chosen from the last frame's cost)
 };
 
 class Renderer {

@@ -903,7 +903,9 @@ RenderImage Renderer::render(const RenderRequest& request, const std::function<b
     all.quality = std::min(perFrame, spp - done);
     all.sampleBase = static_cast<std::uint32_t>(done);
     all.restart = done == 0;
-    sum.add(renderFrame({all}, {}));
+    FrameOptions o;
+    o.pathsPerInvocation = request.pathsPerInvocation;
+    sum.add(renderFrame({all}, o));
     done += all.quality;
     if (progress && !progress(done, spp)) break;
   }
