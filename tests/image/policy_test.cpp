@@ -302,6 +302,56 @@ TEST(Stability, NoTileGoesDarkDuringADrag) {
   }
 }
 
+// The editor's previews re-render the tiles a drag touches, not the pass: every other tile keeps
+// its converged samples through the drag and after it until the pass reaches it at full
+// resolution (previews that ran down the whole queue turned the whole image coarse after each drag).
+TEST(Stability, APreviewKeepsTheConvergedRestUntilThePassReachesIt) {
+  RETILE_RENDERER_OR_SKIP(probe);
+  probe.reset();
+  Scene sc = smallDefault();
+  sc.settings.width = 96;
+  sc.settings.height = 64;
+  const NodeId cup = objectNamed(sc, "Cup");
+  MethodSettings m;
+  m.kind = MethodKind::Spiral;
+  m.tileSize = 8;
+  m.quality = 64;
+  RenderSession s(sc, m);
+  s.setPreview(2);
+  for (int f = 0; f < 40; ++f) s.renderFrame(false);
+  const std::vector<float> converged = s.renderFrame(false).tileSamples;
+  ASSERT_GT(converged.front(), 30.0f);
+  // Tiles a preview restarted (those the drag touched), and tiles the pass served at full resolution.
+  std::vector<char> previewed(converged.size(), 0), served(converged.size(), 0);
+  auto note = [&](const FrameRecord& r) {
+    for (int t : r.servedTiles) (r.block > 1 ? previewed : served)[static_cast<std::size_t>(t)] = 1;
+  };
+  for (int f = 0; f < 6; ++f) {
+    Object o = *s.scene().object(cup);
+    o.transform = Mat4::translate({0.03f, 0, 0}) * o.transform;
+    ASSERT_TRUE(s.applyEdit(SetObject{o}).ok());
+    FrameRecord r = s.renderFrame(false);
+    ASSERT_GT(r.block, 1) << "a preview while edits come";
+    note(r);
+  }
+  // Until the pass reaches a tile at full resolution, it holds its converged samples (or more),
+  // unless a preview restarted it.
+  FrameRecord r;
+  int frames = 0;
+  do {
+    r = s.renderFrame(false);
+    note(r);
+    for (std::size_t t = 0; t < converged.size(); ++t)
+      if (!previewed[t] && !served[t]) {
+        ASSERT_GE(r.tileSamples[t], converged[t]) << "frame " << frames << " tile " << t << " (block " << r.block << ")";
+      }
+  } while (r.mode != "refinement" && ++frames < 400);
+  const auto previews = std::count(previewed.begin(), previewed.end(), 1);
+  EXPECT_GT(previews, 0);
+  EXPECT_LT(previews, static_cast<std::ptrdiff_t>(converged.size() / 4))
+      << "the previews re-rendered where the cup was and is, not the image";
+}
+
 TEST(Stability, CameraMoveDuringAPassResetsGlobally) {
   RETILE_RENDERER_OR_SKIP(probe);
   probe.reset();

@@ -154,6 +154,26 @@ TEST(Planner, SmoothPrefixIsTheTouchedTilesInSpiralOrder) {
   EXPECT_EQ(plan.order.size(), static_cast<std::size_t>(g.count()));
 }
 
+// A preview re-renders what the edit touched, not the pass: without the smooth transition too,
+// where the pass itself ranks no tile first and restarts every one when it reaches it.
+TEST(Planner, APreviewCoversTheTouchedTilesInServingOrder) {
+  TileGrid g(320, 180, 16);
+  for (bool smooth : {false, true}) {
+    Planner p(g, methodOf(MethodKind::Spiral, 16, smooth));
+    Plan plan = p.planBatch({moveFacts(kCup, {100, 50}, {140, 50}, 20)});
+    ASSERT_EQ(plan.kind, PlanKind::Pass);
+    std::set<int> touched;
+    for (int col : {5, 6, 8, 9})
+      for (int row : {2, 3}) touched.insert(g.index(col, row));
+    EXPECT_EQ(std::set<int>(plan.preview.begin(), plan.preview.end()), touched) << "smooth " << smooth;
+    EXPECT_EQ(plan.preview.size(), touched.size());
+    std::vector<int> inOrder;
+    for (int t : plan.order)
+      if (touched.count(t)) inOrder.push_back(t);
+    EXPECT_EQ(plan.preview, inOrder) << "in the pass's order";
+  }
+}
+
 TEST(Planner, FocusInterleavesThePointOfChangeWithFocusPoints) {
   TileGrid g(320, 180, 16);
   MethodSettings m = methodOf(MethodKind::Focus);

@@ -167,6 +167,42 @@ TEST(Scheduler, SmoothTransitionCapsStaleSumsAndKeepsTheBudget) {
   EXPECT_NEAR(s.tileSamples()[1], 4.0 + 2.0, 1e-9);
 }
 
+// A preview restarts its tiles at a sample per block and nothing else: the other tiles keep their
+// converged sums until the pass reaches them at full resolution, and the pass has not advanced.
+TEST(Scheduler, APreviewRestartsOnlyItsTilesAndLeavesThePassWhereItWas) {
+  TileGrid g(64, 64, 16);
+  TileScheduler s(g);
+  s.nextFrame();
+  for (int i = 0; i < 31; ++i) s.nextFrame();  // refinement: 32 spp everywhere
+  s.startPass(spiralOrder(g, 5), 16, g.count(), false, 1);
+  const std::vector<int> touched = {5, 6};
+  s.setPreviewTiles(touched);
+  EXPECT_FALSE(s.previewDone());
+  FramePlan p = s.nextFrame(2);
+  EXPECT_EQ(p.servedTiles, touched);
+  for (const TileChunk& c : p.chunks) {
+    EXPECT_TRUE(c.restart);
+    EXPECT_EQ(c.block, 2);
+    EXPECT_EQ(c.quality, 4) << "Q / block^2";
+  }
+  EXPECT_TRUE(s.previewDone());
+  EXPECT_EQ(s.queueServed(), 0u) << "the pass starts at full resolution from its beginning";
+  for (int t = 0; t < g.count(); ++t) {
+    const bool previewed = t == 5 || t == 6;
+    EXPECT_NEAR(s.tileSamples()[static_cast<std::size_t>(t)], previewed ? 4.0 : 32.0, 1e-9) << t;
+    EXPECT_EQ(s.startedTiles()[static_cast<std::size_t>(t)], previewed ? 1 : 0) << "the denoiser's region grows over the preview";
+  }
+  // A new pass has no preview of its own, but the previewed tiles hold the edit's samples until
+  // the pass re-renders them at full resolution: the denoiser still counts them as re-rendered.
+  s.startPass(spiralOrder(g, 0), 16, g.count(), false, 1);
+  EXPECT_TRUE(s.previewDone());
+  EXPECT_EQ(s.startedTiles()[5], 1);
+  while (s.passActive()) s.nextFrame();
+  EXPECT_NEAR(s.tileSamples()[5], 16.0, 1e-9) << "restarted at full resolution";
+  s.startPass(spiralOrder(g, 0), 16, g.count(), false, 1);
+  EXPECT_EQ(s.startedTiles()[5], 0) << "served at full resolution: no longer a preview's";
+}
+
 TEST(Scheduler, GlobalUpdateRestartsEveryTileThenRefines) {
   TileGrid g(100, 60, 16);
   TileScheduler s(g);

@@ -172,6 +172,7 @@ struct RenderSession::Impl {
       case PlanKind::Probe: scheduler.probe(); break;
       case PlanKind::Pass:
         scheduler.startPass(p.order, p.quality, p.prioritized, p.smooth, p.staleCap);
+        scheduler.setPreviewTiles(p.preview);
         reuse.startPass();
         leading.assign(static_cast<std::size_t>(scheduler.grid().count()), 0);
         for (int i = 0; i < p.leading && i < static_cast<int>(p.order.size()); ++i)

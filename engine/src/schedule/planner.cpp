@@ -91,6 +91,12 @@ std::vector<char> Planner::touchedTiles(const std::vector<EditFacts>& batch) con
   return touched;
 }
 
+void Planner::withPreview(Plan& plan, const std::vector<char>& touched) {
+  plan.preview.clear();
+  for (int t : plan.order)
+    if (static_cast<std::size_t>(t) < touched.size() && touched[static_cast<std::size_t>(t)]) plan.preview.push_back(t);
+}
+
 Plan Planner::pass(std::vector<int> order, int leading, int quality) const {
   Plan p;
   p.kind = PlanKind::Pass;
@@ -228,6 +234,7 @@ Plan Planner::planBatch(const std::vector<EditFacts>& batch) {
     if (indirection() && haveCounts() && object != countsFor_) classes_.clear();  // they do not apply
     plan = spiralPass(touched);
   }
+  withPreview(plan, touched);
   // Change: the spiral (or indirection) order while edits keep coming; one probe when they stop.
   probePending_ = method_.kind == MethodKind::Change;
   lastEditPlan_ = plan;
@@ -267,6 +274,7 @@ Plan Planner::planFromProbe(const std::vector<float>& tileDifference) {
     if (!first[static_cast<std::size_t>(t)]) order.push_back(t);
   passFromEdit_ = true;
   lastEditPlan_ = pass(std::move(order), prioritized, method_.quality > 0 ? method_.quality : kDefaultAutomaticQuality);
+  withPreview(lastEditPlan_, lastTouched_);
   return lastEditPlan_;
 }
 

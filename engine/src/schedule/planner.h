@@ -47,6 +47,7 @@ struct Plan {
   int prioritized = 0;     // Pass: the first `prioritized` tiles restart: all without smooth, else
   bool smooth = false;     //       the leading ones; the rest keep capped stale sums (staleCap)
   int staleCap = 1;
+  std::vector<int> preview;  // Pass: the tiles the edit touched, in order: what a preview re-renders
 };
 
 class Planner {
@@ -115,6 +116,7 @@ class Planner {
   Plan spiralPass(const std::vector<char>& touched) const;
   Plan indirectionPass(const std::vector<char>& touched, Vec2 motion, const IndirectionCounts& counts);
   Plan pass(std::vector<int> order, int leading, int quality) const;
+  static void withPreview(Plan& plan, const std::vector<char>& touched);
   void dropCounts(bool gatherAgain);
 
   TileGrid grid_;

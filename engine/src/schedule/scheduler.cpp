@@ -28,6 +28,8 @@ void TileScheduler::reset(const TileGrid& grid) {
   refineCursor_ = 0;
   pendingGlobal_ = true;
   pendingProbe_ = false;
+  previewed_.clear();
+  setPreviewTiles({});
 }
 
 void TileScheduler::regrid(const TileGrid& grid) {
@@ -68,6 +70,8 @@ void TileScheduler::globalUpdate() {
   queue_.clear();
   pass_.clear();
   pos_ = 0;
+  previewed_.clear();
+  setPreviewTiles({});
 }
 
 void TileScheduler::probe() { pendingProbe_ = true; }
@@ -105,6 +109,19 @@ void TileScheduler::startPass(std::vector<int> order, int quality, int prioritiz
   staleCap_ = std::max(1, staleCap);
   finished_.clear();
   pendingProbe_ = false;
+  setPreviewTiles({});
+}
+
+void TileScheduler::setPreviewTiles(std::vector<int> tiles) {
+  std::vector<char> seen(static_cast<std::size_t>(grid_.count()), 0);
+  preview_.clear();
+  for (int t : tiles)
+    if (t >= 0 && t < grid_.count() && !seen[static_cast<std::size_t>(t)] && inRegion(t)) {
+      seen[static_cast<std::size_t>(t)] = 1;
+      preview_.push_back(t);
+    }
+  previewPos_ = 0;
+  previewed_.resize(static_cast<std::size_t>(grid_.count()), 0);
 }
 
 AccumMode TileScheduler::mode() const {
@@ -124,6 +141,7 @@ std::vector<char> TileScheduler::startedTiles() const {
   std::vector<char> started(static_cast<std::size_t>(grid_.count()), 0);
   for (std::size_t i = 0; i < queue_.size(); ++i)
     if (pass_[i].started) started[static_cast<std::size_t>(queue_[i])] = 1;
+  for (std::size_t t = 0; t < started.size() && t < previewed_.size(); ++t) started[t] = started[t] || previewed_[t];
   return started;
 }
 
@@ -221,7 +239,7 @@ std::int64_t TileScheduler::waterFill(FramePlan& plan, std::vector<int> order, s
 
 bool TileScheduler::previewDone() const {
   if (pendingGlobal_) return false;
-  return pendingProbe_ || pos_ >= queue_.size() || (smooth_ && static_cast<int>(pos_) >= prioritized_);
+  return pendingProbe_ || previewPos_ >= preview_.size();
 }
 
 FramePlan TileScheduler::previewFrame(int block) {
@@ -255,20 +273,20 @@ FramePlan TileScheduler::previewFrame(int block) {
     pos_ = 0;
     refineCursor_ = 0;
     pendingGlobal_ = false;
+    previewed_.clear();
+    setPreviewTiles({});
     return plan;
   }
   plan.mode = passActive() ? AccumMode::Incremental : AccumMode::Refinement;
   std::int64_t remaining = (grid_.pixels() + area - 1) / area;
   const int q = std::max<int>(1, static_cast<int>(quality_ / area));
-  while (pos_ < queue_.size() && !(smooth_ && static_cast<int>(pos_) >= prioritized_)) {
-    const int t = queue_[pos_];
+  while (previewPos_ < preview_.size()) {
+    const int t = preview_[previewPos_];
     if (blocks(t) * q > remaining && !plan.chunks.empty()) break;
     remaining -= blocks(t) * q;
     serve(t, q);
-    pass_[pos_].started = true;
-    pass_[pos_].need = 0;
-    finished_.push_back(t);
-    ++pos_;
+    previewed_[static_cast<std::size_t>(t)] = 1;
+    ++previewPos_;
   }
   return plan;
 }
@@ -340,6 +358,7 @@ FramePlan TileScheduler::nextFrame(int block) {
     bool prior = static_cast<int>(pos_) < prioritized_ || !smooth_;
     emit(plan, t, grid_.rect(t), k, !pt.started && prior, !pt.started && !prior ? staleCap_ : 0, true);
     served[static_cast<std::size_t>(t)] = 1;
+    if (static_cast<std::size_t>(t) < previewed_.size()) previewed_[static_cast<std::size_t>(t)] = 0;
     pt.started = true;
     pt.need -= k;
     remaining -= pixels * k;

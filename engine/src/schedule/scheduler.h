@@ -59,10 +59,18 @@ class TileScheduler {
   // sums capped at `staleCap` samples per pixel and add fresh ones, else they restart too.
   void startPass(std::vector<int> order, int quality, int prioritized, bool smooth, int staleCap);
 
+  // The tiles a preview of the pass just started re-renders, in order: those the edit touched
+  // (where the object was and is). The rest keep what they show until the pass reaches them at
+  // full resolution, as the method keeps them; a preview that restarted them too would throw the
+  // converged image away for a coarse one. startPass clears it. A tile a preview restarted holds
+  // samples of the edit (coarse ones): it counts as started (startedTiles, which the denoiser's
+  // region grows over) in later passes too, until a pass re-renders it at full resolution, so
+  // that the trail of a drag's previews is denoised rather than shown raw.
+  void setPreviewTiles(std::vector<int> tiles);
   // `block` > 1: a preview while edits come (previewFrame); else a frame of the method.
   FramePlan nextFrame(int block = 1);
-  // Whether a preview has anything left to show: a global update, or prioritized tiles of the pass
-  // (previews restart tiles only: coarse samples added to a sum would blur it for good).
+  // Whether a preview has anything left to show: a global update, or preview tiles (previews
+  // restart tiles only: coarse samples added to a sum would blur it for good).
   bool previewDone() const;
   // A render region: only the marked tiles are traced (empty: every tile). Frames then spend the
   // budget on the region (about W x H / region pixels spp per tile, each tile once per frame,
@@ -87,7 +95,7 @@ class TileScheduler {
   const std::vector<double>& tileSamples() const { return samples_; }
   // Per tile: 1 for the head of the queue falling linearly to 0 at its end; -1 when unqueued.
   std::vector<float> priorities() const;
-  // Per tile: 1 when the current pass has started re-rendering it.
+  // Per tile: 1 when the current pass has started re-rendering it, or a preview of it has.
   std::vector<char> startedTiles() const;
 
  private:
@@ -97,8 +105,9 @@ class TileScheduler {
   };
   void emit(FramePlan& plan, int tile, TileRect rect, int quality, bool restart, int cap, bool wholeTile);
   // A frame of W x H / block^2 samples, each standing for a block of pixels: the global update at
-  // 1 sample per block, or the pass's prioritized tiles restarted at Q / block^2 per block. The
-  // caller plans the same edit again at full resolution once the preview ends.
+  // 1 sample per block, or the preview tiles restarted at Q / block^2 per block (the pass's queue
+  // does not advance). The caller plans the same edit again at full resolution once the preview
+  // ends.
   FramePlan previewFrame(int block);
   std::int64_t waterFill(FramePlan& plan, std::vector<int> order, std::int64_t budget, std::vector<char>& served);
   // Samples per pixel tile t holds, its kept history's credit counted.
@@ -124,6 +133,9 @@ class TileScheduler {
   std::vector<double> credit_;
   std::vector<std::uint32_t> nextIndex_;
   std::vector<int> finished_;  // tiles of the pass already at quality, most recent last
+  std::vector<int> preview_;   // setPreviewTiles
+  std::size_t previewPos_ = 0;
+  std::vector<char> previewed_;  // per tile: a preview restarted it since a full-resolution pass last served it
 };
 
 }  // namespace retile
