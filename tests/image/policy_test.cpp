@@ -171,6 +171,14 @@ Scene smallDefault() {
   return s;
 }
 
+// Large enough for a drag to touch a few of its 8-pixel tiles and leave the rest.
+Scene dragScene() {
+  Scene s = smallDefault();
+  s.settings.width = 96;
+  s.settings.height = 64;
+  return s;
+}
+
 using test::objectNamed;
 
 TEST(Policies, EveryMethodConvergesToAFreshRenderAfterAMove) {
@@ -244,9 +252,7 @@ TEST(Stability, AnEditEveryFrameStarvesNoTileAndConvergesAfter) {
 TEST(Stability, NoTileGoesDarkDuringADrag) {
   RETILE_RENDERER_OR_SKIP(probe);
   probe.reset();
-  Scene sc = smallDefault();
-  sc.settings.width = 96;
-  sc.settings.height = 64;
+  Scene sc = dragScene();
   const NodeId cup = objectNamed(sc, "Cup");
   auto tileMeans = [](const RenderImage& img, bool shown) {
     const std::vector<float>& c = shown ? img.shown() : img.color;
@@ -308,9 +314,7 @@ TEST(Stability, NoTileGoesDarkDuringADrag) {
 TEST(Stability, APreviewKeepsTheConvergedRestUntilThePassReachesIt) {
   RETILE_RENDERER_OR_SKIP(probe);
   probe.reset();
-  Scene sc = smallDefault();
-  sc.settings.width = 96;
-  sc.settings.height = 64;
+  Scene sc = dragScene();
   const NodeId cup = objectNamed(sc, "Cup");
   MethodSettings m;
   m.kind = MethodKind::Spiral;
