@@ -113,15 +113,26 @@ std::optional<double> ScrubField::parse(const QString& text) {
   return v;
 }
 
+// A field whose lowest value means none of its effect shows a word there (specialValueText), and
+// the word reads back as that value: Esc, a refusal and the typed word keep it.
+std::optional<double> ScrubField::typedValue(const QString& text) const {
+  if (!specialValueText().isEmpty() && text.trimmed().compare(specialValueText(), Qt::CaseInsensitive) == 0) return minimum();
+  return parse(text);
+}
+
+QString ScrubField::shownText(double v) const {
+  return !specialValueText().isEmpty() && v == minimum() ? specialValueText() : prefix() + textFromValue(v) + suffix();
+}
+
 QValidator::State ScrubField::validate(QString& text, int&) const {
   // Anything may be typed; it is judged once committed, with a word when it is refused.
   const QString typed = text.mid(prefix().size(), text.size() - prefix().size() - suffix().size());
-  const auto v = parse(typed);
+  const auto v = typedValue(typed);
   return v && std::isfinite(*v) && *v >= minimum() && *v <= maximum() ? QValidator::Acceptable : QValidator::Intermediate;
 }
 
 double ScrubField::valueFromText(const QString& text) const {
-  const auto v = parse(text);
+  const auto v = typedValue(text);
   return v && std::isfinite(*v) ? std::clamp(*v, minimum(), maximum()) : value();
 }
 
@@ -133,13 +144,13 @@ void ScrubField::refuse(const QString& why) {
 
 void ScrubField::commitTyped() {
   const QString typed = cleanText();
-  const auto v = parse(typed);
-  const QString shown = textFromValue(committed_);
+  const auto v = typedValue(typed);
+  const QString shown = shownText(committed_);
   if (!v || !std::isfinite(*v)) {
     refuse(v ? tr("%1 is not a finite number: kept %2").arg(typed, shown) : tr("\"%1\" is not a number: kept %2").arg(typed, shown));
     silent_ = true;
     setValue(committed_);
-    lineEdit()->setText(prefix() + shown + suffix());  // setValue rewrites nothing when the value is the same
+    lineEdit()->setText(shown);  // setValue rewrites nothing when the value is the same
     silent_ = false;
     return;
   }
@@ -147,7 +158,7 @@ void ScrubField::commitTyped() {
   const double clamped = std::clamp(*v, minimum(), maximum());
   if (clamped != *v)
     refuse(tr("%1 is outside %2 to %3: set to %4").arg(typed, textFromValue(minimum()), textFromValue(maximum()), textFromValue(clamped)));
-  if (clamped == value()) lineEdit()->setText(prefix() + textFromValue(clamped) + suffix());
+  if (clamped == value()) lineEdit()->setText(shownText(clamped));
   else setValue(clamped);
 }
 
@@ -155,7 +166,7 @@ void ScrubField::keyPressEvent(QKeyEvent* e) {
   if (e->key() == Qt::Key_Escape) {
     silent_ = true;
     setValue(committed_);  // drops the typed text
-    lineEdit()->setText(prefix() + textFromValue(committed_) + suffix());
+    lineEdit()->setText(shownText(committed_));
     silent_ = false;
     typing_ = false;
     clearFocus();

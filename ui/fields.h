@@ -53,6 +53,8 @@ class ScrubField : public QDoubleSpinBox {
   // Takes what was typed (Enter, or the focus leaving while typing): clamped or refused with a word.
   void commitTyped();
   void refuse(const QString& why);
+  std::optional<double> typedValue(const QString& text) const;
+  QString shownText(double v) const;  // the line edit's text for v, as the spin box shows it
 
   double default_;
   double committed_;  // the value Esc returns to

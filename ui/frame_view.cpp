@@ -471,7 +471,8 @@ std::vector<FrameView::LegendItem> FrameView::legendItems(bool everything) const
       if (everything || std::find(f.tileClass.begin(), f.tileClass.end(), c) != f.tileClass.end())
         items.push_back({K::Hatch, kClassColor[c], what[c]});
     // The tiles of no class are the rest, served last: without a key they read as unclassified.
-    if (everything || std::find(f.tileClass.begin(), f.tileClass.end(), 3) != f.tileClass.end())
+    constexpr std::uint8_t kRest = 3;  // FrameRecord::tileClass
+    if (everything || std::find(f.tileClass.begin(), f.tileClass.end(), kRest) != f.tileClass.end())
       items.push_back({K::None, QColor(200, 200, 200), tr("unhatched: the object does not reach it")});
   }
   if (overlays_.order && (everything || f.queueLength > 1)) items.push_back({K::None, Qt::white, tr("numbers: place in the queue")});

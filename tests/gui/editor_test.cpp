@@ -498,6 +498,21 @@ TEST(Editor, AnUncoatedMaterialsCoatReadsNone) {
   ASSERT_TRUE(coat);
   EXPECT_EQ(coat->text(), QLocale().toString(1.01, 'f', 3));
   EXPECT_TRUE(w->findChild<QWidget*>("coatRoughness"));
+  // The word reads back: typed, it takes the coat off; Esc after typing something else shows it again.
+  coat->setFocus();
+  coat->selectAll();
+  QTest::keyClicks(coat, "none");
+  QTest::keyClick(coat, Qt::Key_Return);
+  EXPECT_FALSE(w->scene().material(material)->coated()) << w->scene().material(material)->coatIor;
+  QTest::qWait(50);
+  coat = w->findChild<ScrubField*>("coatIor");
+  ASSERT_TRUE(coat);
+  coat->setFocus();
+  coat->selectAll();
+  QTest::keyClicks(coat, "2");
+  QTest::keyClick(coat, Qt::Key_Escape);
+  EXPECT_EQ(coat->text(), "none");
+  EXPECT_FALSE(w->scene().material(material)->coated());
   // A thin sheet's film, absent at 0, says so too.
   type = w->findChild<QComboBox*>("materialType");
   type->setCurrentIndex(type->findText(materialTypeName(MaterialType::ThinSheet)));

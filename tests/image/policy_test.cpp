@@ -342,9 +342,13 @@ TEST(Stability, APreviewKeepsTheConvergedRestUntilThePassReachesIt) {
   // unless a preview restarted it.
   FrameRecord r;
   int frames = 0;
+  bool full = false;
   do {
     r = s.renderFrame(false);
     note(r);
+    // Once the plan runs at full resolution, no preview comes back to restart what it rendered.
+    ASSERT_FALSE(full && r.block > 1) << "frame " << frames << ": a preview after a full-resolution frame";
+    full = full || r.block == 1;
     for (std::size_t t = 0; t < converged.size(); ++t)
       if (!previewed[t] && !served[t]) {
         ASSERT_GE(r.tileSamples[t], converged[t]) << "frame " << frames << " tile " << t << " (block " << r.block << ")";

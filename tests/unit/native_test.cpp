@@ -107,6 +107,23 @@ TEST(Native, FilesThatNamedTheConventionsTungstenReadAsSaved) {
   EXPECT_TRUE(s.materials[0].tintsReflection);
 }
 
+// A coat whose index is at or below 1 is no coat, in a file as in the panel: it reads as the
+// field's "none" (1) without a warning; a coat above 1 reads as written.
+TEST(Native, ACoatIndexOfOneOrLessReadsAsNoCoatWithoutAWarning) {
+  const auto file = test::tempDir() / "coats.retile";
+  std::ofstream(file) << R"({"format": "retile-scene", "version": 1,
+    "materials": [{"id": 1, "type": "lambert", "coat_ior": 0}, {"id": 2, "type": "lambert", "coat_ior": 0.6},
+                  {"id": 3, "type": "lambert", "coat_ior": 1.3}]})";
+  auto r = loadNativeScene(file);
+  ASSERT_TRUE(r.ok()) << r.error();
+  ASSERT_EQ(r->scene.materials.size(), 3u);
+  EXPECT_EQ(r->scene.materials[0].coatIor, 1.0f);
+  EXPECT_EQ(r->scene.materials[1].coatIor, 1.0f);
+  EXPECT_FALSE(r->scene.materials[1].coated());
+  EXPECT_EQ(r->scene.materials[2].coatIor, 1.3f);
+  for (const std::string& w : r->warnings) EXPECT_EQ(w.find("coat_ior"), std::string::npos) << w;
+}
+
 TEST(Native, DefaultSceneRoundTripsLosslessly) {
   Scene s = makeDefaultScene();
   s.settings.pixelFilter = PixelFilter::BlackmanHarris;

@@ -172,6 +172,14 @@ TEST(Planner, APreviewCoversTheTouchedTilesInServingOrder) {
       if (touched.count(t)) inOrder.push_back(t);
     EXPECT_EQ(plan.preview, inOrder) << "in the pass's order";
   }
+  // An edit with nothing on screen (a light) may change any tile: the preview covers what the
+  // pass restarts, every tile without the smooth transition.
+  Planner p(g, methodOf(MethodKind::Spiral, 16));
+  EditFacts light;
+  light.pointOfChange = {160, 90};
+  Plan plan = p.planBatch({light});
+  ASSERT_EQ(plan.kind, PlanKind::Pass);
+  EXPECT_EQ(plan.preview, plan.order);
 }
 
 TEST(Planner, FocusInterleavesThePointOfChangeWithFocusPoints) {

@@ -201,6 +201,13 @@ TEST(Scheduler, APreviewRestartsOnlyItsTilesAndLeavesThePassWhereItWas) {
   EXPECT_NEAR(s.tileSamples()[5], 16.0, 1e-9) << "restarted at full resolution";
   s.startPass(spiralOrder(g, 0), 16, g.count(), false, 1);
   EXPECT_EQ(s.startedTiles()[5], 0) << "served at full resolution: no longer a preview's";
+  // A render region set before a preview ends keeps the preview inside it.
+  s.setPreviewTiles({9, 10});
+  std::vector<char> region;
+  for (int t = 0; t < g.count(); ++t) region.push_back(t == 9 ? 1 : 0);
+  s.setRegion(region);
+  FramePlan inside = s.nextFrame(2);
+  EXPECT_EQ(inside.servedTiles, std::vector<int>{9});
 }
 
 TEST(Scheduler, GlobalUpdateRestartsEveryTileThenRefines) {

@@ -452,7 +452,12 @@ Material readMaterial(Reader& r) {
   r.id("id", &m.id, true);
   r.string("name", &m.name);
   r.enumeration("type", &m.type, materialName, kMaterialTypeCount);
-  for (const MaterialScalar& f : kMaterialScalars) r.number(f.key, &(m.*f.field));
+  for (const MaterialScalar& f : kMaterialScalars) {
+    r.number(f.key, &(m.*f.field));
+    // Where lo means none of the field's effect, so does anything below it (a coat of index 0.6 is
+    // no coat): taken as lo without the warning an out-of-range value gets.
+    if (*f.atLo && m.*f.field < f.lo) m.*f.field = f.lo;
+  }
   for (const MaterialColor& f : kMaterialColors) r.vec3(f.key, &(m.*f.field));
   for (const MaterialTexture& f : kMaterialTextures) r.id(f.key, &(m.*f.field));
   // Of the choices only the glass convention was ever written "tungsten".

@@ -96,7 +96,13 @@ struct RenderSession::Impl {
       previewed = true;
       return previewBlock;
     }
-    if (previewed && scheduler.mode() != AccumMode::Probe) execute(planner.lastEditPlan());
+    if (previewed && scheduler.mode() != AccumMode::Probe) {
+      // Without its preview, which is shown: armed again, it would restart coarse on the next
+      // frame the tiles this one renders sharp.
+      Plan full = planner.lastEditPlan();
+      full.preview.clear();
+      execute(full);
+    }
     previewed = false;
     return 1;
   }

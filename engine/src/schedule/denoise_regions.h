@@ -55,7 +55,8 @@ class DenoiseRegions {
   void restart();
   // Global update or continuous refinement: the whole frame, denoised this frame.
   DenoiseFrame wholeFrame(std::uint64_t frame);
-  // An incremental frame. `started`: per tile, re-rendered by the pass so far; `grows`: per tile,
+  // An incremental frame. `started`: per tile, re-rendered by the pass so far (or by a preview not
+  // yet followed by a full-resolution pass: TileScheduler::startedTiles); `grows`: per tile,
   // counts for the region's rectangle (all tiles, or the prioritized ones). `threshold`: a share
   // of the image's width (for the region's width) and height (for its height).
   // `passComplete`: the pass has started every tile it will re-render.

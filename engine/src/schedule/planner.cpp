@@ -95,6 +95,10 @@ void Planner::withPreview(Plan& plan, const std::vector<char>& touched) {
   plan.preview.clear();
   for (int t : plan.order)
     if (static_cast<std::size_t>(t) < touched.size() && touched[static_cast<std::size_t>(t)]) plan.preview.push_back(t);
+  // An edit with nothing on screen (a light, the sky, an object out of view) may change any tile:
+  // the preview covers what the pass restarts.
+  if (plan.preview.empty())
+    plan.preview.assign(plan.order.begin(), plan.order.begin() + std::clamp<std::ptrdiff_t>(plan.prioritized, 0, std::ssize(plan.order)));
 }
 
 Plan Planner::pass(std::vector<int> order, int leading, int quality) const {

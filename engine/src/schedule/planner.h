@@ -47,7 +47,9 @@ struct Plan {
   int prioritized = 0;     // Pass: the first `prioritized` tiles restart: all without smooth, else
   bool smooth = false;     //       the leading ones; the rest keep capped stale sums (staleCap)
   int staleCap = 1;
-  std::vector<int> preview;  // Pass: the tiles the edit touched, in order: what a preview re-renders
+  // Pass: what a preview re-renders, in order: the tiles the edit touched (with none on screen,
+  // the ones the pass restarts)
+  std::vector<int> preview;
 };
 
 class Planner {

@@ -91,6 +91,15 @@ void TileScheduler::setRegion(std::vector<char> tiles) {
     queue_ = std::move(q);
     pass_ = std::move(p);
   }
+  // Nor does a preview trace outside it; a tile left outside is no longer the preview's.
+  if (!region_.empty()) {
+    std::vector<int> rest(preview_.begin() + static_cast<std::ptrdiff_t>(std::min(previewPos_, preview_.size())), preview_.end());
+    std::erase_if(rest, [&](int t) { return !inRegion(t); });
+    preview_ = std::move(rest);
+    previewPos_ = 0;
+    for (std::size_t t = 0; t < previewed_.size(); ++t)
+      if (!inRegion(static_cast<int>(t))) previewed_[t] = 0;
+  }
 }
 
 void TileScheduler::startPass(std::vector<int> order, int quality, int prioritized, bool smooth, int staleCap) {
@@ -326,6 +335,8 @@ FramePlan TileScheduler::nextFrame(int block) {
       pass_.clear();
       pos_ = 0;
       refineCursor_ = 0;
+      previewed_.clear();
+      setPreviewTiles({});
     }
     pendingGlobal_ = pendingProbe_ = false;
     return plan;

@@ -95,7 +95,8 @@ class TileScheduler {
   const std::vector<double>& tileSamples() const { return samples_; }
   // Per tile: 1 for the head of the queue falling linearly to 0 at its end; -1 when unqueued.
   std::vector<float> priorities() const;
-  // Per tile: 1 when the current pass has started re-rendering it, or a preview of it has.
+  // Per tile: 1 when the current pass has started re-rendering it, or a preview (of this pass or
+  // an earlier one) restarted it and no pass has served it at full resolution since.
   std::vector<char> startedTiles() const;
 
  private:
@@ -104,7 +105,7 @@ class TileScheduler {
     bool started = false;
   };
   void emit(FramePlan& plan, int tile, TileRect rect, int quality, bool restart, int cap, bool wholeTile);
-  // A frame of W x H / block^2 samples, each standing for a block of pixels: the global update at
+  // A frame of at most W x H / block^2 samples, each standing for a block of pixels: the global update at
   // 1 sample per block, or the preview tiles restarted at Q / block^2 per block (the pass's queue
   // does not advance). The caller plans the same edit again at full resolution once the preview
   // ends.
