@@ -128,6 +128,10 @@ class PropertyPanel::Builder {
     c->setObjectName(objectName);
     c->addItems(items);
     c->setCurrentIndex(index);
+    // Sized by its longest item ("diffuse_transmission"), the row would not fit beside a long
+    // label in the dock and would wrap below its own label; the list still shows whole items.
+    c->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
+    c->setMinimumContentsLength(8);
     QObject::connect(c, &QComboBox::currentIndexChanged, c, [apply](int i) { apply(i); });
     form_->addRow(name, c);
     return c;

@@ -11,6 +11,7 @@
 #include <QComboBox>
 #include <QSpinBox>
 #include <QLabel>
+#include <QFormLayout>
 #include <QLineEdit>
 #include <QLocale>
 #include <QPushButton>
@@ -520,6 +521,24 @@ TEST(Editor, AnUncoatedMaterialsCoatReadsNone) {
   auto* film = w->findChild<ScrubField*>("filmThickness");
   ASSERT_TRUE(film);
   EXPECT_EQ(film->text(), "none");
+}
+
+// A material's type sits beside its label, not wrapped below it: the combo does not demand its
+// longest type's width ("diffuse_transmission"), which beside an emitter's long labels did not fit
+// the dock's default width.
+TEST(Editor, AMaterialsTypeSitsBesideItsLabel) {
+  auto w = makeWindow();
+  w->resize(1280, 800);  // the default window
+  selectWithMaterial(*w, "Area Light");
+  QTest::qWait(100);
+  auto* type = w->findChild<QComboBox*>("materialType");
+  ASSERT_TRUE(type);
+  auto* form = qobject_cast<QFormLayout*>(type->parentWidget()->layout());
+  ASSERT_TRUE(form);
+  QWidget* label = form->labelForField(type);
+  ASSERT_TRUE(label);
+  EXPECT_LT(std::abs(label->geometry().center().y() - type->geometry().center().y()), type->height() / 2)
+      << "label at y " << label->geometry().y() << ", combo at y " << type->geometry().y();
 }
 
 // A roughness texture does not become a sheet's thickness (nor a thickness a roughness) when
