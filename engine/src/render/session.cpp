@@ -97,11 +97,10 @@ struct RenderSession::Impl {
       return previewBlock;
     }
     if (previewed && scheduler.mode() != AccumMode::Probe) {
-      // Without its preview, which is shown: armed again, it would restart coarse on the next
-      // frame the tiles this one renders sharp.
-      Plan full = planner.lastEditPlan();
-      full.preview.clear();
-      execute(full);
+      execute(planner.lastEditPlan());
+      // Its preview is shown: armed again, it would restart coarse on the next frame the tiles
+      // this one renders sharp.
+      scheduler.setPreviewTiles({});
     }
     previewed = false;
     return 1;

@@ -21,15 +21,11 @@ void TileScheduler::reset(const TileGrid& grid) {
   auto n = static_cast<std::size_t>(grid.count());
   samples_.assign(n, 0.0);
   nextIndex_.assign(n, 0);
-  queue_.clear();
-  pass_.clear();
+  dropPass();
   finished_.clear();
-  pos_ = 0;
   refineCursor_ = 0;
   pendingGlobal_ = true;
   pendingProbe_ = false;
-  previewed_.clear();
-  setPreviewTiles({});
 }
 
 void TileScheduler::regrid(const TileGrid& grid) {
@@ -67,11 +63,27 @@ void TileScheduler::regrid(const TileGrid& grid) {
 void TileScheduler::globalUpdate() {
   pendingGlobal_ = true;
   pendingProbe_ = false;
+  dropPass();
+}
+
+void TileScheduler::dropPass() {
   queue_.clear();
   pass_.clear();
   pos_ = 0;
-  previewed_.clear();
-  setPreviewTiles({});
+  preview_.clear();
+  previewPos_ = 0;
+  previewed_.assign(static_cast<std::size_t>(grid_.count()), 0);
+}
+
+std::vector<int> TileScheduler::uniqueInRegion(const std::vector<int>& tiles) const {
+  std::vector<char> seen(static_cast<std::size_t>(grid_.count()), 0);
+  std::vector<int> kept;
+  for (int t : tiles)
+    if (t >= 0 && t < grid_.count() && !seen[static_cast<std::size_t>(t)] && inRegion(t)) {
+      seen[static_cast<std::size_t>(t)] = 1;
+      kept.push_back(t);
+    }
+  return kept;
 }
 
 void TileScheduler::probe() { pendingProbe_ = true; }
@@ -93,9 +105,7 @@ void TileScheduler::setRegion(std::vector<char> tiles) {
   }
   // Nor does a preview trace outside it; a tile left outside is no longer the preview's.
   if (!region_.empty()) {
-    std::vector<int> rest(preview_.begin() + static_cast<std::ptrdiff_t>(std::min(previewPos_, preview_.size())), preview_.end());
-    std::erase_if(rest, [&](int t) { return !inRegion(t); });
-    preview_ = std::move(rest);
+    preview_ = uniqueInRegion({preview_.begin() + static_cast<std::ptrdiff_t>(previewPos_), preview_.end()});
     previewPos_ = 0;
     for (std::size_t t = 0; t < previewed_.size(); ++t)
       if (!inRegion(static_cast<int>(t))) previewed_[t] = 0;
@@ -103,13 +113,7 @@ void TileScheduler::setRegion(std::vector<char> tiles) {
 }
 
 void TileScheduler::startPass(std::vector<int> order, int quality, int prioritized, bool smooth, int staleCap) {
-  std::vector<char> seen(static_cast<std::size_t>(grid_.count()), 0);
-  queue_.clear();
-  for (int t : order)
-    if (t >= 0 && t < grid_.count() && !seen[static_cast<std::size_t>(t)] && inRegion(t)) {
-      seen[static_cast<std::size_t>(t)] = 1;
-      queue_.push_back(t);
-    }
+  queue_ = uniqueInRegion(order);
   quality_ = std::max(1, quality);
   pass_.assign(queue_.size(), PassTile{quality_, false});
   pos_ = 0;
@@ -121,16 +125,9 @@ void TileScheduler::startPass(std::vector<int> order, int quality, int prioritiz
   setPreviewTiles({});
 }
 
-void TileScheduler::setPreviewTiles(std::vector<int> tiles) {
-  std::vector<char> seen(static_cast<std::size_t>(grid_.count()), 0);
-  preview_.clear();
-  for (int t : tiles)
-    if (t >= 0 && t < grid_.count() && !seen[static_cast<std::size_t>(t)] && inRegion(t)) {
-      seen[static_cast<std::size_t>(t)] = 1;
-      preview_.push_back(t);
-    }
+void TileScheduler::setPreviewTiles(const std::vector<int>& tiles) {
+  preview_ = uniqueInRegion(tiles);
   previewPos_ = 0;
-  previewed_.resize(static_cast<std::size_t>(grid_.count()), 0);
 }
 
 AccumMode TileScheduler::mode() const {
@@ -150,7 +147,7 @@ std::vector<char> TileScheduler::startedTiles() const {
   std::vector<char> started(static_cast<std::size_t>(grid_.count()), 0);
   for (std::size_t i = 0; i < queue_.size(); ++i)
     if (pass_[i].started) started[static_cast<std::size_t>(queue_[i])] = 1;
-  for (std::size_t t = 0; t < started.size() && t < previewed_.size(); ++t) started[t] = started[t] || previewed_[t];
+  for (std::size_t t = 0; t < started.size(); ++t) started[t] = started[t] || previewed_[t];
   return started;
 }
 
@@ -277,13 +274,9 @@ FramePlan TileScheduler::previewFrame(int block) {
     plan.mode = AccumMode::GlobalUpdate;
     for (int t = 0; t < grid_.count(); ++t)
       if (inRegion(t)) serve(t, 1);
-    queue_.clear();
-    pass_.clear();
-    pos_ = 0;
+    dropPass();
     refineCursor_ = 0;
     pendingGlobal_ = false;
-    previewed_.clear();
-    setPreviewTiles({});
     return plan;
   }
   plan.mode = passActive() ? AccumMode::Incremental : AccumMode::Refinement;
@@ -331,12 +324,8 @@ FramePlan TileScheduler::nextFrame(int block) {
       }
     }
     if (pendingGlobal_) {
-      queue_.clear();
-      pass_.clear();
-      pos_ = 0;
+      dropPass();
       refineCursor_ = 0;
-      previewed_.clear();
-      setPreviewTiles({});
     }
     pendingGlobal_ = pendingProbe_ = false;
     return plan;
@@ -369,7 +358,7 @@ FramePlan TileScheduler::nextFrame(int block) {
     bool prior = static_cast<int>(pos_) < prioritized_ || !smooth_;
     emit(plan, t, grid_.rect(t), k, !pt.started && prior, !pt.started && !prior ? staleCap_ : 0, true);
     served[static_cast<std::size_t>(t)] = 1;
-    if (static_cast<std::size_t>(t) < previewed_.size()) previewed_[static_cast<std::size_t>(t)] = 0;
+    previewed_[static_cast<std::size_t>(t)] = 0;
     pt.started = true;
     pt.need -= k;
     remaining -= pixels * k;

@@ -66,7 +66,7 @@ class TileScheduler {
   // samples of the edit (coarse ones): it counts as started (startedTiles, which the denoiser's
   // region grows over) in later passes too, until a pass re-renders it at full resolution, so
   // that the trail of a drag's previews is denoised rather than shown raw.
-  void setPreviewTiles(std::vector<int> tiles);
+  void setPreviewTiles(const std::vector<int>& tiles);
   // `block` > 1: a preview while edits come (previewFrame); else a frame of the method.
   FramePlan nextFrame(int block = 1);
   // Whether a preview has anything left to show: a global update, or preview tiles (previews
@@ -117,6 +117,10 @@ class TileScheduler {
     return samples_[i] + (i < credit_.size() ? credit_[i] : 0.0);
   }
   std::vector<char> region_;
+  // Ends the pass and forgets its previews and every preview mark (a global update, a new grid).
+  void dropPass();
+  // `tiles` in order, each once, those off the grid or outside the render region left out.
+  std::vector<int> uniqueInRegion(const std::vector<int>& tiles) const;
   void fillRemainder(FramePlan& plan, std::int64_t remainder, const std::vector<char>& served);
 
   TileGrid grid_;
