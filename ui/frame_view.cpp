@@ -104,6 +104,14 @@ void FrameView::showFrame(std::shared_ptr<const FrameRecord> frame) {
   refresh();
 }
 
+void FrameView::clearFrame(const QString& message) {
+  frame_.reset();
+  image_ = QImage();
+  outlineOf_ = nullptr;
+  waiting_ = message;
+  refresh();
+}
+
 void FrameView::takeSnapshot() {
   if (!frame_ || !frame_->image) return;
   snapshotLinear_ = frame_->image;  // frames are immutable once published: sharing is enough
@@ -222,7 +230,8 @@ void FrameView::compose(QPainter& p, const QRect& area) const {
   p.fillRect(area, QColor(32, 32, 36));
   if (image_.isNull()) {
     p.setPen(Qt::lightGray);
-    p.drawText(area, Qt::AlignCenter, tr("Starting the renderer..."));
+    p.drawText(area, Qt::AlignCenter | Qt::TextWordWrap, waiting_.isEmpty() ? tr("Starting the renderer...") : waiting_);
+    drawNotice(p, imageArea());
     return;
   }
   QRectF r = imageRect();
@@ -243,19 +252,7 @@ void FrameView::compose(QPainter& p, const QRect& area) const {
   drawOverlays(p, r);
   if (overlays_.legend) drawLegend(p);
   drawGizmo(p);
-  if (!notice_.isEmpty() && QDateTime::currentMSecsSinceEpoch() < noticeUntil_) {
-    // A short confirmation where the artist is looking (Ctrl+B has no other visible effect).
-    // As wide as its text, up to the image's width, where it wraps.
-    const QFont noticeFont(font().family(), 10, QFont::Bold);
-    p.setFont(noticeFont);
-    const QFontMetricsF fm(noticeFont);
-    const double maxWidth = std::max(120.0, r.width() - 24);
-    const QRectF text = fm.boundingRect(QRectF(0, 0, maxWidth, 1000), Qt::AlignCenter | Qt::TextWordWrap, notice_);
-    const QRectF box(r.center().x() - text.width() / 2 - 12, r.y() + 12, text.width() + 24, text.height() + 10);
-    p.fillRect(box, QColor(0, 0, 0, 190));
-    p.setPen(Qt::white);
-    p.drawText(box, Qt::AlignCenter | Qt::TextWordWrap, notice_);
-  }
+  drawNotice(p, r);
   if (compare_ != Compare::Off && snapshotUsable) {
     p.setFont(QFont(font().family(), 11, QFont::Bold));
     p.setPen(QColor(255, 255, 255));
@@ -303,6 +300,21 @@ void FrameView::compose(QPainter& p, const QRect& area) const {
     const QRectF band = r.top() - area.top() >= line ? QRectF(r.left(), r.top() - line, r.width(), line) : r.adjusted(10, 8, -10, -8);
     p.drawText(band, Qt::AlignTop | Qt::AlignRight, tr("PAUSED (Esc resumes, . steps a frame)"));
   }
+}
+
+void FrameView::drawNotice(QPainter& p, const QRectF& r) const {
+  if (notice_.isEmpty() || QDateTime::currentMSecsSinceEpoch() >= noticeUntil_) return;
+  // A short confirmation where the artist is looking (Ctrl+B has no other visible effect).
+  // As wide as its text, up to the image's width, where it wraps.
+  const QFont noticeFont(font().family(), 10, QFont::Bold);
+  p.setFont(noticeFont);
+  const QFontMetricsF fm(noticeFont);
+  const double maxWidth = std::max(120.0, r.width() - 24);
+  const QRectF text = fm.boundingRect(QRectF(0, 0, maxWidth, 1000), Qt::AlignCenter | Qt::TextWordWrap, notice_);
+  const QRectF box(r.center().x() - text.width() / 2 - 12, r.y() + 12, text.width() + 24, text.height() + 10);
+  p.fillRect(box, QColor(0, 0, 0, 190));
+  p.setPen(Qt::white);
+  p.drawText(box, Qt::AlignCenter | Qt::TextWordWrap, notice_);
 }
 
 void FrameView::drawOverlays(QPainter& p, const QRectF& r) const {

@@ -38,6 +38,10 @@ class FrameView : public QWidget {
   explicit FrameView(QWidget* parent = nullptr);
 
   void showFrame(std::shared_ptr<const FrameRecord> frame);
+  // Drops the frame shown (it was another scene's) and says `message` in its place until the
+  // next frame comes.
+  void clearFrame(const QString& message);
+  QString waitingMessage() const { return frame_ ? QString() : waiting_; }
   const std::shared_ptr<const FrameRecord>& frame() const { return frame_; }
   OverlaySettings& overlays() { return overlays_; }
   void setOverlays(const OverlaySettings& o);
@@ -205,6 +209,8 @@ class FrameView : public QWidget {
   Compare compare_ = Compare::Off;
   QString notice_;
   qint64 noticeUntil_ = 0;
+  QString waiting_;  // said while there is no frame
+  void drawNotice(QPainter& p, const QRectF& r) const;
   double wipe_ = 0.5;
   VulkanViewport* vulkan_ = nullptr;
   QWidget* container_ = nullptr;

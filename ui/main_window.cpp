@@ -77,6 +77,7 @@ MainWindow::MainWindow(Scene scene, std::filesystem::path file, EditorOptions op
   toolLabel_->setObjectName("toolStatus");
   statusBar()->addWidget(toolLabel_);
   status_ = new QLabel(this);
+  status_->setObjectName("renderStatus");
   statusBar()->addPermanentWidget(status_);
   showTool();
   for (PropertyPanel* p : {panel_, renderPanel_}) connect(p, &PropertyPanel::message, this, &MainWindow::notify);
@@ -694,6 +695,11 @@ void MainWindow::startEngine(Scene scene) {
   engineOptions.documentVersion = doc_.version();
   engineOptions.previewBlock = options_.previewBlock;
   engine_ = std::make_unique<Engine>(std::move(scene), methodPanel_->settings(), engineOptions);
+  // Until the new scene's first frame (its BVH built and uploaded: seconds for a million
+  // triangles), neither the viewport nor the status bar may go on showing the old one's.
+  const QString name = file_.empty() ? tr("the built-in scene") : QString::fromStdString(file_.filename().string());
+  view_->clearFrame(tr("Preparing %1 for the renderer...").arg(name));
+  status_->setText(tr("preparing %1").arg(name));
   engine_->setFrameCallback([this] {
     QMetaObject::invokeMethod(
         this, [this] { onFrame(); }, Qt::QueuedConnection);

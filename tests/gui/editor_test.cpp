@@ -334,6 +334,27 @@ TEST(Editor, SaveOpenRoundTripAndABrokenFileKeepsTheScene) {
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 1; })) << "and keeps rendering";
 }
 
+// While an opened scene is prepared for the renderer (its BVH built and uploaded, seconds for a
+// million triangles), the viewport and the status bar say so; neither goes on showing the old
+// scene's frame and figures as if they were the new one's.
+TEST(Editor, AnOpenedSceneIsSaidToBePreparedUntilItsFirstFrame) {
+  auto w = makeWindow();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 2; }));
+  QTemporaryDir dir;
+  const std::filesystem::path file = (dir.path() + "/other.retile").toStdString();
+  ASSERT_TRUE(w->saveTo(file));
+  auto* status = w->findChild<QLabel*>("renderStatus");
+  ASSERT_TRUE(status);
+  ASSERT_TRUE(status->text().contains("fps")) << status->text().toStdString();
+  ASSERT_TRUE(w->openFile(file));
+  EXPECT_EQ(w->viewport()->frame(), nullptr) << "the old scene's frame was still shown";
+  EXPECT_TRUE(w->viewport()->waitingMessage().contains("other.retile")) << w->viewport()->waitingMessage().toStdString();
+  EXPECT_TRUE(status->text().startsWith("preparing other.retile")) << status->text().toStdString();
+  ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 1; }));
+  EXPECT_TRUE(w->viewport()->waitingMessage().isEmpty());
+  EXPECT_TRUE(status->text().contains("fps")) << status->text().toStdString();
+}
+
 // A scene that names the view its author saw it through (a Tungsten camera's tonemap) opens in
 // that view; one that names none leaves the viewport's as it was.
 TEST(Editor, AScenesViewIsTheViewportsWhenItOpens) {
