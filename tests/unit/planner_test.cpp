@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <set>
+#include <utility>
 
 #include "schedule/planner.h"
 
@@ -232,6 +233,58 @@ TEST(Planner, IndirectionOrdersClassesAndFitsAutomaticQToHighAndTouchedTiles) {
     if (p.classes()[static_cast<std::size_t>(t)] == TileClass::High) high.push_back(t);
   EXPECT_LE(plan.quality * pixelsOf(g, high), g.pixels()) << "all high and touched tiles fit one frame";
   EXPECT_GT((plan.quality + 1) * pixelsOf(g, high), g.pixels()) << "at the largest Q that does";
+}
+
+// A material edit of an object whose screen rectangle holds far more than it shows (a backdrop, a
+// plant, a cupboard behind a table): every tile of the rectangle was high, so automatic Q fell to
+// what the whole rectangle allows (1 when it fills the image). Where the counters saw it is what
+// such an edit changes directly; a move still takes its rectangles, as does an object the
+// counters did not see.
+TEST(Planner, AnEditThatLeavesTheObjectInPlacePrioritizesWhereItIsSeenNotItsRectangle) {
+  TileGrid g(320, 180, 16);  // 20 x 12 tiles
+  const std::vector<int> seen = {g.index(4, 4), g.index(5, 4), g.index(15, 9)};
+  const std::vector<int> shadow = {g.index(4, 6)};
+  auto planned = [&](const IndirectionCounts& counts, bool move) {
+    Planner p(g, methodOf(MethodKind::Indirection, 0));
+    p.select(kCup);
+    gather(p, kCup, counts, {160, 90});
+    EditFacts edit;
+    edit.object = kCup;
+    edit.pointOfChange = {160, 90};
+    edit.centreBefore = Vec2{160, 90};
+    edit.centreAfter = move ? Vec2{176, 90} : Vec2{160, 90};
+    edit.moved = move;
+    edit.screen = {{0, 0, 320, 180}};  // its rectangle fills the image
+    Plan plan = p.planBatch({edit});
+    std::vector<int> high;
+    for (int t = 0; t < g.count(); ++t)
+      if (p.classes()[static_cast<std::size_t>(t)] == TileClass::High) high.push_back(t);
+    return std::pair{plan, high};
+  };
+
+  const auto [material, high] = planned(countsOf(g, seen, shadow, {}), false);
+  ASSERT_EQ(material.kind, PlanKind::Pass);
+  // Where it is seen, and the tiles around (a silhouette's sliver the counters' samples missed).
+  std::set<int> around;
+  for (int t : seen)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) around.insert(g.index(t % g.cols() + dx, t / g.cols() + dy));
+  std::set<int> expected = around;
+  expected.insert(shadow[0]);
+  EXPECT_EQ(std::set<int>(high.begin(), high.end()), expected)
+      << "high: where it is seen and what it shadows, not every tile of its rectangle (" << high.size() << " high)";
+  EXPECT_EQ(material.leading, static_cast<int>(expected.size()));
+  EXPECT_GE(material.quality, g.pixels() / pixelsOf(g, std::vector<int>(expected.begin(), expected.end())))
+      << "automatic Q fits the tiles it is seen in";
+  EXPECT_EQ(std::set<int>(material.preview.begin(), material.preview.end()), around) << "the preview re-renders where it is seen";
+
+  const auto [move, movedHigh] = planned(countsOf(g, seen, shadow, {}), true);
+  EXPECT_EQ(static_cast<int>(movedHigh.size()), g.count()) << "a move takes its rectangles: where it was and is";
+  EXPECT_EQ(move.quality, 1);
+
+  const auto [shown, shownHigh] = planned(countsOf(g, {}, {}, {}), false);
+  EXPECT_EQ(static_cast<int>(shownHigh.size()), g.count()) << "counters that did not see it: its rectangle";
+  EXPECT_EQ(shown.quality, 1);
 }
 
 TEST(Planner, IndirectionDragMovesDirectTilesKeepsShadowsAndEveryClass) {

@@ -91,6 +91,33 @@ std::vector<char> Planner::touchedTiles(const std::vector<EditFacts>& batch) con
   return touched;
 }
 
+// The tiles an indirection pass takes as touched. An edit that leaves its objects where they were
+// counted (a material, a visibility) changes them where the counters saw them, and only there
+// directly: their screen rectangles also cover what a large, thin or partly hidden object does
+// not show (a backdrop's rectangle fills the image), which made every such tile high and
+// automatic Q small. The counters' few samples a pixel can miss a silhouette's sliver of a tile,
+// so the tiles around a seen one count too, within the rectangles. A move needs the rectangles:
+// the object's old and new places. So does an object the counters did not see (shown again after
+// it was hidden).
+std::vector<char> Planner::seenWhereCounted(const std::vector<char>& touched, bool moved, const IndirectionCounts& counts) const {
+  if (moved) return touched;
+  std::vector<char> seen(touched.size(), 0);
+  bool any = false;
+  for (int row = 0; row < grid_.rows(); ++row)
+    for (int col = 0; col < grid_.cols(); ++col) {
+      const auto t = static_cast<std::size_t>(grid_.index(col, row));
+      if (t >= counts.direct.size() || counts.direct[t] <= 0) continue;
+      any = true;
+      seen[t] = 1;
+      for (int r = std::max(0, row - 1); r <= std::min(grid_.rows() - 1, row + 1); ++r)
+        for (int c = std::max(0, col - 1); c <= std::min(grid_.cols() - 1, col + 1); ++c) {
+          const auto n = static_cast<std::size_t>(grid_.index(c, r));
+          if (touched[n]) seen[n] = 1;
+        }
+    }
+  return any ? seen : touched;
+}
+
 void Planner::withPreview(Plan& plan, const std::vector<char>& touched) {
   plan.preview.clear();
   for (int t : plan.order)
@@ -225,14 +252,17 @@ Plan Planner::planBatch(const std::vector<EditFacts>& batch) {
   NodeId material = kNoNode;
   for (const EditFacts& f : batch)
     if (f.material != kNoNode) material = f.material;
+  const bool moved = std::any_of(batch.begin(), batch.end(), [](const EditFacts& f) { return f.moved; });
   Plan plan;
   if (indirection() && haveCounts() && object == countsFor_ && object != kNoNode) {
     Vec2 motion{0.0f};
     if (centreNow && countedCentre_) motion = Vec2{centreNow->x - countedCentre_->x, centreNow->y - countedCentre_->y};
+    touched = seenWhereCounted(touched, moved || motion.x != 0.0f || motion.y != 0.0f, counts_);
     plan = indirectionPass(touched, motion, counts_);
   } else if (indirection() && material != kNoNode && material == groupMaterial_ && !groupCounts_.empty()) {
     // Every object of the material changed where it stands: its direct, reflected and shadow
     // tiles first, as for a move.
+    touched = seenWhereCounted(touched, moved, groupCounts_);
     plan = indirectionPass(touched, Vec2{0.0f}, groupCounts_);
   } else {
     if (indirection() && haveCounts() && object != countsFor_) classes_.clear();  // they do not apply

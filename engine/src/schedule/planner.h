@@ -115,6 +115,7 @@ class Planner {
   Vec2 centre() const { return {grid_.width() * 0.5f, grid_.height() * 0.5f}; }
   std::vector<int> centres() const;  // tiles of the points of change, then (focus policies) of the focus points
   std::vector<char> touchedTiles(const std::vector<EditFacts>& batch) const;
+  std::vector<char> seenWhereCounted(const std::vector<char>& touched, bool moved, const IndirectionCounts& counts) const;
   Plan spiralPass(const std::vector<char>& touched) const;
   Plan indirectionPass(const std::vector<char>& touched, Vec2 motion, const IndirectionCounts& counts);
   Plan pass(std::vector<int> order, int leading, int quality) const;
