@@ -99,7 +99,7 @@ RETILE_MATERIAL_SCALAR(emissionStrength, "emission_strength", 1.0, 0.0, 1e6, RT_
 // The half-angle about the front's normal of the cone the front emits into: 90 is the whole
 // hemisphere; less, a spot with a hard edge. Seen from outside the cone the emitter is dark, and
 // light samples from there find nothing.
-RETILE_MATERIAL_SCALAR(emissionCone, "emission_cone", 90.0, 0.0, 90.0, RT_ALL_TYPES & ~RT_TYPE(Boundary), -1, -1, "Emission cone half angle", "degrees", 1,
+RETILE_MATERIAL_SCALAR(emissionCone, "emission_cone", 90.0, 0.0, 90.0, RT_ALL_TYPES & ~RT_TYPE(Boundary), -1, -1, "Emission cone", "degrees", 1,
                        "", RT_PANEL(Emissive),
                        "The half-angle about the normal within which the front emits: 90 lights the whole hemisphere, less makes a spot with a hard edge")
 // A blend's share of this material (Material::blendWith), the partner's the rest.
