@@ -697,9 +697,8 @@ void MainWindow::startEngine(Scene scene) {
   engine_ = std::make_unique<Engine>(std::move(scene), methodPanel_->settings(), engineOptions);
   // Until the new scene's first frame (its BVH built and uploaded: seconds for a million
   // triangles), neither the viewport nor the status bar may go on showing the old one's.
-  const QString name = file_.empty() ? tr("the built-in scene") : QString::fromStdString(file_.filename().string());
-  view_->clearFrame(tr("Preparing %1 for the renderer...").arg(name));
-  status_->setText(tr("preparing %1").arg(name));
+  view_->clearFrame(tr("Preparing %1 for the renderer...").arg(documentName()));
+  status_->setText(tr("preparing %1").arg(documentName()));
   engine_->setFrameCallback([this] {
     QMetaObject::invokeMethod(
         this, [this] { onFrame(); }, Qt::QueuedConnection);

@@ -143,6 +143,8 @@ class MainWindow : public QMainWindow {
   void updateRenderSize();
   QSize desiredRenderSize() const;
   void updateTitle();  // the file's name, and [*] while there are unsaved changes
+  // The file's name and its folder's ("scene.json (kitchen)": Tungsten scenes are all scene.json).
+  QString documentName() const;
   void rememberRecent(const std::filesystem::path& file);
   void rebuildRecentMenu();
   void editCamera(const std::function<void(Camera&)>& change, const QString& what);

@@ -114,8 +114,7 @@ void MainWindow::opened(const std::filesystem::path& file, const std::vector<std
   for (const auto& w : warnings) log(tr("warning: %1").arg(QString::fromStdString(w)));
   importWarnings_ = warnings;
   if (warnings.empty()) return;
-  const QString text = tr("%n warning(s) opening %1: see the Log", nullptr, static_cast<int>(warnings.size()))
-                           .arg(QString::fromStdString(file.filename().string()));
+  const QString text = tr("%n warning(s) opening %1: see the Log", nullptr, static_cast<int>(warnings.size())).arg(documentName());
   view_->showNotice(text, 8000);
   statusBar()->showMessage(text, 15000);
   auto* logDock = findChild<QDockWidget*>("log");
@@ -186,8 +185,15 @@ bool MainWindow::saveImageTo(const std::filesystem::path& file) {
   return true;
 }
 
+QString MainWindow::documentName() const {
+  if (file_.empty()) return tr("the built-in scene");
+  const QString name = QString::fromStdString(file_.filename().string());
+  const std::string folder = file_.parent_path().filename().string();
+  return folder.empty() ? name : tr("%1 (%2)").arg(name, QString::fromStdString(folder));
+}
+
 void MainWindow::updateTitle() {
-  const QString name = file_.empty() ? tr("built-in scene") : QString::fromStdString(file_.filename().string());
+  const QString name = file_.empty() ? tr("built-in scene") : documentName();
   setWindowTitle(tr("%1[*] - Retile").arg(name));
   setWindowModified(!undo_.isClean());
 }

@@ -2,6 +2,7 @@
 // edit from the properties reaches the render thread and re-renders around the object, undo
 // restores, save and open round-trip, overlays draw, a broken file leaves the scene alone.
 #include <QApplication>
+#include <QDir>
 #include <QDockWidget>
 #include <QSettings>
 #include <QStandardPaths>
@@ -348,8 +349,11 @@ TEST(Editor, AnOpenedSceneIsSaidToBePreparedUntilItsFirstFrame) {
   ASSERT_TRUE(status->text().contains("fps")) << status->text().toStdString();
   ASSERT_TRUE(w->openFile(file));
   EXPECT_EQ(w->viewport()->frame(), nullptr) << "the old scene's frame was still shown";
-  EXPECT_TRUE(w->viewport()->waitingMessage().contains("other.retile")) << w->viewport()->waitingMessage().toStdString();
-  EXPECT_TRUE(status->text().startsWith("preparing other.retile")) << status->text().toStdString();
+  // Named with its folder, as the window's title names it: Tungsten scenes are all scene.json.
+  const QString name = QString("other.retile (%1)").arg(QDir(dir.path()).dirName());
+  EXPECT_TRUE(w->viewport()->waitingMessage().contains(name)) << w->viewport()->waitingMessage().toStdString();
+  EXPECT_TRUE(status->text().startsWith("preparing " + name)) << status->text().toStdString();
+  EXPECT_TRUE(w->windowTitle().startsWith(name)) << w->windowTitle().toStdString();
   ASSERT_TRUE(waitForFrame(*w, [](const FrameRecord& f) { return f.frame >= 1; }));
   EXPECT_TRUE(w->viewport()->waitingMessage().isEmpty());
   EXPECT_TRUE(status->text().contains("fps")) << status->text().toStdString();
